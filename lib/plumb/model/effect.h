@@ -1,0 +1,146 @@
+// plumb/model/effect.h — the extension point: one physical effect of the IMU error model.
+//
+// The forward model (SPEC sections 1-2) is a composition of effects:
+//
+//   y_a = F f_b + b_a + sum_k accel_term_k(theta_k, input)
+//   y_g = E omega_b + b_g + sum_k gyro_term_k(theta_k, input)
+//
+// The base model is itself made of effects (`accel_linear` writes F and b_a, `gyro_linear`
+// writes E and b_g); catalogue effects add terms. Every effect owns one parameter block whose
+// all-zero value means "no effect" (for the linear effects: F = I, b = 0), so every effect is
+// the identity at zero, as basalt's calib_bias.hpp is.
+//
+// Writing an effect (worked example, see docs/extending.md and tests/model/effect_test.cc):
+//
+//   // lib/plumb/model/effects/accel_bias_drift.cc
+//   class AccelBiasDrift : public EffectBase<AccelBiasDrift> {
+//    public:
+//     AccelBiasDrift() : EffectBase(MakeInfo()) {}
+//     template <typename T>
+//     void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
+//       Eigen::Map<const Vec3T<T>> d_a(theta);   // m/s^3
+//       out.acc += d_a * in.dt_s;
+//     }
+//   };
+//   PLUMB_DEFINE_EFFECT(accel_bias_drift, AccelBiasDrift)
+//
+// and one line `accel_bias_drift` in lib/plumb/model/effects/effects.cmake. The effect then
+// appears in `plumb calibrate --model base+accel_bias_drift`, in the simulator and in diagnose.
+#pragma once
+
+#include <ceres/jet.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "plumb/core/types.h"
+
+namespace plumb::model {
+
+/// Jet width used by every dynamic autodiff cost function in plumb (see residuals/).
+inline constexpr int kJetStride = 8;
+using Jet = ceres::Jet<double, kJetStride>;
+
+enum class Sensor { kAccel, kGyro };
+
+/// One scalar parameter of an effect.
+struct ParameterInfo {
+  std::string name;      ///< within the effect, e.g. "matrix.xy", "bias.z", "G.xy", "c1.x"
+  std::string unit;      ///< SI unit of the reported value, e.g. "m/s^2", "rad/s per m/s^2"
+  double typical = 1.0;  ///< typical magnitude for a MEMS IMU on a small UAV, same unit (> 0)
+  double nominal = 0.0;  ///< reported value = nominal + block value (1 on matrix diagonals)
+};
+
+/// What data excites an effect (used to explain "not identifiable" and "too little data").
+struct Excitation {
+  bool still_orientations = false;  ///< still poses in several orientations
+  bool rotation = false;            ///< motion between still poses (angular rate)
+  bool angular_acceleration = false;
+  bool temperature = false;         ///< temperature that varies
+  bool time = false;                ///< a session long enough for drift
+};
+
+/// Static description of an effect: its name, its term and its parameters.
+struct EffectInfo {
+  std::string name;    ///< catalogue name (CLI and JSON contract), e.g. "gyro_g_sensitivity"
+  std::string prefix;  ///< parameter-name prefix: "accel", "gyro" or the effect name
+  std::string option;  ///< the option it was made with ("" or e.g. "2" for a polynomial order)
+  Sensor sensor = Sensor::kAccel;
+  bool linear_stage = false;  ///< true only for the base effects that write F/E and the bias
+  std::string term;           ///< its term in the forward model, as text
+  std::vector<ParameterInfo> parameters;
+  Excitation excitation;
+
+  int size() const { return static_cast<int>(parameters.size()); }
+  /// Full name of parameter i: prefix + "." + parameters[i].name.
+  std::string ParameterName(int i) const { return prefix + "." + parameters[i].name; }
+};
+
+/// What a sensor sees at one instant (or on average over a still segment).
+template <typename T>
+struct SensorInput {
+  Vec3T<T> f_b = Vec3T<T>::Zero();      ///< true specific force, body frame, m/s^2
+  Vec3T<T> omega_b = Vec3T<T>::Zero();  ///< true angular rate wrt inertial, body frame, rad/s
+  Vec3T<T> alpha_b = Vec3T<T>::Zero();  ///< angular acceleration, body frame, rad/s^2
+  T dt_s = T(0);     ///< time since the model's reference time t_ref, s
+  T dtemp_c = T(0);  ///< temperature minus the model's reference temperature, degC
+};
+
+/// The predicted outputs, built up effect by effect.
+template <typename T>
+struct SensorOutput {
+  Vec3T<T> acc = Vec3T<T>::Zero();  ///< predicted accelerometer output y_a
+  Vec3T<T> gyr = Vec3T<T>::Zero();  ///< predicted gyroscope output y_g
+  Mat3T<T> F = Mat3T<T>::Identity();  ///< accelerometer matrix written by accel_linear
+  Mat3T<T> E = Mat3T<T>::Identity();  ///< gyroscope matrix written by gyro_linear
+};
+
+/// Interface of an effect. Implement it through EffectBase<Derived> (CRTP) with one templated
+/// `Term<T>()`, which gives both the double and the Jet overloads.
+class Effect {
+ public:
+  explicit Effect(EffectInfo info) : info_(std::move(info)) {}
+  virtual ~Effect() = default;
+  const EffectInfo& info() const { return info_; }
+
+  /// Adds this effect's term to `out`. `theta` points at this effect's parameter block
+  /// (info().size() values). Linear-stage effects overwrite acc or gyr and F or E instead.
+  virtual void Apply(const double* theta, const SensorInput<double>& in,
+                     SensorOutput<double>& out) const = 0;
+  virtual void Apply(const Jet* theta, const SensorInput<Jet>& in,
+                     SensorOutput<Jet>& out) const = 0;
+
+ private:
+  EffectInfo info_;
+};
+
+template <class Derived>
+class EffectBase : public Effect {
+ public:
+  using Effect::Effect;
+  void Apply(const double* theta, const SensorInput<double>& in,
+             SensorOutput<double>& out) const final {
+    static_cast<const Derived*>(this)->Term(theta, in, out);
+  }
+  void Apply(const Jet* theta, const SensorInput<Jet>& in, SensorOutput<Jet>& out) const final {
+    static_cast<const Derived*>(this)->Term(theta, in, out);
+  }
+};
+
+using EffectFactory = std::unique_ptr<Effect> (*)(const std::string& option);
+
+/// Defines the factory that the generated registration list refers to. `option` is the text
+/// after ':' in a model spec (e.g. "2" in accel_temperature_bias:2), empty when absent.
+#define PLUMB_DEFINE_EFFECT(NAME, CLASS)                                          \
+  namespace plumb::model::effects {                                               \
+  std::unique_ptr<::plumb::model::Effect> Make_##NAME(const std::string& option) { \
+    return std::make_unique<CLASS>(option);                                       \
+  }                                                                               \
+  }
+
+/// Per-axis parameter helper: {"<stem>.x", "<stem>.y", "<stem>.z"}.
+std::vector<ParameterInfo> AxisParameters(const std::string& stem, const std::string& unit,
+                                          double typical, double nominal = 0.0);
+
+}  // namespace plumb::model

@@ -1,0 +1,39 @@
+// accel_bias_drift — the accelerometer bias changes linearly with time (SPEC section 4).
+//
+//   y_a += d_a (t - t_ref)
+//
+// Parameter block (3 values, zero = no drift): d.x, d.y, d.z in m/s^3.
+// Residual signature: accelerometer residual that trends with time.
+#include "plumb/core/error.h"
+#include "plumb/model/effect.h"
+
+namespace plumb::model {
+namespace {
+
+EffectInfo MakeInfo(const std::string& option) {
+  if (!option.empty()) throw Error("accel_bias_drift takes no option (got '" + option + "')");
+  EffectInfo info;
+  info.name = "accel_bias_drift";
+  info.prefix = info.name;
+  info.sensor = Sensor::kAccel;
+  info.term = "y_a += d_a (t - t_ref)";
+  info.parameters = AxisParameters("d", "m/s^3", 1e-4);
+  info.excitation.time = true;
+  return info;
+}
+
+class AccelBiasDrift : public EffectBase<AccelBiasDrift> {
+ public:
+  explicit AccelBiasDrift(const std::string& option) : EffectBase(MakeInfo(option)) {}
+
+  template <typename T>
+  void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
+    Eigen::Map<const Vec3T<T>> d_a(theta);
+    out.acc += d_a * in.dt_s;
+  }
+};
+
+}  // namespace
+}  // namespace plumb::model
+
+PLUMB_DEFINE_EFFECT(accel_bias_drift, ::plumb::model::AccelBiasDrift)

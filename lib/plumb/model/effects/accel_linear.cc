@@ -1,0 +1,55 @@
+// accel_linear — the base accelerometer model (SPEC section 2, the paper's Equation (1)).
+//
+//   y_a = F f_b + b_a,   F upper triangular (sensor and body x axes coincide, body y lies in
+//                        the sensor x-y plane), b_a the bias.
+//
+// Parameter block (9 values; zero = identity F, no bias):
+//   [0..5] F - I, upper triangle row-major: matrix.xx, matrix.xy, matrix.xz, matrix.yy,
+//          matrix.yz, matrix.zz (dimensionless; the diagonals are reported as 1 + value)
+//   [6..8] b_a: bias.x, bias.y, bias.z (m/s^2)
+#include "plumb/core/error.h"
+#include "plumb/model/effect.h"
+
+namespace plumb::model {
+namespace {
+
+EffectInfo MakeInfo(const std::string& option) {
+  if (!option.empty()) throw Error("accel_linear takes no option (got '" + option + "')");
+  EffectInfo info;
+  info.name = "accel_linear";
+  info.prefix = "accel";
+  info.sensor = Sensor::kAccel;
+  info.linear_stage = true;
+  info.term = "y_a = F f_b + b_a, F upper triangular";
+  info.parameters = {{"matrix.xx", "1", 0.02, 1.0}, {"matrix.xy", "1", 0.01, 0.0},
+                     {"matrix.xz", "1", 0.01, 0.0}, {"matrix.yy", "1", 0.02, 1.0},
+                     {"matrix.yz", "1", 0.01, 0.0}, {"matrix.zz", "1", 0.02, 1.0}};
+  auto bias = AxisParameters("bias", "m/s^2", 0.2);
+  info.parameters.insert(info.parameters.end(), bias.begin(), bias.end());
+  info.excitation.still_orientations = true;
+  return info;
+}
+
+class AccelLinear : public EffectBase<AccelLinear> {
+ public:
+  explicit AccelLinear(const std::string& option) : EffectBase(MakeInfo(option)) {}
+
+  template <typename T>
+  void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
+    Mat3T<T> F = Mat3T<T>::Identity();
+    F(0, 0) += theta[0];
+    F(0, 1) = theta[1];
+    F(0, 2) = theta[2];
+    F(1, 1) += theta[3];
+    F(1, 2) = theta[4];
+    F(2, 2) += theta[5];
+    Eigen::Map<const Vec3T<T>> b_a(theta + 6);
+    out.F = F;
+    out.acc = F * in.f_b + b_a;
+  }
+};
+
+}  // namespace
+}  // namespace plumb::model
+
+PLUMB_DEFINE_EFFECT(accel_linear, ::plumb::model::AccelLinear)

@@ -1,0 +1,7 @@
+# The built-in effects, one per line. Adding an effect: write effects/<name>.cc (with
+# PLUMB_DEFINE_EFFECT(<name>, Class)) and add its name here. Nothing else changes.
+set(PLUMB_EFFECTS
+  accel_linear
+  gyro_linear
+  accel_bias_drift
+)

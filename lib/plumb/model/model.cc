@@ -1,0 +1,211 @@
+#include "plumb/model/model.h"
+
+#include <Eigen/LU>
+#include <sstream>
+
+#include "plumb/core/error.h"
+#include "plumb/model/registry.h"
+
+namespace plumb::model {
+namespace {
+
+std::vector<std::string> Split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, sep)) out.push_back(item);
+  return out;
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  const auto e = s.find_last_not_of(" \t");
+  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
+}
+
+}  // namespace
+
+Model Model::Parse(const std::string& spec) {
+  Model m;
+  const auto tokens = Split(spec, '+');
+  if (tokens.empty()) throw Error("empty model spec; try 'base'");
+  for (const auto& raw : tokens) {
+    const std::string token = Trim(raw);
+    if (token.empty()) throw Error("model spec '" + spec + "' has an empty term");
+    if (token == "base") {
+      m.Add("accel_linear");
+      m.Add("gyro_linear");
+    } else if (token == "paper") {
+      m.Add("accel_linear");
+      m.Add("gyro_linear", "triangular");
+    } else {
+      const auto colon = token.find(':');
+      m.Add(token.substr(0, colon), colon == std::string::npos ? "" : token.substr(colon + 1));
+    }
+  }
+  if (m.FindTerm("accel_linear") < 0) {
+    throw Error("model spec '" + spec + "' lacks the base accelerometer; start it with 'base'");
+  }
+  return m;
+}
+
+void Model::Add(const std::string& name, const std::string& option) {
+  if (has_effect(name)) throw Error("effect '" + name + "' appears twice in the model");
+  ModelTerm term;
+  term.effect = Registry::Global().Make(name, option);
+  term.fixed.assign(static_cast<std::size_t>(term.effect->info().size()), false);
+  // The linear stage runs first: insert linear effects before the additive ones.
+  if (term.effect->info().linear_stage) {
+    auto it = terms_.begin();
+    while (it != terms_.end() && it->effect->info().linear_stage) ++it;
+    terms_.insert(it, std::move(term));
+  } else {
+    terms_.push_back(std::move(term));
+  }
+  // Rebuild the normalised spec.
+  spec_.clear();
+  const bool is_base = FindTerm("accel_linear") == 0 && FindTerm("gyro_linear") == 1 &&
+                       terms_[1].effect->info().option.empty();
+  const bool is_paper = FindTerm("accel_linear") == 0 && FindTerm("gyro_linear") == 1 &&
+                        terms_[1].effect->info().option == "triangular";
+  std::size_t first = 0;
+  if (is_base || is_paper) {
+    spec_ = is_base ? "base" : "paper";
+    first = 2;
+  }
+  for (std::size_t i = first; i < terms_.size(); ++i) {
+    const auto& info = terms_[i].effect->info();
+    if (!spec_.empty()) spec_ += "+";
+    spec_ += info.name + (info.option.empty() ? "" : ":" + info.option);
+  }
+  // The triangular gyro variant holds E's lower triangle at zero.
+  if (name == "gyro_linear" && option == "triangular") {
+    for (const char* p : {"gyro.matrix.yx", "gyro.matrix.zx", "gyro.matrix.zy"}) Fix(p);
+  }
+}
+
+void Model::DropGyro() {
+  std::vector<ModelTerm> kept;
+  for (auto& t : terms_) {
+    if (t.effect->info().sensor != Sensor::kGyro) kept.push_back(std::move(t));
+  }
+  terms_ = std::move(kept);
+  spec_ += " (accelerometer only)";
+}
+
+bool Model::has_gyro() const { return FindTerm("gyro_linear") >= 0; }
+bool Model::has_effect(const std::string& name) const { return FindTerm(name) >= 0; }
+
+int Model::FindTerm(const std::string& name) const {
+  for (int i = 0; i < num_terms(); ++i) {
+    if (terms_[static_cast<std::size_t>(i)].effect->info().name == name) return i;
+  }
+  return -1;
+}
+
+ParameterBlocks Model::ZeroParameters() const {
+  ParameterBlocks blocks;
+  for (const auto& t : terms_) blocks.emplace_back(static_cast<std::size_t>(t.effect->info().size()), 0.0);
+  return blocks;
+}
+
+int Model::num_parameters() const {
+  int n = 0;
+  for (const auto& t : terms_) n += t.effect->info().size();
+  return n;
+}
+
+int Model::num_free_parameters() const {
+  int n = 0;
+  for (const auto& t : terms_) {
+    for (bool f : t.fixed) n += f ? 0 : 1;
+  }
+  return n;
+}
+
+std::vector<std::string> Model::ParameterNames() const {
+  std::vector<std::string> names;
+  for (const auto& t : terms_) {
+    const auto& info = t.effect->info();
+    for (int i = 0; i < info.size(); ++i) names.push_back(info.ParameterName(i));
+  }
+  return names;
+}
+
+std::optional<std::pair<int, int>> Model::FindParameter(const std::string& full_name) const {
+  for (int k = 0; k < num_terms(); ++k) {
+    const auto& info = terms_[static_cast<std::size_t>(k)].effect->info();
+    for (int i = 0; i < info.size(); ++i) {
+      if (info.ParameterName(i) == full_name) return std::make_pair(k, i);
+    }
+  }
+  return std::nullopt;
+}
+
+void Model::Fix(const std::string& full_name, bool fixed) {
+  const auto where = FindParameter(full_name);
+  if (!where) throw Error("model '" + spec_ + "' has no parameter '" + full_name + "'");
+  terms_[static_cast<std::size_t>(where->first)].fixed[static_cast<std::size_t>(where->second)] = fixed;
+}
+
+template <typename T>
+SensorOutput<T> Model::Predict(const T* const* theta, const SensorInput<T>& in) const {
+  SensorOutput<T> out;
+  for (std::size_t i = 0; i < terms_.size(); ++i) terms_[i].effect->Apply(theta[i], in, out);
+  return out;
+}
+
+template <typename T>
+std::pair<Vec3T<T>, Vec3T<T>> Model::Correct(const T* const* theta, const Vec3T<T>& y_a,
+                                             const Vec3T<T>& y_g, SensorInput<T> in,
+                                             int iterations) const {
+  const bool gyro = has_gyro();
+  in.f_b.setZero();
+  in.omega_b.setZero();
+  for (int it = 0; it <= iterations; ++it) {
+    const SensorOutput<T> out = Predict(theta, in);
+    // Newton step with the linear part's Jacobian (exact when all terms are additive and
+    // independent of the inputs; the others converge at the rate of their size).
+    in.f_b += out.F.inverse() * (y_a - out.acc);
+    if (gyro) in.omega_b += out.E.inverse() * (y_g - out.gyr);
+  }
+  return {in.f_b, in.omega_b};
+}
+
+SensorOutput<double> Model::Predict(const ParameterBlocks& theta,
+                                    const SensorInput<double>& in) const {
+  std::vector<const double*> ptr;
+  for (const auto& b : theta) ptr.push_back(b.data());
+  return Predict<double>(ptr.data(), in);
+}
+
+std::pair<Vec3, Vec3> Model::Correct(const ParameterBlocks& theta, const Vec3& y_a,
+                                     const Vec3& y_g, const SensorInput<double>& in) const {
+  std::vector<const double*> ptr;
+  for (const auto& b : theta) ptr.push_back(b.data());
+  return Correct<double>(ptr.data(), y_a, y_g, in);
+}
+
+std::vector<double> ReportedValues(const Model& model, const ParameterBlocks& theta) {
+  std::vector<double> values;
+  for (int k = 0; k < model.num_terms(); ++k) {
+    const auto& info = model.terms()[static_cast<std::size_t>(k)].effect->info();
+    for (int i = 0; i < info.size(); ++i) {
+      values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal +
+                       theta[static_cast<std::size_t>(k)][static_cast<std::size_t>(i)]);
+    }
+  }
+  return values;
+}
+
+template SensorOutput<double> Model::Predict<double>(const double* const*,
+                                                     const SensorInput<double>&) const;
+template SensorOutput<Jet> Model::Predict<Jet>(const Jet* const*, const SensorInput<Jet>&) const;
+template std::pair<Vec3, Vec3> Model::Correct<double>(const double* const*, const Vec3&,
+                                                      const Vec3&, SensorInput<double>, int) const;
+template std::pair<Vec3T<Jet>, Vec3T<Jet>> Model::Correct<Jet>(const Jet* const*,
+                                                              const Vec3T<Jet>&,
+                                                              const Vec3T<Jet>&,
+                                                              SensorInput<Jet>, int) const;
+
+}  // namespace plumb::model

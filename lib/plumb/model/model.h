@@ -1,0 +1,95 @@
+// plumb/model/model.h — an IMU error model: an ordered composition of effects.
+//
+// A model is written as a spec (SPEC section 2): "base", "paper", or "base+EFFECT[:OPTION]...",
+// e.g. "base+gyro_g_sensitivity+accel_temperature_bias:2". "base" is accel_linear +
+// gyro_linear (F upper triangular, E full); "paper" is accel_linear + gyro_linear:triangular,
+// the seed paper's upper-triangular E.
+//
+// Parameter layout: effect i owns parameter block i (effects()[i].info().size() values);
+// the block's zero is "no effect". Parameters are addressed by their full names
+// ("accel.matrix.xy", "gyro.bias.z", "gyro_g_sensitivity.G.xy"), and a parameter can be held
+// fixed (the paper's constants, the triangular variant's zeros).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "plumb/model/effect.h"
+
+namespace plumb::model {
+
+/// One effect in a model with its fixed parameters.
+struct ModelTerm {
+  std::shared_ptr<const Effect> effect;
+  std::vector<bool> fixed;  ///< per parameter: held at its value in the fit
+};
+
+/// Parameter values of a model: one block per effect, in model order.
+using ParameterBlocks = std::vector<std::vector<double>>;
+
+class Model {
+ public:
+  /// Parses a spec; throws plumb::Error naming the unknown effect and the catalogue.
+  static Model Parse(const std::string& spec);
+
+  /// Reference time and temperature of the drift and temperature terms.
+  double t_ref_s = 0.0;
+  double temp_ref_c = 25.0;
+
+  /// The spec this model was parsed from, normalised (e.g. "base+gyro_g_sensitivity").
+  const std::string& spec() const { return spec_; }
+  const std::vector<ModelTerm>& terms() const { return terms_; }
+  int num_terms() const { return static_cast<int>(terms_.size()); }
+  bool has_gyro() const;
+  bool has_effect(const std::string& name) const;
+  /// Index of the term with this effect name, or -1.
+  int FindTerm(const std::string& name) const;
+
+  /// Adds an effect (its block starts at zero); throws if already present.
+  void Add(const std::string& name, const std::string& option = "");
+  /// Removes the gyroscope terms (accelerometer-only sessions).
+  void DropGyro();
+
+  /// Zero-valued parameter blocks (the identity model).
+  ParameterBlocks ZeroParameters() const;
+  /// Total number of scalar parameters, and of free ones.
+  int num_parameters() const;
+  int num_free_parameters() const;
+  /// Full names of all parameters, in block order.
+  std::vector<std::string> ParameterNames() const;
+  /// (term, index) of a full parameter name, or nullopt.
+  std::optional<std::pair<int, int>> FindParameter(const std::string& full_name) const;
+  /// Holds a parameter fixed at its value (throws if the name is unknown).
+  void Fix(const std::string& full_name, bool fixed = true);
+
+  /// Forward model: predicted outputs for the true inputs. `theta[i]` is block i.
+  /// Defined for T = double and T = Jet.
+  template <typename T>
+  SensorOutput<T> Predict(const T* const* theta, const SensorInput<T>& in) const;
+
+  /// Inverse model: the true specific force and angular rate that produce measured y_a, y_g,
+  /// by Newton iterations on the forward model started from the linear inverse. `in` supplies
+  /// the other inputs (time, temperature, angular acceleration); its f_b and omega_b are
+  /// ignored. Without gyroscope terms, omega_b is returned as zero.
+  template <typename T>
+  std::pair<Vec3T<T>, Vec3T<T>> Correct(const T* const* theta, const Vec3T<T>& y_a,
+                                        const Vec3T<T>& y_g, SensorInput<T> in,
+                                        int iterations = 3) const;
+
+  /// Convenience: the same on double blocks.
+  SensorOutput<double> Predict(const ParameterBlocks& theta, const SensorInput<double>& in) const;
+  std::pair<Vec3, Vec3> Correct(const ParameterBlocks& theta, const Vec3& y_a, const Vec3& y_g,
+                                const SensorInput<double>& in) const;
+
+ private:
+  std::string spec_;
+  std::vector<ModelTerm> terms_;
+};
+
+/// Reported value of every parameter (nominal + block value), in ParameterNames() order.
+std::vector<double> ReportedValues(const Model& model, const ParameterBlocks& theta);
+
+}  // namespace plumb::model
