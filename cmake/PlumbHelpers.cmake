@@ -19,6 +19,7 @@ function(plumb_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   target_compile_definitions(${name} PRIVATE
     PLUMB_SHARED_DATA_DIR="${PLUMB_SHARED_DATA_DIR}"
     PLUMB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

@@ -4,4 +4,12 @@ set(PLUMB_EFFECTS
   accel_linear
   gyro_linear
   accel_bias_drift
+  gyro_bias_drift
+  accel_temperature_bias
+  gyro_temperature_bias
+  gyro_g_sensitivity
+  accel_scale_nonlinearity
+  gyro_scale_nonlinearity
+  accel_size_effect
+  time_offset
 )

@@ -1,0 +1,565 @@
+#include "plumb/estimation/calibrator.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "plumb/core/error.h"
+#include "plumb/estimation/initialization.h"
+#include "plumb/estimation/observability.h"
+#include "plumb/residuals/manifolds.h"
+#include "plumb/residuals/motion_residual.h"
+#include "plumb/residuals/still_residuals.h"
+#include "plumb/signal/correlation_time.h"
+#include "plumb/signal/segment_stats.h"
+
+namespace plumb::estimation {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr double kDegToRad = M_PI / 180.0;
+
+using residuals::MotionResidual;
+using residuals::StillResidual;
+
+/// One still segment as the solver sees it.
+struct Still {
+  StillSegment segment;
+  signal::SegmentStats stats;
+  std::array<double, 4> q{0, 0, 0, 1};  // R_n_b, Eigen order x y z w
+  bool known = false;
+  bool chain_head = false;
+  ceres::ResidualBlockId acc_block = nullptr;
+  ceres::ResidualBlockId gyr_block = nullptr;
+  residuals::StillMeasurement acc_measurement, gyr_measurement;
+  std::unique_ptr<StillResidual> acc_functor, gyr_functor;  // copies for reporting
+};
+
+struct Motion {
+  std::size_t from = 0;  // still index
+  std::size_t first = 0, last = 0;  // sample range [first, last]
+  ceres::ResidualBlockId block = nullptr;
+  Vec3 sqrt_info = Vec3::Ones();
+};
+
+Quat ToQuat(const std::array<double, 4>& q) { return Quat(q[3], q[0], q[1], q[2]); }
+std::array<double, 4> FromQuat(const Quat& q) { return {q.x(), q.y(), q.z(), q.w()}; }
+
+std::vector<Vec3> Column(const std::vector<Still>& still, bool gyro) {
+  std::vector<Vec3> out;
+  for (const auto& s : still) out.push_back(gyro ? s.stats.gyr_mean : s.stats.acc_mean);
+  return out;
+}
+
+void CheckEffectData(const model::Model& model, const ImuSeries& series) {
+  for (const auto& term : model.terms()) {
+    const auto& info = term.effect->info();
+    if (info.excitation.temperature && !series.has_temperature()) {
+      throw InsufficientDataError(info.name + " needs the sensor temperature, but the input has "
+                                  "no temperature column; record it (temp_c) or drop the effect");
+    }
+  }
+}
+
+}  // namespace
+
+int CountDistinctOrientations(const std::vector<Vec3>& acc_means, double min_angle_deg) {
+  std::vector<Vec3> reps;
+  for (const auto& m : acc_means) {
+    const Vec3 u = m.normalized();
+    const bool seen = std::any_of(reps.begin(), reps.end(), [&](const Vec3& r) {
+      return std::acos(std::clamp(r.dot(u), -1.0, 1.0)) * kRadToDeg < min_angle_deg;
+    });
+    if (!seen) reps.push_back(u);
+  }
+  return static_cast<int>(reps.size());
+}
+
+CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                            const model::Model& model_in, const geo::Site& site,
+                            const CalibrationOptions& options) {
+  CalibrationResult result;
+  result.method = options.method;
+  result.site = site;
+  model::Model model = model_in;
+  const bool gyro_data = series.has_gyro();
+  if (!gyro_data && model.has_gyro()) {
+    model.DropGyro();
+    result.warnings.push_back("the input has no gyroscope: calibrating the accelerometer only");
+  }
+  CheckEffectData(model, series);
+  result.has_gyro = model.has_gyro();
+
+  // Still segments and their statistics.
+  std::vector<Still> still;
+  for (const auto& seg : segments) {
+    if (seg.end > series.size() || seg.begin >= seg.end) {
+      throw Error("still segment '" + seg.label + "' [" + std::to_string(seg.begin) + ", " +
+                  std::to_string(seg.end) + ") is outside the " + std::to_string(series.size()) +
+                  " samples");
+    }
+    if (static_cast<int>(seg.count()) < options.min_segment_samples) continue;
+    Still s;
+    s.segment = seg;
+    s.stats = signal::ComputeSegmentStats(series, seg);
+    s.known = seg.known_R_n_b.has_value();
+    still.push_back(std::move(s));
+  }
+  if (still.empty()) {
+    throw InsufficientDataError(
+        "no still segment of at least " + std::to_string(options.min_segment_samples) +
+        " samples: record the IMU still (a minute level, or many still poses joined by turns)");
+  }
+  const double g = site.gravity();
+
+  // Noise from the data: pooled scatter and correlation time over the still segments.
+  std::vector<StillSegment> used;
+  for (const auto& s : still) used.push_back(s.segment);
+  const auto acc_noise = signal::EstimateCorrelationTime(series, used, signal::Sensor::kAccel);
+  std::array<signal::CorrelationTime, 3> gyr_noise{};
+  if (result.has_gyro) {
+    gyr_noise = signal::EstimateCorrelationTime(series, used, signal::Sensor::kGyro);
+  }
+  for (int i = 0; i < 3; ++i) {
+    result.noise_acc[i] = std::max(std::sqrt(acc_noise[static_cast<std::size_t>(i)].variance), options.min_sigma_acc);
+    result.tau_acc = std::max(result.tau_acc, acc_noise[static_cast<std::size_t>(i)].tau_int);
+    if (result.has_gyro) {
+      result.noise_gyr[i] = std::max(std::sqrt(gyr_noise[static_cast<std::size_t>(i)].variance), options.min_sigma_gyr);
+      result.tau_gyr = std::max(result.tau_gyr, gyr_noise[static_cast<std::size_t>(i)].tau_int);
+    }
+  }
+  // Per-axis tau, kept separately for whitening.
+  Vec3 tau_acc, tau_gyr = Vec3::Ones();
+  for (int i = 0; i < 3; ++i) {
+    tau_acc[i] = std::max(1.0, acc_noise[static_cast<std::size_t>(i)].tau_int);
+    if (result.has_gyro) tau_gyr[i] = std::max(1.0, gyr_noise[static_cast<std::size_t>(i)].tau_int);
+  }
+
+  // Initial accelerometer.
+  model::ParameterBlocks theta = model.ZeroParameters();
+  const int t_acc = model.FindTerm("accel_linear");
+  const AccelGuess acc_guess = GuessAccel(Column(still, false), g);
+  {
+    auto& b = theta[static_cast<std::size_t>(t_acc)];
+    b[0] = b[3] = b[5] = acc_guess.scale - 1.0;
+    for (int i = 0; i < 3; ++i) b[static_cast<std::size_t>(6 + i)] = acc_guess.bias[i];
+  }
+  auto down_of = [&](const Still& s) {
+    return Vec3(-(s.stats.acc_mean - acc_guess.bias) / acc_guess.scale).normalized();
+  };
+
+  // Chains of segments joined by motion.
+  const bool motion_on = options.use_motion && result.has_gyro;
+  std::vector<Motion> motions;
+  for (std::size_t k = 0; k + 1 < still.size(); ++k) {
+    const std::size_t first = still[k].segment.end - 1;
+    const std::size_t last = still[k + 1].segment.begin;
+    const double gap = series.t_s[last] - series.t_s[first];
+    if (!motion_on || last <= first || gap > options.max_motion_s) continue;
+    Motion m;
+    m.from = k;
+    m.first = first;
+    m.last = last;
+    motions.push_back(m);
+  }
+  std::vector<bool> joined_to_previous(still.size(), false);
+  for (const auto& m : motions) joined_to_previous[m.from + 1] = true;
+
+  // Initial gyroscope: bias from the still means, scale by the one-dimensional search.
+  const int t_gyr = model.FindTerm("gyro_linear");
+  double gyro_scale = 1.0;  // rad/s per sensor unit
+  Vec3 gyro_bias0 = Vec3::Zero();
+  if (result.has_gyro) {
+    for (const auto& s : still) gyro_bias0 += s.stats.gyr_mean / static_cast<double>(still.size());
+    std::vector<std::pair<std::size_t, std::size_t>> intervals;
+    std::vector<Vec3> before, after;
+    for (const auto& m : motions) {
+      intervals.emplace_back(m.first, m.last);
+      before.push_back(down_of(still[m.from]));
+      after.push_back(down_of(still[m.from + 1]));
+    }
+    gyro_scale = GuessGyroScale(series, intervals, before, after, gyro_bias0);
+    auto& b = theta[static_cast<std::size_t>(t_gyr)];
+    b[0] = b[4] = b[8] = 1.0 / gyro_scale - 1.0;
+    for (int i = 0; i < 3; ++i) b[static_cast<std::size_t>(9 + i)] = gyro_bias0[i];
+  }
+
+  // Initial attitudes: tilt from gravity, heading carried along each chain.
+  for (std::size_t k = 0; k < still.size(); ++k) {
+    Still& s = still[k];
+    if (s.known) {
+      s.q = FromQuat(*s.segment.known_R_n_b);
+      continue;
+    }
+    if (k > 0 && joined_to_previous[k]) {
+      const auto it = std::find_if(motions.begin(), motions.end(),
+                                   [&](const Motion& m) { return m.from + 1 == k; });
+      const Quat dR = IntegrateRaw(series, it->first, it->last, gyro_bias0, gyro_scale);
+      s.q = FromQuat(CorrectTilt(ToQuat(still[k - 1].q) * dR, down_of(s)));
+    } else {
+      const double heading = (k == 0 && options.first_heading_deg)
+                                 ? *options.first_heading_deg * kDegToRad
+                                 : 0.0;
+      s.q = FromQuat(AttitudeFromDown(down_of(s), heading));
+    }
+  }
+  // Gauge: the first segment of each chain holds its heading unless a known attitude in the
+  // chain already fixes it (or there is no gyroscope, where every heading is free).
+  {
+    std::size_t k = 0;
+    while (k < still.size()) {
+      std::size_t end = k + 1;
+      while (end < still.size() && joined_to_previous[end]) ++end;
+      bool any_known = false;
+      for (std::size_t j = k; j < end; ++j) any_known = any_known || still[j].known;
+      if (!any_known) still[k].chain_head = true;
+      k = end;
+    }
+    if (!result.has_gyro) {
+      for (auto& s : still) s.chain_head = !s.known;
+    }
+  }
+
+  // The problem, built from the current values; `held` adds parameters (term, index) held
+  // at their values (the pivots of unobservable directions, see below).
+  const auto acc_terms = StillResidual::TermsOf(model, model::Sensor::kAccel);
+  const auto gyr_terms = StillResidual::TermsOf(model, model::Sensor::kGyro);
+  const bool still_gyro = result.has_gyro && options.use_still_gyro;
+  for (auto& s : still) {
+    const double n = static_cast<double>(s.stats.count);
+    residuals::StillMeasurement m;
+    m.dt_s = s.stats.t_mid_s - model.t_ref_s;
+    m.dtemp_c = std::isfinite(s.stats.temp_mean_c) ? s.stats.temp_mean_c - model.temp_ref_c : 0.0;
+    m.mean = s.stats.acc_mean;
+    for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / tau_acc[i]) / result.noise_acc[i];
+    s.acc_measurement = m;
+    s.acc_functor = std::make_unique<StillResidual>(model, model::Sensor::kAccel, acc_terms, m,
+                                                    site.g_n, site.omega_ie_n);
+    if (still_gyro) {
+      m.mean = s.stats.gyr_mean;
+      for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / tau_gyr[i]) / result.noise_gyr[i];
+      s.gyr_measurement = m;
+      s.gyr_functor = std::make_unique<StillResidual>(
+          model, model::Sensor::kGyro, gyr_terms, m, site.g_n, site.omega_ie_n,
+          s.segment.known_omega_eb_b.value_or(Vec3::Zero()));
+    }
+  }
+  std::vector<residuals::MotionSamples> motion_samples;
+  for (auto& mo : motions) {
+    residuals::MotionSamples ms;
+    for (std::size_t i = mo.first; i <= mo.last; ++i) {
+      ms.dt_s.push_back(series.t_s[i] - model.t_ref_s);
+      ms.acc.push_back(series.acc[i].cast<double>());
+      ms.gyr.push_back(series.gyr[i].cast<double>());
+      ms.dtemp_c.push_back(series.has_temperature() ? series.temp_c[i] - model.temp_ref_c : 0.0);
+      const std::size_t a = i > 0 ? i - 1 : i, b = std::min(i + 1, series.size() - 1);
+      const double h = series.t_s[b] - series.t_s[a];
+      ms.alpha_b.push_back(h > 0 ? Vec3(gyro_scale * (series.gyr[b] - series.gyr[a]).cast<double>() / h)
+                                 : Vec3::Zero());
+    }
+    const double steps = static_cast<double>(mo.last - mo.first);
+    const double dt = (series.t_s[mo.last] - series.t_s[mo.first]) / std::max(1.0, steps);
+    for (int i = 0; i < 3; ++i) {
+      const double sigma_rate = result.noise_gyr[i] * gyro_scale;  // rad/s per sample
+      mo.sqrt_info[i] = 1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * tau_gyr[i]));
+    }
+    ms.sqrt_info = mo.sqrt_info;
+    motion_samples.push_back(std::move(ms));
+  }
+
+  std::vector<std::unique_ptr<ceres::Manifold>> manifolds;
+  auto build = [&](const std::vector<std::pair<int, int>>& held_extra) {
+    auto problem = std::make_unique<ceres::Problem>([] {
+      ceres::Problem::Options o;
+      o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+      return o;
+    }());
+    for (int t = 0; t < model.num_terms(); ++t) {
+      auto& block = theta[static_cast<std::size_t>(t)];
+      const auto& fixed = model.terms()[static_cast<std::size_t>(t)].fixed;
+      problem->AddParameterBlock(block.data(), static_cast<int>(block.size()));
+      std::vector<int> held;
+      for (std::size_t i = 0; i < fixed.size(); ++i) {
+        const bool extra = std::find(held_extra.begin(), held_extra.end(),
+                                     std::make_pair(t, static_cast<int>(i))) != held_extra.end();
+        if (fixed[i] || extra) held.push_back(static_cast<int>(i));
+      }
+      if (held.size() == block.size()) {
+        problem->SetParameterBlockConstant(block.data());
+      } else if (!held.empty()) {
+        manifolds.push_back(std::make_unique<ceres::SubsetManifold>(static_cast<int>(block.size()), held));
+        problem->SetManifold(block.data(), manifolds.back().get());
+      }
+    }
+    for (auto& s : still) {
+      problem->AddParameterBlock(s.q.data(), 4);
+      if (s.known) {
+        problem->SetParameterBlockConstant(s.q.data());
+      } else {
+        manifolds.push_back(s.chain_head ? residuals::TiltManifold() : residuals::AttitudeManifold());
+        problem->SetManifold(s.q.data(), manifolds.back().get());
+      }
+    }
+    auto blocks_of = [&](const std::vector<int>& terms, double* q) {
+      std::vector<double*> blocks = {q};
+      for (int t : terms) blocks.push_back(theta[static_cast<std::size_t>(t)].data());
+      return blocks;
+    };
+    for (auto& s : still) {
+      s.acc_block = problem->AddResidualBlock(
+          StillResidual::Create(model, model::Sensor::kAccel, s.acc_measurement, site.g_n,
+                                site.omega_ie_n),
+          nullptr, blocks_of(acc_terms, s.q.data()));
+      if (still_gyro) {
+        s.gyr_block = problem->AddResidualBlock(
+            StillResidual::Create(model, model::Sensor::kGyro, s.gyr_measurement, site.g_n,
+                                  site.omega_ie_n, s.segment.known_omega_eb_b.value_or(Vec3::Zero())),
+            nullptr, blocks_of(gyr_terms, s.q.data()));
+      }
+    }
+    for (std::size_t k = 0; k < motions.size(); ++k) {
+      auto& mo = motions[k];
+      std::vector<double*> blocks = {still[mo.from].q.data(), still[mo.from + 1].q.data()};
+      for (auto& b : theta) blocks.push_back(b.data());
+      mo.block = problem->AddResidualBlock(
+          MotionResidual::Create(model, motion_samples[k], site.omega_ie_n), nullptr, blocks);
+    }
+    return problem;
+  };
+
+  auto solve = [&](ceres::Problem& problem) {
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_QR;
+    solver_options.max_num_iterations = options.max_iterations;
+    solver_options.function_tolerance = options.function_tolerance;
+    solver_options.parameter_tolerance = options.parameter_tolerance;
+    solver_options.gradient_tolerance = 1e-14;
+    solver_options.num_threads = 1;
+    solver_options.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    result.fit.solver_report = summary.BriefReport();
+    result.fit.iterations += static_cast<int>(summary.iterations.size());
+    result.fit.converged = summary.termination_type == ceres::CONVERGENCE;
+    if (!summary.IsSolutionUsable()) throw Error("the solver failed: " + summary.BriefReport());
+  };
+
+  // Jacobian over every free unknown (model parameters, then attitudes) and its analysis.
+  std::vector<std::pair<int, int>> model_index;  // per column: (term, index) or (-1, still)
+  auto analyse = [&](ceres::Problem& problem, double* cost, std::vector<double>* residual_values) {
+    std::vector<double*> free_blocks;
+    std::vector<std::string> names;
+    std::vector<double> values;
+    std::vector<bool> is_model;
+    model_index.clear();
+    for (int t = 0; t < model.num_terms(); ++t) {
+      auto& block = theta[static_cast<std::size_t>(t)];
+      if (problem.IsParameterBlockConstant(block.data())) continue;
+      free_blocks.push_back(block.data());
+      const auto& term = model.terms()[static_cast<std::size_t>(t)];
+      const auto& info = term.effect->info();
+      for (int i = 0; i < info.size(); ++i) {
+        if (term.fixed[static_cast<std::size_t>(i)]) continue;
+        names.push_back(info.ParameterName(i));
+        values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal + block[static_cast<std::size_t>(i)]);
+        is_model.push_back(true);
+        model_index.emplace_back(t, i);
+      }
+    }
+    const char* kTangentName[3] = {"north", "east", "down"};
+    for (std::size_t k = 0; k < still.size(); ++k) {
+      if (still[k].known) continue;
+      free_blocks.push_back(still[k].q.data());
+      const int dims = still[k].chain_head ? 2 : 3;
+      for (int i = 0; i < dims; ++i) {
+        names.push_back("attitude[" + std::to_string(k) + "]." + kTangentName[i]);
+        values.push_back(std::nan(""));
+        is_model.push_back(false);
+        model_index.emplace_back(-1, static_cast<int>(k));
+      }
+    }
+    ceres::Problem::EvaluateOptions eval;
+    eval.parameter_blocks = free_blocks;
+    ceres::CRSMatrix crs;
+    problem.Evaluate(eval, cost, residual_values, nullptr, &crs);
+    ObservabilityInput oin;
+    oin.J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    for (int r = 0; r < crs.num_rows; ++r) {
+      for (int idx = crs.rows[static_cast<std::size_t>(r)]; idx < crs.rows[static_cast<std::size_t>(r) + 1]; ++idx) {
+        oin.J(r, crs.cols[static_cast<std::size_t>(idx)]) = crs.values[static_cast<std::size_t>(idx)];
+      }
+    }
+    oin.names = names;
+    oin.values = values;
+    oin.is_model = is_model;
+    oin.rank_tolerance = options.rank_tolerance;
+    return AnalyseObservability(oin);
+  };
+
+  // Solve. Where the data leaves directions unobservable, the solver could wander along them
+  // (or exploit ones that are observable only at the level of rounding), so the fit is redone
+  // from the starting values with one parameter per null direction (its row-echelon pivot,
+  // e.g. accel.matrix.zz for "9.78 accel.bias.z + 1 accel.matrix.zz") held at its start value.
+  const model::ParameterBlocks theta0 = theta;
+  std::vector<std::array<double, 4>> q0;
+  for (const auto& s : still) q0.push_back(s.q);
+  std::vector<std::pair<int, int>> held;
+  {
+    auto problem = build({});
+    solve(*problem);
+    double cost0 = 0;
+    const ObservabilityAnalysis first = analyse(*problem, &cost0, nullptr);
+    for (int c : first.pivots) {
+      if (model_index[static_cast<std::size_t>(c)].first >= 0) held.push_back(model_index[static_cast<std::size_t>(c)]);
+    }
+  }
+  if (!held.empty()) {
+    theta = theta0;
+    for (std::size_t k = 0; k < still.size(); ++k) still[k].q = q0[k];
+    auto problem = build(held);
+    solve(*problem);
+  }
+  auto problem_ptr = build({});
+  ceres::Problem& problem = *problem_ptr;
+  double cost = 0;
+  std::vector<double> residual_values;
+  const ObservabilityAnalysis analysis = analyse(problem, &cost, &residual_values);
+  result.observability = analysis.summary;
+
+  // Parameters.
+  const auto all_values = model::ReportedValues(model, theta);
+  const auto num_params = static_cast<Eigen::Index>(all_values.size());
+  result.covariance = Eigen::MatrixXd::Zero(num_params, num_params);
+  std::vector<Eigen::Index> column_of(all_values.size(), -1);
+  int flat = 0;
+  for (int t = 0; t < model.num_terms(); ++t) {
+    const auto& term = model.terms()[static_cast<std::size_t>(t)];
+    const auto& info = term.effect->info();
+    for (int i = 0; i < info.size(); ++i, ++flat) {
+      ParameterEstimate p;
+      p.name = info.ParameterName(i);
+      p.unit = info.parameters[static_cast<std::size_t>(i)].unit;
+      p.value = all_values[static_cast<std::size_t>(flat)];
+      p.fixed = term.fixed[static_cast<std::size_t>(i)];
+      const auto col = std::find(model_index.begin(), model_index.end(), std::make_pair(t, i));
+      if (col != model_index.end()) {
+        const auto c = col - model_index.begin();
+        column_of[static_cast<std::size_t>(flat)] = c;
+        p.observable = analysis.observable[static_cast<std::size_t>(c)];
+        if (p.observable) p.sigma = std::sqrt(std::max(0.0, analysis.covariance(c, c)));
+      }
+      result.parameters.push_back(p);
+    }
+  }
+  for (Eigen::Index a = 0; a < num_params; ++a) {
+    for (Eigen::Index b = 0; b < num_params; ++b) {
+      const auto ca = column_of[static_cast<std::size_t>(a)], cb = column_of[static_cast<std::size_t>(b)];
+      if (ca >= 0 && cb >= 0) result.covariance(a, b) = analysis.covariance(ca, cb);
+    }
+  }
+
+  // Forward quantities.
+  {
+    const auto out = model.Predict(theta, model::SensorInput<double>());
+    result.accel_matrix = out.F;
+    result.accel_bias = theta[static_cast<std::size_t>(t_acc)].size() >= 9
+                            ? Vec3(theta[static_cast<std::size_t>(t_acc)][6], theta[static_cast<std::size_t>(t_acc)][7],
+                                   theta[static_cast<std::size_t>(t_acc)][8])
+                            : Vec3::Zero();
+    if (result.has_gyro) {
+      result.gyro_matrix = out.E;
+      const auto& b = theta[static_cast<std::size_t>(t_gyr)];
+      result.gyro_bias = Vec3(b[9], b[10], b[11]);
+    }
+  }
+
+  // Residuals per segment and fit summary.
+  FitSummary& fit = result.fit;
+  fit.chi2 = 2.0 * cost;
+  fit.num_residuals = static_cast<int>(residual_values.size());
+  fit.dof = fit.num_residuals - analysis.summary.rank;
+  fit.still_segments = static_cast<int>(still.size());
+  fit.motion_segments = static_cast<int>(motions.size());
+  Vec3 ss_acc = Vec3::Zero(), ss_gyr = Vec3::Zero(), ss_mot = Vec3::Zero();
+  for (auto& s : still) {
+    StillSegmentFit f;
+    f.segment = s.segment;
+    f.t_mid_s = s.stats.t_mid_s;
+    f.R_n_b = ToQuat(s.q);
+    f.attitude_known = s.known;
+    f.acc_residual = s.stats.acc_mean - s.acc_functor->Predict(s.q.data(), theta);
+    ss_acc += f.acc_residual.cwiseAbs2();
+    if (s.gyr_functor) {
+      f.gyr_residual = s.stats.gyr_mean - s.gyr_functor->Predict(s.q.data(), theta);
+      ss_gyr += f.gyr_residual.cwiseAbs2();
+    }
+    double w[3];
+    problem.EvaluateResidualBlock(s.acc_block, false, nullptr, w, nullptr);
+    f.acc_whitened = Vec3(w[0], w[1], w[2]);
+    if (s.gyr_block) {
+      problem.EvaluateResidualBlock(s.gyr_block, false, nullptr, w, nullptr);
+      f.gyr_whitened = Vec3(w[0], w[1], w[2]);
+    }
+    result.still.push_back(f);
+  }
+  for (const auto& mo : motions) {
+    MotionFit f;
+    f.from = mo.from;
+    f.to = mo.from + 1;
+    f.duration_s = series.t_s[mo.last] - series.t_s[mo.first];
+    double w[3];
+    problem.EvaluateResidualBlock(mo.block, false, nullptr, w, nullptr);
+    f.whitened = Vec3(w[0], w[1], w[2]);
+    f.rotation_residual = f.whitened.cwiseQuotient(mo.sqrt_info);
+    ss_mot += f.rotation_residual.cwiseAbs2();
+    result.motion.push_back(f);
+  }
+  const double ns = static_cast<double>(still.size());
+  fit.rms_acc = (ss_acc / ns).cwiseSqrt();
+  if (still_gyro) fit.rms_gyr = (ss_gyr / ns).cwiseSqrt();
+  if (!motions.empty()) fit.rms_motion = (ss_mot / static_cast<double>(motions.size())).cwiseSqrt();
+
+  // What the data cannot determine, and what to record.
+  const int orientations = CountDistinctOrientations(Column(still, false));
+  bool accel_short = false, gyro_short = false;
+  std::vector<std::string> lost;
+  for (const auto& p : result.parameters) {
+    if (p.fixed || p.observable) continue;
+    lost.push_back(p.name);
+    accel_short = accel_short || p.name.rfind("accel.", 0) == 0;
+    gyro_short = gyro_short || p.name.rfind("gyro.", 0) == 0;
+  }
+  std::vector<std::string> advice;
+  if (accel_short) {
+    advice.push_back("the base accelerometer model needs still poses in at least 9 distinct "
+                     "orientations (fewer when attitudes are known); found " +
+                     std::to_string(orientations));
+  }
+  if (gyro_short) {
+    advice.push_back("the gyroscope matrix needs turns about three independent axes between still "
+                     "poses; found " + std::to_string(motions.size()) + " motion intervals" +
+                     (result.has_gyro && !site.known ? " (and no site: Earth rate unused)" : ""));
+  }
+  if (!lost.empty()) {
+    std::string list;
+    for (const auto& name : lost) list += (list.empty() ? "" : ", ") + name;
+    std::string message = "the data cannot determine " + list;
+    for (const auto& a : advice) message += "; " + a;
+    if (options.on_insufficient == InsufficientData::kError) throw InsufficientDataError(message);
+    result.warnings.push_back(message);
+  }
+  if (!site.known) {
+    result.warnings.push_back("no site given: gravity fixed at " + std::to_string(g) +
+                              " m/s^2 and Earth rate left out; the accelerometer scale and the "
+                              "gyroscope bias depend on it (give --lat --lon --height)");
+  }
+  result.model = model;
+  result.theta = theta;
+  return result;
+}
+
+}  // namespace plumb::estimation

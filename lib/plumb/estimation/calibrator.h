@@ -1,0 +1,40 @@
+// plumb/estimation/calibrator.h — the one least-squares backend (SPEC section 3).
+//
+// Unknowns: the model's parameter blocks and one attitude R_k per still segment (on SO(3),
+// held constant where known). Residuals: still accelerometer and gyroscope on segment
+// statistics, motion residuals integrating the gyroscope between consecutive segments.
+// Gauge: the heading of the first segment of every motion-joined chain is held (TiltManifold),
+// at the stated heading if the options give one. Noise levels come from the data: the pooled
+// within-segment scatter per axis and its integrated autocorrelation time.
+//
+// Example:
+//   auto site = geo::Site::At(51.64, -1.2, 100, "flags");
+//   auto model = model::Model::Parse("base");
+//   CalibrationResult r = Calibrate(session.series, segments, model, site, {});
+//   std::cout << r.BriefReport();
+#pragma once
+
+#include <vector>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/core/segment.h"
+#include "plumb/estimation/options.h"
+#include "plumb/estimation/result.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+
+namespace plumb::estimation {
+
+/// Fits `model` to the still segments of `series` (and the motion between them). Throws
+/// plumb::InsufficientDataError when there is nothing to fit (no usable still segment, an
+/// effect whose data is absent) or, with InsufficientData::kError, when the data cannot
+/// determine every parameter; the message says what to record.
+CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                            const model::Model& model, const geo::Site& site,
+                            const CalibrationOptions& options = {});
+
+/// Number of distinct still orientations (gravity directions more than `min_angle_deg`
+/// apart) among the segments' accelerometer means.
+int CountDistinctOrientations(const std::vector<Vec3>& acc_means, double min_angle_deg = 10.0);
+
+}  // namespace plumb::estimation

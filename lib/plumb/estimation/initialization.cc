@@ -1,0 +1,111 @@
+#include "plumb/estimation/initialization.h"
+
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+
+namespace plumb::estimation {
+
+AccelGuess GuessAccel(const std::vector<Vec3>& means, double g) {
+  AccelGuess guess;
+  std::vector<double> norms;
+  for (const auto& m : means) norms.push_back(m.norm());
+  if (!norms.empty()) {
+    std::nth_element(norms.begin(), norms.begin() + static_cast<std::ptrdiff_t>(norms.size() / 2), norms.end());
+    guess.scale = norms[norms.size() / 2] / g;
+    // Data already in m/s^2: start at the nominal F = I rather than at a noisy scale.
+    if (std::abs(guess.scale - 1.0) < 0.1) guess.scale = 1.0;
+  }
+  if (means.size() < 4) return guess;
+  // |m|^2 = 2 c.m + (r^2 - |c|^2): linear in (c, d).
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(means.size()), 4);
+  Eigen::VectorXd b(static_cast<Eigen::Index>(means.size()));
+  for (std::size_t k = 0; k < means.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    A.row(i) << 2 * means[k].transpose(), 1.0;
+    b[i] = means[k].squaredNorm();
+  }
+  // Only trust the fit when the orientations span 3-D (well-conditioned A).
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A);
+  const auto s = svd.singularValues();
+  if (s[3] < 1e-3 * s[0]) return guess;
+  const Eigen::Vector4d x = A.colPivHouseholderQr().solve(b);
+  const Vec3 c = x.head<3>();
+  const double r2 = x[3] + c.squaredNorm();
+  if (!(r2 > 0)) return guess;
+  guess.scale = std::sqrt(r2) / g;
+  guess.bias = c;
+  guess.sphere_fit = true;
+  return guess;
+}
+
+double Heading(const Quat& R_n_b) {
+  const Mat3 R = R_n_b.toRotationMatrix();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+
+Quat AttitudeFromDown(const Vec3& down_b, double heading_rad) {
+  const Quat R0 = Quat::FromTwoVectors(down_b.normalized(), Vec3::UnitZ());
+  const double turn = heading_rad - Heading(R0);
+  return (Eigen::AngleAxisd(turn, Vec3::UnitZ()) * R0).normalized();
+}
+
+Quat CorrectTilt(const Quat& R_n_b, const Vec3& down_b) {
+  const Vec3 down_n = R_n_b * down_b.normalized();
+  return (Quat::FromTwoVectors(down_n, Vec3::UnitZ()) * R_n_b).normalized();
+}
+
+Quat IntegrateRaw(const ImuSeries& series, std::size_t first, std::size_t last,
+                  const Vec3& bias, double scale) {
+  Quat q = Quat::Identity();
+  for (std::size_t i = first; i < last; ++i) {
+    const double h = series.t_s[i + 1] - series.t_s[i];
+    const Vec3 w = 0.5 * scale *
+                   ((series.gyr[i].cast<double>() - bias) + (series.gyr[i + 1].cast<double>() - bias));
+    const Vec3 rv = w * h;
+    const double angle = rv.norm();
+    if (angle > 0) q = q * Quat(Eigen::AngleAxisd(angle, rv / angle));
+  }
+  return q.normalized();
+}
+
+double GuessGyroScale(const ImuSeries& series,
+                      const std::vector<std::pair<std::size_t, std::size_t>>& intervals,
+                      const std::vector<Vec3>& down_before, const std::vector<Vec3>& down_after,
+                      const Vec3& bias) {
+  if (intervals.empty()) return 1.0;
+  // down_after = dR^T down_before, dR = R_k^T R_k+1.
+  auto cost = [&](double log10_s) {
+    const double s = std::pow(10.0, log10_s);
+    double c = 0;
+    for (std::size_t k = 0; k < intervals.size(); ++k) {
+      const Quat dR = IntegrateRaw(series, intervals[k].first, intervals[k].second, bias, s);
+      c += (dR.conjugate() * down_before[k] - down_after[k]).squaredNorm();
+    }
+    return c;
+  };
+  double best = 0.0, best_cost = cost(0.0);
+  for (double e = -7.0; e <= 7.0; e += 0.25) {
+    const double c = cost(e);
+    if (c < best_cost) {
+      best_cost = c;
+      best = e;
+    }
+  }
+  // Golden-section refinement within one grid step either side.
+  double a = best - 0.25, b = best + 0.25;
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
+  double f1 = cost(x1), f2 = cost(x2);
+  for (int it = 0; it < 30; ++it) {
+    if (f1 < f2) {
+      b = x2; x2 = x1; f2 = f1; x1 = b - phi * (b - a); f1 = cost(x1);
+    } else {
+      a = x1; x1 = x2; f1 = f2; x2 = a + phi * (b - a); f2 = cost(x2);
+    }
+  }
+  return std::pow(10.0, 0.5 * (a + b));
+}
+
+}  // namespace plumb::estimation

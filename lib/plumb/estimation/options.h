@@ -1,0 +1,45 @@
+// plumb/estimation/options.h — how the one backend (SPEC section 3) is configured.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace plumb::estimation {
+
+/// What to do when the data cannot determine every parameter of the requested model.
+enum class InsufficientData {
+  kReport,  ///< fit anyway; report the unobservable directions and what to record (default)
+  kError,   ///< throw plumb::InsufficientDataError saying what to record
+};
+
+struct CalibrationOptions {
+  /// Label of the method in outputs ("generalized", or a paper method run on the backend).
+  std::string method = "generalized";
+  /// Integrate the gyroscope between consecutive still segments (motion residuals).
+  bool use_motion = true;
+  /// Motion intervals longer than this are not integrated, s (> 0): the attitude before and
+  /// after are then treated as unrelated and each chain gets its own heading gauge.
+  double max_motion_s = 120.0;
+  /// Heading of the first still segment's x axis from north, degrees, if the user states it
+  /// (e.g. 0 for "x points north"); otherwise the heading gauge is held at its initial value.
+  std::optional<double> first_heading_deg;
+  /// Still residuals of the gyroscope (the Earth-rate constraint) are used when true.
+  bool use_still_gyro = true;
+  /// Relative singular-value threshold of the column-scaled whitened Jacobian below which a
+  /// direction counts as unobservable (0 < value < 1).
+  double rank_tolerance = 1e-9;
+  /// Minimum samples for a still segment to be used.
+  int min_segment_samples = 10;
+  /// Lower bound on the noise standard deviation per sample, in sensor units, guarding
+  /// against quantised data whose scatter reads zero (> 0).
+  double min_sigma_acc = 1e-6;
+  double min_sigma_gyr = 1e-8;
+  /// Solver limits.
+  int max_iterations = 200;
+  double function_tolerance = 1e-12;
+  double parameter_tolerance = 1e-12;
+  InsufficientData on_insufficient = InsufficientData::kReport;
+};
+
+}  // namespace plumb::estimation

@@ -1,0 +1,74 @@
+// Text reports of a CalibrationResult (the library formats; only the command prints).
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "plumb/estimation/result.h"
+
+namespace plumb::estimation {
+namespace {
+
+std::string Format(const char* fmt, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, a);
+  return buf;
+}
+
+std::string Vec(const Vec3& v, const char* fmt = "%.4g") {
+  return "(" + Format(fmt, v.x()) + ", " + Format(fmt, v.y()) + ", " + Format(fmt, v.z()) + ")";
+}
+
+}  // namespace
+
+std::string CalibrationResult::BriefReport() const {
+  std::ostringstream os;
+  os << "method " << method << ", model " << model.spec() << ": " << fit.still_segments
+     << " still segments, " << fit.motion_segments << " motion intervals\n";
+  os << "chi2 " << Format("%.6g", fit.chi2) << " on " << fit.dof << " dof, chi2/dof "
+     << Format("%.4g", fit.chi2_dof()) << "; rank " << observability.rank << " of "
+     << observability.num_unknowns << " unknowns; "
+     << (fit.converged ? "converged" : "NOT converged") << " in " << fit.iterations
+     << " iterations\n";
+  return os.str();
+}
+
+std::string CalibrationResult::FullReport() const {
+  std::ostringstream os;
+  os << BriefReport();
+  os << "site: " << (site.known ? Format("%.6f", site.lat_deg) + " deg, " +
+                                      Format("%.6f", site.lon_deg) + " deg, " +
+                                      Format("%.1f", site.height_m) + " m (" + site.source + ")"
+                                : std::string("none"))
+     << ", gravity " << Format("%.6f", site.gravity()) << " m/s^2\n";
+  os << "residual RMS per axis: accel " << Vec(fit.rms_acc) << " m/s^2";
+  if (has_gyro) os << ", gyro " << Vec(fit.rms_gyr) << " rad/s";
+  if (fit.motion_segments > 0) os << ", motion " << Vec(fit.rms_motion) << " rad";
+  os << "\nnoise per sample: accel " << Vec(noise_acc) << " (tau " << Format("%.2f", tau_acc)
+     << " samples)";
+  if (has_gyro) os << ", gyro " << Vec(noise_gyr) << " (tau " << Format("%.2f", tau_gyr) << ")";
+  os << "\n\n";
+  char line[160];
+  std::snprintf(line, sizeof line, "%-34s %15s %12s  %s\n", "parameter", "value", "sigma", "unit");
+  os << line;
+  for (const auto& p : parameters) {
+    std::string sigma = p.fixed ? "fixed" : !p.observable ? "unobservable" : Format("%.3g", p.sigma);
+    std::snprintf(line, sizeof line, "%-34s %15.8g %12s  %s\n", p.name.c_str(), p.value,
+                  sigma.c_str(), p.unit.c_str());
+    os << line;
+  }
+  if (!observability.unobservable.empty()) {
+    os << "\nunobservable directions (moving along them changes no prediction):\n";
+    for (const auto& u : observability.unobservable) os << "  " << u << "\n";
+  }
+  if (!observability.determined.empty()) {
+    os << "determined combinations:\n";
+    for (const auto& d : observability.determined) {
+      os << "  " << d.text << " = " << Format("%.8g", d.value) << " +- "
+         << Format("%.3g", d.sigma) << "\n";
+    }
+  }
+  for (const auto& w : warnings) os << "warning: " << w << "\n";
+  return os.str();
+}
+
+}  // namespace plumb::estimation

@@ -1,0 +1,69 @@
+#include "plumb/residuals/still_residuals.h"
+
+#include <Eigen/Geometry>
+
+namespace plumb::residuals {
+
+StillResidual::StillResidual(const model::Model& model, model::Sensor sensor,
+                             std::vector<int> terms, StillMeasurement measurement,
+                             const Vec3& g_n, const Vec3& omega_ie_n, const Vec3& omega_eb_b)
+    : model_(&model), sensor_(sensor), terms_(std::move(terms)), m_(measurement), g_n_(g_n),
+      omega_ie_n_(omega_ie_n), omega_eb_b_(omega_eb_b) {}
+
+std::vector<int> StillResidual::TermsOf(const model::Model& model, model::Sensor sensor) {
+  std::vector<int> terms;
+  for (int i = 0; i < model.num_terms(); ++i) {
+    if (model.terms()[static_cast<std::size_t>(i)].effect->info().sensor == sensor) {
+      terms.push_back(i);
+    }
+  }
+  return terms;
+}
+
+template <typename T>
+Vec3T<T> StillResidual::PredictT(T const* const* parameters) const {
+  const Eigen::Map<const Eigen::Quaternion<T>> q_n_b(parameters[0]);
+  const Mat3T<T> R_b_n = q_n_b.toRotationMatrix().transpose();
+  model::SensorInput<T> in;
+  in.f_b = R_b_n * (-g_n_.cast<T>());
+  in.omega_b = R_b_n * omega_ie_n_.cast<T>() + omega_eb_b_.cast<T>();
+  in.dt_s = T(m_.dt_s);
+  in.dtemp_c = T(m_.dtemp_c);
+  model::SensorOutput<T> out;
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    model_->terms()[static_cast<std::size_t>(terms_[i])].effect->Apply(parameters[i + 1], in, out);
+  }
+  return sensor_ == model::Sensor::kAccel ? out.acc : out.gyr;
+}
+
+template <typename T>
+bool StillResidual::operator()(T const* const* parameters, T* residuals) const {
+  const Vec3T<T> predicted = PredictT(parameters);
+  Eigen::Map<Vec3T<T>> r(residuals);
+  r = (m_.mean.cast<T>() - predicted).cwiseProduct(m_.sqrt_info.cast<T>());
+  return true;
+}
+
+Vec3 StillResidual::Predict(const double* q_k, const model::ParameterBlocks& theta) const {
+  std::vector<const double*> p = {q_k};
+  for (int t : terms_) p.push_back(theta[static_cast<std::size_t>(t)].data());
+  return PredictT<double>(p.data());
+}
+
+ceres::CostFunction* StillResidual::Create(const model::Model& model, model::Sensor sensor,
+                                           StillMeasurement measurement, const Vec3& g_n,
+                                           const Vec3& omega_ie_n, const Vec3& omega_eb_b) {
+  auto terms = TermsOf(model, sensor);
+  auto* functor =
+      new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n, omega_eb_b);
+  auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, model::kJetStride>(functor);
+  cost->AddParameterBlock(4);
+  for (int t : terms) cost->AddParameterBlock(model.terms()[static_cast<std::size_t>(t)].effect->info().size());
+  cost->SetNumResiduals(3);
+  return cost;
+}
+
+template bool StillResidual::operator()<double>(double const* const*, double*) const;
+template bool StillResidual::operator()<model::Jet>(model::Jet const* const*, model::Jet*) const;
+
+}  // namespace plumb::residuals

@@ -1,0 +1,67 @@
+// plumb/residuals/still_residuals.h — residuals of still segments (SPEC section 3).
+//
+// Still accelerometer, segment k, attitude R_k = R_n_b during the segment:
+//
+//   r_a = W_a (mean(y_a)_k - h_a(theta, f_b = R_k^T (-g_n), omega_b = R_k^T omega_ie_n))
+//
+// Still gyroscope (the Earth-rate constraint), with a known turntable rate if stated:
+//
+//   r_g = W_g (mean(y_g)_k - h_g(theta, f_b, omega_b = R_k^T omega_ie_n + omega_eb_b))
+//
+// h is the model's forward prediction (plumb/model/model.h) evaluated only with the terms of
+// the residual's sensor. W = diag(sqrt_info) whitens by the standard deviation of the segment
+// mean (sqrt(N_k) / sigma_k, corrected for sample correlation), so the cost does not grow with
+// the number of samples.
+//
+// Parameter blocks, in order: q_k (4, Eigen order x y z w, unit quaternion of R_n_b), then
+// the blocks of the model terms listed in `terms` (their sizes in info().size()).
+// Units: g_n in m/s^2 (NED, down positive), omega in rad/s, outputs in sensor units.
+#pragma once
+
+#include <ceres/dynamic_autodiff_cost_function.h>
+
+#include <memory>
+#include <vector>
+
+#include "plumb/model/model.h"
+#include "plumb/residuals/measurements.h"
+
+namespace plumb::residuals {
+
+
+class StillResidual {
+ public:
+  /// `sensor` selects accelerometer or gyroscope; `terms` are the model's term indices for
+  /// that sensor (see TermsOf); `g_n` gravity in NED, m/s^2; `omega_ie_n` Earth rate in NED,
+  /// rad/s (zero without a site); `omega_eb_b` a known rate relative to the Earth, rad/s.
+  StillResidual(const model::Model& model, model::Sensor sensor, std::vector<int> terms,
+                StillMeasurement measurement, const Vec3& g_n, const Vec3& omega_ie_n,
+                const Vec3& omega_eb_b = Vec3::Zero());
+
+  template <typename T>
+  bool operator()(T const* const* parameters, T* residuals) const;
+
+  /// The cost function; parameter blocks as documented above.
+  static ceres::CostFunction* Create(const model::Model& model, model::Sensor sensor,
+                                     StillMeasurement measurement, const Vec3& g_n,
+                                     const Vec3& omega_ie_n,
+                                     const Vec3& omega_eb_b = Vec3::Zero());
+
+  /// Indices of the model terms that act on `sensor`.
+  static std::vector<int> TermsOf(const model::Model& model, model::Sensor sensor);
+
+  /// The prediction (unwhitened) at given values, for reports: q_k and the model blocks.
+  Vec3 Predict(const double* q_k, const model::ParameterBlocks& theta) const;
+
+ private:
+  template <typename T>
+  Vec3T<T> PredictT(T const* const* parameters) const;
+
+  const model::Model* model_;
+  model::Sensor sensor_;
+  std::vector<int> terms_;
+  StillMeasurement m_;
+  Vec3 g_n_, omega_ie_n_, omega_eb_b_;
+};
+
+}  // namespace plumb::residuals

@@ -1,0 +1,260 @@
+#include "plumb/sim/simulate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "plumb/core/error.h"
+
+namespace plumb::sim {
+namespace {
+
+constexpr double kMaxRateHz = 100000.0;
+constexpr double kMaxSamples = 200e6;
+/// Tolerance, in samples, when placing step boundaries on the sample grid.
+constexpr double kGridTolerance = 1e-6;
+
+void CheckNonNegative(double value, const char* name) {
+  if (!std::isfinite(value) || value < 0.0) {
+    throw Error(std::string("simulation option ") + name + " = " + std::to_string(value) +
+                " must be finite and >= 0");
+  }
+}
+
+void ValidateOptions(const SimulationOptions& o) {
+  if (!std::isfinite(o.rate_hz) || o.rate_hz <= 0.0 || o.rate_hz > kMaxRateHz) {
+    throw Error("simulation option rate_hz = " + std::to_string(o.rate_hz) +
+                " must be in (0, 100000] Hz");
+  }
+  CheckNonNegative(o.accel_noise_density, "accel_noise_density (m/s^2/sqrt(Hz))");
+  CheckNonNegative(o.gyro_noise_density, "gyro_noise_density (rad/s/sqrt(Hz))");
+  CheckNonNegative(o.accel_bias_walk_density, "accel_bias_walk_density (m/s^3/sqrt(Hz))");
+  CheckNonNegative(o.gyro_bias_walk_density, "gyro_bias_walk_density (rad/s^2/sqrt(Hz))");
+  CheckNonNegative(o.accel_quantum, "accel_quantum (m/s^2)");
+  CheckNonNegative(o.gyro_quantum, "gyro_quantum (rad/s)");
+  if (!std::isfinite(o.t0_s)) throw Error("simulation option t0_s must be finite");
+  if (!std::isfinite(o.model.temp_ref_c)) throw Error("model temp_ref_c must be finite");
+  if (!o.site.g_n.allFinite() || !o.site.omega_ie_n.allFinite()) {
+    throw Error("simulation site has non-finite gravity or Earth rate");
+  }
+  o.temperature.Validate();
+}
+
+/// The truth blocks in the model's layout (zeros when empty); throws on a mismatch.
+model::ParameterBlocks CheckedTruth(const model::Model& m, const model::ParameterBlocks& truth) {
+  if (truth.empty()) return m.ZeroParameters();
+  if (truth.size() != static_cast<std::size_t>(m.num_terms())) {
+    throw Error("true parameters have " + std::to_string(truth.size()) + " blocks; model '" +
+                m.spec() + "' has " + std::to_string(m.num_terms()) + " effects");
+  }
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    const auto& info = m.terms()[k].effect->info();
+    if (truth[k].size() != static_cast<std::size_t>(info.size())) {
+      throw Error("true parameters of '" + info.name + "' have " +
+                  std::to_string(truth[k].size()) + " values; expected " +
+                  std::to_string(info.size()));
+    }
+    for (double v : truth[k]) {
+      if (!std::isfinite(v)) throw Error("true parameters of '" + info.name + "' are not finite");
+    }
+  }
+  return truth;
+}
+
+/// Index of the first sample at or after time t_s from the start.
+std::size_t FirstSampleAt(double t_s, double rate_hz) {
+  return static_cast<std::size_t>(std::max(0.0, std::ceil(t_s * rate_hz - kGridTolerance)));
+}
+
+Vec3 Quantise(const Vec3& y, double quantum) {
+  if (quantum <= 0.0) return y;
+  return (y / quantum).array().round().matrix() * quantum;
+}
+
+/// The model inputs for a motion at a site, at time dt_s after t_ref and temperature offset.
+model::SensorInput<double> InputFor(const Motion& motion, const geo::Site& site, double dt_s,
+                                    double dtemp_c) {
+  const Mat3 R_b_n = motion.R_n_b.toRotationMatrix().transpose();
+  const Vec3 omega_ie_b = R_b_n * site.omega_ie_n;
+  model::SensorInput<double> in;
+  in.f_b = -(R_b_n * site.g_n);
+  in.omega_b = omega_ie_b + motion.omega_nb_b;
+  in.alpha_b = motion.alpha_nb_b - motion.omega_nb_b.cross(omega_ie_b);
+  in.dt_s = dt_s;
+  in.dtemp_c = dtemp_c;
+  return in;
+}
+
+/// Draws the per-sample noise in a fixed order.
+struct NoiseSource {
+  std::mt19937_64 rng;
+  std::normal_distribution<double> normal{0.0, 1.0};
+  Vec3 Draw() {
+    const double x = normal(rng);
+    const double y = normal(rng);
+    const double z = normal(rng);
+    return Vec3(x, y, z);
+  }
+};
+
+}  // namespace
+
+TemperatureProfile TemperatureProfile::Constant(double temp_c) {
+  TemperatureProfile p;
+  p.kind = Kind::kConstant;
+  p.start_c = p.end_c = temp_c;
+  return p;
+}
+
+TemperatureProfile TemperatureProfile::Ramp(double start_c, double end_c) {
+  TemperatureProfile p;
+  p.kind = Kind::kRamp;
+  p.start_c = start_c;
+  p.end_c = end_c;
+  return p;
+}
+
+TemperatureProfile TemperatureProfile::UpDown(double start_c, double end_c, double period_s) {
+  TemperatureProfile p;
+  p.kind = Kind::kUpDown;
+  p.start_c = start_c;
+  p.end_c = end_c;
+  p.period_s = period_s;
+  return p;
+}
+
+double TemperatureProfile::At(double t_s, double duration_s) const {
+  switch (kind) {
+    case Kind::kConstant:
+      return start_c;
+    case Kind::kRamp:
+      return duration_s > 0.0 ? start_c + (end_c - start_c) * std::clamp(t_s / duration_s, 0.0, 1.0)
+                              : start_c;
+    case Kind::kUpDown: {
+      const double phase = std::fmod(std::max(t_s, 0.0), period_s) / period_s;  // [0, 1)
+      const double up = phase < 0.5 ? 2.0 * phase : 2.0 * (1.0 - phase);     // 0 -> 1 -> 0
+      return start_c + (end_c - start_c) * up;
+    }
+  }
+  return start_c;
+}
+
+void TemperatureProfile::Validate() const {
+  if (!std::isfinite(start_c) || !std::isfinite(end_c)) {
+    throw Error("temperature profile values must be finite degC");
+  }
+  if (kind == Kind::kUpDown && (!std::isfinite(period_s) || period_s <= 0.0)) {
+    throw Error("temperature profile period_s = " + std::to_string(period_s) +
+                " must be finite and > 0");
+  }
+}
+
+SimulationOptions SimulationOptions::TypicalMems() {
+  SimulationOptions o;
+  o.accel_noise_density = 1e-3;
+  o.gyro_noise_density = 7e-5;
+  o.accel_bias_walk_density = 1e-4;
+  o.gyro_bias_walk_density = 2e-6;
+  return o;
+}
+
+model::SensorInput<double> TrueInput(const Simulation& sim, double t_s) {
+  const double t_rel_s = t_s - sim.t0_s;
+  return InputFor(sim.schedule.At(t_rel_s), sim.site, t_s - sim.model.t_ref_s,
+                  sim.temperature.At(t_rel_s, sim.schedule.duration_s()) - sim.model.temp_ref_c);
+}
+
+Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) {
+  if (schedule.empty()) throw Error("cannot simulate an empty schedule; add still or turn steps");
+  ValidateOptions(options);
+  const double rate_hz = options.rate_hz;
+  const double n_real = std::ceil(schedule.duration_s() * rate_hz - kGridTolerance);
+  if (n_real > kMaxSamples) {
+    throw Error("simulation of " + std::to_string(schedule.duration_s()) + " s at " +
+                std::to_string(rate_hz) + " Hz exceeds 200 million samples");
+  }
+  const std::size_t n = static_cast<std::size_t>(std::max(0.0, n_real));
+
+  Simulation sim;
+  sim.model = options.model;
+  sim.model.t_ref_s = options.t0_s;
+  sim.truth = CheckedTruth(sim.model, options.truth);
+  sim.site = options.site;
+  sim.schedule = schedule;
+  sim.temperature = options.temperature;
+  sim.t0_s = options.t0_s;
+  sim.rate_hz = rate_hz;
+  sim.accel_sigma = options.accel_noise_density * std::sqrt(rate_hz);
+  sim.gyro_sigma = options.gyro_noise_density * std::sqrt(rate_hz);
+  const double accel_walk_step = options.accel_bias_walk_density / std::sqrt(rate_hz);
+  const double gyro_walk_step = options.gyro_bias_walk_density / std::sqrt(rate_hz);
+  const bool gyro = sim.model.has_gyro();
+
+  Session& session = sim.session;
+  session.source = "simulated: model " + sim.model.spec() + ", seed " + std::to_string(options.seed);
+  if (sim.site.known) {
+    session.site = SiteInput{sim.site.lat_deg, sim.site.lon_deg, sim.site.height_m, "simulation"};
+  }
+  ImuSeries& series = session.series;
+  series.reserve(n);
+  if (!gyro) series.gyr.clear();
+  if (options.record_temperature) series.temp_c.reserve(n);
+
+  NoiseSource noise{std::mt19937_64(options.seed)};
+  Vec3 accel_walk = Vec3::Zero();
+  Vec3 gyro_walk = Vec3::Zero();
+  std::vector<const double*> theta;
+  for (const auto& block : sim.truth) theta.push_back(block.data());
+
+  for (std::size_t i = 0; i < schedule.size(); ++i) {
+    const std::size_t begin = std::min(n, FirstSampleAt(schedule.step_start_s(i), rate_hz));
+    const std::size_t end = std::min(n, FirstSampleAt(schedule.step_start_s(i + 1), rate_hz));
+    StillTruth still;
+    still.step = i;
+    for (std::size_t k = begin; k < end; ++k) {
+      const double t_rel_s = static_cast<double>(k) / rate_hz;
+      const double t_s = options.t0_s + t_rel_s;
+      const double temp_c = sim.temperature.At(t_rel_s, schedule.duration_s());
+      const Motion motion = schedule.AtStep(i, t_rel_s - schedule.step_start_s(i));
+      const model::SensorInput<double> in =
+          InputFor(motion, sim.site, t_s - sim.model.t_ref_s, temp_c - sim.model.temp_ref_c);
+      const model::SensorOutput<double> out = sim.model.Predict<double>(theta.data(), in);
+      const Vec3 accel_white = noise.Draw();
+      const Vec3 gyro_white = noise.Draw();
+      const Vec3 acc = out.acc + accel_walk + sim.accel_sigma * accel_white;
+      const Vec3 gyr = out.gyr + gyro_walk + sim.gyro_sigma * gyro_white;
+      series.t_s.push_back(t_s);
+      series.acc.push_back(Quantise(acc, options.accel_quantum).cast<float>());
+      if (gyro) series.gyr.push_back(Quantise(gyr, options.gyro_quantum).cast<float>());
+      if (options.record_temperature) series.temp_c.push_back(static_cast<float>(temp_c));
+      if (k == begin) {
+        still.R_n_b = motion.R_n_b;
+        still.f_b = in.f_b;
+        still.omega_b = in.omega_b;
+      }
+      still.accel_bias_walk += accel_walk;
+      still.gyro_bias_walk += gyro_walk;
+      still.mean_temp_c += temp_c;
+      accel_walk += accel_walk_step * noise.Draw();
+      gyro_walk += gyro_walk_step * noise.Draw();
+    }
+    if (!schedule.is_still(i) || end == begin) continue;
+    const double count = static_cast<double>(end - begin);
+    still.accel_bias_walk /= count;
+    still.gyro_bias_walk /= count;
+    still.mean_temp_c /= count;
+    StillSegment segment;
+    segment.begin = begin;
+    segment.end = end;
+    const std::string& label = std::get<Still>(schedule.steps()[i]).label;
+    segment.label = label.empty() ? "still #" + std::to_string(sim.truth_segments.size() + 1) : label;
+    segment.known_R_n_b = still.R_n_b;
+    sim.truth_segments.push_back(segment);
+    sim.true_R_n_b.push_back(still.R_n_b);
+    sim.still_truth.push_back(still);
+  }
+  return sim;
+}
+
+}  // namespace plumb::sim

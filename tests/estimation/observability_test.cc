@@ -1,0 +1,71 @@
+// Rank, null space and determined combinations on small problems with known structure.
+#include "plumb/estimation/observability.h"
+
+#include <gtest/gtest.h>
+
+namespace plumb::estimation {
+namespace {
+
+/// One level pose, accelerometer z only: y_z = -g F_zz + b_z, measured with sigma 0.01.
+ObservabilityInput OneLevelPoseZ() {
+  ObservabilityInput in;
+  const double g = 9.78, w = 1.0 / 0.01;
+  in.J.resize(1, 2);
+  in.J << -g * w, 1.0 * w;  // d r / d(F_zz, b_z), up to the residual's sign
+  in.names = {"accel.matrix.zz", "accel.bias.z"};
+  in.values = {1.002, 0.05};
+  in.is_model = {true, true};
+  return in;
+}
+
+TEST(Observability, OneLevelPoseHasOneNullDirection) {
+  const auto a = AnalyseObservability(OneLevelPoseZ());
+  EXPECT_EQ(a.summary.rank, 1);
+  ASSERT_EQ(a.summary.unobservable.size(), 1u);
+  EXPECT_EQ(a.summary.unobservable[0], "9.78 accel.bias.z + 1 accel.matrix.zz");
+  EXPECT_FALSE(a.observable[0]);
+  EXPECT_FALSE(a.observable[1]);
+}
+
+TEST(Observability, OneLevelPoseDeterminesTheMeasuredCombination) {
+  const auto a = AnalyseObservability(OneLevelPoseZ());
+  ASSERT_EQ(a.summary.determined.size(), 1u);
+  const auto& c = a.summary.determined[0];
+  EXPECT_EQ(c.text, "accel.bias.z - 9.78 accel.matrix.zz");
+  EXPECT_NEAR(c.value, 0.05 - 9.78 * 1.002, 1e-12);
+  EXPECT_NEAR(c.sigma, 0.01, 1e-12);  // the one measurement's sigma
+}
+
+TEST(Observability, FullRankCovarianceIsTheInverseNormalMatrix) {
+  ObservabilityInput in;
+  in.J.resize(4, 2);
+  in.J << 1, 2, 3, -1, 0.5, 4, -2, 1;
+  in.names = {"a", "b"};
+  in.values = {0, 0};
+  in.is_model = {true, true};
+  const auto a = AnalyseObservability(in);
+  EXPECT_EQ(a.summary.rank, 2);
+  EXPECT_TRUE(a.summary.unobservable.empty());
+  const Eigen::MatrixXd expected = (in.J.transpose() * in.J).inverse();
+  EXPECT_LT((a.covariance - expected).norm(), 1e-12);
+}
+
+TEST(Observability, RankDecisionIgnoresUnits) {
+  // The same full-rank problem with one unknown in units a million times smaller.
+  ObservabilityInput in;
+  in.J.resize(3, 2);
+  in.J << 1e6, 1, 2e6, -1, 0.5e6, 3;
+  in.names = {"raw", "si"};
+  in.values = {0, 0};
+  in.is_model = {true, true};
+  EXPECT_EQ(AnalyseObservability(in).summary.rank, 2);
+}
+
+TEST(Observability, FormatCombinationDropsNegligibleTerms) {
+  Eigen::VectorXd c(3);
+  c << 1.0, -2.5, 1e-15;
+  EXPECT_EQ(FormatCombination(c, {"a", "b", "c"}, false), "a - 2.5 b");
+}
+
+}  // namespace
+}  // namespace plumb::estimation
