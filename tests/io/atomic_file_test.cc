@@ -1,0 +1,65 @@
+#include "plumb/io/atomic_file.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "io_test_util.h"
+#include "plumb/core/error.h"
+
+namespace plumb::io {
+namespace {
+
+using testing::TempDir;
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::size_t CountEntries(const std::filesystem::path& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir)) ++n;
+  return n;
+}
+
+TEST(AtomicFile, WritesAndReplacesLeavingNoTemporaryFile) {
+  TempDir dir;
+  const std::string path = dir.File("out.txt");
+  WriteFileAtomic(path, "first\n");
+  EXPECT_EQ(Slurp(path), "first\n");
+  WriteFileAtomic(path, std::string("second\0line\n", 12));
+  EXPECT_EQ(Slurp(path), std::string("second\0line\n", 12));
+  EXPECT_EQ(CountEntries(dir.path()), 1u);
+  EXPECT_EQ(std::filesystem::status(path).permissions() & std::filesystem::perms::others_read,
+            std::filesystem::perms::others_read);
+}
+
+TEST(AtomicFile, FailureNamesThePath) {
+  TempDir dir;
+  const std::string path = dir.File("missing_folder/out.txt");
+  try {
+    WriteFileAtomic(path, "x");
+    ADD_FAILURE() << "expected plumb::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(AtomicFile, UncommittedWriterLeavesTheOldFile) {
+  TempDir dir;
+  const std::string path = dir.Write("keep.txt", "old\n");
+  {
+    AtomicFileWriter writer(path);
+    writer.Write("new content that is never committed\n");
+  }
+  EXPECT_EQ(Slurp(path), "old\n");
+  EXPECT_EQ(CountEntries(dir.path()), 1u);
+}
+
+}  // namespace
+}  // namespace plumb::io
