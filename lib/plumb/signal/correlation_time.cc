@@ -1,0 +1,126 @@
+#include "plumb/signal/correlation_time.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "plumb/core/error.h"
+
+namespace plumb::signal {
+namespace {
+
+/// Samples of every usable chunk centred on the chunk's mean, stored back to back.
+struct CentredChunks {
+  std::vector<double> values;
+  std::vector<std::size_t> offsets;  ///< chunk c is values[offsets[c], offsets[c + 1])
+  std::size_t longest = 0;
+
+  std::size_t count() const { return offsets.size() - 1; }
+  std::size_t length(std::size_t c) const { return offsets[c + 1] - offsets[c]; }
+};
+
+CentredChunks Centre(const std::vector<AxisView>& chunks) {
+  CentredChunks out;
+  out.offsets.push_back(0);
+  for (const AxisView& chunk : chunks) {
+    const auto n = static_cast<std::size_t>(chunk.size());
+    if (n < 2) continue;
+    const double mean = chunk.cast<double>().mean();
+    for (Eigen::Index i = 0; i < chunk.size(); ++i) {
+      out.values.push_back(static_cast<double>(chunk[i]) - mean);
+    }
+    out.offsets.push_back(out.values.size());
+    out.longest = std::max(out.longest, n);
+  }
+  return out;
+}
+
+/// Autocovariance at lag k pooled over chunks (divided by the number of pairs), or NaN when
+/// no chunk is longer than k.
+double PooledAutocovariance(const CentredChunks& data, std::size_t k) {
+  double sum = 0.0;
+  std::size_t pairs = 0;
+  for (std::size_t c = 0; c < data.count(); ++c) {
+    const std::size_t n = data.length(c);
+    if (n <= k) continue;
+    const double* y = data.values.data() + data.offsets[c];
+    double chunk_sum = 0.0;
+    for (std::size_t i = 0; i + k < n; ++i) chunk_sum += y[i] * y[i + k];
+    sum += chunk_sum;
+    pairs += n - k;
+  }
+  return pairs == 0 ? std::numeric_limits<double>::quiet_NaN()
+                    : sum / static_cast<double>(pairs);
+}
+
+void CheckOptions(const CorrelationTimeOptions& options) {
+  if (!(options.sokal_c > 1.0 && options.sokal_c <= 20.0)) {
+    throw Error("correlation time: Sokal window factor c = " + std::to_string(options.sokal_c) +
+                " is not in (1, 20]");
+  }
+  if (options.max_lag < 1) throw Error("correlation time: max_lag must be at least 1");
+}
+
+}  // namespace
+
+CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
+                                        const CorrelationTimeOptions& options) {
+  CheckOptions(options);
+  const CentredChunks data = Centre(chunks);
+  if (data.count() == 0) {
+    throw Error("correlation time: no chunk has at least 2 samples (" +
+                std::to_string(chunks.size()) + " chunks given)");
+  }
+  CorrelationTime out;
+  out.chunks = data.count();
+  out.samples = data.values.size();
+  double sum_sq = 0.0;
+  for (double y : data.values) sum_sq += y * y;
+  out.variance = sum_sq / static_cast<double>(out.samples - out.chunks);
+  const double c0 = sum_sq / static_cast<double>(out.samples);
+  if (!(c0 > 0.0) || !std::isfinite(c0)) {
+    throw Error("correlation time: the samples have zero or non-finite variance (" +
+                std::to_string(out.variance) + ")");
+  }
+
+  const std::size_t last_lag = std::min(options.max_lag, data.longest / 2);
+  double tau = 1.0;
+  double tau_sq = 1.0;
+  for (std::size_t k = 1; k <= last_lag; ++k) {
+    const double rho = PooledAutocovariance(data, k) / c0;
+    tau += 2.0 * rho;
+    tau_sq += 2.0 * rho * rho;
+    out.window = k;
+    if (static_cast<double>(k) >= options.sokal_c * tau) {
+      out.converged = true;
+      break;
+    }
+  }
+  out.tau_int = std::max(tau, 1e-3);
+  out.tau_sq = tau_sq;
+  return out;
+}
+
+std::array<CorrelationTime, 3> EstimateCorrelationTime(const ImuSeries& series,
+                                                       const std::vector<StillSegment>& segments,
+                                                       Sensor sensor,
+                                                       const CorrelationTimeOptions& options) {
+  std::array<CorrelationTime, 3> out;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<AxisView> chunks;
+    chunks.reserve(segments.size());
+    for (const StillSegment& segment : segments) {
+      chunks.push_back(ViewAxis(series, sensor, axis, segment.begin, segment.end));
+    }
+    out[static_cast<std::size_t>(axis)] = EstimateCorrelationTime(chunks, options);
+  }
+  return out;
+}
+
+double VarianceOfMean(double variance, double tau_int, std::size_t count) {
+  if (count == 0) return std::numeric_limits<double>::infinity();
+  return variance * tau_int / static_cast<double>(count);
+}
+
+}  // namespace plumb::signal

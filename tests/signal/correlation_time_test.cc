@@ -1,0 +1,117 @@
+#include "plumb/signal/correlation_time.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "plumb/core/error.h"
+#include "noise.h"
+
+namespace plumb::signal {
+namespace {
+
+/// Ten still chunks of 20000 samples of AR(1) noise with the same phi, different seeds and
+/// different offsets (each chunk is centred on its own mean).
+struct PooledAr1 {
+  std::vector<std::vector<float>> data;
+  std::vector<AxisView> views;
+
+  PooledAr1(double phi, double sigma_e) {
+    for (int c = 0; c < 10; ++c) {
+      data.push_back(testing::Ar1Noise(100 + static_cast<std::uint64_t>(c), 20000, phi, sigma_e,
+                                       0.3 * c - 1.0));
+    }
+    for (const auto& d : data) views.push_back(ViewContiguous(d.data(), d.size()));
+  }
+};
+
+TEST(CorrelationTime, WhiteNoiseIsOne) {
+  const PooledAr1 noise(0.0, 0.02);
+  const CorrelationTime ct = EstimateCorrelationTime(noise.views);
+  EXPECT_TRUE(ct.converged);
+  EXPECT_EQ(ct.chunks, 10U);
+  EXPECT_EQ(ct.samples, 200000U);
+  EXPECT_NEAR(ct.tau_int, 1.0, 0.05);
+  EXPECT_NEAR(ct.tau_sq, 1.0, 0.01);
+  EXPECT_NEAR(std::sqrt(ct.variance), 0.02, 0.0003);
+}
+
+TEST(CorrelationTime, Ar1MatchesTheory) {
+  for (double phi : {0.5, 0.8, 0.9}) {
+    const PooledAr1 noise(phi, 0.01);
+    const CorrelationTime ct = EstimateCorrelationTime(noise.views);
+    const double tau = (1.0 + phi) / (1.0 - phi);
+    const double tau_sq = (1.0 + phi * phi) / (1.0 - phi * phi);
+    // Sokal: var(tau_hat) / tau^2 ~ 2 (2 M + 1) / N with M ~ 5 tau; allow 4 standard errors.
+    const double relative_tolerance = 4.0 * std::sqrt(2.0 * (10.0 * tau + 1.0) / 200000.0);
+    EXPECT_TRUE(ct.converged) << "phi " << phi;
+    EXPECT_NEAR(ct.tau_int / tau, 1.0, relative_tolerance) << "phi " << phi << " tau_int "
+                                                           << ct.tau_int;
+    EXPECT_NEAR(ct.tau_sq / tau_sq, 1.0, relative_tolerance) << "phi " << phi << " tau_sq "
+                                                             << ct.tau_sq;
+    EXPECT_NEAR(ct.variance * (1.0 - phi * phi) / (0.01 * 0.01), 1.0, 0.05) << "phi " << phi;
+  }
+}
+
+TEST(CorrelationTime, PredictsTheScatterOfChunkMeans) {
+  // 400 chunks of 500 samples of AR(1) with phi = 0.8: the scatter of their means must match
+  // sigma^2 tau_int / n, not sigma^2 / n (which would be 9 times too small).
+  const double phi = 0.8;
+  const std::vector<float> x = testing::Ar1Noise(7, 200000, phi, 0.01);
+  std::vector<AxisView> chunks;
+  std::vector<double> means;
+  for (std::size_t c = 0; c < 400; ++c) {
+    chunks.push_back(ViewContiguous(x.data() + 500 * c, 500));
+    means.push_back(chunks.back().cast<double>().mean());
+  }
+  const CorrelationTime ct = EstimateCorrelationTime(chunks);
+  double mean_of_means = 0.0;
+  for (double m : means) mean_of_means += m;
+  mean_of_means /= static_cast<double>(means.size());
+  double scatter = 0.0;
+  for (double m : means) scatter += (m - mean_of_means) * (m - mean_of_means);
+  scatter /= static_cast<double>(means.size() - 1);
+  const double predicted = VarianceOfMean(ct.variance, ct.tau_int, 500);
+  // The scatter of 400 means has a relative standard error of about sqrt(2 / 400) = 7%.
+  EXPECT_NEAR(scatter / predicted, 1.0, 0.25);
+  EXPECT_GT(scatter / VarianceOfMean(ct.variance, 1.0, 500), 5.0);
+}
+
+TEST(CorrelationTime, TriadsOverStillSegments) {
+  const std::vector<float> x = testing::Ar1Noise(3, 30000, 0.6, 0.01, 9.8);
+  const std::vector<float> y = testing::Ar1Noise(4, 30000, 0.0, 0.01);
+  ImuSeries s;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    s.t_s.push_back(0.01 * static_cast<double>(i));
+    s.acc.emplace_back(x[i], y[i], x[i] + y[i]);
+  }
+  const auto ct = EstimateCorrelationTime(s, {StillSegment{0, 10000}, StillSegment{12000, 30000}},
+                                          Sensor::kAccel);
+  EXPECT_NEAR(ct[0].tau_int, 4.0, 0.4);
+  EXPECT_NEAR(ct[1].tau_int, 1.0, 0.1);
+  EXPECT_EQ(ct[2].samples, 28000U);
+  EXPECT_THROW(EstimateCorrelationTime(s, {StillSegment{0, 10}}, Sensor::kGyro), Error);
+}
+
+TEST(CorrelationTime, RejectsUnusableInput) {
+  const std::vector<float> constant(100, 1.0F);
+  EXPECT_THROW(EstimateCorrelationTime({ViewContiguous(constant.data(), 100)}), Error);
+  EXPECT_THROW(EstimateCorrelationTime({ViewContiguous(constant.data(), 1)}), Error);
+  CorrelationTimeOptions bad;
+  bad.sokal_c = 0.5;
+  const std::vector<float> x = testing::Ar1Noise(5, 100, 0.0, 1.0);
+  EXPECT_THROW(EstimateCorrelationTime({ViewContiguous(x.data(), 100)}, bad), Error);
+}
+
+TEST(CorrelationTime, MarksTheWindowNotReached) {
+  CorrelationTimeOptions short_lags;
+  short_lags.max_lag = 10;
+  const std::vector<float> x = testing::Ar1Noise(6, 20000, 0.95, 0.01);
+  const CorrelationTime ct = EstimateCorrelationTime({ViewContiguous(x.data(), x.size())},
+                                                     short_lags);
+  EXPECT_FALSE(ct.converged);
+  EXPECT_EQ(ct.window, 10U);
+}
+
+}  // namespace
+}  // namespace plumb::signal
