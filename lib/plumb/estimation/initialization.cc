@@ -18,21 +18,28 @@ AccelGuess GuessAccel(const std::vector<Vec3>& means, double g) {
     if (std::abs(guess.scale - 1.0) < 0.1) guess.scale = 1.0;
   }
   if (means.size() < 4) return guess;
-  // |m|^2 = 2 c.m + (r^2 - |c|^2): linear in (c, d).
+  // |m|^2 = 2 c.m + (r^2 - |c|^2): linear in (c, d). Centred and normalised first, so that
+  // raw counts around 32768 condition the fit as well as m/s^2 do.
+  Vec3 centre = Vec3::Zero();
+  for (const auto& m : means) centre += m / static_cast<double>(means.size());
+  double spread = 0;
+  for (const auto& m : means) spread = std::max(spread, (m - centre).norm());
+  if (!(spread > 0)) return guess;
   Eigen::MatrixXd A(static_cast<Eigen::Index>(means.size()), 4);
   Eigen::VectorXd b(static_cast<Eigen::Index>(means.size()));
   for (std::size_t k = 0; k < means.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
-    A.row(i) << 2 * means[k].transpose(), 1.0;
-    b[i] = means[k].squaredNorm();
+    const Vec3 u = (means[k] - centre) / spread;
+    A.row(i) << 2 * u.transpose(), 1.0;
+    b[i] = u.squaredNorm();
   }
   // Only trust the fit when the orientations span 3-D (well-conditioned A).
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A);
   const auto s = svd.singularValues();
   if (s[3] < 1e-3 * s[0]) return guess;
   const Eigen::Vector4d x = A.colPivHouseholderQr().solve(b);
-  const Vec3 c = x.head<3>();
-  const double r2 = x[3] + c.squaredNorm();
+  const Vec3 c = centre + spread * x.head<3>();
+  const double r2 = spread * spread * (x[3] + x.head<3>().squaredNorm());
   if (!(r2 > 0)) return guess;
   guess.scale = std::sqrt(r2) / g;
   guess.bias = c;
