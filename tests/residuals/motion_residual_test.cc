@@ -43,15 +43,21 @@ TEST(MotionResidual, IntegratesAKnownTurn) {
   EXPECT_LT(dR.angularDistance(dR_true), 1e-8);
 }
 
-TEST(MotionResidual, JacobianMatchesNumeric) {
+/// Jacobian error of the motion residual for `spec` with small non-zero parameters, the
+/// attitudes off the turn by 0.01 rad and Earth rate present.
+double MotionJacobianError(const std::string& spec) {
   Quat dR_true;
   const MotionSamples s = Turn(&dR_true);
-  const model::Model m = model::Model::Parse("base+accel_bias_drift");
+  const model::Model m = model::Model::Parse(spec);
   auto theta = m.ZeroParameters();
   theta[0][6] = 0.1;
   theta[1][0] = 0.01;
   theta[1][1] = -0.004;
+  theta[1][5] = 0.003;
   theta[1][9] = 0.002;
+  for (std::size_t t = 2; t < theta.size(); ++t) {
+    for (std::size_t i = 0; i < theta[t].size(); ++i) theta[t][i] = 1e-4 * (1.0 + static_cast<double>(i));
+  }
   std::unique_ptr<ceres::CostFunction> cost(MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5)));
   const Quat qa = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 0, 1).normalized()));
   const Quat qb = qa * dR_true * Quat(Eigen::AngleAxisd(0.01, Vec3::UnitX()));
@@ -62,7 +68,21 @@ TEST(MotionResidual, JacobianMatchesNumeric) {
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifolds[1] = manifold.get();
-  EXPECT_LT(testing::JacobianError(*cost, params, manifolds), 1e-7);
+  return testing::JacobianError(*cost, params, manifolds);
+}
+
+TEST(MotionResidual, JacobianMatchesNumericBase) {
+  EXPECT_LT(MotionJacobianError("base"), 1e-7);
+}
+
+TEST(MotionResidual, JacobianMatchesNumericWithGyroEffects) {
+  EXPECT_LT(MotionJacobianError("base+gyro_g_sensitivity"), 1e-7);
+  EXPECT_LT(MotionJacobianError("base+gyro_scale_nonlinearity"), 1e-7);
+  EXPECT_LT(MotionJacobianError("base+gyro_scale_nonlinearity+gyro_g_sensitivity"), 1e-7);
+}
+
+TEST(MotionResidual, JacobianMatchesNumericWithAccelEffect) {
+  EXPECT_LT(MotionJacobianError("base+accel_bias_drift"), 1e-7);
 }
 
 }  // namespace

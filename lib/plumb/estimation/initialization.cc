@@ -1,5 +1,7 @@
 #include "plumb/estimation/initialization.h"
 
+#include "plumb/core/so3.h"
+
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -70,9 +72,7 @@ Quat IntegrateRaw(const ImuSeries& series, std::size_t first, std::size_t last,
     const double h = series.t_s[i + 1] - series.t_s[i];
     const Vec3 w = 0.5 * scale *
                    ((series.gyr[i].cast<double>() - bias) + (series.gyr[i + 1].cast<double>() - bias));
-    const Vec3 rv = w * h;
-    const double angle = rv.norm();
-    if (angle > 0) q = q * Quat(Eigen::AngleAxisd(angle, rv / angle));
+    q = q * so3::ExpQuat(w * h);
   }
   return q.normalized();
 }
@@ -105,7 +105,7 @@ double GuessGyroScale(const ImuSeries& series,
   const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
   double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
   double f1 = cost(x1), f2 = cost(x2);
-  for (int it = 0; it < 30; ++it) {
+  for (int it = 0; it < 20; ++it) {
     if (f1 < f2) {
       b = x2; x2 = x1; f2 = f1; x1 = b - phi * (b - a); f1 = cost(x1);
     } else {

@@ -85,8 +85,10 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
     d[j] = norm > 0 ? 1.0 / norm : 1.0;
   }
   const Eigen::MatrixXd Js = in.J * d.asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
-  const Eigen::VectorXd s = svd.singularValues();
+  // One SVD; for m < n the thin V lacks the null directions beyond m, so take the full V.
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeFullV);
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(n);
+  s.head(svd.singularValues().size()) = svd.singularValues();
   const Eigen::MatrixXd& V = svd.matrixV();
   const double s_max = s.size() > 0 ? s[0] : 0.0;
   int rank = 0;
@@ -97,10 +99,7 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
 
   // Null space: columns rank..n-1 of V (and any directions beyond m, if m < n).
   Eigen::MatrixXd Ns;
-  if (rank < n) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> full(Js, Eigen::ComputeFullV);
-    Ns = full.matrixV().rightCols(n - rank);
-  }
+  if (rank < n) Ns = V.rightCols(n - rank);
   const Eigen::MatrixXd Vr = V.leftCols(rank);
   const Eigen::VectorXd inv_s2 = s.head(rank).cwiseInverse().cwiseAbs2();
   out.covariance = d.asDiagonal() * (Vr * inv_s2.asDiagonal() * Vr.transpose()) * d.asDiagonal();

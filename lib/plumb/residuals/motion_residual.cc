@@ -1,120 +1,192 @@
 #include "plumb/residuals/motion_residual.h"
 
-#include <ceres/dynamic_autodiff_cost_function.h>
-#include <ceres/rotation.h>
-
 #include <Eigen/LU>
+#include <cmath>
+
+#include "plumb/core/so3.h"
 
 namespace plumb::residuals {
+using so3::Skew;
 namespace {
 
-/// dq/dt = 0.5 q (x) (0, w)
-template <typename T>
-Eigen::Quaternion<T> Derivative(const Eigen::Quaternion<T>& q, const Vec3T<T>& w) {
-  const Eigen::Quaternion<T> wq(T(0), w.x(), w.y(), w.z());
-  Eigen::Quaternion<T> d = q * wq;
-  d.coeffs() *= T(0.5);
-  return d;
-}
-
-template <typename T>
-Eigen::Quaternion<T> AddScaled(const Eigen::Quaternion<T>& q, const Eigen::Quaternion<T>& d,
-                               double h) {
-  Eigen::Quaternion<T> out;
-  out.coeffs() = q.coeffs() + d.coeffs() * T(h);
-  return out;
-}
-
 }  // namespace
+
+Eigen::Matrix<double, 4, 3> LeftPlusJacobian(const Quat& q) {
+  // (0, a) (x) (w, v) = (-a.v, w a + a x v); Exp(delta) ~ (1, delta / 2).
+  Eigen::Matrix<double, 4, 3> P;
+  const Vec3 v = q.vec();
+  for (int j = 0; j < 3; ++j) {
+    const Vec3 a = Vec3::Unit(j);
+    P.block<3, 1>(0, j) = 0.5 * (q.w() * a + a.cross(v));
+    P(3, j) = -0.5 * v[j];
+  }
+  return P;
+}
 
 MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
                                const Vec3& omega_ie_n)
     : model_(&model), s_(std::move(samples)), omega_ie_n_(omega_ie_n) {
-  bool linear_only = true;
-  for (const auto& t : model.terms()) linear_only = linear_only && t.effect->info().linear_stage;
-  newton_iterations_ = linear_only ? 1 : 3;
+  for (const auto& t : model.terms()) {
+    linear_only_ = linear_only_ && t.effect->info().linear_stage;
+    block_offset_.push_back(num_model_parameters_);
+    num_model_parameters_ += t.effect->info().size();
+  }
+  set_num_residuals(3);
+  mutable_parameter_block_sizes()->push_back(4);
+  mutable_parameter_block_sizes()->push_back(4);
+  for (const auto& t : model.terms()) mutable_parameter_block_sizes()->push_back(t.effect->info().size());
 }
 
-template <typename T>
-Eigen::Quaternion<T> MotionResidual::IntegrateT(T const* const* parameters) const {
-  const Eigen::Map<const Eigen::Quaternion<T>> q_k(parameters[0]);
-  T const* const* theta = parameters + 2;
-  // The linear part, for the Newton steps of the inverse model.
-  const model::SensorOutput<T> at_zero = model_->Predict(theta, model::SensorInput<T>());
-  const Mat3T<T> F_inv = at_zero.F.inverse();
-  const Mat3T<T> E_inv = at_zero.E.inverse();
-  const Vec3T<T> omega_ie_k = q_k.conjugate() * omega_ie_n_.cast<T>();  // Earth rate in b_k
+void MotionResidual::CorrectedRates(double const* const* theta, std::vector<Vec3>* w,
+                                    std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const {
+  const std::size_t n = s_.size();
+  const int P = num_model_parameters_;
+  w->resize(n);
+  if (W) W->assign(n, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, P));
+  const model::SensorOutput<double> at_zero = model_->Predict(theta, model::SensorInput<double>());
+  const Mat3 F_inv = at_zero.F.inverse();
+  const Mat3 E_inv = at_zero.E.inverse();
+  const Vec3 b_g = at_zero.gyr;  // E * 0 + b_g (+ terms that vanish at zero input)
 
-  auto corrected_rate = [&](std::size_t i) {
+  if (linear_only_) {
+    // w = E^-1 (y - b_g): dw/db_g = -E^-1, dw/dE_rc = -E^-1 e_r w_c.
+    const int g = model_->FindTerm("gyro_linear");
+    const int off = g >= 0 ? block_offset_[static_cast<std::size_t>(g)] : 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      (*w)[i] = E_inv * (s_.gyr[i] - b_g);
+      if (!W || g < 0) continue;
+      auto& Wi = (*W)[i];
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) Wi.col(off + 3 * r + c) = -E_inv.col(r) * (*w)[i][c];
+      }
+      Wi.block<3, 3>(0, off + 9) = -E_inv;
+    }
+    return;
+  }
+
+  // General model: Newton on the forward model (as Model::Correct), with Jets for dw/dtheta.
+  auto correct = [&](auto const* const* th, const auto& Finv, const auto& Einv, std::size_t i) {
+    using T = std::decay_t<decltype(Finv(0, 0))>;
     model::SensorInput<T> in;
     in.alpha_b = s_.alpha_b[i].cast<T>();
     in.dt_s = T(s_.dt_s[i]);
     in.dtemp_c = T(s_.dtemp_c[i]);
     const Vec3T<T> y_a = s_.acc[i].cast<T>();
     const Vec3T<T> y_g = s_.gyr[i].cast<T>();
-    for (int it = 0; it < newton_iterations_; ++it) {
-      const model::SensorOutput<T> out = model_->Predict(theta, in);
-      in.f_b += F_inv * (y_a - out.acc);
-      in.omega_b += E_inv * (y_g - out.gyr);
+    for (int it = 0; it < 3; ++it) {
+      const model::SensorOutput<T> out = model_->Predict(th, in);
+      in.f_b += Finv * (y_a - out.acc);
+      in.omega_b += Einv * (y_g - out.gyr);
     }
     return Vec3T<T>(in.omega_b);
   };
-
-  Eigen::Quaternion<T> dq(T(1), T(0), T(0), T(0));
-  Vec3T<T> w0 = corrected_rate(0);
-  for (std::size_t i = 0; i + 1 < s_.size(); ++i) {
-    const double h = s_.dt_s[i + 1] - s_.dt_s[i];
-    const Vec3T<T> w1 = corrected_rate(i + 1);
-    // Earth rate seen in the current body frame, removed from the measured rate.
-    const Vec3T<T> earth_b = dq.conjugate() * omega_ie_k;
-    const Vec3T<T> a = w0 - earth_b;
-    const Vec3T<T> b = w1 - earth_b;
-    const Vec3T<T> m = (a + b) * T(0.5);
-    const auto k1 = Derivative(dq, a);
-    const auto k2 = Derivative(AddScaled(dq, k1, 0.5 * h), m);
-    const auto k3 = Derivative(AddScaled(dq, k2, 0.5 * h), m);
-    const auto k4 = Derivative(AddScaled(dq, k3, h), b);
-    dq.coeffs() += (k1.coeffs() + T(2) * k2.coeffs() + T(2) * k3.coeffs() + k4.coeffs()) *
-                   T(h / 6.0);
-    dq.normalize();
-    w0 = w1;
+  for (std::size_t i = 0; i < n; ++i) (*w)[i] = correct(theta, F_inv, E_inv, i);
+  if (!W) return;
+  using Jet = model::Jet;
+  constexpr int kStride = model::kJetStride;
+  std::vector<std::vector<Jet>> blocks(static_cast<std::size_t>(model_->num_terms()));
+  std::vector<const Jet*> ptr(blocks.size());
+  for (int chunk = 0; chunk < P; chunk += kStride) {
+    for (int t = 0; t < model_->num_terms(); ++t) {
+      const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
+      auto& b = blocks[static_cast<std::size_t>(t)];
+      b.assign(static_cast<std::size_t>(size), Jet());
+      for (int j = 0; j < size; ++j) {
+        const int global = block_offset_[static_cast<std::size_t>(t)] + j;
+        b[static_cast<std::size_t>(j)] = Jet(theta[t][j]);
+        if (global >= chunk && global < chunk + kStride) b[static_cast<std::size_t>(j)].v[global - chunk] = 1.0;
+      }
+      ptr[static_cast<std::size_t>(t)] = b.data();
+    }
+    const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), model::SensorInput<Jet>());
+    const Mat3T<Jet> Fi = z.F.inverse(), Ei = z.E.inverse();
+    const int width = std::min(kStride, P - chunk);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3T<Jet> wj = correct(ptr.data(), Fi, Ei, i);
+      for (int r = 0; r < 3; ++r) (*W)[i].block(r, chunk, 1, width) = wj[r].v.head(width).transpose();
+    }
   }
-  return dq;
 }
 
-template <typename T>
-bool MotionResidual::operator()(T const* const* parameters, T* residuals) const {
-  const Eigen::Map<const Eigen::Quaternion<T>> q_k(parameters[0]);
-  const Eigen::Map<const Eigen::Quaternion<T>> q_k1(parameters[1]);
-  const Eigen::Quaternion<T> dq = IntegrateT(parameters);
-  Eigen::Quaternion<T> err = (q_k * dq).conjugate() * q_k1;
-  if (err.w() < T(0)) err.coeffs() = -err.coeffs();
-  const T wxyz[4] = {err.w(), err.x(), err.y(), err.z()};
-  T angle_axis[3];
-  ceres::QuaternionToAngleAxis(wxyz, angle_axis);
-  for (int i = 0; i < 3; ++i) residuals[i] = angle_axis[i] * T(s_.sqrt_info[i]);
+bool MotionResidual::Evaluate(double const* const* parameters, double* residuals,
+                              double** jacobians) const {
+  const Quat q_k(parameters[0][3], parameters[0][0], parameters[0][1], parameters[0][2]);
+  const Quat q_k1(parameters[1][3], parameters[1][0], parameters[1][1], parameters[1][2]);
+  const Mat3 R_k = q_k.normalized().toRotationMatrix();
+  const Mat3 R_k1 = q_k1.normalized().toRotationMatrix();
+  double const* const* theta = parameters + 2;
+  const bool want_jacobians = jacobians != nullptr;
+  const int P = num_model_parameters_;
+  const int U = P + 3;  // unknowns: model parameters, then the left perturbation of R_k
+
+  std::vector<Vec3> w;
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> W;
+  CorrectedRates(theta, &w, want_jacobians ? &W : nullptr);
+
+  const Vec3 omega_k = R_k.transpose() * omega_ie_n_;  // Earth rate in b_k
+  const Mat3 d_omega_k = R_k.transpose() * Skew(omega_ie_n_);  // d omega_k / d delta_k
+  Mat3 dR = Mat3::Identity();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> A = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, U);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> dU0(3, U), dU1(3, U), dphi(3, U);
+  for (std::size_t i = 0; i + 1 < s_.size(); ++i) {
+    const double h = s_.dt_s[i + 1] - s_.dt_s[i];
+    // Earth rate at the start of the step, held over the step.
+    const Vec3 e = dR.transpose() * omega_k;
+    const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
+    const Vec3 phi = 0.5 * h * (u0 + u1) + (h * h / 12.0) * u0.cross(u1);
+    if (want_jacobians) {
+      // d e = [e]x A d(unknowns) (through dR) + dR^T d omega_k (through R_k).
+      Eigen::Matrix<double, 3, Eigen::Dynamic> de = Skew(e) * A;
+      de.rightCols<3>() += dR.transpose() * d_omega_k;
+      dU0 = -de;
+      dU1 = -de;
+      dU0.leftCols(P) += W[i];
+      dU1.leftCols(P) += W[i + 1];
+      dphi = 0.5 * h * (dU0 + dU1) + (h * h / 12.0) * (-Skew(u1) * dU0 + Skew(u0) * dU1);
+      const Mat3 Ex = so3::Exp(phi);
+      A = Ex.transpose() * A + so3::RightJacobian(phi) * dphi;
+      dR = dR * Ex;
+    } else {
+      dR = dR * so3::Exp(phi);
+    }
+  }
+  const Mat3 M = dR.transpose() * R_k.transpose();
+  const Vec3 r = so3::Log(M * R_k1);
+  for (int i = 0; i < 3; ++i) residuals[i] = s_.sqrt_info[i] * r[i];
+  if (!want_jacobians) return true;
+
+  const Mat3 Jli = so3::LeftJacobianInverse(r);
+  const Eigen::DiagonalMatrix<double, 3> Wsi(s_.sqrt_info);
+  // Tangent Jacobians (left perturbations in NED for the attitudes), then ambient ones
+  // J_amb = J_tan 4 P^T, which satisfy J_amb P = J_tan since P^T P = I / 4.
+  const Mat3 J_k = Wsi * (-Jli * (M + A.rightCols<3>()));
+  const Mat3 J_k1 = Wsi * (Jli * M);
+  auto ambient = [](const Mat3& J_tan, const Quat& q, double* out) {
+    const Eigen::Matrix<double, 3, 4> J = J_tan * 4.0 * LeftPlusJacobian(q).transpose();
+    Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>> J_out(out);
+    J_out = J;
+  };
+  if (jacobians[0]) ambient(J_k, q_k, jacobians[0]);
+  if (jacobians[1]) ambient(J_k1, q_k1, jacobians[1]);
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> J_theta = Wsi * (-Jli * A.leftCols(P));
+  for (int t = 0; t < model_->num_terms(); ++t) {
+    double* out = jacobians[t + 2];
+    if (!out) continue;
+    const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
+    Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J_out(out, 3, size);
+    J_out = J_theta.middleCols(block_offset_[static_cast<std::size_t>(t)], size);
+  }
   return true;
 }
 
 Quat MotionResidual::Integrate(const double* q_k, const model::ParameterBlocks& theta) const {
+  // Residual with R_k+1 = R_k: r = Log(dR^T), so dR = Exp(-r).
   std::vector<const double*> p = {q_k, q_k};
   for (const auto& b : theta) p.push_back(b.data());
-  return IntegrateT<double>(p.data());
+  double r[3];
+  Evaluate(p.data(), r, nullptr);
+  const Vec3 rv = Vec3(r[0], r[1], r[2]).cwiseQuotient(s_.sqrt_info);
+  return Quat(so3::Exp(-rv));
 }
-
-ceres::CostFunction* MotionResidual::Create(const model::Model& model, MotionSamples samples,
-                                            const Vec3& omega_ie_n) {
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<MotionResidual, model::kJetStride>(
-      new MotionResidual(model, std::move(samples), omega_ie_n));
-  cost->AddParameterBlock(4);
-  cost->AddParameterBlock(4);
-  for (const auto& t : model.terms()) cost->AddParameterBlock(t.effect->info().size());
-  cost->SetNumResiduals(3);
-  return cost;
-}
-
-template bool MotionResidual::operator()<double>(double const* const*, double*) const;
-template bool MotionResidual::operator()<model::Jet>(model::Jet const* const*,
-                                                      model::Jet*) const;
 
 }  // namespace plumb::residuals

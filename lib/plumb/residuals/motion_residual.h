@@ -2,18 +2,26 @@
 //
 // Between still segment k (attitude R_k) and k+1 (attitude R_k+1) the corrected rate
 //
-//   omega_b(t) = model inverse of y_g(t) (E^-1 (y_g - b_g - effects) for the base model),
-//   omega_nb_b(t) = omega_b(t) - R_b_n(t) omega_ie_n       (Earth rate removed)
+//   w_i = model inverse of y_g,i (E^-1 (y_g - b_g - effects) for the base model),  rad/s
+//   e_i = dR_i^T R_k^T omega_ie_n           (Earth rate seen in the body frame at sample i)
 //
-// is integrated on SO(3) with fourth-order Runge-Kutta on the unit quaternion, the rate
-// linear between samples, giving dR = R_k^T R(t_end). The residual is
+// is integrated on SO(3) as a product of exponentials of the two-sample coning-corrected
+// increments (third order in the step, like RK4 on a rate linear between samples):
 //
-//   r = W Log(dR^T R_k^T R_k+1)   (3 values, rad)
+//   phi_i = (h/2) (u_i + u_i+1) + (h^2/12) u_i x u_i+1,   u_i = w_i - e_i,   h = t_i+1 - t_i
+//   dR = prod_i Exp(phi_i)
 //
-// whitened by W = diag(sqrt_info), the propagated white gyroscope noise of the interval.
+// and the residual is r = W Log(dR^T R_k^T R_k+1) (3 values, rad), whitened by
+// W = diag(sqrt_info), the propagated white gyroscope noise of the interval.
 //
-// Parameter blocks, in order: q_k (4), q_k+1 (4) (Eigen order x y z w, R_n_b), then every
-// block of the model in model order. Samples and time in plumb::residuals::MotionSamples.
+// Jacobians are analytic, as in IMU preintegration: the right-perturbation sensitivity of
+// dR, A (3 x unknowns), follows A_i+1 = Exp(phi_i)^T A_i + J_r(phi_i) d(phi_i)/d(unknowns);
+// d(w_i)/d(theta) is closed-form for the base model and from Jets (one pass per 8 parameters)
+// when the model has other effects. The cost is one pass over the samples per evaluation.
+//
+// Parameter blocks, in order: q_k (4), q_k+1 (4) (Eigen order x y z w, R_n_b, manifolds of
+// plumb/residuals/manifolds.h: left perturbation in NED), then every block of the model in
+// model order.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -23,30 +31,38 @@
 
 namespace plumb::residuals {
 
-class MotionResidual {
+class MotionResidual final : public ceres::CostFunction {
  public:
   /// `omega_ie_n`: Earth rate in NED, rad/s (zero without a site). The model must outlive
-  /// the functor.
+  /// the cost function.
   MotionResidual(const model::Model& model, MotionSamples samples, const Vec3& omega_ie_n);
 
-  template <typename T>
-  bool operator()(T const* const* parameters, T* residuals) const;
-
   static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
-                                     const Vec3& omega_ie_n);
+                                     const Vec3& omega_ie_n) {
+    return new MotionResidual(model, std::move(samples), omega_ie_n);
+  }
 
-  /// The integrated rotation dR (as a quaternion x y z w) at given values, for reports and
-  /// initialisation.
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+  /// The integrated rotation dR = R_k^T R(t_end) (body frame) at given values.
   Quat Integrate(const double* q_k, const model::ParameterBlocks& theta) const;
 
  private:
-  template <typename T>
-  Eigen::Quaternion<T> IntegrateT(T const* const* parameters) const;
+  /// Corrected rates w_i and, if `W` is non-null, their Jacobians d w_i / d theta (3 x P,
+  /// P = all model parameters in block order).
+  void CorrectedRates(double const* const* theta, std::vector<Vec3>* w,
+                      std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const;
 
   const model::Model* model_;
   MotionSamples s_;
   Vec3 omega_ie_n_;
-  int newton_iterations_;
+  bool linear_only_ = true;
+  int num_model_parameters_ = 0;
+  std::vector<int> block_offset_;  // offset of each model block in the P parameters
 };
+
+/// d(Exp(delta) (x) q)/d(delta) at delta = 0 for q in Eigen order (x y z w): 4 x 3.
+Eigen::Matrix<double, 4, 3> LeftPlusJacobian(const Quat& q);
 
 }  // namespace plumb::residuals

@@ -1,0 +1,37 @@
+// apps/plumb/commands.h — the subcommands of `plumb` and how main runs them.
+//
+// Each subcommand registers its options on a CLI11 subcommand when made, and does its work in
+// Run() once parsing selected it. Run() returns the exit code; errors are thrown (plumb::Error
+// and other std::exception: exit 1; UsageError: exit 2) and caught only in main.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace plumb::cli {
+
+/// A mistake in the command line found after parsing (e.g. options that do not go together).
+class UsageError : public std::runtime_error {
+ public:
+  explicit UsageError(const std::string& what) : std::runtime_error(what) {}
+};
+
+class Command {
+ public:
+  virtual ~Command() = default;
+  /// The CLI11 subcommand this command registered.
+  CLI::App* app() const { return app_; }
+  /// Does the work; returns the process exit code.
+  virtual int Run() = 0;
+
+ protected:
+  CLI::App* app_ = nullptr;
+};
+
+std::unique_ptr<Command> MakeCalibrateCommand(CLI::App& parent);
+std::unique_ptr<Command> MakeSimulateCommand(CLI::App& parent);
+std::unique_ptr<Command> MakeEffectsCommand(CLI::App& parent);
+
+}  // namespace plumb::cli

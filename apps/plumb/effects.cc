@@ -1,0 +1,44 @@
+// plumb effects [NAME] — the effect catalogue: each effect's term, parameters and units.
+#include <iostream>
+
+#include "commands.h"
+#include "plumb/model/registry.h"
+#include "plumb/report/catalogue.h"
+#include "plumb/report/json_report.h"
+
+namespace plumb::cli {
+namespace {
+
+class EffectsCommand : public Command {
+ public:
+  explicit EffectsCommand(CLI::App& parent) {
+    app_ = parent.add_subcommand("effects",
+                                 "List the effects a model can be made of, with their terms, "
+                                 "parameters and units");
+    app_->add_option("NAME", name_, "Show only this effect");
+    app_->add_option("--json", json_path_, "Also write the catalogue as JSON to FILE")
+        ->type_name("FILE");
+  }
+
+  int Run() override {
+    const auto& registry = model::Registry::Global();
+    std::cout << report::CatalogueText(registry, name_);
+    if (!json_path_.empty()) {
+      report::WriteJson(json_path_, report::CatalogueJson(registry, name_));
+      std::cout << "wrote " << json_path_ << "\n";
+    }
+    return 0;
+  }
+
+ private:
+  std::string name_;
+  std::string json_path_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeEffectsCommand(CLI::App& parent) {
+  return std::make_unique<EffectsCommand>(parent);
+}
+
+}  // namespace plumb::cli

@@ -1,0 +1,67 @@
+// apps/plumb/input_options.h — how `plumb calibrate` reads its INPUT files.
+//
+// Three forms, chosen by the command line:
+//   native CSV    the default: the header time_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z[,temp_c]
+//                 is recognised (SI units, FRD); `--format native` insists on it.
+//   text table    any delimited text, described by --columns (which quantity each column holds,
+//                 by position) and the unit options; `--format table` or --columns selects it.
+//   two files     an accelerometer table and a gyroscope table with shared times (imu_tk's
+//                 `t x y z` layout): INPUT given as `acc.txt,gyr.txt`, or --acc FILE --gyr FILE.
+//                 --columns then describes both files with t, x, y, z (default `t,x,y,z`).
+// Conversion to SI for tables: value_SI = (value - offset) * scale * unit, per sensor
+// (--acc-offset, --acc-scale, --acc-unit m/s^2|g; --gyr-offset, --gyr-scale,
+// --gyr-unit rad/s|deg/s); --axis-map then turns sensor axes into body FRD axes.
+// Several INPUTs are joined one after the other into one session (times kept when they
+// increase, otherwise shifted, with a warning, so that no motion is assumed between files).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "plumb/core/session.h"
+#include "plumb/io/text_table.h"
+
+namespace plumb::cli {
+
+struct InputArgs {
+  std::vector<std::string> inputs;  ///< positional INPUT files (or `acc,gyr` pairs)
+  std::string acc_file, gyr_file;   ///< --acc / --gyr: the two-file form
+  std::string format = "auto";      ///< auto | native | table
+  std::string delimiter;            ///< , ; tab space; empty = detect from the first row
+  std::size_t skip_lines = 0;       ///< lines dropped at the top, >= 0
+  bool header = false;              ///< the first line after skipped ones names the columns
+  std::string comment = "#";        ///< comment prefix; "" = none
+  std::string columns;              ///< e.g. "t,ax,ay,az,gx,gy,gz"; "-" skips a column
+  double time_unit_s = 1.0;         ///< seconds per file time unit, > 0 (--time-scale)
+  double rate_hz = 0.0;             ///< sample rate when there is no time column, Hz, > 0
+  std::string acc_scale = "1";      ///< number or fraction "a/b", multiplies --acc-unit
+  std::string gyr_scale = "1";
+  double acc_offset = 0.0;  ///< file units, subtracted first
+  double gyr_offset = 0.0;
+  std::string acc_unit = "m/s^2";  ///< m/s^2 | g
+  std::string gyr_unit = "rad/s";  ///< rad/s | deg/s
+  std::string axis_map = "1,2,3";  ///< body axis i = sign * sensor axis |m_i|, e.g. 1,-2,-3
+  bool drop_nan = false;           ///< drop rows with NaN/inf instead of failing
+
+  /// Options that only describe text tables, to tell the user when they are given in vain.
+  std::vector<CLI::Option*> table_only;
+};
+
+/// Registers INPUT... and every input option on `app`.
+void AddInputOptions(CLI::App* app, InputArgs& args);
+
+/// The text-table options described by the arguments; `split` selects the two-file meaning
+/// of --columns (t, x, y, z). Throws UsageError for malformed values.
+io::TextTableOptions MakeTableOptions(const InputArgs& args, bool split);
+
+/// Reads every input and joins them into one session (see the file comment). Throws
+/// UsageError for contradictory options, plumb::InputError naming the file for bad input.
+Session ReadInputs(const InputArgs& args);
+
+/// Parses a positive scale "x" or "a/b" (e.g. "9.80665/16384"); throws UsageError naming
+/// `option` otherwise.
+double ParseScale(const std::string& text, const std::string& option);
+
+}  // namespace plumb::cli

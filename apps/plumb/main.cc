@@ -1,0 +1,61 @@
+// plumb — IMU accelerometer and gyroscope calibration with honest uncertainty.
+//
+// The only place that catches exceptions: usage mistakes exit 2 (CLI11's parse errors and
+// UsageError), every other error prints `plumb: error: <message>` on stderr and exits 1.
+#include <exception>
+#include <iostream>
+#include <memory>
+#include <vector>
+
+#include "commands.h"
+#include "plumb/report/version.h"
+
+namespace {
+
+std::string UsageMessage(const CLI::App* app, const CLI::Error& e) {
+  const std::string name = app->get_parent() ? "plumb " + app->get_name() : "plumb";
+  return "plumb: error: " + std::string(e.what()) + "\nRun '" + name +
+         " --help' for the options.\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("plumb " + plumb::report::Version() +
+                   ": calibrate an IMU's accelerometer and gyroscope from real logs, with "
+                   "honest uncertainty",
+               "plumb");
+  app.failure_message(UsageMessage);  // before the subcommands, which inherit it
+  app.set_version_flag("--version", plumb::report::Version(), "Print the version and exit");
+  app.require_subcommand(1);
+  app.footer("Run 'plumb COMMAND --help' for the options of a command.");
+
+  std::vector<std::unique_ptr<plumb::cli::Command>> commands;
+  commands.push_back(plumb::cli::MakeCalibrateCommand(app));
+  commands.push_back(plumb::cli::MakeSimulateCommand(app));
+  commands.push_back(plumb::cli::MakeEffectsCommand(app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  plumb::cli::Command* selected = nullptr;
+  for (auto& command : commands) {
+    if (command->app()->parsed()) selected = command.get();
+  }
+  if (selected == nullptr) return 2;  // unreachable: require_subcommand(1)
+  try {
+    return selected->Run();
+  } catch (const plumb::cli::UsageError& e) {
+    std::cerr << "plumb: error: " << e.what() << "\nRun 'plumb " << selected->app()->get_name()
+              << " --help' for the options.\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "plumb: error: " << e.what() << "\n";
+    return 1;
+  } catch (...) {
+    std::cerr << "plumb: error: unknown exception\n";
+    return 1;
+  }
+}

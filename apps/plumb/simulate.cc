@@ -1,0 +1,300 @@
+// plumb simulate --out FILE.csv — a synthetic session with a chosen error model and known
+// truth (plumb::sim), written as native CSV; optionally the truth as JSON and the true still
+// segments as a segments file, for checking a calibration against them.
+#include "plumb/sim/simulate.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+#include "commands.h"
+#include "plumb/io/atomic_file.h"
+#include "plumb/io/native_csv.h"
+#include "plumb/model/model.h"
+#include "plumb/report/json_report.h"
+#include "plumb/report/version.h"
+#include "plumb/sim/schedule.h"
+#include "plumb/sim/truth.h"
+#include "site_options.h"
+
+namespace plumb::cli {
+namespace {
+
+struct SimulateArgs {
+  std::string out_path;                ///< --out: native CSV written here
+  std::string schedule = "multipose";  ///< multipose | paper-static | paper-benchmark
+  int poses = 12;                      ///< multipose: number of still poses, 1..10000
+  CLI::Option* poses_option = nullptr;
+  double still_s = 0.0;  ///< length of each still hold, s, > 0
+  CLI::Option* still_option = nullptr;
+  double turn_s = 0.0;  ///< length of each turn, s, > 0
+  CLI::Option* turn_option = nullptr;
+  double rate_hz = 200.0;          ///< sample rate, Hz
+  std::string model = "base";      ///< true error model spec
+  std::vector<std::string> truth;  ///< PARAM=VALUE settings of the true parameters
+  double random_truth = 0.0;       ///< scale of random true parameters (x typical), >= 0
+  sim::SimulationOptions noise = sim::SimulationOptions::TypicalMems();
+  std::string temperature = "const:25";  ///< temperature profile
+  bool no_temperature = false;           ///< leave the temp_c column out
+  double temp_ref_c = 25.0;              ///< reference temperature of the true model, degC
+  double t0_s = 0.0;                     ///< time of the first sample, s
+  SiteArgs site;
+  std::uint64_t seed = 1;    ///< seed of the noise, the poses and random truth
+  std::string truth_json;    ///< --truth-json FILE
+  std::string segments_out;  ///< --segments-out FILE
+};
+
+double ParseNumber(const std::string& text, const std::string& what) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || errno != 0 || end != text.c_str() + text.size() || !std::isfinite(v)) {
+    throw UsageError(what + ": '" + text + "' is not a finite number");
+  }
+  return v;
+}
+
+/// const:T, ramp:T0:T1, updown:T0:T1:PERIOD_S (degC, s).
+sim::TemperatureProfile ParseTemperature(const std::string& spec) {
+  std::vector<std::string> parts;
+  std::stringstream ss(spec);
+  std::string item;
+  while (std::getline(ss, item, ':')) parts.push_back(item);
+  const auto num = [&](std::size_t i) { return ParseNumber(parts[i], "--temperature " + spec); };
+  if (parts.size() == 2 && parts[0] == "const") return sim::TemperatureProfile::Constant(num(1));
+  if (parts.size() == 3 && parts[0] == "ramp") return sim::TemperatureProfile::Ramp(num(1), num(2));
+  if (parts.size() == 4 && parts[0] == "updown") {
+    return sim::TemperatureProfile::UpDown(num(1), num(2), num(3));
+  }
+  throw UsageError("--temperature must be const:T, ramp:T0:T1 or updown:T0:T1:PERIOD_S (got '" +
+                   spec + "')");
+}
+
+nlohmann::json TruthJson(const sim::Simulation& s, const SimulateArgs& a) {
+  using nlohmann::json;
+  const auto names = s.model.ParameterNames();
+  const auto values = model::ReportedValues(s.model, s.truth);
+  json params = json::array();
+  int flat = 0;
+  for (const auto& term : s.model.terms()) {
+    const auto& info = term.effect->info();
+    for (int i = 0; i < info.size(); ++i, ++flat) {
+      params.push_back({{"name", names[static_cast<std::size_t>(flat)]},
+                        {"value", report::Number(values[static_cast<std::size_t>(flat)])},
+                        {"unit", info.parameters[static_cast<std::size_t>(i)].unit}});
+    }
+  }
+  json segments = json::array();
+  for (std::size_t k = 0; k < s.truth_segments.size(); ++k) {
+    const auto& seg = s.truth_segments[k];
+    const Quat& q = s.true_R_n_b[k];
+    segments.push_back({{"label", seg.label},
+                        {"begin", seg.begin},
+                        {"end", seg.end},
+                        {"attitude_quaternion_wxyz",
+                         {report::Number(q.w()), report::Number(q.x()), report::Number(q.y()),
+                          report::Number(q.z())}}});
+  }
+  json site{{"lat_deg", s.site.known ? report::Number(s.site.lat_deg) : json(nullptr)},
+            {"lon_deg", s.site.known ? report::Number(s.site.lon_deg) : json(nullptr)},
+            {"height_m", s.site.known ? report::Number(s.site.height_m) : json(nullptr)},
+            {"gravity", report::Number(s.site.gravity())},
+            {"source", s.site.known ? s.site.source : std::string("none")}};
+  return json{
+      {"plumb_version", report::Version()},
+      {"model", s.model.spec()},
+      {"model_reference", {{"t_ref_s", s.model.t_ref_s}, {"temp_ref_c", s.model.temp_ref_c}}},
+      {"parameters", params},
+      {"segments", segments},
+      {"site", site},
+      {"noise",
+       {{"accel_sigma", report::Number(s.accel_sigma)},
+        {"gyro_sigma", report::Number(s.gyro_sigma)},
+        {"accel_noise_density", a.noise.accel_noise_density},
+        {"gyro_noise_density", a.noise.gyro_noise_density},
+        {"accel_rw_density", a.noise.accel_bias_walk_density},
+        {"gyro_rw_density", a.noise.gyro_bias_walk_density}}},
+      {"schedule", a.schedule},
+      {"rate_hz", s.rate_hz},
+      {"t0_s", s.t0_s},
+      {"seed", a.seed}};
+}
+
+/// The true still segments as a segments file (CSV, sample indices, half-open).
+std::string SegmentsCsv(const std::vector<StillSegment>& segments) {
+  std::string out = "start,end,label\n";
+  for (const auto& seg : segments) {
+    std::string label = seg.label;
+    for (char& c : label) c = (c == ',' || c == '\n') ? ';' : c;
+    out += std::to_string(seg.begin) + "," + std::to_string(seg.end) + "," + label + "\n";
+  }
+  return out;
+}
+
+class SimulateCommand : public Command {
+ public:
+  explicit SimulateCommand(CLI::App& parent) {
+    app_ = parent.add_subcommand("simulate",
+                                 "Simulate a session of an IMU with a chosen error model and "
+                                 "write it as native CSV");
+    SimulateArgs& a = args_;
+    app_->add_option("--out", a.out_path, "Native CSV file to write")
+        ->required()
+        ->type_name("FILE");
+    app_->add_option("--schedule", a.schedule,
+                     "What the IMU does: multipose (well-spread still poses joined by turns), "
+                     "paper-static (one level, x-north hold), paper-benchmark (the seed paper's "
+                     "sequence)")
+        ->check(CLI::IsMember({"multipose", "paper-static", "paper-benchmark"}))
+        ->capture_default_str();
+    a.poses_option = app_->add_option("--poses", a.poses, "multipose: number of still poses")
+                         ->check(CLI::Range(1, 10000))
+                         ->capture_default_str();
+    a.still_option = app_->add_option("--still", a.still_s,
+                                      "Length of each still hold, s (default: multipose 5, "
+                                      "paper-static 60, paper-benchmark 20)")
+                         ->check(CLI::PositiveNumber);
+    a.turn_option = app_->add_option("--turn", a.turn_s,
+                                     "Length of each turn, s (default: multipose 2, "
+                                     "paper-benchmark 3)")
+                        ->check(CLI::PositiveNumber);
+    app_->add_option("--rate", a.rate_hz, "Sample rate, Hz")
+        ->check(CLI::Range(1e-3, 1e5))
+        ->capture_default_str();
+    app_->add_option("--model", a.model,
+                     "True error model spec, e.g. base+gyro_g_sensitivity (see 'plumb effects')")
+        ->capture_default_str();
+    app_->add_option("--truth", a.truth,
+                     "True parameter PARAM=VALUE in its unit (matrix diagonals near 1), e.g. "
+                     "accel.bias.x=0.1 gyro_g_sensitivity.G.xy=1e-4; repeatable; others are "
+                     "ideal (or random with --random-truth)");
+    app_->add_option("--random-truth", a.random_truth,
+                     "Draw every free parameter from N(nominal, (SCALE x typical size)^2) before "
+                     "--truth applies; 0 = ideal IMU")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    auto* noise = app_->add_option_group("Noise", "Sensor noise (defaults: a typical MEMS IMU)");
+    noise
+        ->add_option("--accel-noise", a.noise.accel_noise_density,
+                     "Accelerometer white-noise density, m/s^2/sqrt(Hz)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--gyro-noise", a.noise.gyro_noise_density,
+                     "Gyroscope white-noise density, rad/s/sqrt(Hz)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--accel-rw", a.noise.accel_bias_walk_density,
+                     "Accelerometer bias random-walk density, m/s^3/sqrt(Hz)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--gyro-rw", a.noise.gyro_bias_walk_density,
+                     "Gyroscope bias random-walk density, rad/s^2/sqrt(Hz)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--quantisation-acc", a.noise.accel_quantum,
+                     "Accelerometer quantisation step, m/s^2 (0 = none)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--quantisation-gyr", a.noise.gyro_quantum,
+                     "Gyroscope quantisation step, rad/s (0 = none)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app_->add_option("--temperature", a.temperature,
+                     "Sensor temperature profile, degC: const:T, ramp:T0:T1 (over the session) "
+                     "or updown:T0:T1:PERIOD_S")
+        ->capture_default_str();
+    app_->add_flag("--no-temperature", a.no_temperature, "Leave the temp_c column out");
+    app_->add_option("--temp-ref", a.temp_ref_c,
+                     "Reference temperature of the true temperature terms, degC")
+        ->capture_default_str();
+    app_->add_option("--t0", a.t0_s, "Time of the first sample, s")->capture_default_str();
+    AddSiteOptions(app_, a.site);
+    app_->add_option("--seed", a.seed, "Seed of the noise, the poses and --random-truth")
+        ->capture_default_str();
+    app_->add_option("--truth-json", a.truth_json,
+                     "Write the true parameters, segments, site and noise as JSON to FILE")
+        ->type_name("FILE");
+    app_->add_option("--segments-out", a.segments_out,
+                     "Write the true still segments as a segments file (start,end,label sample "
+                     "indices) for 'plumb calibrate --segments'")
+        ->type_name("FILE");
+  }
+
+  int Run() override {
+    const SimulateArgs& a = args_;
+    const sim::Schedule schedule = MakeSchedule();
+    sim::SimulationOptions options = a.noise;
+    options.rate_hz = a.rate_hz;
+    options.model = model::Model::Parse(a.model);
+    options.model.temp_ref_c = a.temp_ref_c;
+    options.truth = a.random_truth > 0
+                        ? sim::RandomParameters(options.model, a.random_truth, a.seed)
+                        : options.model.ZeroParameters();
+    for (const auto& setting : a.truth) {
+      const auto eq = setting.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        throw UsageError("--truth must be PARAM=VALUE (got '" + setting + "')");
+      }
+      sim::SetParameter(options.model, options.truth, setting.substr(0, eq),
+                        ParseNumber(setting.substr(eq + 1), "--truth " + setting));
+    }
+    options.temperature = ParseTemperature(a.temperature);
+    options.record_temperature = !a.no_temperature;
+    options.t0_s = a.t0_s;
+    options.seed = a.seed;
+    options.site = ResolveSite(a.site, std::nullopt, std::nullopt);
+
+    const sim::Simulation sim = sim::Simulate(schedule, options);
+    io::WriteNativeCsv(a.out_path, sim.session);
+    std::cout << "wrote " << a.out_path << ": " << sim.session.series.size() << " samples, "
+              << sim.session.series.duration_s() << " s at " << sim.rate_hz << " Hz, "
+              << sim.truth_segments.size() << " still holds; model " << sim.model.spec()
+              << "; noise per sample " << sim.accel_sigma << " m/s^2, " << sim.gyro_sigma
+              << " rad/s; site " << (sim.site.known ? "given" : "none (no Earth rate)") << "\n";
+    if (!a.truth_json.empty()) {
+      report::WriteJson(a.truth_json, TruthJson(sim, a));
+      std::cout << "wrote " << a.truth_json << "\n";
+    }
+    if (!a.segments_out.empty()) {
+      io::WriteFileAtomic(a.segments_out, SegmentsCsv(sim.truth_segments));
+      std::cout << "wrote " << a.segments_out << "\n";
+    }
+    return 0;
+  }
+
+ private:
+  sim::Schedule MakeSchedule() const {
+    const SimulateArgs& a = args_;
+    const bool still_given = a.still_option->count() > 0;
+    const bool turn_given = a.turn_option->count() > 0;
+    if (a.schedule != "multipose" && a.poses_option->count() > 0) {
+      throw UsageError("--poses applies to --schedule multipose only");
+    }
+    if (a.schedule == "paper-static") {
+      if (turn_given) throw UsageError("--turn does not apply to --schedule paper-static");
+      return sim::PaperStatic(still_given ? a.still_s : 60.0);
+    }
+    if (a.schedule == "paper-benchmark") {
+      return sim::PaperBenchmark(still_given ? a.still_s : 20.0, turn_given ? a.turn_s : 3.0);
+    }
+    return sim::MultiPose(a.poses, still_given ? a.still_s : 5.0, turn_given ? a.turn_s : 2.0,
+                          a.seed);
+  }
+
+  SimulateArgs args_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeSimulateCommand(CLI::App& parent) {
+  return std::make_unique<SimulateCommand>(parent);
+}
+
+}  // namespace plumb::cli

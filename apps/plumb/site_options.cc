@@ -1,0 +1,33 @@
+#include "site_options.h"
+
+namespace plumb::cli {
+
+void AddSiteOptions(CLI::App* app, SiteArgs& args) {
+  args.lat = app->add_option("--lat", args.lat_deg,
+                             "Geodetic latitude of the site, degrees (-90..90); sets local "
+                             "gravity (WGS84 normal gravity) and the Earth rate")
+                 ->check(CLI::Range(-90.0, 90.0));
+  args.lon = app->add_option("--lon", args.lon_deg, "Longitude of the site, degrees (-180..180)")
+                 ->check(CLI::Range(-180.0, 180.0));
+  args.height = app->add_option("--height", args.height_m,
+                                "Height of the site above the WGS84 ellipsoid, m (default 0)");
+  args.lat->needs(args.lon);
+  args.lon->needs(args.lat);
+  args.height->needs(args.lat);
+}
+
+geo::Site ResolveSite(const SiteArgs& args, const std::optional<SiteInput>& from_log,
+                      std::optional<double> gravity_m_s2) {
+  geo::Site site;
+  if (args.given()) {
+    site = geo::Site::At(args.lat_deg, args.lon_deg, args.height_m, "flags");
+  } else if (from_log) {
+    site = geo::Site::At(*from_log);
+  } else {
+    return geo::Site::Unknown(gravity_m_s2.value_or(9.80665));
+  }
+  if (gravity_m_s2) site.g_n = Vec3(0.0, 0.0, *gravity_m_s2);
+  return site;
+}
+
+}  // namespace plumb::cli

@@ -1,0 +1,32 @@
+// apps/plumb/site_options.h — --lat --lon --height, shared by calibrate and simulate.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <optional>
+
+#include "plumb/core/session.h"
+#include "plumb/geo/site.h"
+
+namespace plumb::cli {
+
+struct SiteArgs {
+  double lat_deg = 0.0;        ///< geodetic latitude, degrees [-90, 90]
+  double lon_deg = 0.0;        ///< longitude, degrees [-180, 180]
+  double height_m = 0.0;       ///< height above the WGS84 ellipsoid, m
+  CLI::Option* lat = nullptr;  ///< the registered options, to tell whether they were given
+  CLI::Option* lon = nullptr;
+  CLI::Option* height = nullptr;
+
+  bool given() const { return lat != nullptr && lat->count() > 0; }
+};
+
+/// Registers --lat, --lon (each needing the other) and --height (needing --lat).
+void AddSiteOptions(CLI::App* app, SiteArgs& args);
+
+/// The site from the flags when given (source "flags"), else from `from_log` (e.g. the log's
+/// GPS), else none. `gravity_m_s2`, when set, replaces the gravity magnitude (still pointing
+/// down); without a site it is the fixed gravity of Site::Unknown.
+geo::Site ResolveSite(const SiteArgs& args, const std::optional<SiteInput>& from_log,
+                      std::optional<double> gravity_m_s2);
+
+}  // namespace plumb::cli

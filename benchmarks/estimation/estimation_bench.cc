@@ -1,0 +1,105 @@
+// Speed of the full calibration (SPEC section 7): imu_tk's own data (imu_tk takes about 1 s
+// of calibration on this kind of machine), mikoff's imu0 (bundled), and a simulated one-hour
+// 1 kHz session. Reading and segmentation are measured apart (io and segmentation benches)
+// and, for the end-to-end figure, together in BM_EndToEndImuTk.
+//
+//   build/benchmarks/estimation/plumb_bench_estimation --benchmark_counters_tabular=true
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+#include "plumb/estimation/calibrator.h"
+#include "plumb/io/text_table.h"
+#include "plumb/segmentation/still_detector.h"
+#include "plumb/sim/schedule.h"
+#include "plumb/sim/simulate.h"
+#include "plumb/sim/truth.h"
+
+namespace plumb {
+namespace {
+
+const std::string kShared = PLUMB_SHARED_DATA_DIR;
+
+Session ReadImuTk() {
+  io::TextTableOptions o;
+  o.time = 0;
+  o.acc.axes = {1, 2, 3};
+  o.gyr.axes = {1, 2, 3};
+  return io::ReadSplitTables(kShared + "/multipose/imu_tk/xsens_acc.mat",
+                             kShared + "/multipose/imu_tk/xsens_gyro.mat", o);
+}
+
+Session ReadMikoff() {
+  io::TextTableOptions o;
+  o.acc.axes = {0, 1, 2};
+  o.gyr.axes = {3, 4, 5};
+  o.rate_hz = 100;
+  return io::ReadTextTable(std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log", o);
+}
+
+void CalibrateSession(benchmark::State& state, const Session& s, const geo::Site& site,
+                      double init_still_s) {
+  segmentation::StillDetectorOptions d;
+  d.init_still_s = init_still_s;
+  const auto seg = segmentation::DetectStillSegments(s.series, d);
+  model::Model m = model::Model::Parse("base");
+  m.t_ref_s = s.series.t_s.front();
+  estimation::CalibrationResult r;
+  for (auto _ : state) {
+    r = estimation::Calibrate(s.series, seg.segments, m, site);
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["segments"] = static_cast<double>(r.fit.still_segments);
+  state.counters["chi2_dof"] = r.fit.chi2_dof();
+  state.counters["samples"] = static_cast<double>(s.series.size());
+}
+
+void BM_CalibrateImuTk(benchmark::State& state) {
+  if (!std::filesystem::exists(kShared + "/multipose/imu_tk/xsens_acc.mat")) {
+    state.SkipWithError("shared data absent");
+    return;
+  }
+  CalibrateSession(state, ReadImuTk(), geo::Site::Unknown(9.81744), 50.0);
+}
+BENCHMARK(BM_CalibrateImuTk)->Unit(benchmark::kMillisecond);
+
+void BM_CalibrateMikoff(benchmark::State& state) {
+  CalibrateSession(state, ReadMikoff(), geo::Site::Unknown(), 0.0);
+}
+BENCHMARK(BM_CalibrateMikoff)->Unit(benchmark::kMillisecond);
+
+void BM_EndToEndImuTk(benchmark::State& state) {
+  if (!std::filesystem::exists(kShared + "/multipose/imu_tk/xsens_acc.mat")) {
+    state.SkipWithError("shared data absent");
+    return;
+  }
+  for (auto _ : state) {
+    const Session s = ReadImuTk();
+    segmentation::StillDetectorOptions d;
+    d.init_still_s = 50.0;
+    const auto seg = segmentation::DetectStillSegments(s.series, d);
+    model::Model m = model::Model::Parse("base");
+    m.t_ref_s = s.series.t_s.front();
+    benchmark::DoNotOptimize(estimation::Calibrate(s.series, seg.segments, m, geo::Site::Unknown(9.81744)));
+  }
+}
+BENCHMARK(BM_EndToEndImuTk)->Unit(benchmark::kMillisecond);
+
+/// One hour at 1 kHz: 60 still poses of about 55 s joined by 3 s turns.
+void BM_CalibrateSimulatedHour(benchmark::State& state) {
+  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  opt.rate_hz = 1000.0;
+  opt.truth = sim::RandomParameters(opt.model, 1.0, 3);
+  opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
+  opt.seed = 3;
+  const sim::Simulation sim = sim::Simulate(sim::MultiPose(60, 57.0, 3.0, 3), opt);
+  CalibrateSession(state, sim.session, sim.site, 0.0);
+  state.counters["bytes_per_sample"] = static_cast<double>(
+      sizeof(double) + 2 * sizeof(Vec3f) + sizeof(float));
+}
+BENCHMARK(BM_CalibrateSimulatedHour)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+}  // namespace plumb
+
+BENCHMARK_MAIN();

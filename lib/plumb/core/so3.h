@@ -1,0 +1,76 @@
+// plumb/core/so3.h — SO(3) helpers on doubles (Sophus conventions): Skew, Exp, Log and the
+// Jacobians used by the motion residual. Exp(phi) is the rotation by |phi| rad about phi.
+//
+//   Exp(phi + d) = Exp(phi) Exp(J_r(phi) d)     (to first order in d)
+//   Log(Exp(d) R) = Log(R) + J_l^-1(Log R) d
+#pragma once
+
+#include <cmath>
+
+#include "plumb/core/types.h"
+
+namespace plumb::so3 {
+
+inline Mat3 Skew(const Vec3& v) {
+  Mat3 S;
+  S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return S;
+}
+
+/// sin(a)/a and (1 - cos a)/a^2, by series below 0.05 rad (error < 1e-17) to avoid sincos
+/// on the many small steps of an integration.
+inline void ExpCoefficients(double a, double* A, double* B) {
+  if (a < 0.05) {
+    const double a2 = a * a;
+    *A = 1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0));
+    *B = 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0));
+  } else {
+    *A = std::sin(a) / a;
+    *B = (1.0 - std::cos(a)) / (a * a);
+  }
+}
+
+/// Rotation matrix Exp(phi), phi a rotation vector in rad.
+inline Mat3 Exp(const Vec3& phi) {
+  double A, B;
+  ExpCoefficients(phi.norm(), &A, &B);
+  const Mat3 S = Skew(phi);
+  return Mat3::Identity() + A * S + B * S * S;
+}
+
+/// Unit quaternion of Exp(phi).
+inline Quat ExpQuat(const Vec3& phi) {
+  const double a = phi.norm();
+  const double half = 0.5 * a;
+  // sin(a/2)/a by series for small angles.
+  const double s = a < 0.05 ? 0.5 * (1.0 - half * half / 6.0 * (1.0 - half * half / 20.0))
+                            : std::sin(half) / a;
+  const double c = a < 0.05 ? 1.0 - half * half / 2.0 * (1.0 - half * half / 12.0) : std::cos(half);
+  return Quat(c, s * phi.x(), s * phi.y(), s * phi.z());
+}
+
+/// Rotation vector of R, rad, angle in [0, pi].
+inline Vec3 Log(const Mat3& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
+/// Right Jacobian J_r(phi).
+inline Mat3 RightJacobian(const Vec3& phi) {
+  const double a = phi.norm();
+  const Mat3 S = Skew(phi);
+  if (a < 1e-4) return Mat3::Identity() - 0.5 * S + S * S / 6.0;
+  return Mat3::Identity() - (1 - std::cos(a)) / (a * a) * S +
+         (a - std::sin(a)) / (a * a * a) * S * S;
+}
+
+/// Inverse of the left Jacobian, J_l^-1(phi).
+inline Mat3 LeftJacobianInverse(const Vec3& phi) {
+  const double a = phi.norm();
+  const Mat3 S = Skew(phi);
+  if (a < 1e-4) return Mat3::Identity() - 0.5 * S + S * S / 12.0;
+  return Mat3::Identity() - 0.5 * S +
+         (1.0 / (a * a) - (1 + std::cos(a)) / (2 * a * std::sin(a))) * S * S;
+}
+
+}  // namespace plumb::so3

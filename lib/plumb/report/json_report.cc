@@ -1,0 +1,284 @@
+#include "plumb/report/json_report.h"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <map>
+
+#include "plumb/io/atomic_file.h"
+#include "plumb/report/version.h"
+
+namespace plumb::report {
+namespace {
+
+using nlohmann::json;
+
+bool IsBaseEffect(const std::string& name) {
+  return name == "accel_linear" || name == "gyro_linear";
+}
+
+/// Names of the model's non-base effects, for the correction's note.
+std::vector<std::string> ExtraEffects(const model::Model& model, model::Sensor sensor) {
+  std::vector<std::string> out;
+  for (const auto& term : model.terms()) {
+    const auto& info = term.effect->info();
+    if (!IsBaseEffect(info.name) && info.sensor == sensor) out.push_back(info.name);
+  }
+  return out;
+}
+
+/// The correction a user applies, x = M^-1 (y - b), labelled; null matrix when M is singular.
+json Correction(const Mat3& forward, const Vec3& bias, const std::string& formula,
+                const std::vector<std::string>& extra_effects) {
+  const Eigen::FullPivLU<Mat3> lu(forward);
+  json c;
+  c["formula"] = formula;
+  c["matrix"] = lu.isInvertible() ? Matrix(lu.inverse()) : json(nullptr);
+  c["offset"] = Vector(bias);
+  if (!extra_effects.empty()) {
+    std::string list;
+    for (const auto& e : extra_effects) list += (list.empty() ? "" : ", ") + e;
+    c["note"] = "linear part only: the terms of " + list +
+                " (see effects) must be subtracted from the output first";
+  }
+  return c;
+}
+
+json Sensor(const Mat3& forward, const Vec3& bias, const json& correction) {
+  return json{{"matrix", Matrix(forward)}, {"bias", Vector(bias)}, {"correction", correction}};
+}
+
+json ParameterJson(const estimation::ParameterEstimate& p) {
+  return json{{"name", p.name},
+              {"value", Number(p.value)},
+              {"sigma", (p.fixed || !p.observable) ? json(nullptr) : Number(p.sigma)},
+              {"observable", p.observable},
+              {"fixed", p.fixed},
+              {"unit", p.unit}};
+}
+
+/// One entry of "effects": the effect's parameters in block order with sigma and units.
+json EffectJson(const model::EffectInfo& info,
+                const std::map<std::string, const estimation::ParameterEstimate*>& by_name) {
+  json names = json::array(), values = json::array(), sigmas = json::array(), units = json::array();
+  bool uniform = true;
+  for (int i = 0; i < info.size(); ++i) {
+    const std::string full = info.ParameterName(i);
+    const auto& unit = info.parameters[static_cast<std::size_t>(i)].unit;
+    uniform = uniform && unit == info.parameters.front().unit;
+    names.push_back(full);
+    units.push_back(unit);
+    const auto it = by_name.find(full);
+    if (it == by_name.end()) {
+      values.push_back(nullptr);
+      sigmas.push_back(nullptr);
+      continue;
+    }
+    const auto& p = *it->second;
+    values.push_back(Number(p.value));
+    sigmas.push_back((p.fixed || !p.observable) ? json(nullptr) : Number(p.sigma));
+  }
+  json e{{"term", info.term},
+         {"option", info.option},
+         {"names", names},
+         {"parameters", values},
+         {"sigma", sigmas}};
+  e["unit"] = (uniform && info.size() > 0) ? json(info.parameters.front().unit) : units;
+  return e;
+}
+
+json EffectsJson(const estimation::CalibrationResult& r) {
+  std::map<std::string, const estimation::ParameterEstimate*> by_name;
+  for (const auto& p : r.parameters) by_name[p.name] = &p;
+  json effects = json::object();
+  for (const auto& term : r.model.terms()) {
+    const auto& info = term.effect->info();
+    if (!IsBaseEffect(info.name)) effects[info.name] = EffectJson(info, by_name);
+  }
+  return effects;
+}
+
+json FitJson(const estimation::CalibrationResult& r) {
+  const auto& f = r.fit;
+  json rms{{"accel", Vector(f.rms_acc)},
+           {"gyro", r.has_gyro ? Vector(f.rms_gyr) : json(nullptr)},
+           {"motion", f.motion_segments > 0 ? Vector(f.rms_motion) : json(nullptr)}};
+  return json{{"chi2", Number(f.chi2)},
+              {"dof", f.dof},
+              {"chi2_dof", Number(f.chi2_dof())},
+              {"num_residuals", f.num_residuals},
+              {"residual_rms", rms},
+              {"segments", {{"still", f.still_segments}, {"motion", f.motion_segments}}},
+              {"converged", f.converged},
+              {"iterations", f.iterations},
+              {"solver", f.solver_report}};
+}
+
+json ObservabilityJson(const estimation::Observability& o) {
+  json determined = json::array();
+  for (const auto& d : o.determined) {
+    determined.push_back(
+        {{"combination", d.text}, {"value", Number(d.value)}, {"sigma", Number(d.sigma)}});
+  }
+  return json{{"rank", o.rank},
+              {"unknowns", o.num_unknowns},
+              {"unobservable", o.unobservable},
+              {"determined", determined}};
+}
+
+json SiteJson(const geo::Site& site) {
+  const json none(nullptr);
+  return json{{"lat_deg", site.known ? Number(site.lat_deg) : none},
+              {"lon_deg", site.known ? Number(site.lon_deg) : none},
+              {"height_m", site.known ? Number(site.height_m) : none},
+              {"gravity", Number(site.gravity())},
+              {"earth_rate", site.known ? Number(site.omega_ie_n.norm()) : none},
+              {"source", site.known ? site.source : std::string("none")}};
+}
+
+json NoiseJson(const estimation::CalibrationResult& r) {
+  return json{{"accel", Vector(r.noise_acc)},
+              {"gyro", r.has_gyro ? Vector(r.noise_gyr) : json(nullptr)},
+              {"tau_accel", Number(r.tau_acc)},
+              {"tau_gyro", r.has_gyro ? Number(r.tau_gyr) : json(nullptr)},
+              {"units", "sensor units per sample; tau in samples"}};
+}
+
+json StillJson(const estimation::StillSegmentFit& s, bool has_gyro) {
+  const Quat& q = s.R_n_b;
+  return json{
+      {"label", s.segment.label},
+      {"begin", s.segment.begin},
+      {"end", s.segment.end},
+      {"t_mid_s", Number(s.t_mid_s)},
+      {"acc_residual", Vector(s.acc_residual)},
+      {"gyr_residual", has_gyro ? Vector(s.gyr_residual) : json(nullptr)},
+      {"acc_whitened", Vector(s.acc_whitened)},
+      {"gyr_whitened", has_gyro ? Vector(s.gyr_whitened) : json(nullptr)},
+      {"attitude_quaternion_wxyz", {Number(q.w()), Number(q.x()), Number(q.y()), Number(q.z())}},
+      {"attitude_known", s.attitude_known}};
+}
+
+json MotionJson(const estimation::MotionFit& m) {
+  return json{{"from", m.from},
+              {"to", m.to},
+              {"duration_s", Number(m.duration_s)},
+              {"rotation_residual", Vector(m.rotation_residual)},
+              {"whitened", Vector(m.whitened)}};
+}
+
+json NoiseEstimateJson(const segmentation::NoiseEstimate& n) {
+  json periods = json::array();
+  for (const auto& p : n.periods) periods.push_back(json::array({p.begin, p.end}));
+  json out{{"periods", periods},
+           {"samples", n.samples},
+           {"source", n.source},
+           {"acc_mean", Vector(n.acc_mean)},
+           {"acc_sigma", Vector(n.acc_sigma)},
+           {"acc_tau_int", Vector(n.acc_tau_int)}};
+  out["gyr_sigma"] = n.has_gyro ? Vector(n.gyr_sigma) : json(nullptr);
+  out["gyr_tau_int"] = n.has_gyro ? Vector(n.gyr_tau_int) : json(nullptr);
+  out["gyr_still_rate"] = n.has_gyro ? Vector(n.gyr_still_rate) : json(nullptr);
+  return out;
+}
+
+json DetectionJson(const segmentation::DetectionDetail& d) {
+  return json{{"window_samples", d.window_samples},
+              {"acc_dof", Number(d.acc_dof)},
+              {"acc_threshold", Number(d.acc_threshold)},
+              {"gyr_dof", Number(d.gyr_dof)},
+              {"gyr_threshold", Number(d.gyr_threshold)},
+              {"rate_threshold", Number(d.rate_threshold)},
+              {"rate_allowance", Vector(d.rate_allowance)},
+              {"windows", d.windows},
+              {"failed_acc", d.failed_acc},
+              {"failed_gyr", d.failed_gyr},
+              {"failed_rate", d.failed_rate},
+              {"failed_gap", d.failed_gap},
+              {"still_runs", d.still_runs},
+              {"rejected_by_gyro", d.rejected_by_gyro}};
+}
+
+}  // namespace
+
+json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
+
+json Vector(const Vec3& v) { return json::array({Number(v.x()), Number(v.y()), Number(v.z())}); }
+
+json Matrix(const Mat3& m) {
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back(Vector(m.row(r).transpose()));
+  return rows;
+}
+
+json ToJson(const estimation::CalibrationResult& r) {
+  json doc;
+  doc["plumb_version"] = Version();
+  doc["method"] = r.method;
+  doc["model"] = r.model.spec();
+  doc["model_reference"] = {{"t_ref_s", Number(r.model.t_ref_s)},
+                            {"temp_ref_c", Number(r.model.temp_ref_c)}};
+  doc["convention"] = {
+      {"frame", "body = accelerometer-defined, FRD; navigation NED; SI units"},
+      {"accel",
+       "forward: y_a = matrix f_b + bias + effects; correction: f_b = correction.matrix "
+       "(y_a - correction.offset)"},
+      {"gyro",
+       "forward: y_g = matrix omega_b + bias + effects; correction: omega_b = "
+       "correction.matrix (y_g - correction.offset)"}};
+  doc["accel"] = Sensor(r.accel_matrix, r.accel_bias,
+                        Correction(r.accel_matrix, r.accel_bias, "f_b = matrix (y_a - offset)",
+                                   ExtraEffects(r.model, model::Sensor::kAccel)));
+  doc["gyro"] =
+      r.has_gyro ? Sensor(r.gyro_matrix, r.gyro_bias,
+                          Correction(r.gyro_matrix, r.gyro_bias, "omega_b = matrix (y_g - offset)",
+                                     ExtraEffects(r.model, model::Sensor::kGyro)))
+                 : json(nullptr);
+  doc["effects"] = EffectsJson(r);
+  doc["parameters"] = json::array();
+  for (const auto& p : r.parameters) doc["parameters"].push_back(ParameterJson(p));
+  doc["fit"] = FitJson(r);
+  doc["observability"] = ObservabilityJson(r.observability);
+  doc["site"] = SiteJson(r.site);
+  doc["noise"] = NoiseJson(r);
+  doc["segments"] = json::array();
+  for (const auto& s : r.still) doc["segments"].push_back(StillJson(s, r.has_gyro));
+  doc["motion"] = json::array();
+  for (const auto& m : r.motion) doc["motion"].push_back(MotionJson(m));
+  doc["warnings"] = r.warnings;
+  return doc;
+}
+
+json ToJson(const segmentation::SegmentationResult& s) {
+  const auto& rep = s.report;
+  const bool detected = rep.method != "given";
+  json out{{"method", rep.method},
+           {"segments", s.segments.size()},
+           {"window_s", detected ? Number(rep.window_s) : json(nullptr)},
+           {"min_still_s", detected ? Number(rep.min_still_s) : json(nullptr)},
+           {"init_still_s", detected ? Number(rep.init_still_s) : json(nullptr)},
+           {"threshold", detected ? Number(rep.threshold) : json(nullptr)},
+           {"rejected_short", rep.rejected_short},
+           {"notes", rep.notes}};
+  out["noise"] = detected ? NoiseEstimateJson(s.noise) : json(nullptr);
+  out["thresholds"] = detected ? DetectionJson(s.detail) : json(nullptr);
+  return out;
+}
+
+json CalibrationJson(const estimation::CalibrationResult& result,
+                     const segmentation::SegmentationResult& segmentation,
+                     const std::vector<std::string>& inputs,
+                     const std::vector<std::string>& input_warnings) {
+  json doc = ToJson(result);
+  doc["segmentation"] = ToJson(segmentation);
+  doc["inputs"] = inputs;
+  std::vector<std::string> warnings = input_warnings;
+  warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
+  doc["warnings"] = warnings;
+  return doc;
+}
+
+void WriteJson(const std::string& path, const json& document) {
+  io::WriteFileAtomic(path, document.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
+}
+
+}  // namespace plumb::report

@@ -1,0 +1,65 @@
+// plumb/report/json_report.h — the JSON documents that `plumb calibrate --json` writes
+// (SPEC section 6).
+//
+// Every number is SI (m/s^2, rad/s, s, degC; degrees only in `*_deg` site fields). A value
+// that is not finite (an unobservable parameter's sigma, chi^2/dof without degrees of
+// freedom) is written as null, never as NaN: the output is always valid JSON.
+//
+// Top-level keys of CalibrationJson():
+//   plumb_version, method, model, model_reference {t_ref_s, temp_ref_c},
+//   convention {accel, gyro}                      the forward model, in words
+//   accel {matrix, bias, correction {formula, matrix, offset}}   forward model F, b_a, SI;
+//   gyro  {... the same with E, b_g}              the correction is f_b = F^-1 (y_a - b_a)
+//   effects {name: {term, option, names, parameters, sigma, unit}}   non-base effects only
+//   parameters [{name, value, sigma, observable, fixed, unit}]
+//   fit {chi2, dof, chi2_dof, num_residuals, residual_rms {accel, gyro, motion},
+//        segments {still, motion}, converged, iterations, solver}
+//   observability {rank, unknowns, unobservable [], determined [{combination, value, sigma}]}
+//   site {lat_deg, lon_deg, height_m, gravity, source}   null coordinates, source "none"
+//                                                         without a site
+//   noise {accel, gyro, tau_accel, tau_gyro}       per-sample sigma (sensor units), tau in samples
+//   segments [{label, begin, end, t_mid_s, acc_residual, gyr_residual, acc_whitened,
+//              gyr_whitened, attitude_quaternion_wxyz, attitude_known}]
+//   motion [{from, to, duration_s, rotation_residual, whitened}]
+//   segmentation {...}                             see ToJson(SegmentationResult)
+//   inputs [file names], warnings [text]
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "plumb/core/types.h"
+#include "plumb/estimation/result.h"
+#include "plumb/segmentation/still_detector.h"
+
+namespace plumb::report {
+
+/// A finite number, or null when `value` is NaN or infinite.
+nlohmann::json Number(double value);
+/// [x, y, z], non-finite entries null.
+nlohmann::json Vector(const Vec3& v);
+/// [[row x], [row y], [row z]], non-finite entries null.
+nlohmann::json Matrix(const Mat3& m);
+
+/// The calibration result alone: every key listed above except segmentation and inputs.
+nlohmann::json ToJson(const estimation::CalibrationResult& result);
+
+/// How the still segments were found: {method, segments, window_s, min_still_s, init_still_s,
+/// threshold, rejected_short, notes [], noise {...}, thresholds {...}} (noise and thresholds
+/// are null for given segments).
+nlohmann::json ToJson(const segmentation::SegmentationResult& segmentation);
+
+/// The whole `calibrate --json` document: ToJson(result), plus "segmentation", "inputs", and
+/// the readers' warnings (`input_warnings`) placed before the result's own in "warnings".
+nlohmann::json CalibrationJson(const estimation::CalibrationResult& result,
+                               const segmentation::SegmentationResult& segmentation,
+                               const std::vector<std::string>& inputs,
+                               const std::vector<std::string>& input_warnings);
+
+/// Writes `document` (indented, newline-terminated, invalid UTF-8 in strings replaced) to
+/// `path` atomically: temporary file in the same folder, then rename. Throws plumb::Error
+/// naming `path` when it cannot be written.
+void WriteJson(const std::string& path, const nlohmann::json& document);
+
+}  // namespace plumb::report

@@ -1,0 +1,97 @@
+#include "plumb/report/summary.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "plumb/report/version.h"
+
+namespace plumb::report {
+namespace {
+
+std::string Format(const char* fmt, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, a);
+  return buf;
+}
+
+std::string Vec(const Vec3& v) {
+  return "(" + Format("%.3g", v.x()) + ", " + Format("%.3g", v.y()) + ", " + Format("%.3g", v.z()) +
+         ")";
+}
+
+std::string DetectedLines(const segmentation::SegmentationResult& s) {
+  const auto& rep = s.report;
+  const auto& n = s.noise;
+  const auto& d = s.detail;
+  std::ostringstream os;
+  os << "still segments: " << s.segments.size() << " detected (window "
+     << Format("%.3g", rep.window_s) << " s, shortest kept " << Format("%.3g", rep.min_still_s)
+     << " s";
+  if (rep.rejected_short > 0) os << ", " << rep.rejected_short << " shorter runs dropped";
+  os << ")\n";
+  os << "  noise from " << n.samples << " samples in " << n.periods.size() << " still period"
+     << (n.periods.size() == 1 ? "" : "s") << " (" << n.source << "): accel sigma "
+     << Vec(n.acc_sigma);
+  if (n.has_gyro) os << ", gyro sigma " << Vec(n.gyr_sigma);
+  os << " per sample\n";
+  os << "  thresholds: accel variance ratio " << Format("%.3g", d.acc_threshold);
+  if (d.gyr_threshold > 0) os << ", gyro variance ratio " << Format("%.3g", d.gyr_threshold);
+  if (d.rate_threshold > 0) os << ", rate chi2(3) " << Format("%.3g", d.rate_threshold);
+  os << "; windows failing: accel " << d.failed_acc;
+  if (d.gyr_threshold > 0) os << ", gyro " << d.failed_gyr;
+  if (d.rate_threshold > 0) os << ", rate " << d.failed_rate;
+  os << ", gap " << d.failed_gap << " of " << d.windows << "\n";
+  if (d.rejected_by_gyro > 0) {
+    os << "  " << d.rejected_by_gyro << " still runs of the accelerometer rejected by the "
+       << "gyroscope tests (slow turns?)\n";
+  }
+  return os.str();
+}
+
+}  // namespace
+
+std::string SegmentationSummary(const segmentation::SegmentationResult& s,
+                                const std::string& source, bool with_notes) {
+  std::ostringstream os;
+  if (s.report.method == "given") {
+    os << "still segments: " << s.segments.size() << " given"
+       << (source.empty() ? "" : " in " + source) << "\n";
+  } else {
+    os << DetectedLines(s);
+  }
+  if (with_notes) {
+    for (const auto& note : s.report.notes) os << "  note: " << note << "\n";
+  }
+  return os.str();
+}
+
+std::string FitVerdict(const estimation::FitSummary& fit) {
+  if (fit.dof <= 0) {
+    return "no degrees of freedom left: the fit cannot be judged (record more still poses)";
+  }
+  const double ratio = fit.chi2_dof();
+  const double spread = std::sqrt(2.0 / fit.dof);
+  const std::string value =
+      "chi2/dof " + Format("%.3g", ratio) + " (expected 1 +- " + Format("%.2g", spread) + ")";
+  if (ratio > 1.0 + 3.0 * spread) {
+    return value + ": residuals exceed the noise; the model or the segments miss something";
+  }
+  if (ratio < 1.0 - 3.0 * spread) {
+    return value + ": residuals below the noise; the noise level is overestimated";
+  }
+  return value + ": consistent with the noise";
+}
+
+std::string CalibrationSummary(const estimation::CalibrationResult& r) {
+  std::ostringstream os;
+  os << "plumb " << Version() << " calibrate: method " << r.method << ", model " << r.model.spec()
+     << "\n";
+  os << FitVerdict(r.fit);
+  const std::size_t lost = r.observability.unobservable.size();
+  if (lost > 0) os << "; " << lost << " unobservable direction" << (lost > 1 ? "s" : "");
+  os << "\n\n" << r.FullReport();
+  return os.str();
+}
+
+}  // namespace plumb::report

@@ -1,0 +1,28 @@
+// plumb/report/summary.h — what `plumb calibrate` prints on a terminal (the library formats,
+// only the command prints).
+//
+// SegmentationSummary: how many still segments, how they were found, the thresholds and the
+// noise they came from. CalibrationSummary: a two-line header (version, method, model, and a
+// verdict on chi^2/dof against its spread) followed by CalibrationResult::FullReport().
+#pragma once
+
+#include <string>
+
+#include "plumb/estimation/result.h"
+#include "plumb/segmentation/still_detector.h"
+
+namespace plumb::report {
+
+/// A few lines on the still segments; `source` names the segments file for given segments
+/// (may be empty). `with_notes` appends the detector's own notes (long: every rejected run).
+std::string SegmentationSummary(const segmentation::SegmentationResult& segmentation,
+                                const std::string& source = "", bool with_notes = false);
+
+/// One line judging chi^2/dof: consistent with the noise when within 3 standard deviations of
+/// 1 (the standard deviation of chi^2/dof is sqrt(2 / dof)), otherwise what it suggests.
+std::string FitVerdict(const estimation::FitSummary& fit);
+
+/// Header plus the full report of the result.
+std::string CalibrationSummary(const estimation::CalibrationResult& result);
+
+}  // namespace plumb::report

@@ -1,0 +1,324 @@
+// The plumb command as a user runs it: exit codes (0 success, 1 error, 2 usage), the text on
+// stdout and stderr, and the JSON it writes (SPEC section 6).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
+#include "run_tool.h"
+
+namespace plumb::cli {
+namespace {
+
+using nlohmann::json;
+using testing::Run;
+using testing::TempDir;
+using testing::ToolRun;
+
+constexpr const char* kTool = PLUMB_TOOL;
+
+ToolRun Plumb(const std::vector<std::string>& args, const TempDir& dir) {
+  return Run(kTool, args, dir);
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  return json::parse(in);  // throws (failing the test) on invalid JSON, e.g. a bare NaN
+}
+
+/// True when no number anywhere in `j` is NaN or infinite.
+bool AllNumbersFinite(const json& j) {
+  if (j.is_number_float()) return std::isfinite(j.get<double>());
+  if (j.is_structured()) {
+    for (const auto& item : j) {
+      if (!AllNumbersFinite(item)) return false;
+    }
+  }
+  return true;
+}
+
+/// The SPEC section 6 keys of `calibrate --json`, and the ones this command adds.
+void ExpectCalibrationKeys(const json& doc) {
+  for (const char* key :
+       {"method", "model", "accel", "gyro", "effects", "parameters", "fit", "observability", "site",
+        "noise", "segments", "motion", "segmentation", "warnings", "plumb_version", "inputs"}) {
+    EXPECT_TRUE(doc.contains(key)) << key;
+  }
+  for (const char* key : {"matrix", "bias", "correction"}) {
+    EXPECT_TRUE(doc["accel"].contains(key)) << key;
+    EXPECT_TRUE(doc["gyro"].contains(key)) << key;
+  }
+  for (const char* key :
+       {"chi2", "dof", "chi2_dof", "residual_rms", "segments", "converged", "iterations"}) {
+    EXPECT_TRUE(doc["fit"].contains(key)) << key;
+  }
+  for (const char* key : {"rank", "unknowns", "unobservable", "determined"}) {
+    EXPECT_TRUE(doc["observability"].contains(key)) << key;
+  }
+  for (const char* key : {"lat_deg", "lon_deg", "height_m", "gravity", "source"}) {
+    EXPECT_TRUE(doc["site"].contains(key)) << key;
+  }
+  ASSERT_FALSE(doc["parameters"].empty());
+  for (const char* key : {"name", "value", "sigma", "observable", "fixed", "unit"}) {
+    EXPECT_TRUE(doc["parameters"][0].contains(key)) << key;
+  }
+}
+
+/// Files of a small simulated session: 12 poses of 4 s joined by 1.5 s turns at 100 Hz
+/// (64 s, 6450 samples), white noise only, at a known site, with chosen true parameters.
+struct SimulatedSession {
+  std::string csv, truth, segments;
+};
+const std::vector<std::string> kSite = {"--lat", "51.64", "--lon", "-1.2", "--height", "100"};
+
+SimulatedSession Simulate(const TempDir& dir) {
+  SimulatedSession s{dir.File("session.csv"), dir.File("truth.json"), dir.File("segments.csv")};
+  std::vector<std::string> args = {"simulate",
+                                   "--out",
+                                   s.csv,
+                                   "--poses",
+                                   "12",
+                                   "--still",
+                                   "4",
+                                   "--turn",
+                                   "1.5",
+                                   "--rate",
+                                   "100",
+                                   "--model",
+                                   "base+gyro_g_sensitivity",
+                                   "--truth",
+                                   "accel.bias.x=0.1",
+                                   "--truth",
+                                   "accel.matrix.xy=0.01",
+                                   "--truth",
+                                   "gyro.matrix.xx=1.01",
+                                   "--truth",
+                                   "gyro.bias.z=0.005",
+                                   "--truth",
+                                   "gyro_g_sensitivity.G.xy=2e-4",
+                                   "--accel-rw",
+                                   "0",
+                                   "--gyro-rw",
+                                   "0",
+                                   "--no-temperature",
+                                   "--seed",
+                                   "1",
+                                   "--truth-json",
+                                   s.truth,
+                                   "--segments-out",
+                                   s.segments};
+  args.insert(args.end(), kSite.begin(), kSite.end());
+  const ToolRun run = Plumb(args, dir);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return s;
+}
+
+/// Calibrates with the simulated model at the simulated site; extra arguments appended.
+ToolRun Calibrate(const std::vector<std::string>& inputs, const std::string& json_path,
+                  const std::vector<std::string>& extra, const TempDir& dir) {
+  std::vector<std::string> args = {"calibrate"};
+  args.insert(args.end(), inputs.begin(), inputs.end());
+  args.insert(args.end(), {"--model", "base+gyro_g_sensitivity", "--json", json_path});
+  args.insert(args.end(), kSite.begin(), kSite.end());
+  args.insert(args.end(), extra.begin(), extra.end());
+  return Plumb(args, dir);
+}
+
+/// Splits the native CSV into imu_tk's two tables `t x y z` (same text, so the same numbers).
+void SplitNativeCsv(const std::string& csv, const std::string& acc, const std::string& gyr) {
+  std::ifstream in(csv);
+  std::ofstream a(acc), g(gyr);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string item; std::getline(ss, item, ',');) f.push_back(item);
+    a << f[0] << ' ' << f[1] << ' ' << f[2] << ' ' << f[3] << '\n';
+    g << f[0] << ' ' << f[4] << ' ' << f[5] << ' ' << f[6] << '\n';
+  }
+}
+
+TEST(Cli, HelpListsTheSubcommands) {
+  TempDir dir;
+  const ToolRun run = Plumb({"--help"}, dir);
+  EXPECT_EQ(run.exit_code, 0);
+  for (const char* sub : {"calibrate", "simulate", "effects"}) {
+    EXPECT_TRUE(Contains(run.out, sub)) << sub << " missing from:\n" << run.out;
+  }
+}
+
+TEST(Cli, CalibrateHelpDescribesInputAndDetectorOptions) {
+  TempDir dir;
+  const ToolRun run = Plumb({"calibrate", "--help"}, dir);
+  EXPECT_EQ(run.exit_code, 0);
+  for (const char* flag : {"--columns", "--rate", "--acc-scale", "--gyr-unit", "--segments",
+                           "--level-north", "--heading", "--window", "--false-alarm", "--json"}) {
+    EXPECT_TRUE(Contains(run.out, flag)) << flag;
+  }
+}
+
+TEST(Cli, VersionPrintsTheProjectVersion) {
+  TempDir dir;
+  const ToolRun run = Plumb({"--version"}, dir);
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_EQ(run.out, std::string(PLUMB_VERSION) + "\n");
+}
+
+TEST(Cli, UnknownFlagIsAUsageError) {
+  TempDir dir;
+  const ToolRun run = Plumb({"calibrate", "x.csv", "--no-such-flag"}, dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_TRUE(Contains(run.err, "--no-such-flag")) << run.err;
+  EXPECT_TRUE(run.out.empty());
+}
+
+TEST(Cli, LatitudeWithoutLongitudeIsAUsageError) {
+  TempDir dir;
+  const ToolRun run = Plumb({"calibrate", "x.csv", "--lat", "51"}, dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_TRUE(Contains(run.err, "--lon")) << run.err;
+}
+
+TEST(Cli, TableOptionWithoutColumnsIsAUsageError) {
+  TempDir dir;
+  const std::string csv = dir.Write("a.csv", "time_s,acc_x,acc_y,acc_z\n0,0,0,-9.8\n");
+  const ToolRun run = Plumb({"calibrate", csv, "--rate", "100"}, dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_TRUE(Contains(run.err, "--columns")) << run.err;
+}
+
+TEST(Cli, MissingInputFileIsAnErrorNamingIt) {
+  TempDir dir;
+  const std::string missing = dir.File("no_such_session.csv");
+  const ToolRun run = Plumb({"calibrate", missing}, dir);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.err.rfind("plumb: error: ", 0), 0u) << run.err;
+  EXPECT_TRUE(Contains(run.err, missing)) << run.err;
+}
+
+TEST(Cli, NonNativeTableSaysWhichOptionsToGive) {
+  TempDir dir;
+  const std::string log = dir.Write("imu.log", "-8.42 0.06 5.24 0.035 0.002 0.041\n");
+  const ToolRun run = Plumb({"calibrate", log}, dir);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_TRUE(Contains(run.err, log)) << run.err;
+  EXPECT_TRUE(Contains(run.err, "--columns")) << run.err;
+  EXPECT_TRUE(Contains(run.err, "--rate")) << run.err;
+}
+
+TEST(Cli, EffectsListsTheCatalogueWithUnits) {
+  TempDir dir;
+  const ToolRun run = Plumb({"effects"}, dir);
+  EXPECT_EQ(run.exit_code, 0);
+  for (const char* part : {"accel_linear", "gyro_g_sensitivity", "y_g += G f_b",
+                           "gyro_g_sensitivity.G.xy", "rad/s per m/s^2", "time_offset"}) {
+    EXPECT_TRUE(Contains(run.out, part)) << part;
+  }
+}
+
+TEST(Cli, UnknownEffectIsAnErrorNamingIt) {
+  TempDir dir;
+  const ToolRun run = Plumb({"effects", "no_such_effect"}, dir);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_TRUE(Contains(run.err, "no_such_effect")) << run.err;
+}
+
+TEST(Cli, SimulateThenCalibrateRecoversTheTruthWithinThreeSigma) {
+  TempDir dir;
+  const SimulatedSession s = Simulate(dir);
+  const std::string out = dir.File("calibration.json");
+  const ToolRun run = Calibrate({s.csv}, out, {}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "still segments: 12 detected")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "wrote " + out));
+
+  const json doc = ReadJson(out);
+  ExpectCalibrationKeys(doc);
+  EXPECT_TRUE(AllNumbersFinite(doc));
+  EXPECT_EQ(doc["fit"]["segments"]["still"], 12);
+  EXPECT_EQ(doc["fit"]["converged"], true);
+  std::map<std::string, double> truth;
+  const json truth_doc = ReadJson(s.truth);
+  for (const auto& p : truth_doc["parameters"]) truth[p["name"]] = p["value"];
+  ASSERT_EQ(doc["parameters"].size(), truth.size());
+  for (const auto& p : doc["parameters"]) {
+    const std::string name = p["name"];
+    ASSERT_TRUE(p["sigma"].is_number()) << name << " has no sigma";
+    const double sigma = p["sigma"];
+    EXPECT_LT(std::abs(p["value"].get<double>() - truth.at(name)), 3.0 * sigma)
+        << name << ": " << p["value"] << " vs truth " << truth.at(name) << " +- " << sigma;
+  }
+}
+
+TEST(Cli, GivenSegmentsFileReplacesDetection) {
+  TempDir dir;
+  const SimulatedSession s = Simulate(dir);
+  const std::string out = dir.File("calibration.json");
+  const ToolRun run = Calibrate({s.csv}, out, {"--segments", s.segments}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "still segments: 12 given in " + s.segments)) << run.out;
+  const json doc = ReadJson(out);
+  EXPECT_EQ(doc["segmentation"]["method"], "given");
+  EXPECT_EQ(doc["segments"][0]["label"], "pose 1 (z down)");
+}
+
+TEST(Cli, TwoFileFormGivesTheSameCalibrationAsNativeCsv) {
+  TempDir dir;
+  const SimulatedSession s = Simulate(dir);
+  const std::string acc = dir.File("acc.txt"), gyr = dir.File("gyr.txt");
+  SplitNativeCsv(s.csv, acc, gyr);
+  const std::string native = dir.File("native.json"), pair = dir.File("pair.json"),
+                    flags = dir.File("flags.json");
+  ASSERT_EQ(Calibrate({s.csv}, native, {}, dir).exit_code, 0);
+  const ToolRun pair_run = Calibrate({acc + "," + gyr}, pair, {}, dir);
+  ASSERT_EQ(pair_run.exit_code, 0) << pair_run.err;
+  const ToolRun flags_run = Calibrate({}, flags, {"--acc", acc, "--gyr", gyr}, dir);
+  ASSERT_EQ(flags_run.exit_code, 0) << flags_run.err;
+  const json expected = ReadJson(native)["accel"]["matrix"];
+  EXPECT_EQ(ReadJson(pair)["accel"]["matrix"], expected);
+  EXPECT_EQ(ReadJson(flags)["accel"]["matrix"], expected);
+}
+
+TEST(Cli, StrictFailsWhenThePosesCannotDetermineTheModel) {
+  TempDir dir;
+  const std::string csv = dir.File("three.csv");
+  const ToolRun sim = Plumb({"simulate", "--out", csv, "--poses", "3", "--still", "4", "--turn",
+                             "1.5", "--rate", "100", "--seed", "2"},
+                            dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const ToolRun run = Plumb({"calibrate", csv, "--strict"}, dir);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_TRUE(Contains(run.err, "distinct orientations")) << run.err;
+}
+
+TEST(Cli, MikoffSessionCalibratesAndWritesEverySpecKey) {
+  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/multipose/mikoff/imu0.log";
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  const std::string out = dir.File("imu0.json");
+  const ToolRun run = Plumb(
+      {"calibrate", log, "--columns", "ax,ay,az,gx,gy,gz", "--rate", "100", "--json", out}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "still segments: ")) << run.out;
+  const std::string text = testing::ReadAll(out);
+  EXPECT_FALSE(std::regex_search(text, std::regex("[:,\\[]\\s*-?(nan|inf)", std::regex::icase)));
+  const json doc = ReadJson(out);
+  ExpectCalibrationKeys(doc);
+  EXPECT_TRUE(AllNumbersFinite(doc));
+  EXPECT_EQ(doc["site"]["source"], "none");
+  EXPECT_TRUE(doc["site"]["lat_deg"].is_null());
+  EXPECT_GE(doc["fit"]["segments"]["still"].get<int>(), 1);
+}
+
+}  // namespace
+}  // namespace plumb::cli

@@ -1,0 +1,77 @@
+// Runs the plumb command as a child process (fork/exec, no shell) and captures its exit code,
+// standard output and standard error, in the spirit of GeographicLib's command-line tests.
+#pragma once
+
+#include <fcntl.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace plumb::cli::testing {
+
+struct ToolRun {
+  int exit_code = -1;  ///< the process's exit status; -1 if it did not exit normally
+  std::string out;     ///< standard output
+  std::string err;     ///< standard error
+};
+
+inline std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+/// A fresh folder under the system temporary folder, removed with its content at the end.
+class TempDir {
+ public:
+  TempDir() {
+    std::string templ = (std::filesystem::temp_directory_path() / "plumb_cli_test.XXXXXX").string();
+    path_ = ::mkdtemp(templ.data());
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
+  std::string Write(const std::string& name, const std::string& content) const {
+    std::ofstream(File(name), std::ios::binary) << content;
+    return File(name);
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Runs `tool args...`; stdout and stderr go to files in `dir`, read back after the exit.
+inline ToolRun Run(const std::string& tool, const std::vector<std::string>& args,
+                   const TempDir& dir) {
+  const std::string out_path = dir.File(".stdout"), err_path = dir.File(".stderr");
+  std::vector<std::string> argv_text = {tool};
+  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  ToolRun run;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out, STDOUT_FILENO);
+    ::dup2(err, STDERR_FILENO);
+    ::execv(tool.c_str(), argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  if (pid > 0 && ::waitpid(pid, &status, 0) == pid && WIFEXITED(status)) {
+    run.exit_code = WEXITSTATUS(status);
+  }
+  run.out = ReadAll(out_path);
+  run.err = ReadAll(err_path);
+  return run;
+}
+
+}  // namespace plumb::cli::testing
