@@ -92,12 +92,30 @@ double GuessGyroScale(const ImuSeries& series,
     }
     return c;
   };
-  double best = 0.0, best_cost = cost(0.0);
-  for (double e = -7.0; e <= 7.0; e += 0.25) {
-    const double c = cost(e);
-    if (c < best_cost) {
-      best_cost = c;
-      best = e;
+  // A first estimate: the angle between the down directions over the integrated raw angle,
+  // from the intervals that turn the IMU by more than 20 degrees (a turn about the vertical
+  // shows no change of down: such intervals count only in the refinement).
+  std::vector<double> ratios;
+  for (std::size_t k = 0; k < intervals.size(); ++k) {
+    const double angle = std::acos(std::clamp(down_before[k].dot(down_after[k]), -1.0, 1.0));
+    Vec3 raw = Vec3::Zero();
+    for (std::size_t i = intervals[k].first; i < intervals[k].second; ++i) {
+      raw += (series.gyr[i].cast<double>() - bias) * (series.t_s[i + 1] - series.t_s[i]);
+    }
+    if (angle > 0.35 && raw.norm() > 0) ratios.push_back(angle / raw.norm());
+  }
+  double best = 0.0;
+  if (!ratios.empty()) {
+    std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
+    best = std::log10(ratios[ratios.size() / 2]);
+  } else {
+    double best_cost = cost(0.0);
+    for (double e = -7.0; e <= 7.0; e += 0.25) {
+      const double c = cost(e);
+      if (c < best_cost) {
+        best_cost = c;
+        best = e;
+      }
     }
   }
   // Golden-section refinement within one grid step either side.
@@ -105,7 +123,7 @@ double GuessGyroScale(const ImuSeries& series,
   const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
   double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
   double f1 = cost(x1), f2 = cost(x2);
-  for (int it = 0; it < 20; ++it) {
+  for (int it = 0; it < 16; ++it) {
     if (f1 < f2) {
       b = x2; x2 = x1; f2 = f1; x1 = b - phi * (b - a); f1 = cost(x1);
     } else {

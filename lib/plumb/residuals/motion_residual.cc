@@ -126,29 +126,34 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   const Vec3 omega_k = R_k.transpose() * omega_ie_n_;  // Earth rate in b_k
   const Mat3 d_omega_k = R_k.transpose() * Skew(omega_ie_n_);  // d omega_k / d delta_k
   Mat3 dR = Mat3::Identity();
+  // A = d(right perturbation of dR)/d(unknowns), propagated step by step. With
+  // C0 = h/2 I - h^2/12 [u1]x and C1 = h/2 I + h^2/12 [u0]x,
+  //   d phi = C0 dU0 + C1 dU1,  dU = W - d e,  d e = [e]x A + [0 | dR^T d omega_k],
+  //   A' = Exp(phi)^T A + J_r(phi) d phi
+  //      = (Exp(phi)^T - J_r (C0 + C1) [e]x) A + J_r C0 W_i + J_r C1 W_i+1
+  //        - [0 | J_r (C0 + C1) dR^T d omega_k].
   Eigen::Matrix<double, 3, Eigen::Dynamic> A = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, U);
-  Eigen::Matrix<double, 3, Eigen::Dynamic> dU0(3, U), dU1(3, U), dphi(3, U);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> A_next(3, U);
   for (std::size_t i = 0; i + 1 < s_.size(); ++i) {
     const double h = s_.dt_s[i + 1] - s_.dt_s[i];
     // Earth rate at the start of the step, held over the step.
     const Vec3 e = dR.transpose() * omega_k;
     const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
     const Vec3 phi = 0.5 * h * (u0 + u1) + (h * h / 12.0) * u0.cross(u1);
+    const Mat3 Ex = so3::Exp(phi);
     if (want_jacobians) {
-      // d e = [e]x A d(unknowns) (through dR) + dR^T d omega_k (through R_k).
-      Eigen::Matrix<double, 3, Eigen::Dynamic> de = Skew(e) * A;
-      de.rightCols<3>() += dR.transpose() * d_omega_k;
-      dU0 = -de;
-      dU1 = -de;
-      dU0.leftCols(P) += W[i];
-      dU1.leftCols(P) += W[i + 1];
-      dphi = 0.5 * h * (dU0 + dU1) + (h * h / 12.0) * (-Skew(u1) * dU0 + Skew(u0) * dU1);
-      const Mat3 Ex = so3::Exp(phi);
-      A = Ex.transpose() * A + so3::RightJacobian(phi) * dphi;
-      dR = dR * Ex;
-    } else {
-      dR = dR * so3::Exp(phi);
+      const Mat3 Jr = so3::RightJacobian(phi);
+      const Mat3 K0 = Jr * (0.5 * h * Mat3::Identity() - (h * h / 12.0) * Skew(u1));
+      const Mat3 K1 = Jr * (0.5 * h * Mat3::Identity() + (h * h / 12.0) * Skew(u0));
+      const Mat3 K = K0 + K1;
+      const Mat3 G = Ex.transpose() - K * Skew(e);
+      A_next.noalias() = G * A;
+      A_next.leftCols(P).noalias() += K0 * W[i];
+      A_next.leftCols(P).noalias() += K1 * W[i + 1];
+      A_next.rightCols<3>().noalias() -= K * (dR.transpose() * d_omega_k);
+      A.swap(A_next);
     }
+    dR = dR * Ex;
   }
   const Mat3 M = dR.transpose() * R_k.transpose();
   const Vec3 r = so3::Log(M * R_k1);
