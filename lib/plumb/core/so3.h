@@ -43,9 +43,10 @@ inline Quat ExpQuat(const Vec3& phi) {
   const double a = phi.norm();
   const double half = 0.5 * a;
   // sin(a/2)/a by series for small angles.
-  const double s = a < 0.05 ? 0.5 * (1.0 - half * half / 6.0 * (1.0 - half * half / 20.0))
+  const double x2 = half * half;
+  const double s = a < 0.05 ? 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
                             : std::sin(half) / a;
-  const double c = a < 0.05 ? 1.0 - half * half / 2.0 * (1.0 - half * half / 12.0) : std::cos(half);
+  const double c = a < 0.05 ? 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0)) : std::cos(half);
   return Quat(c, s * phi.x(), s * phi.y(), s * phi.z());
 }
 
