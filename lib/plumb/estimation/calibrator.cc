@@ -489,6 +489,9 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     StillSegmentFit f;
     f.segment = s.segment;
     f.t_mid_s = s.stats.t_mid_s;
+    f.count = s.stats.count;
+    f.acc_mean = s.stats.acc_mean;
+    if (result.has_gyro) f.gyr_mean = s.stats.gyr_mean;
     f.R_n_b = ToQuat(s.q);
     f.attitude_known = s.known;
     f.acc_residual = s.stats.acc_mean - s.acc_functor->Predict(s.q.data(), theta);

@@ -47,6 +47,9 @@ struct Observability {
 struct StillSegmentFit {
   StillSegment segment;
   double t_mid_s = 0;
+  std::size_t count = 0;             ///< samples in the segment
+  Vec3 acc_mean = Vec3::Zero();      ///< measured mean output, sensor units
+  Vec3 gyr_mean = Vec3::Zero();
   Vec3 acc_residual = Vec3::Zero();  ///< measured minus predicted mean, sensor units
   Vec3 gyr_residual = Vec3::Zero();
   Vec3 acc_whitened = Vec3::Zero();
