@@ -156,6 +156,8 @@ class CalibrateCommand : public Command {
     }
     segmentation::StillDetectorOptions detector = args_.detector;
     detector.use_gyro = !args_.still_accel_only;
+    detector.acc_unit = series.acc_unit;
+    detector.gyr_unit = series.gyr_unit;
     return segmentation::DetectStillSegments(series, detector);
   }
 

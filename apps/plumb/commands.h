@@ -33,5 +33,6 @@ class Command {
 std::unique_ptr<Command> MakeCalibrateCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeSimulateCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeEffectsCommand(CLI::App& parent);
+std::unique_ptr<Command> MakeCompareCommand(CLI::App& parent);
 
 }  // namespace plumb::cli

@@ -231,16 +231,20 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
           ->add_option("--rate", a.rate_hz,
                        "Sample rate, Hz, when the table has no time column (time = row / rate)")
           ->check(CLI::PositiveNumber),
-      group->add_option("--acc-unit", a.acc_unit, "Accelerometer unit in the file: m/s^2 or g")
-          ->check(CLI::IsMember({"m/s^2", "m/s2", "g"})),
+      group->add_option("--acc-unit", a.acc_unit,
+                        "Accelerometer unit in the file: m/s^2, g, or counts (unscaled sensor "
+                        "output: calibrated in counts, the matrix then in counts per m/s^2)")
+          ->check(CLI::IsMember({"m/s^2", "m/s2", "g", "counts"})),
       group->add_option("--acc-scale", a.acc_scale,
                         "Accelerometer units per count, number or fraction (1/16384 for a +-2 g "
                         "MPU-6050 with --acc-unit g); SI = (value - offset) * scale * unit"),
       group->add_option("--acc-offset", a.acc_offset,
                         "Subtracted from every accelerometer value first, file units (32768 for "
                         "offset-binary counts)"),
-      group->add_option("--gyr-unit", a.gyr_unit, "Gyroscope unit in the file: rad/s or deg/s")
-          ->check(CLI::IsMember({"rad/s", "deg/s"})),
+      group->add_option("--gyr-unit", a.gyr_unit,
+                        "Gyroscope unit in the file: rad/s, deg/s, or counts (unscaled sensor "
+                        "output: calibrated in counts, the matrix then in counts per rad/s)")
+          ->check(CLI::IsMember({"rad/s", "deg/s", "counts"})),
       group->add_option("--gyr-scale", a.gyr_scale,
                         "Gyroscope units per count, number or fraction (1/131 for a +-250 deg/s "
                         "MPU-6050 with --gyr-unit deg/s)"),
@@ -310,6 +314,8 @@ Session ReadInputs(const InputArgs& a) {
       }
       s = ReadNative(input, a.format == "native");
     }
+    if (a.acc_unit == "counts") s.series.acc_unit = "counts";
+    if (a.gyr_unit == "counts") s.series.gyr_unit = "counts";
     if (!joined) {
       joined = std::move(s);
     } else {

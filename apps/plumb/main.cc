@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   commands.push_back(plumb::cli::MakeCalibrateCommand(app));
   commands.push_back(plumb::cli::MakeSimulateCommand(app));
   commands.push_back(plumb::cli::MakeEffectsCommand(app));
+  commands.push_back(plumb::cli::MakeCompareCommand(app));
 
   try {
     app.parse(argc, argv);

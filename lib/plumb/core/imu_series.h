@@ -24,6 +24,11 @@ struct ImuSeries {
   std::vector<Vec3f> gyr;
   /// Sensor temperature, degC. Empty when the input has none.
   std::vector<float> temp_c;
+  /// Units of the accelerometer and gyroscope samples: SI unless the reader was told the
+  /// file holds unscaled sensor output (e.g. "counts"); calibrated matrices then map SI
+  /// inputs to these units, and biases are in them.
+  std::string acc_unit = "m/s^2";
+  std::string gyr_unit = "rad/s";
 
   std::size_t size() const { return t_s.size(); }
   bool empty() const { return t_s.empty(); }

@@ -65,6 +65,19 @@ void CheckEffectData(const model::Model& model, const ImuSeries& series) {
   }
 }
 
+/// Unit of a reported parameter: the catalogue's SI unit, or, for the base effects on
+/// unscaled sensor output, that output's unit (bias) and unit per SI input (matrix).
+std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series) {
+  const std::string& si = info.parameters[static_cast<std::size_t>(i)].unit;
+  if (!info.linear_stage) return si;
+  const bool accel = info.sensor == model::Sensor::kAccel;
+  const std::string& out = accel ? series.acc_unit : series.gyr_unit;
+  const std::string in = accel ? "m/s^2" : "rad/s";
+  if (out == in) return si;
+  const bool matrix = info.parameters[static_cast<std::size_t>(i)].name.rfind("matrix.", 0) == 0;
+  return matrix ? out + " per " + in : out;
+}
+
 }  // namespace
 
 int CountDistinctOrientations(const std::vector<Vec3>& acc_means, double min_angle_deg) {
@@ -93,6 +106,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   }
   CheckEffectData(model, series);
   result.has_gyro = model.has_gyro();
+  result.acc_unit = series.acc_unit;
+  result.gyr_unit = series.gyr_unit;
 
   // Still segments and their statistics.
   std::vector<Still> still;
@@ -442,7 +457,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     for (int i = 0; i < info.size(); ++i, ++flat) {
       ParameterEstimate p;
       p.name = info.ParameterName(i);
-      p.unit = info.parameters[static_cast<std::size_t>(i)].unit;
+      p.unit = UnitOf(info, i, series);
       p.value = all_values[static_cast<std::size_t>(flat)];
       p.fixed = term.fixed[static_cast<std::size_t>(i)];
       const auto col = std::find(model_index.begin(), model_index.end(), std::make_pair(t, i));

@@ -40,12 +40,15 @@ std::string CalibrationResult::FullReport() const {
                                       Format("%.1f", site.height_m) + " m (" + site.source + ")"
                                 : std::string("none"))
      << ", gravity " << Format("%.6f", site.gravity()) << " m/s^2\n";
-  os << "residual RMS per axis: accel " << Vec(fit.rms_acc) << " m/s^2";
-  if (has_gyro) os << ", gyro " << Vec(fit.rms_gyr) << " rad/s";
+  os << "residual RMS per axis: accel " << Vec(fit.rms_acc) << " " << acc_unit;
+  if (has_gyro) os << ", gyro " << Vec(fit.rms_gyr) << " " << gyr_unit;
   if (fit.motion_segments > 0) os << ", motion " << Vec(fit.rms_motion) << " rad";
-  os << "\nnoise per sample: accel " << Vec(noise_acc) << " (tau " << Format("%.2f", tau_acc)
-     << " samples)";
-  if (has_gyro) os << ", gyro " << Vec(noise_gyr) << " (tau " << Format("%.2f", tau_gyr) << ")";
+  os << "\nnoise per sample: accel " << Vec(noise_acc) << " " << acc_unit << " (tau "
+     << Format("%.2f", tau_acc) << " samples)";
+  if (has_gyro) {
+    os << ", gyro " << Vec(noise_gyr) << " " << gyr_unit << " (tau " << Format("%.2f", tau_gyr)
+       << ")";
+  }
   os << "\n\n";
   char line[160];
   std::snprintf(line, sizeof line, "%-34s %15s %12s  %s\n", "parameter", "value", "sigma", "unit");

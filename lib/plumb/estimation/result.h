@@ -96,6 +96,8 @@ struct CalibrationResult {
   Mat3 gyro_matrix = Mat3::Identity();
   Vec3 gyro_bias = Vec3::Zero();
   bool has_gyro = false;
+  std::string acc_unit = "m/s^2";  ///< units of the accelerometer samples (see ImuSeries)
+  std::string gyr_unit = "rad/s";
   FitSummary fit;
   Observability observability;
   geo::Site site;

@@ -10,19 +10,19 @@
 // all-zero value means "no effect" (for the linear effects: F = I, b = 0), so every effect is
 // the identity at zero, as basalt's calib_bias.hpp is.
 //
-// Writing an effect (worked example, see docs/extending.md and tests/model/effect_test.cc):
+// Writing an effect (worked example, see docs/extending.md and tests/model/effects_test.cc):
 //
 //   // lib/plumb/model/effects/accel_bias_drift.cc
 //   class AccelBiasDrift : public EffectBase<AccelBiasDrift> {
 //    public:
-//     AccelBiasDrift() : EffectBase(MakeInfo()) {}
+//     explicit AccelBiasDrift(const std::string& option) : EffectBase(MakeInfo(option)) {}
 //     template <typename T>
 //     void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
 //       Eigen::Map<const Vec3T<T>> d_a(theta);   // m/s^3
 //       out.acc += d_a * in.dt_s;
 //     }
 //   };
-//   PLUMB_DEFINE_EFFECT(accel_bias_drift, AccelBiasDrift)
+//   PLUMB_DEFINE_EFFECT(accel_bias_drift, ::plumb::model::AccelBiasDrift)
 //
 // and one line `accel_bias_drift` in lib/plumb/model/effects/effects.cmake. The effect then
 // appears in `plumb calibrate --model base+accel_bias_drift`, in the simulator and in diagnose.

@@ -1,0 +1,105 @@
+// plumb compare RESULT.json --imu-tk ACC.calib GYRO.calib | --imu-tk-params FILE |
+//               --imucal CAL.json [--gravity G] [--json FILE]
+//
+// Sets plumb's calibration (what `plumb calibrate --json` wrote) beside another tool's answer,
+// both in plumb's forward form (plumb/peers), prints the side-by-side table and imu_tk's
+// accelerometer cost of both on plumb's still segments, and writes the comparison as JSON.
+#include <iostream>
+
+#include "commands.h"
+#include "plumb/peers/comparison.h"
+#include "plumb/peers/imu_tk.h"
+#include "plumb/peers/imucal.h"
+#include "plumb/peers/plumb_result.h"
+#include "plumb/report/json_report.h"
+
+namespace plumb::cli {
+namespace {
+
+struct CompareArgs {
+  std::string result_path;              ///< RESULT.json of plumb calibrate --json
+  std::vector<std::string> imu_tk;      ///< --imu-tk ACC.calib GYRO.calib
+  std::string imu_tk_params;            ///< --imu-tk-params full_precision_params.txt
+  std::string imucal;                   ///< --imucal CAL.json
+  double gravity_m_s2 = 0.0;            ///< --gravity, m/s^2, > 0; 0 = the result's
+  std::string json_path;                ///< --json FILE
+};
+
+class CompareCommand : public Command {
+ public:
+  explicit CompareCommand(CLI::App& parent) {
+    app_ = parent.add_subcommand(
+        "compare",
+        "Compare plumb's calibration (calibrate --json) with another tool's answer on the same "
+        "data, parameter by parameter in plumb's forward form");
+    CompareArgs& a = args_;
+    app_->add_option("RESULT", a.result_path, "The JSON that 'plumb calibrate --json' wrote")
+        ->required()
+        ->type_name("RESULT.json");
+    auto* tk = app_->add_option("--imu-tk", a.imu_tk,
+                                "imu_tk's accelerometer and gyroscope .calib files "
+                                "(calibrated = T K (raw - B))")
+                   ->expected(2)
+                   ->type_name("ACC.calib GYRO.calib");
+    auto* tk_full = app_->add_option("--imu-tk-params", a.imu_tk_params,
+                                     "imu_tk's answer in full precision (sections ACC and GYRO "
+                                     "with T=, K=, B=), instead of the rounded .calib files")
+                        ->type_name("FILE");
+    auto* cal = app_->add_option("--imucal", a.imucal,
+                                 "imucal's Ferraris (or Turntable) calibration JSON")
+                    ->type_name("CAL.json");
+    tk->excludes(tk_full)->excludes(cal);
+    tk_full->excludes(cal);
+    app_->add_option("--gravity", a.gravity_m_s2,
+                     "Gravity magnitude of imu_tk's cost, m/s^2 (default: the result's "
+                     "site.gravity; imu_tk's demo used 9.81744)")
+        ->check(CLI::PositiveNumber);
+    app_->add_option("--json", a.json_path, "Also write the comparison as JSON to FILE")
+        ->type_name("FILE");
+  }
+
+  int Run() override {
+    const CompareArgs& a = args_;
+    const peers::ForwardCalibration peer = ReadPeer();
+    const peers::PlumbResult result = peers::ReadPlumbResult(a.result_path);
+    peers::CompareOptions options;
+    options.gravity_m_s2 = a.gravity_m_s2;
+    const peers::Comparison comparison = peers::Compare(result, peer, options);
+    std::cout << peers::ComparisonText(comparison);
+    if (!a.json_path.empty()) {
+      report::WriteJson(a.json_path, peers::ComparisonJson(comparison));
+      std::cout << "wrote " << a.json_path << "\n";
+    }
+    return 0;
+  }
+
+ private:
+  peers::ForwardCalibration ReadPeer() const {
+    const CompareArgs& a = args_;
+    if (!a.imu_tk.empty()) {
+      peers::ImuTkCalibration c;
+      c.acc = peers::ReadImuTkCalib(a.imu_tk[0]);
+      c.gyro = peers::ReadImuTkCalib(a.imu_tk[1]);
+      return peers::ImuTkToForward(c, a.imu_tk);
+    }
+    if (!a.imu_tk_params.empty()) {
+      return peers::ImuTkToForward(peers::ReadImuTkFullPrecision(a.imu_tk_params),
+                                   {a.imu_tk_params});
+    }
+    if (!a.imucal.empty()) {
+      return peers::ImucalToForward(peers::ReadImucalJson(a.imucal), a.imucal);
+    }
+    throw UsageError("name the other tool's answer: --imu-tk ACC.calib GYRO.calib, "
+                     "--imu-tk-params FILE or --imucal CAL.json");
+  }
+
+  CompareArgs args_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeCompareCommand(CLI::App& parent) {
+  return std::make_unique<CompareCommand>(parent);
+}
+
+}  // namespace plumb::cli

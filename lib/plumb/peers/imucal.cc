@@ -1,0 +1,107 @@
+#include "plumb/peers/imucal.h"
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "plumb/core/error.h"
+#include "plumb/peers/json_fields.h"
+
+namespace plumb::peers {
+namespace {
+
+using nlohmann::json;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kStandardGravity = 9.80665;  // m/s^2, imucal's "g"
+
+Mat3 MatrixKey(const json& root, const std::string& path, const std::string& key) {
+  return detail::Matrix3(detail::Field(root, key, path, key, "3 rows of 3 numbers"), path, key);
+}
+
+Vec3 VectorKey(const json& root, const std::string& path, const std::string& key) {
+  return detail::Vector3(detail::Field(root, key, path, key, "[x, y, z]"), path, key);
+}
+
+std::string Text(const json& root, const std::string& key, const std::string& fallback) {
+  return root.contains(key) && root.at(key).is_string() ? root.at(key).get<std::string>() : fallback;
+}
+
+/// SI value of one output unit; unknown units are kept as they are (1), with a note.
+double OutputScale(const std::string& unit, const std::string& what, ForwardCalibration& f) {
+  const double si = SiPerUnit(unit);
+  if (si > 0.0) return si;
+  f.notes.push_back(what + " output unit '" + unit +
+                    "' is not one plumb converts: values kept in that unit (give plumb the "
+                    "same raw data without unit conversion)");
+  return 1.0;
+}
+
+double CalibratedScale(const std::string& unit, const std::string& what) {
+  const double si = SiPerUnit(unit);
+  if (si > 0.0) return si;
+  throw Error("imucal " + what + " calibrated unit '" + unit +
+              "' is unknown (expected m/s^2, g, rad/s or deg/s)");
+}
+
+}  // namespace
+
+double SiPerUnit(const std::string& unit) {
+  if (unit == "m/s^2" || unit == "m/s2") return 1.0;
+  if (unit == "g") return kStandardGravity;
+  if (unit == "rad/s") return 1.0;
+  if (unit == "deg/s" || unit == "dps") return kPi / 180.0;
+  return 0.0;
+}
+
+ImucalFerraris ReadImucalJson(const std::string& path) {
+  const json root = detail::ParseJsonFile(path);
+  if (!root.is_object()) throw InputError(path, "", "expected imucal's calibration JSON object");
+  ImucalFerraris c;
+  c.cal_type = Text(root, "cal_type", "");
+  if (c.cal_type != "Ferraris" && c.cal_type != "Turntable") {
+    throw InputError(path, "key 'cal_type'",
+                     "expected \"Ferraris\" or \"Turntable\", found '" + c.cal_type + "'");
+  }
+  c.acc_unit = Text(root, "acc_unit", "m/s^2");
+  c.gyr_unit = Text(root, "gyr_unit", "deg/s");
+  c.from_acc_unit = Text(root, "from_acc_unit", "a.u.");
+  c.from_gyr_unit = Text(root, "from_gyr_unit", "a.u.");
+  c.K_a = MatrixKey(root, path, "K_a");
+  c.R_a = MatrixKey(root, path, "R_a");
+  c.b_a = VectorKey(root, path, "b_a");
+  c.K_g = MatrixKey(root, path, "K_g");
+  c.R_g = MatrixKey(root, path, "R_g");
+  c.K_ga = MatrixKey(root, path, "K_ga");
+  c.b_g = VectorKey(root, path, "b_g");
+  return c;
+}
+
+ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string& source) {
+  ForwardCalibration f;
+  f.peer = "imucal";
+  f.sources = {source};
+  const double out_a = OutputScale(cal.from_acc_unit, "accelerometer", f);
+  const double out_g = OutputScale(cal.from_gyr_unit, "gyroscope", f);
+  const double cal_a = CalibratedScale(cal.acc_unit, "accelerometer");
+  const double cal_g = CalibratedScale(cal.gyr_unit, "gyroscope");
+  f.accel_matrix = UpperTriangularFrame((out_a / cal_a) * cal.K_a * cal.R_a, f.R_peer_b);
+  f.accel_bias = out_a * cal.b_a;
+  f.has_gyro = true;
+  f.gyro_matrix = (out_g / cal_g) * cal.K_g * cal.R_g * f.R_peer_b;
+  f.gyro_bias = out_g * cal.b_g;
+  f.has_g_sensitivity = true;
+  f.g_sensitivity = (out_g / cal_a) * cal.K_ga * f.R_peer_b;
+  const double angle_deg =
+      std::acos(std::clamp((f.R_peer_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / kPi;
+  f.notes.push_back(
+      "imucal applies acc_cal = R_a^-1 K_a^-1 (acc - b_a), gyr_cal = R_g^-1 K_g^-1 (gyr - K_ga "
+      "acc_cal - b_g); forward form F = K_a R_a R, E = K_g R_g R, G = K_ga R, converted to SI");
+  f.notes.push_back("imucal's frame (its six poses) is turned by " + std::to_string(angle_deg) +
+                    " deg from plumb's accelerometer-defined frame (R_peer_b)");
+  f.notes.push_back(
+      "imucal's gyroscope bias is the mean of its six static poses, Earth rate included");
+  return f;
+}
+
+}  // namespace plumb::peers

@@ -1,0 +1,125 @@
+#include "plumb/peers/plumb_result.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "plumb/core/error.h"
+#include "plumb/peers/json_fields.h"
+
+namespace plumb::peers {
+namespace {
+
+using nlohmann::json;
+using detail::Field;
+using detail::KeyPlace;
+
+std::string TextOr(const json& object, const std::string& key, const std::string& fallback) {
+  return object.is_object() && object.contains(key) && object.at(key).is_string()
+             ? object.at(key).get<std::string>()
+             : fallback;
+}
+
+bool BoolOr(const json& object, const std::string& key, bool fallback) {
+  return object.contains(key) && object.at(key).is_boolean() ? object.at(key).get<bool>() : fallback;
+}
+
+/// A number, or NaN when the key is absent or null (plumb writes null for non-finite values).
+double NumberOr(const json& object, const std::string& key, double fallback) {
+  if (!object.is_object() || !object.contains(key) || !object.at(key).is_number()) return fallback;
+  return object.at(key).get<double>();
+}
+
+void ReadSensor(const json& root, const std::string& name, const std::string& path, Mat3& matrix,
+                Vec3& bias) {
+  const json& sensor = Field(root, name, path, name, "{\"matrix\": ..., \"bias\": ...}");
+  matrix = detail::Matrix3(Field(sensor, "matrix", path, name + ".matrix", "3 rows of 3 numbers"),
+                           path, name + ".matrix");
+  bias = detail::Vector3(Field(sensor, "bias", path, name + ".bias", "[x, y, z]"), path,
+                         name + ".bias");
+}
+
+PlumbParameter ReadParameter(const json& p, const std::string& path, std::size_t index) {
+  const std::string where = "parameters[" + std::to_string(index) + "]";
+  PlumbParameter out;
+  const json& name = Field(p, "name", path, where + ".name", "a parameter name");
+  if (!name.is_string()) throw InputError(path, KeyPlace(where + ".name"), "expected a string");
+  out.name = name.get<std::string>();
+  out.value = detail::FiniteNumber(Field(p, "value", path, where + ".value", "a number"), path,
+                                   where + ".value");
+  if (p.contains("sigma") && !p.at("sigma").is_null()) {
+    out.sigma = detail::FiniteNumber(p.at("sigma"), path, where + ".sigma");
+  }
+  out.observable = BoolOr(p, "observable", true);
+  out.fixed = BoolOr(p, "fixed", false);
+  out.unit = TextOr(p, "unit", "");
+  return out;
+}
+
+PlumbStillSegment ReadSegment(const json& s, const std::string& path, std::size_t index) {
+  const std::string where = "segments[" + std::to_string(index) + "]";
+  PlumbStillSegment out;
+  out.label = TextOr(s, "label", where);
+  out.acc_mean = detail::Vector3(
+      Field(s, "acc_mean", path, where + ".acc_mean", "the segment's mean accelerometer output"),
+      path, where + ".acc_mean");
+  out.count = detail::FiniteNumber(
+      Field(s, "count", path, where + ".count", "the segment's number of samples"), path,
+      where + ".count");
+  if (out.count < 0) throw InputError(path, KeyPlace(where + ".count"), "expected a count >= 0");
+  return out;
+}
+
+}  // namespace
+
+PlumbResult ReadPlumbResult(const std::string& path) {
+  const json root = detail::ParseJsonFile(path);
+  if (!root.is_object()) {
+    throw InputError(path, "", "expected the JSON object that 'plumb calibrate --json' writes");
+  }
+  PlumbResult r;
+  r.path = path;
+  r.method = TextOr(root, "method", "");
+  r.model = TextOr(root, "model", "");
+  ReadSensor(root, "accel", path, r.accel_matrix, r.accel_bias);
+  r.has_gyro = root.contains("gyro") && !root.at("gyro").is_null();
+  if (r.has_gyro) ReadSensor(root, "gyro", path, r.gyro_matrix, r.gyro_bias);
+
+  const json& params = Field(root, "parameters", path, "parameters", "a list of parameters");
+  if (!params.is_array()) throw InputError(path, KeyPlace("parameters"), "expected a list");
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    r.parameters.push_back(ReadParameter(params[i], path, i));
+  }
+  if (root.contains("segments")) {
+    const json& segments = root.at("segments");
+    if (!segments.is_array()) throw InputError(path, KeyPlace("segments"), "expected a list");
+    for (std::size_t i = 0; i < segments.size(); ++i) {
+      r.segments.push_back(ReadSegment(segments[i], path, i));
+    }
+  }
+  const json empty = json::object();
+  const json& site = root.contains("site") ? root.at("site") : empty;
+  r.gravity_m_s2 = NumberOr(site, "gravity", 0.0);
+  r.site_source = TextOr(site, "source", "");
+  const json& fit = root.contains("fit") ? root.at("fit") : empty;
+  r.chi2_dof = NumberOr(fit, "chi2_dof", std::numeric_limits<double>::quiet_NaN());
+  r.dof = static_cast<long>(NumberOr(fit, "dof", 0.0));
+  if (root.contains("noise") && root.at("noise").contains("accel") &&
+      root.at("noise").at("accel").is_array()) {
+    r.noise_accel = detail::Vector3(root.at("noise").at("accel"), path, "noise.accel");
+  }
+  if (root.contains("inputs") && root.at("inputs").is_array()) {
+    for (const auto& input : root.at("inputs")) {
+      if (input.is_string()) r.inputs.push_back(input.get<std::string>());
+    }
+  }
+  return r;
+}
+
+const PlumbParameter* FindParameter(const PlumbResult& result, const std::string& name) {
+  for (const auto& p : result.parameters) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+}  // namespace plumb::peers

@@ -1,0 +1,63 @@
+// plumb/peers/plumb_result.h — reads back what `plumb calibrate --json` wrote
+// (plumb/report/json_report.h), the part a comparison with another tool needs.
+//
+// Values are in the units of the data plumb was given (SI after plumb's own conversion; raw
+// counts when it was given counts), as in the file.
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plumb/core/types.h"
+
+namespace plumb::peers {
+
+/// One entry of "parameters".
+struct PlumbParameter {
+  std::string name;              ///< e.g. "accel.matrix.xy", "gyro.bias.z"
+  double value = 0.0;            ///< the estimate, in `unit`
+  std::optional<double> sigma;   ///< standard deviation, `unit`; none when fixed/unobservable
+  bool observable = true;
+  bool fixed = false;
+  std::string unit;              ///< as written by plumb ("1", "m/s^2", "rad/s", ...)
+};
+
+/// One entry of "segments" (a still segment).
+struct PlumbStillSegment {
+  std::string label;
+  Vec3 acc_mean = Vec3::Zero();  ///< mean accelerometer output, output units
+  double count = 0.0;            ///< samples in the mean, >= 0
+};
+
+struct PlumbResult {
+  std::string path;    ///< the file read
+  std::string method;  ///< "generalized", ...
+  std::string model;   ///< model spec, e.g. "base"
+  Mat3 accel_matrix = Mat3::Identity();  ///< F, output units per m/s^2
+  Vec3 accel_bias = Vec3::Zero();        ///< b_a, output units
+  bool has_gyro = false;
+  Mat3 gyro_matrix = Mat3::Identity();   ///< E, output units per rad/s
+  Vec3 gyro_bias = Vec3::Zero();         ///< b_g, output units
+  std::vector<PlumbParameter> parameters;
+  std::vector<PlumbStillSegment> segments;  ///< empty when the file has no segment means
+  double gravity_m_s2 = 0.0;     ///< site.gravity, m/s^2; 0 when absent
+  std::string site_source;       ///< "gps", "flags" or "none"
+  double chi2_dof = 0.0;         ///< fit.chi2_dof; NaN when null
+  long dof = 0;                  ///< fit.dof
+  /// noise.accel: per-sample standard deviation of the accelerometer, output units; NaN when
+  /// absent.
+  Vec3 noise_accel = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  std::vector<std::string> inputs;  ///< the data files plumb read
+};
+
+/// Reads the JSON document. Throws plumb::InputError naming `path` and the key when the JSON is
+/// invalid (with its byte offset), or "accel" or "parameters" are missing or malformed; a
+/// segment without acc_mean/count is an error too, a document without "segments" is not.
+PlumbResult ReadPlumbResult(const std::string& path);
+
+/// The parameter called `name`, or nullptr.
+const PlumbParameter* FindParameter(const PlumbResult& result, const std::string& name);
+
+}  // namespace plumb::peers
