@@ -87,7 +87,7 @@ void BM_WriteNativeCsvHour(benchmark::State& state) {
 BENCHMARK(BM_WriteNativeCsvHour)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_ReadMikoffImu0(benchmark::State& state) {
-  const std::string path = std::string(PLUMB_SHARED_DATA_DIR) + "/multipose/mikoff/imu0.log";
+  const std::string path = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";  // bundled
   if (!std::filesystem::exists(path)) {
     state.SkipWithError(("shared data absent: " + path).c_str());
     return;
@@ -105,6 +105,31 @@ void BM_ReadMikoffImu0(benchmark::State& state) {
   SetCounters(state, std::filesystem::file_size(path), samples);
 }
 BENCHMARK(BM_ReadMikoffImu0)->Unit(benchmark::kMillisecond);
+
+/// imu_tk's own data: two `t x y z` files of raw counts (6.6 MB, 51175 samples).
+void BM_ReadImuTkPair(benchmark::State& state) {
+  const std::string dir = std::string(PLUMB_SHARED_DATA_DIR) + "/multipose/imu_tk/";
+  if (!std::filesystem::exists(dir + "xsens_acc.mat")) {
+    state.SkipWithError(("shared data absent: " + dir).c_str());
+    return;
+  }
+  plumb::io::TextTableOptions options;
+  options.time = 0;
+  options.acc.axes = {1, 2, 3};
+  options.gyr.axes = {1, 2, 3};
+  std::size_t samples = 0;
+  for (auto _ : state) {
+    const plumb::Session s =
+        plumb::io::ReadSplitTables(dir + "xsens_acc.mat", dir + "xsens_gyro.mat", options);
+    samples = s.series.size();
+    benchmark::DoNotOptimize(s.series.acc.data());
+  }
+  SetCounters(state,
+              std::filesystem::file_size(dir + "xsens_acc.mat") +
+                  std::filesystem::file_size(dir + "xsens_gyro.mat"),
+              samples);
+}
+BENCHMARK(BM_ReadImuTkPair)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

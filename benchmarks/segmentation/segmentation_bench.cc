@@ -61,7 +61,7 @@ const ImuSeries& OneHourAt1kHz() {
 
 ImuSeries ReadMikoffImu0() {
   ImuSeries s;
-  std::ifstream in(std::string(PLUMB_SHARED_DATA_DIR) + "/multipose/mikoff/imu0.log");
+  std::ifstream in(std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log");  // bundled
   float v[6];
   while (in >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5]) {
     s.t_s.push_back(0.01 * static_cast<double>(s.t_s.size()));
@@ -105,12 +105,39 @@ BENCHMARK(BM_Detect_OneHour1kHz_AccelOnly)->Unit(benchmark::kMillisecond);
 void BM_Detect_MikoffImu0(benchmark::State& state) {
   static const ImuSeries series = ReadMikoffImu0();
   if (series.empty()) {
-    state.SkipWithError("shared data absent: multipose/mikoff/imu0.log");
+    state.SkipWithError("bundled data/mikoff/imu0.log absent");
     return;
   }
   RunDetection(state, series, {});
 }
 BENCHMARK(BM_Detect_MikoffImu0)->Unit(benchmark::kMicrosecond);
+
+/// imu_tk's own data (raw counts, 511 s at 100 Hz) with imu_tk's 50 s initial still period.
+ImuSeries ReadImuTk() {
+  const std::string dir = std::string(PLUMB_SHARED_DATA_DIR) + "/multipose/imu_tk/";
+  std::ifstream acc(dir + "xsens_acc.mat"), gyr(dir + "xsens_gyro.mat");
+  ImuSeries s;
+  double t = 0, tg = 0;
+  float a[3], g[3];
+  while (acc >> t >> a[0] >> a[1] >> a[2] && gyr >> tg >> g[0] >> g[1] >> g[2]) {
+    s.t_s.push_back(t);
+    s.acc.emplace_back(a[0], a[1], a[2]);
+    s.gyr.emplace_back(g[0], g[1], g[2]);
+  }
+  return s;
+}
+
+void BM_Detect_ImuTk(benchmark::State& state) {
+  static const ImuSeries series = ReadImuTk();
+  if (series.empty()) {
+    state.SkipWithError("shared data absent: multipose/imu_tk");
+    return;
+  }
+  plumb::segmentation::StillDetectorOptions options;
+  options.init_still_s = 50.0;
+  RunDetection(state, series, options);
+}
+BENCHMARK(BM_Detect_ImuTk)->Unit(benchmark::kMicrosecond);
 
 void BM_SegmentStats_OneHour1kHz(benchmark::State& state) {
   const ImuSeries& series = OneHourAt1kHz();

@@ -98,6 +98,38 @@ TEST(CalibrateSimulated, CovarianceIsHonestOverMonteCarlo) {
   std::cout << "average NEES " << mean << " (95% band " << lo << " .. " << hi << ")\n";
 }
 
+TEST(CalibrateSimulated, CeresCovarianceEqualsThePseudoInverse) {
+  // Full rank (multi-pose) and rank-deficient (one pose, pivots held) alike: ceres::Covariance
+  // and the column-scaled pseudo-inverse agree on every observable parameter (with one pose
+  // none is observable alone; both must then give no sigma).
+  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  opt.rate_hz = 100.0;
+  opt.truth = sim::RandomParameters(opt.model, 1.0, 21);
+  opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
+  opt.seed = 21;
+  for (const auto& schedule : {sim::MultiPose(12, 3.0, 2.0, 21), sim::PaperStatic(60.0)}) {
+    const sim::Simulation s = sim::Simulate(schedule, opt);
+    std::vector<StillSegment> segments = s.truth_segments;
+    if (segments.size() > 1) {
+      for (auto& seg : segments) seg.known_R_n_b.reset();
+    }
+    CalibrationOptions pinv;
+    pinv.use_ceres_covariance = false;
+    const CalibrationResult a = Calibrate(s.session.series, segments, s.model, s.site);
+    const CalibrationResult b = Calibrate(s.session.series, segments, s.model, s.site, pinv);
+    EXPECT_EQ(a.sigma_source, "ceres::Covariance (DENSE_SVD)");
+    EXPECT_EQ(b.sigma_source, "pseudo-inverse");
+    int compared = 0;
+    for (std::size_t i = 0; i < a.parameters.size(); ++i) {
+      if (!a.parameters[i].observable || a.parameters[i].fixed) continue;
+      EXPECT_NEAR(a.parameters[i].sigma, b.parameters[i].sigma, 1e-6 * b.parameters[i].sigma)
+          << a.parameters[i].name;
+      ++compared;
+    }
+    if (segments.size() > 1) EXPECT_EQ(compared, 21);  // one pose: nothing alone is observable
+  }
+}
+
 /// The paper's one-minute still pose: level, x north, attitude known, site known.
 CalibrationResult CalibratePaperStatic() {
   sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();

@@ -55,7 +55,7 @@ std::string Listing(const ImuSeries& series, const SegmentationResult& result) {
 }
 
 TEST(RealData, MikoffImu0PosesAreFoundAndDistinct) {
-  const std::string path = kMultipose + "/mikoff/imu0.log";
+  const std::string path = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";  // bundled
   if (!Exists(path)) GTEST_SKIP() << "shared data absent: " << path;
   const ImuSeries series = ReadMikoff(path);
   ASSERT_EQ(series.size(), 15969U);

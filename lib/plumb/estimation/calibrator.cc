@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <limits>
 #include <sstream>
 
 #include "plumb/core/error.h"
@@ -465,17 +466,87 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
         const auto c = col - model_index.begin();
         column_of[static_cast<std::size_t>(flat)] = c;
         p.observable = analysis.observable[static_cast<std::size_t>(c)];
-        if (p.observable) p.sigma = std::sqrt(std::max(0.0, analysis.covariance(c, c)));
       }
       result.parameters.push_back(p);
     }
   }
-  for (Eigen::Index a = 0; a < num_params; ++a) {
-    for (Eigen::Index b = 0; b < num_params; ++b) {
-      const auto ca = column_of[static_cast<std::size_t>(a)], cb = column_of[static_cast<std::size_t>(b)];
-      if (ca >= 0 && cb >= 0) result.covariance(a, b) = analysis.covariance(ca, cb);
+  // Covariance by ceres::Covariance on the problem with the pivots held, full rank by
+  // construction. For every observable parameter and every determined combination (estimable
+  // functions) the variance does not depend on which member of a null direction is held, so
+  // it equals the analysis's pseudo-inverse (tests/estimation checks this); held pivots get
+  // zero rows and columns. Should Ceres find the held problem singular, the pseudo-inverse is
+  // used and a warning says so.
+  std::vector<int> offset_of_term;
+  for (int t = 0, off = 0; t < model.num_terms(); ++t) {
+    offset_of_term.push_back(off);
+    off += model.terms()[static_cast<std::size_t>(t)].effect->info().size();
+  }
+  bool ceres_covariance = false;
+  {
+    // build() records residual ids in `still` and `motions`; keep those of `problem`.
+    std::vector<std::pair<ceres::ResidualBlockId, ceres::ResidualBlockId>> still_ids;
+    for (const auto& st : still) still_ids.emplace_back(st.acc_block, st.gyr_block);
+    std::vector<ceres::ResidualBlockId> motion_ids;
+    for (const auto& mo : motions) motion_ids.push_back(mo.block);
+    auto held_problem = build(held);
+    for (std::size_t k = 0; k < still.size(); ++k) {
+      still[k].acc_block = still_ids[k].first;
+      still[k].gyr_block = still_ids[k].second;
+    }
+    for (std::size_t k = 0; k < motions.size(); ++k) motions[k].block = motion_ids[k];
+    std::vector<const double*> blocks;
+    std::vector<int> block_term;
+    for (int t = 0; t < model.num_terms(); ++t) {
+      const double* b = theta[static_cast<std::size_t>(t)].data();
+      if (held_problem->IsParameterBlockConstant(b)) continue;
+      blocks.push_back(b);
+      block_term.push_back(t);
+    }
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      for (std::size_t j = i; j < blocks.size(); ++j) pairs.emplace_back(blocks[i], blocks[j]);
+    }
+    ceres::Covariance::Options cov_options;
+    cov_options.algorithm_type = ceres::DENSE_SVD;
+    cov_options.num_threads = 1;
+    ceres::Covariance covariance(cov_options);
+    if (options.use_ceres_covariance && !pairs.empty() &&
+        covariance.Compute(pairs, held_problem.get())) {
+      ceres_covariance = true;
+      for (std::size_t i = 0; i < blocks.size(); ++i) {
+        for (std::size_t j = i; j < blocks.size(); ++j) {
+          const int ti = block_term[i], tj = block_term[j];
+          const int ni = model.terms()[static_cast<std::size_t>(ti)].effect->info().size();
+          const int nj = model.terms()[static_cast<std::size_t>(tj)].effect->info().size();
+          Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(ni, nj);
+          covariance.GetCovarianceBlock(blocks[i], blocks[j], C.data());
+          result.covariance.block(offset_of_term[static_cast<std::size_t>(ti)],
+                                  offset_of_term[static_cast<std::size_t>(tj)], ni, nj) = C;
+          result.covariance.block(offset_of_term[static_cast<std::size_t>(tj)],
+                                  offset_of_term[static_cast<std::size_t>(ti)], nj, ni) = C.transpose();
+        }
+      }
     }
   }
+  if (!ceres_covariance) {
+    if (options.use_ceres_covariance && model.num_free_parameters() > 0) {
+      result.warnings.push_back("ceres::Covariance found the problem singular; sigmas are from "
+                                "the pseudo-inverse of the column-scaled Jacobian");
+    }
+    for (Eigen::Index a = 0; a < num_params; ++a) {
+      for (Eigen::Index b = 0; b < num_params; ++b) {
+        const auto ca = column_of[static_cast<std::size_t>(a)], cb = column_of[static_cast<std::size_t>(b)];
+        if (ca >= 0 && cb >= 0) result.covariance(a, b) = analysis.covariance(ca, cb);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < result.parameters.size(); ++i) {
+    auto& p = result.parameters[i];
+    const auto ii = static_cast<Eigen::Index>(i);
+    p.sigma = (p.observable && !p.fixed) ? std::sqrt(std::max(0.0, result.covariance(ii, ii)))
+                                         : std::numeric_limits<double>::quiet_NaN();
+  }
+  result.sigma_source = ceres_covariance ? "ceres::Covariance (DENSE_SVD)" : "pseudo-inverse";
 
   // Forward quantities.
   {
@@ -571,9 +642,20 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     result.warnings.push_back(message);
   }
   if (!site.known) {
-    result.warnings.push_back("no site given: gravity fixed at " + std::to_string(g) +
-                              " m/s^2 and Earth rate left out; the accelerometer scale and the "
-                              "gyroscope bias depend on it (give --lat --lon --height)");
+    result.warnings.push_back(
+        "no site given: gravity fixed at " + std::to_string(g) + " m/s^2" +
+        (result.has_gyro ? " and Earth rate left out; the accelerometer scale and the gyroscope "
+                           "bias depend on it"
+                         : "; the accelerometer scale depends on it") +
+        " (give --lat --lon --height)");
+  }
+  const bool any_known = std::any_of(still.begin(), still.end(), [](const Still& s) { return s.known; });
+  if (site.known && result.has_gyro && !any_known && !options.first_heading_deg) {
+    result.warnings.push_back(
+        "the heading of the first still pose is held at 0 (x north) as the gauge; with a site, "
+        "Earth rate (" + std::to_string(site.omega_ie_n.head<2>().norm()) +
+        " rad/s horizontal) is predicted for that heading: state it (--heading DEG or "
+        "--level-north) or the gyroscope biases absorb up to that much");
   }
   result.model = model;
   result.theta = theta;

@@ -90,6 +90,8 @@ struct CalibrationResult {
   /// and columns of fixed parameters are zero; for unobservable ones it is the pseudo-inverse
   /// (minimum-norm) value and is meaningless on its own: use `determined` combinations.
   Eigen::MatrixXd covariance;
+  /// Where the covariance came from: "ceres::Covariance (DENSE_SVD)" or "pseudo-inverse".
+  std::string sigma_source;
   /// The forward quantities of SPEC section 1, SI.
   Mat3 accel_matrix = Mat3::Identity();
   Vec3 accel_bias = Vec3::Zero();

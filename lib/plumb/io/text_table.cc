@@ -284,8 +284,8 @@ class TableParser {
     if (!o_.allow_nan_rows) {
       throw InputError(file_, Where(line_no),
                        ColumnLabel(static_cast<std::size_t>(field_of_slot_[slot])) +
-                           ": NaN or infinite value; expected a finite number (set "
-                           "allow_nan_rows to skip such rows)");
+                           ": NaN or infinite value; expected a finite number (to skip such rows: "
+                           "plumb --drop-nan, or TextTableOptions::allow_nan_rows)");
     }
     if (skipped_++ == 0) first_skipped_line_ = line_no;
   }
