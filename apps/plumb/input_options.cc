@@ -81,6 +81,8 @@ bool IsNativeHeader(const std::string& line) {
 /// Reads one file in the native format, or fails telling how to describe another layout.
 Session ReadNative(const std::string& path, bool insist) {
   const std::string first = FirstContentLine(path);
+  // An empty file (or a missing one) gets the reader's own message.
+  if (first.empty()) return io::ReadNativeCsv(path);
   if (!insist && !IsNativeHeader(first)) {
     throw InputError(path, "",
                      "not plumb's native CSV (header time_s,acc_x,acc_y,acc_z[,gyr_x,gyr_y,gyr_z]"

@@ -36,9 +36,27 @@ int main(int argc, char** argv) {
   commands.push_back(plumb::cli::MakeEffectsCommand(app));
   commands.push_back(plumb::cli::MakeCompareCommand(app));
 
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string name = argv[1];
+    bool known = false;
+    std::string names;
+    for (const auto& command : commands) {
+      known = known || command->app()->get_name() == name;
+      names += (names.empty() ? "" : ", ") + command->app()->get_name();
+    }
+    if (!known) {
+      std::cerr << "plumb: error: unknown command '" << name << "'; the commands are " << names
+                << "\nRun 'plumb --help' for an overview.\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // Report the error against the subcommand being parsed, so the help hint names it.
+    for (const auto& command : commands) {
+      if (command->app()->parsed()) return command->app()->exit(e) == 0 ? 0 : 2;
+    }
     return app.exit(e) == 0 ? 0 : 2;
   }
   plumb::cli::Command* selected = nullptr;

@@ -70,11 +70,14 @@ void CheckEffectData(const model::Model& model, const ImuSeries& series) {
 /// unscaled sensor output, that output's unit (bias) and unit per SI input (matrix).
 std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series) {
   const std::string& si = info.parameters[static_cast<std::size_t>(i)].unit;
-  if (!info.linear_stage) return si;
   const bool accel = info.sensor == model::Sensor::kAccel;
   const std::string& out = accel ? series.acc_unit : series.gyr_unit;
   const std::string in = accel ? "m/s^2" : "rad/s";
   if (out == in) return si;
+  if (!info.linear_stage) {
+    // Additive terms are in output units: "rad/s per m/s^2" becomes "counts per m/s^2".
+    return si.rfind(in, 0) == 0 ? out + si.substr(in.size()) : si;
+  }
   const bool matrix = info.parameters[static_cast<std::size_t>(i)].name.rfind("matrix.", 0) == 0;
   return matrix ? out + " per " + in : out;
 }

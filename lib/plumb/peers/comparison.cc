@@ -122,11 +122,11 @@ std::string Largest(const std::vector<ComparisonRow>& rows, const std::string& p
 void WriteTable(const Comparison& c, std::ostream& os) {
   const std::string& peer = c.peer.peer;
   const double scale = std::sqrt(std::max(1.0, std::isfinite(c.chi2_dof) ? c.chi2_dof : 1.0));
-  os << Cell("parameter", 26) << Cell("unit", 17) << Cell("plumb", 15) << Cell("+- sigma", 11)
+  os << Cell("parameter", 26) << Cell("unit", 18) << Cell("plumb", 15) << Cell("+- sigma", 11)
      << Cell(peer, 15) << Cell("plumb-" + peer, 14) << Cell("d/sigma", 9)
      << "d/(sigma*" << Fmt("%.3g", scale) << ")\n";
   for (const auto& row : c.rows) {
-    os << Cell(row.name, 26) << Cell(row.in_plumb_model ? row.unit : "(not in model)", 17)
+    os << Cell(row.name, 26) << Cell(row.in_plumb_model ? row.unit : "(not in model)", 18)
        << Cell(row.in_plumb_model ? Fmt("%.9g", row.plumb_value) : "0", 15)
        << Cell(SigmaCell(row), 11) << Cell(Fmt("%.9g", row.peer_value), 15)
        << Cell(Fmt("%.4g", row.difference), 14) << Cell(OptionalCell(row.z, "%.2f"), 9)

@@ -1,7 +1,7 @@
 // plumb/peers/imu_tk.h — imu_tk's calibration files, its model in plumb's forward form, and
 // its accelerometer cost for any forward calibration.
 //
-// imu_tk (Pretto and Grisetti, Tedaldi et al. ICRA 2014; github.com/Kyle-ak/imu_tk) writes one
+// imu_tk (Tedaldi, Pretto and Menegatti, ICRA 2014; github.com/Kyle-ak/imu_tk) writes one
 // CalibratedTriad per sensor (include/imu_tk/calibration.h): a misalignment matrix T, a
 // diagonal scale matrix K and a bias B, applied in the INVERSE direction,
 //
@@ -96,8 +96,9 @@ struct StillMean {
 /// expected sum of squares is n (r_k^2 + s_k^2), r_k the residual of the mean and
 /// s_k^2 = u_k^T F^-1 diag(noise^2) F^-T u_k the variance of one sample's calibrated norm
 /// (u_k the unit calibrated vector). `noise_per_sample`: per-axis standard deviation of one
-/// accelerometer sample, output units (plumb's noise.accel). The result's `weight` is the
-/// number of residuals. Same errors as ImuTkAccelCost.
+/// accelerometer sample, output units (plumb's noise.accel). In the result, `terms` is the
+/// number of segments used, `weight` the number of residuals, `rms_m_s2` includes the noise
+/// and `max_abs_m_s2` is the largest |r_k| of the means. Same errors as ImuTkAccelCost.
 ImuTkCost ImuTkSampleCostEstimate(const Mat3& accel_matrix, const Vec3& accel_bias,
                                   const std::vector<StillMean>& segments,
                                   const Vec3& noise_per_sample, double gravity_m_s2,

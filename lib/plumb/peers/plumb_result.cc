@@ -1,5 +1,6 @@
 #include "plumb/peers/plumb_result.h"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -103,10 +104,12 @@ PlumbResult ReadPlumbResult(const std::string& path) {
   const json& fit = root.contains("fit") ? root.at("fit") : empty;
   r.chi2_dof = NumberOr(fit, "chi2_dof", std::numeric_limits<double>::quiet_NaN());
   r.dof = static_cast<long>(NumberOr(fit, "dof", 0.0));
-  if (root.contains("noise") && root.at("noise").contains("accel") &&
-      root.at("noise").at("accel").is_array()) {
-    r.noise_accel = detail::Vector3(root.at("noise").at("accel"), path, "noise.accel");
-  }
+  const json& noise = root.contains("noise") ? root.at("noise") : empty;
+  const json& noise_accel = noise.is_object() && noise.contains("accel") ? noise.at("accel") : empty;
+  const bool noise_known = noise_accel.is_array() && noise_accel.size() == 3 &&
+                           std::all_of(noise_accel.begin(), noise_accel.end(),
+                                       [](const json& v) { return v.is_number(); });
+  if (noise_known) r.noise_accel = detail::Vector3(noise_accel, path, "noise.accel");
   if (root.contains("inputs") && root.at("inputs").is_array()) {
     for (const auto& input : root.at("inputs")) {
       if (input.is_string()) r.inputs.push_back(input.get<std::string>());

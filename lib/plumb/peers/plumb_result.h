@@ -47,7 +47,7 @@ struct PlumbResult {
   double chi2_dof = 0.0;         ///< fit.chi2_dof; NaN when null
   long dof = 0;                  ///< fit.dof
   /// noise.accel: per-sample standard deviation of the accelerometer, output units; NaN when
-  /// absent.
+  /// absent or not three numbers.
   Vec3 noise_accel = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
   std::vector<std::string> inputs;  ///< the data files plumb read
 };
