@@ -32,10 +32,19 @@ inline void ExpCoefficients(double a, double* A, double* B) {
 
 /// Rotation matrix Exp(phi), phi a rotation vector in rad.
 inline Mat3 Exp(const Vec3& phi) {
+  const double a2 = phi.squaredNorm();
   double A, B;
-  ExpCoefficients(phi.norm(), &A, &B);
-  const Mat3 S = Skew(phi);
-  return Mat3::Identity() + A * S + B * S * S;
+  ExpCoefficients(std::sqrt(a2), &A, &B);
+  // Rodrigues with S^2 = phi phi^T - |phi|^2 I.
+  Mat3 R = B * (phi * phi.transpose());
+  R.diagonal().array() += 1.0 - B * a2;
+  R(0, 1) -= A * phi.z();
+  R(1, 0) += A * phi.z();
+  R(0, 2) += A * phi.y();
+  R(2, 0) -= A * phi.y();
+  R(1, 2) -= A * phi.x();
+  R(2, 1) += A * phi.x();
+  return R;
 }
 
 /// Unit quaternion of Exp(phi).

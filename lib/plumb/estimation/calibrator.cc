@@ -280,15 +280,27 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       ms.alpha_b.push_back(h > 0 ? Vec3(gyro_scale * (series.gyr[b] - series.gyr[a]).cast<double>() / h)
                                  : Vec3::Zero());
     }
-    const double steps = static_cast<double>(mo.last - mo.first);
-    const double dt = (series.t_s[mo.last] - series.t_s[mo.first]) / std::max(1.0, steps);
-    for (int i = 0; i < 3; ++i) {
-      const double sigma_rate = result.noise_gyr[i] * gyro_scale;  // rad/s per sample
-      mo.sqrt_info[i] = 1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * tau_gyr[i]));
-    }
-    ms.sqrt_info = mo.sqrt_info;
     motion_samples.push_back(std::move(ms));
   }
+  // Whitening of the motion residuals: the white gyroscope noise (sensor units) carried through
+  // E^-1 into rad/s and integrated over the interval's steps. It depends on E, so it is set
+  // from the starting E and again from the solved E before the final solve (the chi^2 then does
+  // not depend on the starting values).
+  auto set_motion_weights = [&](const Mat3& E) {
+    const Mat3 E_inv = E.inverse();
+    const Mat3 cov_rate = E_inv * result.noise_gyr.cwiseAbs2().asDiagonal() * E_inv.transpose();
+    for (std::size_t k = 0; k < motions.size(); ++k) {
+      auto& mo = motions[k];
+      const double steps = static_cast<double>(mo.last - mo.first);
+      const double dt = (series.t_s[mo.last] - series.t_s[mo.first]) / std::max(1.0, steps);
+      for (int i = 0; i < 3; ++i) {
+        const double sigma_rate = std::sqrt(cov_rate(i, i));  // rad/s per sample
+        mo.sqrt_info[i] = 1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * tau_gyr[i]));
+      }
+      motion_samples[k].sqrt_info = mo.sqrt_info;
+    }
+  };
+  set_motion_weights(Mat3::Identity() / gyro_scale);
 
   std::vector<std::unique_ptr<ceres::Manifold>> manifolds;
   auto build = [&](const std::vector<std::pair<int, int>>& held_extra) {
@@ -350,12 +362,13 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     return problem;
   };
 
-  auto solve = [&](ceres::Problem& problem) {
+  // `rough`: a first solve that another will refine (looser tolerances, fewer iterations).
+  auto solve = [&](ceres::Problem& problem, bool rough) {
     ceres::Solver::Options solver_options;
     solver_options.linear_solver_type = ceres::DENSE_QR;
     solver_options.max_num_iterations = options.max_iterations;
-    solver_options.function_tolerance = options.function_tolerance;
-    solver_options.parameter_tolerance = options.parameter_tolerance;
+    solver_options.function_tolerance = rough ? 1e-6 : options.function_tolerance;
+    solver_options.parameter_tolerance = rough ? 1e-8 : options.parameter_tolerance;
     solver_options.gradient_tolerance = 1e-14;
     solver_options.num_threads = 1;
     solver_options.logging_type = ceres::SILENT;
@@ -429,18 +442,23 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   std::vector<std::pair<int, int>> held;
   {
     auto problem = build({});
-    solve(*problem);
+    solve(*problem, result.has_gyro && !motions.empty());
     double cost0 = 0;
     const ObservabilityAnalysis first = analyse(*problem, &cost0, nullptr);
     for (int c : first.pivots) {
       if (model_index[static_cast<std::size_t>(c)].first >= 0) held.push_back(model_index[static_cast<std::size_t>(c)]);
     }
   }
+  if (result.has_gyro && !motions.empty()) {
+    set_motion_weights(model.Predict(theta, model::SensorInput<double>()).E);
+  }
   if (!held.empty()) {
     theta = theta0;
     for (std::size_t k = 0; k < still.size(); ++k) still[k].q = q0[k];
+  }
+  if (!held.empty() || (result.has_gyro && !motions.empty())) {
     auto problem = build(held);
-    solve(*problem);
+    solve(*problem, false);
   }
   auto problem_ptr = build({});
   ceres::Problem& problem = *problem_ptr;

@@ -118,12 +118,14 @@ double GuessGyroScale(const ImuSeries& series,
       }
     }
   }
-  // Golden-section refinement within one grid step either side.
-  double a = best - 0.25, b = best + 0.25;
+  // Golden-section refinement: within 0.15 decade of the ratio estimate, or one grid step
+  // either side of the grid's best.
+  const double half_width = ratios.empty() ? 0.25 : 0.15;
+  double a = best - half_width, b = best + half_width;
   const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
   double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
   double f1 = cost(x1), f2 = cost(x2);
-  for (int it = 0; it < 16; ++it) {
+  for (int it = 0; it < 14; ++it) {
     if (f1 < f2) {
       b = x2; x2 = x1; f2 = f1; x1 = b - phi * (b - a); f1 = cost(x1);
     } else {

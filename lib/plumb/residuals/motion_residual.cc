@@ -121,7 +121,33 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
 
   std::vector<Vec3> w;
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> W;
-  CorrectedRates(theta, &w, want_jacobians ? &W : nullptr);
+  // For the base model dw/dtheta has a closed form used on the fly (no per-sample storage):
+  // w = E^-1 (y - b_g), dw/dE_rc = -E^-1 e_r w_c, dw/db_g = -E^-1.
+  const bool closed_form = linear_only_;
+  CorrectedRates(theta, &w, want_jacobians && !closed_form ? &W : nullptr);
+  Mat3 E_inv = Mat3::Identity();
+  int gyro_offset = -1;
+  if (closed_form && want_jacobians) {
+    const int g = model_->FindTerm("gyro_linear");
+    if (g >= 0) {
+      gyro_offset = block_offset_[static_cast<std::size_t>(g)];
+      E_inv = model_->Predict(theta, model::SensorInput<double>()).E.inverse();
+    }
+  }
+  // Adds K dw_i/dtheta to the first P columns of `out`.
+  auto add_rate_jacobian = [&](const Mat3& K, std::size_t i,
+                               Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
+    if (!closed_form) {
+      out.leftCols(P).noalias() += K * W[i];
+      return;
+    }
+    if (gyro_offset < 0) return;
+    const Mat3 KM = K * E_inv;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) out.col(gyro_offset + 3 * r + c) -= KM.col(r) * w[i][c];
+    }
+    out.middleCols<3>(gyro_offset + 9) -= KM;
+  };
 
   const Vec3 omega_k = R_k.transpose() * omega_ie_n_;  // Earth rate in b_k
   const Mat3 d_omega_k = R_k.transpose() * Skew(omega_ie_n_);  // d omega_k / d delta_k
@@ -148,8 +174,8 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
       const Mat3 K = K0 + K1;
       const Mat3 G = Ex.transpose() - K * Skew(e);
       A_next.noalias() = G * A;
-      A_next.leftCols(P).noalias() += K0 * W[i];
-      A_next.leftCols(P).noalias() += K1 * W[i + 1];
+      add_rate_jacobian(K0, i, A_next);
+      add_rate_jacobian(K1, i + 1, A_next);
       A_next.rightCols<3>().noalias() -= K * (dR.transpose() * d_omega_k);
       A.swap(A_next);
     }
