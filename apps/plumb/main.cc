@@ -2,6 +2,8 @@
 //
 // The only place that catches exceptions: usage mistakes exit 2 (CLI11's parse errors and
 // UsageError), every other error prints `plumb: error: <message>` on stderr and exits 1.
+#include <glog/logging.h>
+
 #include <exception>
 #include <iostream>
 #include <memory>
@@ -21,6 +23,11 @@ std::string UsageMessage(const CLI::App* app, const CLI::Error& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Ceres reports through glog; plumb reports itself (a failed covariance falls back with a
+  // warning in the result), so only fatal glog messages may reach the user's terminal.
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  FLAGS_logtostderr = true;
+  google::InitGoogleLogging(argv[0]);
   CLI::App app("plumb " + plumb::report::Version() +
                    ": calibrate an IMU's accelerometer and gyroscope from real logs, with "
                    "honest uncertainty",
