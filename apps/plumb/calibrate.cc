@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "input_options.h"
+#include "paper_methods.h"
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/io/segments_file.h"
@@ -48,8 +49,12 @@ class CalibrateCommand : public Command {
                                  "still poses joined by turns");
     CalibrateArgs& a = args_;
     AddInputOptions(app_, a.input);
-    app_->add_option("--method", a.method, "Calibration method")
-        ->check(CLI::IsMember({"generalized"}))
+    app_->add_option("--method", a.method,
+                     "Calibration method: generalized (least squares), or the seed paper's "
+                     "procedures as printed: paper-benchmark (section 4, six poses and turns "
+                     "about each axis), paper-static (section 5, one level x-north minute; "
+                     "needs --lat --lon)")
+        ->check(CLI::IsMember({"generalized", "paper-benchmark", "paper-static"}))
         ->capture_default_str();
     app_->add_option("--model", a.model,
                      "Error model spec: base, paper, or base+EFFECT[:OPTION]+... "
@@ -107,6 +112,7 @@ class CalibrateCommand : public Command {
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     if (series.empty()) throw Error(session.source + ": no samples");
+    if (a.method != "generalized") return RunPaperMethod(session);
 
     const segmentation::SegmentationResult seg = FindSegments(series);
     std::vector<StillSegment> segments = seg.segments;
@@ -150,6 +156,41 @@ class CalibrateCommand : public Command {
   }
 
  private:
+  /// --method paper-benchmark | paper-static (plumb/paper; paper_methods.h).
+  int RunPaperMethod(const Session& session) const {
+    const CalibrateArgs& a = args_;
+    std::optional<double> gravity;
+    if (a.gravity->count() > 0) gravity = a.gravity_m_s2;
+    const geo::Site site = ResolveSite(a.site, session.site, gravity);
+    std::cout << session.source << ": " << session.series.size() << " samples, "
+              << session.series.duration_s() << " s\n";
+    for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+    if (a.method == "paper-static") {
+      // The paper's minute is the whole record; a section file picks its first still section.
+      std::size_t begin = 0;
+      std::size_t end = session.series.size();
+      if (!a.segments_path.empty()) {
+        const auto given = io::ReadSegments(a.segments_path, session.series);
+        if (given.empty()) throw UsageError(a.segments_path + ": no still section");
+        begin = given.front().begin;
+        end = given.front().end;
+      }
+      return RunPaperStatic(session, begin, end, site, a.json_path);
+    }
+    std::vector<StillSegment> still;
+    std::vector<paper::MotionRange> motion;
+    if (!a.segments_path.empty()) {
+      const io::GivenSections given = io::ReadGivenSections(a.segments_path, session.series);
+      still = given.still;
+      for (const auto& m : given.motion) motion.push_back({m.begin, m.end, m.label});
+    } else {
+      const segmentation::SegmentationResult seg = FindSegments(session.series);
+      std::cout << report::SegmentationSummary(seg, a.segments_path, a.verbose) << "\n";
+      still = seg.segments;
+    }
+    return RunPaperBenchmark(session, still, motion, site, a.json_path);
+  }
+
   segmentation::SegmentationResult FindSegments(const ImuSeries& series) const {
     if (!args_.segments_path.empty()) {
       return segmentation::UseGivenSegments(series, io::ReadSegments(args_.segments_path, series));

@@ -1,0 +1,28 @@
+// apps/plumb/paper_methods.h — `plumb calibrate --method paper-benchmark|paper-static`: the
+// seed paper's two procedures as printed (plumb/paper), printed and written as JSON in the
+// paper's convention and in plumb's forward one (SPEC section 1).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "plumb/core/segment.h"
+#include "plumb/core/session.h"
+#include "plumb/geo/site.h"
+#include "plumb/paper/benchmark.h"
+
+namespace plumb::cli {
+
+/// Runs paper-benchmark on the series with the given still periods and turn sections (empty:
+/// the gaps between still periods of the same pose); prints both conventions; writes
+/// `json_path` when not empty. Returns the exit code.
+int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& still,
+                      const std::vector<paper::MotionRange>& motion, const geo::Site& site,
+                      const std::string& json_path);
+
+/// Runs paper-static on samples [begin, end) at `site` (must be known); prints both
+/// conventions; writes `json_path` when not empty. Returns the exit code.
+int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
+                   const geo::Site& site, const std::string& json_path);
+
+}  // namespace plumb::cli
