@@ -321,5 +321,41 @@ TEST(Cli, MikoffSessionCalibratesAndWritesEverySpecKey) {
   EXPECT_GE(doc["fit"]["segments"]["still"].get<int>(), 1);
 }
 
+TEST(Cli, PaperBenchmarkMethodRunsOnThePapersSchedule) {
+  // The seed paper's section 3.1 schedule, simulated with a known accelerometer bias; the
+  // section 4 closed form recovers it (Eq. (3) is exact up to noise) in both conventions.
+  TempDir dir;
+  const std::string csv = dir.File("bench.csv"), out = dir.File("bench.json");
+  const ToolRun sim = Plumb({"simulate", "--out", csv, "--schedule", "paper-benchmark", "--still",
+                             "5", "--turn", "2", "--rate", "100", "--truth", "accel.bias.x=0.2",
+                             "--accel-rw", "0", "--gyro-rw", "0", "--seed", "4"},
+                            dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const ToolRun run =
+      Plumb({"calibrate", csv, "--method", "paper-benchmark", "--json", out}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("Paper's convention"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("Forward convention"), std::string::npos) << run.out;
+  const json doc = ReadJson(out);
+  EXPECT_EQ(doc["method"], "paper-benchmark");
+  EXPECT_NEAR(doc["forward"]["accel"]["bias"][0].get<double>(), 0.2, 0.01) << doc.dump(2);
+}
+
+TEST(Cli, PaperStaticMethodNeedsASite) {
+  TempDir dir;
+  const std::string csv = dir.File("static.csv");
+  const ToolRun sim = Plumb({"simulate", "--out", csv, "--schedule", "paper-static", "--rate",
+                             "100", "--lat", "6.67", "--lon", "-1.57", "--seed", "5"},
+                            dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  EXPECT_NE(Plumb({"calibrate", csv, "--method", "paper-static"}, dir).exit_code, 0);
+  const ToolRun run = Plumb({"calibrate", csv, "--method", "paper-static", "--lat", "6.67",
+                             "--lon", "-1.57"},
+                            dir);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("Paper's convention"), std::string::npos) << run.out;
+}
+
+
 }  // namespace
 }  // namespace plumb::cli
