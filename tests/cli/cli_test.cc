@@ -19,21 +19,10 @@ using nlohmann::json;
 using testing::Run;
 using testing::TempDir;
 using testing::ToolRun;
+using testing::Plumb;
+using testing::Contains;
+using testing::ReadJson;
 
-constexpr const char* kTool = PLUMB_TOOL;
-
-ToolRun Plumb(const std::vector<std::string>& args, const TempDir& dir) {
-  return Run(kTool, args, dir);
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  return json::parse(in);  // throws (failing the test) on invalid JSON, e.g. a bare NaN
-}
 
 /// True when no number anywhere in `j` is NaN or infinite.
 bool AllNumbersFinite(const json& j) {

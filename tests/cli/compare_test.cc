@@ -17,23 +17,12 @@ using nlohmann::json;
 using testing::Run;
 using testing::TempDir;
 using testing::ToolRun;
+using testing::Plumb;
+using testing::Contains;
+using testing::ReadJson;
 
-constexpr const char* kTool = PLUMB_TOOL;
 const std::string kImuTk = std::string(PLUMB_SHARED_DATA_DIR) + "/multipose/imu_tk";
 constexpr double kG = 9.81744;
-
-ToolRun Plumb(const std::vector<std::string>& args, const TempDir& dir) {
-  return Run(kTool, args, dir);
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  return json::parse(in);
-}
 
 json Parameter(const std::string& name, double value, double sigma, const std::string& unit) {
   return {{"name", name}, {"value", value}, {"sigma", sigma}, {"observable", true},

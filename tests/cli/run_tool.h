@@ -2,6 +2,10 @@
 // standard output and standard error, in the spirit of GeographicLib's command-line tests.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
+#include "support/temp_dir.h"
+
 #include <fcntl.h>
 #include <stdlib.h>
 #include <sys/wait.h>
@@ -28,23 +32,7 @@ inline std::string ReadAll(const std::string& path) {
   return os.str();
 }
 
-/// A fresh folder under the system temporary folder, removed with its content at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::string templ = (std::filesystem::temp_directory_path() / "plumb_cli_test.XXXXXX").string();
-    path_ = ::mkdtemp(templ.data());
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-  std::string Write(const std::string& name, const std::string& content) const {
-    std::ofstream(File(name), std::ios::binary) << content;
-    return File(name);
-  }
-
- private:
-  std::filesystem::path path_;
-};
+using ::plumb::testing::TempDir;
 
 /// Runs `tool args...`; stdout and stderr go to files in `dir`, read back after the exit.
 inline ToolRun Run(const std::string& tool, const std::vector<std::string>& args,
@@ -72,6 +60,21 @@ inline ToolRun Run(const std::string& tool, const std::vector<std::string>& args
   run.out = ReadAll(out_path);
   run.err = ReadAll(err_path);
   return run;
+}
+
+/// Runs the plumb command built with this tree (PLUMB_TOOL) in `dir`.
+inline ToolRun Plumb(const std::vector<std::string>& args, const TempDir& dir) {
+  return Run(PLUMB_TOOL, args, dir);
+}
+
+inline bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// Parses a JSON file; throws (failing the test) on invalid JSON, e.g. a bare NaN.
+inline nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
 }
 
 }  // namespace plumb::cli::testing

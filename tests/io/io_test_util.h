@@ -1,6 +1,8 @@
 // Helpers for the io tests: a private temporary folder and checks on plumb::InputError.
 #pragma once
 
+#include "support/temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -12,25 +14,7 @@
 
 namespace plumb::io::testing {
 
-/// A fresh folder under the system temporary folder, removed with its content at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::string templ = (std::filesystem::temp_directory_path() / "plumb_io_test.XXXXXX").string();
-    path_ = ::mkdtemp(templ.data());
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-  /// Writes `content` to `name` in the folder and returns its path.
-  std::string Write(const std::string& name, const std::string& content) const {
-    std::ofstream(File(name), std::ios::binary) << content;
-    return File(name);
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using ::plumb::testing::TempDir;
 
 /// Runs `read` and checks that it throws plumb::InputError for `file` at `where` with a message
 /// containing every one of `parts`.

@@ -1,6 +1,8 @@
 // A fresh folder under the system temporary folder for files a test writes, removed at the end.
 #pragma once
 
+#include "support/temp_dir.h"
+
 #include <stdlib.h>
 
 #include <filesystem>
@@ -9,26 +11,7 @@
 
 namespace plumb::peers::testing {
 
-class TempFolder {
- public:
-  TempFolder() {
-    std::string templ = (std::filesystem::temp_directory_path() / "plumb_peers_test.XXXXXX").string();
-    path_ = ::mkdtemp(templ.data());
-  }
-  ~TempFolder() { std::filesystem::remove_all(path_); }
-  TempFolder(const TempFolder&) = delete;
-  TempFolder& operator=(const TempFolder&) = delete;
-
-  /// Writes `content` to `name` in the folder and returns its path.
-  std::string Write(const std::string& name, const std::string& content) const {
-    const std::string path = (path_ / name).string();
-    std::ofstream(path, std::ios::binary) << content;
-    return path;
-  }
-
- private:
-  std::filesystem::path path_;
-};
+using TempFolder = ::plumb::testing::TempDir;
 
 /// The message of the plumb::Error that `f` throws, or "" when it throws none.
 template <typename F>

@@ -2,6 +2,8 @@
 // JSON can be checked key by key without running a fit), and a private temporary folder.
 #pragma once
 
+#include "support/temp_dir.h"
+
 #include <stdlib.h>
 
 #include <cmath>
@@ -83,19 +85,6 @@ inline estimation::CalibrationResult MakeResult() {
   return r;
 }
 
-/// A fresh folder under the system temporary folder, removed with its content at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::string templ =
-        (std::filesystem::temp_directory_path() / "plumb_report_test.XXXXXX").string();
-    path_ = ::mkdtemp(templ.data());
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
+using ::plumb::testing::TempDir;
 
 }  // namespace plumb::report::testing
