@@ -34,17 +34,19 @@ struct Still {
   std::array<double, 4> q{0, 0, 0, 1};  // R_n_b, Eigen order x y z w
   bool known = false;
   bool chain_head = false;
-  ceres::ResidualBlockId acc_block = nullptr;
-  ceres::ResidualBlockId gyr_block = nullptr;
   residuals::StillMeasurement acc_measurement, gyr_measurement;
-  std::unique_ptr<StillResidual> acc_functor, gyr_functor;  // copies for reporting
 };
 
 struct Motion {
   std::size_t from = 0;  // still index
   std::size_t first = 0, last = 0;  // sample range [first, last]
-  ceres::ResidualBlockId block = nullptr;
-  Vec3 sqrt_info = Vec3::Ones();
+};
+
+/// A problem built from the current values, with its residual blocks (null where absent).
+struct BuiltProblem {
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<ceres::ResidualBlockId> acc, gyr;  // per still segment
+  std::vector<ceres::ResidualBlockId> motion;    // per motion interval
 };
 
 Quat ToQuat(const std::array<double, 4>& q) { return Quat(q[3], q[0], q[1], q[2]); }
@@ -143,20 +145,19 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   if (result.has_gyro) {
     gyr_noise = signal::EstimateCorrelationTime(series, used, signal::Sensor::kGyro);
   }
+  // Per-axis tau for whitening (at least 1); the result reports the largest.
+  Vec3 tau_acc = Vec3::Ones(), tau_gyr = Vec3::Ones();
   for (int i = 0; i < 3; ++i) {
-    result.noise_acc[i] = std::max(std::sqrt(acc_noise[static_cast<std::size_t>(i)].variance), options.min_sigma_acc);
-    result.tau_acc = std::max(result.tau_acc, acc_noise[static_cast<std::size_t>(i)].tau_int);
+    const auto axis = static_cast<std::size_t>(i);
+    result.noise_acc[i] = std::max(std::sqrt(acc_noise[axis].variance), options.min_sigma_acc);
+    tau_acc[i] = std::max(1.0, acc_noise[axis].tau_int);
     if (result.has_gyro) {
-      result.noise_gyr[i] = std::max(std::sqrt(gyr_noise[static_cast<std::size_t>(i)].variance), options.min_sigma_gyr);
-      result.tau_gyr = std::max(result.tau_gyr, gyr_noise[static_cast<std::size_t>(i)].tau_int);
+      result.noise_gyr[i] = std::max(std::sqrt(gyr_noise[axis].variance), options.min_sigma_gyr);
+      tau_gyr[i] = std::max(1.0, gyr_noise[axis].tau_int);
     }
   }
-  // Per-axis tau, kept separately for whitening.
-  Vec3 tau_acc, tau_gyr = Vec3::Ones();
-  for (int i = 0; i < 3; ++i) {
-    tau_acc[i] = std::max(1.0, acc_noise[static_cast<std::size_t>(i)].tau_int);
-    if (result.has_gyro) tau_gyr[i] = std::max(1.0, gyr_noise[static_cast<std::size_t>(i)].tau_int);
-  }
+  result.tau_acc = tau_acc.maxCoeff();
+  result.tau_gyr = tau_gyr.maxCoeff();
 
   // Initial accelerometer.
   model::ParameterBlocks theta = model.ZeroParameters();
@@ -256,15 +257,10 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     m.mean = s.stats.acc_mean;
     for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / tau_acc[i]) / result.noise_acc[i];
     s.acc_measurement = m;
-    s.acc_functor = std::make_unique<StillResidual>(model, model::Sensor::kAccel, acc_terms, m,
-                                                    site.g_n, site.omega_ie_n);
     if (still_gyro) {
       m.mean = s.stats.gyr_mean;
       for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / tau_gyr[i]) / result.noise_gyr[i];
       s.gyr_measurement = m;
-      s.gyr_functor = std::make_unique<StillResidual>(
-          model, model::Sensor::kGyro, gyr_terms, m, site.g_n, site.omega_ie_n,
-          s.segment.known_omega_eb_b.value_or(Vec3::Zero()));
     }
   }
   std::vector<residuals::MotionSamples> motion_samples;
@@ -290,25 +286,27 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     const Mat3 E_inv = E.inverse();
     const Mat3 cov_rate = E_inv * result.noise_gyr.cwiseAbs2().asDiagonal() * E_inv.transpose();
     for (std::size_t k = 0; k < motions.size(); ++k) {
-      auto& mo = motions[k];
+      const auto& mo = motions[k];
       const double steps = static_cast<double>(mo.last - mo.first);
       const double dt = (series.t_s[mo.last] - series.t_s[mo.first]) / std::max(1.0, steps);
       for (int i = 0; i < 3; ++i) {
         const double sigma_rate = std::sqrt(cov_rate(i, i));  // rad/s per sample
-        mo.sqrt_info[i] = 1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * tau_gyr[i]));
+        motion_samples[k].sqrt_info[i] =
+            1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * tau_gyr[i]));
       }
-      motion_samples[k].sqrt_info = mo.sqrt_info;
     }
   };
   set_motion_weights(Mat3::Identity() / gyro_scale);
 
   std::vector<std::unique_ptr<ceres::Manifold>> manifolds;
   auto build = [&](const std::vector<std::pair<int, int>>& held_extra) {
-    auto problem = std::make_unique<ceres::Problem>([] {
+    BuiltProblem built;
+    built.problem = std::make_unique<ceres::Problem>([] {
       ceres::Problem::Options o;
       o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
       return o;
     }());
+    ceres::Problem* problem = built.problem.get();
     for (int t = 0; t < model.num_terms(); ++t) {
       auto& block = theta[static_cast<std::size_t>(t)];
       const auto& fixed = model.terms()[static_cast<std::size_t>(t)].fixed;
@@ -341,25 +339,26 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       return blocks;
     };
     for (auto& s : still) {
-      s.acc_block = problem->AddResidualBlock(
+      built.acc.push_back(problem->AddResidualBlock(
           StillResidual::Create(model, model::Sensor::kAccel, s.acc_measurement, site.g_n,
                                 site.omega_ie_n),
-          nullptr, blocks_of(acc_terms, s.q.data()));
-      if (still_gyro) {
-        s.gyr_block = problem->AddResidualBlock(
-            StillResidual::Create(model, model::Sensor::kGyro, s.gyr_measurement, site.g_n,
-                                  site.omega_ie_n, s.segment.known_omega_eb_b.value_or(Vec3::Zero())),
-            nullptr, blocks_of(gyr_terms, s.q.data()));
-      }
+          nullptr, blocks_of(acc_terms, s.q.data())));
+      built.gyr.push_back(
+          still_gyro ? problem->AddResidualBlock(
+                           StillResidual::Create(model, model::Sensor::kGyro, s.gyr_measurement,
+                                                 site.g_n, site.omega_ie_n,
+                                                 s.segment.known_omega_eb_b.value_or(Vec3::Zero())),
+                           nullptr, blocks_of(gyr_terms, s.q.data()))
+                     : nullptr);
     }
     for (std::size_t k = 0; k < motions.size(); ++k) {
-      auto& mo = motions[k];
+      const auto& mo = motions[k];
       std::vector<double*> blocks = {still[mo.from].q.data(), still[mo.from + 1].q.data()};
       for (auto& b : theta) blocks.push_back(b.data());
-      mo.block = problem->AddResidualBlock(
-          MotionResidual::Create(model, motion_samples[k], site.omega_ie_n), nullptr, blocks);
+      built.motion.push_back(problem->AddResidualBlock(
+          MotionResidual::Create(model, motion_samples[k], site.omega_ie_n), nullptr, blocks));
     }
-    return problem;
+    return built;
   };
 
   // `rough`: a first solve that another will refine (looser tolerances, fewer iterations).
@@ -441,10 +440,10 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   for (const auto& s : still) q0.push_back(s.q);
   std::vector<std::pair<int, int>> held;
   {
-    auto problem = build({});
-    solve(*problem, result.has_gyro && !motions.empty());
+    const BuiltProblem first_build = build({});
+    solve(*first_build.problem, result.has_gyro && !motions.empty());
     double cost0 = 0;
-    const ObservabilityAnalysis first = analyse(*problem, &cost0, nullptr);
+    const ObservabilityAnalysis first = analyse(*first_build.problem, &cost0, nullptr);
     for (int c : first.pivots) {
       if (model_index[static_cast<std::size_t>(c)].first >= 0) held.push_back(model_index[static_cast<std::size_t>(c)]);
     }
@@ -456,12 +455,14 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     theta = theta0;
     for (std::size_t k = 0; k < still.size(); ++k) still[k].q = q0[k];
   }
-  if (!held.empty() || (result.has_gyro && !motions.empty())) {
-    auto problem = build(held);
-    solve(*problem, false);
-  }
-  auto problem_ptr = build({});
-  ceres::Problem& problem = *problem_ptr;
+  // The final problem: every free unknown, for the analysis and the residuals; with pivots
+  // held (if any), for the fit and its covariance.
+  const BuiltProblem final_build = build({});
+  BuiltProblem held_build;
+  if (!held.empty()) held_build = build(held);
+  ceres::Problem& held_problem = held.empty() ? *final_build.problem : *held_build.problem;
+  if (!held.empty() || (result.has_gyro && !motions.empty())) solve(held_problem, false);
+  ceres::Problem& problem = *final_build.problem;
   double cost = 0;
   std::vector<double> residual_values;
   const ObservabilityAnalysis analysis = analyse(problem, &cost, &residual_values);
@@ -504,22 +505,11 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   }
   bool ceres_covariance = false;
   {
-    // build() records residual ids in `still` and `motions`; keep those of `problem`.
-    std::vector<std::pair<ceres::ResidualBlockId, ceres::ResidualBlockId>> still_ids;
-    for (const auto& st : still) still_ids.emplace_back(st.acc_block, st.gyr_block);
-    std::vector<ceres::ResidualBlockId> motion_ids;
-    for (const auto& mo : motions) motion_ids.push_back(mo.block);
-    auto held_problem = build(held);
-    for (std::size_t k = 0; k < still.size(); ++k) {
-      still[k].acc_block = still_ids[k].first;
-      still[k].gyr_block = still_ids[k].second;
-    }
-    for (std::size_t k = 0; k < motions.size(); ++k) motions[k].block = motion_ids[k];
     std::vector<const double*> blocks;
     std::vector<int> block_term;
     for (int t = 0; t < model.num_terms(); ++t) {
       const double* b = theta[static_cast<std::size_t>(t)].data();
-      if (held_problem->IsParameterBlockConstant(b)) continue;
+      if (held_problem.IsParameterBlockConstant(b)) continue;
       blocks.push_back(b);
       block_term.push_back(t);
     }
@@ -532,7 +522,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     cov_options.num_threads = 1;
     ceres::Covariance covariance(cov_options);
     if (options.use_ceres_covariance && !pairs.empty() &&
-        covariance.Compute(pairs, held_problem.get())) {
+        covariance.Compute(pairs, &held_problem)) {
       ceres_covariance = true;
       for (std::size_t i = 0; i < blocks.size(); ++i) {
         for (std::size_t j = i; j < blocks.size(); ++j) {
@@ -573,10 +563,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   {
     const auto out = model.Predict(theta, model::SensorInput<double>());
     result.accel_matrix = out.F;
-    result.accel_bias = theta[static_cast<std::size_t>(t_acc)].size() >= 9
-                            ? Vec3(theta[static_cast<std::size_t>(t_acc)][6], theta[static_cast<std::size_t>(t_acc)][7],
-                                   theta[static_cast<std::size_t>(t_acc)][8])
-                            : Vec3::Zero();
+    const auto& a = theta[static_cast<std::size_t>(t_acc)];
+    result.accel_bias = Vec3(a[6], a[7], a[8]);
     if (result.has_gyro) {
       result.gyro_matrix = out.E;
       const auto& b = theta[static_cast<std::size_t>(t_gyr)];
@@ -592,7 +580,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   fit.still_segments = static_cast<int>(still.size());
   fit.motion_segments = static_cast<int>(motions.size());
   Vec3 ss_acc = Vec3::Zero(), ss_gyr = Vec3::Zero(), ss_mot = Vec3::Zero();
-  for (auto& s : still) {
+  for (std::size_t k = 0; k < still.size(); ++k) {
+    const Still& s = still[k];
     StillSegmentFit f;
     f.segment = s.segment;
     f.t_mid_s = s.stats.t_mid_s;
@@ -601,30 +590,30 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     if (result.has_gyro) f.gyr_mean = s.stats.gyr_mean;
     f.R_n_b = ToQuat(s.q);
     f.attitude_known = s.known;
-    f.acc_residual = s.stats.acc_mean - s.acc_functor->Predict(s.q.data(), theta);
-    ss_acc += f.acc_residual.cwiseAbs2();
-    if (s.gyr_functor) {
-      f.gyr_residual = s.stats.gyr_mean - s.gyr_functor->Predict(s.q.data(), theta);
-      ss_gyr += f.gyr_residual.cwiseAbs2();
-    }
+    // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
     double w[3];
-    problem.EvaluateResidualBlock(s.acc_block, false, nullptr, w, nullptr);
+    problem.EvaluateResidualBlock(final_build.acc[k], false, nullptr, w, nullptr);
     f.acc_whitened = Vec3(w[0], w[1], w[2]);
-    if (s.gyr_block) {
-      problem.EvaluateResidualBlock(s.gyr_block, false, nullptr, w, nullptr);
+    f.acc_residual = f.acc_whitened.cwiseQuotient(s.acc_measurement.sqrt_info);
+    ss_acc += f.acc_residual.cwiseAbs2();
+    if (final_build.gyr[k]) {
+      problem.EvaluateResidualBlock(final_build.gyr[k], false, nullptr, w, nullptr);
       f.gyr_whitened = Vec3(w[0], w[1], w[2]);
+      f.gyr_residual = f.gyr_whitened.cwiseQuotient(s.gyr_measurement.sqrt_info);
+      ss_gyr += f.gyr_residual.cwiseAbs2();
     }
     result.still.push_back(f);
   }
-  for (const auto& mo : motions) {
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    const Motion& mo = motions[k];
     MotionFit f;
     f.from = mo.from;
     f.to = mo.from + 1;
     f.duration_s = series.t_s[mo.last] - series.t_s[mo.first];
     double w[3];
-    problem.EvaluateResidualBlock(mo.block, false, nullptr, w, nullptr);
+    problem.EvaluateResidualBlock(final_build.motion[k], false, nullptr, w, nullptr);
     f.whitened = Vec3(w[0], w[1], w[2]);
-    f.rotation_residual = f.whitened.cwiseQuotient(mo.sqrt_info);
+    f.rotation_residual = f.whitened.cwiseQuotient(motion_samples[k].sqrt_info);
     ss_mot += f.rotation_residual.cwiseAbs2();
     result.motion.push_back(f);
   }
