@@ -158,18 +158,29 @@ SensorOutput<T> Model::Predict(const T* const* theta, const SensorInput<T>& in) 
 template <typename T>
 std::pair<Vec3T<T>, Vec3T<T>> Model::Correct(const T* const* theta, const Vec3T<T>& y_a,
                                              const Vec3T<T>& y_g, SensorInput<T> in,
-                                             int iterations) const {
+                                             const Mat3T<T>& F_inv, const Mat3T<T>& E_inv,
+                                             int steps) const {
   const bool gyro = has_gyro();
   in.f_b.setZero();
   in.omega_b.setZero();
-  for (int it = 0; it <= iterations; ++it) {
+  for (int it = 0; it < steps; ++it) {
     const SensorOutput<T> out = Predict(theta, in);
     // Newton step with the linear part's Jacobian (exact when all terms are additive and
     // independent of the inputs; the others converge at the rate of their size).
-    in.f_b += out.F.inverse() * (y_a - out.acc);
-    if (gyro) in.omega_b += out.E.inverse() * (y_g - out.gyr);
+    in.f_b += F_inv * (y_a - out.acc);
+    if (gyro) in.omega_b += E_inv * (y_g - out.gyr);
   }
   return {in.f_b, in.omega_b};
+}
+
+template <typename T>
+std::pair<Vec3T<T>, Vec3T<T>> Model::Correct(const T* const* theta, const Vec3T<T>& y_a,
+                                             const Vec3T<T>& y_g, SensorInput<T> in,
+                                             int iterations) const {
+  // F and E are written by the linear stage whatever the inputs.
+  const SensorOutput<T> linear = Predict(theta, SensorInput<T>());
+  return Correct(theta, y_a, y_g, in, Mat3T<T>(linear.F.inverse()), Mat3T<T>(linear.E.inverse()),
+                 iterations + 1);
 }
 
 SensorOutput<double> Model::Predict(const ParameterBlocks& theta,
@@ -207,5 +218,11 @@ template std::pair<Vec3T<Jet>, Vec3T<Jet>> Model::Correct<Jet>(const Jet* const*
                                                               const Vec3T<Jet>&,
                                                               const Vec3T<Jet>&,
                                                               SensorInput<Jet>, int) const;
+template std::pair<Vec3, Vec3> Model::Correct<double>(const double* const*, const Vec3&,
+                                                      const Vec3&, SensorInput<double>,
+                                                      const Mat3&, const Mat3&, int) const;
+template std::pair<Vec3T<Jet>, Vec3T<Jet>> Model::Correct<Jet>(
+    const Jet* const*, const Vec3T<Jet>&, const Vec3T<Jet>&, SensorInput<Jet>,
+    const Mat3T<Jet>&, const Mat3T<Jet>&, int) const;
 
 }  // namespace plumb::model

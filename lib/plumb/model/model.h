@@ -79,6 +79,14 @@ class Model {
                                         const Vec3T<T>& y_g, SensorInput<T> in,
                                         int iterations = 3) const;
 
+  /// The same with the inverses of the linear part given (F^-1, E^-1, which do not depend on
+  /// the inputs) and `steps` Newton steps, for callers that correct many samples.
+  template <typename T>
+  std::pair<Vec3T<T>, Vec3T<T>> Correct(const T* const* theta, const Vec3T<T>& y_a,
+                                        const Vec3T<T>& y_g, SensorInput<T> in,
+                                        const Mat3T<T>& F_inv, const Mat3T<T>& E_inv,
+                                        int steps) const;
+
   /// Convenience: the same on double blocks.
   SensorOutput<double> Predict(const ParameterBlocks& theta, const SensorInput<double>& in) const;
   std::pair<Vec3, Vec3> Correct(const ParameterBlocks& theta, const Vec3& y_a, const Vec3& y_g,

@@ -64,21 +64,15 @@ void MotionResidual::CorrectedRates(double const* const* theta, std::vector<Vec3
     return;
   }
 
-  // General model: Newton on the forward model (as Model::Correct), with Jets for dw/dtheta.
+  // General model: Model::Correct (Newton on the forward model), with Jets for dw/dtheta.
   auto correct = [&](auto const* const* th, const auto& Finv, const auto& Einv, std::size_t i) {
     using T = std::decay_t<decltype(Finv(0, 0))>;
     model::SensorInput<T> in;
     in.alpha_b = s_.alpha_b[i].cast<T>();
     in.dt_s = T(s_.dt_s[i]);
     in.dtemp_c = T(s_.dtemp_c[i]);
-    const Vec3T<T> y_a = s_.acc[i].cast<T>();
-    const Vec3T<T> y_g = s_.gyr[i].cast<T>();
-    for (int it = 0; it < 3; ++it) {
-      const model::SensorOutput<T> out = model_->Predict(th, in);
-      in.f_b += Finv * (y_a - out.acc);
-      in.omega_b += Einv * (y_g - out.gyr);
-    }
-    return Vec3T<T>(in.omega_b);
+    return model_->Correct<T>(th, s_.acc[i].cast<T>(), s_.gyr[i].cast<T>(), in, Finv, Einv, 3)
+        .second;
   };
   for (std::size_t i = 0; i < n; ++i) (*w)[i] = correct(theta, F_inv, E_inv, i);
   if (!W) return;
