@@ -25,6 +25,7 @@ using ::plumb::testing::EffectInvariants;
 /// Options tested besides the default one (keyed by effect name).
 const std::map<std::string, std::vector<std::string>>& ExtraOptions() {
   static const std::map<std::string, std::vector<std::string>> extra = {
+      {"accel_linear", {"full"}},
       {"gyro_linear", {"triangular"}},
       {"accel_temperature_bias", {"2", "3"}},
       {"gyro_temperature_bias", {"2", "3"}}};

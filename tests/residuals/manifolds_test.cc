@@ -11,6 +11,7 @@ namespace ceres {
 namespace {
 
 using plumb::residuals::AttitudeManifold;
+using plumb::residuals::HeadingManifold;
 using plumb::residuals::TiltManifold;
 
 Eigen::Vector4d SomeQuaternion() {
@@ -41,6 +42,26 @@ TEST(Manifolds, TiltManifoldInvariantsAndHeadingHeld) {
   const Eigen::Vector4d y(q.x(), q.y(), q.z(), q.w());
   EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(m, x, delta, y, 1e-9);
   EXPECT_EQ(m.TangentSize(), 2);
+}
+
+TEST(Manifolds, HeadingManifoldInvariantsAndTiltHeld) {
+  const auto owned = HeadingManifold();
+  const Manifold& m = *owned;
+  const Eigen::Vector4d x = SomeQuaternion();
+  const Eigen::Matrix<double, 1, 1> delta(0.03);
+  const Eigen::Quaterniond qd(Eigen::AngleAxisd(-0.2, Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond qx(x[3], x[0], x[1], x[2]);
+  const Eigen::Quaterniond q = qd * qx;
+  const Eigen::Vector4d y(q.x(), q.y(), q.z(), q.w());
+  EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(m, x, delta, y, 1e-9);
+  EXPECT_EQ(m.TangentSize(), 1);
+  // Moving along the tangent keeps the body's gravity direction R^T e_down.
+  Eigen::Vector4d moved;
+  m.Plus(x.data(), delta.data(), moved.data());
+  const Eigen::Quaterniond qm(moved[3], moved[0], moved[1], moved[2]);
+  EXPECT_LT((qm.conjugate() * Eigen::Vector3d::UnitZ() - qx.conjugate() * Eigen::Vector3d::UnitZ())
+                .norm(),
+            1e-12);
 }
 
 }  // namespace

@@ -19,8 +19,19 @@ struct StillSegment {
   std::string label;      ///< user label or "still #k"
   /// Known attitude R_n_b (body to NED) held constant in the fit, if stated.
   std::optional<Quat> known_R_n_b;
-  /// Known angular rate relative to the Earth in body frame, rad/s (turntable), if stated.
+  /// With known_R_n_b: only its tilt (the direction of gravity in body axes) is known, e.g. a
+  /// face of the paper's benchmark platform; the heading about the vertical is estimated
+  /// (through Earth rate; held when Earth rate is not used). Also for a turning segment: the
+  /// heading of its Earth-rate term.
+  bool heading_free = false;
+  /// Known mean angular rate relative to the Earth in body frame, rad/s: a turntable, or a
+  /// turn of known angle about a known axis (angle / duration). A segment with a nonzero known
+  /// rate is used for the gyroscope only (its specific force changes as it turns) and not for
+  /// the noise estimate.
   std::optional<Vec3> known_omega_eb_b;
+
+  /// True when the segment turns at a stated nonzero rate.
+  bool spinning() const { return known_omega_eb_b && known_omega_eb_b->squaredNorm() > 0.0; }
 
   std::size_t count() const { return end - begin; }
 };

@@ -32,8 +32,10 @@ struct Still {
   StillSegment segment;
   signal::SegmentStats stats;
   std::array<double, 4> q{0, 0, 0, 1};  // R_n_b, Eigen order x y z w
-  bool known = false;
-  bool chain_head = false;
+  bool known = false;         // attitude held constant
+  bool heading_only = false;  // tilt known, heading estimated (HeadingManifold)
+  bool chain_head = false;    // heading held as the gauge (TiltManifold)
+  bool spinning = false;      // known nonzero rate: gyroscope residual only
   residuals::StillMeasurement acc_measurement, gyr_measurement;
 };
 
@@ -128,6 +130,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     s.segment = seg;
     s.stats = signal::ComputeSegmentStats(series, seg);
     s.known = seg.known_R_n_b.has_value();
+    s.spinning = seg.spinning();
     still.push_back(std::move(s));
   }
   if (still.empty()) {
@@ -136,10 +139,32 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
         " samples: record the IMU still (a minute level, or many still poses joined by turns)");
   }
   const double g = site.gravity();
+  // A known tilt with a free heading: the heading is seen only through Earth rate, so it is
+  // estimated when the still gyroscope residuals with a site are in the fit, else held.
+  const bool earth_rate_seen = site.known && result.has_gyro && options.use_still_gyro;
+  for (auto& s : still) {
+    if (s.known && s.segment.heading_free && earth_rate_seen) {
+      s.known = false;
+      s.heading_only = true;
+    }
+  }
+  if (std::all_of(still.begin(), still.end(), [](const Still& s) { return s.spinning; })) {
+    throw InsufficientDataError("every segment turns at a stated rate: record still poses too");
+  }
+  auto truly_still = [](const std::vector<Still>& all) {
+    std::vector<Still> out;
+    for (const auto& s : all) {
+      if (!s.spinning) out.push_back(s);
+    }
+    return out;
+  };
 
-  // Noise from the data: pooled scatter and correlation time over the still segments.
+  // Noise from the data: pooled scatter and correlation time over the still segments (not
+  // the turning ones, whose scatter is signal).
   std::vector<StillSegment> used;
-  for (const auto& s : still) used.push_back(s.segment);
+  for (const auto& s : still) {
+    if (!s.spinning) used.push_back(s.segment);
+  }
   const auto acc_noise = signal::EstimateCorrelationTime(series, used, signal::Sensor::kAccel);
   std::array<signal::CorrelationTime, 3> gyr_noise{};
   if (result.has_gyro) {
@@ -162,7 +187,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   // Initial accelerometer.
   model::ParameterBlocks theta = model.ZeroParameters();
   const int t_acc = model.FindTerm("accel_linear");
-  const AccelGuess acc_guess = GuessAccel(Column(still, false), g);
+  const AccelGuess acc_guess = GuessAccel(Column(truly_still(still), false), g);
   {
     auto& b = theta[static_cast<std::size_t>(t_acc)];
     b[0] = b[3] = b[5] = acc_guess.scale - 1.0;
@@ -194,7 +219,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   double gyro_scale = 1.0;  // rad/s per sensor unit
   Vec3 gyro_bias0 = Vec3::Zero();
   if (result.has_gyro) {
-    for (const auto& s : still) gyro_bias0 += s.stats.gyr_mean / static_cast<double>(still.size());
+    const auto at_rest = truly_still(still);
+    for (const auto& s : at_rest) gyro_bias0 += s.stats.gyr_mean / static_cast<double>(at_rest.size());
     std::vector<std::pair<std::size_t, std::size_t>> intervals;
     std::vector<Vec3> before, after;
     for (const auto& m : motions) {
@@ -208,10 +234,18 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     for (int i = 0; i < 3; ++i) b[static_cast<std::size_t>(9 + i)] = gyro_bias0[i];
   }
 
+  // Fixed parameters are held at their nominal values, whatever the guesses above say.
+  for (int t = 0; t < model.num_terms(); ++t) {
+    const auto& fixed = model.terms()[static_cast<std::size_t>(t)].fixed;
+    for (std::size_t i = 0; i < fixed.size(); ++i) {
+      if (fixed[i]) theta[static_cast<std::size_t>(t)][i] = 0.0;
+    }
+  }
+
   // Initial attitudes: tilt from gravity, heading carried along each chain.
   for (std::size_t k = 0; k < still.size(); ++k) {
     Still& s = still[k];
-    if (s.known) {
+    if (s.known || s.heading_only) {
       s.q = FromQuat(*s.segment.known_R_n_b);
       continue;
     }
@@ -235,12 +269,14 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       std::size_t end = k + 1;
       while (end < still.size() && joined_to_previous[end]) ++end;
       bool any_known = false;
-      for (std::size_t j = k; j < end; ++j) any_known = any_known || still[j].known;
+      for (std::size_t j = k; j < end; ++j) {
+        any_known = any_known || still[j].known || still[j].heading_only;
+      }
       if (!any_known) still[k].chain_head = true;
       k = end;
     }
     if (!result.has_gyro) {
-      for (auto& s : still) s.chain_head = !s.known;
+      for (auto& s : still) s.chain_head = !s.known && !s.heading_only;
     }
   }
 
@@ -329,7 +365,9 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       if (s.known) {
         problem->SetParameterBlockConstant(s.q.data());
       } else {
-        manifolds.push_back(s.chain_head ? residuals::TiltManifold() : residuals::AttitudeManifold());
+        manifolds.push_back(s.heading_only ? residuals::HeadingManifold()
+                            : s.chain_head ? residuals::TiltManifold()
+                                           : residuals::AttitudeManifold());
         problem->SetManifold(s.q.data(), manifolds.back().get());
       }
     }
@@ -339,10 +377,12 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       return blocks;
     };
     for (auto& s : still) {
-      built.acc.push_back(problem->AddResidualBlock(
-          StillResidual::Create(model, model::Sensor::kAccel, s.acc_measurement, site.g_n,
-                                site.omega_ie_n),
-          nullptr, blocks_of(acc_terms, s.q.data())));
+      built.acc.push_back(
+          s.spinning ? nullptr
+                     : problem->AddResidualBlock(
+                           StillResidual::Create(model, model::Sensor::kAccel, s.acc_measurement,
+                                                 site.g_n, site.omega_ie_n),
+                           nullptr, blocks_of(acc_terms, s.q.data())));
       built.gyr.push_back(
           still_gyro ? problem->AddResidualBlock(
                            StillResidual::Create(model, model::Sensor::kGyro, s.gyr_measurement,
@@ -405,8 +445,9 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     for (std::size_t k = 0; k < still.size(); ++k) {
       if (still[k].known) continue;
       free_blocks.push_back(still[k].q.data());
-      const int dims = still[k].chain_head ? 2 : 3;
-      for (int i = 0; i < dims; ++i) {
+      const int first = still[k].heading_only ? 2 : 0;
+      const int dims = still[k].heading_only ? 1 : still[k].chain_head ? 2 : 3;
+      for (int i = first; i < first + dims; ++i) {
         names.push_back("attitude[" + std::to_string(k) + "]." + kTangentName[i]);
         values.push_back(std::nan(""));
         is_model.push_back(false);
@@ -592,10 +633,12 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     f.attitude_known = s.known;
     // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
     double w[3];
-    problem.EvaluateResidualBlock(final_build.acc[k], false, nullptr, w, nullptr);
-    f.acc_whitened = Vec3(w[0], w[1], w[2]);
-    f.acc_residual = f.acc_whitened.cwiseQuotient(s.acc_measurement.sqrt_info);
-    ss_acc += f.acc_residual.cwiseAbs2();
+    if (final_build.acc[k]) {
+      problem.EvaluateResidualBlock(final_build.acc[k], false, nullptr, w, nullptr);
+      f.acc_whitened = Vec3(w[0], w[1], w[2]);
+      f.acc_residual = f.acc_whitened.cwiseQuotient(s.acc_measurement.sqrt_info);
+      ss_acc += f.acc_residual.cwiseAbs2();
+    }
     if (final_build.gyr[k]) {
       problem.EvaluateResidualBlock(final_build.gyr[k], false, nullptr, w, nullptr);
       f.gyr_whitened = Vec3(w[0], w[1], w[2]);
@@ -618,12 +661,12 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     result.motion.push_back(f);
   }
   const double ns = static_cast<double>(still.size());
-  fit.rms_acc = (ss_acc / ns).cwiseSqrt();
+  fit.rms_acc = (ss_acc / static_cast<double>(truly_still(still).size())).cwiseSqrt();
   if (still_gyro) fit.rms_gyr = (ss_gyr / ns).cwiseSqrt();
   if (!motions.empty()) fit.rms_motion = (ss_mot / static_cast<double>(motions.size())).cwiseSqrt();
 
   // What the data cannot determine, and what to record.
-  const int orientations = CountDistinctOrientations(Column(still, false));
+  const int orientations = CountDistinctOrientations(Column(truly_still(still), false));
   bool accel_short = false, gyro_short = false;
   std::vector<std::string> lost;
   for (const auto& p : result.parameters) {
@@ -659,7 +702,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
                          : "; the accelerometer scale depends on it") +
         " (give --lat --lon --height)");
   }
-  const bool any_known = std::any_of(still.begin(), still.end(), [](const Still& s) { return s.known; });
+  const bool any_known = std::any_of(still.begin(), still.end(), [](const Still& s) { return s.known || s.heading_only; });
   if (site.known && result.has_gyro && !any_known && !options.first_heading_deg) {
     result.warnings.push_back(
         "the heading of the first still pose is held at 0 (x north) as the gauge; with a site, "

@@ -64,10 +64,10 @@ void Model::Add(const std::string& name, const std::string& option) {
   }
   // Rebuild the normalised spec.
   spec_.clear();
-  const bool is_base = FindTerm("accel_linear") == 0 && FindTerm("gyro_linear") == 1 &&
-                       terms_[1].effect->info().option.empty();
-  const bool is_paper = FindTerm("accel_linear") == 0 && FindTerm("gyro_linear") == 1 &&
-                        terms_[1].effect->info().option == "triangular";
+  const bool pair = FindTerm("accel_linear") == 0 && FindTerm("gyro_linear") == 1 &&
+                    terms_[0].effect->info().option.empty();
+  const bool is_base = pair && terms_[1].effect->info().option.empty();
+  const bool is_paper = pair && terms_[1].effect->info().option == "triangular";
   std::size_t first = 0;
   if (is_base || is_paper) {
     spec_ = is_base ? "base" : "paper";

@@ -62,7 +62,8 @@ class Model {
   std::vector<std::string> ParameterNames() const;
   /// (term, index) of a full parameter name, or nullopt.
   std::optional<std::pair<int, int>> FindParameter(const std::string& full_name) const;
-  /// Holds a parameter fixed at its value (throws if the name is unknown).
+  /// Holds a parameter fixed at its nominal value (the identity model: 1 on the diagonals of
+  /// F and E, 0 elsewhere) in the fit (throws if the name is unknown).
   void Fix(const std::string& full_name, bool fixed = true);
 
   /// Forward model: predicted outputs for the true inputs. `theta[i]` is block i.

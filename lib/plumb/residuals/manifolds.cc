@@ -6,14 +6,15 @@
 namespace plumb::residuals {
 namespace {
 
-/// Left perturbation by a rotation vector whose first kTangent components are free.
-/// Quaternions in Eigen order (x y z w); ceres::rotation uses (w x y z).
-template <int kTangent>
+/// Left perturbation by a rotation vector whose components [kFirst, kFirst + kTangent) are
+/// free (0 north, 1 east, 2 down). Quaternions in Eigen order (x y z w); ceres::rotation uses
+/// (w x y z).
+template <int kFirst, int kTangent>
 struct LeftRotationPlus {
   template <typename T>
   bool Plus(const T* x, const T* delta, T* x_plus_delta) const {
-    T rv[3] = {delta[0], delta[1], T(0)};
-    if constexpr (kTangent == 3) rv[2] = delta[2];
+    T rv[3] = {T(0), T(0), T(0)};
+    for (int i = 0; i < kTangent; ++i) rv[kFirst + i] = delta[i];
     T dq[4];
     ceres::AngleAxisToQuaternion(rv, dq);
     const T q[4] = {x[3], x[0], x[1], x[2]};
@@ -38,7 +39,7 @@ struct LeftRotationPlus {
     }
     T rv[3];
     ceres::QuaternionToAngleAxis(d, rv);
-    for (int i = 0; i < kTangent; ++i) y_minus_x[i] = rv[i];
+    for (int i = 0; i < kTangent; ++i) y_minus_x[i] = rv[kFirst + i];
     return true;
   }
 };
@@ -46,11 +47,15 @@ struct LeftRotationPlus {
 }  // namespace
 
 std::unique_ptr<ceres::Manifold> AttitudeManifold() {
-  return std::make_unique<ceres::AutoDiffManifold<LeftRotationPlus<3>, 4, 3>>();
+  return std::make_unique<ceres::AutoDiffManifold<LeftRotationPlus<0, 3>, 4, 3>>();
 }
 
 std::unique_ptr<ceres::Manifold> TiltManifold() {
-  return std::make_unique<ceres::AutoDiffManifold<LeftRotationPlus<2>, 4, 2>>();
+  return std::make_unique<ceres::AutoDiffManifold<LeftRotationPlus<0, 2>, 4, 2>>();
+}
+
+std::unique_ptr<ceres::Manifold> HeadingManifold() {
+  return std::make_unique<ceres::AutoDiffManifold<LeftRotationPlus<2, 1>, 4, 1>>();
 }
 
 }  // namespace plumb::residuals

@@ -9,6 +9,8 @@
 // direction of this manifold. It fixes the gauge of SPEC section 3: with every R_k free, a
 // common turn about the vertical is seen only through Earth rate, so the heading of the first
 // segment of every chain of segments joined by motion is held.
+// HeadingManifold(): tangent (down), size 1 — the tilt is known (a face of a calibration
+// platform), only the heading about the vertical moves.
 #pragma once
 
 #include <ceres/manifold.h>
@@ -19,5 +21,6 @@ namespace plumb::residuals {
 
 std::unique_ptr<ceres::Manifold> AttitudeManifold();
 std::unique_ptr<ceres::Manifold> TiltManifold();
+std::unique_ptr<ceres::Manifold> HeadingManifold();
 
 }  // namespace plumb::residuals

@@ -7,6 +7,11 @@
 //   [0..5] F - I, upper triangle row-major: matrix.xx, matrix.xy, matrix.xz, matrix.yy,
 //          matrix.yz, matrix.zz (dimensionless; the diagonals are reported as 1 + value)
 //   [6..8] b_a: bias.x, bias.y, bias.z (m/s^2)
+//
+// Option "full": F full 3x3, for a frame that the data defines by known attitudes (the
+// paper's benchmark platform, whose faces give the axes) rather than by the accelerometer
+// itself. Three more values: [9..11] matrix.yx, matrix.zx, matrix.zy (dimensionless). Without
+// known attitudes, a full F is not determined (a rotation of the frame changes no prediction).
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
@@ -14,25 +19,35 @@ namespace plumb::model {
 namespace {
 
 EffectInfo MakeInfo(const std::string& option) {
-  if (!option.empty()) throw Error("accel_linear takes no option (got '" + option + "')");
+  if (!option.empty() && option != "full") {
+    throw Error("accel_linear's only option is 'full' (got '" + option + "')");
+  }
   EffectInfo info;
   info.name = "accel_linear";
   info.prefix = "accel";
+  info.option = option;
   info.sensor = Sensor::kAccel;
   info.linear_stage = true;
-  info.term = "y_a = F f_b + b_a, F upper triangular";
+  info.term = option.empty() ? "y_a = F f_b + b_a, F upper triangular"
+                             : "y_a = F f_b + b_a, F full";
   info.parameters = {{"matrix.xx", "1", 0.02, 1.0}, {"matrix.xy", "1", 0.01, 0.0},
                      {"matrix.xz", "1", 0.01, 0.0}, {"matrix.yy", "1", 0.02, 1.0},
                      {"matrix.yz", "1", 0.01, 0.0}, {"matrix.zz", "1", 0.02, 1.0}};
   auto bias = AxisParameters("bias", "m/s^2", 0.2);
   info.parameters.insert(info.parameters.end(), bias.begin(), bias.end());
+  if (option == "full") {
+    for (const char* name : {"matrix.yx", "matrix.zx", "matrix.zy"}) {
+      info.parameters.push_back({name, "1", 0.01, 0.0});
+    }
+  }
   info.excitation.still_orientations = true;
   return info;
 }
 
 class AccelLinear : public EffectBase<AccelLinear> {
  public:
-  explicit AccelLinear(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit AccelLinear(const std::string& option)
+      : EffectBase(MakeInfo(option)), full_(option == "full") {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -43,10 +58,18 @@ class AccelLinear : public EffectBase<AccelLinear> {
     F(1, 1) += theta[3];
     F(1, 2) = theta[4];
     F(2, 2) += theta[5];
+    if (full_) {
+      F(1, 0) = theta[9];
+      F(2, 0) = theta[10];
+      F(2, 1) = theta[11];
+    }
     Eigen::Map<const Vec3T<T>> b_a(theta + 6);
     out.F = F;
     out.acc = F * in.f_b + b_a;
   }
+
+ private:
+  bool full_;
 };
 
 }  // namespace

@@ -1,0 +1,118 @@
+// plumb/paper/backend.cc — see backend.h.
+#include "plumb/paper/backend.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plumb/core/error.h"
+#include "plumb/estimation/calibrator.h"
+#include "plumb/model/model.h"
+
+namespace plumb::paper {
+namespace {
+
+/// An attitude R_n_b whose body vector `down_b` (unit) maps onto NED down; heading arbitrary.
+Quat AttitudeWithDown(const Vec3& down_b) {
+  return Quat::FromTwoVectors(down_b.normalized(), Vec3::UnitZ());
+}
+
+}  // namespace
+
+PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(const ImuSeries& series,
+                                                       const PaperBenchmarkResult& closed,
+                                                       const geo::Site& site,
+                                                       double max_tilt_rad) {
+  PaperBenchmarkBackend out;
+  for (const StillPeriod& p : closed.still) {
+    if (p.pose.axis < 0 || p.pose.tilt_rad > max_tilt_rad) continue;
+    StillSegment s = p.segment;
+    // The paper's assumption: the axis is exactly along gravity ("parallel": it points down).
+    Vec3 down_b = Vec3::Zero();
+    down_b[p.pose.axis] = p.pose.parallel ? 1.0 : -1.0;
+    s.known_R_n_b = AttitudeWithDown(down_b);
+    s.heading_free = true;
+    s.known_omega_eb_b.reset();
+    out.segments.push_back(s);
+  }
+  for (const TurnPeriod& turn : closed.turns) {
+    const std::size_t n = turn.range.end - turn.range.begin;
+    // The segment mean of N samples spans N sample intervals: duration = span * N / (N - 1).
+    const double span = series.t_s[turn.range.end - 1] - series.t_s[turn.range.begin];
+    if (n < 2 || !(span > 0.0)) continue;
+    const double duration = span * static_cast<double>(n) / static_cast<double>(n - 1);
+    StillSegment s;
+    s.begin = turn.range.begin;
+    s.end = turn.range.end;
+    s.label = turn.range.label;
+    Vec3 omega = Vec3::Zero();
+    omega[turn.axis] = turn.nominal_angle_rad / duration;
+    s.known_omega_eb_b = omega;
+    // The attitude enters only through Earth rate, R^T omega_ie: its horizontal part (up to
+    // 7.3e-5 rad/s) is not negligible against the noise of a turn's mean rate (5e-5 rad/s for
+    // 3 s at 200 Hz of a typical MEMS gyro), so the heading is estimated like a face's; the
+    // tilt is that of the mean specific force over the turn.
+    Vec3 acc_mean = Vec3::Zero();
+    for (std::size_t k = s.begin; k < s.end; ++k) acc_mean += series.acc[k].cast<double>();
+    s.known_R_n_b = acc_mean.norm() > 0.0 ? AttitudeWithDown(-acc_mean) : Quat::Identity();
+    s.heading_free = true;
+    out.segments.push_back(s);
+  }
+  std::sort(out.segments.begin(), out.segments.end(),
+            [](const StillSegment& a, const StillSegment& b) { return a.begin < b.begin; });
+
+  out.model_spec = "accel_linear:full+gyro_linear+gyro_bias_drift";
+  model::Model model = model::Model::Parse(out.model_spec);
+  model.t_ref_s = closed.t0_s;
+  estimation::CalibrationOptions options;
+  options.method = "paper-benchmark (backend)";
+  options.use_motion = false;
+  out.result = estimation::Calibrate(series, out.segments, model, site, options);
+  return out;
+}
+
+const std::vector<std::string>& PaperStaticFixedParameters() {
+  static const std::vector<std::string> names = {"accel.matrix.xx", "accel.matrix.yy",
+                                                 "accel.matrix.xy", "gyro.matrix.xx",
+                                                 "gyro.matrix.yy", "gyro.matrix.xy"};
+  return names;
+}
+
+PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::size_t begin,
+                                                 std::size_t end, const geo::Site& site) {
+  if (begin >= end || end > series.size()) {
+    throw Error("paper-static (backend): sample range [" + std::to_string(begin) + ", " +
+                std::to_string(end) + ") is not inside the " + std::to_string(series.size()) +
+                " samples");
+  }
+  StillSegment s;
+  s.begin = begin;
+  s.end = end;
+  s.label = "level, x north";
+  s.known_R_n_b = Quat::Identity();  // R_n_b = I: body axes along north, east, down
+  const std::vector<StillSegment> segments = {s};
+
+  estimation::CalibrationOptions options;
+  options.method = "paper-static (backend)";
+  options.use_motion = false;
+
+  model::Model freed = model::Model::Parse("paper");
+  freed.t_ref_s = series.t_s.front();
+  model::Model fixed = freed;
+  for (const auto& name : PaperStaticFixedParameters()) {
+    if (fixed.FindParameter(name)) fixed.Fix(name);
+  }
+
+  PaperStaticBackend out;
+  out.fixed = estimation::Calibrate(series, segments, fixed, site, options);
+  options.method = "paper-static (backend, the paper's constants freed)";
+  out.freed = estimation::Calibrate(series, segments, freed, site, options);
+  for (const auto& name : PaperStaticFixedParameters()) {
+    const auto it = std::find_if(out.freed.parameters.begin(), out.freed.parameters.end(),
+                                 [&](const estimation::ParameterEstimate& p) { return p.name == name; });
+    if (it == out.freed.parameters.end()) continue;  // no gyroscope in the data
+    (it->observable ? out.fixed_observable : out.fixed_unobservable).push_back(name);
+  }
+  return out;
+}
+
+}  // namespace plumb::paper
