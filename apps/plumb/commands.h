@@ -34,5 +34,6 @@ std::unique_ptr<Command> MakeCalibrateCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeSimulateCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeEffectsCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeCompareCommand(CLI::App& parent);
+std::unique_ptr<Command> MakePaperCommand(CLI::App& parent);
 
 }  // namespace plumb::cli

@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   commands.push_back(plumb::cli::MakeSimulateCommand(app));
   commands.push_back(plumb::cli::MakeEffectsCommand(app));
   commands.push_back(plumb::cli::MakeCompareCommand(app));
+  commands.push_back(plumb::cli::MakePaperCommand(app));
 
   if (argc > 1 && argv[1][0] != '-') {
     const std::string name = argv[1];

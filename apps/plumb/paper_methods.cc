@@ -7,8 +7,10 @@
 #include <sstream>
 
 #include "commands.h"
+#include "plumb/paper/backend.h"
 #include "plumb/paper/static_procedure.h"
 #include "plumb/report/json_report.h"
+#include "plumb/report/summary.h"
 
 namespace plumb::cli {
 namespace {
@@ -93,16 +95,20 @@ int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& s
                 {"bias_drift", ToJson(r.gyro_bias_drift)}, {"t_ref_s", r.t0_s}}},
       {"gravity", r.gravity_m_s2}};
   doc["notes"] = r.notes;
+
+  std::cout << "\nThe same procedure on the backend (the faces' tilts known, headings estimated; "
+               "turns at their known mean rate; model "
+            << "accel_linear:full+gyro_linear+gyro_bias_drift):\n";
+  const paper::PaperBenchmarkBackend backend =
+      paper::CalibratePaperBenchmarkOnBackend(session.series, r, site);
+  std::cout << report::CalibrationSummary(backend.result);
+  doc["backend"] = report::ToJson(backend.result);
   Finish(doc, r.notes, json_path);
   return 0;
 }
 
 int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
                    const geo::Site& site, const std::string& json_path) {
-  if (!site.known) {
-    throw UsageError("calibrate --method paper-static needs the site (--lat, --lon) for "
-                     "C_ecef^ned, or a log with GPS");
-  }
   const paper::PaperStaticResult r =
       paper::CalibratePaperStatic(session.series, begin, end, site, paper::PaperStaticOptions{});
   const std::string au = session.series.acc_unit;
@@ -146,6 +152,24 @@ int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
   doc["site"] = {{"lat_deg", site.lat_deg}, {"lon_deg", site.lon_deg},
                  {"height_m", site.height_m}, {"source", site.source}};
   doc["notes"] = r.notes;
+
+  std::cout << "\nThe same procedure on the backend (one segment, attitude known level x north; "
+               "the paper's constants held):\n";
+  const paper::PaperStaticBackend backend =
+      paper::CalibratePaperStaticOnBackend(session.series, begin, end, site);
+  std::cout << report::CalibrationSummary(backend.fixed);
+  auto join = [](const std::vector<std::string>& names) {
+    std::string out;
+    for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out.empty() ? std::string("none") : out;
+  };
+  std::cout << "The paper's fixed constants, freed on the same data: unobservable: "
+            << join(backend.fixed_unobservable)
+            << "; observable: " << join(backend.fixed_observable) << "\n";
+  doc["backend"] = report::ToJson(backend.fixed);
+  doc["backend_freed"] = {{"unobservable", backend.fixed_unobservable},
+                          {"observable", backend.fixed_observable},
+                          {"result", report::ToJson(backend.freed)}};
   Finish(doc, r.notes, json_path);
   return 0;
 }

@@ -69,15 +69,19 @@ TEST(PaperStatic, SimulatedMinuteReproducesThePapersPattern) {
   EXPECT_EQ(r.E(0, 1), 0.0);
 }
 
-TEST(PaperStatic, EquatorAndUnknownSiteAreRefused) {
+TEST(PaperStatic, EquatorIsRefusedAndNoSiteLeavesTheGyroscopeOut) {
   const sim::Simulation s = SimulateStill(7);
   const ImuSeries& series = s.session.series;
   EXPECT_THROW(CalibratePaperStatic(series, 0, series.size(), geo::Site::At(0.0, 0.0, 0.0, "t"),
                                     PaperStaticOptions{}),
                InsufficientDataError);
-  EXPECT_THROW(CalibratePaperStatic(series, 0, series.size(), geo::Site::Unknown(),
-                                    PaperStaticOptions{}),
-               Error);
+  const PaperStaticResult no_site =
+      CalibratePaperStatic(series, 0, series.size(), geo::Site::Unknown(), PaperStaticOptions{});
+  EXPECT_FALSE(no_site.has_gyro);
+  EXPECT_NEAR(no_site.accel.bias.x(), 0.10, 2e-3);
+  bool said = false;
+  for (const auto& n : no_site.notes) said = said || n.find("no site") != std::string::npos;
+  EXPECT_TRUE(said);
   EXPECT_THROW(CalibratePaperStatic(series, 5, 6, s.site, PaperStaticOptions{}), Error);
 }
 

@@ -97,6 +97,7 @@ PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::s
 
   model::Model freed = model::Model::Parse("paper");
   freed.t_ref_s = series.t_s.front();
+  if (!site.known && freed.has_gyro()) freed.DropGyro();  // no Earth rate: nothing to fit
   model::Model fixed = freed;
   for (const auto& name : PaperStaticFixedParameters()) {
     if (fixed.FindParameter(name)) fixed.Fix(name);

@@ -65,8 +65,8 @@ struct PaperStaticBackend {
 };
 
 /// Fits the static configuration to samples [begin, end) (still, level, x north). Needs a known
-/// site for the gyroscope (Earth rate); without one the gyroscope is left out with a warning
-/// in the result. Throws plumb::Error for a bad range and what estimation::Calibrate throws.
+/// site for the gyroscope (Earth rate); without one the gyroscope is left out (the model's spec
+/// says "accelerometer only"). Throws plumb::Error for a bad range and what estimation::Calibrate throws.
 PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::size_t begin,
                                                  std::size_t end, const geo::Site& site);
 

@@ -124,6 +124,7 @@ std::vector<MotionRange> TurnsBetweenStill(const PaperBenchmarkResult& r) {
     m.begin = r.still[i].segment.end - 1;  // from the last still sample ...
     m.end = r.still[i + 1].segment.begin + 1;  // ... to the first still sample after it
     m.label = "turn after '" + r.still[i].segment.label + "'";
+    m.axis = a.axis;
     gaps.push_back(m);
   }
   return gaps;
@@ -142,7 +143,11 @@ void GyroscopeCoupling(const ImuSeries& series, const std::vector<MotionRange>& 
     TurnPeriod turn;
     turn.range = m;
     turn.integral = IntegrateRate(series, m.begin, m.end, r);
-    turn.integral.cwiseAbs().maxCoeff(&turn.axis);
+    turn.axis = m.axis;
+    const bool labelled = m.label.size() >= 5 && m.label.compare(1, 4, "_rot") == 0 &&
+                          m.label[0] >= 'x' && m.label[0] <= 'z';
+    if (turn.axis < 0 && labelled) turn.axis = m.label[0] - 'x';
+    if (turn.axis < 0 || turn.axis > 2) turn.integral.cwiseAbs().maxCoeff(&turn.axis);
     const double along = turn.integral[turn.axis];
     turn.nominal_angle_rad = std::round(along / kHalfPi) * kHalfPi;
     if (turn.nominal_angle_rad == 0.0) {

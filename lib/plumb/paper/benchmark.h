@@ -69,12 +69,16 @@ struct MotionRange {
   std::size_t begin = 0;  ///< first sample index
   std::size_t end = 0;    ///< one past the last sample index
   std::string label;      ///< e.g. "x_rot" or "turn after 'x up 90 deg'"
+  /// The body axis turned about (0, 1, 2) when known: from the still pose around the turn
+  /// (the axis along gravity), or from a label "x_rot", "y_rot", "z_rot"; -1: the axis with the
+  /// largest integrated output.
+  int axis = -1;
 };
 
 /// A turn used for the gyroscope coupling matrix.
 struct TurnPeriod {
   MotionRange range;                  ///< samples integrated (trapezoid rule)
-  int axis = -1;                      ///< 0, 1, 2: the axis with the largest integrated angle
+  int axis = -1;                      ///< 0, 1, 2: MotionRange::axis, else the largest integral
   Vec3 integral = Vec3::Zero();       ///< integral of (output - b(t)), gyro units times s
   double nominal_angle_rad = 0.0;     ///< integral along `axis` rounded to a multiple of pi/2
 };

@@ -103,7 +103,10 @@ PaperStaticResult CalibratePaperStatic(const ImuSeries& series, std::size_t begi
   r.b_a = r.accel.bias;
   r.notes.push_back("F is in the frame of the level, x-north pose; alpha = 0 and F_xx = F_yy = " +
                     std::to_string(-options.accel_diagonal) + " are fixed, not estimated");
-  if (series.has_gyro()) {
+  if (series.has_gyro() && !site.known) {
+    r.notes.push_back("no site: the gyroscope part (steps 5-7 need C_ecef^ned) is left out; "
+                      "give --lat --lon");
+  } else if (series.has_gyro()) {
     r.has_gyro = true;
     r.gyro = Gyroscope(series, begin, end, hp, site, options);
     r.E = r.gyro.E_paper;

@@ -88,9 +88,10 @@ struct PaperStaticResult {
 };
 
 /// Runs the static procedure on samples [begin, end) of the series (the still, level, x-north
-/// minute). The gyroscope part needs a known site off the equator. Throws plumb::Error for an
-/// empty or out-of-range sample range, fewer than 3 samples, bad options, or an unknown site
-/// (gyroscope), and plumb::InsufficientDataError at the equator (|lat| < 1e-6 rad).
+/// minute). The gyroscope part needs a known site off the equator: without a site it is left
+/// out (has_gyro false, with a note). Throws plumb::Error for an empty or out-of-range sample
+/// range, fewer than 3 samples or bad options, and plumb::InsufficientDataError at the equator
+/// (|lat| < 1e-6 rad).
 PaperStaticResult CalibratePaperStatic(const ImuSeries& series, std::size_t begin,
                                        std::size_t end, const geo::Site& site,
                                        const PaperStaticOptions& options);

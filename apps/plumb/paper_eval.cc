@@ -1,0 +1,423 @@
+// plumb paper BENCHMARK... (--static FILE | --static-section LABEL) --out DIR — the seed
+// paper's results and evaluation (its sections 6 and 7) on your data.
+//
+// Calibrates the benchmark session by the paper's section 4 and a still, level, x-north record
+// by its section 5 (both as printed, and both again on the backend with sigma and rank),
+// then writes into DIR:
+//   tables.md    Tables 1-4 (benchmark against proposed, % error), Table 5 (datasheet check),
+//                the backend's view of both procedures;
+//   paper.json   everything above as numbers;
+//   inputs.csv   the true inputs reconstructed from the benchmark data by both calibrations
+//                (the paper's Figures 1-6);
+//   figures.gp   a gnuplot script that draws figure1.png ... figure6.png from inputs.csv (run
+//                when gnuplot is on the PATH).
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "commands.h"
+#include "input_options.h"
+#include "plumb/core/error.h"
+#include "plumb/io/atomic_file.h"
+#include "plumb/io/segments_file.h"
+#include "plumb/paper/backend.h"
+#include "plumb/paper/benchmark.h"
+#include "plumb/paper/evaluation.h"
+#include "plumb/paper/static_procedure.h"
+#include "plumb/report/json_report.h"
+#include "plumb/report/summary.h"
+#include "plumb/segmentation/given_segments.h"
+#include "plumb/segmentation/still_detector.h"
+#include "site_options.h"
+
+namespace plumb::cli {
+namespace {
+
+struct PaperArgs {
+  InputArgs input;
+  SiteArgs site;
+  std::string segments_path;   ///< --segments: the benchmark's sections
+  std::string static_path;     ///< --static FILE: the still minute, same input options
+  std::string static_section;  ///< --static-section LABEL: a still section of --segments
+  std::string out_dir;         ///< --out DIR
+  std::string part = "MPU-6000";  ///< --part: datasheet limits for Table 5
+  std::size_t stride = 1;      ///< --stride: every n-th sample in inputs.csv
+  bool no_plot = false;        ///< --no-plot: do not run gnuplot
+  double gravity_m_s2 = 0.0;
+  CLI::Option* gravity = nullptr;
+};
+
+std::string Num(double v, int digits = 4) {
+  if (std::isnan(v)) return "undefined";
+  std::ostringstream out;
+  const double a = std::abs(v);
+  if (v != 0.0 && (a < 1e-3 || a >= 1e4)) {
+    out << std::scientific << std::setprecision(digits - 1) << v;
+  } else {
+    out << std::fixed << std::setprecision(digits) << v;
+  }
+  return out.str();
+}
+
+std::string Pct(double v) {
+  if (std::isnan(v)) return "undefined";
+  std::ostringstream out;
+  const double a = std::abs(v);
+  out << std::showpos;
+  if (a >= 1e4) {
+    out << std::scientific << std::setprecision(3) << v;
+  } else {
+    out << std::fixed << std::setprecision(1) << v;
+  }
+  return out.str();
+}
+
+std::string MatrixCell(const Mat3& m, int row, std::string (*f)(double, int)) {
+  return f(m(row, 0), 4) + " " + f(m(row, 1), 4) + " " + f(m(row, 2), 4);
+}
+
+std::string PctRow(const Mat3& m, int row) {
+  return Pct(m(row, 0)) + " " + Pct(m(row, 1)) + " " + Pct(m(row, 2));
+}
+
+nlohmann::json ChecksJson(const std::vector<paper::LimitCheck>& checks) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& c : checks) {
+    out.push_back({{"quantity", c.quantity}, {"value", report::Number(c.value)},
+                   {"limit", report::Number(c.limit)}, {"within", c.within}});
+  }
+  return out;
+}
+
+std::string ChecksMarkdown(const std::string& title, const std::vector<paper::LimitCheck>& checks) {
+  std::ostringstream md;
+  int out_of_spec = 0;
+  for (const auto& c : checks) out_of_spec += c.within ? 0 : 1;
+  md << "**" << title << "**: " << out_of_spec << " of " << checks.size()
+     << " values outside the datasheet" << (out_of_spec ? ": " : ".");
+  bool first = true;
+  for (const auto& c : checks) {
+    if (c.within) continue;
+    md << (first ? "" : ", ") << c.quantity << " " << Num(c.value) << " (limit " << Num(c.limit)
+       << ")";
+    first = false;
+  }
+  md << (out_of_spec ? ".\n\n" : "\n\n");
+  return md.str();
+}
+
+class PaperCommand : public Command {
+ public:
+  explicit PaperCommand(CLI::App& parent) {
+    app_ = parent.add_subcommand(
+        "paper",
+        "The seed paper's results and evaluation on your data: its benchmark (section 4) and "
+        "static (section 5) calibrations, Tables 1-5 and the reconstructed inputs of "
+        "Figures 1-6, with the backend's sigma and rank for both");
+    PaperArgs& a = args_;
+    AddInputOptions(app_, a.input);
+    AddSiteOptions(app_, a.site);
+    app_->add_option("--segments", a.segments_path,
+                     "The benchmark session's sections (still and *_rot turns; CSV or imucal's "
+                     "JSON) instead of detecting still periods")
+        ->type_name("FILE");
+    auto* st = app_->add_option("--static", a.static_path,
+                                "The still, level, x-north record for section 5 (read with the "
+                                "same input options)")
+                   ->type_name("FILE");
+    auto* sec = app_->add_option("--static-section", a.static_section,
+                                 "Use this still section of --segments as the section-5 record "
+                                 "(e.g. imucal's z_a: z down)")
+                    ->type_name("LABEL");
+    st->excludes(sec);
+    app_->add_option("--out", a.out_dir, "Directory for tables.md, paper.json, inputs.csv, "
+                                         "figures.gp (created if missing)")
+        ->required()
+        ->type_name("DIR");
+    app_->add_option("--part", a.part,
+                     "Datasheet limits for Table 5: MPU-6000 (the paper's), MPU-9250, "
+                     "ICM-42688-P")
+        ->capture_default_str();
+    app_->add_option("--stride", a.stride, "Write every N-th sample to inputs.csv")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app_->add_flag("--no-plot", a.no_plot, "Write figures.gp but do not run gnuplot");
+    a.gravity = app_->add_option("--gravity", a.gravity_m_s2,
+                                 "Fixed gravity magnitude, m/s^2, instead of WGS84 normal "
+                                 "gravity at the site")
+                    ->check(CLI::PositiveNumber);
+  }
+
+  int Run() override {
+    const PaperArgs& a = args_;
+    if (a.static_path.empty() && a.static_section.empty()) {
+      throw UsageError("paper needs the section-5 record: --static FILE or --static-section "
+                       "LABEL (with --segments)");
+    }
+    if (!a.static_section.empty() && a.segments_path.empty()) {
+      throw UsageError("--static-section needs --segments FILE");
+    }
+    const paper::PartLimits& part = paper::FindPart(a.part);
+    Session bench = ReadInputs(a.input);
+    if (bench.series.empty()) throw Error(bench.source + ": no samples");
+    std::optional<double> gravity;
+    if (a.gravity->count() > 0) gravity = a.gravity_m_s2;
+    const geo::Site site = ResolveSite(a.site, bench.site, gravity);
+    if (!site.known) {
+      throw UsageError("paper needs the site (--lat, --lon) for the section-5 gyroscope "
+                       "(C_ecef^ned and Earth rate)");
+    }
+
+    // Benchmark sections.
+    std::vector<StillSegment> still;
+    std::vector<paper::MotionRange> motion;
+    if (!a.segments_path.empty()) {
+      const io::GivenSections given = io::ReadGivenSections(a.segments_path, bench.series);
+      still = given.still;
+      for (const auto& m : given.motion) motion.push_back({m.begin, m.end, m.label});
+    } else {
+      segmentation::StillDetectorOptions detector;
+      detector.acc_unit = bench.series.acc_unit;
+      detector.gyr_unit = bench.series.gyr_unit;
+      still = segmentation::DetectStillSegments(bench.series, detector).segments;
+    }
+
+    // The section-5 record.
+    Session static_session;
+    std::size_t begin = 0, end = 0;
+    const Session* still_minute = &bench;
+    if (!a.static_path.empty()) {
+      InputArgs in = a.input;
+      in.inputs = {a.static_path};
+      in.acc_file.clear();
+      in.gyr_file.clear();
+      static_session = ReadInputs(in);
+      still_minute = &static_session;
+      end = static_session.series.size();
+    } else {
+      const auto it = std::find_if(still.begin(), still.end(), [&](const StillSegment& s) {
+        return s.label == a.static_section;
+      });
+      if (it == still.end()) {
+        throw UsageError(a.segments_path + ": no still section labelled '" + a.static_section + "'");
+      }
+      begin = it->begin;
+      end = it->end;
+    }
+
+    paper::PaperBenchmarkOptions bopt;
+    bopt.gravity_m_s2 = site.gravity();
+    const paper::PaperBenchmarkResult b =
+        paper::CalibratePaperBenchmark(bench.series, still, motion, bopt);
+    const paper::PaperStaticResult s = paper::CalibratePaperStatic(
+        still_minute->series, begin, end, site, paper::PaperStaticOptions{});
+    const paper::PaperBenchmarkBackend bb =
+        paper::CalibratePaperBenchmarkOnBackend(bench.series, b, site);
+    const paper::PaperStaticBackend sb =
+        paper::CalibratePaperStaticOnBackend(still_minute->series, begin, end, site);
+    const paper::PaperTables t = paper::MakePaperTables(b, s);
+    const paper::ReconstructedInputs rec =
+        paper::ReconstructInputs(bench.series, b, s, a.stride);
+
+    const bool si = bench.series.acc_unit == "m/s^2" && bench.series.gyr_unit == "rad/s" &&
+                    still_minute->series.acc_unit == "m/s^2";
+    std::vector<paper::LimitCheck> check_b, check_s, check_bb;
+    if (si) {
+      check_b = paper::CheckDatasheet(part, b.F, b.b_a, b.E, b.b_g, true);
+      check_s = paper::CheckDatasheet(part, s.F, s.b_a, s.E, s.b_g, s.has_gyro);
+      check_bb = paper::CheckDatasheet(part, bb.result.accel_matrix, bb.result.accel_bias,
+                                       bb.result.gyro_matrix, bb.result.gyro_bias, true);
+    }
+
+    std::filesystem::create_directories(a.out_dir);
+    const std::string dir = a.out_dir + "/";
+    const std::string au = bench.series.acc_unit, gu = bench.series.gyr_unit;
+
+    // tables.md
+    std::ostringstream md;
+    md << "Benchmark: " << bench.source << " (" << b.still.size() << " still periods, "
+       << b.turns.size() << " turns). Proposed: " << still_minute->source << " samples [" << begin
+       << ", " << end << ") (" << s.count << " samples, " << Num(s.rate_hz, 1)
+       << " Hz). Site " << Num(site.lat_deg, 4) << " deg, " << Num(site.lon_deg, 4) << " deg, "
+       << Num(site.height_m, 1) << " m (" << site.source << "). % error = 100 (proposed - "
+       << "benchmark) / |benchmark|.\n\n";
+    if (t.has_gyro) {
+      md << "Table 1: gyroscope bias (" << gu << ")\n\n"
+         << "| axis | benchmark b0 | proposed | % error | benchmark b1 (" << gu << "/s) |\n"
+         << "|---|---|---|---|---|\n";
+      for (int i = 0; i < 3; ++i) {
+        md << "| " << kAxisName[i] << " | " << Num(t.gyro_bias_benchmark[i]) << " | "
+           << Num(t.gyro_bias_proposed[i]) << " | " << Pct(t.gyro_bias_error_pct[i]) << " | "
+           << Num(t.gyro_bias_b1_benchmark[i]) << " |\n";
+      }
+      md << "\nTable 2: gyroscope coupling matrix (rows)\n\n"
+         << "| row | benchmark | proposed | % error |\n|---|---|---|---|\n";
+      for (int i = 0; i < 3; ++i) {
+        md << "| " << kAxisName[i] << " | " << MatrixCell(t.gyro_coupling_benchmark, i, Num)
+           << " | " << MatrixCell(t.gyro_coupling_proposed, i, Num) << " | "
+           << PctRow(t.gyro_coupling_error_pct, i) << " |\n";
+      }
+      md << "\n";
+    }
+    md << "Table 3: accelerometer bias (" << au << ")\n\n"
+       << "| axis | benchmark | proposed | % error |\n|---|---|---|---|\n";
+    for (int i = 0; i < 3; ++i) {
+      md << "| " << kAxisName[i] << " | " << Num(t.accel_bias_benchmark[i]) << " | "
+         << Num(t.accel_bias_proposed[i]) << " | " << Pct(t.accel_bias_error_pct[i]) << " |\n";
+    }
+    md << "\nTable 4: accelerometer coupling matrix, the paper's convention (rows)\n\n"
+       << "| row | benchmark | proposed | % error |\n|---|---|---|---|\n";
+    for (int i = 0; i < 3; ++i) {
+      md << "| " << kAxisName[i] << " | " << MatrixCell(t.accel_coupling_benchmark, i, Num)
+         << " | " << MatrixCell(t.accel_coupling_proposed, i, Num) << " | "
+         << PctRow(t.accel_coupling_error_pct, i) << " |\n";
+    }
+    md << "\nTable 5: datasheet check against " << part.name << " (" << part.source
+       << "); scale = F_ii - 1, cross-axis = F_ij / F_ii, forward convention\n\n";
+    if (si) {
+      md << ChecksMarkdown("benchmark (section 4)", check_b)
+         << ChecksMarkdown("proposed (section 5)", check_s)
+         << ChecksMarkdown("benchmark on the backend", check_bb);
+    } else {
+      md << "not checked: the data is not in m/s^2 and rad/s (give --acc-unit/--acc-scale and "
+            "--gyr-unit/--gyr-scale)\n\n";
+    }
+    auto chi = [](const estimation::CalibrationResult& r) {
+      return Num(r.fit.chi2 / std::max(1, r.fit.dof), 3) + " (" + std::to_string(r.fit.dof) +
+             " dof), rank " + std::to_string(r.observability.rank) + " of " +
+             std::to_string(r.observability.num_unknowns);
+    };
+    md << "Backend, benchmark configuration (" << bb.model_spec << "): chi2/dof " << chi(bb.result)
+       << "; unobservable: " << bb.result.observability.unobservable.size() << " directions.\n\n";
+    md << "Backend, static configuration (the paper's constants held): chi2/dof " << chi(sb.fixed)
+       << "; " << sb.fixed.observability.unobservable.size()
+       << " unobservable directions:";
+    for (const auto& u : sb.fixed.observability.unobservable) md << " `" << u << "`;";
+    md << " determined:";
+    for (const auto& c : sb.fixed.observability.determined) {
+      md << " `" << c.text << "` = " << Num(c.value) << " +- " << Num(c.sigma) << ";";
+    }
+    md << " the paper's constants freed, unobservable:";
+    for (const auto& n : sb.fixed_unobservable) md << " `" << n << "`";
+    md << (sb.fixed_unobservable.empty() ? " none" : "") << ".\n\n";
+    md << "Reconstructed inputs (Figures 1-6, inputs.csv): RMS of proposed - benchmark, specific "
+          "force (" << Num(rec.rms_f_difference.x()) << ", " << Num(rec.rms_f_difference.y())
+       << ", " << Num(rec.rms_f_difference.z()) << ") m/s^2";
+    if (!rec.omega_benchmark.empty()) {
+      md << ", rate (" << Num(rec.rms_omega_difference.x()) << ", "
+         << Num(rec.rms_omega_difference.y()) << ", " << Num(rec.rms_omega_difference.z())
+         << ") rad/s";
+    }
+    md << ".\n";
+    for (const auto& n : rec.notes) md << "\nNote: " << n << ".\n";
+    io::WriteFileAtomic(dir + "tables.md", md.str());
+
+    // paper.json
+    nlohmann::json doc;
+    doc["benchmark_input"] = bench.source;
+    doc["static_input"] = still_minute->source;
+    doc["static_range"] = {begin, end};
+    doc["site"] = {{"lat_deg", site.lat_deg}, {"lon_deg", site.lon_deg},
+                   {"height_m", site.height_m}, {"gravity", site.gravity()},
+                   {"source", site.source}};
+    doc["tables"] = {
+        {"accel_bias", {{"benchmark", report::Vector(t.accel_bias_benchmark)},
+                        {"proposed", report::Vector(t.accel_bias_proposed)},
+                        {"error_pct", report::Vector(t.accel_bias_error_pct)}}},
+        {"accel_coupling", {{"benchmark", report::Matrix(t.accel_coupling_benchmark)},
+                            {"proposed", report::Matrix(t.accel_coupling_proposed)},
+                            {"error_pct", report::Matrix(t.accel_coupling_error_pct)}}}};
+    if (t.has_gyro) {
+      doc["tables"]["gyro_bias"] = {{"benchmark", report::Vector(t.gyro_bias_benchmark)},
+                                    {"proposed", report::Vector(t.gyro_bias_proposed)},
+                                    {"error_pct", report::Vector(t.gyro_bias_error_pct)},
+                                    {"b1_benchmark", report::Vector(t.gyro_bias_b1_benchmark)}};
+      doc["tables"]["gyro_coupling"] = {{"benchmark", report::Matrix(t.gyro_coupling_benchmark)},
+                                        {"proposed", report::Matrix(t.gyro_coupling_proposed)},
+                                        {"error_pct", report::Matrix(t.gyro_coupling_error_pct)}};
+    }
+    doc["datasheet"] = {{"part", part.name}, {"source", part.source}, {"checked", si}};
+    if (si) {
+      doc["datasheet"]["benchmark"] = ChecksJson(check_b);
+      doc["datasheet"]["proposed"] = ChecksJson(check_s);
+      doc["datasheet"]["benchmark_backend"] = ChecksJson(check_bb);
+    }
+    doc["backend"] = {{"benchmark", report::ToJson(bb.result)},
+                      {"static", report::ToJson(sb.fixed)},
+                      {"static_freed", {{"unobservable", sb.fixed_unobservable},
+                                        {"observable", sb.fixed_observable}}}};
+    doc["reconstruction"] = {{"rms_f_difference", report::Vector(rec.rms_f_difference)},
+                             {"rms_omega_difference", report::Vector(rec.rms_omega_difference)},
+                             {"notes", rec.notes}};
+    doc["notes"] = {{"benchmark", b.notes}, {"static", s.notes}};
+    report::WriteJson(dir + "paper.json", doc);
+
+    // inputs.csv and figures.gp
+    std::ostringstream csv;
+    csv << std::setprecision(9)
+        << "time_s,f_benchmark_x,f_benchmark_y,f_benchmark_z,f_proposed_x,f_proposed_y,"
+           "f_proposed_z,omega_benchmark_x,omega_benchmark_y,omega_benchmark_z,"
+           "omega_proposed_x,omega_proposed_y,omega_proposed_z\n";
+    for (std::size_t k = 0; k < rec.t_s.size(); ++k) {
+      csv << rec.t_s[k];
+      for (const Vec3* v : {&rec.f_benchmark[k], &rec.f_proposed[k]}) {
+        csv << "," << v->x() << "," << v->y() << "," << v->z();
+      }
+      if (rec.omega_benchmark.empty()) {
+        csv << ",,,,,,\n";
+        continue;
+      }
+      for (const Vec3* v : {&rec.omega_benchmark[k], &rec.omega_proposed[k]}) {
+        csv << "," << v->x() << "," << v->y() << "," << v->z();
+      }
+      csv << "\n";
+    }
+    io::WriteFileAtomic(dir + "inputs.csv", csv.str());
+    std::ostringstream gp;
+    gp << "# Figures 1-6 of the seed paper: the true inputs reconstructed from the benchmark\n"
+          "# data by the benchmark (section 4) and proposed (section 5) calibrations.\n"
+          "# Run in this directory: gnuplot figures.gp\n"
+          "set datafile separator ','\nset terminal pngcairo size 900,420\nset key outside\n"
+          "set xlabel 'time (s)'\n";
+    const char* what[6] = {"X-axis specific force", "Y-axis specific force",
+                           "Z-axis specific force", "X-axis angular rate",
+                           "Y-axis angular rate", "Z-axis angular rate"};
+    for (int f = 0; f < 6; ++f) {
+      const int col_b = 2 + (f < 3 ? f : 6 + (f - 3));
+      const int col_p = col_b + 3;
+      gp << "set output 'figure" << f + 1 << ".png'\nset title 'Fig. " << f + 1 << ": " << what[f]
+         << " input - benchmark vs. proposed'\nset ylabel '" << (f < 3 ? "m/s^2" : "rad/s")
+         << "'\nplot 'inputs.csv' using 1:" << col_b << " with lines title 'benchmark', '' using 1:"
+         << col_p << " with lines title 'proposed'\n";
+    }
+    io::WriteFileAtomic(dir + "figures.gp", gp.str());
+
+    std::cout << md.str();
+    std::cout << "wrote " << dir << "tables.md, paper.json, inputs.csv, figures.gp\n";
+    if (!a.no_plot && !rec.omega_benchmark.empty()) {
+      const std::string command = "cd '" + a.out_dir + "' && gnuplot figures.gp";
+      if (std::system(command.c_str()) == 0) {
+        std::cout << "wrote " << dir << "figure1.png ... figure6.png (gnuplot)\n";
+      } else {
+        std::cout << "warning: gnuplot did not run; draw the figures with '" << command << "'\n";
+      }
+    }
+    return 0;
+  }
+
+ private:
+  PaperArgs args_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakePaperCommand(CLI::App& parent) {
+  return std::make_unique<PaperCommand>(parent);
+}
+
+}  // namespace plumb::cli
