@@ -85,6 +85,15 @@ std::string PctRow(const Mat3& m, int row) {
   return Pct(m(row, 0)) + " " + Pct(m(row, 1)) + " " + Pct(m(row, 2));
 }
 
+nlohmann::json AsJson(const Vec3& v) { return report::Vector(v); }
+nlohmann::json AsJson(const Mat3& m) { return report::Matrix(m); }
+
+template <typename T>
+nlohmann::json ComparedJson(const paper::Compared<T>& c) {
+  return {{"benchmark", AsJson(c.benchmark)}, {"proposed", AsJson(c.proposed)},
+          {"error_pct", AsJson(c.error_pct)}};
+}
+
 nlohmann::json ChecksJson(const std::vector<paper::LimitCheck>& checks) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& c : checks) {
@@ -251,31 +260,31 @@ class PaperCommand : public Command {
          << "| axis | benchmark b0 | proposed | % error | benchmark b1 (" << gu << "/s) |\n"
          << "|---|---|---|---|---|\n";
       for (int i = 0; i < 3; ++i) {
-        md << "| " << kAxisName[i] << " | " << Num(t.gyro_bias_benchmark[i]) << " | "
-           << Num(t.gyro_bias_proposed[i]) << " | " << Pct(t.gyro_bias_error_pct[i]) << " | "
+        md << "| " << kAxisName[i] << " | " << Num(t.gyro_bias.benchmark[i]) << " | "
+           << Num(t.gyro_bias.proposed[i]) << " | " << Pct(t.gyro_bias.error_pct[i]) << " | "
            << Num(t.gyro_bias_b1_benchmark[i]) << " |\n";
       }
       md << "\nTable 2: gyroscope coupling matrix (rows)\n\n"
          << "| row | benchmark | proposed | % error |\n|---|---|---|---|\n";
       for (int i = 0; i < 3; ++i) {
-        md << "| " << kAxisName[i] << " | " << MatrixCell(t.gyro_coupling_benchmark, i, Num)
-           << " | " << MatrixCell(t.gyro_coupling_proposed, i, Num) << " | "
-           << PctRow(t.gyro_coupling_error_pct, i) << " |\n";
+        md << "| " << kAxisName[i] << " | " << MatrixCell(t.gyro_coupling.benchmark, i, Num)
+           << " | " << MatrixCell(t.gyro_coupling.proposed, i, Num) << " | "
+           << PctRow(t.gyro_coupling.error_pct, i) << " |\n";
       }
       md << "\n";
     }
     md << "Table 3: accelerometer bias (" << au << ")\n\n"
        << "| axis | benchmark | proposed | % error |\n|---|---|---|---|\n";
     for (int i = 0; i < 3; ++i) {
-      md << "| " << kAxisName[i] << " | " << Num(t.accel_bias_benchmark[i]) << " | "
-         << Num(t.accel_bias_proposed[i]) << " | " << Pct(t.accel_bias_error_pct[i]) << " |\n";
+      md << "| " << kAxisName[i] << " | " << Num(t.accel_bias.benchmark[i]) << " | "
+         << Num(t.accel_bias.proposed[i]) << " | " << Pct(t.accel_bias.error_pct[i]) << " |\n";
     }
     md << "\nTable 4: accelerometer coupling matrix, the paper's convention (rows)\n\n"
        << "| row | benchmark | proposed | % error |\n|---|---|---|---|\n";
     for (int i = 0; i < 3; ++i) {
-      md << "| " << kAxisName[i] << " | " << MatrixCell(t.accel_coupling_benchmark, i, Num)
-         << " | " << MatrixCell(t.accel_coupling_proposed, i, Num) << " | "
-         << PctRow(t.accel_coupling_error_pct, i) << " |\n";
+      md << "| " << kAxisName[i] << " | " << MatrixCell(t.accel_coupling.benchmark, i, Num)
+         << " | " << MatrixCell(t.accel_coupling.proposed, i, Num) << " | "
+         << PctRow(t.accel_coupling.error_pct, i) << " |\n";
     }
     md << "\nTable 5: datasheet check against " << part.name << " (" << part.source
        << "); scale = F_ii - 1, cross-axis = F_ij / F_ii, forward convention\n\n";
@@ -325,21 +334,12 @@ class PaperCommand : public Command {
     doc["site"] = {{"lat_deg", site.lat_deg}, {"lon_deg", site.lon_deg},
                    {"height_m", site.height_m}, {"gravity", site.gravity()},
                    {"source", site.source}};
-    doc["tables"] = {
-        {"accel_bias", {{"benchmark", report::Vector(t.accel_bias_benchmark)},
-                        {"proposed", report::Vector(t.accel_bias_proposed)},
-                        {"error_pct", report::Vector(t.accel_bias_error_pct)}}},
-        {"accel_coupling", {{"benchmark", report::Matrix(t.accel_coupling_benchmark)},
-                            {"proposed", report::Matrix(t.accel_coupling_proposed)},
-                            {"error_pct", report::Matrix(t.accel_coupling_error_pct)}}}};
+    doc["tables"] = {{"accel_bias", ComparedJson(t.accel_bias)},
+                     {"accel_coupling", ComparedJson(t.accel_coupling)}};
     if (t.has_gyro) {
-      doc["tables"]["gyro_bias"] = {{"benchmark", report::Vector(t.gyro_bias_benchmark)},
-                                    {"proposed", report::Vector(t.gyro_bias_proposed)},
-                                    {"error_pct", report::Vector(t.gyro_bias_error_pct)},
-                                    {"b1_benchmark", report::Vector(t.gyro_bias_b1_benchmark)}};
-      doc["tables"]["gyro_coupling"] = {{"benchmark", report::Matrix(t.gyro_coupling_benchmark)},
-                                        {"proposed", report::Matrix(t.gyro_coupling_proposed)},
-                                        {"error_pct", report::Matrix(t.gyro_coupling_error_pct)}};
+      doc["tables"]["gyro_bias"] = ComparedJson(t.gyro_bias);
+      doc["tables"]["gyro_bias"]["b1_benchmark"] = report::Vector(t.gyro_bias_b1_benchmark);
+      doc["tables"]["gyro_coupling"] = ComparedJson(t.gyro_coupling);
     }
     doc["datasheet"] = {{"part", part.name}, {"source", part.source}, {"checked", si}};
     if (si) {

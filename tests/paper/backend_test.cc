@@ -7,17 +7,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <string>
 #include <vector>
 
-#include "plumb/io/segments_file.h"
-#include "plumb/io/text_table.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/paper/benchmark.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
+#include "ferraris_session.h"
 
 namespace plumb::paper {
 namespace {
@@ -178,28 +176,14 @@ TEST(PaperBackend, StaticConfigurationMarksWhatOneLevelPoseCannotDetermine) {
 }
 
 TEST(PaperBackend, ImucalFerrarisSessionOnTheBackend) {
-  const std::string dir = std::string(PLUMB_SHARED_DATA_DIR) + "/ferraris/imucal/";
-  const std::string csv = dir + "example_ferraris_session.csv";
-  const std::string list = dir + "example_ferraris_session_list.json";
-  for (const std::string& f : {csv, list}) {
-    if (!std::filesystem::exists(f)) GTEST_SKIP() << "shared data absent: " << f;
-  }
-  io::TextTableOptions o;
-  o.header_row = true;
-  o.time = "n_samples";
-  o.time_unit_s = 1.0 / 102.4;
-  o.acc.axes = {"acc_x", "acc_y", "acc_z"};
-  o.gyr.axes = {"gyr_x", "gyr_y", "gyr_z"};
-  o.gyr.SetScale(M_PI / 180.0);
-  const Session session = io::ReadTextTable(csv, o);
-  const io::GivenSections given = io::ReadGivenSections(list, session.series);
-  std::vector<MotionRange> motion;
-  for (const io::MotionSection& m : given.motion) motion.push_back({m.begin, m.end, m.label});
+  SKIP_UNLESS_FERRARIS_DATA();
+  const testing::FerrarisSession f = testing::ReadFerrarisSession();
+  const Session& session = f.session;
   const geo::Site site = geo::Site::Unknown();  // imucal's session states no site
   PaperBenchmarkOptions options;
   options.gravity_m_s2 = site.gravity();
   const PaperBenchmarkResult closed =
-      CalibratePaperBenchmark(session.series, given.still, motion, options);
+      CalibratePaperBenchmark(session.series, f.still, f.motion, options);
   const PaperBenchmarkBackend b = CalibratePaperBenchmarkOnBackend(session.series, closed, site);
 
   // Six faces (no site: headings held) and three 360 deg turns: every parameter determined,

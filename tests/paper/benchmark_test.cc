@@ -3,18 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "plumb/core/error.h"
-#include "plumb/io/segments_file.h"
-#include "plumb/io/text_table.h"
 #include "plumb/paper/benchmark.h"
 #include "plumb/peers/imucal.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
+#include "ferraris_session.h"
 
 namespace plumb::paper {
 namespace {
@@ -115,33 +113,15 @@ TEST(PaperBenchmark, MissingPoseIsNamed) {
 
 // --- imucal's Ferraris session --------------------------------------------------------------
 
-std::string SharedFile(const std::string& relative) {
-  return std::string(PLUMB_SHARED_DATA_DIR) + "/ferraris/imucal/" + relative;
-}
-
 TEST(PaperBenchmark, ImucalFerrarisSessionAgreesWithImucalOnTheAccelerometer) {
-  const std::string csv = SharedFile("example_ferraris_session.csv");
-  const std::string list = SharedFile("example_ferraris_session_list.json");
-  const std::string cal = SharedFile("example_ferraris_session_cal_102.4Hz.json");
-  for (const std::string& f : {csv, list, cal}) {
-    if (!std::filesystem::exists(f)) GTEST_SKIP() << "shared data absent: " << f;
-  }
-  io::TextTableOptions o;
-  o.header_row = true;
-  o.time = "n_samples";
-  o.time_unit_s = 1.0 / 102.4;
-  o.acc.axes = {"acc_x", "acc_y", "acc_z"};
-  o.gyr.axes = {"gyr_x", "gyr_y", "gyr_z"};
-  o.gyr.SetScale(M_PI / 180.0);
-  const Session session = io::ReadTextTable(csv, o);
-  const io::GivenSections given = io::ReadGivenSections(list, session.series);
-  std::vector<MotionRange> motion;
-  for (const io::MotionSection& m : given.motion) motion.push_back({m.begin, m.end, m.label});
-
+  SKIP_UNLESS_FERRARIS_DATA();
+  const testing::FerrarisSession f = testing::ReadFerrarisSession();
+  const Session& session = f.session;
+  const std::string cal = testing::FerrarisFile("example_ferraris_session_cal_102.4Hz.json");
   PaperBenchmarkOptions options;
   options.gravity_m_s2 = 9.81;  // imucal's `grav`
   const PaperBenchmarkResult r =
-      CalibratePaperBenchmark(session.series, given.still, motion, options);
+      CalibratePaperBenchmark(session.series, f.still, f.motion, options);
   const peers::ImucalFerraris imucal = peers::ReadImucalJson(cal);
 
   // Eq. (3) is imucal's bias (diag((U_p + U_a) / 2)); only float storage differs.

@@ -21,6 +21,32 @@ TEST(PaperEvaluation, PercentErrorIsRelativeToTheBenchmarksMagnitude) {
   EXPECT_TRUE(std::isnan(PercentError(NAN, 1.0)));
 }
 
+TEST(PaperEvaluation, TablesSetTheClosedFormsSideBySideInThePapersConvention) {
+  PaperBenchmarkResult b;
+  b.accel_bias = Vec3(-0.0060, 0.1310, 0.8262);
+  b.accel_coupling_paper = -Mat3::Identity() * 0.965;
+  b.gyro_bias_b0 = Vec3(0.1901e-3, -0.1953e-3, -0.5823e-3);
+  b.gyro_bias_b1 = Vec3(1.6e-9, 0, 0);
+  b.gyro_coupling_paper = Mat3::Identity();
+  PaperStaticResult p;
+  p.accel.bias = Vec3(-0.1015, 0.0470, 0.0007);
+  p.accel.F_paper = -Mat3::Identity();
+  p.has_gyro = true;
+  p.gyro.bias = Vec3(0.2e-3, -0.4e-3, -1.1e-3);
+  p.gyro.E_paper << 1, 0, 8.5258, 0, 1, -0.0283, 0, 0, 0.1586;
+  const PaperTables t = MakePaperTables(b, p);
+  EXPECT_EQ(t.accel_bias.proposed, p.accel.bias);
+  EXPECT_NEAR(t.accel_bias.error_pct.z(), -99.9, 0.05);
+  EXPECT_NEAR(t.accel_coupling.error_pct(0, 0), -3.6, 0.05);
+  EXPECT_TRUE(std::isnan(t.accel_coupling.error_pct(0, 1)));  // zero benchmark
+  ASSERT_TRUE(t.has_gyro);
+  EXPECT_NEAR(t.gyro_bias.error_pct.x(), 5.2, 0.05);  // the paper prints +10.8 (rounded 0.2E-3)
+  EXPECT_EQ(t.gyro_bias_b1_benchmark, b.gyro_bias_b1);
+  EXPECT_NEAR(t.gyro_coupling.error_pct(2, 2), -84.14, 0.01);
+  p.has_gyro = false;
+  EXPECT_FALSE(MakePaperTables(b, p).has_gyro);
+}
+
 TEST(PaperEvaluation, DatasheetCheckFlagsOutOfSpecValues) {
   const PartLimits& part = FindPart("mpu6000");
   EXPECT_EQ(part.name, "MPU-6000");

@@ -16,18 +16,15 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDegToRad = 0.017453292519943295;
 constexpr double kMilliG = 9.80665e-3;  // m/s^2 per mg
 
-Vec3 Percent(const Vec3& proposed, const Vec3& benchmark) {
-  Vec3 out;
-  for (int i = 0; i < 3; ++i) out[i] = PercentError(proposed[i], benchmark[i]);
-  return out;
-}
-
-Mat3 Percent(const Mat3& proposed, const Mat3& benchmark) {
-  Mat3 out;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) out(i, j) = PercentError(proposed(i, j), benchmark(i, j));
+template <typename T>
+Compared<T> Compare(const T& benchmark, const T& proposed) {
+  Compared<T> c;
+  c.benchmark = benchmark;
+  c.proposed = proposed;
+  for (Eigen::Index i = 0; i < benchmark.size(); ++i) {
+    c.error_pct.data()[i] = PercentError(proposed.data()[i], benchmark.data()[i]);
   }
-  return out;
+  return c;
 }
 
 std::string Canonical(const std::string& name) {
@@ -65,68 +62,42 @@ double PercentError(double proposed, double benchmark) {
 PaperTables MakePaperTables(const PaperBenchmarkResult& benchmark,
                             const PaperStaticResult& proposed) {
   PaperTables t;
-  t.accel_bias_benchmark = benchmark.accel_bias;
-  t.accel_bias_proposed = proposed.accel.bias;
-  t.accel_bias_error_pct = Percent(t.accel_bias_proposed, t.accel_bias_benchmark);
-  t.accel_coupling_benchmark = benchmark.accel_coupling_paper;
-  t.accel_coupling_proposed = proposed.accel.F_paper;
-  t.accel_coupling_error_pct = Percent(t.accel_coupling_proposed, t.accel_coupling_benchmark);
+  t.accel_bias = Compare(benchmark.accel_bias, proposed.accel.bias);
+  t.accel_coupling = Compare(benchmark.accel_coupling_paper, proposed.accel.F_paper);
   t.has_gyro = proposed.has_gyro;
   if (t.has_gyro) {
-    t.gyro_bias_benchmark = benchmark.gyro_bias_b0;
+    t.gyro_bias = Compare(benchmark.gyro_bias_b0, proposed.gyro.bias);
     t.gyro_bias_b1_benchmark = benchmark.gyro_bias_b1;
-    t.gyro_bias_proposed = proposed.gyro.bias;
-    t.gyro_bias_error_pct = Percent(t.gyro_bias_proposed, t.gyro_bias_benchmark);
-    t.gyro_coupling_benchmark = benchmark.gyro_coupling_paper;
-    t.gyro_coupling_proposed = proposed.gyro.E_paper;
-    t.gyro_coupling_error_pct = Percent(t.gyro_coupling_proposed, t.gyro_coupling_benchmark);
+    t.gyro_coupling = Compare(benchmark.gyro_coupling_paper, proposed.gyro.E_paper);
   }
   return t;
 }
 
 const std::vector<PartLimits>& KnownParts() {
   // Figures as the datasheets print them (deg/s, %, mg), converted to SI here.
-  static const std::vector<PartLimits> parts = [] {
-    std::vector<PartLimits> p;
-    PartLimits mpu6000;
-    mpu6000.name = "MPU-6000";
-    mpu6000.gyro_bias_rad_s = 20.0 * kDegToRad;
-    mpu6000.gyro_scale = 0.03;
-    mpu6000.gyro_cross_axis = 0.02;
-    mpu6000.accel_bias_xy_m_s2 = 50.0 * kMilliG;
-    mpu6000.accel_bias_z_m_s2 = 80.0 * kMilliG;
-    mpu6000.accel_scale = 0.03;
-    mpu6000.accel_cross_axis = 0.02;
-    mpu6000.source = "InvenSense MPU-6000/MPU-6050 Product Specification rev. 3.4, tables 6.1 "
-                     "and 6.2 (the paper's Table 5, ref. [12])";
-    p.push_back(mpu6000);
-    PartLimits mpu9250;
-    mpu9250.name = "MPU-9250";
-    mpu9250.gyro_bias_rad_s = 5.0 * kDegToRad;
-    mpu9250.gyro_scale = 0.03;
-    mpu9250.gyro_cross_axis = 0.02;
-    mpu9250.accel_bias_xy_m_s2 = 60.0 * kMilliG;
-    mpu9250.accel_bias_z_m_s2 = 80.0 * kMilliG;
-    mpu9250.accel_scale = 0.03;
-    mpu9250.accel_cross_axis = 0.02;
-    mpu9250.source = "InvenSense MPU-9250 Product Specification PS-MPU-9250A-01 rev. 1.0, "
-                     "tables 1 and 2 (typical, component level)";
-    p.push_back(mpu9250);
-    PartLimits icm42688;
-    icm42688.name = "ICM-42688-P";
-    icm42688.gyro_bias_rad_s = 0.5 * kDegToRad;
-    icm42688.gyro_scale = 0.005;
-    icm42688.gyro_cross_axis = 0.0125;
-    icm42688.accel_bias_xy_m_s2 = 20.0 * kMilliG;
-    icm42688.accel_bias_z_m_s2 = 20.0 * kMilliG;
-    icm42688.accel_scale = 0.005;
-    icm42688.accel_cross_axis = 0.01;
-    icm42688.source = "TDK InvenSense ICM-42688-P datasheet DS-000347 rev. 1.2/1.8, tables 1 "
-                      "and 2 (typical; offsets and cross-axis board level, from "
-                      "characterisation)";
-    p.push_back(icm42688);
-    return p;
-  }();
+  auto part = [](const char* name, double gyro_zro_deg_s, double gyro_scale_pct,
+                 double gyro_cross_pct, double accel_xy_mg, double accel_z_mg,
+                 double accel_scale_pct, double accel_cross_pct, const char* source) {
+    return PartLimits{name,
+                      gyro_zro_deg_s * kDegToRad,
+                      gyro_scale_pct / 100.0,
+                      gyro_cross_pct / 100.0,
+                      accel_xy_mg * kMilliG,
+                      accel_z_mg * kMilliG,
+                      accel_scale_pct / 100.0,
+                      accel_cross_pct / 100.0,
+                      source};
+  };
+  static const std::vector<PartLimits> parts = {
+      part("MPU-6000", 20.0, 3.0, 2.0, 50.0, 80.0, 3.0, 2.0,
+           "InvenSense MPU-6000/MPU-6050 Product Specification rev. 3.4, tables 6.1 and 6.2 "
+           "(the paper's Table 5, ref. [12])"),
+      part("MPU-9250", 5.0, 3.0, 2.0, 60.0, 80.0, 3.0, 2.0,
+           "InvenSense MPU-9250 Product Specification PS-MPU-9250A-01 rev. 1.0, tables 1 and 2 "
+           "(typical, component level)"),
+      part("ICM-42688-P", 0.5, 0.5, 1.25, 20.0, 20.0, 0.5, 1.0,
+           "TDK InvenSense ICM-42688-P datasheet DS-000347 rev. 1.2/1.8, tables 1 and 2 "
+           "(typical; offsets and cross-axis board level, from characterisation)")};
   return parts;
 }
 

@@ -23,25 +23,22 @@ namespace plumb::paper {
 /// 100 (proposed - benchmark) / |benchmark|, %; NaN when benchmark is 0 or either is not finite.
 double PercentError(double proposed, double benchmark);
 
+/// One quantity of the paper's tables: the benchmark's value, the proposed one, and
+/// PercentError element by element.
+template <typename T>
+struct Compared {
+  T benchmark = T::Zero();
+  T proposed = T::Zero();
+  T error_pct = T::Zero();
+};
+
 /// Tables 1-4 in the paper's convention (its coupling matrices ~ -I for the accelerometer).
 struct PaperTables {
-  // Table 1: gyroscope bias, output units; b1 of the benchmark, output units per s.
-  Vec3 gyro_bias_benchmark = Vec3::Zero();
-  Vec3 gyro_bias_proposed = Vec3::Zero();
-  Vec3 gyro_bias_error_pct = Vec3::Zero();
-  Vec3 gyro_bias_b1_benchmark = Vec3::Zero();
-  // Table 2: gyroscope coupling matrix, dimensionless.
-  Mat3 gyro_coupling_benchmark = Mat3::Zero();
-  Mat3 gyro_coupling_proposed = Mat3::Zero();
-  Mat3 gyro_coupling_error_pct = Mat3::Zero();
-  // Table 3: accelerometer bias, output units.
-  Vec3 accel_bias_benchmark = Vec3::Zero();
-  Vec3 accel_bias_proposed = Vec3::Zero();
-  Vec3 accel_bias_error_pct = Vec3::Zero();
-  // Table 4: accelerometer coupling matrix, dimensionless.
-  Mat3 accel_coupling_benchmark = Mat3::Zero();
-  Mat3 accel_coupling_proposed = Mat3::Zero();
-  Mat3 accel_coupling_error_pct = Mat3::Zero();
+  Compared<Vec3> gyro_bias;             ///< Table 1: gyroscope bias, output units
+  Vec3 gyro_bias_b1_benchmark = Vec3::Zero();  ///< Table 1: the benchmark's b1, units per s
+  Compared<Mat3> gyro_coupling;         ///< Table 2: gyroscope coupling matrix, dimensionless
+  Compared<Vec3> accel_bias;            ///< Table 3: accelerometer bias, output units
+  Compared<Mat3> accel_coupling;        ///< Table 4: accelerometer coupling, dimensionless
   bool has_gyro = false;  ///< Tables 1 and 2 filled (the static result has a gyroscope part)
 };
 
