@@ -25,6 +25,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -64,9 +65,10 @@ inline model::Model ModelWith(const EffectCase& c) {
 }
 
 /// An input that excites every effect: tilted specific force, rotation, angular acceleration,
-/// time and temperature away from their references.
+/// time and temperature away from their references, a known attitude.
 inline model::SensorInput<double> ExcitedInput() {
   model::SensorInput<double> in;
+  in.R_b_n = Eigen::AngleAxisd(0.7, Vec3(0.3, -0.5, 0.8).normalized()).toRotationMatrix();
   in.f_b = Vec3(1.3, -2.1, -9.4);
   in.omega_b = Vec3(0.8, -0.5, 1.1);
   in.alpha_b = Vec3(-1.7, 2.3, 0.9);
@@ -104,6 +106,7 @@ inline model::SensorInput<model::Jet> ToJet(const model::SensorInput<double>& in
   j.alpha_b = in.alpha_b.cast<model::Jet>();
   j.dt_s = model::Jet(in.dt_s);
   j.dtemp_c = model::Jet(in.dtemp_c);
+  j.R_b_n = in.R_b_n.cast<model::Jet>();
   return j;
 }
 

@@ -60,7 +60,11 @@ std::vector<Vec3> Column(const std::vector<Still>& still, bool gyro) {
   return out;
 }
 
-void CheckEffectData(const model::Model& model, const ImuSeries& series) {
+void CheckEffectData(const model::Model& model, const ImuSeries& series, const geo::Site& site) {
+  if (site.known && model.has_effect("earth_rate")) {
+    throw Error("earth_rate is a candidate only without a site: with --lat/--lon Earth rate is "
+                "already in the model (from GeographicLib); drop it from the model");
+  }
   for (const auto& term : model.terms()) {
     const auto& info = term.effect->info();
     if (info.excitation.temperature && !series.has_temperature()) {
@@ -84,6 +88,61 @@ std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series
   }
   const bool matrix = info.parameters[static_cast<std::size_t>(i)].name.rfind("matrix.", 0) == 0;
   return matrix ? out + " per " + in : out;
+}
+
+/// The whitened residuals and Jacobian of `probe` (built with the probe terms free) at the
+/// current values: columns `free_blocks` (the fit's free unknowns, named `names`) then every
+/// probe term's block.
+ProbeJacobian ProbeColumns(const model::Model& model, model::ParameterBlocks& theta,
+                           const BuiltProblem& probe, const std::vector<double*>& free_blocks,
+                           const std::vector<std::string>& names,
+                           const std::vector<bool>& is_model) {
+  ProbeJacobian out;
+  out.unknown_names = names;
+  out.unknown_is_model = is_model;
+  std::vector<double*> blocks = free_blocks;
+  for (int t = 0; t < model.num_terms(); ++t) {
+    const auto& term = model.terms()[static_cast<std::size_t>(t)];
+    if (!term.probe) continue;
+    blocks.push_back(theta[static_cast<std::size_t>(t)].data());
+    for (int i = 0; i < term.effect->info().size(); ++i) {
+      out.probe_names.push_back(term.effect->info().ParameterName(i));
+      out.probe_term.push_back(t);
+    }
+  }
+  ceres::Problem::EvaluateOptions eval;
+  eval.parameter_blocks = blocks;
+  auto add_rows = [&](ceres::ResidualBlockId id, ProbeJacobian::RowKind kind, int index) {
+    if (id == nullptr) return;
+    eval.residual_blocks.push_back(id);
+    for (int axis = 0; axis < 3; ++axis) {
+      out.row_kind.push_back(kind);
+      out.row_index.push_back(index);
+      out.row_axis.push_back(axis);
+    }
+  };
+  for (std::size_t k = 0; k < probe.acc.size(); ++k) {
+    add_rows(probe.acc[k], ProbeJacobian::RowKind::kStillAccel, static_cast<int>(k));
+    add_rows(probe.gyr[k], ProbeJacobian::RowKind::kStillGyro, static_cast<int>(k));
+  }
+  for (std::size_t k = 0; k < probe.motion.size(); ++k) {
+    add_rows(probe.motion[k], ProbeJacobian::RowKind::kMotion, static_cast<int>(k));
+  }
+  std::vector<double> r;
+  ceres::CRSMatrix crs;
+  probe.problem->Evaluate(eval, nullptr, &r, nullptr, &crs);
+  Eigen::MatrixXd all = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int idx = crs.rows[static_cast<std::size_t>(row)];
+         idx < crs.rows[static_cast<std::size_t>(row) + 1]; ++idx) {
+      all(row, crs.cols[static_cast<std::size_t>(idx)]) = crs.values[static_cast<std::size_t>(idx)];
+    }
+  }
+  const auto n_free = static_cast<Eigen::Index>(names.size());
+  out.r = Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  out.J = all.leftCols(n_free);
+  out.Z = all.rightCols(all.cols() - n_free);
+  return out;
 }
 
 }  // namespace
@@ -112,7 +171,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     model.DropGyro();
     result.warnings.push_back("the input has no gyroscope: calibrating the accelerometer only");
   }
-  CheckEffectData(model, series);
+  CheckEffectData(model, series, site);
   result.has_gyro = model.has_gyro();
   result.acc_unit = series.acc_unit;
   result.gyr_unit = series.gyr_unit;
@@ -335,7 +394,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   set_motion_weights(Mat3::Identity() / gyro_scale);
 
   std::vector<std::unique_ptr<ceres::Manifold>> manifolds;
-  auto build = [&](const std::vector<std::pair<int, int>>& held_extra) {
+  // `free_probes`: the probe terms' blocks are left free (for their Jacobian columns only).
+  auto build = [&](const std::vector<std::pair<int, int>>& held_extra, bool free_probes = false) {
     BuiltProblem built;
     built.problem = std::make_unique<ceres::Problem>([] {
       ceres::Problem::Options o;
@@ -347,6 +407,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       auto& block = theta[static_cast<std::size_t>(t)];
       const auto& fixed = model.terms()[static_cast<std::size_t>(t)].fixed;
       problem->AddParameterBlock(block.data(), static_cast<int>(block.size()));
+      if (free_probes && model.terms()[static_cast<std::size_t>(t)].probe) continue;
       std::vector<int> held;
       for (std::size_t i = 0; i < fixed.size(); ++i) {
         const bool extra = std::find(held_extra.begin(), held_extra.end(),
@@ -421,11 +482,14 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
 
   // Jacobian over every free unknown (model parameters, then attitudes) and its analysis.
   std::vector<std::pair<int, int>> model_index;  // per column: (term, index) or (-1, still)
+  std::vector<double*> free_blocks;              // of the last analysis, in column order
+  std::vector<std::string> names;
+  std::vector<bool> is_model;
   auto analyse = [&](ceres::Problem& problem, double* cost, std::vector<double>* residual_values) {
-    std::vector<double*> free_blocks;
-    std::vector<std::string> names;
     std::vector<double> values;
-    std::vector<bool> is_model;
+    free_blocks.clear();
+    names.clear();
+    is_model.clear();
     model_index.clear();
     for (int t = 0; t < model.num_terms(); ++t) {
       auto& block = theta[static_cast<std::size_t>(t)];
@@ -709,6 +773,9 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
         "Earth rate (" + std::to_string(site.omega_ie_n.head<2>().norm()) +
         " rad/s horizontal) is predicted for that heading: state it (--heading DEG or "
         "--level-north) or the gyroscope biases absorb up to that much");
+  }
+  if (model.has_probes()) {
+    result.probes = ProbeColumns(model, theta, build({}, true), free_blocks, names, is_model);
   }
   result.model = model;
   result.theta = theta;

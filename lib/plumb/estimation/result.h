@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,24 @@ struct FitSummary {
   std::string solver_report;  ///< ceres::Solver::Summary::BriefReport()
 };
 
+/// The whitened problem at the optimum with the columns of the model's probe terms
+/// (model::Model::AddProbe), for the score test of plumb/diagnostics. Rows are the whitened
+/// residuals in the order still segment 0 (accelerometer, gyroscope), segment 1, ..., then the
+/// motion intervals; each row is labelled.
+struct ProbeJacobian {
+  Eigen::VectorXd r;  ///< whitened residuals (measured minus predicted), dimensionless
+  Eigen::MatrixXd J;  ///< d r / d(free unknowns: model parameters, then attitude tangents)
+  Eigen::MatrixXd Z;  ///< d r / d(probe parameters) at zero
+  std::vector<std::string> unknown_names;  ///< J's columns
+  std::vector<bool> unknown_is_model;      ///< J's columns: model parameter (else attitude)
+  std::vector<std::string> probe_names;    ///< Z's columns, e.g. "gyro_g_sensitivity.G.xy"
+  std::vector<int> probe_term;             ///< Z's columns: index of the term in the model
+  enum class RowKind { kStillAccel, kStillGyro, kMotion };
+  std::vector<RowKind> row_kind;  ///< per row
+  std::vector<int> row_index;     ///< per row: still segment or motion interval index
+  std::vector<int> row_axis;      ///< per row: 0, 1, 2
+};
+
 struct CalibrationResult {
   std::string method = "generalized";
   model::Model model;
@@ -109,6 +128,8 @@ struct CalibrationResult {
   Vec3 noise_gyr = Vec3::Zero();
   double tau_acc = 1, tau_gyr = 1;  ///< integrated autocorrelation times used, samples
   std::vector<std::string> warnings;
+  /// Present when the model has probe terms.
+  std::optional<ProbeJacobian> probes;
 
   /// A few lines: model, chi^2/dof, rank, convergence.
   std::string BriefReport() const;

@@ -85,6 +85,9 @@ struct SensorInput {
   Vec3T<T> alpha_b = Vec3T<T>::Zero();  ///< angular acceleration, body frame, rad/s^2
   T dt_s = T(0);     ///< time since the model's reference time t_ref, s
   T dtemp_c = T(0);  ///< temperature minus the model's reference temperature, degC
+  /// Attitude, NED vectors into body (R_n_b^T), on still segments; zero where it is not known
+  /// (samples of motion intervals). Used by earth_rate.
+  Mat3T<T> R_b_n = Mat3T<T>::Zero();
 };
 
 /// The predicted outputs, built up effect by effect.

@@ -1,5 +1,6 @@
 #include "plumb/model/model.h"
 
+#include <algorithm>
 #include <Eigen/LU>
 #include <sstream>
 
@@ -62,26 +63,48 @@ void Model::Add(const std::string& name, const std::string& option) {
   } else {
     terms_.push_back(std::move(term));
   }
-  // Rebuild the normalised spec.
-  spec_.clear();
-  const bool pair = FindTerm("accel_linear") == 0 && FindTerm("gyro_linear") == 1 &&
-                    terms_[0].effect->info().option.empty();
-  const bool is_base = pair && terms_[1].effect->info().option.empty();
-  const bool is_paper = pair && terms_[1].effect->info().option == "triangular";
-  std::size_t first = 0;
-  if (is_base || is_paper) {
-    spec_ = is_base ? "base" : "paper";
-    first = 2;
-  }
-  for (std::size_t i = first; i < terms_.size(); ++i) {
-    const auto& info = terms_[i].effect->info();
-    if (!spec_.empty()) spec_ += "+";
-    spec_ += info.name + (info.option.empty() ? "" : ":" + info.option);
-  }
+  RebuildSpec();
   // The triangular gyro variant holds E's lower triangle at zero.
   if (name == "gyro_linear" && option == "triangular") {
     for (const char* p : {"gyro.matrix.yx", "gyro.matrix.zx", "gyro.matrix.zy"}) Fix(p);
   }
+}
+
+void Model::RebuildSpec() {
+  spec_.clear();
+  std::vector<const ModelTerm*> spec_terms;
+  for (const auto& t : terms_) {
+    if (!t.probe) spec_terms.push_back(&t);
+  }
+  auto is = [&](std::size_t i, const char* name, const char* option) {
+    return i < spec_terms.size() && spec_terms[i]->effect->info().name == name &&
+           spec_terms[i]->effect->info().option == option;
+  };
+  std::size_t first = 0;
+  if (is(0, "accel_linear", "") && (is(1, "gyro_linear", "") || is(1, "gyro_linear", "triangular"))) {
+    spec_ = is(1, "gyro_linear", "") ? "base" : "paper";
+    first = 2;
+  }
+  for (std::size_t i = first; i < spec_terms.size(); ++i) {
+    const auto& info = spec_terms[i]->effect->info();
+    if (!spec_.empty()) spec_ += "+";
+    spec_ += info.name + (info.option.empty() ? "" : ":" + info.option);
+  }
+}
+
+void Model::AddProbe(const std::string& name, const std::string& option) {
+  Add(name, option);
+  auto& term = terms_[static_cast<std::size_t>(FindTerm(name))];
+  if (term.effect->info().linear_stage) {
+    throw Error("'" + name + "' is part of the base model, not a candidate effect");
+  }
+  term.probe = true;
+  term.fixed.assign(term.fixed.size(), true);
+  RebuildSpec();
+}
+
+bool Model::has_probes() const {
+  return std::any_of(terms_.begin(), terms_.end(), [](const ModelTerm& t) { return t.probe; });
 }
 
 void Model::DropGyro() {

@@ -25,6 +25,10 @@ namespace plumb::model {
 struct ModelTerm {
   std::shared_ptr<const Effect> effect;
   std::vector<bool> fixed;  ///< per parameter: held at its value in the fit
+  /// A candidate of the score test (Model::AddProbe): every parameter held at zero in the fit,
+  /// not part of the spec; the fit reports the Jacobian columns of its parameters
+  /// (estimation::CalibrationResult::probes).
+  bool probe = false;
 };
 
 /// Parameter values of a model: one block per effect, in model order.
@@ -50,6 +54,10 @@ class Model {
 
   /// Adds an effect (its block starts at zero); throws if already present.
   void Add(const std::string& name, const std::string& option = "");
+  /// Adds an effect as a probe (see ModelTerm::probe): held at zero, left out of the spec.
+  void AddProbe(const std::string& name, const std::string& option = "");
+  /// True when some term is a probe.
+  bool has_probes() const;
   /// Removes the gyroscope terms (accelerometer-only sessions).
   void DropGyro();
 
@@ -94,6 +102,8 @@ class Model {
                                 const SensorInput<double>& in) const;
 
  private:
+  void RebuildSpec();
+
   std::string spec_;
   std::vector<ModelTerm> terms_;
 };

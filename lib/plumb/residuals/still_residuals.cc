@@ -29,6 +29,7 @@ Vec3T<T> StillResidual::PredictT(T const* const* parameters) const {
   in.omega_b = R_b_n * omega_ie_n_.cast<T>() + omega_eb_b_.cast<T>();
   in.dt_s = T(m_.dt_s);
   in.dtemp_c = T(m_.dtemp_c);
+  in.R_b_n = R_b_n;
   model::SensorOutput<T> out;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     model_->terms()[static_cast<std::size_t>(terms_[i])].effect->Apply(parameters[i + 1], in, out);

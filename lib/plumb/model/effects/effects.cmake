@@ -12,4 +12,5 @@ set(PLUMB_EFFECTS
   gyro_scale_nonlinearity
   accel_size_effect
   time_offset
+  earth_rate
 )
