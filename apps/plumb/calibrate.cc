@@ -17,6 +17,7 @@
 #include "plumb/report/summary.h"
 #include "plumb/segmentation/given_segments.h"
 #include "plumb/segmentation/still_detector.h"
+#include "segment_options.h"
 #include "site_options.h"
 
 namespace plumb::cli {
@@ -30,15 +31,13 @@ struct CalibrateArgs {
   double gravity_m_s2 = 0.0;  ///< --gravity: fixed gravity magnitude, m/s^2, > 0
   CLI::Option* gravity = nullptr;
   std::string json_path;      ///< --json FILE
-  std::string segments_path;  ///< --segments FILE
+  SegmentArgs segments;       ///< --segments FILE or the still detector's options
   bool strict = false;        ///< fail when the data cannot determine every parameter
   double heading_deg = 0.0;   ///< --heading: first still pose's x axis from north, degrees
   CLI::Option* heading = nullptr;
   bool level_north = false;       ///< first still pose is level with x north (known attitude)
   double temp_ref_c = 25.0;       ///< reference temperature of the temperature terms, degC
-  bool still_accel_only = false;  ///< detect still segments from the accelerometer alone
-  bool verbose = false;           ///< print the detector's notes
-  segmentation::StillDetectorOptions detector;
+  std::string baseline;           ///< --baseline SPEC: also fit this model, side by side
 };
 
 class CalibrateCommand : public Command {
@@ -67,10 +66,6 @@ class CalibrateCommand : public Command {
                     ->check(CLI::PositiveNumber);
     app_->add_option("--json", a.json_path, "Write the result as JSON to FILE (atomically)")
         ->type_name("FILE");
-    app_->add_option("--segments", a.segments_path,
-                     "Still segments given in FILE (CSV start_s,end_s[,label] or start,end "
-                     "sample indices, or imucal's JSON) instead of detecting them")
-        ->type_name("FILE");
     app_->add_flag("--strict", a.strict,
                    "Fail (exit 1) when the data cannot determine every parameter of the model, "
                    "instead of reporting the unobservable directions");
@@ -84,27 +79,12 @@ class CalibrateCommand : public Command {
     app_->add_option("--temp-ref", a.temp_ref_c,
                      "Reference temperature of the temperature terms, degC")
         ->capture_default_str();
-    auto* det = app_->add_option_group("Still detection", "Finding the still segments");
-    det->add_option("--init-still", a.detector.init_still_s,
-                    "Length of the still period at the start used for the noise, s (0 = the "
-                    "quietest stretch, found automatically)")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    det->add_option("--window", a.detector.window_s, "Length of the moving window, s")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
-    det->add_option("--min-still", a.detector.min_still_s, "Shortest still segment kept, s")
-        ->check(CLI::NonNegativeNumber)
-        ->capture_default_str();
-    det->add_option("--false-alarm", a.detector.false_alarm,
-                    "Probability that a still window is called moving, all tests together "
-                    "(0..0.5)")
-        ->check(CLI::Range(1e-12, 0.5))
-        ->capture_default_str();
-    det->add_flag("--still-accel-only", a.still_accel_only,
-                  "Detect still segments from the accelerometer alone (keeps poses whose "
-                  "gyroscope shows jitter or slow turns)");
-    app_->add_flag("-v,--verbose", a.verbose, "Print the still detector's notes too");
+    app_->add_option("--baseline", a.baseline,
+                     "Also fit this model spec (e.g. base) on the same segments and print both "
+                     "fits side by side: chi2/dof, per-axis RMS, and the parameters the model "
+                     "adds, with sigma (the error falling as an effect is added)")
+        ->type_name("SPEC");
+    AddSegmentOptions(app_, a.segments);
   }
 
   int Run() override {
@@ -114,7 +94,7 @@ class CalibrateCommand : public Command {
     if (series.empty()) throw Error(session.source + ": no samples");
     if (a.method != "generalized") return RunPaperMethod(session);
 
-    const segmentation::SegmentationResult seg = FindSegments(series);
+    const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
     std::vector<StillSegment> segments = seg.segments;
     if (a.level_north && !segments.empty()) segments.front().known_R_n_b = Quat::Identity();
 
@@ -139,17 +119,30 @@ class CalibrateCommand : public Command {
               << " s" << (series.has_gyro() ? "" : ", no gyroscope")
               << (series.has_temperature() ? ", with temperature" : "") << "\n";
     for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
-    std::cout << report::SegmentationSummary(seg, a.segments_path, a.verbose) << "\n";
+    std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose) << "\n";
 
     const estimation::CalibrationResult result =
         estimation::Calibrate(series, segments, model, site, options);
     std::cout << report::CalibrationSummary(result);
+    std::optional<estimation::CalibrationResult> baseline;
+    if (!a.baseline.empty()) {
+      model::Model before = model::Model::Parse(a.baseline);
+      before.t_ref_s = model.t_ref_s;
+      before.temp_ref_c = model.temp_ref_c;
+      baseline = estimation::Calibrate(series, segments, before, site, options);
+      std::cout << "\n" << report::BeforeAfterSummary(*baseline, result);
+    }
 
     if (!a.json_path.empty()) {
       std::vector<std::string> inputs = a.input.inputs;
       if (!a.input.acc_file.empty()) inputs.push_back(a.input.acc_file + "," + a.input.gyr_file);
-      report::WriteJson(a.json_path,
-                        report::CalibrationJson(result, seg, inputs, session.warnings));
+      nlohmann::json doc = report::CalibrationJson(result, seg, inputs, session.warnings);
+      if (baseline) {
+        doc["baseline"] = {{"model", baseline->model.spec()},
+                           {"fit", report::ToJson(*baseline)["fit"]},
+                           {"chi2_drop", baseline->fit.chi2 - result.fit.chi2}};
+      }
+      report::WriteJson(a.json_path, doc);
       std::cout << "wrote " << a.json_path << "\n";
     }
     return 0;
@@ -169,9 +162,9 @@ class CalibrateCommand : public Command {
       // The paper's minute is the whole record; a section file picks its first still section.
       std::size_t begin = 0;
       std::size_t end = session.series.size();
-      if (!a.segments_path.empty()) {
-        const auto given = io::ReadSegments(a.segments_path, session.series);
-        if (given.empty()) throw UsageError(a.segments_path + ": no still section");
+      if (!a.segments.segments_path.empty()) {
+        const auto given = io::ReadSegments(a.segments.segments_path, session.series);
+        if (given.empty()) throw UsageError(a.segments.segments_path + ": no still section");
         begin = given.front().begin;
         end = given.front().end;
       }
@@ -179,27 +172,16 @@ class CalibrateCommand : public Command {
     }
     std::vector<StillSegment> still;
     std::vector<paper::MotionRange> motion;
-    if (!a.segments_path.empty()) {
-      const io::GivenSections given = io::ReadGivenSections(a.segments_path, session.series);
+    if (!a.segments.segments_path.empty()) {
+      const io::GivenSections given = io::ReadGivenSections(a.segments.segments_path, session.series);
       still = given.still;
       for (const auto& m : given.motion) motion.push_back({m.begin, m.end, m.label});
     } else {
-      const segmentation::SegmentationResult seg = FindSegments(session.series);
-      std::cout << report::SegmentationSummary(seg, a.segments_path, a.verbose) << "\n";
+      const segmentation::SegmentationResult seg = FindSegments(session.series, a.segments);
+      std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose) << "\n";
       still = seg.segments;
     }
     return RunPaperBenchmark(session, still, motion, site, a.json_path);
-  }
-
-  segmentation::SegmentationResult FindSegments(const ImuSeries& series) const {
-    if (!args_.segments_path.empty()) {
-      return segmentation::UseGivenSegments(series, io::ReadSegments(args_.segments_path, series));
-    }
-    segmentation::StillDetectorOptions detector = args_.detector;
-    detector.use_gyro = !args_.still_accel_only;
-    detector.acc_unit = series.acc_unit;
-    detector.gyr_unit = series.gyr_unit;
-    return segmentation::DetectStillSegments(series, detector);
   }
 
   CalibrateArgs args_;

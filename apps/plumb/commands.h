@@ -35,5 +35,6 @@ std::unique_ptr<Command> MakeSimulateCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeEffectsCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeCompareCommand(CLI::App& parent);
 std::unique_ptr<Command> MakePaperCommand(CLI::App& parent);
+std::unique_ptr<Command> MakeDiagnoseCommand(CLI::App& parent);
 
 }  // namespace plumb::cli

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
 
   std::vector<std::unique_ptr<plumb::cli::Command>> commands;
   commands.push_back(plumb::cli::MakeCalibrateCommand(app));
+  commands.push_back(plumb::cli::MakeDiagnoseCommand(app));
   commands.push_back(plumb::cli::MakeSimulateCommand(app));
   commands.push_back(plumb::cli::MakeEffectsCommand(app));
   commands.push_back(plumb::cli::MakeCompareCommand(app));

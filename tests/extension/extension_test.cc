@@ -7,7 +7,9 @@
 //   - a simulated multi-pose session with a temperature cycle and a true scale drift is
 //     calibrated with "base" (chi^2/dof well above 1: the drift is left in the residuals) and
 //     with "base+accel_scale_temperature" (chi^2/dof near 1, the drift recovered within
-//     3 sigma). A one-line summary is always printed; PLUMB_PRINT=1 prints both full reports.
+//     3 sigma). A one-line summary is always printed; PLUMB_PRINT=1 prints both full reports;
+//   - diagnose on the base fit ranks it first among the whole catalogue (built-in effects and
+//     this one), significant, and confirms it by refitting.
 //
 // Run: build/tests/extension/plumb_extension_test --gtest_filter='ScaleTemperatureSession.*'
 #include <gtest/gtest.h>
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/diagnostics/diagnose.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/model/model.h"
 #include "plumb/model/registry.h"
@@ -222,6 +225,25 @@ TEST(ScaleTemperatureSession, ExtendedModelRecoversTheBaseParametersWithin3Point
     if (p.fixed || !p.observable) continue;
     EXPECT_LT(std::abs(p.value - truth[i]), 3.5 * p.sigma) << p.name;
   }
+}
+
+TEST(ScaleTemperatureSession, DiagnoseRanksTheUserEffectFirst) {
+  // The registered effect is a catalogue candidate like any built-in one: diagnose on the base
+  // fit ranks it first and significant, and its refit confirms the fall of chi^2.
+  const Demonstration& d = WarmingSession();
+  std::vector<StillSegment> segments = d.sim.truth_segments;
+  for (auto& segment : segments) segment.known_R_n_b.reset();
+  diagnostics::DiagnoseOptions options;
+  options.confirm = 1;
+  const diagnostics::Diagnosis dx = diagnostics::Diagnose(
+      d.sim.session.series, segments, model::Model::Parse("base"), d.sim.site, options);
+  if (std::getenv("PLUMB_PRINT")) std::cout << dx.BriefReport();
+  ASSERT_FALSE(dx.candidates.empty());
+  const diagnostics::Candidate& best = dx.candidates.front();
+  EXPECT_EQ(best.effect, "accel_scale_temperature") << dx.BriefReport();
+  EXPECT_TRUE(best.significant);
+  ASSERT_TRUE(best.refit_drop.has_value());
+  EXPECT_NEAR(*best.refit_drop, d.base.fit.chi2 - d.extended.fit.chi2, 1e-6 * d.base.fit.chi2);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <sstream>
 
 #include "plumb/report/version.h"
@@ -9,9 +10,10 @@
 namespace plumb::report {
 namespace {
 
-std::string Format(const char* fmt, double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, a);
+template <typename... Args>
+std::string Format(const char* fmt, Args... args) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, fmt, args...);
   return buf;
 }
 
@@ -91,6 +93,40 @@ std::string CalibrationSummary(const estimation::CalibrationResult& r) {
   const std::size_t lost = r.observability.unobservable.size();
   if (lost > 0) os << "; " << lost << " unobservable direction" << (lost > 1 ? "s" : "");
   os << "\n\n" << r.FullReport();
+  return os.str();
+}
+
+std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
+                               const estimation::CalibrationResult& after) {
+  std::ostringstream os;
+  auto row = [&](const std::string& what, const std::string& b, const std::string& a) {
+    os << "  " << Format("%-28s", what.c_str()) << Format("%-34s", b.c_str()) << a << "\n";
+  };
+  auto vec = [](const Vec3& v) { return Format("%.4g %.4g %.4g", v.x(), v.y(), v.z()); };
+  os << "before and after (same segments):\n";
+  row("model", before.model.spec(), after.model.spec());
+  row("chi2 / dof", Format("%.1f / %d", before.fit.chi2, before.fit.dof),
+      Format("%.1f / %d", after.fit.chi2, after.fit.dof));
+  row("chi2/dof", Format("%.3f", before.fit.chi2_dof()), Format("%.3f", after.fit.chi2_dof()));
+  row("accel RMS (" + before.acc_unit + ")", vec(before.fit.rms_acc), vec(after.fit.rms_acc));
+  if (before.has_gyro && after.has_gyro) {
+    row("gyro RMS (" + before.gyr_unit + ")", vec(before.fit.rms_gyr), vec(after.fit.rms_gyr));
+    if (before.fit.motion_segments > 0) {
+      row("motion RMS (rad)", vec(before.fit.rms_motion), vec(after.fit.rms_motion));
+    }
+  }
+  os << "  chi2 fell by " << Format("%.1f", before.fit.chi2 - after.fit.chi2) << "\n";
+  bool header = false;
+  for (const auto& p : after.parameters) {
+    const bool known = std::any_of(before.parameters.begin(), before.parameters.end(),
+                                   [&](const estimation::ParameterEstimate& q) { return q.name == p.name; });
+    if (known || p.fixed) continue;
+    if (!header) os << "parameters added:\n";
+    header = true;
+    const std::string sigma = p.observable ? Format("%.3g", p.sigma) : std::string("unobservable");
+    os << "  " << Format("%-36s", p.name.c_str()) << Format("%14.6g", p.value) << " +- "
+       << sigma << "  " << p.unit << "\n";
+  }
   return os.str();
 }
 

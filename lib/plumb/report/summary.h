@@ -25,4 +25,10 @@ std::string FitVerdict(const estimation::FitSummary& fit);
 /// Header plus the full report of the result.
 std::string CalibrationSummary(const estimation::CalibrationResult& result);
 
+/// Two fits of the same data side by side, `before` (e.g. base) and `after` (e.g.
+/// base+gyro_g_sensitivity): chi^2, dof, chi^2/dof, per-axis RMS of the still accelerometer,
+/// still gyroscope and motion residuals, and the parameters that `after` adds, with sigma.
+std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
+                               const estimation::CalibrationResult& after);
+
 }  // namespace plumb::report

@@ -27,7 +27,6 @@ MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
                                const Vec3& omega_ie_n)
     : model_(&model), s_(std::move(samples)), omega_ie_n_(omega_ie_n) {
   for (const auto& t : model.terms()) {
-    linear_only_ = linear_only_ && t.effect->info().linear_stage;
     block_offset_.push_back(num_model_parameters_);
     num_model_parameters_ += t.effect->info().size();
   }
@@ -37,7 +36,20 @@ MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
   for (const auto& t : model.terms()) mutable_parameter_block_sizes()->push_back(t.effect->info().size());
 }
 
-void MotionResidual::CorrectedRates(double const* const* theta, std::vector<Vec3>* w,
+bool MotionResidual::LinearAt(double const* const* theta, double** jacobians) const {
+  for (int t = 0; t < model_->num_terms(); ++t) {
+    const auto& info = model_->terms()[static_cast<std::size_t>(t)].effect->info();
+    if (info.linear_stage) continue;
+    if (jacobians != nullptr && jacobians[2 + t] != nullptr) return false;
+    for (int j = 0; j < info.size(); ++j) {
+      if (theta[t][j] != 0.0) return false;
+    }
+  }
+  return true;
+}
+
+void MotionResidual::CorrectedRates(double const* const* theta, bool linear,
+                                    std::vector<Vec3>* w,
                                     std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const {
   const std::size_t n = s_.size();
   const int P = num_model_parameters_;
@@ -48,7 +60,7 @@ void MotionResidual::CorrectedRates(double const* const* theta, std::vector<Vec3
   const Mat3 E_inv = at_zero.E.inverse();
   const Vec3 b_g = at_zero.gyr;  // E * 0 + b_g (+ terms that vanish at zero input)
 
-  if (linear_only_) {
+  if (linear) {
     // w = E^-1 (y - b_g): dw/db_g = -E^-1, dw/dE_rc = -E^-1 e_r w_c.
     const int g = model_->FindTerm("gyro_linear");
     const int off = g >= 0 ? block_offset_[static_cast<std::size_t>(g)] : 0;
@@ -116,9 +128,10 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   std::vector<Vec3> w;
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> W;
   // For the base model dw/dtheta has a closed form used on the fly (no per-sample storage):
-  // w = E^-1 (y - b_g), dw/dE_rc = -E^-1 e_r w_c, dw/db_g = -E^-1.
-  const bool closed_form = linear_only_;
-  CorrectedRates(theta, &w, want_jacobians && !closed_form ? &W : nullptr);
+  // w = E^-1 (y - b_g), dw/dE_rc = -E^-1 e_r w_c, dw/db_g = -E^-1. It also holds when every
+  // other effect is at zero and its Jacobian is not asked for (e.g. diagnose's probes).
+  const bool closed_form = LinearAt(theta, jacobians);
+  CorrectedRates(theta, closed_form, &w, want_jacobians && !closed_form ? &W : nullptr);
   Mat3 E_inv = Mat3::Identity();
   int gyro_offset = -1;
   if (closed_form && want_jacobians) {

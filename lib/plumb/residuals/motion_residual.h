@@ -49,15 +49,17 @@ class MotionResidual final : public ceres::CostFunction {
   Quat Integrate(const double* q_k, const model::ParameterBlocks& theta) const;
 
  private:
+  /// True when the model acts as its linear stage at `theta`: every other effect is at zero
+  /// and its Jacobian is not requested (`jacobians` may be null).
+  bool LinearAt(double const* const* theta, double** jacobians) const;
   /// Corrected rates w_i and, if `W` is non-null, their Jacobians d w_i / d theta (3 x P,
-  /// P = all model parameters in block order).
-  void CorrectedRates(double const* const* theta, std::vector<Vec3>* w,
+  /// P = all model parameters in block order); `linear` selects the closed form of LinearAt.
+  void CorrectedRates(double const* const* theta, bool linear, std::vector<Vec3>* w,
                       std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const;
 
   const model::Model* model_;
   MotionSamples s_;
   Vec3 omega_ie_n_;
-  bool linear_only_ = true;
   int num_model_parameters_ = 0;
   std::vector<int> block_offset_;  // offset of each model block in the P parameters
 };

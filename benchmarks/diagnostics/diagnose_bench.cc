@@ -1,0 +1,75 @@
+// Speed of diagnose over the whole catalogue (SPEC section 7: under 1 s for a typical
+// session): mikoff's imu0 (bundled, 18 still poses, no site) and imu_tk's own data (38 poses,
+// 51 k samples), with the score test alone (confirm 0) and with the best three refitted.
+// Reading and segmentation are not timed.
+//
+//   build/benchmarks/diagnostics/plumb_bench_diagnostics --benchmark_counters_tabular=true
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+#include "plumb/diagnostics/diagnose.h"
+#include "plumb/io/text_table.h"
+#include "plumb/segmentation/still_detector.h"
+
+namespace plumb {
+namespace {
+
+const std::string kShared = PLUMB_SHARED_DATA_DIR;
+
+Session ReadMikoff() {
+  io::TextTableOptions o;
+  o.acc.axes = {0, 1, 2};
+  o.gyr.axes = {3, 4, 5};
+  o.rate_hz = 100;
+  return io::ReadTextTable(std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log", o);
+}
+
+Session ReadImuTk() {
+  io::TextTableOptions o;
+  o.time = 0;
+  o.acc.axes = {1, 2, 3};
+  o.gyr.axes = {1, 2, 3};
+  return io::ReadSplitTables(kShared + "/multipose/imu_tk/xsens_acc.mat",
+                             kShared + "/multipose/imu_tk/xsens_gyro.mat", o);
+}
+
+void DiagnoseSession(benchmark::State& state, const Session& s, const geo::Site& site,
+                     double init_still_s) {
+  segmentation::StillDetectorOptions d;
+  d.init_still_s = init_still_s;
+  const auto seg = segmentation::DetectStillSegments(s.series, d);
+  model::Model m = model::Model::Parse("base");
+  m.t_ref_s = s.series.t_s.front();
+  diagnostics::DiagnoseOptions options;
+  options.confirm = static_cast<int>(state.range(0));
+  diagnostics::Diagnosis result;
+  for (auto _ : state) {
+    result = diagnostics::Diagnose(s.series, seg.segments, m, site, options);
+    benchmark::DoNotOptimize(result);
+  }
+  state.counters["segments"] = static_cast<double>(result.fit.fit.still_segments);
+  state.counters["candidates"] = static_cast<double>(result.candidates.size());
+  state.counters["samples"] = static_cast<double>(s.series.size());
+}
+
+void BM_DiagnoseMikoff(benchmark::State& state) {
+  static const Session s = ReadMikoff();
+  DiagnoseSession(state, s, geo::Site::Unknown(), 0.0);
+}
+BENCHMARK(BM_DiagnoseMikoff)->Arg(0)->Arg(3)->Unit(benchmark::kMillisecond);
+
+void BM_DiagnoseImuTk(benchmark::State& state) {
+  if (!std::filesystem::exists(kShared + "/multipose/imu_tk/xsens_acc.mat")) {
+    state.SkipWithError("shared data absent");
+    return;
+  }
+  static const Session s = ReadImuTk();
+  DiagnoseSession(state, s, geo::Site::Unknown(9.81744), 50.0);
+}
+BENCHMARK(BM_DiagnoseImuTk)->Arg(0)->Arg(3)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace plumb
+
+BENCHMARK_MAIN();

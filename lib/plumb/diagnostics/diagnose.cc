@@ -1,0 +1,228 @@
+// plumb/diagnostics/diagnose.cc — see diagnose.h.
+#include "plumb/diagnostics/diagnose.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "plumb/core/error.h"
+#include "plumb/estimation/calibrator.h"
+#include "plumb/model/registry.h"
+#include "plumb/signal/chi_square.h"
+
+namespace plumb::diagnostics {
+namespace {
+
+struct CandidateSpec {
+  std::string name;
+  std::string option;
+};
+
+CandidateSpec ParseCandidate(const std::string& text) {
+  const auto colon = text.find(':');
+  return {text.substr(0, colon), colon == std::string::npos ? "" : text.substr(colon + 1)};
+}
+
+/// Why the data cannot carry this effect, or "" when it can.
+std::string Unsupported(const model::EffectInfo& info, const ImuSeries& series,
+                        const geo::Site& site, const model::Model& model) {
+  if (info.linear_stage) return "part of the base model";
+  if (info.sensor == model::Sensor::kGyro && !model.has_gyro()) return "needs a gyroscope";
+  if (info.excitation.temperature && !series.has_temperature()) {
+    return "needs a temperature column";
+  }
+  if (info.name == "earth_rate" && site.known) {
+    return "in the base model: the site is known";
+  }
+  return "";
+}
+
+/// The fit with the probe terms taken out (they are held at zero: the model's own fit).
+estimation::CalibrationResult StripProbes(estimation::CalibrationResult fit,
+                                          const model::Model& model) {
+  const auto n = static_cast<Eigen::Index>(model.num_parameters());
+  fit.parameters.resize(static_cast<std::size_t>(n));
+  fit.covariance = Eigen::MatrixXd(fit.covariance.topLeftCorner(n, n));
+  fit.theta.resize(static_cast<std::size_t>(model.num_terms()));
+  model::Model own = model;
+  own.t_ref_s = fit.model.t_ref_s;
+  own.temp_ref_c = fit.model.temp_ref_c;
+  fit.model = own;
+  fit.probes.reset();
+  return fit;
+}
+
+std::string Fixed(double v, int precision) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(precision) << v;
+  return out.str();
+}
+
+}  // namespace
+
+std::string SpecWith(const model::Model& model, const std::string& effect,
+                     const std::string& option) {
+  return model.spec() + "+" + effect + (option.empty() ? "" : ":" + option);
+}
+
+Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                   const model::Model& model, const geo::Site& site,
+                   const DiagnoseOptions& options) {
+  if (!(options.significance > 0.0 && options.significance < 0.5)) {
+    throw Error("diagnose: significance must be in (0, 0.5)");
+  }
+  Diagnosis d;
+  d.significance = options.significance;
+
+  // The candidates, as probes of one fit.
+  std::vector<CandidateSpec> wanted;
+  if (options.candidates.empty()) {
+    for (const auto& name : model::Registry::Global().CatalogueNames()) wanted.push_back({name, ""});
+  } else {
+    for (const auto& text : options.candidates) wanted.push_back(ParseCandidate(text));
+  }
+  model::Model probed = model;
+  std::vector<CandidateSpec> tested;
+  for (const auto& c : wanted) {
+    const auto effect = model::Registry::Global().Make(c.name, c.option);
+    if (model.has_effect(c.name)) continue;
+    const std::string why = Unsupported(effect->info(), series, site, model);
+    if (!why.empty()) {
+      d.skipped.push_back({c.name, why});
+      continue;
+    }
+    probed.AddProbe(c.name, c.option);
+    tested.push_back(c);
+  }
+  const estimation::CalibrationResult fit =
+      estimation::Calibrate(series, segments, probed, site, options.calibration);
+  d.fit = StripProbes(fit, model);
+  if (!fit.probes) return d;
+  const estimation::ProbeJacobian& p = *fit.probes;
+  d.num_residuals = static_cast<int>(p.r.size());
+  const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
+
+  std::vector<Eigen::MatrixXd> bases;
+  for (const auto& c : tested) {
+    const int term = fit.model.FindTerm(c.name);
+    std::vector<Eigen::Index> cols;
+    for (std::size_t j = 0; j < p.probe_term.size(); ++j) {
+      if (p.probe_term[j] == term) cols.push_back(static_cast<Eigen::Index>(j));
+    }
+    Eigen::MatrixXd Z(p.Z.rows(), static_cast<Eigen::Index>(cols.size()));
+    std::vector<std::string> names;
+    std::vector<double> typical;
+    const auto& info = fit.model.terms()[static_cast<std::size_t>(term)].effect->info();
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+      Z.col(static_cast<Eigen::Index>(k)) = p.Z.col(cols[k]);
+      names.push_back(p.probe_names[static_cast<std::size_t>(cols[k])]);
+      typical.push_back(info.parameters[k].typical);
+    }
+    const ScoreTestResult s = ScoreTest(p.r, p.J, Z, p.unknown_names, names, typical, options.score);
+    Candidate cand;
+    cand.effect = c.name;
+    cand.option = c.option;
+    cand.lm = s.lm;
+    cand.dof = s.dof;
+    cand.num_parameters = s.num_parameters;
+    cand.identifiable = s.identifiable;
+    cand.not_identifiable = s.not_identifiable;
+    cand.evidence = s.lm - s.dof * log_n;
+    cand.threshold = s.dof > 0 ? signal::ChiSquareQuantile(1.0 - options.significance, s.dof) : 0.0;
+    cand.significant = s.identifiable && s.dof > 0 && s.lm > cand.threshold;
+    d.candidates.push_back(std::move(cand));
+    bases.push_back(s.basis);
+  }
+  // Candidates whose explained directions lie within another's: the smallest cosine of the
+  // principal angles between the spans.
+  for (std::size_t a = 0; a < d.candidates.size(); ++a) {
+    for (std::size_t b = 0; b < d.candidates.size(); ++b) {
+      if (a == b || bases[a].cols() == 0 || bases[b].cols() == 0) continue;
+      const Eigen::MatrixXd cosines = bases[a].transpose() * bases[b];
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(cosines);
+      const auto& sv = svd.singularValues();
+      const bool within = sv.size() == bases[a].cols() && sv(sv.size() - 1) >= 0.999;
+      if (within) d.candidates[a].indistinguishable_from.push_back(d.candidates[b].effect);
+    }
+  }
+  std::stable_sort(d.candidates.begin(), d.candidates.end(),
+                   [](const Candidate& a, const Candidate& b) {
+                     if (a.identifiable != b.identifiable) return a.identifiable;
+                     return a.evidence > b.evidence;
+                   });
+
+  // Confirm the best significant candidates by refitting.
+  int confirmed = 0;
+  for (auto& cand : d.candidates) {
+    if (confirmed >= options.confirm) break;
+    if (!cand.significant) continue;
+    model::Model with = model;
+    with.Add(cand.effect, cand.option);
+    estimation::CalibrationResult refit =
+        estimation::Calibrate(series, segments, with, site, options.calibration);
+    cand.refit_drop = d.fit.fit.chi2 - refit.fit.chi2;
+    cand.refit = std::move(refit);
+    ++confirmed;
+  }
+  return d;
+}
+
+std::string Diagnosis::BriefReport() const {
+  std::ostringstream out;
+  const auto& f = fit.fit;
+  out << "model " << fit.model.spec() << ": chi2 " << Fixed(f.chi2, 1) << " on " << f.dof
+      << " dof, chi2/dof " << Fixed(f.chi2_dof(), 3) << "\n";
+  out << "candidates (score test at the current fit; significant at " << significance
+      << "; evidence = LM - q ln N, N = " << num_residuals << "):\n";
+  out << "  " << std::left << std::setw(26) << "effect" << std::right << std::setw(11) << "LM"
+      << std::setw(5) << "q" << std::setw(11) << "evidence" << std::setw(13) << "significant"
+      << std::setw(13) << "refit drop" << "\n";
+  for (const auto& c : candidates) {
+    if (!c.identifiable) continue;
+    const std::string name = c.effect + (c.option.empty() ? "" : ":" + c.option);
+    out << "  " << std::left << std::setw(26) << name << std::right << std::setw(11)
+        << Fixed(c.lm, 1) << std::setw(5) << c.dof << std::setw(11) << Fixed(c.evidence, 1)
+        << std::setw(13) << (c.significant ? "yes" : "no") << std::setw(13)
+        << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-"));
+    for (const auto& other : c.indistinguishable_from) out << "  (same as " << other << " here)";
+    out << "\n";
+  }
+  bool header = false;
+  for (const auto& c : candidates) {
+    if (c.identifiable) continue;
+    if (!header) out << "not identifiable from this data (cannot be judged here; not absent):\n";
+    header = true;
+    out << "  " << c.effect << ": ";
+    std::vector<std::string> unexcited, confounders;
+    for (const auto& n : c.not_identifiable) {
+      if (!n.excited) unexcited.push_back(n.parameter);
+      for (const auto& k : n.confounders) {
+        if (std::find(confounders.begin(), confounders.end(), k) == confounders.end()) {
+          confounders.push_back(k);
+        }
+      }
+    }
+    if (!unexcited.empty()) {
+      out << unexcited.size() << " of " << c.num_parameters << " parameters not excited by this data";
+    }
+    if (!confounders.empty()) {
+      out << (unexcited.empty() ? "" : "; ") << "confounded with";
+      for (const auto& k : confounders) out << " " << k;
+    }
+    out << "\n";
+  }
+  for (const auto& s : skipped) out << "skipped " << s.effect << ": " << s.reason << "\n";
+  const auto best = std::find_if(candidates.begin(), candidates.end(),
+                                 [](const Candidate& c) { return c.significant; });
+  if (best == candidates.end()) {
+    out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
+  } else {
+    out << "best: " << best->effect << (best->option.empty() ? "" : ":" + best->option)
+        << " -> refit with --model " << SpecWith(fit.model, best->effect, best->option) << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace plumb::diagnostics

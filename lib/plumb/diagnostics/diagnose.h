@@ -1,0 +1,98 @@
+// plumb/diagnostics/diagnose.h — which catalogue effects is the model missing (SPEC section 5)?
+//
+// 1. Fit the model once with every candidate effect added as a probe (model::Model::AddProbe:
+//    held at zero, so the fit is the model's own), and take the whitened residuals r, the
+//    Jacobian J over the fit's free unknowns and Z over each candidate's parameters.
+// 2. For each candidate, the score test (score_test.h): LM, the predicted fall of chi^2, with q
+//    degrees of freedom; evidence = LM - q ln N (N residuals), a BIC-like penalty, ranks them;
+//    significant when LM exceeds the chi^2(q) quantile at 1 - significance and the candidate is
+//    identifiable. Not identifiable (confounded with the fit's parameters, or not excited by
+//    the data) is said as such, never "absent".
+// 3. Confirm the best significant ones by refitting the model plus that effect: the actual fall
+//    of chi^2, and the new parameters with their sigma.
+//
+// Candidates: every registered effect that is not in the model and not part of the base, with
+// its default option, when the data can carry it (temperature effects need a temperature
+// column; gyroscope effects a gyroscope; earth_rate only without a site).
+//
+// Example:
+//   Diagnosis d = Diagnose(series, segments, model::Model::Parse("base"), site, {});
+//   std::cout << d.BriefReport();
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/core/segment.h"
+#include "plumb/diagnostics/score_test.h"
+#include "plumb/estimation/options.h"
+#include "plumb/estimation/result.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+
+namespace plumb::diagnostics {
+
+struct DiagnoseOptions {
+  /// Level of the score test: the chance that a candidate which is not missing is called
+  /// significant, in (0, 0.5).
+  double significance = 0.01;
+  /// How many of the best significant candidates to confirm by refitting, >= 0.
+  int confirm = 3;
+  /// Candidate effects ("name" or "name:option"); empty: the whole catalogue.
+  std::vector<std::string> candidates;
+  /// Options of every fit (the probe fit and the refits).
+  estimation::CalibrationOptions calibration;
+  ScoreTestOptions score;
+};
+
+/// One candidate effect.
+struct Candidate {
+  std::string effect;   ///< catalogue name, e.g. "gyro_g_sensitivity"
+  std::string option;   ///< the option it was tested with ("" = default)
+  double lm = 0.0;      ///< score statistic: predicted fall of chi^2
+  int dof = 0;          ///< q, identifiable directions
+  int num_parameters = 0;
+  double evidence = 0.0;   ///< lm - dof ln(N); the ranking
+  double threshold = 0.0;  ///< chi^2(dof) quantile at 1 - significance
+  bool significant = false;
+  bool identifiable = true;
+  std::vector<Confounding> not_identifiable;  ///< parameters the data cannot separate
+  /// Other candidates that this data cannot tell from this one: the residual directions this
+  /// one explains lie (cosine >= 0.999) within theirs, e.g. a temperature term and a drift
+  /// when the temperature rose steadily.
+  std::vector<std::string> indistinguishable_from;
+  /// Refit with the effect added (only for confirmed candidates).
+  std::optional<double> refit_drop;            ///< actual fall of chi^2
+  std::optional<estimation::CalibrationResult> refit;
+};
+
+/// An effect that was not tested, and why.
+struct Skipped {
+  std::string effect;
+  std::string reason;  ///< e.g. "needs a temperature column"
+};
+
+struct Diagnosis {
+  estimation::CalibrationResult fit;    ///< the model's own fit (probes removed)
+  std::vector<Candidate> candidates;    ///< best evidence first; not identifiable ones last
+  std::vector<Skipped> skipped;
+  double significance = 0.01;
+  int num_residuals = 0;                ///< N of the evidence penalty
+
+  /// A terminal summary a person reads in ten seconds.
+  std::string BriefReport() const;
+};
+
+/// Runs the diagnosis. Throws what estimation::Calibrate throws, and plumb::Error for an
+/// unknown candidate name.
+Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                   const model::Model& model, const geo::Site& site,
+                   const DiagnoseOptions& options = {});
+
+/// The spec of `model` plus one effect, e.g. "base+gyro_g_sensitivity".
+std::string SpecWith(const model::Model& model, const std::string& effect,
+                     const std::string& option);
+
+}  // namespace plumb::diagnostics
