@@ -58,6 +58,9 @@ nlohmann::json CandidateJson(const diagnostics::Candidate& c) {
     confounded.push_back({{"parameter", n.parameter},
                           {"excited", n.excited},
                           {"ratio", report::Number(n.ratio)},
+                          {"too_weak", n.too_weak},
+                          {"sigma", report::Number(n.sigma)},
+                          {"typical", n.typical},
                           {"confounded_with", n.confounders},
                           {"shares", n.shares}});
   }

@@ -195,9 +195,15 @@ std::string Diagnosis::BriefReport() const {
     if (!header) out << "not identifiable from this data (cannot be judged here; not absent):\n";
     header = true;
     out << "  " << c.effect << ": ";
-    std::vector<std::string> unexcited, confounders;
+    std::vector<std::string> unexcited, confounders, weak;
     for (const auto& n : c.not_identifiable) {
       if (!n.excited) unexcited.push_back(n.parameter);
+      if (n.too_weak) {
+        std::ostringstream w;
+        w << n.parameter << " only to +-" << std::setprecision(2) << n.sigma << " (typical "
+          << n.typical << ")";
+        weak.push_back(w.str());
+      }
       for (const auto& k : n.confounders) {
         if (std::find(confounders.begin(), confounders.end(), k) == confounders.end()) {
           confounders.push_back(k);
@@ -210,6 +216,10 @@ std::string Diagnosis::BriefReport() const {
     if (!confounders.empty()) {
       out << (unexcited.empty() ? "" : "; ") << "confounded with";
       for (const auto& k : confounders) out << " " << k;
+    }
+    if (!weak.empty()) {
+      out << (unexcited.empty() && confounders.empty() ? "" : "; ") << "this data determines";
+      for (std::size_t k = 0; k < weak.size(); ++k) out << (k ? ", " : " ") << weak[k];
     }
     out << "\n";
   }

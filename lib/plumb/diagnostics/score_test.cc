@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "plumb/core/error.h"
@@ -50,9 +51,12 @@ ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
   for (Eigen::Index j = 0; j < Z.cols(); ++j) {
     const double z = Z.col(j).norm();
     const double pz = PZ.col(j).norm();
-    const bool excited = z * z_typical[static_cast<std::size_t>(j)] > options.excitation_floor;
+    const double typical = z_typical[static_cast<std::size_t>(j)];
+    const bool excited = z * typical > options.excitation_floor;
     const double ratio = z > 0.0 ? pz / z : 0.0;
-    if (excited && ratio >= options.identifiable_ratio) {
+    const bool separate = ratio >= options.identifiable_ratio;
+    const bool strong = pz * typical >= options.detectable_ratio;
+    if (excited && separate && strong) {
       usable.push_back(j);
       continue;
     }
@@ -60,7 +64,10 @@ ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
     c.parameter = z_names[static_cast<std::size_t>(j)];
     c.excited = excited;
     c.ratio = ratio;
-    if (excited && J.cols() > 0) {
+    c.sigma = pz > 0.0 ? 1.0 / pz : std::numeric_limits<double>::infinity();
+    c.typical = typical;
+    c.too_weak = excited && separate && !strong;
+    if (excited && !separate && J.cols() > 0) {
       // Z_j ~ J coef: which unknowns make up the part of Z_j that the fit absorbs.
       const Eigen::VectorXd coef = J.completeOrthogonalDecomposition().solve(Z.col(j));
       std::vector<double> part(static_cast<std::size_t>(J.cols()));

@@ -12,10 +12,14 @@
 // the column-scaled J's singular vectors whose singular values exceed `rank_tolerance` times the
 // largest (the fit's unobservable directions are not counted twice).
 //
-// Identifiability: column j of Z is identifiable when |P Z_j| >= identifiable_ratio |Z_j|; a
-// column with |Z_j| ~ 0 is not excited by the data at all. For a column that is not
-// identifiable, the fit's unknowns it is confounded with are those whose columns make up most
-// of Z_j in the least-squares fit Z_j ~ J c (named with their share of |J c|).
+// Identifiability: column j of Z (parameter typical size s_j) is identifiable when
+//   - the data excites it: |Z_j| s_j >= excitation_floor;
+//   - the fit cannot absorb it: |P Z_j| >= identifiable_ratio |Z_j|; otherwise it is
+//     confounded with the fit's unknowns whose columns make up most of Z_j in the
+//     least-squares fit Z_j ~ J c (named with their share of |J c|);
+//   - the data determines it better than its typical size: 1 / |P Z_j| (the sigma the
+//     parameter alone would get) is below s_j / detectable_ratio; otherwise a typical-size effect
+//     would hide in the noise and "not significant" would not mean "absent".
 #pragma once
 
 #include <Eigen/Core>
@@ -35,6 +39,9 @@ struct ScoreTestOptions {
   /// the residuals by less than this many sigma in all (e.g. a lever arm seen only through
   /// Earth rate on still data).
   double excitation_floor = 1e-3;
+  /// A column is too weakly determined when |P Z_j| s_j is below this, >= 0: the data would
+  /// give the parameter a sigma above s_j / detectable_ratio.
+  double detectable_ratio = 1.0;
   /// How many of the fit's unknowns to name as confounders per column, >= 1.
   int max_confounders = 3;
 };
@@ -44,6 +51,11 @@ struct Confounding {
   std::string parameter;                  ///< the candidate's parameter, e.g. "time_offset.dt"
   bool excited = true;                    ///< false: the data does not move the prediction
   double ratio = 0.0;                     ///< |P Z_j| / |Z_j|, in [0, 1]
+  /// The sigma the data would give the parameter, 1 / |P Z_j|, its unit; infinite when 0.
+  double sigma = 0.0;
+  double typical = 0.0;                   ///< the parameter's typical size, its unit
+  /// Excited and not confounded, but determined only to more than its typical size.
+  bool too_weak = false;
   std::vector<std::string> confounders;   ///< the fit's unknowns that absorb it, most first
   std::vector<double> shares;             ///< their shares of |J c|, in (0, 1]
 };

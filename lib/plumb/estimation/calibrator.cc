@@ -359,8 +359,10 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     }
   }
   std::vector<residuals::MotionSamples> motion_samples;
+  std::vector<std::vector<Vec3>> output_rate;  // per motion, per sample: d y_g / dt, units/s
   for (auto& mo : motions) {
     residuals::MotionSamples ms;
+    std::vector<Vec3> dy;
     for (std::size_t i = mo.first; i <= mo.last; ++i) {
       ms.dt_s.push_back(series.t_s[i] - model.t_ref_s);
       ms.acc.push_back(series.acc[i].cast<double>());
@@ -368,17 +370,25 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       ms.dtemp_c.push_back(series.has_temperature() ? series.temp_c[i] - model.temp_ref_c : 0.0);
       const std::size_t a = i > 0 ? i - 1 : i, b = std::min(i + 1, series.size() - 1);
       const double h = series.t_s[b] - series.t_s[a];
-      ms.alpha_b.push_back(h > 0 ? Vec3(gyro_scale * (series.gyr[b] - series.gyr[a]).cast<double>() / h)
-                                 : Vec3::Zero());
+      dy.push_back(h > 0 ? Vec3((series.gyr[b] - series.gyr[a]).cast<double>() / h) : Vec3::Zero());
     }
+    ms.alpha_b.resize(dy.size());
     motion_samples.push_back(std::move(ms));
+    output_rate.push_back(std::move(dy));
   }
   // Whitening of the motion residuals: the white gyroscope noise (sensor units) carried through
   // E^-1 into rad/s and integrated over the interval's steps. It depends on E, so it is set
   // from the starting E and again from the solved E before the final solve (the chi^2 then does
-  // not depend on the starting values).
+  // not depend on the starting values). The angular acceleration input of the effects
+  // (time_offset, accel_size_effect) is the derivative of the corrected rate, E^-1 d y_g / dt
+  // (central differences), set at the same two points.
   auto set_motion_weights = [&](const Mat3& E) {
     const Mat3 E_inv = E.inverse();
+    for (std::size_t k = 0; k < motions.size(); ++k) {
+      for (std::size_t i = 0; i < output_rate[k].size(); ++i) {
+        motion_samples[k].alpha_b[i] = E_inv * output_rate[k][i];
+      }
+    }
     const Mat3 cov_rate = E_inv * result.noise_gyr.cwiseAbs2().asDiagonal() * E_inv.transpose();
     for (std::size_t k = 0; k < motions.size(); ++k) {
       const auto& mo = motions[k];

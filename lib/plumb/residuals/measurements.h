@@ -21,7 +21,7 @@ struct MotionSamples {
   std::vector<double> dt_s;      ///< per sample: time minus the model's t_ref, s (increasing)
   std::vector<Vec3> acc;         ///< accelerometer output, sensor units
   std::vector<Vec3> gyr;         ///< gyroscope output, sensor units
-  std::vector<Vec3> alpha_b;     ///< angular acceleration from the raw rates, rad/s^2 (approx.)
+  std::vector<Vec3> alpha_b;     ///< angular acceleration, E^-1 d y_g / dt, rad/s^2 (approx.)
   std::vector<double> dtemp_c;   ///< temperature minus temp_ref, degC (0 if none)
   Vec3 sqrt_info = Vec3::Ones(); ///< 1 / sigma of the rotation residual per axis, 1/rad
   std::size_t size() const { return dt_s.size(); }
