@@ -196,19 +196,30 @@ std::string Diagnosis::BriefReport() const {
     header = true;
     out << "  " << c.effect << ": ";
     std::vector<std::string> unexcited, confounders, weak;
+    std::vector<const Confounding*> weak_columns;
     for (const auto& n : c.not_identifiable) {
       if (!n.excited) unexcited.push_back(n.parameter);
-      if (n.too_weak) {
-        std::ostringstream w;
-        w << n.parameter << " only to +-" << std::setprecision(2) << n.sigma << " (typical "
-          << n.typical << ")";
-        weak.push_back(w.str());
-      }
+      if (n.too_weak) weak_columns.push_back(&n);
       for (const auto& k : n.confounders) {
         if (std::find(confounders.begin(), confounders.end(), k) == confounders.end()) {
           confounders.push_back(k);
         }
       }
+    }
+    if (weak_columns.size() <= 2) {
+      for (const Confounding* n : weak_columns) {
+        std::ostringstream w;
+        w << n->parameter << " only to +-" << std::setprecision(2) << n->sigma << " (typical "
+          << n->typical << ")";
+        weak.push_back(w.str());
+      }
+    } else {
+      double least = weak_columns.front()->sigma / weak_columns.front()->typical;
+      for (const Confounding* n : weak_columns) least = std::min(least, n->sigma / n->typical);
+      std::ostringstream w;
+      w << weak_columns.size() << " of " << c.num_parameters << " parameters only to "
+        << std::setprecision(2) << least << " times their typical size or worse";
+      weak.push_back(w.str());
     }
     if (!unexcited.empty()) {
       out << unexcited.size() << " of " << c.num_parameters << " parameters not excited by this data";
