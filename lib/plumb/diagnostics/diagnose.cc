@@ -39,6 +39,21 @@ std::string Unsupported(const model::EffectInfo& info, const ImuSeries& series,
   return "";
 }
 
+/// Factor from a parameter's SI unit to the unit it has in this fit: additive terms on
+/// unscaled output (counts) are in output units (estimation reports "counts per m/s^2" for a
+/// catalogue "rad/s per m/s^2"), so their typical size scales with the output's sensitivity,
+/// the mean diagonal of the fitted F or E (output units per SI unit).
+double OutputScale(const model::EffectInfo& info, std::size_t i, const ImuSeries& series,
+                   const estimation::CalibrationResult& fit) {
+  const bool accel = info.sensor == model::Sensor::kAccel;
+  const std::string& out = accel ? series.acc_unit : series.gyr_unit;
+  const std::string in = accel ? "m/s^2" : "rad/s";
+  const std::string& unit = info.parameters[i].unit;
+  if (out == in || info.input_side || info.linear_stage || unit.rfind(in, 0) != 0) return 1.0;
+  const Mat3& M = accel ? fit.accel_matrix : fit.gyro_matrix;
+  return M.diagonal().cwiseAbs().mean();
+}
+
 /// The fit with the probe terms taken out (they are held at zero: the model's own fit).
 estimation::CalibrationResult StripProbes(estimation::CalibrationResult fit,
                                           const model::Model& model) {
@@ -118,7 +133,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     for (std::size_t k = 0; k < cols.size(); ++k) {
       Z.col(static_cast<Eigen::Index>(k)) = p.Z.col(cols[k]);
       names.push_back(p.probe_names[static_cast<std::size_t>(cols[k])]);
-      typical.push_back(info.parameters[k].typical);
+      typical.push_back(info.parameters[k].typical * OutputScale(info, k, series, fit));
     }
     const ScoreTestResult s = ScoreTest(p.r, p.J, Z, p.unknown_names, names, typical, options.score);
     Candidate cand;

@@ -81,7 +81,7 @@ std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series
   const bool accel = info.sensor == model::Sensor::kAccel;
   const std::string& out = accel ? series.acc_unit : series.gyr_unit;
   const std::string in = accel ? "m/s^2" : "rad/s";
-  if (out == in) return si;
+  if (out == in || info.input_side) return si;
   if (!info.linear_stage) {
     // Additive terms are in output units: "rad/s per m/s^2" becomes "counts per m/s^2".
     return si.rfind(in, 0) == 0 ? out + si.substr(in.size()) : si;

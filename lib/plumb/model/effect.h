@@ -68,6 +68,9 @@ struct EffectInfo {
   std::string option;  ///< the option it was made with ("" or e.g. "2" for a polynomial order)
   Sensor sensor = Sensor::kAccel;
   bool linear_stage = false;  ///< true only for the base effects that write F/E and the bias
+  /// Parameters are quantities of the true input (e.g. earth_rate's rad/s), reported in SI
+  /// whatever the unit of the sensor output; otherwise additive terms are in output units.
+  bool input_side = false;
   std::string term;           ///< its term in the forward model, as text
   std::vector<ParameterInfo> parameters;
   Excitation excitation;

@@ -27,6 +27,7 @@ EffectInfo MakeInfo(const std::string& option) {
   info.term = "y_g += E R_b_n (omega_N, 0, omega_D), still segments (candidate without a site)";
   info.parameters = {{"omega.north", "rad/s", 7.292115e-5, 0.0},
                      {"omega.down", "rad/s", 7.292115e-5, 0.0}};
+  info.input_side = true;
   info.excitation.still_orientations = true;
   return info;
 }
