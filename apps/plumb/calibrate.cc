@@ -129,7 +129,9 @@ class CalibrateCommand : public Command {
       model::Model before = model::Model::Parse(a.baseline);
       before.t_ref_s = model.t_ref_s;
       before.temp_ref_c = model.temp_ref_c;
-      baseline = estimation::Calibrate(series, segments, before, site, options);
+      estimation::CalibrationOptions same = options;  // the same residuals in both fits
+      same.accel_in_motion = result.fit.velocity_segments > 0;
+      baseline = estimation::Calibrate(series, segments, before, site, same);
       std::cout << "\n" << report::BeforeAfterSummary(*baseline, result);
     }
 

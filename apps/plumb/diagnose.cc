@@ -225,7 +225,12 @@ class DiagnoseCommand : public Command {
               << ra.BriefReport() << d.BriefReport();
     const auto best = std::find_if(d.candidates.begin(), d.candidates.end(),
                                    [](const diagnostics::Candidate& c) { return c.refit.has_value(); });
-    if (best != d.candidates.end()) std::cout << "\n" << report::BeforeAfterSummary(d.fit, *best->refit);
+    if (best != d.candidates.end()) {
+      const bool velocity = best->with_velocity && d.fit_with_velocity.has_value();
+      std::cout << "\n"
+                << report::BeforeAfterSummary(velocity ? *d.fit_with_velocity : d.fit,
+                                              *best->refit);
+    }
     for (const auto& w : d.fit.warnings) std::cout << "warning: " << w << "\n";
 
     if (!a.json_path.empty()) {

@@ -98,8 +98,11 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   } else {
     for (const auto& text : options.candidates) wanted.push_back(ParseCandidate(text));
   }
-  model::Model probed = model;
+  // Two probe fits: the candidates seen by the model's own residuals, and those that need the
+  // accelerometer during motion (velocity residuals), tested in a fit that has them.
+  model::Model probed = model, probed_motion = model;
   std::vector<CandidateSpec> tested;
+  std::vector<bool> needs_motion;
   for (const auto& c : wanted) {
     const auto effect = model::Registry::Global().Make(c.name, c.option);
     if (model.has_effect(c.name)) continue;
@@ -108,20 +111,51 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
       d.skipped.push_back({c.name, why});
       continue;
     }
-    probed.AddProbe(c.name, c.option);
+    const bool motion = effect->info().excitation.angular_acceleration;
+    (motion ? probed_motion : probed).AddProbe(c.name, c.option);
     tested.push_back(c);
+    needs_motion.push_back(motion);
   }
-  const estimation::CalibrationResult fit =
-      estimation::Calibrate(series, segments, probed, site, options.calibration);
+  estimation::CalibrationOptions own = options.calibration;
+  if (!own.accel_in_motion) own.accel_in_motion = false;
+  const estimation::CalibrationResult fit = estimation::Calibrate(series, segments, probed, site, own);
   d.fit = StripProbes(fit, model);
-  if (!fit.probes) return d;
-  const estimation::ProbeJacobian& p = *fit.probes;
-  d.num_residuals = static_cast<int>(p.r.size());
-  const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
+  std::optional<estimation::CalibrationResult> fit_motion;
+  if (probed_motion.has_probes() && d.fit.fit.motion_segments > 0) {
+    estimation::CalibrationOptions with = options.calibration;
+    with.accel_in_motion = true;
+    fit_motion = estimation::Calibrate(series, segments, probed_motion, site, with);
+    d.fit_with_velocity = StripProbes(*fit_motion, model);
+  }
+  if (!fit.probes && !fit_motion) return d;
+  d.num_residuals = fit.probes ? static_cast<int>(fit.probes->r.size()) : 0;
 
   std::vector<Eigen::MatrixXd> bases;
-  for (const auto& c : tested) {
-    const int term = fit.model.FindTerm(c.name);
+  for (std::size_t ci = 0; ci < tested.size(); ++ci) {
+    const CandidateSpec& c = tested[ci];
+    const estimation::CalibrationResult* source = needs_motion[ci] ? (fit_motion ? &*fit_motion : nullptr) : &fit;
+    if (source == nullptr || !source->probes) {
+      // No motion between the poses: nothing excites it.
+      Candidate cand;
+      cand.effect = c.name;
+      cand.option = c.option;
+      cand.identifiable = false;
+      const auto effect = model::Registry::Global().Make(c.name, c.option);
+      cand.num_parameters = effect->info().size();
+      for (int i = 0; i < effect->info().size(); ++i) {
+        Confounding n;
+        n.parameter = effect->info().ParameterName(i);
+        n.excited = false;
+        n.typical = effect->info().parameters[static_cast<std::size_t>(i)].typical;
+        cand.not_identifiable.push_back(n);
+      }
+      d.candidates.push_back(std::move(cand));
+      bases.emplace_back();
+      continue;
+    }
+    const estimation::ProbeJacobian& p = *source->probes;
+    const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
+    const int term = source->model.FindTerm(c.name);
     std::vector<Eigen::Index> cols;
     for (std::size_t j = 0; j < p.probe_term.size(); ++j) {
       if (p.probe_term[j] == term) cols.push_back(static_cast<Eigen::Index>(j));
@@ -129,11 +163,11 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     Eigen::MatrixXd Z(p.Z.rows(), static_cast<Eigen::Index>(cols.size()));
     std::vector<std::string> names;
     std::vector<double> typical;
-    const auto& info = fit.model.terms()[static_cast<std::size_t>(term)].effect->info();
+    const auto& info = source->model.terms()[static_cast<std::size_t>(term)].effect->info();
     for (std::size_t k = 0; k < cols.size(); ++k) {
       Z.col(static_cast<Eigen::Index>(k)) = p.Z.col(cols[k]);
       names.push_back(p.probe_names[static_cast<std::size_t>(cols[k])]);
-      typical.push_back(info.parameters[k].typical * OutputScale(info, k, series, fit));
+      typical.push_back(info.parameters[k].typical * OutputScale(info, k, series, *source));
     }
     const ScoreTestResult s = ScoreTest(p.r, p.J, Z, p.unknown_names, names, typical, options.score);
     Candidate cand;
@@ -147,6 +181,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     cand.evidence = s.lm - s.dof * log_n;
     cand.threshold = s.dof > 0 ? signal::ChiSquareQuantile(1.0 - options.significance, s.dof) : 0.0;
     cand.significant = s.identifiable && s.dof > 0 && s.lm > cand.threshold;
+    cand.with_velocity = needs_motion[ci];
     d.candidates.push_back(std::move(cand));
     bases.push_back(s.basis);
   }
@@ -155,6 +190,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   for (std::size_t a = 0; a < d.candidates.size(); ++a) {
     for (std::size_t b = 0; b < d.candidates.size(); ++b) {
       if (a == b || bases[a].cols() == 0 || bases[b].cols() == 0) continue;
+      if (bases[a].rows() != bases[b].rows()) continue;  // from the two probe fits
       const Eigen::MatrixXd cosines = bases[a].transpose() * bases[b];
       Eigen::JacobiSVD<Eigen::MatrixXd> svd(cosines);
       const auto& sv = svd.singularValues();
@@ -175,9 +211,12 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     if (!cand.significant) continue;
     model::Model with = model;
     with.Add(cand.effect, cand.option);
+    estimation::CalibrationOptions refit_options = options.calibration;
+    refit_options.accel_in_motion = cand.with_velocity;
     estimation::CalibrationResult refit =
-        estimation::Calibrate(series, segments, with, site, options.calibration);
-    cand.refit_drop = d.fit.fit.chi2 - refit.fit.chi2;
+        estimation::Calibrate(series, segments, with, site, refit_options);
+    const double before = cand.with_velocity ? fit_motion->fit.chi2 : d.fit.fit.chi2;
+    cand.refit_drop = before - refit.fit.chi2;
     cand.refit = std::move(refit);
     ++confirmed;
   }

@@ -63,6 +63,9 @@ struct Candidate {
   /// one explains lie (cosine >= 0.999) within theirs, e.g. a temperature term and a drift
   /// when the temperature rose steadily.
   std::vector<std::string> indistinguishable_from;
+  /// Tested in the fit with velocity residuals (the accelerometer during motion: lever arms,
+  /// time offset), whose chi^2 is then the "before" of its refit.
+  bool with_velocity = false;
   /// Refit with the effect added (only for confirmed candidates).
   std::optional<double> refit_drop;            ///< actual fall of chi^2
   std::optional<estimation::CalibrationResult> refit;
@@ -76,6 +79,9 @@ struct Skipped {
 
 struct Diagnosis {
   estimation::CalibrationResult fit;    ///< the model's own fit (probes removed)
+  /// The model's fit with velocity residuals (the accelerometer during motion), when some
+  /// candidate needed them: the "before" of those candidates' refits.
+  std::optional<estimation::CalibrationResult> fit_with_velocity;
   std::vector<Candidate> candidates;    ///< best evidence first; not identifiable ones last
   std::vector<Skipped> skipped;
   double significance = 0.01;

@@ -15,6 +15,7 @@
 #include "plumb/residuals/manifolds.h"
 #include "plumb/residuals/motion_residual.h"
 #include "plumb/residuals/still_residuals.h"
+#include "plumb/residuals/velocity_residual.h"
 #include "plumb/signal/correlation_time.h"
 #include "plumb/signal/segment_stats.h"
 
@@ -49,6 +50,7 @@ struct BuiltProblem {
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ceres::ResidualBlockId> acc, gyr;  // per still segment
   std::vector<ceres::ResidualBlockId> motion;    // per motion interval
+  std::vector<ceres::ResidualBlockId> velocity;  // per motion interval, when used
 };
 
 Quat ToQuat(const std::array<double, 4>& q) { return Quat(q[3], q[0], q[1], q[2]); }
@@ -127,6 +129,9 @@ ProbeJacobian ProbeColumns(const model::Model& model, model::ParameterBlocks& th
   }
   for (std::size_t k = 0; k < probe.motion.size(); ++k) {
     add_rows(probe.motion[k], ProbeJacobian::RowKind::kMotion, static_cast<int>(k));
+  }
+  for (std::size_t k = 0; k < probe.velocity.size(); ++k) {
+    add_rows(probe.velocity[k], ProbeJacobian::RowKind::kVelocity, static_cast<int>(k));
   }
   std::vector<double> r;
   ceres::CRSMatrix crs;
@@ -382,8 +387,16 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   // not depend on the starting values). The angular acceleration input of the effects
   // (time_offset, accel_size_effect) is the derivative of the corrected rate, E^-1 d y_g / dt
   // (central differences), set at the same two points.
-  auto set_motion_weights = [&](const Mat3& E) {
+  bool needs_velocity = false;
+  for (const auto& term : model.terms()) {
+    needs_velocity = needs_velocity || term.effect->info().excitation.angular_acceleration;
+  }
+  const bool velocity_on = motion_on && options.accel_in_motion.value_or(needs_velocity);
+  std::vector<Vec3> velocity_info(motions.size(), Vec3::Ones());
+  auto set_motion_weights = [&](const Mat3& E, const Mat3& F) {
     const Mat3 E_inv = E.inverse();
+    const Mat3 F_inv = F.inverse();
+    const Mat3 cov_f = F_inv * result.noise_acc.cwiseAbs2().asDiagonal() * F_inv.transpose();
     for (std::size_t k = 0; k < motions.size(); ++k) {
       for (std::size_t i = 0; i < output_rate[k].size(); ++i) {
         motion_samples[k].alpha_b[i] = E_inv * output_rate[k][i];
@@ -399,9 +412,21 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
         motion_samples[k].sqrt_info[i] =
             1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * tau_gyr[i]));
       }
+      // Velocity: accelerometer noise summed over the steps, and gravity tilted by the
+      // attitude random walk of the gyroscope noise (mean over the axes), which moves the
+      // velocity only across gravity: d, the direction of gravity in the body at the start.
+      const double n = std::max(1.0, steps);
+      const double var_w = cov_rate.trace() / 3.0 * tau_gyr.mean();
+      const Vec3 d = down_of(still[mo.from]);
+      for (int i = 0; i < 3; ++i) {
+        const double across = std::max(0.0, 1.0 - d[i] * d[i]);
+        const double var_v = cov_f(i, i) * tau_acc[i] * dt * dt * n +
+                             across * g * g * var_w * dt * dt * dt * dt * n * n * n / 3.0;
+        velocity_info[k][i] = 1.0 / std::sqrt(var_v);
+      }
     }
   };
-  set_motion_weights(Mat3::Identity() / gyro_scale);
+  set_motion_weights(Mat3::Identity() / gyro_scale, Mat3::Identity() * acc_guess.scale);
 
   std::vector<std::unique_ptr<ceres::Manifold>> manifolds;
   // `free_probes`: the probe terms' blocks are left free (for their Jacobian columns only).
@@ -468,6 +493,14 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
       for (auto& b : theta) blocks.push_back(b.data());
       built.motion.push_back(problem->AddResidualBlock(
           MotionResidual::Create(model, motion_samples[k], site.omega_ie_n), nullptr, blocks));
+      if (velocity_on) {
+        std::vector<double*> vblocks = {still[mo.from].q.data()};
+        for (auto& b : theta) vblocks.push_back(b.data());
+        built.velocity.push_back(problem->AddResidualBlock(
+            residuals::VelocityResidual::Create(model, motion_samples[k], site.g_n,
+                                                site.omega_ie_n, velocity_info[k]),
+            nullptr, vblocks));
+      }
     }
     return built;
   };
@@ -564,7 +597,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     }
   }
   if (result.has_gyro && !motions.empty()) {
-    set_motion_weights(model.Predict(theta, model::SensorInput<double>()).E);
+    const auto linear = model.Predict(theta, model::SensorInput<double>());
+    set_motion_weights(linear.E, linear.F);
   }
   if (!held.empty()) {
     theta = theta0;
@@ -694,7 +728,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   fit.dof = fit.num_residuals - analysis.summary.rank;
   fit.still_segments = static_cast<int>(still.size());
   fit.motion_segments = static_cast<int>(motions.size());
-  Vec3 ss_acc = Vec3::Zero(), ss_gyr = Vec3::Zero(), ss_mot = Vec3::Zero();
+  Vec3 ss_acc = Vec3::Zero(), ss_gyr = Vec3::Zero(), ss_mot = Vec3::Zero(), ss_vel = Vec3::Zero();
   for (std::size_t k = 0; k < still.size(); ++k) {
     const Still& s = still[k];
     StillSegmentFit f;
@@ -732,12 +766,23 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     f.whitened = Vec3(w[0], w[1], w[2]);
     f.rotation_residual = f.whitened.cwiseQuotient(motion_samples[k].sqrt_info);
     ss_mot += f.rotation_residual.cwiseAbs2();
+    if (k < final_build.velocity.size()) {
+      problem.EvaluateResidualBlock(final_build.velocity[k], false, nullptr, w, nullptr);
+      f.has_velocity = true;
+      f.velocity_whitened = Vec3(w[0], w[1], w[2]);
+      f.velocity_residual = f.velocity_whitened.cwiseQuotient(velocity_info[k]);
+      ss_vel += f.velocity_residual.cwiseAbs2();
+    }
     result.motion.push_back(f);
   }
   const double ns = static_cast<double>(still.size());
   fit.rms_acc = (ss_acc / static_cast<double>(truly_still(still).size())).cwiseSqrt();
   if (still_gyro) fit.rms_gyr = (ss_gyr / ns).cwiseSqrt();
   if (!motions.empty()) fit.rms_motion = (ss_mot / static_cast<double>(motions.size())).cwiseSqrt();
+  fit.velocity_segments = static_cast<int>(final_build.velocity.size());
+  if (fit.velocity_segments > 0) {
+    fit.rms_velocity = (ss_vel / static_cast<double>(fit.velocity_segments)).cwiseSqrt();
+  }
 
   // What the data cannot determine, and what to record.
   const int orientations = CountDistinctOrientations(Column(truly_still(still), false));

@@ -26,6 +26,12 @@ struct CalibrationOptions {
   std::optional<double> first_heading_deg;
   /// Still residuals of the gyroscope (the Earth-rate constraint) are used when true.
   bool use_still_gyro = true;
+  /// Velocity residuals over the motion intervals (residuals/velocity_residual.h: the
+  /// accelerometer while the IMU turns, at rest at both ends). Unset: used when the model has
+  /// an effect that needs them (lever arms, time offset: EffectInfo::excitation.
+  /// angular_acceleration); set, forced on or off (e.g. to compare two models on the same
+  /// residuals).
+  std::optional<bool> accel_in_motion;
   /// Relative singular-value threshold of the column-scaled whitened Jacobian below which a
   /// direction counts as unobservable (0 < value < 1).
   double rank_tolerance = 1e-9;

@@ -65,6 +65,9 @@ struct MotionFit {
   double duration_s = 0;
   Vec3 rotation_residual = Vec3::Zero();
   Vec3 whitened = Vec3::Zero();
+  bool has_velocity = false;              ///< a velocity residual was fitted
+  Vec3 velocity_residual = Vec3::Zero();  ///< velocity change over the interval, m/s
+  Vec3 velocity_whitened = Vec3::Zero();
 };
 
 struct FitSummary {
@@ -75,8 +78,10 @@ struct FitSummary {
   Vec3 rms_acc = Vec3::Zero();  ///< RMS of still accelerometer residuals per axis, sensor units
   Vec3 rms_gyr = Vec3::Zero();  ///< RMS of still gyroscope residuals per axis, sensor units
   Vec3 rms_motion = Vec3::Zero();  ///< RMS of motion rotation residuals per axis, rad
+  Vec3 rms_velocity = Vec3::Zero();  ///< RMS of motion velocity residuals per axis, m/s
   int still_segments = 0;
   int motion_segments = 0;
+  int velocity_segments = 0;  ///< motion intervals with a velocity residual (accel in motion)
   int iterations = 0;
   bool converged = false;
   std::string solver_report;  ///< ceres::Solver::Summary::BriefReport()
@@ -94,7 +99,7 @@ struct ProbeJacobian {
   std::vector<bool> unknown_is_model;      ///< J's columns: model parameter (else attitude)
   std::vector<std::string> probe_names;    ///< Z's columns, e.g. "gyro_g_sensitivity.G.xy"
   std::vector<int> probe_term;             ///< Z's columns: index of the term in the model
-  enum class RowKind { kStillAccel, kStillGyro, kMotion };
+  enum class RowKind { kStillAccel, kStillGyro, kMotion, kVelocity };
   std::vector<RowKind> row_kind;  ///< per row
   std::vector<int> row_index;     ///< per row: still segment or motion interval index
   std::vector<int> row_axis;      ///< per row: 0, 1, 2

@@ -162,11 +162,16 @@ json StillJson(const estimation::StillSegmentFit& s, bool has_gyro) {
 }
 
 json MotionJson(const estimation::MotionFit& m) {
-  return json{{"from", m.from},
-              {"to", m.to},
-              {"duration_s", Number(m.duration_s)},
-              {"rotation_residual", Vector(m.rotation_residual)},
-              {"whitened", Vector(m.whitened)}};
+  json out{{"from", m.from},
+           {"to", m.to},
+           {"duration_s", Number(m.duration_s)},
+           {"rotation_residual", Vector(m.rotation_residual)},
+           {"whitened", Vector(m.whitened)}};
+  if (m.has_velocity) {
+    out["velocity_residual"] = Vector(m.velocity_residual);
+    out["velocity_whitened"] = Vector(m.velocity_whitened);
+  }
+  return out;
 }
 
 json NoiseEstimateJson(const segmentation::NoiseEstimate& n) {

@@ -114,6 +114,9 @@ std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
     if (before.fit.motion_segments > 0) {
       row("motion RMS (rad)", vec(before.fit.rms_motion), vec(after.fit.rms_motion));
     }
+    if (before.fit.velocity_segments > 0) {
+      row("velocity RMS (m/s)", vec(before.fit.rms_velocity), vec(after.fit.rms_velocity));
+    }
   }
   os << "  chi2 fell by " << Format("%.1f", before.fit.chi2 - after.fit.chi2) << "\n";
   bool header = false;

@@ -1,0 +1,70 @@
+// plumb/residuals/velocity_residual.cc — see velocity_residual.h.
+#include "plumb/residuals/velocity_residual.h"
+
+#include <ceres/dynamic_numeric_diff_cost_function.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include "plumb/core/so3.h"
+
+namespace plumb::residuals {
+
+VelocityResidual::VelocityResidual(const model::Model& model, MotionSamples samples,
+                                   const Vec3& g_n, const Vec3& omega_ie_n,
+                                   const Vec3& sqrt_info)
+    : model_(&model), s_(std::move(samples)), g_n_(g_n), omega_ie_n_(omega_ie_n),
+      sqrt_info_(sqrt_info) {}
+
+ceres::CostFunction* VelocityResidual::Create(const model::Model& model, MotionSamples samples,
+                                              const Vec3& g_n, const Vec3& omega_ie_n,
+                                              const Vec3& sqrt_info) {
+  auto* functor = new VelocityResidual(model, std::move(samples), g_n, omega_ie_n, sqrt_info);
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<VelocityResidual, ceres::CENTRAL>(functor);
+  cost->AddParameterBlock(4);
+  for (const auto& t : model.terms()) cost->AddParameterBlock(t.effect->info().size());
+  cost->SetNumResiduals(3);
+  return cost;
+}
+
+Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
+  const Quat q_k(parameters[0][3], parameters[0][0], parameters[0][1], parameters[0][2]);
+  const Mat3 R_b_n = q_k.normalized().toRotationMatrix().transpose();
+  double const* const* theta = parameters + 1;
+  const model::SensorOutput<double> linear = model_->Predict(theta, model::SensorInput<double>());
+  const Mat3 F_inv = linear.F.inverse();
+  const Mat3 E_inv = linear.E.inverse();
+  const std::size_t n = s_.size();
+  std::vector<Vec3> f(n), w(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    model::SensorInput<double> in;
+    in.alpha_b = s_.alpha_b[i];
+    in.dt_s = s_.dt_s[i];
+    in.dtemp_c = s_.dtemp_c[i];
+    const auto fw = model_->Correct<double>(theta, s_.acc[i], s_.gyr[i], in, F_inv, E_inv, 3);
+    f[i] = fw.first;
+    w[i] = fw.second;
+  }
+  const Vec3 omega_k = R_b_n * omega_ie_n_;
+  Mat3 dR = Mat3::Identity();
+  Vec3 dv = Vec3::Zero();
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const double h = s_.dt_s[i + 1] - s_.dt_s[i];
+    const Vec3 e = dR.transpose() * omega_k;
+    const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
+    const Vec3 phi = 0.5 * h * (u0 + u1) + (h * h / 12.0) * u0.cross(u1);
+    const Mat3 dR_next = dR * so3::Exp(phi);
+    dv += 0.5 * h * (dR * f[i] + dR_next * f[i + 1]);
+    dR = dR_next;
+  }
+  const double T = n > 0 ? s_.dt_s[n - 1] - s_.dt_s[0] : 0.0;
+  return dv + R_b_n * g_n_ * T;
+}
+
+bool VelocityResidual::operator()(double const* const* parameters, double* residuals) const {
+  const Vec3 dv = VelocityChange(parameters);
+  for (int i = 0; i < 3; ++i) residuals[i] = sqrt_info_[i] * dv[i];
+  return true;
+}
+
+}  // namespace plumb::residuals

@@ -1,0 +1,60 @@
+// plumb/residuals/velocity_residual.h — the accelerometer during the motion between two still
+// segments: the IMU is at rest at both ends, so its velocity does not change.
+//
+// With the corrected gyroscope integrated as in MotionResidual (coning-corrected product of
+// exponentials of u_i = w_i - dR_i^T R_k^T omega_ie_n, dR_0 = I) and the corrected specific force
+// f_i (both from model::Model::Correct on the sample's outputs, with its angular acceleration):
+//
+//   r = W_v ( sum_i (h_i / 2) (dR_i f_i + dR_i+1 f_i+1) + R_k^T g_n T ),   m/s, body frame of k
+//
+// (the velocity change expressed in the body frame of segment k; transport and Coriolis terms
+// over a few seconds are far below the noise). It is what makes the accelerometer's lever arms
+// (accel_size_effect) and the time offset between the triads (time_offset) visible: both
+// change f_i or dR_i only while the IMU turns.
+//
+// Whitening W_v = diag(1 / sigma_v), per axis, from the white noises: the accelerometer's
+// (carried through F^-1) summed over the steps, and the gyroscope's (through E^-1) integrated
+// into an attitude random walk that tilts gravity:
+//   sigma_v^2 = sigma_f^2 h^2 N tau_a + g^2 sigma_w^2 h^4 N^3 tau_g / 3.
+// Its correlation with the rotation residual of the same interval is neglected.
+//
+// Jacobians: central differences (ceres::DynamicNumericDiffCostFunction), one pass over the
+// samples per parameter: the backend adds these residuals only when the model has an effect
+// that needs them (EffectInfo::excitation.angular_acceleration).
+//
+// Parameter blocks, in order: q_k (4, R_n_b in Eigen order x y z w), then every block of the
+// model in model order.
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include "plumb/model/model.h"
+#include "plumb/residuals/measurements.h"
+
+namespace plumb::residuals {
+
+class VelocityResidual {
+ public:
+  /// `g_n` gravity in NED, m/s^2; `omega_ie_n` Earth rate in NED, rad/s; `sqrt_info` 1 / sigma_v
+  /// per axis, s/m. The model must outlive the cost function.
+  VelocityResidual(const model::Model& model, MotionSamples samples, const Vec3& g_n,
+                   const Vec3& omega_ie_n, const Vec3& sqrt_info);
+
+  /// The cost function (numeric differentiation over q_k and every model block).
+  static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
+                                     const Vec3& g_n, const Vec3& omega_ie_n,
+                                     const Vec3& sqrt_info);
+
+  /// r (3 values, whitened) at the given blocks.
+  bool operator()(double const* const* parameters, double* residuals) const;
+
+  /// The velocity change sum (unwhitened, m/s, body frame of k).
+  Vec3 VelocityChange(double const* const* parameters) const;
+
+ private:
+  const model::Model* model_;
+  MotionSamples s_;
+  Vec3 g_n_, omega_ie_n_, sqrt_info_;
+};
+
+}  // namespace plumb::residuals
