@@ -52,7 +52,9 @@ nlohmann::json CandidateJson(const diagnostics::Candidate& c) {
                       {"significant", c.significant},
                       {"predicted_drop", report::Number(c.lm)},
                       {"refit_drop", c.refit_drop ? report::Number(*c.refit_drop) : nullptr},
-                      {"identifiable", c.identifiable}};
+                      {"identifiable", c.identifiable},
+                      {"with_velocity", c.with_velocity},
+                      {"dispersion", report::Number(c.dispersion)}};
   nlohmann::json confounded = nlohmann::json::array();
   for (const auto& n : c.not_identifiable) {
     confounded.push_back({{"parameter", n.parameter},

@@ -155,6 +155,17 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     }
     const estimation::ProbeJacobian& p = *source->probes;
     const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
+    double dispersion = 1.0;
+    if (needs_motion[ci]) {
+      double ss = 0.0;
+      int rows = 0;
+      for (std::size_t row = 0; row < p.row_kind.size(); ++row) {
+        if (p.row_kind[row] != estimation::ProbeJacobian::RowKind::kVelocity) continue;
+        ss += p.r(static_cast<Eigen::Index>(row)) * p.r(static_cast<Eigen::Index>(row));
+        ++rows;
+      }
+      if (rows > 0) dispersion = std::max(1.0, ss / rows);
+    }
     const int term = source->model.FindTerm(c.name);
     std::vector<Eigen::Index> cols;
     for (std::size_t j = 0; j < p.probe_term.size(); ++j) {
@@ -173,14 +184,15 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     Candidate cand;
     cand.effect = c.name;
     cand.option = c.option;
-    cand.lm = s.lm;
+    cand.lm = s.lm / dispersion;
+    cand.dispersion = dispersion;
     cand.dof = s.dof;
     cand.num_parameters = s.num_parameters;
     cand.identifiable = s.identifiable;
     cand.not_identifiable = s.not_identifiable;
-    cand.evidence = s.lm - s.dof * log_n;
+    cand.evidence = cand.lm - s.dof * log_n;
     cand.threshold = s.dof > 0 ? signal::ChiSquareQuantile(1.0 - options.significance, s.dof) : 0.0;
-    cand.significant = s.identifiable && s.dof > 0 && s.lm > cand.threshold;
+    cand.significant = s.identifiable && s.dof > 0 && cand.lm > cand.threshold;
     cand.with_velocity = needs_motion[ci];
     d.candidates.push_back(std::move(cand));
     bases.push_back(s.basis);
@@ -241,6 +253,10 @@ std::string Diagnosis::BriefReport() const {
         << std::setw(13) << (c.significant ? "yes" : "no") << std::setw(13)
         << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-"));
     for (const auto& other : c.indistinguishable_from) out << "  (same as " << other << " here)";
+    if (c.dispersion > 1.0) {
+      out << "  (LM / " << std::setprecision(3) << c.dispersion
+          << ": the velocity residuals' misfit)";
+    }
     out << "\n";
   }
   bool header = false;

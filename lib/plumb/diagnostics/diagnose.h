@@ -66,6 +66,11 @@ struct Candidate {
   /// Tested in the fit with velocity residuals (the accelerometer during motion: lever arms,
   /// time offset), whose chi^2 is then the "before" of its refit.
   bool with_velocity = false;
+  /// For those: the velocity residuals' own chi^2 per residual in that fit, when above 1 (the
+  /// accelerometer during motion is then not modelled to its noise: hand-held vibration,
+  /// sampling jitter, clipping); lm and evidence are divided by it (a quasi-likelihood score
+  /// test), so such misfit is not taken for a lever arm or a time offset. 1 otherwise.
+  double dispersion = 1.0;
   /// Refit with the effect added (only for confirmed candidates).
   std::optional<double> refit_drop;            ///< actual fall of chi^2
   std::optional<estimation::CalibrationResult> refit;

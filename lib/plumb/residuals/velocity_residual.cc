@@ -36,7 +36,20 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
   const Mat3 E_inv = linear.E.inverse();
   const std::size_t n = s_.size();
   std::vector<Vec3> f(n), w(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  // Every effect other than the linear stage at zero (the base model, or diagnose's probes
+  // away from the one being differentiated): the closed-form inverse.
+  bool closed_form = true;
+  for (int t = 0; t < model_->num_terms() && closed_form; ++t) {
+    const auto& info = model_->terms()[static_cast<std::size_t>(t)].effect->info();
+    if (info.linear_stage) continue;
+    for (int j = 0; j < info.size(); ++j) closed_form = closed_form && theta[t][j] == 0.0;
+  }
+  const Vec3 b_a = linear.acc, b_g = linear.gyr;  // the outputs at zero input: the biases
+  for (std::size_t i = 0; i < n && closed_form; ++i) {
+    f[i] = F_inv * (s_.acc[i] - b_a);
+    w[i] = E_inv * (s_.gyr[i] - b_g);
+  }
+  for (std::size_t i = 0; i < n && !closed_form; ++i) {
     model::SensorInput<double> in;
     in.alpha_b = s_.alpha_b[i];
     in.dt_s = s_.dt_s[i];
