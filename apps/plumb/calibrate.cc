@@ -28,8 +28,6 @@ struct CalibrateArgs {
   SiteArgs site;
   std::string method = "generalized";
   std::string model = "base";
-  double gravity_m_s2 = 0.0;  ///< --gravity: fixed gravity magnitude, m/s^2, > 0
-  CLI::Option* gravity = nullptr;
   std::string json_path;      ///< --json FILE
   SegmentArgs segments;       ///< --segments FILE or the still detector's options
   bool strict = false;        ///< fail when the data cannot determine every parameter
@@ -60,10 +58,7 @@ class CalibrateCommand : public Command {
                      "(see 'plumb effects')")
         ->capture_default_str();
     AddSiteOptions(app_, a.site);
-    a.gravity = app_->add_option("--gravity", a.gravity_m_s2,
-                                 "Use this fixed gravity magnitude, m/s^2, instead of WGS84 "
-                                 "normal gravity at the site (only when you know better)")
-                    ->check(CLI::PositiveNumber);
+    AddGravityOption(app_, a.site);
     app_->add_option("--json", a.json_path, "Write the result as JSON to FILE (atomically)")
         ->type_name("FILE");
     app_->add_flag("--strict", a.strict,
@@ -98,8 +93,7 @@ class CalibrateCommand : public Command {
     std::vector<StillSegment> segments = seg.segments;
     if (a.level_north && !segments.empty()) segments.front().known_R_n_b = Quat::Identity();
 
-    std::optional<double> gravity;
-    if (a.gravity->count() > 0) gravity = a.gravity_m_s2;
+    const std::optional<double> gravity = a.site.fixed_gravity();
     const geo::Site site = ResolveSite(a.site, session.site, gravity);
     if (gravity && site.known) {
       session.warnings.push_back("gravity fixed at " + std::to_string(*gravity) +
@@ -154,8 +148,7 @@ class CalibrateCommand : public Command {
   /// --method paper-benchmark | paper-static (plumb/paper; paper_methods.h).
   int RunPaperMethod(const Session& session) const {
     const CalibrateArgs& a = args_;
-    std::optional<double> gravity;
-    if (a.gravity->count() > 0) gravity = a.gravity_m_s2;
+    const std::optional<double> gravity = a.site.fixed_gravity();
     const geo::Site site = ResolveSite(a.site, session.site, gravity);
     std::cout << session.source << ": " << session.series.size() << " samples, "
               << session.series.duration_s() << " s\n";

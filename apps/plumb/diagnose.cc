@@ -37,8 +37,6 @@ struct DiagnoseArgs {
   double heading_deg = 0.0;             ///< --heading: first still pose's x from north, deg
   CLI::Option* heading = nullptr;
   double temp_ref_c = 25.0;             ///< reference temperature of temperature terms, degC
-  double gravity_m_s2 = 0.0;
-  CLI::Option* gravity = nullptr;
 };
 
 nlohmann::json CandidateJson(const diagnostics::Candidate& c) {
@@ -162,10 +160,7 @@ class DiagnoseCommand : public Command {
     app_->add_option("--model", a.model, "The model to diagnose (a spec, see 'plumb effects')")
         ->capture_default_str();
     AddSiteOptions(app_, a.site);
-    a.gravity = app_->add_option("--gravity", a.gravity_m_s2,
-                                 "Fixed gravity magnitude, m/s^2, instead of WGS84 normal "
-                                 "gravity at the site")
-                    ->check(CLI::PositiveNumber);
+    AddGravityOption(app_, a.site);
     app_->add_option("--json", a.json_path, "Write the diagnosis as JSON to FILE (atomically)")
         ->type_name("FILE");
     app_->add_option("--residuals", a.residuals_path,
@@ -200,8 +195,7 @@ class DiagnoseCommand : public Command {
     const ImuSeries& series = session.series;
     if (series.empty()) throw Error(session.source + ": no samples");
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
-    std::optional<double> gravity;
-    if (a.gravity->count() > 0) gravity = a.gravity_m_s2;
+    const std::optional<double> gravity = a.site.fixed_gravity();
     const geo::Site site = ResolveSite(a.site, session.site, gravity);
     model::Model model = model::Model::Parse(a.model);
     model.t_ref_s = series.t_s.front();

@@ -48,8 +48,6 @@ struct PaperArgs {
   std::string part = "MPU-6000";  ///< --part: datasheet limits for Table 5
   std::size_t stride = 1;      ///< --stride: every n-th sample in inputs.csv
   bool no_plot = false;        ///< --no-plot: do not run gnuplot
-  double gravity_m_s2 = 0.0;
-  CLI::Option* gravity = nullptr;
 };
 
 std::string Num(double v, int digits = 4) {
@@ -156,10 +154,7 @@ class PaperCommand : public Command {
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
     app_->add_flag("--no-plot", a.no_plot, "Write figures.gp but do not run gnuplot");
-    a.gravity = app_->add_option("--gravity", a.gravity_m_s2,
-                                 "Fixed gravity magnitude, m/s^2, instead of WGS84 normal "
-                                 "gravity at the site")
-                    ->check(CLI::PositiveNumber);
+    AddGravityOption(app_, a.site);
   }
 
   int Run() override {
@@ -174,8 +169,7 @@ class PaperCommand : public Command {
     const paper::PartLimits& part = paper::FindPart(a.part);
     Session bench = ReadInputs(a.input);
     if (bench.series.empty()) throw Error(bench.source + ": no samples");
-    std::optional<double> gravity;
-    if (a.gravity->count() > 0) gravity = a.gravity_m_s2;
+    const std::optional<double> gravity = a.site.fixed_gravity();
     const geo::Site site = ResolveSite(a.site, bench.site, gravity);
     if (!site.known) {
       throw UsageError("paper needs the site (--lat, --lon) for the section-5 gyroscope "

@@ -17,11 +17,22 @@ struct SiteArgs {
   CLI::Option* lon = nullptr;
   CLI::Option* height = nullptr;
 
+  double gravity_m_s2 = 0.0;       ///< --gravity: fixed gravity magnitude, m/s^2, > 0
+  CLI::Option* gravity = nullptr;  ///< registered by AddGravityOption, if at all
+
   bool given() const { return lat != nullptr && lat->count() > 0; }
+  /// The --gravity value when given.
+  std::optional<double> fixed_gravity() const {
+    if (gravity == nullptr || gravity->count() == 0) return std::nullopt;
+    return gravity_m_s2;
+  }
 };
 
 /// Registers --lat, --lon (each needing the other) and --height (needing --lat).
 void AddSiteOptions(CLI::App* app, SiteArgs& args);
+
+/// Registers --gravity (a fixed gravity magnitude instead of WGS84 normal gravity).
+void AddGravityOption(CLI::App* app, SiteArgs& args);
 
 /// The site from the flags when given (source "flags"), else from `from_log` (e.g. the log's
 /// GPS), else none. `gravity_m_s2`, when set, replaces the gravity magnitude (still pointing

@@ -9,30 +9,15 @@
 #include <filesystem>
 
 #include "plumb/diagnostics/diagnose.h"
-#include "plumb/io/text_table.h"
+#include "support/sessions.h"
 #include "plumb/segmentation/still_detector.h"
 
 namespace plumb {
 namespace {
 
-const std::string kShared = PLUMB_SHARED_DATA_DIR;
-
-Session ReadMikoff() {
-  io::TextTableOptions o;
-  o.acc.axes = {0, 1, 2};
-  o.gyr.axes = {3, 4, 5};
-  o.rate_hz = 100;
-  return io::ReadTextTable(std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log", o);
-}
-
-Session ReadImuTk() {
-  io::TextTableOptions o;
-  o.time = 0;
-  o.acc.axes = {1, 2, 3};
-  o.gyr.axes = {1, 2, 3};
-  return io::ReadSplitTables(kShared + "/multipose/imu_tk/xsens_acc.mat",
-                             kShared + "/multipose/imu_tk/xsens_gyro.mat", o);
-}
+using bench::ImuTkPresent;
+using bench::ReadImuTk;
+using bench::ReadMikoff;
 
 void DiagnoseSession(benchmark::State& state, const Session& s, const geo::Site& site,
                      double init_still_s) {
@@ -60,7 +45,7 @@ void BM_DiagnoseMikoff(benchmark::State& state) {
 BENCHMARK(BM_DiagnoseMikoff)->Arg(0)->Arg(3)->Unit(benchmark::kMillisecond);
 
 void BM_DiagnoseImuTk(benchmark::State& state) {
-  if (!std::filesystem::exists(kShared + "/multipose/imu_tk/xsens_acc.mat")) {
+  if (!ImuTkPresent()) {
     state.SkipWithError("shared data absent");
     return;
   }

@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "plumb/estimation/calibrator.h"
-#include "plumb/io/text_table.h"
+#include "support/sessions.h"
 #include "plumb/segmentation/still_detector.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
@@ -18,24 +18,9 @@
 namespace plumb {
 namespace {
 
-const std::string kShared = PLUMB_SHARED_DATA_DIR;
-
-Session ReadImuTk() {
-  io::TextTableOptions o;
-  o.time = 0;
-  o.acc.axes = {1, 2, 3};
-  o.gyr.axes = {1, 2, 3};
-  return io::ReadSplitTables(kShared + "/multipose/imu_tk/xsens_acc.mat",
-                             kShared + "/multipose/imu_tk/xsens_gyro.mat", o);
-}
-
-Session ReadMikoff() {
-  io::TextTableOptions o;
-  o.acc.axes = {0, 1, 2};
-  o.gyr.axes = {3, 4, 5};
-  o.rate_hz = 100;
-  return io::ReadTextTable(std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log", o);
-}
+using bench::ImuTkPresent;
+using bench::ReadImuTk;
+using bench::ReadMikoff;
 
 void CalibrateSession(benchmark::State& state, const Session& s, const geo::Site& site,
                       double init_still_s) {
@@ -55,7 +40,7 @@ void CalibrateSession(benchmark::State& state, const Session& s, const geo::Site
 }
 
 void BM_CalibrateImuTk(benchmark::State& state) {
-  if (!std::filesystem::exists(kShared + "/multipose/imu_tk/xsens_acc.mat")) {
+  if (!ImuTkPresent()) {
     state.SkipWithError("shared data absent");
     return;
   }
@@ -69,7 +54,7 @@ void BM_CalibrateMikoff(benchmark::State& state) {
 BENCHMARK(BM_CalibrateMikoff)->Unit(benchmark::kMillisecond);
 
 void BM_EndToEndImuTk(benchmark::State& state) {
-  if (!std::filesystem::exists(kShared + "/multipose/imu_tk/xsens_acc.mat")) {
+  if (!ImuTkPresent()) {
     state.SkipWithError("shared data absent");
     return;
   }
