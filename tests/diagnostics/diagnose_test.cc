@@ -348,6 +348,33 @@ TEST(Diagnose, EffectsStillDataCannotExciteAreNotIdentifiable) {
   EXPECT_NE(report.find("not identifiable"), std::string::npos) << report;
 }
 
+TEST(Diagnose, EarthRateIsFoundWithoutASite) {
+  // The session is recorded at a real site (Earth rate in the gyroscope), then diagnosed as if
+  // no site were known: earth_rate is the candidate the gyroscope's still residuals ask for,
+  // and its refit measures the horizontal and vertical Earth rate in the heading gauge (the
+  // first pose's true heading stated), i.e. the latitude.
+  SessionSpec spec;
+  spec.seed = 701;
+  spec.still_s = 8.0;
+  Session s = Simulate(spec);
+  s.options.confirm = 1;
+  const Diagnosis d = Diagnose(s.sim.session.series, s.segments, s.base,
+                               geo::Site::Unknown(s.sim.site.gravity()), s.options);
+  ASSERT_FALSE(d.candidates.empty());
+  const Candidate& best = d.candidates.front();
+  EXPECT_EQ(best.effect, "earth_rate") << d.BriefReport();
+  EXPECT_TRUE(best.significant) << d.BriefReport();
+  ASSERT_TRUE(best.refit.has_value());
+  const double lat = 51.64 * M_PI / 180.0, omega = 7.292115e-5;
+  const estimation::ParameterEstimate* north = FindParameter(*best.refit, "earth_rate.omega.north");
+  const estimation::ParameterEstimate* down = FindParameter(*best.refit, "earth_rate.omega.down");
+  ASSERT_NE(north, nullptr);
+  ASSERT_NE(down, nullptr);
+  EXPECT_EQ(north->unit, "rad/s");
+  EXPECT_LT(std::abs(north->value - omega * std::cos(lat)), 3.0 * north->sigma) << north->sigma;
+  EXPECT_LT(std::abs(down->value + omega * std::sin(lat)), 3.0 * down->sigma) << down->sigma;
+}
+
 // --- 5. predicted against actual fall ------------------------------------------------------
 
 struct SmallEffect {
