@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "plumb/core/error.h"
+#include "plumb/io/ardupilot_session.h"
 #include "plumb/io/native_csv.h"
 
 namespace plumb::cli {
@@ -199,9 +200,19 @@ double ParseScale(const std::string& text, const std::string& option) {
 
 void AddInputOptions(CLI::App* app, InputArgs& a) {
   app->add_option("INPUT", a.inputs,
-                  "Input files: plumb's native CSV, a text table (see --columns), or an "
-                  "accelerometer and a gyroscope table as acc.txt,gyr.txt")
+                  "Input files: plumb's native CSV, a text table (see --columns), an "
+                  "accelerometer and a gyroscope table as acc.txt,gyr.txt, or an ArduPilot "
+                  "DataFlash log (.bin, recognised by its first bytes)")
       ->type_name("FILE...");
+  auto* logs = app->add_option_group("Flight logs", "Reading an ArduPilot DataFlash log (.bin)");
+  logs->add_option("--imu", a.imu, "IMU instance of the log, 0-based (IMU = 0, IMU2 = 1, ...)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  a.from = logs->add_option("--from", a.from_s, "Use the samples from this log time on, s");
+  a.to = logs->add_option("--to", a.to_s, "Use the samples up to this log time, s");
+  logs->add_flag("--as-logged", a.as_logged,
+                 "Keep ArduPilot's INS_* correction in the samples instead of undoing it (the "
+                 "calibration is then of the corrected signal)");
   app->add_option("--acc", a.acc_file,
                   "Accelerometer table of the two-file form (imu_tk's `t x y z`), with --gyr")
       ->type_name("FILE");
@@ -304,6 +315,13 @@ Session ReadInputs(const InputArgs& a) {
       s = io::ReadSplitTables(parts[0], parts[1], MakeTableOptions(a, true));
     } else if (parts.size() != 1) {
       throw UsageError("input '" + input + "': give one file, or two as acc.txt,gyr.txt");
+    } else if (!table_asked && a.format != "native" && io::LooksLikeDataflash(input)) {
+      io::ArdupilotSessionOptions o;
+      o.imu = a.imu;
+      if (a.from != nullptr && a.from->count() > 0) o.from_s = a.from_s;
+      if (a.to != nullptr && a.to->count() > 0) o.to_s = a.to_s;
+      o.undo_correction = !a.as_logged;
+      s = io::ArdupilotSession(io::ReadDataflash(input), o);
     } else if (table_asked) {
       if (a.columns.empty())
         throw UsageError("--format table needs --columns; " + std::string(kTableHint));

@@ -44,6 +44,12 @@ struct InputArgs {
   std::string gyr_unit = "rad/s";  ///< rad/s | deg/s
   std::string axis_map = "1,2,3";  ///< body axis i = sign * sensor axis |m_i|, e.g. 1,-2,-3
   bool drop_nan = false;           ///< drop rows with NaN/inf instead of failing
+  // Flight logs (ArduPilot DataFlash .bin):
+  int imu = 0;                     ///< --imu: IMU instance, 0-based, >= 0
+  double from_s = 0.0, to_s = 0.0; ///< --from / --to: time window in log time, s
+  CLI::Option* from = nullptr;
+  CLI::Option* to = nullptr;
+  bool as_logged = false;          ///< --as-logged: keep ArduPilot's INS_* correction
 
   /// Options that only describe text tables, to tell the user when they are given in vain.
   std::vector<CLI::Option*> table_only;

@@ -391,5 +391,32 @@ TEST(Cli, PaperCommandWritesTablesInputsAndFigures) {
 }
 
 
+TEST(Cli, CalibratesAStillArdupilotLogAndSaysWhatOnePoseCannotDetermine) {
+  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane408_centre_point.BIN";
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  const std::string out = dir.File("log.json");
+  const ToolRun run = Plumb({"calibrate", log, "--min-still", "10", "--json", out}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "(IMU instance 0)")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "accelerometer reconstructed as logged ./ INS_ACCSCAL")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "(gps)")) << run.out;
+  const json doc = ReadJson(out);
+  EXPECT_EQ(doc["site"]["source"], "gps");
+  // One level pose: the z bias and scale are tied; their combination is determined with sigma.
+  bool z_pair = false;
+  for (const auto& c : doc["observability"]["determined"]) {
+    const std::string text = c["combination"].get<std::string>();
+    if (text.find("accel.bias.z") != std::string::npos &&
+        text.find("accel.matrix.zz") != std::string::npos) {
+      z_pair = true;
+      EXPECT_GT(c["sigma"].get<double>(), 0.0);
+      EXPECT_LT(c["sigma"].get<double>(), 1e-2);
+    }
+  }
+  EXPECT_TRUE(z_pair) << doc["observability"].dump(2);
+  EXPECT_GT(doc["observability"]["unobservable"].size(), 0u);
+}
+
 }  // namespace
 }  // namespace plumb::cli
