@@ -113,15 +113,16 @@ Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions&
       for (auto& a : out.acc) {
         a = (a.cast<double>().cwiseQuotient(*scal) + *offs).cast<float>();
       }
-      s.warnings.push_back(who + "accelerometer reconstructed as logged ./ INS_ACCSCAL (" +
-                           Format(*scal) + ") + INS_ACCOFFS (" + Format(*offs) + ") m/s^2");
+      const std::string acc = Prefix("ACC", options.imu);
+      s.warnings.push_back(who + "accelerometer reconstructed as logged ./ " + acc + "SCAL (" +
+                           Format(*scal) + ") + " + acc + "OFFS (" + Format(*offs) + ") m/s^2");
     } else {
       s.warnings.push_back(who + "no INS accelerometer offsets/scales in the log: taken as logged");
     }
     if (gyr_offs) {
       for (auto& g : out.gyr) g = (g.cast<double>() + *gyr_offs).cast<float>();
-      s.warnings.push_back(who + "gyroscope reconstructed as logged + INS_GYROFFS (" +
-                           Format(*gyr_offs) + ") rad/s");
+      s.warnings.push_back(who + "gyroscope reconstructed as logged + " +
+                           Prefix("GYR", options.imu) + "OFFS (" + Format(*gyr_offs) + ") rad/s");
     } else {
       s.warnings.push_back(who + "no INS gyroscope offsets in the log: taken as logged");
     }
