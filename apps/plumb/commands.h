@@ -36,5 +36,6 @@ std::unique_ptr<Command> MakeEffectsCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeCompareCommand(CLI::App& parent);
 std::unique_ptr<Command> MakePaperCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeDiagnoseCommand(CLI::App& parent);
+std::unique_ptr<Command> MakeInfoCommand(CLI::App& parent);
 
 }  // namespace plumb::cli

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   commands.push_back(plumb::cli::MakeEffectsCommand(app));
   commands.push_back(plumb::cli::MakeCompareCommand(app));
   commands.push_back(plumb::cli::MakePaperCommand(app));
+  commands.push_back(plumb::cli::MakeInfoCommand(app));
 
   if (argc > 1 && argv[1][0] != '-') {
     const std::string name = argv[1];

@@ -418,5 +418,30 @@ TEST(Cli, CalibratesAStillArdupilotLogAndSaysWhatOnePoseCannotDetermine) {
   EXPECT_GT(doc["observability"]["unobservable"].size(), 0u);
 }
 
+TEST(Cli, InfoDescribesAnArdupilotLog) {
+  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane408_centre_point.BIN";
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  const std::string out = dir.File("info.json");
+  const ToolRun run = Plumb({"info", log, "--json", out}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "IMU instance 1 (IMU2)")) << run.out;
+  const json doc = ReadJson(out);
+  ASSERT_EQ(doc["imus"].size(), 2u);
+  for (const char* key : {"name", "instance", "samples", "rate_hz", "t_start_s", "t_end_s"}) {
+    EXPECT_TRUE(doc["imus"][0].contains(key)) << key;
+  }
+  EXPECT_NEAR(doc["imus"][0]["rate_hz"].get<double>(), 50.0, 0.1);
+  EXPECT_NEAR(doc["site"]["lat_deg"].get<double>(), 51.64, 0.01);
+  EXPECT_TRUE(doc["params"].contains("INS_ACCOFFS_X"));
+  EXPECT_FALSE(doc["warnings"].empty());  // the truncated last record
+  // Not a log: a clear error naming the file.
+  const std::string csv = dir.File("x.csv");
+  std::ofstream(csv) << "time_s,acc_x,acc_y,acc_z\n0,0,0,-9.8\n";
+  const ToolRun bad = Plumb({"info", csv}, dir);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_TRUE(Contains(bad.err, "not an ArduPilot DataFlash log")) << bad.err;
+}
+
 }  // namespace
 }  // namespace plumb::cli
