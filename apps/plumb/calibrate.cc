@@ -86,7 +86,6 @@ class CalibrateCommand : public Command {
     const CalibrateArgs& a = args_;
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
-    if (series.empty()) throw Error(session.source + ": no samples");
     if (a.method != "generalized") return RunPaperMethod(session);
 
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);

@@ -193,7 +193,6 @@ class DiagnoseCommand : public Command {
     const DiagnoseArgs& a = args_;
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
-    if (series.empty()) throw Error(session.source + ": no samples");
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
     const std::optional<double> gravity = a.site.fixed_gravity();
     const geo::Site site = ResolveSite(a.site, session.site, gravity);

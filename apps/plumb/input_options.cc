@@ -342,6 +342,7 @@ Session ReadInputs(const InputArgs& a) {
       Append(*joined, std::move(s));
     }
   }
+  if (joined->series.empty()) throw Error(joined->source + ": no samples");
   return std::move(*joined);
 }
 

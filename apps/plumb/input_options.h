@@ -63,7 +63,8 @@ void AddInputOptions(CLI::App* app, InputArgs& args);
 io::TextTableOptions MakeTableOptions(const InputArgs& args, bool split);
 
 /// Reads every input and joins them into one session (see the file comment). Throws
-/// UsageError for contradictory options, plumb::InputError naming the file for bad input.
+/// UsageError for contradictory options, plumb::InputError naming the file for bad input,
+/// plumb::Error when the session has no samples.
 Session ReadInputs(const InputArgs& args);
 
 /// Parses a positive scale "x" or "a/b" (e.g. "9.80665/16384"); throws UsageError naming

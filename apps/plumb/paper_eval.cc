@@ -168,7 +168,6 @@ class PaperCommand : public Command {
     }
     const paper::PartLimits& part = paper::FindPart(a.part);
     Session bench = ReadInputs(a.input);
-    if (bench.series.empty()) throw Error(bench.source + ": no samples");
     const std::optional<double> gravity = a.site.fixed_gravity();
     const geo::Site site = ResolveSite(a.site, bench.site, gravity);
     if (!site.known) {

@@ -80,6 +80,13 @@ inline Mat3 RightJacobian(const Vec3& phi) {
          (a - std::sin(a)) / (a * a * a) * S * S;
 }
 
+/// Rotation vector of one integration step of a rate varying linearly from u0 to u1 over h
+/// seconds, with the coning correction (third order in h, like RK4 on SO(3)):
+/// phi = (h/2) (u0 + u1) + (h^2/12) u0 x u1. u in rad/s, phi in rad.
+inline Vec3 ConingIncrement(const Vec3& u0, const Vec3& u1, double h) {
+  return 0.5 * h * (u0 + u1) + (h * h / 12.0) * u0.cross(u1);
+}
+
 /// Inverse of the left Jacobian, J_l^-1(phi).
 inline Mat3 LeftJacobianInverse(const Vec3& phi) {
   const double a = phi.norm();

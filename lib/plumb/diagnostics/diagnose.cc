@@ -48,8 +48,7 @@ double OutputScale(const model::EffectInfo& info, std::size_t i, const ImuSeries
   const bool accel = info.sensor == model::Sensor::kAccel;
   const std::string& out = accel ? series.acc_unit : series.gyr_unit;
   const std::string in = accel ? "m/s^2" : "rad/s";
-  const std::string& unit = info.parameters[i].unit;
-  if (out == in || info.input_side || info.linear_stage || unit.rfind(in, 0) != 0) return 1.0;
+  if (out == in || !info.ScalesWithOutput(static_cast<int>(i))) return 1.0;
   const Mat3& M = accel ? fit.accel_matrix : fit.gyro_matrix;
   return M.diagonal().cwiseAbs().mean();
 }

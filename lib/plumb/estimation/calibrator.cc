@@ -56,9 +56,13 @@ struct BuiltProblem {
 Quat ToQuat(const std::array<double, 4>& q) { return Quat(q[3], q[0], q[1], q[2]); }
 std::array<double, 4> FromQuat(const Quat& q) { return {q.x(), q.y(), q.z(), q.w()}; }
 
-std::vector<Vec3> Column(const std::vector<Still>& still, bool gyro) {
+/// Mean accelerometer (or gyroscope) output of every segment at rest (not turning at a stated
+/// rate), in segment order.
+std::vector<Vec3> AtRestMeans(const std::vector<Still>& still, bool gyro) {
   std::vector<Vec3> out;
-  for (const auto& s : still) out.push_back(gyro ? s.stats.gyr_mean : s.stats.acc_mean);
+  for (const auto& s : still) {
+    if (!s.spinning) out.push_back(gyro ? s.stats.gyr_mean : s.stats.acc_mean);
+  }
   return out;
 }
 
@@ -86,7 +90,7 @@ std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series
   if (out == in || info.input_side) return si;
   if (!info.linear_stage) {
     // Additive terms are in output units: "rad/s per m/s^2" becomes "counts per m/s^2".
-    return si.rfind(in, 0) == 0 ? out + si.substr(in.size()) : si;
+    return info.ScalesWithOutput(i) ? out + si.substr(in.size()) : si;
   }
   const bool matrix = info.parameters[static_cast<std::size_t>(i)].name.rfind("matrix.", 0) == 0;
   return matrix ? out + " per " + in : out;
@@ -215,13 +219,6 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   if (std::all_of(still.begin(), still.end(), [](const Still& s) { return s.spinning; })) {
     throw InsufficientDataError("every segment turns at a stated rate: record still poses too");
   }
-  auto truly_still = [](const std::vector<Still>& all) {
-    std::vector<Still> out;
-    for (const auto& s : all) {
-      if (!s.spinning) out.push_back(s);
-    }
-    return out;
-  };
 
   // Noise from the data: pooled scatter and correlation time over the still segments (not
   // the turning ones, whose scatter is signal).
@@ -251,7 +248,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   // Initial accelerometer.
   model::ParameterBlocks theta = model.ZeroParameters();
   const int t_acc = model.FindTerm("accel_linear");
-  const AccelGuess acc_guess = GuessAccel(Column(truly_still(still), false), g);
+  const AccelGuess acc_guess = GuessAccel(AtRestMeans(still, false), g);
   {
     auto& b = theta[static_cast<std::size_t>(t_acc)];
     b[0] = b[3] = b[5] = acc_guess.scale - 1.0;
@@ -283,8 +280,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   double gyro_scale = 1.0;  // rad/s per sensor unit
   Vec3 gyro_bias0 = Vec3::Zero();
   if (result.has_gyro) {
-    const auto at_rest = truly_still(still);
-    for (const auto& s : at_rest) gyro_bias0 += s.stats.gyr_mean / static_cast<double>(at_rest.size());
+    const auto at_rest = AtRestMeans(still, true);
+    for (const auto& m : at_rest) gyro_bias0 += m / static_cast<double>(at_rest.size());
     std::vector<std::pair<std::size_t, std::size_t>> intervals;
     std::vector<Vec3> before, after;
     for (const auto& m : motions) {
@@ -776,7 +773,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     result.motion.push_back(f);
   }
   const double ns = static_cast<double>(still.size());
-  fit.rms_acc = (ss_acc / static_cast<double>(truly_still(still).size())).cwiseSqrt();
+  fit.rms_acc = (ss_acc / static_cast<double>(AtRestMeans(still, false).size())).cwiseSqrt();
   if (still_gyro) fit.rms_gyr = (ss_gyr / ns).cwiseSqrt();
   if (!motions.empty()) fit.rms_motion = (ss_mot / static_cast<double>(motions.size())).cwiseSqrt();
   fit.velocity_segments = static_cast<int>(final_build.velocity.size());
@@ -785,7 +782,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   }
 
   // What the data cannot determine, and what to record.
-  const int orientations = CountDistinctOrientations(Column(truly_still(still), false));
+  const int orientations = CountDistinctOrientations(AtRestMeans(still, false));
   bool accel_short = false, gyro_short = false;
   std::vector<std::string> lost;
   for (const auto& p : result.parameters) {

@@ -76,6 +76,15 @@ struct EffectInfo {
   Excitation excitation;
 
   int size() const { return static_cast<int>(parameters.size()); }
+  /// True when parameter i is in the sensor's output units on unscaled output (counts): an
+  /// additive term whose SI unit starts with the sensor's input unit ("rad/s per m/s^2" is
+  /// then "counts per m/s^2"), so its value and typical size scale with the output's
+  /// sensitivity. False for the linear stage and input-side parameters.
+  bool ScalesWithOutput(int i) const {
+    if (linear_stage || input_side) return false;
+    const std::string in = sensor == Sensor::kAccel ? "m/s^2" : "rad/s";
+    return parameters[static_cast<std::size_t>(i)].unit.rfind(in, 0) == 0;
+  }
   /// Full name of parameter i: prefix + "." + parameters[i].name.
   std::string ParameterName(int i) const { return prefix + "." + parameters[i].name; }
 };

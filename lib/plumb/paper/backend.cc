@@ -6,17 +6,10 @@
 
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/initialization.h"
 #include "plumb/model/model.h"
 
 namespace plumb::paper {
-namespace {
-
-/// An attitude R_n_b whose body vector `down_b` (unit) maps onto NED down; heading arbitrary.
-Quat AttitudeWithDown(const Vec3& down_b) {
-  return Quat::FromTwoVectors(down_b.normalized(), Vec3::UnitZ());
-}
-
-}  // namespace
 
 PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(const ImuSeries& series,
                                                        const PaperBenchmarkResult& closed,
@@ -29,7 +22,7 @@ PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(const ImuSeries& series,
     // The paper's assumption: the axis is exactly along gravity ("parallel": it points down).
     Vec3 down_b = Vec3::Zero();
     down_b[p.pose.axis] = p.pose.parallel ? 1.0 : -1.0;
-    s.known_R_n_b = AttitudeWithDown(down_b);
+    s.known_R_n_b = estimation::AttitudeFromDown(down_b, 0.0);
     s.heading_free = true;
     s.known_omega_eb_b.reset();
     out.segments.push_back(s);
@@ -53,7 +46,8 @@ PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(const ImuSeries& series,
     // tilt is that of the mean specific force over the turn.
     Vec3 acc_mean = Vec3::Zero();
     for (std::size_t k = s.begin; k < s.end; ++k) acc_mean += series.acc[k].cast<double>();
-    s.known_R_n_b = acc_mean.norm() > 0.0 ? AttitudeWithDown(-acc_mean) : Quat::Identity();
+    s.known_R_n_b =
+        acc_mean.norm() > 0.0 ? estimation::AttitudeFromDown(-acc_mean, 0.0) : Quat::Identity();
     s.heading_free = true;
     out.segments.push_back(s);
   }

@@ -172,7 +172,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     // Earth rate at the start of the step, held over the step.
     const Vec3 e = dR.transpose() * omega_k;
     const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
-    const Vec3 phi = 0.5 * h * (u0 + u1) + (h * h / 12.0) * u0.cross(u1);
+    const Vec3 phi = so3::ConingIncrement(u0, u1, h);
     const Mat3 Ex = so3::Exp(phi);
     if (want_jacobians) {
       const Mat3 Jr = so3::RightJacobian(phi);

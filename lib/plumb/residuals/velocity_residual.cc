@@ -35,7 +35,6 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
   const Mat3 F_inv = linear.F.inverse();
   const Mat3 E_inv = linear.E.inverse();
   const std::size_t n = s_.size();
-  std::vector<Vec3> f(n), w(n);
   // Every effect other than the linear stage at zero (the base model, or diagnose's probes
   // away from the one being differentiated): the closed-form inverse.
   bool closed_form = true;
@@ -45,32 +44,31 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
     for (int j = 0; j < info.size(); ++j) closed_form = closed_form && theta[t][j] == 0.0;
   }
   const Vec3 b_a = linear.acc, b_g = linear.gyr;  // the outputs at zero input: the biases
-  for (std::size_t i = 0; i < n && closed_form; ++i) {
-    f[i] = F_inv * (s_.acc[i] - b_a);
-    w[i] = E_inv * (s_.gyr[i] - b_g);
-  }
-  for (std::size_t i = 0; i < n && !closed_form; ++i) {
+  // Corrected specific force and rate of sample i.
+  auto correct = [&](std::size_t i) -> std::pair<Vec3, Vec3> {
+    if (closed_form) return {F_inv * (s_.acc[i] - b_a), E_inv * (s_.gyr[i] - b_g)};
     model::SensorInput<double> in;
     in.alpha_b = s_.alpha_b[i];
     in.dt_s = s_.dt_s[i];
     in.dtemp_c = s_.dtemp_c[i];
-    const auto fw = model_->Correct<double>(theta, s_.acc[i], s_.gyr[i], in, F_inv, E_inv, 3);
-    f[i] = fw.first;
-    w[i] = fw.second;
-  }
+    return model_->Correct<double>(theta, s_.acc[i], s_.gyr[i], in, F_inv, E_inv, 3);
+  };
+  if (n < 2) return Vec3::Zero();  // no step: no velocity change
   const Vec3 omega_k = R_b_n * omega_ie_n_;
   Mat3 dR = Mat3::Identity();
   Vec3 dv = Vec3::Zero();
+  auto [f0, w0] = correct(0);
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const double h = s_.dt_s[i + 1] - s_.dt_s[i];
+    const auto [f1, w1] = correct(i + 1);
     const Vec3 e = dR.transpose() * omega_k;
-    const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
-    const Vec3 phi = 0.5 * h * (u0 + u1) + (h * h / 12.0) * u0.cross(u1);
-    const Mat3 dR_next = dR * so3::Exp(phi);
-    dv += 0.5 * h * (dR * f[i] + dR_next * f[i + 1]);
+    const Mat3 dR_next = dR * so3::Exp(so3::ConingIncrement(w0 - e, w1 - e, h));
+    dv += 0.5 * h * (dR * f0 + dR_next * f1);
     dR = dR_next;
+    f0 = f1;
+    w0 = w1;
   }
-  const double T = n > 0 ? s_.dt_s[n - 1] - s_.dt_s[0] : 0.0;
+  const double T = s_.dt_s[n - 1] - s_.dt_s[0];
   return dv + R_b_n * g_n_ * T;
 }
 
