@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -225,6 +226,49 @@ TEST(StillDetector, RejectsOptionsOutOfRange) {
   StillDetectorOptions bad_edge;
   bad_edge.edge_s = -1.0;
   EXPECT_THROW(DetectStillSegments(series, bad_edge), Error);
+}
+
+}  // namespace
+}  // namespace plumb::segmentation
+
+namespace plumb::segmentation {
+namespace {
+
+/// 40 s still with zero-mean vibration (8x the noise, both sensors) over 12-16 s and 25-27 s.
+ImuSeries StillWithVibrationBursts() {
+  ImuSeries series = testing::MakeSession({Still(40.0)}, {});
+  std::mt19937_64 rng(42);
+  std::normal_distribution<float> shake(0.0f, 1.0f);
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const double t = series.t_s[i] - series.t_s.front();
+    if ((t > 12.0 && t < 16.0) || (t > 25.0 && t < 27.0)) {
+      series.acc[i] += 0.16f * Vec3f(shake(rng), shake(rng), shake(rng));
+      series.gyr[i] += 0.016f * Vec3f(shake(rng), shake(rng), shake(rng));
+    }
+  }
+  return series;
+}
+
+TEST(StillDetector, VibrationBurstsInOnePoseAreJoined) {
+  const ImuSeries series = StillWithVibrationBursts();
+  StillDetectorOptions separate;
+  separate.join_same_pose = false;
+  EXPECT_EQ(DetectStillSegments(series, separate).segments.size(), 3U);
+  const SegmentationResult joined = DetectStillSegments(series);
+  ASSERT_EQ(joined.segments.size(), 1U);
+  EXPECT_LT(series.t_s[joined.segments[0].begin] - series.t_s.front(), 1.0);
+  EXPECT_GT(series.t_s[joined.segments[0].end - 1] - series.t_s.front(), 39.0);
+}
+
+TEST(StillDetector, AFullTurnBackToTheSamePoseIsNotJoined) {
+  // A full roll back to the same attitude leaves the accelerometer means of the two poses
+  // equal: only the gyroscope's mean rate over the gap tells that the vehicle turned.
+  const ImuSeries series = testing::MakeSession(
+      {Still(15.0), SmoothTurn(4.0, Vec3::UnitX(), 2.0 * kPi), Still(15.0)}, {});
+  StillDetectorOptions separate;
+  separate.join_same_pose = false;
+  EXPECT_EQ(DetectStillSegments(series, separate).segments.size(), 2U);
+  EXPECT_EQ(DetectStillSegments(series).segments.size(), 2U);
 }
 
 }  // namespace

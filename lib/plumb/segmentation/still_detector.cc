@@ -384,6 +384,112 @@ Classification Classify(const ImuSeries& series, const BlockMoments& blocks,
   return out;
 }
 
+/// Mean and per-axis sample variance of a triad over samples [begin, end), in double.
+struct SpanStats {
+  Vec3 mean = Vec3::Zero();
+  Vec3 variance = Vec3::Zero();
+  double n = 0.0;
+};
+
+SpanStats Stats(const std::vector<Vec3f>& triad, std::size_t begin, std::size_t end) {
+  SpanStats out;
+  out.n = static_cast<double>(end - begin);
+  if (end <= begin) return out;
+  const Vec3 reference = triad[begin].cast<double>();
+  Vec3 sum = Vec3::Zero(), sum_sq = Vec3::Zero();
+  for (std::size_t i = begin; i < end; ++i) {
+    const Vec3 d = triad[i].cast<double>() - reference;
+    sum += d;
+    sum_sq += d.cwiseProduct(d);
+  }
+  out.mean = reference + sum / out.n;
+  if (out.n > 1.0) {
+    out.variance = ((sum_sq - sum.cwiseProduct(sum) / out.n) / (out.n - 1.0)).cwiseMax(0.0);
+  }
+  return out;
+}
+
+/// sum_axes (a - b)^2 / (var_a + var_b + allowance^2): chi^2(3) when a and b estimate the same
+/// triad with those variances of the means.
+double MeanDistance(const Vec3& a, const Vec3& var_a, const Vec3& b, const Vec3& var_b,
+                    const Vec3& allowance) {
+  const Vec3 d = a - b;
+  return (d.cwiseProduct(d).array() /
+          (var_a + var_b + allowance.cwiseProduct(allowance)).array())
+      .sum();
+}
+
+/// Variance of the mean of a span: its own sample variance (the gap's vibration, or the
+/// still noise for a still run) times tau_int / n.
+Vec3 VarianceOfMean(const SpanStats& span, const Vec3& noise_sigma, const Vec3& tau_int,
+                    bool own_variance) {
+  const Vec3 var = own_variance ? span.variance.cwiseMax(noise_sigma.cwiseProduct(noise_sigma))
+                                : Vec3(noise_sigma.cwiseProduct(noise_sigma));
+  return var.cwiseProduct(tau_int) / std::max(span.n, 1.0);
+}
+
+/// Joins consecutive still runs whose samples in between show the same pose: a vehicle
+/// standing still but vibrating (engine, wind, a hand on the airframe) fails the window
+/// variance test in bursts and would otherwise be cut into several "poses" joined by
+/// "motion" that holds no rotation — a problem the calibration cannot condition (issue 5:
+/// plane408_centre_point.BIN, a 45 s still log, came out as 2 segments). Runs a and b with
+/// the gap g between them are joined when, at the detector's chi^2(3) threshold on each:
+///  - the accelerometer means of a and b agree (variance of each mean from the still noise,
+///    plus the rate allowance's analogue: one per-sample noise sigma per axis);
+///  - the gap's accelerometer mean agrees with theirs (the gap's own variance of its mean);
+///  - the gap's mean rate is the still rate (the gap's own variance): any turn, even one back
+///    to the same attitude, has a mean rate far outside it. Without the gyroscope (none, or
+///    use_gyro off) runs are never joined, and neither across a time gap (missing samples
+///    over half a window).
+/// A gap holding a pure translation and back also passes: its mean specific force is the
+/// still one (the velocity change is zero), so the joined segment's mean is unbiased.
+std::vector<Run> JoinSamePose(const ImuSeries& series, const std::vector<Run>& runs,
+                              const NoiseEstimate& noise, const StillDetectorOptions& options,
+                              double dt_s, double max_gap_s, std::size_t& joined) {
+  joined = 0;
+  // Without the gyroscope a turn about the vertical keeps the accelerometer means: never join.
+  const bool gyro = noise.has_gyro && series.has_gyro() && options.use_gyro;
+  if (runs.size() < 2 || !options.join_same_pose || !gyro) return runs;
+  const double threshold = signal::ChiSquareQuantile(1.0 - options.false_alarm, 3.0);
+  std::vector<Run> out{runs.front()};
+  SpanStats a = Stats(series.acc, runs.front().begin, runs.front().end);
+  for (std::size_t k = 1; k < runs.size(); ++k) {
+    const Run& next = runs[k];
+    // A time gap (missing samples, over max_gap_s) between the runs is never joined.
+    const double gap_s = series.t_s[next.begin] - series.t_s[out.back().end - 1];
+    const double expected_s = static_cast<double>(next.begin - out.back().end + 1) * dt_s;
+    if (gap_s > expected_s + max_gap_s) {
+      out.push_back(next);
+      a = Stats(series.acc, next.begin, next.end);
+      continue;
+    }
+    const SpanStats b = Stats(series.acc, next.begin, next.end);
+    const SpanStats gap = Stats(series.acc, out.back().end, next.begin);
+    const Vec3 var_a = VarianceOfMean(a, noise.acc_sigma, noise.acc_tau_int, false);
+    const Vec3 var_b = VarianceOfMean(b, noise.acc_sigma, noise.acc_tau_int, false);
+    const Vec3 var_gap = VarianceOfMean(gap, noise.acc_sigma, noise.acc_tau_int, true);
+    bool same = gap.n > 0.0 &&
+                MeanDistance(a.mean, var_a, b.mean, var_b, noise.acc_sigma) <= threshold &&
+                MeanDistance(gap.mean, var_gap, 0.5 * (a.mean + b.mean), 0.25 * (var_a + var_b),
+                             noise.acc_sigma) <= threshold;
+    if (same) {
+      const SpanStats rate = Stats(series.gyr, out.back().end, next.begin);
+      const Vec3 var_rate = VarianceOfMean(rate, noise.gyr_sigma, noise.gyr_tau_int, true);
+      same = MeanDistance(rate.mean, var_rate, noise.gyr_still_rate, Vec3::Zero(),
+                          RateAllowance(noise, options)) <= threshold;
+    }
+    if (same) {
+      out.back().end = next.end;
+      a = Stats(series.acc, out.back().begin, out.back().end);
+      ++joined;
+    } else {
+      out.push_back(next);
+      a = b;
+    }
+  }
+  return out;
+}
+
 /// Trims edge_s from both ends of a run; returns an empty run when nothing is left.
 Run Trim(const ImuSeries& series, Run run, double edge_s) {
   const auto first = series.t_s.begin() + static_cast<std::ptrdiff_t>(run.begin);
@@ -695,9 +801,16 @@ SegmentationResult DetectStillSegments(const ImuSeries& series,
                            "called still");
   }
 
-  // 3. Still runs: trimmed, then kept when long enough.
+  // 3. Still runs: runs showing the same pose joined, trimmed, then kept when long enough.
+  std::size_t joined = 0;
+  const std::vector<Run> runs = JoinSamePose(series, found.runs, noise, options, dt_s, 0.5 * options.window_s, joined);
+  if (joined > 0) {
+    report.notes.push_back(
+        "joined " + std::to_string(joined) + " pairs of still runs: the samples between them "
+        "vibrate but hold the same pose (accelerometer means agree, no rotation)");
+  }
   double still_s = 0.0;
-  for (const Run& run : found.runs) {
+  for (const Run& run : runs) {
     const Run trimmed = Trim(series, run, options.edge_s);
     const double length_s = static_cast<double>(trimmed.size()) * dt_s;
     if (trimmed.size() == 0 || length_s < options.min_still_s) {

@@ -35,7 +35,9 @@
 //    window positions in one window length, so that a still IMU fails any test within a
 //    window length of data with probability at most false_alarm — no magic multiple.
 // 3. A block is still when the window centred on it passes every test (the first and last
-//    half windows take the nearest full window's verdict). Runs of still samples are trimmed
+//    half windows take the nearest full window's verdict). Consecutive runs whose samples in
+//    between hold the same pose (a still vehicle vibrating in bursts) are joined
+//    (join_same_pose). Runs of still samples are trimmed
 //    by edge_s at both ends and kept when at least min_still_s long.
 //
 // The report's notes say where the noise came from and its values, the thresholds, how many
@@ -84,6 +86,10 @@ struct StillDetectorOptions {
   /// the still period on that axis (a steady turn is then caught from about 5 of those, the
   /// square root of the chi^2(3) threshold).
   double rate_allowance = -1.0;
+  /// Join consecutive still runs when the samples between them hold the same pose (a still
+  /// vehicle vibrating in bursts): equal accelerometer means, no rotation (see
+  /// JoinSamePose in still_detector.cc for the three chi^2(3) tests).
+  bool join_same_pose = true;
   /// Units of the series for the report's notes, e.g. "m/s^2" and "rad/s", or "counts".
   std::string acc_unit = "m/s^2";
   std::string gyr_unit = "rad/s";
