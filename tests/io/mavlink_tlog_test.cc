@@ -181,6 +181,25 @@ TEST(MavlinkTlog, CrcMatchesKnownValues) {
   EXPECT_EQ(MavlinkCrcExtra(1u << 20), -1);
 }
 
+/// X.25 bit by bit, the textbook form (independent of the library's sliced tables).
+std::uint16_t BitwiseX25(const Bytes& data) {
+  std::uint16_t crc = 0xFFFF;
+  for (std::uint8_t byte : data) {
+    crc ^= byte;
+    for (int k = 0; k < 8; ++k) crc = (crc & 1u) ? (crc >> 1) ^ 0x8408u : crc >> 1;
+  }
+  return crc;
+}
+
+TEST(MavlinkTlog, SlicedCrcEqualsTheBitwiseOneForEveryLength) {
+  std::mt19937_64 rng(31337);
+  for (std::size_t n = 0; n <= 80; ++n) {
+    Bytes data(n);
+    for (auto& b : data) b = static_cast<std::uint8_t>(rng());
+    EXPECT_EQ(MavlinkCrc(data.data(), data.size()), BitwiseX25(data)) << "length " << n;
+  }
+}
+
 // --- the real log against the golden JSON -------------------------------------------------------
 
 void ExpectImuEq(const MavlinkInt16Imu& r, const nlohmann::json& g) {

@@ -71,20 +71,50 @@ constexpr KnownMessage kKnown[] = {
     {253, "STATUSTEXT", 83, 0},
 };
 
-/// CRC-16/MCRF4XX table (reflected polynomial 0x8408), built once.
+/// CRC-16/MCRF4XX tables (reflected polynomial 0x8408) for slicing by 8, built once.
+/// t[0] is the classic byte table: crc' = (crc >> 8) ^ t[0][(crc ^ byte) & 0xFF]. t[k][v] is
+/// the contribution of byte value v followed by k zero bytes, t[k][v] = (t[k-1][v] >> 8) ^
+/// t[0][t[k-1][v] & 0xFF], so that 8 bytes b0..b7 advance the 16-bit state c as
+///   c' = t[7][(c ^ b0) & 0xFF] ^ t[6][((c >> 8) ^ b1) & 0xFF] ^ t[5][b2] ^ ... ^ t[0][b7]
+/// (the CRC is linear over GF(2); the state holds only two bytes).
 struct CrcTable {
-  std::array<std::uint16_t, 256> v{};
+  std::array<std::array<std::uint16_t, 256>, 8> t{};
   CrcTable() {
     for (unsigned b = 0; b < 256; ++b) {
       std::uint16_t crc = static_cast<std::uint16_t>(b);
       for (int k = 0; k < 8; ++k) {
         crc = static_cast<std::uint16_t>((crc & 1u) ? (crc >> 1) ^ 0x8408u : crc >> 1);
       }
-      v[b] = crc;
+      t[0][b] = crc;
+    }
+    for (std::size_t k = 1; k < 8; ++k) {
+      for (unsigned b = 0; b < 256; ++b) {
+        const std::uint16_t prev = t[k - 1][b];
+        t[k][b] = static_cast<std::uint16_t>((prev >> 8) ^ t[0][prev & 0xFFu]);
+      }
     }
   }
 };
 const CrcTable kCrcTable;
+
+/// One byte into the CRC state.
+inline std::uint16_t CrcByte(std::uint16_t crc, std::uint8_t byte) {
+  return static_cast<std::uint16_t>((crc >> 8) ^ kCrcTable.t[0][(crc ^ byte) & 0xFFu]);
+}
+
+/// X.25 CRC of `size` bytes from state `crc`, sliced by 8 (see CrcTable).
+inline std::uint16_t Crc(const std::uint8_t* data, std::size_t size, std::uint16_t crc) {
+  const auto& t = kCrcTable.t;
+  std::size_t k = 0;
+  for (; k + 8 <= size; k += 8) {
+    const std::uint8_t* b = data + k;
+    crc = static_cast<std::uint16_t>(
+        t[7][(crc ^ b[0]) & 0xFFu] ^ t[6][((crc >> 8) ^ b[1]) & 0xFFu] ^ t[5][b[2]] ^
+        t[4][b[3]] ^ t[3][b[4]] ^ t[2][b[5]] ^ t[1][b[6]] ^ t[0][b[7]]);
+  }
+  for (; k < size; ++k) crc = CrcByte(crc, data[k]);
+  return crc;
+}
 
 /// Per low id (< 256): CRC_EXTRA (-1 unknown) and full decoded length (0 not decoded).
 struct IdTable {
@@ -108,9 +138,7 @@ T Load(const std::uint8_t* p) {
 }
 
 std::uint64_t LoadBigEndian64(const std::uint8_t* p) {
-  std::uint64_t v = 0;
-  for (std::size_t k = 0; k < 8; ++k) v = (v << 8) | p[k];
-  return v;
+  return __builtin_bswap64(Load<std::uint64_t>(p));  // little-endian host
 }
 
 std::array<std::int16_t, 3> Int16Triad(const std::uint8_t* p) {
@@ -181,9 +209,8 @@ Verdict Examine(const std::uint8_t* data, std::size_t size, std::size_t pos, Fra
   f->payload = frame + header;
   const int crc_extra = f->msgid < 256 ? kIds.crc_extra[f->msgid] : -1;
   if (crc_extra < 0) return Verdict::kUnchecked;
-  std::uint16_t crc = MavlinkCrc(frame + 1, header - 1 + f->len);
-  const std::uint8_t extra_byte = static_cast<std::uint8_t>(crc_extra);
-  crc = MavlinkCrc(&extra_byte, 1, crc);
+  const std::uint16_t crc = CrcByte(Crc(frame + 1, header - 1 + f->len, 0xFFFF),
+                                    static_cast<std::uint8_t>(crc_extra));
   const std::uint16_t sent = Load<std::uint16_t>(f->payload + f->len);
   return crc == sent ? Verdict::kChecked : Verdict::kCrcFailed;
 }
@@ -410,10 +437,7 @@ class Parser {
 }  // namespace
 
 std::uint16_t MavlinkCrc(const std::uint8_t* data, std::size_t size, std::uint16_t crc) {
-  for (std::size_t k = 0; k < size; ++k) {
-    crc = static_cast<std::uint16_t>((crc >> 8) ^ kCrcTable.v[(crc ^ data[k]) & 0xFFu]);
-  }
-  return crc;
+  return Crc(data, size, crc);
 }
 
 std::string MavlinkMessageName(std::uint32_t msgid) {
