@@ -520,6 +520,16 @@ TEST(MavlinkSession, ArdupilotRawImuIsMilliGAndTheCorrectionIsUndone) {
   EXPECT_FALSE(raw.site.has_value());
 }
 
+TEST(MavlinkSession, WithoutHeartbeatArdupilotIsRecognisedByItsParameters) {
+  Bytes t = SmallArdupilotLog(4);
+  const std::size_t heartbeat_records = 2 * (8 + 6 + 9 + 2);
+  t.erase(t.begin(), t.begin() + static_cast<std::ptrdiff_t>(heartbeat_records));
+  const MavlinkLog log = Parse(t);
+  EXPECT_TRUE(log.heartbeat.empty());
+  EXPECT_EQ(TlogVehicle(log)->autopilot, kMavAutopilotArdupilotMega);
+  EXPECT_EQ(TlogSession(log, FlightLogSelection{}).series.acc_unit, "m/s^2");
+}
+
 TEST(MavlinkSession, TheAutopilotIsTheSystemSendingMostImuFrames) {
   Bytes t = SmallArdupilotLog(10);
   // System 2 (a PX4 vehicle) sends 3 RAW_IMU frames and a PX4 heartbeat.
@@ -649,6 +659,18 @@ TEST(MavlinkSession, RealLogStreamsAndSessions) {
     // Time base: the message's own time since boot (RAW_IMU time_usec ~1545 s).
     EXPECT_NEAR(raw.series.t_s.front(), 1545.32, 0.01);
   }
+  // The summary `plumb info` shows.
+  const FlightLogSummary summary = TlogSummary(log);
+  EXPECT_EQ(summary.format, "mavlink-tlog");
+  EXPECT_EQ(summary.format_detail,
+            "MAVLink v1 8164 frames, v2 0 frames (0 signed), ArduPilot (system 1, component 1)");
+  EXPECT_EQ(summary.imus.size(), 3u);
+  EXPECT_FALSE(summary.site.has_value());
+  EXPECT_EQ(summary.params.at("INS_ACC2OFFS_Z"), params.at("INS_ACC2OFFS_Z"));
+  EXPECT_EQ(summary.params.count("SYSID_THISMAV"), 0u);
+  EXPECT_EQ(summary.messages.size(), log.message_counts.size());
+  ASSERT_EQ(summary.warnings.size(), 1u);  // the unchecked ardupilotmega messages
+  EXPECT_NE(summary.warnings[0].find("MEMINFO (id 152) x295"), std::string::npos);
   // A time window.
   FlightLogSelection window;
   window.from_s = 1560.0;
@@ -662,7 +684,8 @@ TEST(MavlinkSession, RealLogStreamsAndSessions) {
   missing.imu = 3;
   EXPECT_THROW(TlogSession(log, missing), InputError);
   FlightLogSelection by_name;
-  by_name.imu = 0;
+  by_name.stream = "SCALED_IMU3";  // its only instance (2), whatever imu says
+  EXPECT_EQ(TlogSession(log, by_name).source, kLog + " (SCALED_IMU3 instance 2)");
   by_name.stream = "HIGHRES_IMU";
   EXPECT_THROW(TlogSession(log, by_name), InputError);
   FlightLogSelection empty;

@@ -241,16 +241,24 @@ ImuStreamInfo Describe(const StreamData& d, const MavlinkVehicle& v,
   return info;
 }
 
-/// Index in `streams` of the selected stream, or -1.
-int ChooseStream(const std::vector<StreamData>& streams, const std::vector<ImuStreamInfo>& infos,
-                 const FlightLogSelection& selection) {
-  int best = -1;
-  for (std::size_t i = 0; i < streams.size(); ++i) {
-    if (streams[i].instance != selection.imu) continue;
-    if (!selection.stream.empty()) {
-      if (infos[i].name == selection.stream) return static_cast<int>(i);
-      continue;
+/// Index in `streams` of the selected stream, or -1: by name (at instance selection.imu, or
+/// the only instance of that name), else the default of instance selection.imu (highest rate,
+/// then most samples, then stream order).
+int ChooseStream(const std::vector<ImuStreamInfo>& infos, const FlightLogSelection& selection) {
+  if (!selection.stream.empty()) {
+    int only = -1;
+    int named = 0;
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+      if (infos[i].name != selection.stream) continue;
+      if (infos[i].instance == selection.imu) return static_cast<int>(i);
+      only = static_cast<int>(i);
+      ++named;
     }
+    return named == 1 ? only : -1;
+  }
+  int best = -1;
+  for (std::size_t i = 0; i < infos.size(); ++i) {
+    if (infos[i].instance != selection.imu) continue;
     if (best < 0) {
       best = static_cast<int>(i);
       continue;
@@ -262,6 +270,36 @@ int ChooseStream(const std::vector<StreamData>& streams, const std::vector<ImuSt
     }
   }
   return best;
+}
+
+/// The samples of `d` inside the selection's window as a series in `units`. A sample is
+/// dropped (counted in `*dropped`) when its time is not finite, does not exceed the last kept
+/// sample's, or is not below the next sample's (a corrupted spike), as in the DataFlash reader.
+ImuSeries WindowedSeries(const StreamData& d, const FlightLogSelection& selection,
+                         const Units& units, bool has_temp, std::size_t* dropped) {
+  ImuSeries out;
+  out.acc_unit = units.acc_unit;
+  out.gyr_unit = units.gyr_unit;
+  double last_t = 0.0;
+  bool any = false;
+  for (std::size_t i = 0; i < d.samples.size(); ++i) {
+    const double t = d.t_s[i];
+    const bool spike = i + 1 < d.samples.size() && !(t < d.t_s[i + 1]);
+    if (!std::isfinite(t) || (any && !(t > last_t)) || spike) {
+      ++*dropped;
+      continue;
+    }
+    any = true;
+    last_t = t;
+    if (selection.from_s && t < *selection.from_s) continue;
+    if (selection.to_s && t > *selection.to_s) continue;
+    const Sample& x = d.samples[i];
+    out.t_s.push_back(t);
+    out.acc.push_back(x.acc.cast<float>());
+    out.gyr.push_back(x.gyr.cast<float>());
+    if (has_temp) out.temp_c.push_back(static_cast<float>(x.temp_c));
+  }
+  return out;
 }
 
 }  // namespace
@@ -298,6 +336,15 @@ std::optional<MavlinkVehicle> TlogVehicle(const MavlinkLog& log) {
     if (h.system_id == v.system_id && h.component_id == v.component_id) {
       v.autopilot = h.autopilot;
       break;
+    }
+  }
+  if (v.autopilot < 0) {
+    // No HEARTBEAT (a cut log): ArduPilot is recognised by its INS_ parameters.
+    for (const MavlinkParamValue& p : log.param_value) {
+      if (p.system_id == v.system_id && p.Name() == "INS_ACCOFFS_X") {
+        v.autopilot = kMavAutopilotArdupilotMega;
+        break;
+      }
     }
   }
   return v;
@@ -376,7 +423,7 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
   const std::vector<StreamData> streams = AllStreams(log, v);
   std::vector<ImuStreamInfo> infos;
   for (const StreamData& d : streams) infos.push_back(Describe(d, v, params));
-  const int chosen = ChooseStream(streams, infos, selection);
+  const int chosen = ChooseStream(infos, selection);
   const std::string wanted = (selection.stream.empty() ? "IMU" : selection.stream) +
                              " instance " + std::to_string(selection.imu);
   if (chosen < 0) {
@@ -409,37 +456,16 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
                                   ? "message times all zero: times from the tlog (unix s)"
                                   : "times from the message's own time stamps (s)"));
 
-  // Times cleaned as in the DataFlash reader, then the window.
-  ImuSeries& out = s.series;
-  out.acc_unit = units.acc_unit;
-  out.gyr_unit = units.gyr_unit;
-  const bool has_temp = info.has_temperature;
   std::size_t dropped = 0;
-  double last_t = 0.0;
-  bool any = false;
-  for (std::size_t i = 0; i < d.samples.size(); ++i) {
-    const double t = d.t_s[i];
-    const bool spike = i + 1 < d.samples.size() && !(t < d.t_s[i + 1]);
-    if (!std::isfinite(t) || (any && !(t > last_t)) || spike) {
-      ++dropped;
-      continue;
-    }
-    any = true;
-    last_t = t;
-    if (selection.from_s && t < *selection.from_s) continue;
-    if (selection.to_s && t > *selection.to_s) continue;
-    const Sample& x = d.samples[i];
-    out.t_s.push_back(t);
-    out.acc.push_back(x.acc.cast<float>());
-    out.gyr.push_back(x.gyr.cast<float>());
-    if (has_temp) out.temp_c.push_back(static_cast<float>(x.temp_c));
-  }
+  s.series = WindowedSeries(d, selection, units, info.has_temperature, &dropped);
+  ImuSeries& out = s.series;
   if (dropped > 0) {
     s.warnings.push_back(who + "dropped " + std::to_string(dropped) +
                          " sample(s) whose time did not increase (a reboot or a corrupted time)");
   }
   if (out.size() < 2) {
-    throw InputError(log.source, wanted, "fewer than 2 samples in the time window");
+    throw InputError(log.source, info.name + " instance " + std::to_string(d.instance),
+                     "fewer than 2 samples in the time window");
   }
 
   // ArduPilot's correction, undone (ardupilot_params.h has the equations).
@@ -455,6 +481,35 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
   }
   s.site = SiteFromTlog(log);
   return s;
+}
+
+FlightLogSummary TlogSummary(const MavlinkLog& log) {
+  FlightLogSummary out;
+  out.source = log.source;
+  out.format = "mavlink-tlog";
+  out.size_bytes = log.size_bytes;
+  out.format_detail = "MAVLink v1 " + std::to_string(log.frames_v1) + " frames, v2 " +
+                      std::to_string(log.frames_v2) + " frames (" +
+                      std::to_string(log.frames_signed) + " signed)";
+  if (const std::optional<MavlinkVehicle> v = TlogVehicle(log)) {
+    out.format_detail += ", " + AutopilotName(v->autopilot) + " (system " +
+                         std::to_string(v->system_id) + ", component " +
+                         std::to_string(v->component_id) + ")";
+  }
+  out.imus = TlogImuStreams(log);
+  out.site = SiteFromTlog(log);
+  for (const auto& [name, value] : TlogParams(log)) {
+    for (const char* prefix :
+         {"INS_ACC", "INS_GYR", "INS_TCAL", "AHRS_ORIENTATION", "CAL_ACC", "CAL_GYRO"}) {
+      if (name.rfind(prefix, 0) == 0) {
+        out.params[name] = value;
+        break;
+      }
+    }
+  }
+  out.messages = log.MessageCounts();
+  out.warnings = log.warnings.Describe(log.message_counts);
+  return out;
 }
 
 bool LooksLikeTlog(const std::string& path) {

@@ -49,7 +49,9 @@ inline constexpr int kMavAutopilotPx4 = 12;
 struct MavlinkVehicle {
   std::uint8_t system_id = 0;      ///< MAVLink system id, 0..255
   std::uint8_t component_id = 0;   ///< component id that sent the IMU messages, 0..255
-  int autopilot = -1;              ///< MAV_AUTOPILOT from that component's HEARTBEAT; -1 if none
+  /// MAV_AUTOPILOT from that component's HEARTBEAT; without one, 3 (ArduPilotMega) when the
+  /// system sent an INS_ACCOFFS_X PARAM_VALUE, else -1 (unknown).
+  int autopilot = -1;
   std::size_t imu_frames = 0;      ///< IMU frames it sent
   std::size_t other_sources = 0;   ///< other (system, component) pairs that sent IMU frames
 };
@@ -78,13 +80,20 @@ std::optional<SiteInput> SiteFromTlog(const MavlinkLog& log);
 /// (1..6: UINT8, INT8, UINT16, INT16, UINT32, INT32).
 std::map<std::string, double> TlogParams(const MavlinkLog& log);
 
-/// The session of one stream (selection.stream by name, else the default stream of instance
-/// selection.imu: both triads, highest rate, then most samples), in SI FRD units, inside the
+/// The session of one stream (selection.stream by name at instance selection.imu, or the only
+/// instance of that name, e.g. "SCALED_IMU2"; else the default stream of instance
+/// selection.imu: highest rate, then most samples), in SI FRD units, inside the
 /// time window, with ArduPilot's correction undone when selection.undo_correction. Warnings
 /// say which message the samples came from, in which units, what was reconstructed and what
 /// taken as logged, plus the reader's own warnings. Throws plumb::InputError naming the log
 /// when the stream is absent or the window holds fewer than 2 samples.
 Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection);
+
+/// The log as `plumb info` shows it: format "mavlink-tlog", format_detail "MAVLink v1 N
+/// frames, v2 M frames (K signed), autopilot A (system S, component C)", the streams, the site,
+/// the calibration parameters in force (names starting INS_ACC, INS_GYR, INS_TCAL,
+/// AHRS_ORIENTATION, CAL_ACC, CAL_GYRO), the message counts by name and the reader's warnings.
+FlightLogSummary TlogSummary(const MavlinkLog& log);
 
 /// True when the file starts with a plausible tlog record: an 8-byte big-endian time between
 /// 2000 and 2100 (µs since the unix epoch) followed by 0xFE or 0xFD.

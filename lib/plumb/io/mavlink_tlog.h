@@ -72,7 +72,7 @@ struct MavlinkHeartbeat {
   std::uint8_t autopilot = 0;     ///< MAV_AUTOPILOT (3 ArduPilotMega, 8 invalid/GCS, 12 PX4)
   std::uint8_t base_mode = 0;     ///< MAV_MODE_FLAG bits (128 = armed)
   std::uint8_t system_status = 0; ///< MAV_STATE
-  std::uint8_t mavlink_version = 0;
+  std::uint8_t mavlink_version = 0;  ///< MAVLink protocol version field (3 for 1.0/2.0)
 };
 
 /// RAW_IMU (27), SCALED_IMU (26), SCALED_IMU2 (116), SCALED_IMU3 (129): int16 triads.
@@ -103,8 +103,8 @@ struct MavlinkHighresImu {
   float temperature_degc = 0.0f;   ///< degC
   std::uint16_t fields_updated = 0;  ///< bit 0 xacc ... bit 12 temperature
   std::uint8_t id = 0;             ///< IMU instance (extension, 0-based)
-  std::uint8_t system_id = 0;
-  std::uint8_t component_id = 0;
+  std::uint8_t system_id = 0;      ///< sender's system id
+  std::uint8_t component_id = 0;   ///< sender's component id
 };
 
 /// GPS_RAW_INT (24).
@@ -126,8 +126,8 @@ struct MavlinkGpsRawInt {
   std::uint32_t vel_acc_mm_s = 0; ///< speed accuracy, mm/s (extension)
   std::uint32_t hdg_acc_degE5 = 0;  ///< heading accuracy, degE5 (extension)
   std::uint16_t yaw_cdeg = 0;     ///< yaw from GPS, cdeg, 0 = not provided (extension)
-  std::uint8_t system_id = 0;
-  std::uint8_t component_id = 0;
+  std::uint8_t system_id = 0;     ///< sender's system id
+  std::uint8_t component_id = 0;  ///< sender's component id
 };
 
 /// PARAM_VALUE (22).
@@ -138,8 +138,8 @@ struct MavlinkParamValue {
   std::uint16_t index = 0;        ///< param_index (65535 when sent unrequested)
   std::array<char, 16> id{};      ///< param_id, NUL-padded, not terminated when 16 long
   std::uint8_t type = 0;          ///< MAV_PARAM_TYPE (9 = REAL32, 1..8 integer types)
-  std::uint8_t system_id = 0;
-  std::uint8_t component_id = 0;
+  std::uint8_t system_id = 0;     ///< sender's system id
+  std::uint8_t component_id = 0;  ///< sender's component id
 
   /// param_id as text (up to the first NUL, at most 16 characters).
   std::string Name() const;
