@@ -514,14 +514,10 @@ FlightLogSummary TlogSummary(const MavlinkLog& log) {
 
 bool LooksLikeTlog(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  unsigned char head[9] = {};
+  std::uint8_t head[9] = {};
   in.read(reinterpret_cast<char*>(head), sizeof(head));
-  if (in.gcount() != static_cast<std::streamsize>(sizeof(head))) return false;
-  std::uint64_t t_us = 0;
-  for (int k = 0; k < 8; ++k) t_us = (t_us << 8) | head[k];
-  constexpr std::uint64_t kMin = 946684800ull * 1000000ull;   // 2000-01-01, µs
-  constexpr std::uint64_t kMax = 4102444800ull * 1000000ull;  // 2100-01-01, µs
-  return t_us >= kMin && t_us < kMax && (head[8] == 0xFE || head[8] == 0xFD);
+  return in.gcount() == static_cast<std::streamsize>(sizeof(head)) &&
+         LooksLikeTlogRecord(head, sizeof(head));
 }
 
 }  // namespace plumb::io

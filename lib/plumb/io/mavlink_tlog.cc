@@ -218,9 +218,7 @@ Verdict Examine(const std::uint8_t* data, std::size_t size, std::size_t pos, Fra
 /// A record of any id could start at `pos`: the end of the data, a tail too short for a
 /// record header, or a plausible time followed by a start byte.
 bool NextLooksLikeRecord(const std::uint8_t* data, std::size_t size, std::size_t pos) {
-  if (size - pos < kTimeBytes + 1) return true;
-  const std::uint8_t stx = data[pos + kTimeBytes];
-  return PlausibleTime(LoadBigEndian64(data + pos)) && (stx == kStxV1 || stx == kStxV2);
+  return size - pos < kTimeBytes + 1 || LooksLikeTlogRecord(data + pos, size - pos);
 }
 
 /// The one-pass decoder.
@@ -438,6 +436,12 @@ class Parser {
 
 std::uint16_t MavlinkCrc(const std::uint8_t* data, std::size_t size, std::uint16_t crc) {
   return Crc(data, size, crc);
+}
+
+bool LooksLikeTlogRecord(const std::uint8_t* data, std::size_t size) {
+  if (size < kTimeBytes + 1) return false;
+  const std::uint8_t stx = data[kTimeBytes];
+  return PlausibleTime(LoadBigEndian64(data)) && (stx == kStxV1 || stx == kStxV2);
 }
 
 std::string MavlinkMessageName(std::uint32_t msgid) {

@@ -194,6 +194,10 @@ int MavlinkCrcExtra(std::uint32_t msgid);
 /// X.25 / CRC-16/MCRF4XX of `size` bytes continuing from `crc` (start with 0xFFFF).
 std::uint16_t MavlinkCrc(const std::uint8_t* data, std::size_t size, std::uint16_t crc = 0xFFFF);
 
+/// True when `size` >= 9 and `data` starts like a tlog record: an 8-byte big-endian time
+/// between 2000-01-01 and 2100-01-01 (µs since the unix epoch), then 0xFE or 0xFD.
+bool LooksLikeTlogRecord(const std::uint8_t* data, std::size_t size);
+
 /// Decodes a tlog held in memory; `source` names it in errors. Throws plumb::InputError(source,
 /// "byte 0", ...) when not a single MAVLink frame is found.
 MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source);
