@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <sstream>
 
 #include "plumb/core/error.h"
+#include "plumb/io/ardupilot_params.h"
 
 namespace plumb::io {
 namespace {
@@ -14,30 +14,6 @@ namespace {
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
-}
-
-/// INS parameter prefix of an instance: "INS_ACC" / "INS_ACC2" / "INS_ACC3" (kind "ACC"),
-/// "INS_GYR" / "INS_GYR2" / ... (kind "GYR").
-std::string Prefix(const std::string& kind, int instance) {
-  return "INS_" + kind + (instance == 0 ? "" : std::to_string(instance + 1));
-}
-
-/// The triad PREFIX+SUFFIX_X/Y/Z, or nullopt when any is missing.
-std::optional<Vec3> Triad(const DataflashLog& log, const std::string& name) {
-  Vec3 v;
-  const char* axes[3] = {"_X", "_Y", "_Z"};
-  for (int i = 0; i < 3; ++i) {
-    const auto it = log.params.find(name + axes[i]);
-    if (it == log.params.end()) return std::nullopt;
-    v[i] = it->second;
-  }
-  return v;
-}
-
-std::string Format(const Vec3& v) {
-  std::ostringstream out;
-  out << v.x() << ", " << v.y() << ", " << v.z();
-  return out.str();
 }
 
 }  // namespace
@@ -95,45 +71,11 @@ Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions&
                      "fewer than 2 samples in the time window");
   }
 
-  // ArduPilot's correction, undone.
-  const auto orientation = log.params.find("AHRS_ORIENTATION");
-  const bool rotated = orientation != log.params.end() && orientation->second != 0.0;
-  const auto offs = Triad(log, Prefix("ACC", options.imu) + "OFFS");
-  const auto scal = Triad(log, Prefix("ACC", options.imu) + "SCAL");
-  const auto gyr_offs = Triad(log, Prefix("GYR", options.imu) + "OFFS");
-  const std::string who = "IMU instance " + std::to_string(options.imu) + ": ";
-  if (!options.undo_correction) {
-    s.warnings.push_back(who + "samples taken as logged (corrected by ArduPilot with INS_*)");
-  } else if (rotated) {
-    s.warnings.push_back(who + "AHRS_ORIENTATION = " + std::to_string(orientation->second) +
-                         ": the logged samples are rotated into the vehicle frame; the INS_* "
-                         "correction is not undone (samples taken as logged)");
-  } else {
-    if (offs && scal && (scal->array() != 0.0).all()) {
-      for (auto& a : out.acc) {
-        a = (a.cast<double>().cwiseQuotient(*scal) + *offs).cast<float>();
-      }
-      const std::string acc = Prefix("ACC", options.imu);
-      s.warnings.push_back(who + "accelerometer reconstructed as logged ./ " + acc + "SCAL (" +
-                           Format(*scal) + ") + " + acc + "OFFS (" + Format(*offs) + ") m/s^2");
-    } else {
-      s.warnings.push_back(who + "no INS accelerometer offsets/scales in the log: taken as logged");
-    }
-    if (gyr_offs) {
-      for (auto& g : out.gyr) g = (g.cast<double>() + *gyr_offs).cast<float>();
-      s.warnings.push_back(who + "gyroscope reconstructed as logged + " +
-                           Prefix("GYR", options.imu) + "OFFS (" + Format(*gyr_offs) + ") rad/s");
-    } else {
-      s.warnings.push_back(who + "no INS gyroscope offsets in the log: taken as logged");
-    }
-  }
-  for (int k = 1; k <= 3; ++k) {
-    const auto tcal = log.params.find("INS_TCAL" + std::to_string(k) + "_ENABLE");
-    if (tcal != log.params.end() && tcal->second == 1.0) {
-      s.warnings.push_back("INS_TCAL" + std::to_string(k) + "_ENABLE = 1: ArduPilot's "
-                           "temperature calibration is in the logged samples and not undone");
-    }
-  }
+  // ArduPilot's correction, undone (ardupilot_params.h has the equations).
+  const std::vector<std::string> undo =
+      UndoInsCorrection(log.params, options.imu, options.undo_correction,
+                        "IMU instance " + std::to_string(options.imu) + ": ", &out);
+  s.warnings.insert(s.warnings.end(), undo.begin(), undo.end());
   s.site = SiteFromDataflash(log);
   return s;
 }
