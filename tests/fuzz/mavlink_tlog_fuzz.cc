@@ -2,7 +2,7 @@
 // plumb::Error, never crash, hang or read out of bounds; then every stream of whatever was
 // decoded becomes a session the same way.
 //
-// Build (the project's CMake adds the target; by hand):
+// Built by tests/fuzz/CMakeLists.txt (scripts/fuzz); by hand:
 //   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I lib -I /usr/include/eigen3 \
 //     tests/fuzz/mavlink_tlog_fuzz.cc lib/plumb/io/mavlink_tlog.cc \
 //     lib/plumb/io/mavlink_session.cc lib/plumb/io/ardupilot_params.cc lib/plumb/core/imu_series.cc
