@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "export_options.h"
 #include "input_options.h"
 #include "paper_methods.h"
 #include "plumb/core/error.h"
@@ -36,6 +37,7 @@ struct CalibrateArgs {
   bool level_north = false;       ///< first still pose is level with x north (known attitude)
   double temp_ref_c = 25.0;       ///< reference temperature of the temperature terms, degC
   std::string baseline;           ///< --baseline SPEC: also fit this model, side by side
+  ExportArgs exports;             ///< --export FORMAT=FILE, --export-imu, --kalibr-topic
 };
 
 class CalibrateCommand : public Command {
@@ -80,13 +82,19 @@ class CalibrateCommand : public Command {
                      "adds, with sigma (the error falling as an effect is added)")
         ->type_name("SPEC");
     AddSegmentOptions(app_, a.segments);
+    AddExportOptions(app_, a.exports);
   }
 
   int Run() override {
     const CalibrateArgs& a = args_;
+    const std::vector<ExportRequest> exports = ParseExports(a.exports);
+    if (!exports.empty() && a.method != "generalized") {
+      throw UsageError("--export needs --method generalized (plumb's forward model)");
+    }
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     if (a.method != "generalized") return RunPaperMethod(session);
+    if (!exports.empty()) CheckExportable(series);
 
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
     std::vector<StillSegment> segments = seg.segments;
@@ -128,6 +136,11 @@ class CalibrateCommand : public Command {
       std::cout << "\n" << report::BeforeAfterSummary(*baseline, result);
     }
 
+    nlohmann::json exported;
+    if (!exports.empty()) {
+      exported = RunExports(exports, a.exports, a.input.imu, result, series, std::cout);
+    }
+
     if (!a.json_path.empty()) {
       std::vector<std::string> inputs = a.input.inputs;
       if (!a.input.acc_file.empty()) inputs.push_back(a.input.acc_file + "," + a.input.gyr_file);
@@ -137,6 +150,7 @@ class CalibrateCommand : public Command {
                            {"fit", report::ToJson(*baseline)["fit"]},
                            {"chi2_drop", baseline->fit.chi2 - result.fit.chi2}};
       }
+      if (!exports.empty()) doc["export"] = exported;
       report::WriteJson(a.json_path, doc);
       std::cout << "wrote " << a.json_path << "\n";
     }
