@@ -3,6 +3,7 @@
 // Reads the inputs (input_options.h), finds the still segments (detected, or --segments),
 // resolves the site (flags, else the log's GPS, else none), fits, prints the detector's
 // finding and the calibration report, and writes the JSON document when asked.
+#include <algorithm>
 #include <iostream>
 #include <optional>
 
@@ -90,6 +91,13 @@ class CalibrateCommand : public Command {
     const std::vector<ExportRequest> exports = ParseExports(a.exports);
     if (!exports.empty() && a.method != "generalized") {
       throw UsageError("--export needs --method generalized (plumb's forward model)");
+    }
+    const bool firmware = std::any_of(exports.begin(), exports.end(),
+                                      [](const ExportRequest& r) { return r.format != "kalibr"; });
+    if (firmware && a.input.as_logged) {
+      throw UsageError("--export with --as-logged: the samples keep the log's INS_* correction, "
+                       "so exported parameters would replace it instead of adding to it; drop "
+                       "--as-logged so that plumb calibrates the sensor's own output");
     }
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;

@@ -103,5 +103,26 @@ TEST(ExportCli, CountsAreRefusedBeforeCalibrating) {
   EXPECT_FALSE(std::filesystem::exists(dir.File("x.param")));
 }
 
+TEST(ExportCli, ArdupilotLogAsLoggedIsRefusedForFirmwareFormats) {
+  const std::string log =
+      std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane408_centre_point.BIN";
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  const std::string param = dir.File("ap.param");
+  const ToolRun refused = Plumb({"calibrate", log, "--as-logged", "--export", "px4=" + param}, dir);
+  EXPECT_EQ(refused.exit_code, 2) << refused.out << refused.err;
+  EXPECT_TRUE(Contains(refused.err, "--as-logged")) << refused.err;
+  // Without it: the log's second IMU, named after its instance by default.
+  const ToolRun run = Plumb({"calibrate", log, "--imu", "1", "--min-still", "10", "--export",
+                             "ardupilot=" + param},
+                            dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto p = ReadParam(param);
+  EXPECT_EQ(p.count("INS_ACC2OFFS_Z"), 1u);
+  EXPECT_EQ(p.count("INS_GYR2OFFS_Z"), 1u);
+  // One pose: the report says the values are not all determined.
+  EXPECT_TRUE(Contains(run.out, "not determined by this session")) << run.out;
+}
+
 }  // namespace
 }  // namespace plumb::cli

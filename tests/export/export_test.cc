@@ -339,5 +339,33 @@ TEST(Kalibr, WhiteNoiseDensityMatchesTheAllanDeviationAtOneSecond) {
   EXPECT_NE(KalibrYaml(imu).find("upper bound"), std::string::npos);
 }
 
+TEST(Kalibr, ShortSegmentsFallBackToTheAutocorrelationTime) {
+  // 2 s of still data: too short for ADEV at 1 s; the low-frequency level is then
+  // sigma sqrt(tau dt), which the correlated output (tau = 4 samples) makes the larger.
+  const double dt = 0.005, sigma = 0.01, tau = 4.0;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, sigma);
+  Session s;
+  s.r.model = model::Model::Parse("base");
+  s.r.model.DropGyro();
+  s.r.theta = s.r.model.ZeroParameters();
+  for (int i = 0; i < 400; ++i) {
+    s.series.t_s.push_back(i * dt);
+    s.series.acc.push_back(Vec3f(n(rng), n(rng), -kG + n(rng)));
+  }
+  estimation::StillSegmentFit fit;
+  fit.segment.end = s.series.size();
+  s.r.still.push_back(fit);
+  s.r.noise_acc = Vec3::Constant(sigma);
+  s.r.tau_acc = tau;
+  const KalibrImu imu = KalibrNoise(s.r, s.series, "/imu");
+  EXPECT_FALSE(imu.accel.low_from_allan);
+  EXPECT_NEAR(imu.accelerometer_noise_density(), sigma * std::sqrt(tau * dt), 1e-15);
+  EXPECT_FALSE(imu.has_gyro);
+  const std::string yaml = KalibrYaml(imu);
+  EXPECT_EQ(yaml.find("gyroscope"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("rostopic: /imu\n"), std::string::npos) << yaml;
+}
+
 }  // namespace
 }  // namespace plumb::exporter

@@ -188,6 +188,12 @@ ExportReport Evaluate(const estimation::CalibrationResult& r, const ImuSeries& s
     first += n;
   }
   if (rep.accel_still.segments == 0) rep.notes.push_back("no still segment to measure the error on");
+  if (!r.observability.unobservable.empty()) {
+    rep.notes.push_back(std::to_string(r.observability.unobservable.size()) +
+                        " direction(s) of the parameters are not determined by this session (see "
+                        "the observability report): the exported values are one of many that "
+                        "fit it equally, right for poses like the session's only");
+  }
   return rep;
 }
 
