@@ -11,7 +11,8 @@ namespace {
 using nlohmann::json;
 
 constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
-constexpr double kRadPerSToDegPerH = 180.0 / M_PI * 3600.0;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadPerSToDegPerH = 180.0 / kPi * 3600.0;  // deg/h per rad/s
 
 json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 json Vec(const Vec3& v) { return json::array({Num(v.x()), Num(v.y()), Num(v.z())}); }

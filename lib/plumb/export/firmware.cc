@@ -12,7 +12,8 @@ namespace plumb::exporter {
 namespace {
 
 constexpr double kStandardGravity = 9.80665;          // m/s^2 per g, for mg
-constexpr double kRadPerSToDegPerH = 180.0 / M_PI * 3600.0;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadPerSToDegPerH = 180.0 / kPi * 3600.0;  // deg/h per rad/s
 
 /// Binomial coefficient C(k, j) for k <= 3.
 double Binomial(int k, int j) {
