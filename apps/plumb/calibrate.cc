@@ -3,10 +3,12 @@
 // Reads the inputs (input_options.h), finds the still segments (detected, or --segments),
 // resolves the site (flags, else the log's GPS, else none), fits, prints the detector's
 // finding and the calibration report, and writes the JSON document when asked.
+#include <algorithm>
 #include <iostream>
 #include <optional>
 
 #include "commands.h"
+#include "export_options.h"
 #include "input_options.h"
 #include "paper_methods.h"
 #include "plumb/core/error.h"
@@ -36,6 +38,7 @@ struct CalibrateArgs {
   bool level_north = false;       ///< first still pose is level with x north (known attitude)
   double temp_ref_c = 25.0;       ///< reference temperature of the temperature terms, degC
   std::string baseline;           ///< --baseline SPEC: also fit this model, side by side
+  ExportArgs exports;             ///< --export FORMAT=FILE, --export-imu, --kalibr-topic
 };
 
 class CalibrateCommand : public Command {
@@ -80,13 +83,26 @@ class CalibrateCommand : public Command {
                      "adds, with sigma (the error falling as an effect is added)")
         ->type_name("SPEC");
     AddSegmentOptions(app_, a.segments);
+    AddExportOptions(app_, a.exports);
   }
 
   int Run() override {
     const CalibrateArgs& a = args_;
+    const std::vector<ExportRequest> exports = ParseExports(a.exports);
+    if (!exports.empty() && a.method != "generalized") {
+      throw UsageError("--export needs --method generalized (plumb's forward model)");
+    }
+    const bool firmware = std::any_of(exports.begin(), exports.end(),
+                                      [](const ExportRequest& r) { return r.format != "kalibr"; });
+    if (firmware && a.input.as_logged) {
+      throw UsageError("--export with --as-logged: the samples keep the log's INS_* correction, "
+                       "so exported parameters would replace it instead of adding to it; drop "
+                       "--as-logged so that plumb calibrates the sensor's own output");
+    }
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     if (a.method != "generalized") return RunPaperMethod(session);
+    if (!exports.empty()) CheckExportable(series);
 
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
     std::vector<StillSegment> segments = seg.segments;
@@ -128,6 +144,11 @@ class CalibrateCommand : public Command {
       std::cout << "\n" << report::BeforeAfterSummary(*baseline, result);
     }
 
+    nlohmann::json exported;
+    if (!exports.empty()) {
+      exported = RunExports(exports, a.exports, a.input.imu, result, series, std::cout);
+    }
+
     if (!a.json_path.empty()) {
       std::vector<std::string> inputs = a.input.inputs;
       if (!a.input.acc_file.empty()) inputs.push_back(a.input.acc_file + "," + a.input.gyr_file);
@@ -137,6 +158,7 @@ class CalibrateCommand : public Command {
                            {"fit", report::ToJson(*baseline)["fit"]},
                            {"chi2_drop", baseline->fit.chi2 - result.fit.chi2}};
       }
+      if (!exports.empty()) doc["export"] = exported;
       report::WriteJson(a.json_path, doc);
       std::cout << "wrote " << a.json_path << "\n";
     }

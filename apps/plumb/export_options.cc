@@ -1,0 +1,75 @@
+#include "export_options.h"
+
+#include <algorithm>
+
+#include "commands.h"
+#include "plumb/core/error.h"
+#include "plumb/export/export.h"
+#include "plumb/io/atomic_file.h"
+
+namespace plumb::cli {
+
+void AddExportOptions(CLI::App* app, ExportArgs& a) {
+  app->add_option("--export", a.exports,
+                  "Write the calibration for another tool, FORMAT=FILE (repeatable): ardupilot "
+                  "(Mission Planner .param: INS_ACCOFFS/ACCSCAL/GYROFFS, INS_TCALn_* when a "
+                  "temperature term was fitted), px4 (QGroundControl .params: CAL_ACCn_*, "
+                  "CAL_GYROn_*, TC_A/TC_G), kalibr (imu.yaml noise densities and random walks), "
+                  "json (all three); prints what each target cannot represent, in numbers")
+      ->type_name("FORMAT=FILE");
+  a.imu_option = app->add_option("--export-imu", a.imu,
+                                 "IMU instance in the exported parameter names, 0-based "
+                                 "(ArduPilot 0..2: INS_ACC, INS_ACC2, INS_ACC3; PX4 0..3: "
+                                 "CAL_ACC0..3); default: --imu")
+                     ->check(CLI::NonNegativeNumber);
+  app->add_option("--kalibr-topic", a.rostopic, "rostopic written in Kalibr's imu.yaml")
+      ->capture_default_str();
+}
+
+std::vector<ExportRequest> ParseExports(const ExportArgs& a) {
+  std::vector<ExportRequest> out;
+  const auto& formats = exporter::ExportFormats();
+  for (const std::string& e : a.exports) {
+    const auto eq = e.find('=');
+    if (eq == std::string::npos || eq + 1 == e.size()) {
+      throw UsageError("--export takes FORMAT=FILE (e.g. ardupilot=imu.param), got '" + e + "'");
+    }
+    ExportRequest r{e.substr(0, eq), e.substr(eq + 1)};
+    if (std::find(formats.begin(), formats.end(), r.format) == formats.end()) {
+      throw UsageError("--export: unknown format '" + r.format +
+                       "' (ardupilot, px4, kalibr, json)");
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+void CheckExportable(const ImuSeries& series) {
+  if (series.acc_unit != "m/s^2" || (series.has_gyro() && series.gyr_unit != "rad/s")) {
+    throw Error("--export: the samples are in " + series.acc_unit + " and " + series.gyr_unit +
+                " (unscaled sensor output), not m/s^2 and rad/s; firmware parameters and noise "
+                "densities act on SI output, so they cannot be exported from this session "
+                "(give --acc-scale/--acc-unit and --gyr-scale/--gyr-unit to calibrate in SI)");
+  }
+}
+
+nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const ExportArgs& a,
+                          int imu, const estimation::CalibrationResult& result,
+                          const ImuSeries& series, std::ostream& out) {
+  nlohmann::json doc = nlohmann::json::object();
+  exporter::ExportOptions options;
+  options.imu = a.imu_option != nullptr && a.imu_option->count() > 0 ? a.imu : imu;
+  options.rostopic = a.rostopic;
+  for (const ExportRequest& r : requests) {
+    const exporter::ExportOutput e = exporter::Export(r.format, result, series, options);
+    io::WriteFileAtomic(r.path, e.text);
+    out << "\n";
+    for (const std::string& line : e.lines) out << line << "\n";
+    out << "wrote " << r.path << " (" << r.format << ")\n";
+    doc[r.format] = e.json;
+    doc[r.format]["file"] = r.path;
+  }
+  return doc;
+}
+
+}  // namespace plumb::cli

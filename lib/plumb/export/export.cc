@@ -1,0 +1,174 @@
+#include "plumb/export/export.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "plumb/core/error.h"
+
+namespace plumb::exporter {
+namespace {
+
+using nlohmann::json;
+
+constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadPerSToDegPerH = 180.0 / kPi * 3600.0;  // deg/h per rad/s
+
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json Vec(const Vec3& v) { return json::array({Num(v.x()), Num(v.y()), Num(v.z())}); }
+json Mat(const Mat3& m) {
+  return json::array({Vec(m.row(0).transpose()), Vec(m.row(1).transpose()),
+                      Vec(m.row(2).transpose())});
+}
+
+json ErrorsJson(const AxisErrors& e, double factor, const std::string& unit,
+                const std::string& reader_unit) {
+  return {{"segments", e.segments},
+          {"rms", Vec(e.rms)},
+          {"max_abs", Vec(e.max_abs)},
+          {"unit", unit},
+          {"rms_" + reader_unit, Vec(e.rms * factor)},
+          {"max_abs_" + reader_unit, Vec(e.max_abs * factor)}};
+}
+
+json ParametersJson(const ParameterSet& set) {
+  json out = json::object();
+  for (const Parameter& p : set.parameters) out[p.name] = Num(p.value);
+  return out;
+}
+
+/// A firmware format: parameters, their read-back correction, and the report.
+ExportOutput Firmware(const std::string& format, const estimation::CalibrationResult& r,
+                      const ImuSeries& series, const ExportOptions& options) {
+  const FirmwareCorrection target = BestDiagonal(r, SessionTemperatureRange(series));
+  ExportOutput out;
+  out.format = format;
+  ParameterSet set;
+  FirmwareCorrection applied;
+  if (format == "ardupilot") {
+    set = ArdupilotParameters(target, options.imu);
+    out.text = ArdupilotParamFile(set);
+    applied = ArdupilotCorrection(ReadArdupilotParamFile(out.text, format), options.imu);
+  } else {
+    set = Px4Parameters(target, options.imu);
+    out.text = Px4ParamsFile(set);
+    applied = Px4Correction(ReadPx4ParamsFile(out.text, format), options.imu);
+  }
+  ExportReport report = Evaluate(r, series, applied, format, /*keeps_temperature=*/true);
+  report.notes.insert(report.notes.end(), set.notes.begin(), set.notes.end());
+  report.notes.push_back("axes as plumb calibrated them (the log's board frame); the firmware "
+                         "applies its board rotation after this correction");
+  out.lines = report.Lines();
+  out.json = ToJson(report);
+  out.json["imu"] = options.imu;
+  out.json["parameters"] = ParametersJson(set);
+  return out;
+}
+
+ExportOutput Kalibr(const estimation::CalibrationResult& r, const ImuSeries& series,
+                    const ExportOptions& options) {
+  ExportOutput out;
+  out.format = "kalibr";
+  const KalibrImu imu = KalibrNoise(r, series, options.rostopic);
+  out.text = KalibrYaml(imu);
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "kalibr: accel noise density %.3g m/s^2/sqrt(Hz), random walk %.3g m/s^3/sqrt(Hz)%s",
+                imu.accelerometer_noise_density(), imu.accelerometer_random_walk(),
+                imu.accel.walk_resolved ? "" : " (upper bound)");
+  out.lines.push_back(buf);
+  if (imu.has_gyro) {
+    std::snprintf(buf, sizeof buf,
+                  "        gyro noise density %.3g rad/s/sqrt(Hz), random walk %.3g "
+                  "rad/s^2/sqrt(Hz)%s",
+                  imu.gyroscope_noise_density(), imu.gyroscope_random_walk(),
+                  imu.gyro.walk_resolved ? "" : " (upper bound)");
+    out.lines.push_back(buf);
+  }
+  auto detail = [&](const char* name, const SensorNoise& n) {
+    std::snprintf(buf, sizeof buf,
+                  "        %s: per-sample sigma sqrt(dt) %.3g, %s %.3g (largest axis; the "
+                  "larger is written)",
+                  name, n.white_sample.maxCoeff(),
+                  n.low_from_allan ? "ADEV(1 s)" : "sigma sqrt(tau dt)", n.white_low.maxCoeff());
+    out.lines.push_back(buf);
+  };
+  detail("accel", imu.accel);
+  if (imu.has_gyro) detail("gyro", imu.gyro);
+  for (const std::string& note : imu.notes) out.lines.push_back("  note: " + note);
+  out.json = ToJson(imu);
+  return out;
+}
+
+}  // namespace
+
+const std::vector<std::string>& ExportFormats() {
+  static const std::vector<std::string> formats = {"ardupilot", "px4", "kalibr", "json"};
+  return formats;
+}
+
+ExportOutput Export(const std::string& format, const estimation::CalibrationResult& r,
+                    const ImuSeries& series, const ExportOptions& options) {
+  if (format == "ardupilot" || format == "px4") return Firmware(format, r, series, options);
+  if (format == "kalibr") return Kalibr(r, series, options);
+  if (format == "json") {
+    ExportOutput out;
+    out.format = format;
+    for (const char* f : {"ardupilot", "px4", "kalibr"}) {
+      ExportOutput one = Export(f, r, series, options);
+      out.json[f] = one.json;
+      out.lines.insert(out.lines.end(), one.lines.begin(), one.lines.end());
+    }
+    out.text = out.json.dump(2) + "\n";
+    return out;
+  }
+  throw Error("unknown export format '" + format + "' (ardupilot, px4, kalibr, json)");
+}
+
+json ToJson(const ExportReport& rep) {
+  json out = {{"target", rep.target},
+              {"accel_still", ErrorsJson(rep.accel_still, 1e3 / kStandardGravity, "m/s^2", "mg")},
+              {"accel_per_input", Mat(rep.accel_per_input)}};
+  if (rep.has_gyro) {
+    out["gyro_still"] = ErrorsJson(rep.gyro_still, kRadPerSToDegPerH, "rad/s", "deg_h");
+    out["gyro_per_input"] = Mat(rep.gyro_per_input);
+  }
+  json dropped = json::array();
+  for (const DroppedEffect& d : rep.dropped) {
+    json params = json::array();
+    for (std::size_t i = 0; i < d.names.size(); ++i) {
+      params.push_back({{"name", d.names[i]}, {"value", Num(d.values[i])}, {"unit", d.units[i]}});
+    }
+    dropped.push_back({{"effect", d.effect}, {"parameters", params},
+                       {"seen_at_rest", d.seen_at_rest}});
+  }
+  out["dropped"] = dropped;
+  out["notes"] = rep.notes;
+  return out;
+}
+
+json ToJson(const KalibrImu& imu) {
+  auto sensor = [](const SensorNoise& n) {
+    return json{{"noise_density", Vec(n.white)},
+                {"noise_density_sample", Vec(n.white_sample)},
+                {"noise_density_low", Vec(n.white_low)},
+                {"low_from_allan", n.low_from_allan},
+                {"random_walk", Vec(n.walk)},
+                {"random_walk_resolved", n.walk_resolved}};
+  };
+  json out = {{"rostopic", imu.rostopic},
+              {"update_rate", Num(imu.update_rate_hz)},
+              {"accelerometer_noise_density", Num(imu.accelerometer_noise_density())},
+              {"accelerometer_random_walk", Num(imu.accelerometer_random_walk())},
+              {"longest_still_s", Num(imu.longest_still_s)},
+              {"accel", sensor(imu.accel)},
+              {"notes", imu.notes}};
+  if (imu.has_gyro) {
+    out["gyroscope_noise_density"] = Num(imu.gyroscope_noise_density());
+    out["gyroscope_random_walk"] = Num(imu.gyroscope_random_walk());
+    out["gyro"] = sensor(imu.gyro);
+  }
+  return out;
+}
+
+}  // namespace plumb::exporter

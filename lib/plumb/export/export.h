@@ -1,0 +1,52 @@
+// plumb/export/export.h — one call per export format, for the command line: the file's text,
+// the report lines for the terminal and the JSON for `calibrate --json` ("export").
+//
+// Formats:
+//   ardupilot  Mission Planner .param (formats.h), INS_* for the chosen IMU instance
+//   px4        QGroundControl .params (formats.h), CAL_ACC/CAL_GYRO/TC_* for the instance
+//   kalibr     Kalibr imu.yaml (kalibr.h), noise only
+//   json       the three above as one JSON document (parameters, reports, noise)
+// Every firmware format is evaluated from the parameter values it writes (read back through
+// ArdupilotCorrection / Px4Correction), so the reported error is that of the file.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/estimation/result.h"
+#include "plumb/export/firmware.h"
+#include "plumb/export/formats.h"
+#include "plumb/export/kalibr.h"
+
+namespace plumb::exporter {
+
+struct ExportOptions {
+  int imu = 0;                     ///< IMU instance for parameter names, 0-based (ArduPilot 0..2,
+                                   ///< PX4 0..3)
+  std::string rostopic = "/imu0";  ///< Kalibr's rostopic
+};
+
+/// The formats Export() knows, in the order above.
+const std::vector<std::string>& ExportFormats();
+
+struct ExportOutput {
+  std::string format;              ///< one of ExportFormats()
+  std::string text;                ///< the file's content
+  std::vector<std::string> lines;  ///< the report for the terminal
+  nlohmann::json json;             ///< parameters and report, for "export" in calibrate's JSON
+};
+
+/// Builds one format for the calibration `result` of the session `series`. Throws
+/// plumb::Error for an unknown format, outputs not in SI (counts), or an instance the
+/// target has no parameters for.
+ExportOutput Export(const std::string& format, const estimation::CalibrationResult& result,
+                    const ImuSeries& series, const ExportOptions& options);
+
+/// JSON of a report: errors in SI and in mg / deg/h, per-input matrices, dropped effects.
+nlohmann::json ToJson(const ExportReport& report);
+/// JSON of Kalibr's values with the per-axis numbers behind them.
+nlohmann::json ToJson(const KalibrImu& imu);
+
+}  // namespace plumb::exporter

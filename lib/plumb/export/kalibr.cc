@@ -1,0 +1,146 @@
+#include "plumb/export/kalibr.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "plumb/core/error.h"
+#include "plumb/signal/allan.h"
+#include "plumb/signal/axis_view.h"
+
+namespace plumb::exporter {
+namespace {
+
+constexpr double kAllanCheckTau_s = 1.0;      // N is ADEV at 1 s for white noise
+constexpr double kMinSegmentForCheck_s = 3.0; // 1 s clusters need a few seconds of data
+constexpr double kRandomWalkSlope = 0.4;      // log-log slope taken as the +1/2 rise
+constexpr std::size_t kMaxClusterFraction = 3;  // clusters up to a third of the segment
+
+/// The longest still segment that is not turning, or nullptr.
+const StillSegment* LongestStill(const estimation::CalibrationResult& r, std::size_t n) {
+  const StillSegment* best = nullptr;
+  for (const auto& s : r.still) {
+    if (s.segment.spinning() || s.segment.end > n || s.segment.count() < 2) continue;
+    if (!best || s.segment.count() > best->count()) best = &s.segment;
+  }
+  return best;
+}
+
+/// N from the whitening noise, ADEV(1 s) and the random-walk bound of one sensor.
+SensorNoise Measure(const ImuSeries& series, signal::Sensor sensor, const Vec3& sigma,
+                    double tau_samples, double dt_s, const StillSegment* seg) {
+  SensorNoise noise;
+  noise.white_sample = sigma * std::sqrt(dt_s);
+  noise.white_low = sigma * std::sqrt(std::max(1.0, tau_samples) * dt_s);
+  noise.white = noise.white_sample.cwiseMax(noise.white_low);
+  noise.walk = Vec3::Constant(kNaN);
+  if (!seg) return noise;
+  noise.low_from_allan = true;
+  const std::size_t n = seg->count();
+  bool all_resolved = true;
+  for (int axis = 0; axis < 3; ++axis) {
+    bool allan_at_1s = false;
+    const signal::AxisView x = signal::ViewAxis(series, sensor, axis, seg->begin, seg->end);
+    signal::AllanOptions options;
+    const std::size_t m_max = std::max<std::size_t>(1, n / kMaxClusterFraction);
+    const auto adev = signal::OverlappingAllanDeviation(x, dt_s, options);
+    double bound = kNaN;
+    std::size_t last = 0;
+    for (std::size_t j = 0; j < adev.tau_s.size(); ++j) {
+      if (adev.cluster_size[j] > m_max) break;
+      const double k = adev.adev[j] * std::sqrt(3.0 / adev.tau_s[j]);
+      if (!(k >= bound)) bound = k;  // NaN-initialised minimum
+      last = j;
+    }
+    noise.walk[axis] = bound;
+    // +1/2 slope over the last decade-ish of cluster times: a resolved random walk.
+    bool resolved = false;
+    if (last >= 5) {
+      const std::size_t from = last - 5;
+      const double slope = std::log(adev.adev[last] / adev.adev[from]) /
+                           std::log(adev.tau_s[last] / adev.tau_s[from]);
+      resolved = slope >= kRandomWalkSlope;
+    }
+    all_resolved = all_resolved && resolved;
+    const double seg_s = static_cast<double>(n) * dt_s;
+    if (seg_s >= kMinSegmentForCheck_s) {
+      const std::size_t m1 = static_cast<std::size_t>(std::lround(kAllanCheckTau_s / dt_s));
+      if (m1 >= 1 && m1 <= n / 2) {
+        signal::AllanOptions at1;
+        at1.cluster_sizes = {m1};
+        const auto one = signal::OverlappingAllanDeviation(x, dt_s, at1);
+        // ADEV at the rounded cluster time, scaled to exactly 1 s by the white-noise law.
+        noise.white_low[axis] = one.adev[0] * std::sqrt(one.tau_s[0] / kAllanCheckTau_s);
+        allan_at_1s = true;
+      }
+    }
+    noise.low_from_allan = noise.low_from_allan && allan_at_1s;
+  }
+  noise.white = noise.white_sample.cwiseMax(noise.white_low);
+  noise.walk_resolved = all_resolved;
+  return noise;
+}
+
+std::string Num(double value) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", value);
+  return buf;
+}
+
+}  // namespace
+
+KalibrImu KalibrNoise(const estimation::CalibrationResult& r, const ImuSeries& series,
+                      const std::string& rostopic) {
+  if (r.acc_unit != "m/s^2" || (r.has_gyro && r.gyr_unit != "rad/s")) {
+    throw Error("the session's samples are in " + r.acc_unit + " and " + r.gyr_unit +
+                ", not m/s^2 and rad/s: Kalibr's noise densities are in SI, so plumb cannot "
+                "export them; give the sensor's scale (--acc-scale, --gyr-scale)");
+  }
+  const double dt_s = series.median_dt_s();
+  if (!(dt_s > 0)) throw Error("Kalibr export: the session has no sample interval");
+  KalibrImu imu;
+  imu.rostopic = rostopic;
+  imu.update_rate_hz = 1.0 / dt_s;
+  imu.has_gyro = r.has_gyro && series.has_gyro();
+  const StillSegment* seg = LongestStill(r, series.size());
+  imu.longest_still_s = seg ? static_cast<double>(seg->count()) * dt_s : 0.0;
+  imu.accel = Measure(series, signal::Sensor::kAccel, r.noise_acc, r.tau_acc, dt_s, seg);
+  if (imu.has_gyro) {
+    imu.gyro = Measure(series, signal::Sensor::kGyro, r.noise_gyr, r.tau_gyr, dt_s, seg);
+  }
+  imu.notes.push_back("Kalibr's imu.yaml holds the noise model only: plumb's scale, "
+                      "misalignment, biases and effects are not in it (Kalibr estimates its own "
+                      "IMU intrinsics)");
+  const bool resolved = imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved);
+  if (!seg) {
+    imu.notes.push_back("no still segment: random walks unknown, written as 0");
+    imu.accel.walk = imu.gyro.walk = Vec3::Zero();
+  } else if (!resolved) {
+    imu.notes.push_back("random walks are upper bounds (min over t of ADEV(t) sqrt(3/t)): the "
+                        "longest still segment (" + Num(imu.longest_still_s) +
+                        " s) is too short to show the +1/2 slope");
+  }
+  return imu;
+}
+
+std::string KalibrYaml(const KalibrImu& imu) {
+  std::string text = "# Kalibr IMU noise model from plumb (white noise densities and bias random "
+                     "walks of the session)\n";
+  for (const std::string& note : imu.notes) text += "# " + note + "\n";
+  const bool bound = !(imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved));
+  const std::string walk_comment = bound ? "  # upper bound from a short session" : "";
+  text += "rostopic: " + imu.rostopic + "\n";
+  text += "update_rate: " + Num(imu.update_rate_hz) + "  # Hz\n";
+  text += "accelerometer_noise_density: " + Num(imu.accelerometer_noise_density()) +
+          "  # m/s^2/sqrt(Hz)\n";
+  text += "accelerometer_random_walk: " + Num(imu.accelerometer_random_walk()) +
+          "  # m/s^3/sqrt(Hz)" + walk_comment + "\n";
+  if (imu.has_gyro) {
+    text += "gyroscope_noise_density: " + Num(imu.gyroscope_noise_density()) +
+            "  # rad/s/sqrt(Hz)\n";
+    text += "gyroscope_random_walk: " + Num(imu.gyroscope_random_walk()) +
+            "  # rad/s^2/sqrt(Hz)" + walk_comment + "\n";
+  }
+  return text;
+}
+
+}  // namespace plumb::exporter

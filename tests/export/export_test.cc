@@ -1,0 +1,371 @@
+// plumb/export: temperature polynomial re-expansion, the firmware parameter files (written and
+// read back), the error a diagonal firmware correction leaves on a session, Kalibr's noise.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "plumb/core/error.h"
+#include "plumb/export/export.h"
+#include "plumb/export/firmware.h"
+#include "plumb/export/formats.h"
+#include "plumb/export/kalibr.h"
+#include "plumb/model/model.h"
+
+namespace plumb::exporter {
+namespace {
+
+constexpr double kG = 9.80665;
+
+// ---- helpers --------------------------------------------------------------------------------
+
+/// A hand-made calibration: `spec`'s model with the given blocks, one still segment per
+/// specific force in `f_b` (100 samples each, noise-free outputs from the model), segment k at
+/// temperature temps[k]. The series holds those samples; r.still their means.
+struct Session {
+  estimation::CalibrationResult r;
+  ImuSeries series;
+};
+
+Session MakeSession(const std::string& spec, const model::ParameterBlocks& theta,
+                    const std::vector<Vec3>& f_b, const std::vector<double>& temps_c) {
+  Session s;
+  s.r.model = model::Model::Parse(spec);
+  s.r.model.t_ref_s = 0.0;
+  s.r.model.temp_ref_c = 25.0;
+  s.r.theta = theta;
+  s.r.has_gyro = s.r.model.has_gyro();
+  const std::size_t per = 100;
+  const double dt = 0.01;
+  for (std::size_t k = 0; k < f_b.size(); ++k) {
+    model::SensorInput<double> in;
+    in.f_b = f_b[k];
+    in.omega_b = Vec3(1e-5, -2e-5, 3e-5) * static_cast<double>(k + 1);
+    in.dtemp_c = temps_c[k] - s.r.model.temp_ref_c;
+    const auto out = s.r.model.Predict(s.r.theta, in);
+    s.r.accel_matrix = out.F;
+    s.r.gyro_matrix = out.E;
+    estimation::StillSegmentFit fit;
+    fit.segment.begin = s.series.size();
+    for (std::size_t i = 0; i < per; ++i) {
+      s.series.t_s.push_back(static_cast<double>(s.series.size()) * dt);
+      s.series.acc.push_back(out.acc.cast<float>());
+      s.series.gyr.push_back(out.gyr.cast<float>());
+      s.series.temp_c.push_back(static_cast<float>(temps_c[k]));
+    }
+    fit.segment.end = s.series.size();
+    fit.t_mid_s = 0.0;  // no time-dependent terms in these models
+    fit.acc_mean = out.acc;
+    fit.gyr_mean = out.gyr;
+    s.r.still.push_back(fit);
+  }
+  // Biases: the model's value at zero input and the reference temperature.
+  const auto zero = s.r.model.Predict(s.r.theta, model::SensorInput<double>{});
+  s.r.accel_bias = zero.acc;
+  s.r.gyro_bias = zero.gyr;
+  return s;
+}
+
+/// Six faces: +-g along each axis.
+std::vector<Vec3> SixFaces() {
+  return {Vec3(0, 0, -kG), Vec3(0, 0, kG), Vec3(0, -kG, 0),
+          Vec3(0, kG, 0),  Vec3(-kG, 0, 0), Vec3(kG, 0, 0)};
+}
+
+/// A firmware correction with temperature polynomials on both sensors.
+FirmwareCorrection ThermalCorrection() {
+  FirmwareCorrection fw;
+  fw.has_gyro = true;
+  fw.accel.scale = Vec3(1.01, 0.995, 1.002);
+  fw.accel.offset = Vec3(0.12, -0.05, 0.31);
+  fw.gyro.offset = Vec3(0.01, -0.02, 0.005);
+  for (DiagonalCorrection* c : {&fw.accel, &fw.gyro}) {
+    c->has_thermal = true;
+    c->temp_min_c = 18.0;
+    c->temp_max_c = 52.0;
+    c->thermal.t0_c = 25.0;
+    c->thermal.c[1] = Vec3(2e-3, -1e-3, 4e-3);
+    c->thermal.c[2] = Vec3(-3e-5, 2e-5, 1e-5);
+    c->thermal.c[3] = Vec3(4e-7, -2e-7, 1e-7);
+  }
+  return fw;
+}
+
+/// Largest difference between two corrections over outputs and temperatures (inside and
+/// outside the clamp range).
+double MaxDifference(const DiagonalCorrection& a, const DiagonalCorrection& b) {
+  double worst = 0;
+  for (double t : {0.0, 18.0, 25.0, 35.0, 44.5, 52.0, 70.0}) {
+    for (const Vec3& y : {Vec3(0, 0, -9.8), Vec3(9.8, -0.3, 0.1), Vec3(0.02, 0.5, -0.01)}) {
+      worst = std::max(worst, (a.Apply(y, t) - b.Apply(y, t)).cwiseAbs().maxCoeff());
+    }
+  }
+  return worst;
+}
+
+// ---- temperature polynomial ------------------------------------------------------------------
+
+TEST(TemperaturePolynomial, RebaseIsExactAtEveryTemperature) {
+  std::mt19937_64 rng(20261122);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  TemperaturePolynomial p;
+  p.t0_c = 25.0;
+  for (int k = 0; k < 4; ++k) p.c[k] = Vec3(u(rng), u(rng), u(rng)) * std::pow(1e-2, k);
+  const TemperaturePolynomial q = Rebase(p, 35.0);
+  EXPECT_EQ(q.t0_c, 35.0);
+  for (double t : {-20.0, 0.0, 25.0, 35.0, 47.3, 80.0}) {
+    EXPECT_LT((p.At(t) - q.At(t)).cwiseAbs().maxCoeff(), 1e-12) << "T = " << t;
+  }
+  // q(35) is its constant term, p(35) by definition.
+  EXPECT_LT((q.c[0] - p.At(35.0)).norm(), 1e-15);
+}
+
+TEST(TemperaturePolynomial, RebaseOfALineKeepsTheSlope) {
+  TemperaturePolynomial p;
+  p.t0_c = 25.0;
+  p.c[1] = Vec3(2.0, -1.0, 0.5);
+  const TemperaturePolynomial q = Rebase(p, 35.0);
+  EXPECT_EQ(q.c[1], p.c[1]);
+  EXPECT_EQ(q.c[0], Vec3(20.0, -10.0, 5.0));  // 10 degC above the old reference
+  EXPECT_EQ(q.c[2], Vec3::Zero());
+}
+
+// ---- parameter files -------------------------------------------------------------------------
+
+TEST(Ardupilot, ParameterFileRoundTripsAndReproducesTheCorrection) {
+  const FirmwareCorrection fw = ThermalCorrection();
+  const ParameterSet set = ArdupilotParameters(fw, 0);
+  const std::string text = ArdupilotParamFile(set);
+  const auto read = ReadArdupilotParamFile(text, "test.param");
+  const auto written = set.Values();
+  ASSERT_EQ(read.size(), written.size());
+  for (const auto& [name, value] : written) {
+    ASSERT_EQ(read.count(name), 1u) << name;
+    EXPECT_NEAR(read.at(name), value, 1e-8 * std::max(1.0, std::abs(value))) << name;
+  }
+  const FirmwareCorrection back = ArdupilotCorrection(read, 0);
+  EXPECT_LT(MaxDifference(back.accel, fw.accel), 1e-7);
+  EXPECT_LT(MaxDifference(back.gyro, fw.gyro), 1e-7);
+}
+
+TEST(Ardupilot, NamesFollowTheInstanceAndTheTemperatureTermIsScaledAbout35C) {
+  FirmwareCorrection fw;
+  fw.has_gyro = true;
+  fw.accel.offset = Vec3(0.1, 0.2, 0.3);
+  fw.accel.has_thermal = true;
+  fw.accel.temp_min_c = 20.0;
+  fw.accel.temp_max_c = 40.0;
+  fw.accel.thermal.t0_c = 25.0;
+  fw.accel.thermal.c[1] = Vec3(1e-3, 0, 0);  // 1 mm/s^2 per degC on x
+  const auto v = ArdupilotParameters(fw, 1).Values();
+  EXPECT_EQ(v.at("INS_TCAL2_ENABLE"), 1.0);
+  EXPECT_DOUBLE_EQ(v.at("INS_TCAL2_ACC1_X"), 1000.0);  // 1e-3 * 1e6
+  EXPECT_EQ(v.at("INS_TCAL2_ACC2_X"), 0.0);
+  EXPECT_EQ(v.at("INS_ACC2_CALTEMP"), 25.0);  // plumb's reference, inside [20, 40]
+  EXPECT_DOUBLE_EQ(v.at("INS_ACC2OFFS_X"), 0.1);  // h(CALTEMP) = h(25) = 0
+  EXPECT_EQ(v.count("INS_GYR2OFFS_X"), 1u);
+  EXPECT_EQ(v.count("INS_ACCOFFS_X"), 0u);
+  EXPECT_EQ(v.count("INS_GYR2_CALTEMP"), 0u);  // no gyro temperature term
+  EXPECT_THROW(ArdupilotParameters(fw, 3), Error);
+}
+
+TEST(Ardupilot, ReferenceOutsideTheRangeMovesTheOffsetToTheCalibrationTemperature) {
+  FirmwareCorrection fw = ThermalCorrection();
+  fw.accel.thermal.t0_c = 10.0;  // below TMIN = 18: CALTEMP clamps to 18
+  const auto v = ArdupilotParameters(fw, 0).Values();
+  EXPECT_EQ(v.at("INS_ACC1_CALTEMP"), 18.0);
+  EXPECT_NEAR(v.at("INS_ACCOFFS_Y"), fw.accel.offset.y() + fw.accel.thermal.At(18.0).y(), 1e-15);
+  EXPECT_LT(MaxDifference(ArdupilotCorrection(v, 0).accel, fw.accel), 1e-12);
+}
+
+TEST(Ardupilot, MalformedLineIsAnInputErrorNamingTheLine) {
+  try {
+    ReadArdupilotParamFile("# c\nINS_ACCOFFS_X,0.1,2\n", "bad.param");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bad.param"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ReadArdupilotParamFile("INS_ACCOFFS_X nan\n", "bad.param"), InputError);
+  EXPECT_EQ(ReadArdupilotParamFile("INS_ACCOFFS_X 0.25\n", "ok.param").at("INS_ACCOFFS_X"), 0.25);
+}
+
+TEST(Px4, ParameterFileRoundTripsAndReproducesTheCorrection) {
+  const FirmwareCorrection fw = ThermalCorrection();
+  const ParameterSet set = Px4Parameters(fw, 2);
+  const std::string text = Px4ParamsFile(set);
+  EXPECT_NE(text.find("1\t1\tCAL_ACC2_XOFF\t"), std::string::npos) << text;
+  EXPECT_NE(text.find("1\t1\tTC_A_ENABLE\t1\t6\n"), std::string::npos) << text;
+  const auto read = ReadPx4ParamsFile(text, "test.params");
+  for (const auto& [name, value] : set.Values()) {
+    ASSERT_EQ(read.count(name), 1u) << name;
+    EXPECT_NEAR(read.at(name), value, 1e-8 * std::max(1.0, std::abs(value))) << name;
+  }
+  EXPECT_EQ(read.at("TC_A2_TREF"), 25.0);
+  const FirmwareCorrection back = Px4Correction(read, 2);
+  EXPECT_LT(MaxDifference(back.accel, fw.accel), 1e-7);
+  EXPECT_LT(MaxDifference(back.gyro, fw.gyro), 1e-7);
+  EXPECT_THROW(ReadPx4ParamsFile("1 1 CAL_ACC0_XOFF 0.1 9\n", "spaces.params"), InputError);
+}
+
+// ---- the error a diagonal correction leaves --------------------------------------------------
+
+TEST(Evaluate, DiagonalModelLeavesNoErrorThroughEitherFile) {
+  model::Model m = model::Model::Parse("base+accel_temperature_bias:2");
+  model::ParameterBlocks theta = m.ZeroParameters();
+  theta[0] = {0.01, 0, 0, -0.02, 0, 0.005, 0.15, -0.08, 0.3};  // F diagonal, b_a
+  theta[1][9] = 0.01;  // gyro biases, E = I
+  theta[1][10] = -0.02;
+  theta[1][11] = 0.004;
+  theta[2] = {2e-3, -1e-3, 5e-4, -2e-5, 1e-5, 3e-5};  // c1, c2
+  const std::vector<double> temps = {20, 24, 29, 33, 38, 45};
+  const Session s = MakeSession("base+accel_temperature_bias:2", theta, SixFaces(), temps);
+  for (const char* format : {"ardupilot", "px4"}) {
+    const ExportOutput out = Export(format, s.r, s.series, ExportOptions{});
+    const auto& a = out.json["accel_still"];
+    EXPECT_EQ(a["segments"].get<int>(), 6);
+    for (int i = 0; i < 3; ++i) {
+      // float32 sample storage and 9-digit parameters: well under a micro-g.
+      EXPECT_LT(a["max_abs"][i].get<double>(), 2e-6) << format << " axis " << i;
+      EXPECT_LT(out.json["gyro_still"]["max_abs"][i].get<double>(), 1e-9) << format;
+    }
+    EXPECT_TRUE(out.json["dropped"].empty()) << out.json["dropped"].dump();
+  }
+}
+
+TEST(Evaluate, OffDiagonalTermMatchesTheHandComputation) {
+  model::Model m = model::Model::Parse("base");
+  model::ParameterBlocks theta = m.ZeroParameters();
+  theta[0][1] = 0.01;  // F_xy: y_a,x = f_x + 0.01 f_y
+  const std::vector<Vec3> f = {Vec3(0, 0, -kG), Vec3(0, -kG, 0), Vec3(0, kG, 0)};
+  const Session s = MakeSession("base", theta, f, {25, 25, 25});
+  const FirmwareCorrection fw = BestDiagonal(s.r, SessionTemperatureRange(s.series));
+  EXPECT_NEAR((fw.accel.scale - Vec3::Ones()).norm(), 0.0, 1e-15);  // diag(F^-1) = 1
+  const ExportReport rep = Evaluate(s.r, s.series, fw, "ardupilot", true);
+  // Firmware: y - b = F f, plumb: f, so the x error is 0.01 f_y: 0, -0.01 g, +0.01 g.
+  EXPECT_NEAR(rep.accel_still.rms.x(), 0.01 * kG * std::sqrt(2.0 / 3.0), 1e-6);
+  EXPECT_NEAR(rep.accel_still.max_abs.x(), 0.01 * kG, 1e-6);
+  EXPECT_LT(rep.accel_still.max_abs.y(), 1e-6);
+  EXPECT_LT(rep.accel_still.max_abs.z(), 1e-6);
+  EXPECT_NEAR(rep.accel_per_input(0, 1), 0.01, 1e-15);
+}
+
+TEST(Evaluate, EffectsTheTargetHasNoParameterForAreListed) {
+  model::Model m = model::Model::Parse("base+gyro_g_sensitivity");
+  model::ParameterBlocks theta = m.ZeroParameters();
+  theta[2][0] = 1e-4;
+  const Session s = MakeSession("base+gyro_g_sensitivity", theta, SixFaces(),
+                                std::vector<double>(6, 25.0));
+  const ExportReport rep =
+      Evaluate(s.r, s.series, BestDiagonal(s.r, SessionTemperatureRange(s.series)), "px4", true);
+  ASSERT_EQ(rep.dropped.size(), 1u);
+  EXPECT_EQ(rep.dropped[0].effect, "gyro_g_sensitivity");
+  EXPECT_EQ(rep.dropped[0].values[0], 1e-4);
+  // The g-sensitivity term G_xx f_x shows on the x gyro in the two x faces: 1e-4 g.
+  EXPECT_NEAR(rep.gyro_still.max_abs.x(), 1e-4 * kG, 1e-7);
+}
+
+TEST(Evaluate, CountsAreRefused) {
+  Session s = MakeSession("base", model::Model::Parse("base").ZeroParameters(), SixFaces(),
+                          std::vector<double>(6, 25.0));
+  s.r.acc_unit = "counts";
+  EXPECT_THROW(BestDiagonal(s.r, TemperatureRange{}), Error);
+  EXPECT_THROW(KalibrNoise(s.r, s.series, "/imu0"), Error);
+  EXPECT_THROW(Export("ardupilot", s.r, s.series, ExportOptions{}), Error);
+}
+
+// ---- Kalibr ----------------------------------------------------------------------------------
+
+/// Key -> value of a flat `key: value  # comment` YAML text.
+std::map<std::string, std::string> FlatYaml(const std::string& text) {
+  std::map<std::string, std::string> out;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const auto colon = line.find(':');
+    std::string value = line.substr(colon + 1);
+    value = value.substr(0, value.find('#'));
+    value.erase(0, value.find_first_not_of(' '));
+    value.erase(value.find_last_not_of(' ') + 1);
+    out[line.substr(0, colon)] = value;
+  }
+  return out;
+}
+
+TEST(Kalibr, WhiteNoiseDensityMatchesTheAllanDeviationAtOneSecond) {
+  // One 120 s still segment of white noise at 100 Hz.
+  const double dt = 0.01, sigma_a = 0.02, sigma_g = 0.001;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Session s;
+  s.r.model = model::Model::Parse("base");
+  s.r.theta = s.r.model.ZeroParameters();
+  s.r.has_gyro = true;
+  for (int i = 0; i < 12000; ++i) {
+    s.series.t_s.push_back(i * dt);
+    s.series.acc.push_back(Vec3f(sigma_a * n(rng), sigma_a * n(rng), -kG + sigma_a * n(rng)));
+    s.series.gyr.push_back(Vec3f(sigma_g * n(rng), sigma_g * n(rng), sigma_g * n(rng)));
+  }
+  estimation::StillSegmentFit fit;
+  fit.segment.begin = 0;
+  fit.segment.end = s.series.size();
+  s.r.still.push_back(fit);
+  s.r.noise_acc = Vec3::Constant(sigma_a);
+  s.r.noise_gyr = Vec3::Constant(sigma_g);
+  const KalibrImu imu = KalibrNoise(s.r, s.series, "/imu0");
+  EXPECT_NEAR(imu.update_rate_hz, 100.0, 1e-6);
+  EXPECT_TRUE(imu.accel.low_from_allan);
+  EXPECT_NEAR(imu.accel.white_sample.x(), sigma_a * std::sqrt(dt), 1e-15);
+  for (int i = 0; i < 3; ++i) {
+    // White noise: ADEV(1 s) = sigma sqrt(dt), within the estimator's scatter.
+    EXPECT_NEAR(imu.accel.white_low[i] / (sigma_a * std::sqrt(dt)), 1.0, 0.1) << i;
+    EXPECT_NEAR(imu.gyro.white_low[i] / (sigma_g * std::sqrt(dt)), 1.0, 0.1) << i;
+    EXPECT_EQ(imu.gyro.white[i], std::max(imu.gyro.white_sample[i], imu.gyro.white_low[i]));
+  }
+  // White noise has no random walk: the bound is small but the +1/2 slope is not there.
+  EXPECT_FALSE(imu.accel.walk_resolved);
+  EXPECT_GT(imu.accelerometer_random_walk(), 0.0);
+  EXPECT_LT(imu.accelerometer_random_walk(), sigma_a * std::sqrt(dt));
+
+  const auto yaml = FlatYaml(KalibrYaml(imu));
+  EXPECT_EQ(yaml.at("rostopic"), "/imu0");
+  EXPECT_NEAR(std::stod(yaml.at("update_rate")), 100.0, 1e-4);
+  EXPECT_NEAR(std::stod(yaml.at("accelerometer_noise_density")),
+              imu.accelerometer_noise_density(), 1e-5 * imu.accelerometer_noise_density());  // 6 digits
+  EXPECT_NEAR(std::stod(yaml.at("gyroscope_random_walk")), imu.gyroscope_random_walk(),
+              1e-5 * imu.gyroscope_random_walk());
+  EXPECT_NE(KalibrYaml(imu).find("upper bound"), std::string::npos);
+}
+
+TEST(Kalibr, ShortSegmentsFallBackToTheAutocorrelationTime) {
+  // 2 s of still data: too short for ADEV at 1 s; the low-frequency level is then
+  // sigma sqrt(tau dt), which the correlated output (tau = 4 samples) makes the larger.
+  const double dt = 0.005, sigma = 0.01, tau = 4.0;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, sigma);
+  Session s;
+  s.r.model = model::Model::Parse("base");
+  s.r.model.DropGyro();
+  s.r.theta = s.r.model.ZeroParameters();
+  for (int i = 0; i < 400; ++i) {
+    s.series.t_s.push_back(i * dt);
+    s.series.acc.push_back(Vec3f(n(rng), n(rng), -kG + n(rng)));
+  }
+  estimation::StillSegmentFit fit;
+  fit.segment.end = s.series.size();
+  s.r.still.push_back(fit);
+  s.r.noise_acc = Vec3::Constant(sigma);
+  s.r.tau_acc = tau;
+  const KalibrImu imu = KalibrNoise(s.r, s.series, "/imu");
+  EXPECT_FALSE(imu.accel.low_from_allan);
+  EXPECT_NEAR(imu.accelerometer_noise_density(), sigma * std::sqrt(tau * dt), 1e-15);
+  EXPECT_FALSE(imu.has_gyro);
+  const std::string yaml = KalibrYaml(imu);
+  EXPECT_EQ(yaml.find("gyroscope"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("rostopic: /imu\n"), std::string::npos) << yaml;
+}
+
+}  // namespace
+}  // namespace plumb::exporter
