@@ -102,7 +102,7 @@ void SeriesFigure(const ImuSeries& series, const std::vector<StillSegment>& segm
   }
   if (series.has_temperature()) {
     gp << "set ylabel 'temperature (degC)'\n"
-       << "plot 'series.csv' using 1:8 with lines lc rgb 'black' title 'temperature'\n";
+       << "plot 'series.csv' using 1:8 with lines lc rgb 'black' notitle\n";
   }
   gp << End() << "unset object\n";
   plan.job.script += gp.str();
@@ -285,7 +285,8 @@ FigurePlan PlanFigures(const ImuSeries& series, const std::vector<StillSegment>&
   FigurePlan plan;
   plan.job.script =
       "# The figures of plumb report. Run in this folder: gnuplot figures.gp\n"
-      "set datafile separator ','\nset grid\nset key outside right top\n";
+      "set datafile separator ','\nset grid\nset key outside right top\n"
+      "set lmargin 12\nset rmargin 16\n";  // the same plot width in every panel
   SeriesFigure(series, segments, o, plan);
   ResidualData(series, analysis, plan);
   ResidualFigure(analysis, o, plan);
