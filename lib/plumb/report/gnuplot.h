@@ -2,7 +2,8 @@
 // files and the script into a folder, run `gnuplot SCRIPT` there as a child process, and say
 // what came out. plumb never draws a plot itself.
 //
-// The child gets no shell (posix_spawnp: the program is looked up on PATH), its working folder
+// The child gets no shell (posix_spawnp: the program is looked up on PATH; the working folder
+// is set with posix_spawn_file_actions_addchdir_np, glibc 2.29 or later), its working folder
 // is the output folder, its stdin is /dev/null and its stdout and stderr go to LOG in that
 // folder (the library never prints). Data and script files are written atomically
 // (plumb/io/atomic_file.h); the PNGs are gnuplot's own.

@@ -1,6 +1,7 @@
 #include "plumb/report/html_report.h"
 
 #include <Eigen/LU>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -15,6 +16,8 @@ namespace {
 
 /// Two-sided probability outside the band of chi^2/dof drawn on the page.
 constexpr double kBandOutside = 0.01;
+/// Unobservable directions name at most this many of their terms in words.
+constexpr std::size_t kNamedTerms = 6;
 
 const char kStyle[] = R"css(
 body { font-family: system-ui, sans-serif; max-width: 1060px; margin: 2em auto; padding: 0 1em;
@@ -275,6 +278,35 @@ std::string MatrixSection(const estimation::CalibrationResult& r) {
   return out;
 }
 
+/// The names in a direction "a p1 + b p2 - ..." (tokens that start with a letter).
+std::vector<std::string> NamesIn(const std::string& direction) {
+  std::vector<std::string> names;
+  std::istringstream tokens(direction);
+  std::string token;
+  while (tokens >> token) {
+    if (std::isalpha(static_cast<unsigned char>(token.front()))) names.push_back(token);
+  }
+  return names;
+}
+
+/// An unobservable direction in words: which parameters the data cannot tell apart.
+std::string DirectionWords(const std::string& direction) {
+  const std::vector<std::string> names = NamesIn(direction);
+  if (names.size() == 1) {
+    return "The data does not determine " + Code(names.front()) + " at all (" + Code(direction) +
+           ").";
+  }
+  // The largest terms lead; a long direction names the first few and counts the rest.
+  const std::size_t shown = names.size() > kNamedTerms + 1 ? kNamedTerms : names.size();
+  std::string list;
+  for (std::size_t i = 0; i < shown; ++i) {
+    list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + Code(names[i]);
+  }
+  if (shown < names.size()) list += " and " + std::to_string(names.size() - shown) + " more";
+  return "The data cannot tell apart " + list + ": moving them together along " +
+         Code(direction) + " changes no prediction.";
+}
+
 std::string ObservabilitySection(const estimation::CalibrationResult& r) {
   const auto& o = r.observability;
   std::string out = "<h2 id=\"observability\">Observability</h2>\n<p>Rank " +
@@ -283,10 +315,11 @@ std::string ObservabilitySection(const estimation::CalibrationResult& r) {
   if (o.unobservable.empty()) {
     return out + "<p>Every parameter is determined by the data.</p>\n";
   }
-  out += "<p>The data cannot determine these directions: moving the parameters along one of "
-         "them changes no prediction, so any split between them fits equally well. Record "
-         "poses or motions that excite them, or fix one of the parameters.</p>\n<ul>\n";
-  for (const auto& u : o.unobservable) out += "<li>" + Code(u) + "</li>\n";
+  out += "<p>Some combinations of parameters are not determined by this data: any split "
+         "between the parameters of each fits equally well, so their separate values and sigmas "
+         "mean nothing; use the determined combinations below, or record poses or motions that "
+         "excite them.</p>\n<ul>\n";
+  for (const auto& u : o.unobservable) out += "<li>" + DirectionWords(u) + "</li>\n";
   out += "</ul>\n";
   if (o.determined.empty()) return out;
   out += "<p>What the data does determine:</p>\n<table>\n" +
