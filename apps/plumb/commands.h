@@ -9,6 +9,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace plumb::cli {
 
@@ -37,5 +38,10 @@ std::unique_ptr<Command> MakeCompareCommand(CLI::App& parent);
 std::unique_ptr<Command> MakePaperCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeDiagnoseCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeInfoCommand(CLI::App& parent);
+std::unique_ptr<Command> MakeReportCommand(CLI::App& parent);
+
+/// The command line as typed (argv), stored by main before parsing; `plumb report` prints it
+/// as the command that reproduces the page.
+std::vector<std::string>& CommandLineArgs();
 
 }  // namespace plumb::cli

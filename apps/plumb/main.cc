@@ -22,12 +22,20 @@ std::string UsageMessage(const CLI::App* app, const CLI::Error& e) {
 
 }  // namespace
 
+namespace plumb::cli {
+std::vector<std::string>& CommandLineArgs() {
+  static std::vector<std::string> args;
+  return args;
+}
+}  // namespace plumb::cli
+
 int main(int argc, char** argv) {
   // Ceres reports through glog; plumb reports itself (a failed covariance falls back with a
   // warning in the result), so only fatal glog messages may reach the user's terminal.
   FLAGS_minloglevel = google::GLOG_FATAL;
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
+  plumb::cli::CommandLineArgs().assign(argv, argv + argc);
   CLI::App app("plumb " + plumb::report::Version() +
                    ": calibrate an IMU's accelerometer and gyroscope from real logs, with "
                    "honest uncertainty",
@@ -45,6 +53,7 @@ int main(int argc, char** argv) {
   commands.push_back(plumb::cli::MakeCompareCommand(app));
   commands.push_back(plumb::cli::MakePaperCommand(app));
   commands.push_back(plumb::cli::MakeInfoCommand(app));
+  commands.push_back(plumb::cli::MakeReportCommand(app));
 
   if (argc > 1 && argv[1][0] != '-') {
     const std::string name = argv[1];

@@ -1,0 +1,274 @@
+// plumb report INPUT... --out DIR — one page that says what was calibrated and how well
+// (SPEC section 6): DIR/index.html, beside it result.json (calibrate's JSON), diagnose.json,
+// residuals.csv and the figures (PNG, drawn by gnuplot from figures.gp and its CSV files).
+//
+// Reads the inputs, finds the still segments and resolves the site exactly as calibrate does
+// (the same options), fits, runs diagnose's ranking of the missing-effect catalogue unless
+// --no-diagnose, compares the fit with the measurements (plumb/diagnostics), draws the
+// figures (plumb/report/gnuplot.h) and writes the page (plumb/report/html_report.h). Every
+// file is written atomically. Without gnuplot the page is written without figures, says why,
+// and the command warns on stderr and exits 0: figures.gp and its data stay in DIR, to be
+// drawn later with `gnuplot figures.gp` there.
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "commands.h"
+#include "input_options.h"
+#include "plumb/core/error.h"
+#include "plumb/diagnostics/diagnose.h"
+#include "plumb/diagnostics/residual_analysis.h"
+#include "plumb/estimation/calibrator.h"
+#include "plumb/io/atomic_file.h"
+#include "plumb/model/model.h"
+#include "plumb/report/diagnosis_json.h"
+#include "plumb/report/figures.h"
+#include "plumb/report/gnuplot.h"
+#include "plumb/report/html_report.h"
+#include "plumb/report/json_report.h"
+#include "plumb/report/summary.h"
+#include "segment_options.h"
+#include "site_options.h"
+
+namespace plumb::cli {
+namespace {
+
+struct ReportArgs {
+  InputArgs input;
+  SiteArgs site;
+  SegmentArgs segments;
+  std::string model = "base";
+  std::string out_dir;              ///< --out DIR: created when missing
+  bool diagnose = true;             ///< --diagnose / --no-diagnose
+  double significance = 0.01;       ///< level of the score test, (0, 0.5)
+  int confirm = 3;                  ///< refit the best N significant candidates, >= 0
+  bool strict = false;              ///< fail when the data cannot determine every parameter
+  double heading_deg = 0.0;         ///< --heading: first still pose's x from north, degrees
+  CLI::Option* heading = nullptr;
+  bool level_north = false;         ///< first still pose level with x north (known attitude)
+  double temp_ref_c = 25.0;         ///< reference temperature of temperature terms, degC
+  bool no_figures = false;          ///< --no-figures: do not draw (nor write figure data)
+  std::string gnuplot = "gnuplot";  ///< --gnuplot PROGRAM
+};
+
+/// `text` quoted for a POSIX shell when it holds anything but safe characters.
+std::string ShellQuote(const std::string& text) {
+  const bool safe = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) ||
+           std::string("_-./=:,+@%^").find(c) != std::string::npos;
+  });
+  if (safe) return text;
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string CommandText() {
+  std::string out;
+  for (const auto& arg : CommandLineArgs()) out += (out.empty() ? "" : " ") + ShellQuote(arg);
+  return out;
+}
+
+report::InputSummary Summarise(const Session& session, const InputArgs& args) {
+  const ImuSeries& s = session.series;
+  report::InputSummary in;
+  in.source = session.source;
+  in.inputs = args.inputs;
+  if (!args.acc_file.empty()) in.inputs.push_back(args.acc_file + "," + args.gyr_file);
+  in.samples = s.size();
+  const double dt = s.median_dt_s();
+  in.rate_hz = dt > 0 ? 1.0 / dt : 0.0;
+  in.duration_s = s.duration_s();
+  in.has_gyro = s.has_gyro();
+  in.has_temperature = s.has_temperature();
+  if (s.has_temperature()) {
+    const auto range = std::minmax_element(s.temp_c.begin(), s.temp_c.end());
+    in.temp_min_c = *range.first;
+    in.temp_max_c = *range.second;
+  }
+  in.acc_unit = s.acc_unit;
+  in.gyr_unit = s.gyr_unit;
+  in.warnings = session.warnings;
+  return in;
+}
+
+class ReportCommand : public Command {
+ public:
+  explicit ReportCommand(CLI::App& parent) {
+    app_ = parent.add_subcommand(
+        "report",
+        "Calibrate, diagnose and write one self-contained HTML page with figures: what was "
+        "calibrated and how well (DIR/index.html)");
+    ReportArgs& a = args_;
+    AddInputOptions(app_, a.input);
+    app_->add_option("--out", a.out_dir,
+                     "Folder of the page (created when missing): index.html, result.json, "
+                     "diagnose.json, residuals.csv, figures.gp, its CSV data and the PNGs")
+        ->type_name("DIR")
+        ->required();
+    app_->add_option("--model", a.model,
+                     "Error model spec: base, paper, or base+EFFECT[:OPTION]+... "
+                     "(see 'plumb effects')")
+        ->capture_default_str();
+    AddSiteOptions(app_, a.site);
+    AddGravityOption(app_, a.site);
+    app_->add_flag("--diagnose,!--no-diagnose", a.diagnose,
+                   "Rank the missing effects of the catalogue on the page (default), or not")
+        ->capture_default_str();
+    app_->add_option("--significance", a.significance,
+                     "Level of the score test and of the residual signature tests")
+        ->check(CLI::Range(1e-12, 0.5))
+        ->capture_default_str();
+    app_->add_option("--confirm", a.confirm,
+                     "Refit the model with each of the best N significant effects")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app_->add_flag("--strict", a.strict,
+                   "Fail (exit 1) when the data cannot determine every parameter of the model");
+    a.heading = app_->add_option("--heading", a.heading_deg,
+                                 "Heading of the first still pose's x axis from north, degrees "
+                                 "(0 = x north); otherwise the heading is an arbitrary gauge");
+    auto* level = app_->add_flag("--level-north", a.level_north,
+                                 "The first still pose is level with x north: its attitude is "
+                                 "known and held");
+    level->excludes(a.heading);
+    app_->add_option("--temp-ref", a.temp_ref_c,
+                     "Reference temperature of the temperature terms, degC")
+        ->capture_default_str();
+    app_->add_flag("--no-figures", a.no_figures, "Write the page without figures (no gnuplot)");
+    app_->add_option("--gnuplot", a.gnuplot,
+                     "The gnuplot program (a name looked up on PATH, or a path)")
+        ->type_name("PROGRAM")
+        ->capture_default_str();
+    AddSegmentOptions(app_, a.segments);
+  }
+
+  int Run() override {
+    const ReportArgs& a = args_;
+    Session session = ReadInputs(a.input);
+    const ImuSeries& series = session.series;
+    const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
+    std::vector<StillSegment> segments = seg.segments;
+    if (a.level_north && !segments.empty()) segments.front().known_R_n_b = Quat::Identity();
+    const std::optional<double> gravity = a.site.fixed_gravity();
+    const geo::Site site = ResolveSite(a.site, session.site, gravity);
+    if (gravity && site.known) {
+      session.warnings.push_back("gravity fixed at " + std::to_string(*gravity) +
+                                 " m/s^2 by --gravity instead of WGS84 normal gravity");
+    }
+    model::Model model = model::Model::Parse(a.model);
+    model.t_ref_s = series.t_s.front();
+    model.temp_ref_c = a.temp_ref_c;
+    estimation::CalibrationOptions options;
+    if (a.heading->count() > 0) options.first_heading_deg = a.heading_deg;
+    if (a.strict) options.on_insufficient = estimation::InsufficientData::kError;
+
+    std::cout << session.source << ": " << series.size() << " samples, " << series.duration_s()
+              << " s" << (series.has_gyro() ? "" : ", no gyroscope")
+              << (series.has_temperature() ? ", with temperature" : "") << "\n";
+    for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+    std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose);
+
+    const estimation::CalibrationResult result =
+        estimation::Calibrate(series, segments, model, site, options);
+    std::cout << report::FitVerdict(result.fit) << "\n";
+    std::optional<diagnostics::Diagnosis> diagnosis;
+    if (a.diagnose) diagnosis = RunDiagnosis(series, segments, model, site, options);
+
+    diagnostics::ResidualAnalysisOptions ra_options;
+    ra_options.significance = a.significance;
+    const diagnostics::ResidualAnalysis analysis =
+        diagnostics::AnalyseResiduals(series, result, ra_options);
+
+    const std::filesystem::path dir(a.out_dir);
+    std::filesystem::create_directories(dir);
+    std::vector<std::string> files = {"result.json", "residuals.csv"};
+    report::WriteJson((dir / "result.json").string(),
+                      report::CalibrationJson(result, seg, Summarise(session, a.input).inputs,
+                                              session.warnings));
+    if (diagnosis) {
+      report::WriteJson((dir / "diagnose.json").string(),
+                        report::DiagnosisJson(*diagnosis, analysis));
+      files.insert(files.begin() + 1, "diagnose.json");
+    }
+    io::WriteFileAtomic((dir / "residuals.csv").string(), report::ResidualsCsv(analysis.samples));
+
+    report::PageExtras extras;
+    extras.title = "plumb report: " + session.source;
+    extras.command = CommandText();
+    extras.segments_source = a.segments.segments_path;
+    if (a.no_figures) {
+      extras.figure_notes.push_back("not drawn (--no-figures)");
+    } else {
+      DrawFigures(series, segments, result, ra_options, extras, files);
+    }
+    extras.files = files;
+    const std::string page = report::HtmlReport(Summarise(session, a.input), seg, result,
+                                                analysis, diagnosis ? &*diagnosis : nullptr,
+                                                extras);
+    io::WriteFileAtomic((dir / "index.html").string(), page);
+    std::cout << "wrote " << (dir / "index.html").string() << " (" << extras.figures.size()
+              << " figures; also " << files.size() << " files beside it)\n";
+    return 0;
+  }
+
+ private:
+  /// diagnose's ranking; a failure is a warning on the page and on stdout, not the end of
+  /// the report (the calibration itself succeeded).
+  std::optional<diagnostics::Diagnosis> RunDiagnosis(
+      const ImuSeries& series, const std::vector<StillSegment>& segments,
+      const model::Model& model, const geo::Site& site,
+      const estimation::CalibrationOptions& calibration) {
+    diagnostics::DiagnoseOptions options;
+    options.significance = args_.significance;
+    options.confirm = args_.confirm;
+    options.calibration = calibration;
+    options.calibration.on_insufficient = estimation::InsufficientData::kReport;
+    try {
+      diagnostics::Diagnosis d = diagnostics::Diagnose(series, segments, model, site, options);
+      std::cout << d.BriefReport();
+      return d;
+    } catch (const Error& e) {
+      std::cout << "warning: the diagnosis failed: " << e.what() << "\n";
+      return std::nullopt;
+    }
+  }
+
+  /// Plans the figures, runs gnuplot in the output folder, and keeps the figures it drew.
+  /// The Allan figure pools only the longest still segment(s).
+  void DrawFigures(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                   const estimation::CalibrationResult& result,
+                   diagnostics::ResidualAnalysisOptions ra_options, report::PageExtras& extras,
+                   std::vector<std::string>& files) const {
+    ra_options.allan_length_fraction = 1.0;
+    const diagnostics::ResidualAnalysis longest =
+        diagnostics::AnalyseResiduals(series, result, ra_options);
+    const report::FigurePlan plan = report::PlanFigures(series, segments, result, longest);
+    const report::GnuplotOutcome outcome = report::RunGnuplot(args_.out_dir, plan.job, args_.gnuplot);
+    for (const auto& figure : plan.figures) {
+      if (std::find(outcome.written.begin(), outcome.written.end(), figure.file) !=
+          outcome.written.end()) {
+        extras.figures.push_back(figure);
+      }
+    }
+    if (!outcome.message.empty()) {
+      extras.figure_notes.push_back(outcome.message);
+      std::cerr << "plumb: warning: " << outcome.message << "\n";
+    }
+    files.push_back(plan.job.script_name);
+    for (const auto& data : plan.job.data) files.push_back(data.name);
+    files.push_back(plan.job.log_name);
+  }
+
+  ReportArgs args_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeReportCommand(CLI::App& parent) {
+  return std::make_unique<ReportCommand>(parent);
+}
+
+}  // namespace plumb::cli

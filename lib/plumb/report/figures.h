@@ -1,0 +1,60 @@
+// plumb/report/figures.h — the figures of `plumb report`, as a gnuplot job (gnuplot.h): the
+// data files, one script and the list of PNGs with their titles and captions.
+//
+//   series.png       the input time series (accelerometer, gyroscope, temperature when present)
+//                    against time since the first sample, still segments shaded
+//   residuals.png    the fit's whitened residuals per axis against time: still accelerometer
+//                    and still gyroscope per segment (at its mean time), motion per interval
+//                    (at its middle), with the +-3 lines (whitened residuals are ~N(0, 1) when
+//                    the model is complete)
+//   temperature.png  (only with temperature) still residuals per segment, series' units,
+//                    against the segment's mean temperature
+//   allan.png        (only when the analysis has an Allan deviation) the residual's Allan
+//                    deviation per axis against the white-noise line sigma_white / sqrt(m),
+//                    log-log, series' units against cluster time in s
+// Times in every figure are seconds since the first sample of the series (log times may be
+// Unix times). Data files are CSV with a '#' header line; non-finite values are left empty
+// (gnuplot skips them).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/core/segment.h"
+#include "plumb/diagnostics/residual_analysis.h"
+#include "plumb/estimation/result.h"
+#include "plumb/report/gnuplot.h"
+
+namespace plumb::report {
+
+/// One figure of the page.
+struct ReportFigure {
+  std::string file;     ///< PNG name relative to the page, e.g. "series.png"
+  std::string title;    ///< a few words
+  std::string caption;  ///< what is drawn, with units
+};
+
+struct FigureOptions {
+  /// Most samples drawn of the input series, >= 100: every k-th sample with
+  /// k = ceil(samples / max_series_points) (the caption states k).
+  std::size_t max_series_points = 6000;
+  int width_px = 1000;        ///< image width, pixels, > 0
+  int panel_height_px = 260;  ///< height per panel, pixels, > 0
+};
+
+struct FigurePlan {
+  GnuplotJob job;                      ///< data files, script, outputs
+  std::vector<ReportFigure> figures;   ///< in page order, one per job output
+};
+
+/// The figures of a fit of `series` on `segments`. `analysis` is AnalyseResiduals(series,
+/// fit); its `allan` entries (drawn as they are: the caller chooses which segments they pool,
+/// `plumb report` the longest) give allan.png. Throws plumb::Error for options out of range.
+FigurePlan PlanFigures(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                       const estimation::CalibrationResult& fit,
+                       const diagnostics::ResidualAnalysis& analysis,
+                       const FigureOptions& options = {});
+
+}  // namespace plumb::report

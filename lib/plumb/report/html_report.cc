@@ -1,0 +1,497 @@
+#include "plumb/report/html_report.h"
+
+#include <Eigen/LU>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "plumb/report/summary.h"
+#include "plumb/report/version.h"
+#include "plumb/signal/chi_square.h"
+
+namespace plumb::report {
+namespace {
+
+/// Two-sided probability outside the band of chi^2/dof drawn on the page.
+constexpr double kBandOutside = 0.01;
+/// Unobservable directions name at most this many of their terms in words.
+constexpr std::size_t kNamedTerms = 6;
+
+const char kStyle[] = R"css(
+body { font-family: system-ui, sans-serif; max-width: 1060px; margin: 2em auto; padding: 0 1em;
+       color: #222; line-height: 1.4; }
+h1 { font-size: 1.6em; margin-bottom: 0.2em; }
+h2 { font-size: 1.25em; border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 1.6em; }
+table { border-collapse: collapse; margin: 0.5em 0; }
+th, td { border: 1px solid #ddd; padding: 0.2em 0.6em; text-align: left; vertical-align: top; }
+th { background: #f3f5f8; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+code, pre { font-family: ui-monospace, monospace; font-size: 0.92em; }
+pre { background: #f6f8fa; padding: 0.8em; overflow-x: auto; white-space: pre-wrap; }
+.ok { background: #e8f5e9; border-left: 4px solid #2e7d32; padding: 0.5em 0.8em; }
+.bad { background: #fff3e0; border-left: 4px solid #e65100; padding: 0.5em 0.8em; }
+.warn { color: #8a4b00; }
+.muted { color: #666; }
+figure { margin: 1em 0; }
+figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: 0.92em; color: #444; }
+)css";
+
+std::string Fmt(double value, const char* format) {
+  if (!std::isfinite(value)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, value);
+  return buf;
+}
+std::string G6(double value) { return Fmt(value, "%.6g"); }
+std::string G3(double value) { return Fmt(value, "%.3g"); }
+std::string G2(double value) { return Fmt(value, "%.2g"); }
+
+std::string Td(const std::string& html) { return "<td>" + html + "</td>"; }
+std::string TdNum(const std::string& html) { return "<td class=\"num\">" + html + "</td>"; }
+std::string Th(const std::string& html) { return "<th>" + html + "</th>"; }
+std::string Code(const std::string& text) { return "<code>" + HtmlEscape(text) + "</code>"; }
+
+/// A header row from plain-text column names.
+std::string HeaderRow(const std::vector<std::string>& names) {
+  std::string row = "<tr>";
+  for (const auto& n : names) row += Th(HtmlEscape(n));
+  return row + "</tr>\n";
+}
+
+/// A two-column row: `what` (plain text) and `html`.
+std::string KeyRow(const std::string& what, const std::string& html) {
+  return "<tr>" + Th(HtmlEscape(what)) + Td(html) + "</tr>\n";
+}
+
+std::string List(const std::vector<std::string>& items, const std::string& css_class = "") {
+  std::string out = css_class.empty() ? "<ul>\n" : "<ul class=\"" + css_class + "\">\n";
+  for (const auto& item : items) out += "<li>" + HtmlEscape(item) + "</li>\n";
+  return out + "</ul>\n";
+}
+
+std::string VecCells(const Vec3& v) { return TdNum(G3(v.x())) + TdNum(G3(v.y())) + TdNum(G3(v.z())); }
+
+std::string SiteSourceWords(const std::string& source) {
+  if (source == "flags") return "the command-line flags";
+  if (source == "gps") return "the log's GPS";
+  if (source == "file") return "the input file";
+  return source;
+}
+
+std::string SummarySection(const estimation::CalibrationResult& r,
+                           const diagnostics::Diagnosis* d) {
+  const auto band = Chi2DofBand(r.fit.dof);
+  const double ratio = r.fit.chi2_dof();
+  const bool good = r.fit.dof > 0 && ratio >= band.first && ratio <= band.second;
+  std::string out = "<h2 id=\"summary\">Summary</h2>\n<p class=\"" +
+                    std::string(good ? "ok" : "bad") + "\">" + HtmlEscape(FitVerdict(r.fit)) +
+                    "</p>\n<ul>\n";
+  int free = 0;
+  for (const auto& p : r.parameters) free += p.fixed ? 0 : 1;
+  out += "<li>" + std::to_string(free) + " parameters fitted (model " + Code(r.model.spec()) +
+         ", method " + HtmlEscape(r.method) + ") on " + std::to_string(r.fit.still_segments) +
+         " still segments and " + std::to_string(r.fit.motion_segments) +
+         " motion intervals.</li>\n";
+  const std::size_t lost = r.observability.unobservable.size();
+  out += lost == 0 ? std::string("<li>Every parameter is determined by the data.</li>\n")
+                   : "<li class=\"warn\">" + std::to_string(lost) +
+                         " unobservable direction" + (lost > 1 ? "s" : "") +
+                         ": see <a href=\"#observability\">observability</a>.</li>\n";
+  if (d != nullptr) {
+    const diagnostics::Candidate* best = nullptr;
+    for (const auto& c : d->candidates) {
+      if (c.significant) {
+        best = &c;
+        break;
+      }
+    }
+    out += best == nullptr
+               ? "<li>No effect of the catalogue is significantly missing at the " +
+                     G2(100.0 * d->significance) + " % level.</li>\n"
+               : "<li class=\"warn\">Most likely missing: " + Code(best->effect) +
+                     " (predicted fall of chi2 " + G3(best->lm) +
+                     (best->refit_drop ? ", refit " + G3(*best->refit_drop) : std::string()) +
+                     "): see <a href=\"#diagnosis\">missing effects</a>.</li>\n";
+  }
+  return out + "</ul>\n";
+}
+
+std::string SiteHtml(const geo::Site& site) {
+  if (site.known) {
+    return G6(site.lat_deg) + "&deg; N, " + G6(site.lon_deg) + "&deg; E, " + G6(site.height_m) +
+           " m (from " + HtmlEscape(SiteSourceWords(site.source)) + "); gravity " +
+           G6(site.gravity()) + " m/s^2";
+  }
+  return "<span class=\"warn\">none: gravity fixed at " + G6(site.gravity()) +
+         " m/s^2 and the Earth rate left out. The gyroscope biases absorb the Earth rate "
+         "(up to 7.3e-5 rad/s) and the accelerometer scales take the gravity error; give "
+         "--lat --lon --height, or use a log with GPS.</span>";
+}
+
+std::string InputSection(const InputSummary& in, const segmentation::SegmentationResult& seg,
+                         const estimation::CalibrationResult& r, const PageExtras& extras) {
+  std::string out = "<h2 id=\"input\">Input</h2>\n<table>\n";
+  out += KeyRow("source", HtmlEscape(in.source));
+  if (!in.inputs.empty()) {
+    std::string files;
+    for (const auto& f : in.inputs) files += (files.empty() ? "" : "<br>") + Code(f);
+    out += KeyRow("inputs", files);
+  }
+  out += KeyRow("samples", std::to_string(in.samples));
+  out += KeyRow("rate", in.rate_hz > 0 ? G6(in.rate_hz) + " Hz" : std::string("unknown"));
+  out += KeyRow("duration", G6(in.duration_s) + " s");
+  out += KeyRow("sensors", "accelerometer (" + HtmlEscape(in.acc_unit) + ")" +
+                               (in.has_gyro ? ", gyroscope (" + HtmlEscape(in.gyr_unit) + ")"
+                                            : std::string(", no gyroscope")));
+  out += KeyRow("temperature", in.has_temperature ? G3(in.temp_min_c) + " to " +
+                                                        G3(in.temp_max_c) + " degC"
+                                                  : std::string("none"));
+  out += KeyRow("site", SiteHtml(r.site));
+  const std::string how = seg.report.method == "given"
+                              ? "given" + (extras.segments_source.empty()
+                                               ? std::string()
+                                               : " in " + Code(extras.segments_source))
+                              : std::string("detected (window ") + G3(seg.report.window_s) +
+                                    " s, shortest kept " + G3(seg.report.min_still_s) + " s)";
+  out += KeyRow("still segments", std::to_string(seg.segments.size()) + ", " + how);
+  out += "</table>\n";
+  if (!in.warnings.empty()) out += "<p>Reader warnings:</p>\n" + List(in.warnings, "warn");
+  return out;
+}
+
+std::string ModelSection(const estimation::CalibrationResult& r) {
+  std::string out = "<h2 id=\"model\">Model</h2>\n<p>Spec " + Code(r.model.spec()) +
+                    ", method " + HtmlEscape(r.method) + "; reference time " +
+                    G6(r.model.t_ref_s) + " s, reference temperature " +
+                    G6(r.model.temp_ref_c) + " degC. Forward model y_a = F f_b + b_a + "
+                    "(effects), y_g = E omega_b + b_g + (effects), body frame FRD.</p>\n<table>\n" +
+                    HeaderRow({"effect", "term in the forward model", "parameters"});
+  for (const auto& term : r.model.terms()) {
+    const auto& info = term.effect->info();
+    out += "<tr>" + Td(Code(info.name + (info.option.empty() ? "" : ":" + info.option))) +
+           Td(Code(info.term)) + TdNum(std::to_string(info.size())) + "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+std::string FitSection(const estimation::CalibrationResult& r) {
+  const auto& f = r.fit;
+  const auto band = Chi2DofBand(f.dof);
+  std::string out = "<h2 id=\"fit\">Fit quality</h2>\n<table>\n";
+  out += KeyRow("chi2", G6(f.chi2) + " over " + std::to_string(f.num_residuals) +
+                            " whitened residuals");
+  out += KeyRow("degrees of freedom", std::to_string(f.dof));
+  out += KeyRow("chi2/dof", "<b>" + G3(f.chi2_dof()) + "</b> (99 % band of a complete model: " +
+                                G3(band.first) + " to " + G3(band.second) + ")");
+  out += KeyRow("verdict", HtmlEscape(FitVerdict(f)));
+  out += KeyRow("solver", std::string(f.converged ? "converged" : "<span class=\"warn\">not "
+                                                                  "converged</span>") +
+                              " after " + std::to_string(f.iterations) + " iterations");
+  out += KeyRow("sigmas from", HtmlEscape(r.sigma_source.empty() ? "n/a" : r.sigma_source));
+  out += "</table>\n<p>Residual RMS per axis (measured minus predicted):</p>\n<table>\n" +
+         HeaderRow({"residual", "unit", "x", "y", "z"});
+  out += "<tr>" + Td("still accelerometer") + Td(HtmlEscape(r.acc_unit)) + VecCells(f.rms_acc) +
+         "</tr>\n";
+  if (r.has_gyro) {
+    out += "<tr>" + Td("still gyroscope") + Td(HtmlEscape(r.gyr_unit)) + VecCells(f.rms_gyr) +
+           "</tr>\n";
+  }
+  if (f.motion_segments > 0) {
+    out += "<tr>" + Td("motion rotation") + Td("rad") + VecCells(f.rms_motion) + "</tr>\n";
+  }
+  if (f.velocity_segments > 0) {
+    out += "<tr>" + Td("motion velocity") + Td("m/s") + VecCells(f.rms_velocity) + "</tr>\n";
+  }
+  out += "<tr>" + Td("noise per sample, accelerometer") + Td(HtmlEscape(r.acc_unit)) +
+         VecCells(r.noise_acc) + "</tr>\n";
+  if (r.has_gyro) {
+    out += "<tr>" + Td("noise per sample, gyroscope") + Td(HtmlEscape(r.gyr_unit)) +
+           VecCells(r.noise_gyr) + "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+std::string FigureSection(const PageExtras& extras) {
+  std::string out = "<h2 id=\"figures\">Figures</h2>\n";
+  for (const auto& note : extras.figure_notes) {
+    out += "<p class=\"warn\">No figures: " + HtmlEscape(note) + "</p>\n";
+  }
+  for (const auto& fig : extras.figures) {
+    out += "<figure><img src=\"" + HtmlEscape(fig.file) + "\" alt=\"" + HtmlEscape(fig.title) +
+           "\"><figcaption><b>" + HtmlEscape(fig.title) + ".</b> " + HtmlEscape(fig.caption) +
+           "</figcaption></figure>\n";
+  }
+  return out;
+}
+
+std::string ParameterSection(const estimation::CalibrationResult& r) {
+  std::string out = "<h2 id=\"parameters\">Parameters</h2>\n<p>Forward-model quantities, SI "
+                    "(sample units for biases and additive terms); sigma is one standard "
+                    "deviation.</p>\n<table>\n" +
+                    HeaderRow({"parameter", "value", "sigma", "unit", "status"});
+  for (const auto& p : r.parameters) {
+    const std::string status = p.fixed ? "fixed" : !p.observable ? "unobservable" : "";
+    out += "<tr>" + Td(Code(p.name)) + TdNum(G6(p.value)) +
+           TdNum(p.fixed || !p.observable ? "&ndash;" : "&plusmn; " + G2(p.sigma)) +
+           Td(HtmlEscape(p.unit)) +
+           Td(status.empty() ? std::string() : "<span class=\"warn\">" + status + "</span>") +
+           "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+std::string MatrixTable(const Mat3& m) {
+  std::string out = "<table>\n";
+  for (int i = 0; i < 3; ++i) {
+    out += "<tr>";
+    for (int j = 0; j < 3; ++j) out += TdNum(G6(m(i, j)));
+    out += "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+std::string VectorTable(const Vec3& v) {
+  return "<table>\n<tr>" + TdNum(G6(v.x())) + TdNum(G6(v.y())) + TdNum(G6(v.z())) +
+         "</tr>\n</table>\n";
+}
+
+/// One sensor's forward matrix, bias and the correction x = M^-1 (y - b).
+std::string SensorMatrices(const std::string& sensor, const std::string& m, const std::string& b,
+                           const Mat3& matrix, const Vec3& bias) {
+  const Eigen::FullPivLU<Mat3> lu(matrix);
+  std::string out = "<h3>" + HtmlEscape(sensor) + "</h3>\n<p>" + Code(m) + " (forward):</p>\n" +
+                    MatrixTable(matrix) + "<p>" + Code(b) + ":</p>\n" + VectorTable(bias);
+  out += lu.isInvertible()
+             ? "<p>Correction " + Code(m + "^-1") + ", applied as " +
+                   Code(m + "^-1 (y - " + b + ")") + ":</p>\n" + MatrixTable(lu.inverse())
+             : std::string("<p class=\"warn\">The matrix is singular: no correction.</p>\n");
+  return out;
+}
+
+std::string MatrixSection(const estimation::CalibrationResult& r) {
+  std::string out = "<h2 id=\"correction\">Forward model and correction</h2>\n";
+  out += SensorMatrices("Accelerometer", "F", "b_a", r.accel_matrix, r.accel_bias);
+  if (r.has_gyro) out += SensorMatrices("Gyroscope", "E", "b_g", r.gyro_matrix, r.gyro_bias);
+  return out;
+}
+
+/// The names in a direction "a p1 + b p2 - ..." (tokens that start with a letter).
+std::vector<std::string> NamesIn(const std::string& direction) {
+  std::vector<std::string> names;
+  std::istringstream tokens(direction);
+  std::string token;
+  while (tokens >> token) {
+    if (std::isalpha(static_cast<unsigned char>(token.front()))) names.push_back(token);
+  }
+  return names;
+}
+
+/// An unobservable direction in words: which parameters the data cannot tell apart.
+std::string DirectionWords(const std::string& direction) {
+  const std::vector<std::string> names = NamesIn(direction);
+  if (names.size() == 1) {
+    return "The data does not determine " + Code(names.front()) + " at all (" + Code(direction) +
+           ").";
+  }
+  // The largest terms lead; a long direction names the first few and counts the rest.
+  const std::size_t shown = names.size() > kNamedTerms + 1 ? kNamedTerms : names.size();
+  std::string list;
+  for (std::size_t i = 0; i < shown; ++i) {
+    list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + Code(names[i]);
+  }
+  if (shown < names.size()) list += " and " + std::to_string(names.size() - shown) + " more";
+  return "The data cannot tell apart " + list + ": moving them together along " +
+         Code(direction) + " changes no prediction.";
+}
+
+std::string ObservabilitySection(const estimation::CalibrationResult& r) {
+  const auto& o = r.observability;
+  std::string out = "<h2 id=\"observability\">Observability</h2>\n<p>Rank " +
+                    std::to_string(o.rank) + " of " + std::to_string(o.num_unknowns) +
+                    " unknowns (parameters and attitudes).</p>\n";
+  if (o.unobservable.empty()) {
+    return out + "<p>Every parameter is determined by the data.</p>\n";
+  }
+  out += "<p>Some combinations of parameters are not determined by this data: any split "
+         "between the parameters of each fits equally well, so their separate values and sigmas "
+         "mean nothing; use the determined combinations below, or record poses or motions that "
+         "excite them.</p>\n<ul>\n";
+  for (const auto& u : o.unobservable) out += "<li>" + DirectionWords(u) + "</li>\n";
+  out += "</ul>\n";
+  if (o.determined.empty()) return out;
+  out += "<p>What the data does determine:</p>\n<table>\n" +
+         HeaderRow({"combination", "value", "sigma"});
+  for (const auto& d : o.determined) {
+    out += "<tr>" + Td(Code(d.text)) + TdNum(G6(d.value)) + TdNum("&plusmn; " + G2(d.sigma)) +
+           "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+std::string YesNo(bool value) { return value ? "yes" : "no"; }
+
+/// Why one parameter of a candidate cannot be judged, in words.
+std::string ConfoundingWords(const diagnostics::Confounding& n) {
+  if (!n.excited) return n.parameter + " is not excited by this data";
+  if (n.too_weak) {
+    return n.parameter + " is determined only to " + G3(n.sigma) + ", its typical size is " +
+           G3(n.typical);
+  }
+  std::string with;
+  for (const auto& c : n.confounders) with += (with.empty() ? "" : ", ") + c;
+  return n.parameter + " is confounded with " + (with.empty() ? std::string("the fit") : with);
+}
+
+/// The candidate's notes: the divisor of its LM, the candidates it cannot be told from.
+std::string CandidateNotes(const diagnostics::Candidate& c) {
+  std::string notes;
+  if (c.dispersion > 1.0) {
+    notes = "LM divided by " + G3(c.dispersion) + " (the velocity residuals' misfit)";
+  }
+  if (!c.indistinguishable_from.empty()) {
+    std::string others;
+    for (const auto& o : c.indistinguishable_from) others += (others.empty() ? "" : ", ") + o;
+    notes += (notes.empty() ? "" : "; ") + std::string("indistinguishable here from ") + others;
+  }
+  return notes;
+}
+
+std::string CandidateRow(const diagnostics::Candidate& c) {
+  return "<tr>" + Td(Code(c.effect + (c.option.empty() ? "" : ":" + c.option))) +
+         TdNum(G3(c.lm)) + TdNum(std::to_string(c.dof)) + TdNum(G3(c.evidence)) +
+         TdNum(G3(c.threshold)) +
+         Td(c.significant ? "<b>yes</b>" : std::string("no")) + Td(YesNo(c.identifiable)) +
+         TdNum(c.refit_drop ? G3(*c.refit_drop) : std::string("&ndash;")) +
+         Td(HtmlEscape(CandidateNotes(c))) + "</tr>\n";
+}
+
+std::string DiagnosisSection(const diagnostics::Diagnosis* d) {
+  std::string out = "<h2 id=\"diagnosis\">Missing effects</h2>\n";
+  if (d == nullptr) return out + "<p class=\"muted\">Not run (--no-diagnose).</p>\n";
+  out += "<p>The score test of every catalogue effect not in the model, at the fit: LM is the "
+         "predicted fall of chi2 if the effect were added (chi2 with q degrees of freedom when "
+         "it is not missing), ranked by evidence = LM - q ln N (N = " +
+         std::to_string(d->num_residuals) + " residuals); significant when LM exceeds the "
+         "threshold (level " + G2(d->significance) + ") and the effect is identifiable; the "
+         "best ones refitted.</p>\n<table>\n" +
+         HeaderRow({"effect", "LM", "q", "evidence", "threshold", "significant", "identifiable",
+                    "refit drop", "notes"});
+  std::vector<std::string> notes;
+  for (const auto& c : d->candidates) {
+    out += CandidateRow(c);
+    if (c.not_identifiable.empty()) continue;
+    std::string why;
+    for (const auto& n : c.not_identifiable) why += (why.empty() ? "" : "; ") + ConfoundingWords(n);
+    notes.push_back(c.effect + ": " + why);
+  }
+  out += "</table>\n";
+  if (!notes.empty()) out += "<p>Not identifiable from this data (not absent):</p>\n" + List(notes);
+  std::vector<std::string> skipped;
+  for (const auto& s : d->skipped) skipped.push_back(s.effect + ": " + s.reason);
+  if (!skipped.empty()) out += "<p>Not tested:</p>\n" + List(skipped, "muted");
+  return out;
+}
+
+std::string WorstSection(const diagnostics::ResidualAnalysis& a) {
+  std::string out = "<h2 id=\"worst\">Where the model fits worst</h2>\n";
+  if (a.worst.empty()) return out + "<p class=\"muted\">No residual ranges.</p>\n";
+  out += "<p>The largest whitened residual components (in standard deviations; above about 3 "
+         "is unlikely under a complete model):</p>\n<table>\n" +
+         HeaderRow({"range", "residual", "axis", "score (sigma)"});
+  for (const auto& w : a.worst) {
+    out += "<tr>" + Td(HtmlEscape(w.name)) +
+           Td(HtmlEscape(diagnostics::ResidualKindName(w.residual))) +
+           Td(std::string(1, "xyz"[w.axis])) + TdNum(G3(w.score)) + "</tr>\n";
+  }
+  out += "</table>\n";
+  std::string rows;
+  for (const auto& s : a.signatures) {
+    if (!s.significant) continue;
+    rows += "<tr>" + Td(HtmlEscape(std::string(diagnostics::ResidualKindName(s.residual)) + " " +
+                                   "xyz"[s.axis])) +
+            Td(HtmlEscape(s.regressor + " (" + s.unit + ")")) + TdNum(G2(s.correlation)) +
+            TdNum(G3(s.slope_residual) + " &plusmn; " + G2(s.slope_residual_sigma)) +
+            TdNum(G2(s.p_value)) + "</tr>\n";
+  }
+  if (rows.empty()) {
+    return out + "<p>No residual signature is significant (" + std::to_string(a.num_tests) +
+           " tests, p below " + G2(a.p_threshold) + ").</p>\n";
+  }
+  return out + "<p>Significant residual signatures (p below " + G2(a.p_threshold) + ", " +
+         std::to_string(a.num_tests) + " tests):</p>\n<table>\n" +
+         HeaderRow({"residual", "against", "correlation", "slope", "p"}) + rows + "</table>\n";
+}
+
+std::string TailSection(const estimation::CalibrationResult& r, const PageExtras& extras) {
+  std::string out;
+  if (!r.warnings.empty()) {
+    out += "<h2 id=\"warnings\">Warnings</h2>\n" + List(r.warnings, "warn");
+  }
+  if (!extras.files.empty()) {
+    out += "<h2 id=\"files\">Files</h2>\n<ul>\n";
+    for (const auto& f : extras.files) {
+      out += "<li><a href=\"" + HtmlEscape(f) + "\">" + HtmlEscape(f) + "</a></li>\n";
+    }
+    out += "</ul>\n";
+  }
+  out += "<h2 id=\"reproduce\">Reproduce</h2>\n<pre>" + HtmlEscape(extras.command) + "</pre>\n";
+  out += "<p class=\"muted\">Made by plumb " + HtmlEscape(Version()) + ".</p>\n";
+  return out;
+}
+
+}  // namespace
+
+std::string HtmlEscape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::pair<double, double> Chi2DofBand(int dof) {
+  if (dof <= 0) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {nan, nan};
+  }
+  const double n = static_cast<double>(dof);
+  return {signal::ChiSquareQuantile(0.5 * kBandOutside, n) / n,
+          signal::ChiSquareQuantile(1.0 - 0.5 * kBandOutside, n) / n};
+}
+
+std::string HtmlReport(const InputSummary& input,
+                       const segmentation::SegmentationResult& segmentation,
+                       const estimation::CalibrationResult& result,
+                       const diagnostics::ResidualAnalysis& analysis,
+                       const diagnostics::Diagnosis* diagnosis, const PageExtras& extras) {
+  std::string page = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+                     "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+                     "<title>" + HtmlEscape(extras.title) + "</title>\n<style>" + kStyle +
+                     "</style>\n</head>\n<body>\n<h1>" + HtmlEscape(extras.title) + "</h1>\n" +
+                     "<p class=\"muted\">" + HtmlEscape(input.source) + "</p>\n";
+  page += SummarySection(result, diagnosis);
+  page += InputSection(input, segmentation, result, extras);
+  page += ModelSection(result);
+  page += FitSection(result);
+  page += FigureSection(extras);
+  page += ParameterSection(result);
+  page += MatrixSection(result);
+  page += ObservabilitySection(result);
+  page += DiagnosisSection(diagnosis);
+  page += WorstSection(analysis);
+  page += TailSection(result, extras);
+  return page + "</body>\n</html>\n";
+}
+
+}  // namespace plumb::report

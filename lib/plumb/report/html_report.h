@@ -1,0 +1,73 @@
+// plumb/report/html_report.h — the page of `plumb report`: one self-contained HTML file (inline
+// CSS, no script, images referenced by relative names) that says what was calibrated and how
+// well, for a browser and for sharing.
+//
+// Sections, in order: summary (the verdict on chi^2/dof, unobservable directions, the best
+// candidate), input (source, samples, rate, duration, site and where it came from, still
+// segments, reader warnings), model (spec, terms), fit quality (chi^2, dof, chi^2/dof with
+// the 99 % band of a complete model, per-axis RMS, noise), figures, parameters (value +- sigma
+// with units, or "unobservable"/"fixed"), forward model and correction matrices,
+// observability (unobservable directions in words, determined combinations), missing effects
+// (diagnose's ranking), worst residual ranges and residual signatures, warnings, files, and
+// the command that reproduces the page.
+//
+// The 99 % band: under a complete model chi^2 ~ chi^2(dof), so chi^2/dof lies in
+// [Q(0.005), Q(0.995)] / dof with probability 0.99 (Q the chi^2(dof) quantile,
+// plumb/signal/chi_square.h).
+//
+// Every piece of text from outside (file names, labels, warnings, the command) is
+// HTML-escaped; numbers are printed with %.6g (values) and %.2g (sigmas).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "plumb/diagnostics/diagnose.h"
+#include "plumb/diagnostics/residual_analysis.h"
+#include "plumb/estimation/result.h"
+#include "plumb/report/figures.h"
+#include "plumb/segmentation/still_detector.h"
+
+namespace plumb::report {
+
+/// What was read, for the input section.
+struct InputSummary {
+  std::string source;                 ///< file name(s) as the reader names them
+  std::vector<std::string> inputs;    ///< the INPUT arguments
+  std::size_t samples = 0;            ///< samples in the session, >= 0
+  double rate_hz = 0.0;               ///< 1 / median sample interval, Hz (0: unknown)
+  double duration_s = 0.0;            ///< last minus first sample time, s
+  bool has_gyro = false;
+  bool has_temperature = false;
+  double temp_min_c = 0.0, temp_max_c = 0.0;  ///< temperature range, degC (with temperature)
+  std::string acc_unit = "m/s^2", gyr_unit = "rad/s";  ///< units of the samples
+  std::vector<std::string> warnings;  ///< the readers' warnings
+};
+
+/// Everything on the page besides the result structs.
+struct PageExtras {
+  std::string title = "plumb report";       ///< the page's <title> and heading
+  std::vector<ReportFigure> figures;        ///< drawn figures, in order (may be empty)
+  std::vector<std::string> figure_notes;    ///< why figures are missing (e.g. no gnuplot)
+  std::string command;                      ///< the command line that reproduces the page
+  std::vector<std::string> files;           ///< other files written beside the page
+  std::string segments_source;              ///< --segments FILE, or "" when detected
+};
+
+/// Escapes & < > " ' for HTML text and attribute values; invalid UTF-8 passes unchanged.
+std::string HtmlEscape(std::string_view text);
+
+/// The whole page. `diagnosis` may be null (not run); `segmentation` is how the still
+/// segments were found; `analysis` is AnalyseResiduals of `result`.
+std::string HtmlReport(const InputSummary& input,
+                       const segmentation::SegmentationResult& segmentation,
+                       const estimation::CalibrationResult& result,
+                       const diagnostics::ResidualAnalysis& analysis,
+                       const diagnostics::Diagnosis* diagnosis, const PageExtras& extras);
+
+/// The 99 % band of chi^2/dof under a complete model, [lower, upper]; {NaN, NaN} when dof <= 0.
+std::pair<double, double> Chi2DofBand(int dof);
+
+}  // namespace plumb::report

@@ -1,0 +1,166 @@
+// The page of `plumb report`: text from outside is escaped, the parameter table, chi2 and its
+// band, the figure list, and the sections that depend on what was run.
+#include "plumb/report/html_report.h"
+
+#include <gtest/gtest.h>
+
+#include "report_test_util.h"
+
+namespace plumb::report {
+namespace {
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// The pieces of a page around MakeResult() (dof set to 10), no diagnosis, no figures.
+struct PageParts {
+  InputSummary input;
+  segmentation::SegmentationResult segmentation;
+  estimation::CalibrationResult result = testing::MakeResult();
+  diagnostics::ResidualAnalysis analysis;
+  PageExtras extras;
+  PageParts() {
+    input.source = "session.csv";
+    input.samples = 6450;
+    input.rate_hz = 100.0;
+    input.duration_s = 64.5;
+    input.has_gyro = true;
+    segmentation.report.method = "given";
+    result.fit.dof = 10;
+    extras.command = "plumb report session.csv --out out";
+  }
+  std::string Page(const diagnostics::Diagnosis* diagnosis = nullptr) const {
+    return HtmlReport(input, segmentation, result, analysis, diagnosis, extras);
+  }
+};
+
+TEST(HtmlReport, EscapesTheFiveSpecialCharacters) {
+  EXPECT_EQ(HtmlEscape("<a href=\"x\">Tom & Jerry's</a>"),
+            "&lt;a href=&quot;x&quot;&gt;Tom &amp; Jerry&#39;s&lt;/a&gt;");
+  EXPECT_EQ(HtmlEscape("plain text 1.5 m/s^2"), "plain text 1.5 m/s^2");
+}
+
+TEST(HtmlReport, EscapesFileNamesWarningsAndTheCommand) {
+  PageParts parts;
+  parts.input.source = "<script>alert(1)</script>.csv";
+  parts.input.warnings = {"row 7: <bad> & skipped"};
+  parts.extras.command = "plumb report 'a<b>.csv' --out out";
+  const std::string page = parts.Page();
+  EXPECT_FALSE(Contains(page, "<script>"));
+  EXPECT_TRUE(Contains(page, "&lt;script&gt;alert(1)&lt;/script&gt;.csv"));
+  EXPECT_TRUE(Contains(page, "row 7: &lt;bad&gt; &amp; skipped"));
+  EXPECT_TRUE(Contains(page, "plumb report &#39;a&lt;b&gt;.csv&#39; --out out"));
+}
+
+TEST(HtmlReport, ListsEveryParameterWithSigmaOrStatus) {
+  PageParts parts;
+  const std::string page = parts.Page();
+  for (const auto& p : parts.result.parameters) {
+    EXPECT_TRUE(Contains(page, "<td><code>" + p.name + "</code></td>")) << p.name;
+  }
+  // accel.bias.x: value 0.01 * its index, sigma 1e-3, unit "u<index>".
+  EXPECT_TRUE(Contains(page, "<td class=\"num\">&plusmn; 0.001</td>"));
+  EXPECT_TRUE(Contains(page, "<span class=\"warn\">unobservable</span>"));
+  EXPECT_TRUE(Contains(page, "<span class=\"warn\">fixed</span>"));
+}
+
+TEST(HtmlReport, ShowsChi2TheRatioAndItsBand) {
+  PageParts parts;
+  const std::string page = parts.Page();
+  EXPECT_TRUE(Contains(page, "12.5 over 18 whitened residuals"));
+  EXPECT_TRUE(Contains(page, "<b>1.25</b>"));
+  const auto band = Chi2DofBand(10);
+  char text[128];
+  std::snprintf(text, sizeof text, "99 %% band of a complete model: %.3g to %.3g", band.first,
+                band.second);
+  EXPECT_TRUE(Contains(page, text)) << text;
+}
+
+TEST(HtmlReport, Chi2BandMatchesTheChiSquareQuantiles) {
+  // chi2(10) quantiles: 2.156 at 0.005 and 25.19 at 0.995 (tables); Wilson-Hilferty is within
+  // a few per cent at 10 degrees of freedom.
+  const auto band = Chi2DofBand(10);
+  EXPECT_NEAR(band.first, 0.2156, 0.01);
+  EXPECT_NEAR(band.second, 2.519, 0.03);
+  EXPECT_TRUE(std::isnan(Chi2DofBand(0).first));
+}
+
+TEST(HtmlReport, ShowsUnobservableDirectionsAndDeterminedCombinations) {
+  const std::string page = PageParts().Page();
+  EXPECT_TRUE(Contains(page, "The data cannot tell apart <code>accel.bias.z</code> and "
+                             "<code>accel.matrix.zz</code>: moving them together along "
+                             "<code>9.81 accel.bias.z + 1 accel.matrix.zz</code>"));
+  EXPECT_TRUE(Contains(page, "<code>accel.bias.z - 9.81 accel.matrix.zz</code>"));
+}
+
+TEST(HtmlReport, ReferencesTheDrawnFiguresRelatively) {
+  PageParts parts;
+  parts.extras.figures = {{"series.png", "Input time series", "shaded < still"},
+                          {"residuals.png", "Whitened residuals", "dashed: +-3"}};
+  const std::string page = parts.Page();
+  EXPECT_TRUE(Contains(page, "<img src=\"series.png\" alt=\"Input time series\">"));
+  EXPECT_TRUE(Contains(page, "<img src=\"residuals.png\""));
+  EXPECT_TRUE(Contains(page, "shaded &lt; still"));
+  EXPECT_FALSE(Contains(page, "No figures"));
+}
+
+TEST(HtmlReport, SaysWhyThereAreNoFigures) {
+  PageParts parts;
+  parts.extras.figure_notes = {"'gnuplot' was not found on the PATH"};
+  const std::string page = parts.Page();
+  EXPECT_TRUE(Contains(page, "No figures: &#39;gnuplot&#39; was not found on the PATH"));
+  EXPECT_FALSE(Contains(page, "<img"));
+}
+
+TEST(HtmlReport, SaysWhenTheDiagnosisWasNotRun) {
+  EXPECT_TRUE(Contains(PageParts().Page(), "Not run (--no-diagnose)"));
+}
+
+TEST(HtmlReport, ListsTheCandidatesOfTheDiagnosis) {
+  PageParts parts;
+  diagnostics::Diagnosis d;
+  diagnostics::Candidate best;
+  best.effect = "gyro_g_sensitivity";
+  best.lm = 812.4;
+  best.dof = 9;
+  best.evidence = 730.1;
+  best.significant = true;
+  best.refit_drop = 790.2;
+  diagnostics::Candidate hidden;
+  hidden.effect = "time_offset";
+  hidden.identifiable = false;
+  diagnostics::Confounding c;
+  c.parameter = "time_offset.dt";
+  c.excited = false;
+  hidden.not_identifiable = {c};
+  d.candidates = {best, hidden};
+  d.skipped = {{"accel_temperature_bias", "needs a temperature column"}};
+  const std::string page = parts.Page(&d);
+  EXPECT_TRUE(Contains(page, "<td><code>gyro_g_sensitivity</code></td><td class=\"num\">812</td>"));
+  EXPECT_TRUE(Contains(page, "<td class=\"num\">790</td>"));
+  EXPECT_TRUE(Contains(page, "Most likely missing: <code>gyro_g_sensitivity</code>"));
+  EXPECT_TRUE(Contains(page, "time_offset: time_offset.dt is not excited by this data"));
+  EXPECT_TRUE(Contains(page, "accel_temperature_bias: needs a temperature column"));
+}
+
+TEST(HtmlReport, NamesTheWorstRanges) {
+  PageParts parts;
+  diagnostics::WorstRange w;
+  w.name = "still 'x up' 12.0-17.0 s";
+  w.residual = diagnostics::ResidualKind::kStillGyro;
+  w.axis = 2;
+  w.score = 41.5;
+  parts.analysis.worst = {w};
+  const std::string page = parts.Page();
+  EXPECT_TRUE(Contains(page, "<td>still &#39;x up&#39; 12.0-17.0 s</td><td>gyro</td><td>z</td>"
+                             "<td class=\"num\">41.5</td>"));
+}
+
+TEST(HtmlReport, SaysWhichResultsDependOnAMissingSite) {
+  const std::string page = PageParts().Page();  // MakeResult has no site
+  EXPECT_TRUE(Contains(page, "none: gravity fixed at 9.80665 m/s^2 and the Earth rate left out"));
+}
+
+}  // namespace
+}  // namespace plumb::report
