@@ -18,7 +18,7 @@ constexpr std::size_t kMsgHeaderSize = 3;
 constexpr std::size_t kFlagBitsSize = 40;        // 8 + 8 + 3 * 8
 constexpr std::size_t kMaxDataBody = 65535 - 2;  // largest D body after the msg_id
 constexpr int kMaxNesting = 32;
-constexpr std::size_t kMsgIds = 65536;
+constexpr std::size_t kPreScanMinSize = std::size_t{1} << 16;  // inputs worth a counting pass
 
 template <typename T>
 T Load(const std::uint8_t* p) {
@@ -230,9 +230,10 @@ std::string InfoText(const KeyValue& kv) {
 class Parser {
  public:
   Parser(const std::uint8_t* data, std::size_t size, ULog* log)
-      : data_(data), size_(size), log_(log), index_(kMsgIds, -1) {}
+      : data_(data), size_(size), log_(log) {}
 
   void Run() {
+    if (size_ >= kPreScanMinSize) PreScan();
     std::size_t pos = kFileHeaderSize;
     std::size_t end = size_;
     std::size_t next_segment = 0;  // index into log_->appended_offsets
@@ -293,7 +294,7 @@ class Parser {
       case 'D': {
         if (size < 2) return true;
         if (end - pos < kMsgHeaderSize + 2) return false;  // truncated: the caller decides
-        const int idx = index_[Load<std::uint16_t>(data_ + pos + kMsgHeaderSize)];
+        const int idx = Index(Load<std::uint16_t>(data_ + pos + kMsgHeaderSize));
         if (idx < 0) return false;
         const ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
         return size - 2 < t.body_size || size - 2 > t.full_size;
@@ -319,7 +320,7 @@ class Parser {
     if (size > end - pos - kMsgHeaderSize) return false;
     const std::uint8_t* body = data_ + pos + kMsgHeaderSize;
     if (type == 'D' && size >= 2) {
-      const int idx = index_[Load<std::uint16_t>(body)];
+      const int idx = Index(Load<std::uint16_t>(body));
       if (idx < 0) return false;
       const ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
       return size - 2 >= t.body_size && size - 2 <= t.full_size;
@@ -332,7 +333,7 @@ class Parser {
 
   void Data(const std::uint8_t* body, std::size_t size) {
     const std::uint16_t msg_id = Load<std::uint16_t>(body);
-    const int idx = index_[msg_id];
+    const int idx = Index(msg_id);
     if (idx < 0) {
       ++log_->warnings.unknown_msg_id_messages;
       return;
@@ -341,10 +342,15 @@ class Parser {
     (void)size;  // checked by Corrupt(): body_size <= size - 2 <= full_size
     t.bodies.insert(t.bodies.end(), body + 2, body + 2 + t.body_size);
     ++t.rows;
-    if (t.timestamp_col >= 0) {
-      const std::uint64_t ts = t.TimestampUs(t.rows - 1);
-      if (ts > last_timestamp_us_) last_timestamp_us_ = ts;
+  }
+
+  /// The newest timestamp among the last message of every topic, us (for parameter changes).
+  std::uint64_t NewestTimestampUs() const {
+    std::uint64_t newest = 0;
+    for (const ULogTopic& t : log_->topics) {
+      if (t.rows > 0) newest = std::max(newest, t.TimestampUs(t.rows - 1));
     }
+    return newest;
   }
 
   void Other(std::size_t at, std::uint8_t type, const std::uint8_t* body, std::size_t size,
@@ -370,6 +376,31 @@ class Parser {
   }
 
   void Malformed() { ++log_->warnings.malformed_messages; }
+
+  /// Counts D messages per msg_id by hopping from header to header, so that each topic's
+  /// storage is reserved once (no reallocation copies). Stops at the first implausible header;
+  /// the counts are only a hint.
+  void PreScan() {
+    expected_rows_.assign(std::size_t{65536}, 0);
+    std::size_t pos = kFileHeaderSize;
+    while (size_ - pos >= kMsgHeaderSize + 2) {
+      const std::size_t size = Load<std::uint16_t>(data_ + pos);
+      if (size == 0 || size > size_ - pos - kMsgHeaderSize) break;
+      if (data_[pos + 2] == 'D') ++expected_rows_[Load<std::uint16_t>(data_ + pos + 3)];
+      pos += kMsgHeaderSize + size;
+    }
+  }
+
+  void Reserve(ULogTopic* t) {
+    if (expected_rows_.empty()) return;
+    const std::size_t bytes = std::size_t{expected_rows_[t->msg_id]} * t->body_size;
+    if (bytes <= size_) t->bodies.reserve(bytes);
+  }
+
+  /// Index into log_->topics of a msg_id, -1 when it is not subscribed.
+  int Index(std::uint16_t msg_id) const {
+    return msg_id < index_.size() ? index_[msg_id] : -1;
+  }
 
   void FlagBits(std::size_t at, const std::uint8_t* body, std::size_t size, std::size_t* end) {
     if (at != kFileHeaderSize || size < kFlagBitsSize) return Malformed();
@@ -434,7 +465,7 @@ class Parser {
     if (in_definitions_) {
       log_->params[kv->name] = *value;
     } else {
-      log_->param_changes.push_back({last_timestamp_us_, kv->name, *value});
+      log_->param_changes.push_back({NewestTimestampUs(), kv->name, *value});
     }
   }
 
@@ -451,12 +482,14 @@ class Parser {
     t.multi_id = body[0];
     t.msg_id = Load<std::uint16_t>(body + 1);
     t.name.assign(reinterpret_cast<const char*>(body + 3), size - 3);
-    if (index_[t.msg_id] >= 0) return Malformed();  // an id must not be reused
+    if (Index(t.msg_id) >= 0) return Malformed();  // an id must not be reused
     FormatResolver resolver(log_->formats);
     if (!resolver.Resolve(&t)) {
       ++log_->warnings.unresolved_subscriptions;
       return;
     }
+    Reserve(&t);
+    if (index_.size() <= t.msg_id) index_.resize(std::size_t{t.msg_id} + 1, -1);
     index_[t.msg_id] = static_cast<int>(log_->topics.size());
     log_->topics.push_back(std::move(t));
   }
@@ -492,9 +525,9 @@ class Parser {
   const std::uint8_t* data_;
   std::size_t size_;
   ULog* log_;
-  std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed
+  std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
+  std::vector<std::uint32_t> expected_rows_;  // PreScan() counts per msg_id, or empty
   bool in_definitions_ = true;
-  std::uint64_t last_timestamp_us_ = 0;
   std::size_t last_skip_ = 0;
 };
 

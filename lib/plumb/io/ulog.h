@@ -104,7 +104,7 @@ struct ULogFormatField {
 
 /// A parameter change logged in the data section.
 struct ULogParamChange {
-  std::uint64_t timestamp_us = 0;  ///< newest D timestamp seen before the change, us since boot
+  std::uint64_t timestamp_us = 0;  ///< newest timestamp among the topics' latest messages, us since boot
   std::string name;
   double value = 0.0;
 };
