@@ -594,5 +594,93 @@ TEST(ULogSession, VehicleImuIsDeltaOverDt) {
   EXPECT_DOUBLE_EQ(s.series.t_s[0], t->Column("timestamp_sample")[0] * 1e-6);
 }
 
+// A hand-built modern log: vehicle_imu of accel device 77, its temperature in sensor_accel,
+// CAL_ACC0 with SENS_BOARD_ROT = 2 (yaw 90) and thermal compensation TC_A0 enabled.
+Writer ThermalLog() {
+  Writer w;
+  w.Format("vehicle_imu:uint64_t timestamp;uint64_t timestamp_sample;uint32_t accel_device_id;"
+           "uint32_t gyro_device_id;float[3] delta_angle;float[3] delta_velocity;"
+           "uint16_t delta_angle_dt;uint16_t delta_velocity_dt;");
+  w.Format("sensor_accel:uint64_t timestamp;uint64_t timestamp_sample;uint32_t device_id;"
+           "float x;float y;float z;float temperature;");
+  const auto f = [&](const std::string& name, float v) { w.KeyValue('P', "float " + name, Le(v)); };
+  const auto i = [&](const std::string& name, std::int32_t v) {
+    w.KeyValue('P', "int32_t " + name, Le(v));
+  };
+  i("CAL_ACC0_ID", 77);
+  i("CAL_ACC0_ROT", -1);
+  i("CAL_GYRO0_ID", 88);
+  i("SENS_BOARD_ROT", 2);
+  i("TC_A_ENABLE", 1);
+  i("TC_A0_ID", 77);
+  f("TC_A0_TREF", 25.0f);
+  f("TC_A0_TMIN", 10.0f);
+  f("TC_A0_TMAX", 50.0f);
+  const char* axis = "XYZ";
+  for (int k = 0; k < 3; ++k) {
+    const std::string a(1, axis[k]);
+    f("CAL_ACC0_" + a + "OFF", 0.1f * static_cast<float>(k + 1));
+    f("CAL_ACC0_" + a + "SCALE", 1.0f + 0.01f * static_cast<float>(k + 1));
+    f("CAL_GYRO0_" + a + "OFF", -0.01f * static_cast<float>(k + 1));
+    for (int order = 0; order < 4; ++order) {
+      f("TC_A0_X" + std::to_string(order) + "_" + std::to_string(k),
+        0.02f / static_cast<float>(order + 1) * static_cast<float>(k + 1));
+    }
+  }
+  w.Add(0, 0, "vehicle_imu");
+  w.Add(0, 1, "sensor_accel");
+  const auto accel = [&](std::uint64_t t_us, float temp) {
+    w.Data(1, Cat({Le(t_us), Le(t_us), Le<std::uint32_t>(77), Le(0.f), Le(0.f), Le(-9.8f),
+                   Le(temp)}));
+  };
+  const auto imu = [&](std::uint64_t t_us, float ax) {
+    w.Data(0, Cat({Le(t_us), Le(t_us), Le<std::uint32_t>(77), Le<std::uint32_t>(88),
+                   Le(0.001f * 0.005f), Le(0.f), Le(0.f),                  // delta_angle, rad
+                   Le(ax * 0.005f), Le(0.5f * 0.005f), Le(-9.8f * 0.005f),  // delta_velocity
+                   Le<std::uint16_t>(5000), Le<std::uint16_t>(5000)}));      // dt, us
+  };
+  accel(1000000, 30.0f);
+  imu(1500000, 0.2f);
+  accel(2000000, 60.0f);  // above TC_A0_TMAX: clamped to 50
+  imu(2500000, 0.3f);
+  return w;
+}
+
+TEST(ULogSession, UndoesBoardRotationCalibrationAndThermalOffset) {
+  Writer w = ThermalLog();
+  const ULog log = Parse(w);
+  FlightLogSelection sel;
+  sel.stream = "vehicle_imu";
+  const Session s = ULogSession(log, sel);
+  sel.undo_correction = false;
+  const Session logged = ULogSession(log, sel);
+  ASSERT_EQ(s.series.size(), 2u);
+  const Mat3 r = Eigen::AngleAxisd(3.14159265358979323846 / 2, Vec3::UnitZ()).toRotationMatrix();
+  const auto p = [&](const std::string& name) { return log.params.at(name); };
+  const Vec3 scale(p("CAL_ACC0_XSCALE"), p("CAL_ACC0_YSCALE"), p("CAL_ACC0_ZSCALE"));
+  const Vec3 offset(p("CAL_ACC0_XOFF"), p("CAL_ACC0_YOFF"), p("CAL_ACC0_ZOFF"));
+  const double temps_c[2] = {30.0, 50.0};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const double dt = temps_c[k] - p("TC_A0_TREF");
+    Vec3 thermal;
+    for (int i = 0; i < 3; ++i) {
+      const std::string ax = "_" + std::to_string(i);
+      thermal[i] = p("TC_A0_X0" + ax) + p("TC_A0_X1" + ax) * dt + p("TC_A0_X2" + ax) * dt * dt +
+                   p("TC_A0_X3" + ax) * dt * dt * dt;
+    }
+    const Vec3 expected =
+        (r.transpose() * logged.series.acc[k].cast<double>()).cwiseQuotient(scale) + offset +
+        thermal;
+    EXPECT_LT((s.series.acc[k].cast<double>() - expected).norm(), 1e-4) << "sample " << k;
+    const Vec3 gyro_expected = r.transpose() * logged.series.gyr[k].cast<double>() +
+                               Vec3(p("CAL_GYRO0_XOFF"), p("CAL_GYRO0_YOFF"), p("CAL_GYRO0_ZOFF"));
+    EXPECT_LT((s.series.gyr[k].cast<double>() - gyro_expected).norm(), 1e-6) << "sample " << k;
+  }
+  EXPECT_NEAR(logged.series.acc[0].x(), 0.2, 1e-6);  // delta_velocity / dt
+  bool thermal_said = false;
+  for (const auto& m : s.warnings) thermal_said = thermal_said || m.find("TC_A0") != std::string::npos;
+  EXPECT_TRUE(thermal_said);
+}
+
 }  // namespace
 }  // namespace plumb::io

@@ -250,6 +250,37 @@ struct Correction {
   Vec3 scale = Vec3::Ones();
   Mat3 rotation = Mat3::Identity();
   std::string rotation_text;  ///< how R was obtained
+  double device_id = 0.0;     ///< the sensor's device id (0 when unknown)
+};
+
+/// PX4's thermal offset of one sensor (TemperatureCompensation): with T clamped to
+/// [t_min_c, t_max_c] and dT = T - t_ref_c, offset_i = x[0]_i + x[1]_i dT + x[2]_i dT^2 +
+/// x[3]_i dT^3 (sensor units: m/s^2 or rad/s).
+struct Thermal {
+  std::string prefix;        ///< e.g. "TC_A1"
+  double t_ref_c = 0.0;      ///< TC_An_TREF, degC
+  double t_min_c = 0.0;      ///< TC_An_TMIN, degC
+  double t_max_c = 0.0;      ///< TC_An_TMAX, degC
+  std::array<Vec3, 4> x;     ///< TC_An_X0_* .. TC_An_X3_*, per axis
+
+  Vec3 Offset(double temp_c) const {
+    const double dt = std::clamp(temp_c, t_min_c, std::max(t_min_c, t_max_c)) - t_ref_c;
+    return x[0] + dt * (x[1] + dt * (x[2] + dt * x[3]));
+  }
+};
+
+/// A sensor temperature over time, degC at t_s (s), sorted by time.
+struct TemperatureTrack {
+  std::vector<double> t_s;
+  std::vector<double> temp_c;
+  std::string source;  ///< topic(s) it came from
+
+  /// The latest temperature at or before t_s (the first one before the track starts).
+  double At(double t) const {
+    const auto it = std::upper_bound(t_s.begin(), t_s.end(), t);
+    const std::size_t i = it == t_s.begin() ? 0 : static_cast<std::size_t>(it - t_s.begin()) - 1;
+    return temp_c[i];
+  }
 };
 
 /// The device id of the accel ("ACC") or gyro ("GYRO") behind a calibrated stream; nullopt
@@ -297,6 +328,7 @@ std::optional<Correction> FindCorrection(const ULog& log, const StreamSource& sr
   }
   Correction c;
   c.prefix = "CAL_" + kind + std::to_string(slot);
+  c.device_id = *id;
   const char* axes[3] = {"X", "Y", "Z"};
   for (int i = 0; i < 3; ++i) {
     const auto off = Param(log, c.prefix + "_" + axes[i] + "OFF");
@@ -337,11 +369,91 @@ std::optional<Correction> FindCorrection(const ULog& log, const StreamSource& sr
   return c;
 }
 
-/// m = R^T logged ./ scale + offset, in place.
-void Undo(const Correction& c, std::vector<Vec3f>* v) {
+/// The TC_An / TC_Gn coefficients whose TC_*n_ID equals `device_id` (kind "A" or "G").
+std::optional<Thermal> FindThermal(const ULog& log, const std::string& kind, double device_id,
+                                   std::string* why) {
+  for (int n = 0; n < kMaxCalSlots; ++n) {
+    const std::string prefix = "TC_" + kind + std::to_string(n);
+    const auto id = Param(log, prefix + "_ID");
+    if (!id || *id != device_id) continue;
+    Thermal t;
+    t.prefix = prefix;
+    const auto ref = Param(log, prefix + "_TREF");
+    const auto tmin = Param(log, prefix + "_TMIN");
+    const auto tmax = Param(log, prefix + "_TMAX");
+    if (!ref || !tmin || !tmax) {
+      *why = prefix + "_TREF/TMIN/TMAX missing";
+      return std::nullopt;
+    }
+    t.t_ref_c = *ref;
+    t.t_min_c = *tmin;
+    t.t_max_c = *tmax;
+    for (int k = 0; k < 4; ++k) {
+      for (int i = 0; i < 3; ++i) {
+        const std::string name = prefix + "_X" + std::to_string(k) + "_" + std::to_string(i);
+        const auto v = Param(log, name);
+        if (!v) {
+          *why = name + " missing";
+          return std::nullopt;
+        }
+        t.x[static_cast<std::size_t>(k)][i] = *v;
+      }
+    }
+    return t;
+  }
+  *why = "no TC_" + kind + "n_ID equals the device id " +
+         std::to_string(static_cast<long long>(device_id));
+  return std::nullopt;
+}
+
+/// The temperature of the sensor with `device_id` from sensor_accel/sensor_gyro (device_id,
+/// temperature) and vehicle_imu_status (accel_device_id/gyro_device_id,
+/// temperature_accel/temperature_gyro) messages; nullopt when none is logged.
+std::optional<TemperatureTrack> SensorTemperature(const ULog& log, bool accel, double device_id) {
+  std::vector<std::pair<double, double>> points;
+  std::string source;
+  for (const ULogTopic& t : log.topics) {
+    int id_col = -1, temp_col = -1;
+    if (t.name == (accel ? "sensor_accel" : "sensor_gyro")) {
+      id_col = t.ColumnIndex("device_id");
+      temp_col = t.ColumnIndex("temperature");
+    } else if (t.name == "vehicle_imu_status") {
+      id_col = t.ColumnIndex(accel ? "accel_device_id" : "gyro_device_id");
+      temp_col = t.ColumnIndex(accel ? "temperature_accel" : "temperature_gyro");
+    }
+    const int time = TimeColumn(t);
+    if (id_col < 0 || temp_col < 0 || time < 0) continue;
+    const std::size_t before = points.size();
+    for (std::size_t r = 0; r < t.rows; ++r) {
+      if (t.Value(r, static_cast<std::size_t>(id_col)) != device_id) continue;
+      const double temp = t.Value(r, static_cast<std::size_t>(temp_col));
+      const double when = TimeS(t, r, time);
+      if (std::isfinite(temp) && std::isfinite(when)) points.emplace_back(when, temp);
+    }
+    if (points.size() > before) {
+      source += (source.empty() ? "" : ", ") + t.name + " instance " + std::to_string(t.multi_id);
+    }
+  }
+  if (points.empty()) return std::nullopt;
+  std::sort(points.begin(), points.end());
+  TemperatureTrack track;
+  track.source = source;
+  for (const auto& [when, temp] : points) {
+    track.t_s.push_back(when);
+    track.temp_c.push_back(temp);
+  }
+  return track;
+}
+
+/// m = R^T logged ./ scale + offset (+ thermal offset at the sample's temperature), in place.
+void Undo(const Correction& c, const std::optional<Thermal>& thermal,
+          const std::optional<TemperatureTrack>& temp, const std::vector<double>& t_s,
+          std::vector<Vec3f>* v) {
   const Mat3 rt = c.rotation.transpose();
-  for (Vec3f& x : *v) {
-    x = ((rt * x.cast<double>()).cwiseQuotient(c.scale) + c.offset).cast<float>();
+  for (std::size_t k = 0; k < v->size(); ++k) {
+    Vec3 m = (rt * (*v)[k].cast<double>()).cwiseQuotient(c.scale) + c.offset;
+    if (thermal && temp) m += thermal->Offset(temp->At(t_s[k]));
+    (*v)[k] = m.cast<float>();
   }
 }
 
@@ -373,17 +485,37 @@ void UndoCorrection(const ULog& log, const StreamSource& src, Session* s) {
                             why + ")");
       continue;
     }
-    Undo(*c, acc ? &s->series.acc : &s->series.gyr);
+    // Thermal compensation (TC_A_ENABLE / TC_G_ENABLE = 1) at the sensor's logged temperature.
+    const std::string tc = acc ? "TC_A_ENABLE" : "TC_G_ENABLE";
+    std::optional<Thermal> thermal;
+    std::optional<TemperatureTrack> temp;
+    std::string thermal_text;
+    if (Param(log, tc).value_or(0.0) == 1.0) {
+      std::string tc_why;
+      thermal = FindThermal(log, acc ? "A" : "G", c->device_id, &tc_why);
+      temp = thermal ? SensorTemperature(log, acc, c->device_id) : std::nullopt;
+      if (!thermal || !temp) {
+        if (thermal) tc_why = "no temperature of device " +
+                              std::to_string(static_cast<long long>(c->device_id)) + " in the log";
+        s->warnings.push_back(who + tc + " = 1: PX4's thermal " + what +
+                              " correction is in the samples and NOT undone (" + tc_why + ")");
+        thermal.reset();
+      } else {
+        thermal_text = " + thermal offset " + thermal->prefix + "_X0..X3 (X0 " +
+                       Format(thermal->x[0]) + ", X1 " + Format(thermal->x[1]) + ", X2 " +
+                       Format(thermal->x[2]) + ", X3 " + Format(thermal->x[3]) + ", TREF " +
+                       std::to_string(thermal->t_ref_c) + " degC, clamped to [" +
+                       std::to_string(thermal->t_min_c) + ", " +
+                       std::to_string(thermal->t_max_c) + "]) at the temperature of " +
+                       temp->source;
+      }
+    }
+    Undo(*c, thermal, temp, s->series.t_s, acc ? &s->series.acc : &s->series.gyr);
     const std::string unit = acc ? " m/s^2" : " rad/s";
     s->warnings.push_back(who + what + " reconstructed as R^T logged ./ " + c->prefix +
                           "_*SCALE (" + Format(c->scale) + ") + " + c->prefix + "_*OFF (" +
-                          Format(c->offset) + ")" + unit + ", R from " + c->rotation_text);
-    const std::string tc = acc ? "TC_A_ENABLE" : "TC_G_ENABLE";
-    if (Param(log, tc).value_or(0.0) == 1.0) {
-      s->warnings.push_back(who + tc + " = 1: PX4's thermal " + what +
-                            " correction is in the samples and NOT undone (no temperature in "
-                            "this stream)");
-    }
+                          Format(c->offset) + ")" + unit + thermal_text + ", R from " +
+                          c->rotation_text);
   }
 }
 

@@ -28,9 +28,14 @@
 // deg, 8..15 roll 180 with yaw, 12 pitch 180, 16..23 roll 90/270 with yaw, 24/25 pitch
 // 90/270). n is the CAL_ACCn whose CAL_ACCn_ID equals the sensor's device id: vehicle_imu's
 // accel_device_id/gyro_device_id; for sensor_combined CAL_ACC_PRIME/CAL_GYRO_PRIME (2016
-// logs) or vehicle_imu instance 0's ids. Undone:  m = R^T logged ./ SCALE + OFF.
-// The thermal term (TC_A_ENABLE / TC_G_ENABLE = 1: TC_An_X0..X3 polynomial in the sensor
-// temperature) is not undone: these streams carry no temperature; the session says so.
+// logs) or vehicle_imu instance 0's ids. The thermal term (TemperatureCompensation, applied
+// when TC_A_ENABLE / TC_G_ENABLE = 1) comes from the TC_An / TC_Gn set whose TC_*n_ID equals
+// the device id: with T the sensor temperature clamped to [TC_An_TMIN, TC_An_TMAX] and
+// dT = T - TC_An_TREF, thermal_i = X0_i + X1_i dT + X2_i dT^2 + X3_i dT^3 (TC_An_Xk_i).
+// T is the latest logged temperature of that device at or before the sample (sensor_accel /
+// sensor_gyro "temperature", vehicle_imu_status "temperature_accel"/"temperature_gyro").
+// Undone:  m = R^T logged ./ SCALE + OFF + thermal(T). When a parameter or the temperature is
+// missing, that part is left in the samples and the session's warnings say so.
 #pragma once
 
 #include <map>
