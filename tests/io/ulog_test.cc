@@ -574,6 +574,13 @@ TEST(ULogSession, SmallLogStreamsSiteAndRawSensorAccel) {
   const auto params = ULogParams(log);
   EXPECT_EQ(params.at("SENS_BOARD_ROT"), 4.0);
   EXPECT_FALSE(params.count("MPC_XY_VEL_MAX"));
+  const FlightLogSummary summary = ULogSummary(log);
+  EXPECT_EQ(summary.format, "px4-ulog");
+  EXPECT_EQ(summary.imus.size(), 7u);
+  EXPECT_EQ(summary.params, params);
+  EXPECT_TRUE(summary.site.has_value());
+  EXPECT_EQ(summary.messages, log.MessageCounts());
+  EXPECT_EQ(summary.warnings.size(), 1u);  // one dropout
 }
 
 // vehicle_imu: mean specific force = delta_velocity / dt, checked against the raw fields.

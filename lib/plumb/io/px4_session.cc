@@ -251,6 +251,7 @@ struct Correction {
   Mat3 rotation = Mat3::Identity();
   std::string rotation_text;  ///< how R was obtained
   double device_id = 0.0;     ///< the sensor's device id (0 when unknown)
+  std::string id_source;      ///< where the device id came from
 };
 
 /// PX4's thermal offset of one sensor (TemperatureCompensation): with T clamped to
@@ -329,6 +330,7 @@ std::optional<Correction> FindCorrection(const ULog& log, const StreamSource& sr
   Correction c;
   c.prefix = "CAL_" + kind + std::to_string(slot);
   c.device_id = *id;
+  c.id_source = how;
   const char* axes[3] = {"X", "Y", "Z"};
   for (int i = 0; i < 3; ++i) {
     const auto off = Param(log, c.prefix + "_" + axes[i] + "OFF");
@@ -465,6 +467,8 @@ std::string CalibrationNames(const ULog& log, const StreamSource& src) {
   out += ", ";
   out += gyr ? gyr->prefix + "_*" : "CAL_GYROn_*";
   out += ", board rotation";
+  if (Param(log, "TC_A_ENABLE").value_or(0.0) == 1.0) out += ", TC_A* thermal";
+  if (Param(log, "TC_G_ENABLE").value_or(0.0) == 1.0) out += ", TC_G* thermal";
   return out;
 }
 
@@ -515,7 +519,9 @@ void UndoCorrection(const ULog& log, const StreamSource& src, Session* s) {
     s->warnings.push_back(who + what + " reconstructed as R^T logged ./ " + c->prefix +
                           "_*SCALE (" + Format(c->scale) + ") + " + c->prefix + "_*OFF (" +
                           Format(c->offset) + ")" + unit + thermal_text + ", R from " +
-                          c->rotation_text);
+                          c->rotation_text + "; " + c->prefix + " chosen by device id " +
+                          std::to_string(static_cast<long long>(c->device_id)) + " from " +
+                          c->id_source);
   }
 }
 
@@ -648,9 +654,10 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   const std::vector<StreamSource> sources = Sources(log);
   std::vector<ImuStreamInfo> infos;
   std::vector<ImuSeries> all;
-  for (const StreamSource& src : sources) {
-    all.push_back(Extract(src, nullptr));
-    infos.push_back(Describe(log, src, all.back()));
+  std::vector<std::vector<std::string>> notes(sources.size());
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    all.push_back(Extract(sources[i], &notes[i]));
+    infos.push_back(Describe(log, sources[i], all.back()));
   }
   const StreamSource* src = Select(sources, infos, selection);
   const std::string wanted = (selection.stream.empty() ? std::string("IMU") : selection.stream) +
@@ -659,6 +666,7 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
     throw InputError(log.source, "", "no " + wanted +
                                          " stream (sensor_combined, vehicle_imu or sensor_accel)");
   }
+  const auto chosen = static_cast<std::size_t>(src - sources.data());
   Session s;
   s.source = log.source + " (" + KindName(src->kind) + " instance " +
              std::to_string(src->instance) + ")";
@@ -668,9 +676,8 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
                          " logging dropout(s), " + std::to_string(log.dropout_total_ms) +
                          " ms in total");
   }
-  std::vector<std::string> notes;
-  const ImuSeries whole = Extract(*src, &notes);
-  for (auto& n : notes) s.warnings.push_back(std::move(n));
+  for (auto& n : notes[chosen]) s.warnings.push_back(std::move(n));
+  const ImuSeries& whole = all[chosen];
 
   ImuSeries& out = s.series;
   for (std::size_t i = 0; i < whole.size(); ++i) {
@@ -692,13 +699,36 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
     s.warnings.push_back(who + "raw driver output (not calibrated by PX4), taken as logged");
   } else if (!selection.undo_correction) {
     s.warnings.push_back(who + "samples taken as logged (calibrated by PX4 with " +
-                         infos[static_cast<std::size_t>(src - sources.data())].applied + ")");
+                         infos[chosen].applied + ")");
   } else {
     UndoCorrection(log, *src, &s);
     WarnParamChanges(log, &s);
   }
   s.site = SiteFromULog(log);
   return s;
+}
+
+FlightLogSummary ULogSummary(const ULog& log) {
+  FlightLogSummary out;
+  out.source = log.source;
+  out.format = "px4-ulog";
+  out.format_detail = "ULog version " + std::to_string(log.version) + ", " +
+                      std::to_string(log.topics.size()) + " subscriptions";
+  if (log.data_appended) {
+    out.format_detail += ", data appended at " + std::to_string(log.appended_offsets.size()) +
+                         " offset(s)";
+  }
+  out.size_bytes = log.size_bytes;
+  out.imus = ULogImuStreams(log);
+  out.site = SiteFromULog(log);
+  out.params = ULogParams(log);
+  out.messages = log.MessageCounts();
+  out.warnings = log.warnings.Describe();
+  if (log.dropouts > 0) {
+    out.warnings.push_back(std::to_string(log.dropouts) + " logging dropout(s), " +
+                           std::to_string(log.dropout_total_ms) + " ms in total");
+  }
+  return out;
 }
 
 bool LooksLikeULog(const std::string& path) {

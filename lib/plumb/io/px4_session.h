@@ -74,6 +74,11 @@ std::map<std::string, double> ULogParams(const ULog& log);
 /// stream is absent or the window holds fewer than 2 samples.
 Session ULogSession(const ULog& log, const FlightLogSelection& selection);
 
+/// The log as `plumb info` shows it: format "px4-ulog", format_detail "ULog version N, K
+/// subscriptions[, data appended at M offset(s)]", the IMU streams, the GPS site, ULogParams(),
+/// D message counts per "topic/multi_id" and the reader's warnings (dropouts included).
+FlightLogSummary ULogSummary(const ULog& log);
+
 /// True when the file starts with the ULog magic 'U' 'L' 'o' 'g' 0x01 0x12 0x35.
 bool LooksLikeULog(const std::string& path);
 
