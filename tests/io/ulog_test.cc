@@ -460,6 +460,24 @@ TEST(ULogBuilt, UnresolvableFormatsAreCountedNotAllocated) {
   EXPECT_TRUE(log.topics.empty());
 }
 
+// A binary tree of nested formats: t14 flattens to 32768 columns. Subscribing it 100 times
+// in a 2 KB input must stop at the column budget (input bytes + 65536), quickly.
+TEST(ULogBuilt, NestedFanOutIsBoundedByTheColumnBudget) {
+  Writer w;
+  w.Format("t0:uint8_t a;uint8_t b;");
+  for (int k = 1; k <= 15; ++k) {
+    const std::string inner = "t" + std::to_string(k - 1);
+    w.Format("t" + std::to_string(k) + ":" + inner + " a;" + inner + " b;");
+  }
+  for (std::uint16_t id = 0; id < 100; ++id) w.Add(0, id, "t14");
+  w.Add(0, 100, "t15");  // 65536 bytes: larger than a D message
+  const ULog log = Parse(w);
+  EXPECT_EQ(log.topics.size(), 2u);
+  EXPECT_EQ(log.topics[0].columns.size(), 32768u);
+  EXPECT_EQ(log.topics[0].columns.back().name, "b.b.b.b.b.b.b.b.b.b.b.b.b.b.b");
+  EXPECT_EQ(log.warnings.unresolved_subscriptions, 99u);
+}
+
 TEST(ULogBuilt, BadHeadersAndUnknownIncompatibleBitsThrow) {
   const Bytes short_input = {'U', 'L', 'o', 'g'};
   EXPECT_THROW(ParseULog(short_input.data(), short_input.size(), "short"), InputError);

@@ -18,6 +18,7 @@ constexpr std::size_t kMsgHeaderSize = 3;
 constexpr std::size_t kFlagBitsSize = 40;        // 8 + 8 + 3 * 8
 constexpr std::size_t kMaxDataBody = 65535 - 2;  // largest D body after the msg_id
 constexpr int kMaxNesting = 32;
+constexpr std::size_t kMinColumnBudget = 65536;  // columns allowed beyond one per input byte
 constexpr std::size_t kPreScanMinSize = std::size_t{1} << 16;  // inputs worth a counting pass
 
 template <typename T>
@@ -95,24 +96,35 @@ bool ParseFormat(std::string_view text, std::string* name,
   return !fields->empty();
 }
 
-/// Resolves a subscribed format into flattened columns (see the contract in ulog.h).
+/// Resolves a subscribed format into flattened columns (see the contract in ulog.h). Sizes and
+/// column counts of resolved types are cached (a redefined format clears the cache), and the
+/// columns created over the whole log are limited to a budget proportional to the input, so
+/// that no input makes resolution slow or large.
 class FormatResolver {
  public:
-  explicit FormatResolver(const std::map<std::string, std::vector<ULogFormatField>>& formats)
-      : formats_(formats) {}
+  FormatResolver(const std::map<std::string, std::vector<ULogFormatField>>& formats,
+                 std::size_t column_budget)
+      : formats_(formats), column_budget_(column_budget) {}
 
-  /// Fills columns, body_size, full_size and timestamp_col of `topic`; false if unresolvable.
+  /// Forgets cached layouts (call when a format is redefined).
+  void Invalidate() { cache_.clear(); }
+
+  /// Fills columns, body_size, full_size and timestamp_col of `topic`; false if unresolvable
+  /// or over the column budget.
   bool Resolve(ULogTopic* topic) {
     const auto it = formats_.find(topic->name);
     if (it == formats_.end()) return false;
-    const std::optional<std::size_t> full = Size(topic->name, 0);
-    if (!full || *full == 0 || *full > kMaxDataBody) return false;
-    topic->full_size = *full;
+    const std::optional<Layout> full = LayoutOf(topic->name, 0);
+    if (!full || full->size == 0 || full->size > kMaxDataBody) return false;
+    if (full->columns > column_budget_) return false;
+    column_budget_ -= full->columns;
+    topic->full_size = full->size;
     std::size_t trailing = 0;
     for (auto f = it->second.rbegin(); f != it->second.rend() && IsPadding(f->name); ++f) {
-      trailing += *Size(f->type, 1) * f->count;
+      trailing += LayoutOf(f->type, 1)->size * f->count;
     }
-    topic->body_size = *full - trailing;
+    topic->body_size = full->size - trailing;
+    topic->columns.reserve(full->columns);
     std::size_t offset = 0;
     Flatten(it->second, "", &offset, &topic->columns);
     for (std::size_t c = 0; c < topic->columns.size(); ++c) {
@@ -128,20 +140,33 @@ class FormatResolver {
   }
 
  private:
-  /// Byte size of a type, nullopt when unknown, circular/too deep, empty or too large.
-  std::optional<std::size_t> Size(const std::string& type, int depth) {
-    if (const auto basic = BasicType(type)) return basic->second;
+  struct Layout {
+    std::size_t size = 0;     ///< bytes
+    std::size_t columns = 0;  ///< non-padding basic fields after flattening
+  };
+
+  /// Layout of a type; nullopt when unknown, circular or nested deeper than kMaxNesting,
+  /// empty, or larger than a D message. Only successes are cached: they do not depend on the
+  /// depth they were computed at.
+  std::optional<Layout> LayoutOf(const std::string& type, int depth) {
+    if (const auto basic = BasicType(type)) return Layout{basic->second, 1};
     if (depth > kMaxNesting) return std::nullopt;
+    if (const auto hit = cache_.find(type); hit != cache_.end()) return hit->second;
     const auto it = formats_.find(type);
     if (it == formats_.end()) return std::nullopt;
-    std::size_t total = 0;
+    Layout total;
     for (const ULogFormatField& f : it->second) {
-      const std::optional<std::size_t> s = Size(f.type, depth + 1);
-      if (!s || *s == 0) return std::nullopt;
-      if (*s > kMaxDataBody / f.count) return std::nullopt;
-      total += *s * f.count;
-      if (total > kMaxDataBody) return std::nullopt;
+      const std::optional<Layout> l = LayoutOf(f.type, depth + 1);
+      if (!l || l->size == 0 || l->size > kMaxDataBody / f.count) return std::nullopt;
+      total.size += l->size * f.count;
+      if (!BasicType(f.type)) {
+        total.columns += l->columns * f.count;  // Flatten() keeps nested columns
+      } else if (!IsPadding(f.name)) {
+        total.columns += f.count;
+      }
+      if (total.size > kMaxDataBody) return std::nullopt;
     }
+    cache_[type] = total;
     return total;
   }
 
@@ -163,6 +188,8 @@ class FormatResolver {
   }
 
   const std::map<std::string, std::vector<ULogFormatField>>& formats_;
+  std::size_t column_budget_;
+  std::map<std::string, Layout> cache_;
 };
 
 /// Key and value of an I/P/Q/M body after its leading bytes: uint8 key_len, key, value.
@@ -230,7 +257,8 @@ std::string InfoText(const KeyValue& kv) {
 class Parser {
  public:
   Parser(const std::uint8_t* data, std::size_t size, ULog* log)
-      : data_(data), size_(size), log_(log) {}
+      : data_(data), size_(size), log_(log),
+        resolver_(log->formats, size + kMinColumnBudget) {}
 
   void Run() {
     if (size_ >= kPreScanMinSize) PreScan();
@@ -382,19 +410,26 @@ class Parser {
   /// the counts are only a hint.
   void PreScan() {
     expected_rows_.assign(std::size_t{65536}, 0);
+    expected_bytes_.assign(std::size_t{65536}, 0);
     std::size_t pos = kFileHeaderSize;
     while (size_ - pos >= kMsgHeaderSize + 2) {
       const std::size_t size = Load<std::uint16_t>(data_ + pos);
       if (size == 0 || size > size_ - pos - kMsgHeaderSize) break;
-      if (data_[pos + 2] == 'D') ++expected_rows_[Load<std::uint16_t>(data_ + pos + 3)];
+      if (data_[pos + 2] == 'D' && size >= 2) {
+        const std::uint16_t id = Load<std::uint16_t>(data_ + pos + 3);
+        ++expected_rows_[id];
+        expected_bytes_[id] += size - 2;
+      }
       pos += kMsgHeaderSize + size;
     }
   }
 
   void Reserve(ULogTopic* t) {
     if (expected_rows_.empty()) return;
-    const std::size_t bytes = std::size_t{expected_rows_[t->msg_id]} * t->body_size;
-    if (bytes <= size_) t->bodies.reserve(bytes);
+    // Never more than the D bytes seen for this id: the reservations add up to at most the
+    // input size.
+    t->bodies.reserve(std::min(std::size_t{expected_rows_[t->msg_id]} * t->body_size,
+                               expected_bytes_[t->msg_id]));
   }
 
   /// Index into log_->topics of a msg_id, -1 when it is not subscribed.
@@ -437,6 +472,7 @@ class Parser {
                      &fields)) {
       return Malformed();
     }
+    if (log_->formats.count(name) != 0) resolver_.Invalidate();
     log_->formats[name] = std::move(fields);
   }
 
@@ -483,8 +519,7 @@ class Parser {
     t.msg_id = Load<std::uint16_t>(body + 1);
     t.name.assign(reinterpret_cast<const char*>(body + 3), size - 3);
     if (Index(t.msg_id) >= 0) return Malformed();  // an id must not be reused
-    FormatResolver resolver(log_->formats);
-    if (!resolver.Resolve(&t)) {
+    if (!resolver_.Resolve(&t)) {
       ++log_->warnings.unresolved_subscriptions;
       return;
     }
@@ -527,6 +562,8 @@ class Parser {
   ULog* log_;
   std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
   std::vector<std::uint32_t> expected_rows_;  // PreScan() counts per msg_id, or empty
+  std::vector<std::size_t> expected_bytes_;   // PreScan() D body bytes per msg_id, or empty
+  FormatResolver resolver_;
   bool in_definitions_ = true;
   std::size_t last_skip_ = 0;
 };

@@ -24,7 +24,8 @@
 //    flattened into columns named "outer.inner[2].x" with byte offsets; fields whose name
 //    starts with "_padding" are not columns but keep their bytes. A format that cannot be
 //    resolved (unknown or circular type, more than 32 levels, empty, or larger than a D message
-//    can hold) leaves its msg_id unsubscribed (counted).
+//    can hold) leaves its msg_id unsubscribed (counted); so does a subscription that would take
+//    the columns of all topics past (input bytes + 65536), a bound no real log comes near.
 //  * Trailing top-level padding fields need not be logged: a D body is accepted when its size
 //    lies between the format's size without and with them; the bytes without it are stored.
 //  * Appended data (incompat bit 0 and non-zero offsets): the data section is read in segments
