@@ -76,6 +76,8 @@ void ExpectCountsMatchGolden(const ULog& log, const nlohmann::json& g) {
   EXPECT_EQ(log.warnings.truncated_bytes, g["truncated_bytes"].get<std::size_t>());
   EXPECT_EQ(log.warnings.unknown_msg_id_messages, g["unknown_msg_id_messages"].get<std::size_t>());
   EXPECT_EQ(log.warnings.unknown_type_messages, g["unknown_type_messages"].get<std::size_t>());
+  EXPECT_EQ(log.warnings.unresolved_subscriptions,
+            g["unresolved_subscriptions"].get<std::size_t>());
   EXPECT_EQ(log.dropouts, g["dropouts"].get<std::size_t>());
   EXPECT_EQ(log.dropout_total_ms, g["dropout_total_ms"].get<std::uint64_t>());
   EXPECT_EQ(log.sync_messages, g["sync_messages"].get<std::size_t>());
@@ -228,6 +230,26 @@ TEST(ULog, GarbledCopyResynchronisesAndCountsSkippedBytes) {
   EXPECT_GT(Topics(log, "sensor_combined", 0), Topics(whole, "sensor_combined", 0) * 8 / 10);
   const Session s = ULogSession(log, FlightLogSelection{});
   EXPECT_GT(s.series.size(), Topics(whole, "sensor_combined", 0) * 8 / 10);
+}
+
+// The damaged copy decode_golden.py --damaged makes (XOR 0x5A at the type bytes of an F, a P
+// and an A header, and at 70000 + 97001 k): both decoders must resynchronise alike, in the
+// definitions section (on chains of valid headers) and in the data section.
+TEST(ULog, DamagedCopyMatchesIndependentDecoder) {
+  const std::string path = SharedLog("sample_log_small.ulg");
+  SKIP_IF_ABSENT(path);
+  Bytes data = ReadBytes(path);
+  for (std::size_t offset : {std::size_t{5202}, std::size_t{30012}, std::size_t{61026}}) {
+    data[offset] ^= 0x5A;
+  }
+  for (std::size_t offset = 70000; offset < data.size(); offset += 97001) data[offset] ^= 0x5A;
+  const nlohmann::json g = ReadGolden("sample_log_small.ulg.damaged");
+  const ULog log = ParseULog(data.data(), data.size(), "damaged");
+  ExpectCountsMatchGolden(log, g);
+  EXPECT_EQ(log.warnings.first_skip_offset, g["first_skip_offset"].get<std::size_t>());
+  EXPECT_EQ(log.params.size(), g["param_count"].get<std::size_t>());
+  EXPECT_EQ(log.formats.size(), g["format_count"].get<std::size_t>());
+  EXPECT_GT(log.warnings.bytes_skipped, 0u);
 }
 
 // Flips bits anywhere (header and definitions included), then runs everything the CLI runs.

@@ -18,6 +18,7 @@ constexpr std::size_t kMsgHeaderSize = 3;
 constexpr std::size_t kFlagBitsSize = 40;        // 8 + 8 + 3 * 8
 constexpr std::size_t kMaxDataBody = 65535 - 2;  // largest D body after the msg_id
 constexpr int kMaxNesting = 32;
+constexpr int kResyncChain = 4;  // consecutive valid headers that end a resync without D or S
 constexpr std::size_t kMinColumnBudget = 65536;  // columns allowed beyond one per input byte
 constexpr std::size_t kPreScanMinSize = std::size_t{1} << 16;  // inputs worth a counting pass
 
@@ -46,6 +47,11 @@ std::optional<std::pair<ULogType, std::size_t>> BasicType(std::string_view name)
 bool IsPadding(std::string_view field) { return field.substr(0, 8) == "_padding"; }
 
 bool IsLetter(std::uint8_t c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
+
+/// The message types of ULog version 1.
+bool IsKnownType(std::uint8_t c) {
+  return std::memchr("BFIMPQARDLCSO", c, 13) != nullptr && c != 0;
+}
 
 /// Parses "type name" or "type[n] name"; nullopt when malformed.
 std::optional<ULogFormatField> ParseField(std::string_view item) {
@@ -339,24 +345,34 @@ class Parser {
     }
   }
 
-  /// True when a complete D message of a subscribed msg_id with a fitting size, or a complete
-  /// S message, starts at `pos`.
+  /// True when reading may resume at `pos`: a complete D message of a subscribed msg_id with a
+  /// fitting size, a complete S message with its magic, or a chain of kResyncChain complete,
+  /// non-corrupt messages of known types (fewer when the segment ends right after them).
   bool ResyncPoint(std::size_t pos, std::size_t end) const {
     if (end - pos < kMsgHeaderSize) return false;
     const std::size_t size = Load<std::uint16_t>(data_ + pos);
     const std::uint8_t type = data_[pos + 2];
     if (size > end - pos - kMsgHeaderSize) return false;
     const std::uint8_t* body = data_ + pos + kMsgHeaderSize;
-    if (type == 'D' && size >= 2) {
-      const int idx = Index(Load<std::uint16_t>(body));
-      if (idx < 0) return false;
-      const ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
+    if (type == 'D' && size >= 2 && Index(Load<std::uint16_t>(body)) >= 0) {
+      const ULogTopic& t = log_->topics[static_cast<std::size_t>(Index(Load<std::uint16_t>(body)))];
       return size - 2 >= t.body_size && size - 2 <= t.full_size;
     }
     if (type == 'S') {
       return size == sizeof(kSyncMagic) && std::memcmp(body, kSyncMagic, size) == 0;
     }
-    return false;
+    std::size_t at = pos;
+    for (int k = 0; k < kResyncChain; ++k) {
+      if (at == end) return true;
+      if (end - at < kMsgHeaderSize) return false;
+      const std::size_t n = Load<std::uint16_t>(data_ + at);
+      const std::uint8_t ty = data_[at + 2];
+      if (!IsKnownType(ty) || Corrupt(at, end, n, ty) || n > end - at - kMsgHeaderSize) {
+        return false;
+      }
+      at += kMsgHeaderSize + n;
+    }
+    return true;
   }
 
   void Data(const std::uint8_t* body, std::size_t size) {

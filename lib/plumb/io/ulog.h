@@ -38,7 +38,10 @@
 //    does not fit its subscription, an S without the sync magic or not 8 bytes, an O or R not
 //    2 bytes, an A shorter than 4, an L shorter than 9, a C shorter than 11 — starts a resync:
 //    bytes are skipped one by one (counted) until a complete D message of a subscribed msg_id
-//    with a fitting size, or a complete S message, starts.
+//    with a fitting size starts, or a complete S message with its magic, or a chain of 4
+//    complete, non-corrupt messages of known types (B F I M P Q A R D L C S O; fewer when the
+//    segment ends right after them) — the last rule recovers the definitions section, which
+//    has no D or S to resynchronise on.
 //  * A D whose msg_id was never subscribed is skipped by its size (counted); so is a message
 //    of an unknown letter type (a future ULog message, counted). A known message whose body
 //    does not parse (e.g. a key length past its end) is skipped (counted as malformed).

@@ -4,8 +4,9 @@
 Written separately from plumb's C++ reader (lib/plumb/io/ulog.cc) to produce the JSON files the
 C++ tests compare against. It is NOT run by the tests.
 
-Usage:  python3 decode_golden.py LOG.ulg [LOG2.ulg ...] --out-dir DIR
-Writes DIR/<basename>.golden.json for each log.
+Usage:  python3 decode_golden.py LOG.ulg [LOG2.ulg ...] --out-dir DIR [--damaged]
+Writes DIR/<basename>.golden.json for each log (with --damaged: <basename>.damaged.golden.json
+for a copy with bytes XORed at fixed offsets, see damage()).
 
 Format (PX4 "ULog File Format"): 16-byte header 'U' 'L' 'o' 'g' 0x01 0x12 0x35, version byte,
 uint64 start time (us); then messages, each a uint16 size (bytes after the 3-byte header), a
@@ -27,8 +28,12 @@ Decoding rules (the same contract the C++ reader documents):
     message that runs past its segment's end is that segment's truncated record (dropped).
   * Corrupt header: a size of 0, a non-letter type, a D whose size does not fit its
     subscription, an S without the sync magic or not 8 bytes, an O or R not 2 bytes, an A
-    shorter than 4, an L shorter than 9, a C shorter than 11. The decoder then skips byte by byte (counted)
-    until a D header with a subscribed id and a fitting size, or a complete S message, starts.
+    shorter than 4, an L shorter than 9, a C shorter than 11. The decoder then skips byte by
+    byte (counted) until a D header with a subscribed id and a fitting size, a complete S
+    message, or a chain of 4 complete non-corrupt messages of known types (fewer when the
+    segment ends right after them) starts.
+  * A subscription whose format cannot be resolved (unknown or circular type, empty, larger
+    than 65533 bytes) is counted and leaves its id unsubscribed.
   * D with an id never subscribed: counted, skipped by its size. Unknown letter types:
     counted, skipped by their size.
 """
@@ -144,13 +149,16 @@ class Log:
         self.appended = False
         self.appended_offsets = []
         self.in_defs = True
-        self.w = dict(bytes_skipped=0, skip_runs=0, truncated_records=0, truncated_bytes=0,
-                      unknown_msg_id_messages=0, unknown_type_messages=0, dropouts=0,
+        self.w = dict(bytes_skipped=0, skip_runs=0, first_skip_offset=0, truncated_records=0, truncated_bytes=0,
+                      unknown_msg_id_messages=0, unknown_type_messages=0,
+                      unresolved_subscriptions=0, dropouts=0,
                       dropout_total_ms=0, sync_messages=0, logging_messages=0)
         self.last_skip = -2
         self.run()
 
     def skip(self, pos):
+        if self.w["bytes_skipped"] == 0:
+            self.w["first_skip_offset"] = pos
         if pos != self.last_skip + 1:
             self.w["skip_runs"] += 1
         self.w["bytes_skipped"] += 1
@@ -166,12 +174,23 @@ class Log:
         if typ == ord("D") and size >= 2:
             (mid,) = struct.unpack_from("<H", d, pos + 3)
             s = self.subs.get(mid)
-            return s is not None and s.min_size <= size - 2 <= s.max_size
+            if s is not None:
+                return s.min_size <= size - 2 <= s.max_size
         if typ == ord("S"):
             return size == 8 and d[pos + 3:pos + 11] == SYNC
-        return False
+        at = pos
+        for _ in range(4):
+            if at == end:
+                return True
+            if end - at < 3:
+                return False
+            n, ty = struct.unpack_from("<HB", d, at)
+            if ty not in KNOWN or self.corrupt(n, ty, at, end) or at + 3 + n > end:
+                return False
+            at += 3 + n
+        return True
 
-    def corrupt(self, size, typ, pos):
+    def corrupt(self, size, typ, pos, end):
         if size == 0:
             return True
         if not (ord("A") <= typ <= ord("Z") or ord("a") <= typ <= ord("z")):
@@ -179,6 +198,8 @@ class Log:
         if typ == ord("D"):
             if size < 2:
                 return True
+            if end - pos < 5:
+                return False  # truncated: the caller decides
             (mid,) = struct.unpack_from("<H", self.data, pos + 3)
             s = self.subs.get(mid)
             if s is not None and not (s.min_size <= size - 2 <= s.max_size):
@@ -190,7 +211,7 @@ class Log:
         if (typ == ord("A") and size < 4) or (typ == ord("L") and size < 9) or \
                 (typ == ord("C") and size < 11):
             return True
-        if typ == ord("S") and pos + 11 <= len(self.data) and self.data[pos + 3:pos + 11] != SYNC:
+        if typ == ord("S") and pos + 11 <= end and self.data[pos + 3:pos + 11] != SYNC:
             return True
         return False
 
@@ -223,7 +244,7 @@ class Log:
                 pos = end
                 continue
             size, typ = struct.unpack_from("<HB", d, pos)
-            if self.corrupt(size, typ, pos):
+            if self.corrupt(size, typ, pos, end):
                 resync = True
                 continue
             if pos + 3 + size > end:
@@ -274,7 +295,16 @@ class Log:
                 multi_id = body[0]
                 (mid,) = struct.unpack_from("<H", body, 1)
                 name = body[3:].decode("latin-1")
-                self.subs[mid] = Sub(name, multi_id, self.formats)
+                if mid in self.subs:
+                    continue  # an id is never reused; the first subscription stays
+                try:
+                    sub = Sub(name, multi_id, self.formats)
+                except (ValueError, KeyError, RecursionError):
+                    sub = None
+                if sub is None or not 0 < sub.max_size <= 65533:
+                    self.w["unresolved_subscriptions"] += 1
+                else:
+                    self.subs[mid] = sub
             elif typ == ord("D"):
                 (mid,) = struct.unpack_from("<H", body, 0)
                 s = self.subs.get(mid)
@@ -315,6 +345,40 @@ SAMPLE_FIELDS = ("timestamp", "timestamp_sample", "gyro_rad", "gyro_rad_s", "acc
 
 def keep_fields(rec):
     return {k: v for k, v in rec.items() if k.split("[")[0] in SAMPLE_FIELDS}
+
+
+DAMAGE_OFFSETS_FIXED = (5202, 30012, 61026)  # type bytes of an F, a P and an A header
+DAMAGE_START, DAMAGE_STEP, DAMAGE_XOR = 70000, 97001, 0x5A
+
+
+def damage(data):
+    """The damaged copy the C++ test makes too: XOR 0x5A at offsets 5202, 30012, 61026 and
+    70000 + 97001 k."""
+    out = bytearray(data)
+    offsets = list(DAMAGE_OFFSETS_FIXED) + list(range(DAMAGE_START, len(out), DAMAGE_STEP))
+    for o in offsets:
+        if o < len(out):
+            out[o] ^= DAMAGE_XOR
+    return bytes(out)
+
+
+def damaged_golden(path):
+    with open(path, "rb") as f:
+        data = damage(f.read())
+    log = Log(data)
+    out = {"file": os.path.basename(path), "damage": "XOR 0x5A at 5202, 30012, 61026, 70000 + 97001 k",
+           "size_bytes": len(data)}
+    out.update(log.w)
+    counts = {}
+    for mid in sorted(log.subs):
+        s = log.subs[mid]
+        if s.count:
+            key = "%s/%d" % (s.name, s.multi_id)
+            counts[key] = counts.get(key, 0) + s.count
+    out["topic_counts"] = counts
+    out["param_count"] = len(log.params)
+    out["format_count"] = len(log.formats)
+    return out
 
 
 def golden(path):
@@ -404,10 +468,13 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("logs", nargs="+")
     ap.add_argument("--out-dir", required=True)
+    ap.add_argument("--damaged", action="store_true",
+                    help="write <log>.damaged.golden.json for the damaged copy (see damage())")
     args = ap.parse_args()
     for path in args.logs:
-        g = golden(path)
-        out = os.path.join(args.out_dir, os.path.basename(path) + ".golden.json")
+        g = damaged_golden(path) if args.damaged else golden(path)
+        suffix = ".damaged.golden.json" if args.damaged else ".golden.json"
+        out = os.path.join(args.out_dir, os.path.basename(path) + suffix)
         with open(out, "w") as f:
             json.dump(g, f, indent=1)
             f.write("\n")
