@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -62,10 +63,24 @@ int TimeColumn(const ULogTopic& t) {
   return sample >= 0 ? sample : t.timestamp_col;
 }
 
+/// double -> float with out-of-range values as +-infinity (a plain cast is undefined there).
+float ToFloat(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::infinity();
+  if (v < -kMax) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(v);
+}
+
+Vec3f ToFloat(const Vec3& v) { return Vec3f(ToFloat(v.x()), ToFloat(v.y()), ToFloat(v.z())); }
+
+Vec3 Row3d(const ULogTopic& t, std::size_t row, const Triad& c) {
+  return Vec3(t.Value(row, static_cast<std::size_t>(c[0])),
+              t.Value(row, static_cast<std::size_t>(c[1])),
+              t.Value(row, static_cast<std::size_t>(c[2])));
+}
+
 Vec3f Row3(const ULogTopic& t, std::size_t row, const Triad& c) {
-  return Vec3f(static_cast<float>(t.Value(row, static_cast<std::size_t>(c[0]))),
-               static_cast<float>(t.Value(row, static_cast<std::size_t>(c[1]))),
-               static_cast<float>(t.Value(row, static_cast<std::size_t>(c[2]))));
+  return ToFloat(Row3d(t, row, c));
 }
 
 double TimeS(const ULogTopic& t, std::size_t row, int col) {
@@ -109,8 +124,8 @@ ImuSeries FromVehicleImu(const ULogTopic& t) {
     const double v_dt_s = t.Value(r, static_cast<std::size_t>(dv_dt)) * kUsToS;
     const double a_dt_s = t.Value(r, static_cast<std::size_t>(da_dt)) * kUsToS;
     if (!(v_dt_s > 0.0) || !(a_dt_s > 0.0)) continue;
-    const Vec3f acc = (Row3(t, r, *dv).cast<double>() / v_dt_s).cast<float>();
-    const Vec3f g = (Row3(t, r, *da).cast<double>() / a_dt_s).cast<float>();
+    const Vec3f acc = ToFloat(Row3d(t, r, *dv) / v_dt_s);
+    const Vec3f g = ToFloat(Row3d(t, r, *da) / a_dt_s);
     Push(&s, TimeS(t, r, time), acc, &g, nullptr);
   }
   return s;
@@ -171,8 +186,8 @@ ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topi
   s.reserve(acc_topic.rows);
   for (std::size_t r = 0; r < acc_topic.rows; ++r) {
     if (paired && match[r] < 0) continue;
-    const float tc = temp >= 0 ? static_cast<float>(acc_topic.Value(r, static_cast<std::size_t>(temp)))
-                               : 0.0f;
+    const float tc =
+        temp >= 0 ? ToFloat(acc_topic.Value(r, static_cast<std::size_t>(temp))) : 0.0f;
     Vec3f g;
     if (paired) g = Row3(*gyro_topic, static_cast<std::size_t>(match[r]), *gyr);
     // Temperature and gyro columns must stay aligned with t_s: Push keeps or drops all.
@@ -215,8 +230,19 @@ std::optional<double> Param(const ULog& log, const std::string& name) {
   return it->second;
 }
 
-/// PX4's rotation enum as (roll, pitch, yaw) degrees, for 0..25; nullopt otherwise.
-std::optional<Vec3> RotationEuler(int k) {
+/// A parameter or id value as integer text (any double, NaN and huge values included).
+std::string Integer(double v) {
+  std::ostringstream out;
+  out.precision(0);
+  out << std::fixed << v;
+  return out.str();
+}
+
+/// PX4's rotation enum as (roll, pitch, yaw) degrees, for the integers 0..25; nullopt
+/// otherwise (other values, fractions, NaN).
+std::optional<Vec3> RotationEuler(double value) {
+  if (!(value >= 0.0 && value <= 25.0) || value != std::floor(value)) return std::nullopt;
+  const int k = static_cast<int>(value);
   static const double kTable[26][3] = {
       {0, 0, 0},     {0, 0, 45},    {0, 0, 90},    {0, 0, 135},   {0, 0, 180},
       {0, 0, 225},   {0, 0, 270},   {0, 0, 315},   {180, 0, 0},   {180, 0, 45},
@@ -224,7 +250,6 @@ std::optional<Vec3> RotationEuler(int k) {
       {180, 0, 315}, {90, 0, 0},    {90, 0, 45},   {90, 0, 90},   {90, 0, 135},
       {270, 0, 0},   {270, 0, 45},  {270, 0, 90},  {270, 0, 135}, {0, 90, 0},
       {0, 270, 0}};
-  if (k < 0 || k > 25) return std::nullopt;
   return Vec3(kTable[k][0], kTable[k][1], kTable[k][2]);
 }
 
@@ -323,7 +348,7 @@ std::optional<Correction> FindCorrection(const ULog& log, const StreamSource& sr
   }
   if (slot < 0) {
     *why = id ? "no CAL_" + kind + "n_ID equals the device id " +
-                    std::to_string(static_cast<long long>(*id)) + " (from " + how + ")"
+                    Integer(*id) + " (from " + how + ")"
               : "the log does not say which sensor it is (no device id)";
     return std::nullopt;
   }
@@ -347,25 +372,25 @@ std::optional<Correction> FindCorrection(const ULog& log, const StreamSource& sr
   }
   const auto cal_rot = Param(log, c.prefix + "_ROT");
   if (cal_rot && *cal_rot >= 0) {
-    const auto euler = RotationEuler(static_cast<int>(*cal_rot));
+    const auto euler = RotationEuler(*cal_rot);
     if (!euler) {
-      *why = c.prefix + "_ROT = " + std::to_string(*cal_rot) + " is not a rotation plumb knows";
+      *why = c.prefix + "_ROT = " + Integer(*cal_rot) + " is not a rotation plumb knows";
       return std::nullopt;
     }
     c.rotation = EulerDeg(*euler);
-    c.rotation_text = c.prefix + "_ROT = " + std::to_string(static_cast<int>(*cal_rot));
+    c.rotation_text = c.prefix + "_ROT = " + Integer(*cal_rot);
   } else {
-    const int board = static_cast<int>(Param(log, "SENS_BOARD_ROT").value_or(0.0));
+    const double board = Param(log, "SENS_BOARD_ROT").value_or(0.0);
     const auto euler = RotationEuler(board);
     if (!euler) {
-      *why = "SENS_BOARD_ROT = " + std::to_string(board) + " is not a rotation plumb knows";
+      *why = "SENS_BOARD_ROT = " + Integer(board) + " is not a rotation plumb knows";
       return std::nullopt;
     }
     const Vec3 trim(Param(log, "SENS_BOARD_X_OFF").value_or(0.0),
                     Param(log, "SENS_BOARD_Y_OFF").value_or(0.0),
                     Param(log, "SENS_BOARD_Z_OFF").value_or(0.0));
     c.rotation = EulerDeg(trim) * EulerDeg(*euler);
-    c.rotation_text = "SENS_BOARD_ROT = " + std::to_string(board) + ", SENS_BOARD_X/Y/Z_OFF = " +
+    c.rotation_text = "SENS_BOARD_ROT = " + Integer(board) + ", SENS_BOARD_X/Y/Z_OFF = " +
                       Format(trim) + " deg";
   }
   return c;
@@ -404,7 +429,7 @@ std::optional<Thermal> FindThermal(const ULog& log, const std::string& kind, dou
     return t;
   }
   *why = "no TC_" + kind + "n_ID equals the device id " +
-         std::to_string(static_cast<long long>(device_id));
+         Integer(device_id);
   return std::nullopt;
 }
 
@@ -455,7 +480,7 @@ void Undo(const Correction& c, const std::optional<Thermal>& thermal,
   for (std::size_t k = 0; k < v->size(); ++k) {
     Vec3 m = (rt * (*v)[k].cast<double>()).cwiseQuotient(c.scale) + c.offset;
     if (thermal && temp) m += thermal->Offset(temp->At(t_s[k]));
-    (*v)[k] = m.cast<float>();
+    (*v)[k] = ToFloat(m);
   }
 }
 
@@ -500,7 +525,7 @@ void UndoCorrection(const ULog& log, const StreamSource& src, Session* s) {
       temp = thermal ? SensorTemperature(log, acc, c->device_id) : std::nullopt;
       if (!thermal || !temp) {
         if (thermal) tc_why = "no temperature of device " +
-                              std::to_string(static_cast<long long>(c->device_id)) + " in the log";
+                              Integer(c->device_id) + " in the log";
         s->warnings.push_back(who + tc + " = 1: PX4's thermal " + what +
                               " correction is in the samples and NOT undone (" + tc_why + ")");
         thermal.reset();
@@ -520,7 +545,7 @@ void UndoCorrection(const ULog& log, const StreamSource& src, Session* s) {
                           "_*SCALE (" + Format(c->scale) + ") + " + c->prefix + "_*OFF (" +
                           Format(c->offset) + ")" + unit + thermal_text + ", R from " +
                           c->rotation_text + "; " + c->prefix + " chosen by device id " +
-                          std::to_string(static_cast<long long>(c->device_id)) + " from " +
+                          Integer(c->device_id) + " from " +
                           c->id_source);
   }
 }
