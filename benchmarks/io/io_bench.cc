@@ -9,12 +9,9 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <random>
 #include <string>
 
-#include "plumb/io/mavlink_tlog.h"
 #include "plumb/io/native_csv.h"
 #include "plumb/io/text_table.h"
 
@@ -133,32 +130,6 @@ void BM_ReadImuTkPair(benchmark::State& state) {
               samples);
 }
 BENCHMARK(BM_ReadImuTkPair)->Unit(benchmark::kMillisecond);
-
-/// The real MAVLink tlog (plane385_disarmed, 313 KB) repeated 480 times in memory (150 MB,
-/// 3.9 M frames), parsed with every CRC checked and the IMU messages decoded (SPEC section 7:
-/// the MAVLink C parser does 210 MB/s, the goal is 400 MB/s).
-void BM_ParseTlogRepeated(benchmark::State& state) {
-  const std::string path = std::string(PLUMB_SHARED_DATA_DIR) + "/mavlink/plane385_disarmed.tlog";
-  if (!std::filesystem::exists(path)) {
-    state.SkipWithError(("shared data absent: " + path).c_str());
-    return;
-  }
-  std::ifstream in(path, std::ios::binary);
-  const std::vector<std::uint8_t> one((std::istreambuf_iterator<char>(in)),
-                                      std::istreambuf_iterator<char>());
-  constexpr int kCopies = 480;
-  std::vector<std::uint8_t> data;
-  data.reserve(one.size() * kCopies);
-  for (int k = 0; k < kCopies; ++k) data.insert(data.end(), one.begin(), one.end());
-  std::size_t samples = 0;
-  for (auto _ : state) {
-    const plumb::io::MavlinkLog log = plumb::io::ParseTlog(data.data(), data.size(), path);
-    samples = log.raw_imu.size() + log.scaled_imu2.size() + log.scaled_imu3.size();
-    benchmark::DoNotOptimize(log.raw_imu.data());
-  }
-  SetCounters(state, data.size(), samples);
-}
-BENCHMARK(BM_ParseTlogRepeated)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -19,6 +19,10 @@
 #include <vector>
 
 #include "plumb/io/dataflash.h"
+#include "plumb/io/mavlink_session.h"
+#include "plumb/io/mavlink_tlog.h"
+#include "plumb/io/px4_session.h"
+#include "plumb/io/ulog.h"
 
 namespace {
 
@@ -90,6 +94,50 @@ BENCHMARK_CAPTURE(BM_ReadDataflash, copter36_chibios, std::string("ardupilot/cop
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ReadDataflash, plane408_centre_point,
                   std::string("ardupilot/plane408_centre_point.BIN"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// MAVLink .tlog: every frame's CRC checked, the IMU messages decoded, then every IMU stream
+/// as a session (units, time) without undoing the calibration.
+void BM_ReadTlog(benchmark::State& state, const std::string& relative) {
+  const RepeatedLog* log = Repeated(relative);
+  if (log == nullptr) {
+    state.SkipWithError(("shared data absent: " + relative).c_str());
+    return;
+  }
+  std::size_t samples = 0;
+  for (auto _ : state) {
+    const plumb::io::MavlinkLog decoded = plumb::io::ReadTlog(log->path());
+    samples = decoded.raw_imu.size() + decoded.scaled_imu2.size() + decoded.scaled_imu3.size();
+    benchmark::DoNotOptimize(decoded.raw_imu.data());
+  }
+  SetCounters(state, std::filesystem::file_size(log->path()), samples);
+}
+BENCHMARK_CAPTURE(BM_ReadTlog, plane385_disarmed, std::string("mavlink/plane385_disarmed.tlog"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// PX4 ULog: decode the log (every topic) and build the sensor_combined session. A repeated
+/// ULog is one header and definitions followed by the data of every copy read as data
+/// (later copies' headers are resynchronised over), so the bytes are all walked.
+void BM_ReadULog(benchmark::State& state, const std::string& relative) {
+  const RepeatedLog* log = Repeated(relative);
+  if (log == nullptr) {
+    state.SkipWithError(("shared data absent: " + relative).c_str());
+    return;
+  }
+  std::size_t samples = 0;
+  for (auto _ : state) {
+    const plumb::io::ULog decoded = plumb::io::ReadULog(log->path());
+    samples = 0;
+    for (const auto& topic : decoded.topics) {
+      if (topic.name == "sensor_combined") samples += topic.rows;
+    }
+    benchmark::DoNotOptimize(decoded.topics.data());
+  }
+  SetCounters(state, std::filesystem::file_size(log->path()), samples);
+}
+BENCHMARK_CAPTURE(BM_ReadULog, sample, std::string("px4/sample.ulg"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

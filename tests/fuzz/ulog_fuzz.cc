@@ -1,0 +1,32 @@
+// libFuzzer target for the PX4 ULog reader: any byte sequence must yield a ULog or a
+// plumb::Error, never a crash, a hang or a huge allocation; the streams and sessions built
+// from whatever was decoded must behave the same way.
+//   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I lib -I <eigen> \
+//     tests/fuzz/ulog_fuzz.cc lib/plumb/io/ulog.cc lib/plumb/io/px4_session.cc \
+//     lib/plumb/core/imu_series.cc
+#include <cstddef>
+#include <cstdint>
+
+#include "plumb/core/error.h"
+#include "plumb/io/px4_session.h"
+#include "plumb/io/ulog.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    const plumb::io::ULog log = plumb::io::ParseULog(data, size, "fuzz");
+    (void)log.warnings.Describe();
+    (void)plumb::io::SiteFromULog(log);
+    (void)plumb::io::ULogParams(log);
+    for (const plumb::io::ImuStreamInfo& info : plumb::io::ULogImuStreams(log)) {
+      plumb::io::FlightLogSelection selection;
+      selection.imu = info.instance;
+      selection.stream = info.name;
+      try {
+        (void)plumb::io::ULogSession(log, selection);
+      } catch (const plumb::Error&) {
+      }
+    }
+  } catch (const plumb::Error&) {
+  }
+  return 0;
+}
