@@ -2,11 +2,13 @@
 #include "plumb/io/ardupilot_session.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
 #include "plumb/core/error.h"
+#include "plumb/io/ardupilot_correction.h"
 
 namespace plumb::io {
 namespace {
@@ -16,28 +18,125 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-/// INS parameter prefix of an instance: "INS_ACC" / "INS_ACC2" / "INS_ACC3" (kind "ACC"),
-/// "INS_GYR" / "INS_GYR2" / ... (kind "GYR").
-std::string Prefix(const std::string& kind, int instance) {
-  return "INS_" + kind + (instance == 0 ? "" : std::to_string(instance + 1));
-}
-
-/// The triad PREFIX+SUFFIX_X/Y/Z, or nullopt when any is missing.
-std::optional<Vec3> Triad(const DataflashLog& log, const std::string& name) {
-  Vec3 v;
-  const char* axes[3] = {"_X", "_Y", "_Z"};
-  for (int i = 0; i < 3; ++i) {
-    const auto it = log.params.find(name + axes[i]);
-    if (it == log.params.end()) return std::nullopt;
-    v[i] = it->second;
-  }
-  return v;
-}
-
 std::string Format(const Vec3& v) {
   std::ostringstream out;
   out << v.x() << ", " << v.y() << ", " << v.z();
   return out.str();
+}
+
+std::string Format(const Mat3& m) {
+  std::ostringstream out;
+  out << "[" << Format(Vec3(m.row(0).transpose())) << "; " << Format(Vec3(m.row(1).transpose())) << "; "
+      << Format(Vec3(m.row(2).transpose())) << "]";
+  return out.str();
+}
+
+std::string Format(const std::array<Vec3, 3>& c) {
+  return "c1 (" + Format(c[0]) + "), c2 (" + Format(c[1]) + "), c3 (" + Format(c[2]) + ")";
+}
+
+std::string Format(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+/// "INS_ACC", "INS_ACC2", ... for kind "ACC"; "INS_GYR", ... for "GYR".
+std::string Prefix(const std::string& kind, int instance) {
+  return "INS_" + kind + (instance == 0 ? "" : std::to_string(instance + 1));
+}
+
+/// Step 1 of the undo: board = R_board^T logged.
+void UndoRotation(const ArdupilotCorrection& c, const std::string& who, Session* s) {
+  if (c.orientation == 0) return;
+  const Mat3 Rt = c.R_board->transpose();
+  for (auto& a : s->series.acc) a = (Rt * a.cast<double>()).cast<float>();
+  for (auto& g : s->series.gyr) g = (Rt * g.cast<double>()).cast<float>();
+  s->warnings.push_back(who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
+                        ArdupilotRotationName(c.orientation) +
+                        ") undone: board = R^T logged, R = " + Format(*c.R_board));
+}
+
+/// Step 2: offsets and scales.
+void UndoOffsets(const ArdupilotCorrection& c, const std::string& who, Session* s) {
+  const std::string acc = Prefix("ACC", c.instance);
+  const std::string gyr = Prefix("GYR", c.instance);
+  if (c.acc_offset && c.acc_scale) {
+    for (auto& a : s->series.acc) {
+      a = (a.cast<double>().cwiseQuotient(*c.acc_scale) + *c.acc_offset).cast<float>();
+    }
+    s->warnings.push_back(who + "accelerometer reconstructed as logged ./ " + acc + "SCAL (" +
+                          Format(*c.acc_scale) + ") + " + acc + "OFFS (" +
+                          Format(*c.acc_offset) + ") m/s^2");
+  } else {
+    s->warnings.push_back(who + "no " + acc + "OFFS/" + acc +
+                          "SCAL in the log: accelerometer offsets/scales not undone");
+  }
+  if (!s->series.has_gyro()) return;
+  if (c.gyr_offset) {
+    for (auto& g : s->series.gyr) g = (g.cast<double>() + *c.gyr_offset).cast<float>();
+    s->warnings.push_back(who + "gyroscope reconstructed as logged + " + gyr + "OFFS (" +
+                          Format(*c.gyr_offset) + ") rad/s");
+  } else {
+    s->warnings.push_back(who + "no " + gyr + "OFFS in the log: gyroscope offsets not undone");
+  }
+}
+
+/// Step 3: the temperature calibration.
+void UndoTempCal(const ArdupilotCorrection& c, const std::string& who, Session* s) {
+  const std::string tcal = "INS_TCAL" + std::to_string(c.instance + 1);
+  if (c.tcal_enable == 2) {
+    s->warnings.push_back(who + tcal + "_ENABLE = 2 (learning): ArduPilot applied no "
+                                "temperature correction, nothing to undo");
+  }
+  if (c.tcal_enable != 1) return;
+  if (!c.tcal) {
+    s->warnings.push_back(who + tcal + "_ENABLE = 1 but its TMIN/TMAX/ACC*/GYR* parameters "
+                                "are not all in the log: temperature calibration not undone");
+    return;
+  }
+  if (!s->series.has_temperature()) {
+    s->warnings.push_back(who + tcal + "_ENABLE = 1 but the stream has no temperature: "
+                                "temperature calibration not undone");
+    return;
+  }
+  const ArdupilotTempCal& t = *c.tcal;
+  ImuSeries& series = s->series;
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const double temp_c = series.temp_c[i];
+    series.acc[i] += ArdupilotTcalCorrection(t, t.acc_coeff, temp_c, t.acc_cal_temp_degc)
+                         .cast<float>();
+    if (series.has_gyro()) {
+      series.gyr[i] += ArdupilotTcalCorrection(t, t.gyr_coeff, temp_c, t.gyr_cal_temp_degc)
+                           .cast<float>();
+    }
+  }
+  s->warnings.push_back(
+      who + tcal + " temperature calibration undone: sensor = corrected + P(clamp(T) - 35) - "
+            "P(clamp(T_cal) - 35), P(d) = (c1 + (c2 + c3 d) d) d * 1e-6, clamp to [" +
+      Format(t.t_min_degc) + ", " + Format(t.t_max_degc) + "] degC, T from the stream; "
+      "accelerometer T_cal " + Format(t.acc_cal_temp_degc) + " degC, " + Format(t.acc_coeff) +
+      "; gyroscope T_cal " + Format(t.gyr_cal_temp_degc) + " degC, " + Format(t.gyr_coeff));
+}
+
+/// Undoes ArduPilot's correction on s->series (see the header), saying what was done.
+void UndoCorrection(const ArdupilotCorrection& c, bool undo, const std::string& who,
+                    Session* s) {
+  const std::string applied = c.Describe(true, s->series.has_gyro());
+  if (!undo) {
+    s->warnings.push_back(who + "samples taken as logged (ArduPilot applied " + applied + ")");
+    return;
+  }
+  if (!c.R_board) {
+    s->warnings.push_back(who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
+                          ArdupilotRotationName(c.orientation) +
+                          ") is not a rotation plumb knows: ArduPilot's correction (" + applied +
+                          ") is not undone, samples taken as logged");
+    return;
+  }
+  UndoRotation(c, who, s);
+  UndoOffsets(c, who, s);
+  UndoTempCal(c, who, s);
 }
 
 }  // namespace
@@ -70,72 +169,32 @@ std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
   return site;
 }
 
-Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions& options) {
-  if (options.imu < 0) throw Error("ArdupilotSession: the IMU instance must be >= 0");
+Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection) {
+  if (selection.imu < 0) throw Error("ArdupilotSession: the IMU instance must be >= 0");
+  const std::optional<ImuStreamInfo> info = FindDataflashStream(log, selection);
   Session s;
-  s.source = log.source + " (IMU instance " + std::to_string(options.imu) + ")";
-  ImuSeries all = ImuFromDataflash(log, options.imu);
+  s.series = DataflashStream(log, selection);  // throws when absent, gyro-only or empty
+  const std::string stream = info ? info->name : selection.stream;
+  const int instance = info ? info->instance : selection.imu;
+  const std::string label = stream + " of IMU instance " + std::to_string(instance);
+  s.source = log.source + " (" + label + ")";
   for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
-
-  // The time window.
-  ImuSeries& out = s.series;
-  out.acc_unit = all.acc_unit;
-  out.gyr_unit = all.gyr_unit;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    const double t = all.t_s[i];
-    if (options.from_s && t < *options.from_s) continue;
-    if (options.to_s && t > *options.to_s) continue;
-    out.t_s.push_back(t);
-    out.acc.push_back(all.acc[i]);
-    if (all.has_gyro()) out.gyr.push_back(all.gyr[i]);
-    if (all.has_temperature()) out.temp_c.push_back(all.temp_c[i]);
+  if (s.series.size() < 2) {
+    throw InputError(log.source, label, "fewer than 2 samples in the time window");
   }
-  if (out.size() < 2) {
-    throw InputError(log.source, "IMU instance " + std::to_string(options.imu),
-                     "fewer than 2 samples in the time window");
-  }
-
-  // ArduPilot's correction, undone.
-  const auto orientation = log.params.find("AHRS_ORIENTATION");
-  const bool rotated = orientation != log.params.end() && orientation->second != 0.0;
-  const auto offs = Triad(log, Prefix("ACC", options.imu) + "OFFS");
-  const auto scal = Triad(log, Prefix("ACC", options.imu) + "SCAL");
-  const auto gyr_offs = Triad(log, Prefix("GYR", options.imu) + "OFFS");
-  const std::string who = "IMU instance " + std::to_string(options.imu) + ": ";
-  if (!options.undo_correction) {
-    s.warnings.push_back(who + "samples taken as logged (corrected by ArduPilot with INS_*)");
-  } else if (rotated) {
-    s.warnings.push_back(who + "AHRS_ORIENTATION = " + std::to_string(orientation->second) +
-                         ": the logged samples are rotated into the vehicle frame; the INS_* "
-                         "correction is not undone (samples taken as logged)");
-  } else {
-    if (offs && scal && (scal->array() != 0.0).all()) {
-      for (auto& a : out.acc) {
-        a = (a.cast<double>().cwiseQuotient(*scal) + *offs).cast<float>();
-      }
-      const std::string acc = Prefix("ACC", options.imu);
-      s.warnings.push_back(who + "accelerometer reconstructed as logged ./ " + acc + "SCAL (" +
-                           Format(*scal) + ") + " + acc + "OFFS (" + Format(*offs) + ") m/s^2");
-    } else {
-      s.warnings.push_back(who + "no INS accelerometer offsets/scales in the log: taken as logged");
-    }
-    if (gyr_offs) {
-      for (auto& g : out.gyr) g = (g.cast<double>() + *gyr_offs).cast<float>();
-      s.warnings.push_back(who + "gyroscope reconstructed as logged + " +
-                           Prefix("GYR", options.imu) + "OFFS (" + Format(*gyr_offs) + ") rad/s");
-    } else {
-      s.warnings.push_back(who + "no INS gyroscope offsets in the log: taken as logged");
-    }
-  }
-  for (int k = 1; k <= 3; ++k) {
-    const auto tcal = log.params.find("INS_TCAL" + std::to_string(k) + "_ENABLE");
-    if (tcal != log.params.end() && tcal->second == 1.0) {
-      s.warnings.push_back("INS_TCAL" + std::to_string(k) + "_ENABLE = 1: ArduPilot's "
-                           "temperature calibration is in the logged samples and not undone");
-    }
-  }
+  const ArdupilotCorrection correction = ArdupilotCorrectionFor(log.params, instance);
+  UndoCorrection(correction, selection.undo_correction, label + ": ", &s);
   s.site = SiteFromDataflash(log);
   return s;
+}
+
+Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions& options) {
+  FlightLogSelection selection;
+  selection.imu = options.imu;
+  selection.from_s = options.from_s;
+  selection.to_s = options.to_s;
+  selection.undo_correction = options.undo_correction;
+  return ArdupilotSession(log, selection);
 }
 
 bool LooksLikeDataflash(const std::string& path) {
