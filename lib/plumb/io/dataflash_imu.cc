@@ -278,7 +278,10 @@ std::vector<StreamRef> StreamRefs(const DataflashLog& log) {
   const std::vector<int> acc = InstancesFor(log, "ACC", true, true);
   const std::vector<int> gyr = InstancesFor(log, "GYR", true, true);
   for (int k : acc) {
-    if (std::find(gyr.begin(), gyr.end(), k) != gyr.end()) add(Kind::kAccGyr, k, "ACC+GYR");
+    const bool both = std::find(gyr.begin(), gyr.end(), k) != gyr.end();
+    if (both && !ReadStream(log, {Kind::kAccGyr, "ACC+GYR", k}).empty()) {
+      add(Kind::kAccGyr, k, "ACC+GYR");
+    }
     add(Kind::kAcc, k, "ACC");
   }
   for (int k : gyr) add(Kind::kGyr, k, "GYR");
