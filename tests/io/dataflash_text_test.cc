@@ -50,9 +50,9 @@ void ExpectSampleEq(const ImuSeries& s, std::size_t i, const nlohmann::json& g) 
 }
 
 void ExpectCountsAndWarnings(const DataflashLog& log, const nlohmann::json& golden) {
-  std::map<std::string, std::size_t> counts(log.MessageCounts().begin(),
-                                            log.MessageCounts().end());
-  EXPECT_EQ(counts, golden["message_counts"].get<decltype(counts)>());
+  const auto message_counts = log.MessageCounts();
+  const std::map<std::string, std::size_t> counts(message_counts.begin(), message_counts.end());
+  EXPECT_EQ(counts, (golden["message_counts"].get<std::map<std::string, std::size_t>>()));
   EXPECT_EQ(log.size_bytes, golden["size_bytes"].get<std::size_t>());
   EXPECT_EQ(log.warnings.text_header_lines, golden["text_header_lines"].get<std::size_t>());
   EXPECT_EQ(log.warnings.text_bad_lines, golden["text_bad_lines"].get<std::size_t>());
