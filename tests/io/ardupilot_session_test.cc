@@ -214,9 +214,10 @@ TEST(ArdupilotSession, UndoRecoversRawSamplesForEveryRotation) {
       EXPECT_LT((s.series.gyr[i].cast<double>() - raw_gyr[i]).norm(), 2e-6) << orientation;
     }
     bool tcal_said = false;
-    for (const auto& w : s.warnings) tcal_said = tcal_said || w.find("INS_TCAL1 temperature "
-                                                                     "calibration undone") !=
-                                                                  std::string::npos;
+    for (const auto& w : s.warnings) {
+      tcal_said = tcal_said || w.find("INS_TCAL1 temperature calibration undone") !=
+                                   std::string::npos;
+    }
     EXPECT_TRUE(tcal_said) << orientation;
   }
 }
@@ -261,7 +262,8 @@ TEST(ArdupilotSession, TemperatureCalibrationWithoutTemperatureIsSaid) {
 }
 
 TEST(ArdupilotSession, UndoesAhrsOrientationOfARealLog) {
-  const std::string path = std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane382_pymavlink_test.BIN";
+  const std::string path =
+      std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane382_pymavlink_test.BIN";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
   const DataflashLog log = ReadDataflash(path);
   ASSERT_EQ(log.params.at("AHRS_ORIENTATION"), 8.0);  // ROLL_180: R = diag(1, -1, -1)

@@ -79,6 +79,11 @@ void ExpectImu(const DataflashLog& log, const nlohmann::json& golden) {
     ExpectSampleEq(s, 0, g["first"]);
     ExpectSampleEq(s, s.size() - 1, g["last"]);
   }
+  for (const auto& name : golden["imu_defined_without_rows"]) {
+    const DataflashType* t = log.Find(name.get<std::string>());
+    ASSERT_NE(t, nullptr) << name;
+    EXPECT_EQ(t->rows, 0u) << name;
+  }
   if (golden.contains("last_gps")) {
     const DataflashType* gps = log.Find("GPS");
     ASSERT_NE(gps, nullptr);

@@ -196,7 +196,9 @@ ArdupilotCorrection ArdupilotCorrectionFor(const std::map<std::string, double>& 
   c.orientation = std::isfinite(orientation) && std::abs(orientation) < 1e6
                       ? static_cast<int>(orientation)
                       : -1;
-  if (static_cast<double>(c.orientation) == orientation) c.R_board = ArdupilotRotation(c.orientation);
+  if (static_cast<double>(c.orientation) == orientation) {
+    c.R_board = ArdupilotRotation(c.orientation);
+  }
   const double enable =
       Param(params, "INS_TCAL" + std::to_string(instance + 1) + "_ENABLE").value_or(0.0);
   c.tcal_enable = enable == 1.0 ? 1 : enable == 2.0 ? 2 : enable == 0.0 ? 0 : -1;

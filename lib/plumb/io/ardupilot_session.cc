@@ -20,14 +20,15 @@ double Median(std::vector<double> v) {
 
 std::string Format(const Vec3& v) {
   std::ostringstream out;
+  out.precision(9);
   out << v.x() << ", " << v.y() << ", " << v.z();
   return out.str();
 }
 
 std::string Format(const Mat3& m) {
   std::ostringstream out;
-  out << "[" << Format(Vec3(m.row(0).transpose())) << "; " << Format(Vec3(m.row(1).transpose())) << "; "
-      << Format(Vec3(m.row(2).transpose())) << "]";
+  out << "[" << Format(Vec3(m.row(0).transpose())) << "; "
+      << Format(Vec3(m.row(1).transpose())) << "; " << Format(Vec3(m.row(2).transpose())) << "]";
   return out.str();
 }
 
@@ -37,6 +38,7 @@ std::string Format(const std::array<Vec3, 3>& c) {
 
 std::string Format(double v) {
   std::ostringstream out;
+  out.precision(9);
   out << v;
   return out.str();
 }
@@ -177,7 +179,7 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
   const std::string stream = info ? info->name : selection.stream;
   const int instance = info ? info->instance : selection.imu;
   const std::string label = stream + " of IMU instance " + std::to_string(instance);
-  s.source = log.source + " (" + label + ")";
+  s.source = log.source + " " + stream + " (IMU instance " + std::to_string(instance) + ")";
   for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
   if (s.series.size() < 2) {
     throw InputError(log.source, label, "fewer than 2 samples in the time window");

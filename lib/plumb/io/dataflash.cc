@@ -207,7 +207,10 @@ void ApplyUnits(DataflashLog* log) {
     const int label = u->ColumnIndex("Label");
     if (id >= 0 && label >= 0) {
       for (std::size_t r = 0; r < u->rows; ++r) {
-        units[static_cast<char>(u->Value(r, id))] = u->Text(r, label);
+        const double key = u->Value(r, id);
+        if (key >= -128 && key < 256) {
+          units[static_cast<char>(static_cast<int>(key))] = u->Text(r, label);
+        }
       }
     }
   }
@@ -216,7 +219,10 @@ void ApplyUnits(DataflashLog* log) {
     const int mult = m->ColumnIndex("Mult");
     if (id >= 0 && mult >= 0) {
       for (std::size_t r = 0; r < m->rows; ++r) {
-        mults[static_cast<char>(m->Value(r, id))] = m->Value(r, mult);
+        const double key = m->Value(r, id);
+        if (key >= -128 && key < 256) {
+          mults[static_cast<char>(static_cast<int>(key))] = m->Value(r, mult);
+        }
       }
     }
   }
