@@ -211,6 +211,21 @@ TEST(DataflashText, MalformedLinesAreSkippedAndCountedWithTheFirstLineNumber) {
   EXPECT_TRUE(described);
 }
 
+TEST(DataflashText, ANumericModeMustBeAValidModeNumber) {
+  const std::string text = std::string(kFmtHeader) +
+                           "FMT, 3, 6, MODE, Mh, Mode,ThrCrs\n"
+                           "MODE, 5, 424\n"          // good
+                           "MODE, 300, 424\n"        // a number, out of range: bad
+                           "MODE, 1.5, 424\n"        // a number, not integral: bad
+                           "MODE, LOITER, 424\n";    // a name: 255
+  const DataflashLog d = Parse(text);
+  ASSERT_NE(d.Find("MODE"), nullptr);
+  EXPECT_EQ(d.Find("MODE")->Column("Mode"), (std::vector<double>{5, 255}));
+  EXPECT_EQ(d.warnings.text_bad_lines, 2u);
+  EXPECT_EQ(d.warnings.text_first_bad_line, 7u);
+  EXPECT_EQ(d.warnings.text_mode_names, 1u);
+}
+
 TEST(DataflashText, LastTextColumnTakesTheRestOfTheLine) {
   const std::string text = std::string(kFmtHeader) +
                            "FMT, 132, 67, MSG, Z, Message\n"

@@ -191,7 +191,9 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance);
 ///  * "ISBD_ACC" / "ISBD_GYR": the batch sampler (ISBH header + ISBD data): sensor type 0 =
 ///    accelerometer, 1 = gyroscope, per ISBH instance; sample j of a batch (j = ISBD seqno * 32
 ///    + position) at SampleUS * 1e-6 + j / smp_rate s, value = int16 / mul. Accelerometer-only
-///    or gyroscope-only.
+///    or gyroscope-only; rate_hz is the median ISBH smp_rate (batches are not contiguous).
+///    With INS_LOG_BAT_OPT post-filter logging ArduPilot logs filtered samples and may offset
+///    the instance by the sensor count; they are listed as logged.
 /// ArduPilot computes ACC/GYR/ISBD from the same corrected sample as IMU
 /// (AP_InertialSensor_Backend: _rotate_and_correct_accel/_gyro run before the raw-sample
 /// notification that logs them), so `applied` is the same INS_* correction for all; the

@@ -212,7 +212,9 @@ ImuSeries ReadIsbd(const DataflashLog& log, int sensor, int instance) {
   // Per header: the samples by index in the batch (absent ones stay missing).
   std::vector<std::map<std::size_t, Vec3f>> batches(headers.size());
   for (std::size_t r = 0; r < d->rows; ++r) {
-    const auto candidates = by_n.find(ValueAt(*d, r, c_n));
+    const double n = ValueAt(*d, r, c_n);
+    if (!std::isfinite(n)) continue;
+    const auto candidates = by_n.find(n);
     if (candidates == by_n.end()) continue;
     const double time_us = ValueAt(*d, r, c_time);
     std::size_t best = headers.size();

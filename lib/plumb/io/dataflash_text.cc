@@ -113,12 +113,14 @@ bool EncodeField(char format, std::string_view text, std::uint8_t* p, std::size_
     case 'I': return EncodeInteger<std::uint32_t>(text, p);
     case 'q': return EncodeInteger64<std::int64_t>(text, p);
     case 'Q': return EncodeInteger64<std::uint64_t>(text, p);
-    case 'M':
-      if (EncodeInteger<std::uint8_t>(text, p)) return true;
+    case 'M': {
+      double number;
+      if (detail::ParseNumber(text, number)) return EncodeInteger<std::uint8_t>(text, p);
       if (text.empty()) return false;
-      Store<std::uint8_t>(p, kModeNameValue);
+      Store<std::uint8_t>(p, kModeNameValue);  // a mode name ("Stabilize")
       *mode_name = true;
       return true;
+    }
     case 'c': return EncodeScaled<std::int16_t>(text, 100.0, p);
     case 'C': return EncodeScaled<std::uint16_t>(text, 100.0, p);
     case 'e': return EncodeScaled<std::int32_t>(text, 100.0, p);

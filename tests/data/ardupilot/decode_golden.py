@@ -234,6 +234,9 @@ def parse_float(text):
 
 def encode_text_field(c, text):
     """Returns (value as the binary reader would return it, mode_name flag) or None."""
+    if c == "M" and parse_float(text) is None:
+        # a flight-mode name ("Stabilize"): stored as 255
+        return (255, True) if text != "" else None
     if c in INT_RANGES:
         lo, hi = INT_RANGES[c]
         v = None
@@ -247,8 +250,6 @@ def encode_text_field(c, text):
             if f is not None and math.isfinite(f) and f == math.floor(f):
                 v = int(f)
         if v is None or v < lo or v > hi:
-            if c == "M" and text != "" and v is None:
-                return 255, True
             return None
         return v, False
     if c in SCALED:
