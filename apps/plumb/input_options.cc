@@ -11,7 +11,7 @@
 
 #include "commands.h"
 #include "plumb/core/error.h"
-#include "plumb/io/ardupilot_session.h"
+#include "plumb/io/flight_log_file.h"
 #include "plumb/io/native_csv.h"
 
 namespace plumb::cli {
@@ -201,18 +201,28 @@ double ParseScale(const std::string& text, const std::string& option) {
 void AddInputOptions(CLI::App* app, InputArgs& a) {
   app->add_option("INPUT", a.inputs,
                   "Input files: plumb's native CSV, a text table (see --columns), an "
-                  "accelerometer and a gyroscope table as acc.txt,gyr.txt, or an ArduPilot "
-                  "DataFlash log (.bin, recognised by its first bytes)")
+                  "accelerometer and a gyroscope table as acc.txt,gyr.txt, or a flight log: "
+                  "ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg "
+                  "(recognised by their first bytes)")
       ->type_name("FILE...");
-  auto* logs = app->add_option_group("Flight logs", "Reading an ArduPilot DataFlash log (.bin)");
+  auto* logs = app->add_option_group(
+      "Flight logs", "Reading an ArduPilot .bin/.log, MAVLink .tlog or PX4 .ulg log "
+                     "(`plumb info LOG` lists its IMU streams)");
   logs->add_option("--imu", a.imu, "IMU instance of the log, 0-based (IMU = 0, IMU2 = 1, ...)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  logs->add_option("--stream", a.stream,
+                   "IMU stream (message or topic) of that instance, as `plumb info` names it, "
+                   "e.g. IMU, ACC+GYR, ISBD_ACC, SCALED_IMU2, sensor_combined, vehicle_imu, "
+                   "sensor_accel; default: the one with accelerometer and gyroscope at the "
+                   "highest rate")
+      ->type_name("NAME");
   a.from = logs->add_option("--from", a.from_s, "Use the samples from this log time on, s");
   a.to = logs->add_option("--to", a.to_s, "Use the samples up to this log time, s");
   logs->add_flag("--as-logged", a.as_logged,
-                 "Keep ArduPilot's INS_* correction in the samples instead of undoing it (the "
-                 "calibration is then of the corrected signal)");
+                 "Keep the firmware's correction (ArduPilot INS_*, PX4 CAL_*/TC_*) in the "
+                 "samples instead of undoing it (the calibration is then of the corrected "
+                 "signal)");
   app->add_option("--acc", a.acc_file,
                   "Accelerometer table of the two-file form (imu_tk's `t x y z`), with --gyr")
       ->type_name("FILE");
@@ -315,13 +325,15 @@ Session ReadInputs(const InputArgs& a) {
       s = io::ReadSplitTables(parts[0], parts[1], MakeTableOptions(a, true));
     } else if (parts.size() != 1) {
       throw UsageError("input '" + input + "': give one file, or two as acc.txt,gyr.txt");
-    } else if (!table_asked && a.format != "native" && io::LooksLikeDataflash(input)) {
-      io::ArdupilotSessionOptions o;
+    } else if (!table_asked && a.format != "native" &&
+               io::SniffFlightLog(input) != io::FlightLogFormat::kNone) {
+      io::FlightLogSelection o;
       o.imu = a.imu;
+      o.stream = a.stream;
       if (a.from != nullptr && a.from->count() > 0) o.from_s = a.from_s;
       if (a.to != nullptr && a.to->count() > 0) o.to_s = a.to_s;
       o.undo_correction = !a.as_logged;
-      s = io::ArdupilotSession(io::ReadDataflash(input), o);
+      s = io::FlightLog::Open(input).Select(o);
     } else if (table_asked) {
       if (a.columns.empty())
         throw UsageError("--format table needs --columns; " + std::string(kTableHint));

@@ -44,12 +44,13 @@ struct InputArgs {
   std::string gyr_unit = "rad/s";  ///< rad/s | deg/s
   std::string axis_map = "1,2,3";  ///< body axis i = sign * sensor axis |m_i|, e.g. 1,-2,-3
   bool drop_nan = false;           ///< drop rows with NaN/inf instead of failing
-  // Flight logs (ArduPilot DataFlash .bin):
+  // Flight logs (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg):
   int imu = 0;                     ///< --imu: IMU instance, 0-based, >= 0
+  std::string stream;              ///< --stream: message/topic name; empty = the default
   double from_s = 0.0, to_s = 0.0; ///< --from / --to: time window in log time, s
   CLI::Option* from = nullptr;
   CLI::Option* to = nullptr;
-  bool as_logged = false;          ///< --as-logged: keep ArduPilot's INS_* correction
+  bool as_logged = false;          ///< --as-logged: keep the firmware's correction
 
   /// Options that only describe text tables, to tell the user when they are given in vain.
   std::vector<CLI::Option*> table_only;

@@ -1,17 +1,22 @@
-// libFuzzer target: the DataFlash binary reader and the IMU stream extraction on any bytes.
-// Contract (SPEC section 8): never crash; bad input is a plumb::Error or a warning count.
+// libFuzzer target: any byte sequence as an ArduPilot DataFlash .bin log. Decoding, listing
+// the IMU streams and reading every one of them must either succeed or throw plumb::Error;
+// never crash, hang or read out of bounds (build with -fsanitize=fuzzer,address,undefined).
 #include <cstddef>
 #include <cstdint>
 
 #include "plumb/core/error.h"
 #include "plumb/io/dataflash.h"
+#include "plumb/io/flight_log.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const plumb::io::DataflashLog log = plumb::io::ParseDataflash(data, size, "fuzz.bin");
-    for (const auto& imu : plumb::io::DataflashImuInstances(log)) {
+    for (const plumb::io::ImuStreamInfo& info : plumb::io::DataflashImuStreams(log)) {
+      plumb::io::FlightLogSelection selection;
+      selection.imu = info.instance;
+      selection.stream = info.name;
       try {
-        (void)plumb::io::ImuFromDataflash(log, imu.instance);
+        plumb::io::DataflashStream(log, selection);
       } catch (const plumb::Error&) {
       }
     }

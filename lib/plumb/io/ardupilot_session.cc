@@ -2,11 +2,13 @@
 #include "plumb/io/ardupilot_session.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 
 #include "plumb/core/error.h"
-#include "plumb/io/ardupilot_params.h"
+#include "plumb/io/ardupilot_correction.h"
 
 namespace plumb::io {
 namespace {
@@ -46,38 +48,34 @@ std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
   return site;
 }
 
-Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions& options) {
-  if (options.imu < 0) throw Error("ArdupilotSession: the IMU instance must be >= 0");
+Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection) {
+  if (selection.imu < 0) throw Error("ArdupilotSession: the IMU instance must be >= 0");
+  const std::optional<ImuStreamInfo> info = FindDataflashStream(log, selection);
   Session s;
-  s.source = log.source + " (IMU instance " + std::to_string(options.imu) + ")";
-  ImuSeries all = ImuFromDataflash(log, options.imu);
+  s.series = DataflashStream(log, selection);  // throws when absent, gyro-only or empty
+  const std::string stream = info ? info->name : selection.stream;
+  const int instance = info ? info->instance : selection.imu;
+  const std::string label = stream + " of IMU instance " + std::to_string(instance);
+  s.source = log.source + " " + stream + " (IMU instance " + std::to_string(instance) + ")";
   for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
-
-  // The time window.
-  ImuSeries& out = s.series;
-  out.acc_unit = all.acc_unit;
-  out.gyr_unit = all.gyr_unit;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    const double t = all.t_s[i];
-    if (options.from_s && t < *options.from_s) continue;
-    if (options.to_s && t > *options.to_s) continue;
-    out.t_s.push_back(t);
-    out.acc.push_back(all.acc[i]);
-    if (all.has_gyro()) out.gyr.push_back(all.gyr[i]);
-    if (all.has_temperature()) out.temp_c.push_back(all.temp_c[i]);
+  if (s.series.size() < 2) {
+    throw InputError(log.source, label, "fewer than 2 samples in the time window");
   }
-  if (out.size() < 2) {
-    throw InputError(log.source, "IMU instance " + std::to_string(options.imu),
-                     "fewer than 2 samples in the time window");
-  }
-
-  // ArduPilot's correction, undone (ardupilot_params.h has the equations).
-  const std::vector<std::string> undo =
-      UndoInsCorrection(log.params, options.imu, options.undo_correction,
-                        "IMU instance " + std::to_string(options.imu) + ": ", &out);
-  s.warnings.insert(s.warnings.end(), undo.begin(), undo.end());
+  const ArdupilotCorrection correction = ArdupilotCorrectionFor(log.params, instance);
+  const std::vector<std::string> undone =
+      UndoArdupilotCorrection(correction, selection.undo_correction, label + ": ", &s.series);
+  s.warnings.insert(s.warnings.end(), undone.begin(), undone.end());
   s.site = SiteFromDataflash(log);
   return s;
+}
+
+Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions& options) {
+  FlightLogSelection selection;
+  selection.imu = options.imu;
+  selection.from_s = options.from_s;
+  selection.to_s = options.to_s;
+  selection.undo_correction = options.undo_correction;
+  return ArdupilotSession(log, selection);
 }
 
 bool LooksLikeDataflash(const std::string& path) {

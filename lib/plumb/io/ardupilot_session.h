@@ -1,17 +1,21 @@
-// plumb/io/ardupilot_session.h — an ArduPilot DataFlash log (.bin) as a plumb Session: one IMU
-// instance, a time window, the site from the GPS, and ArduPilot's own correction undone.
+// plumb/io/ardupilot_session.h — an ArduPilot DataFlash log (.bin or text .log) as a plumb
+// Session: one IMU stream (FlightLogSelection), a time window, the site from the GPS, and
+// ArduPilot's own correction undone.
 //
-// ArduPilot logs IMU samples already corrected with the INS_* parameters of the same log
-// (../shared/data/README.md, AP_InertialSensor): in the board frame, after the sensor's own
-// rotation and the temperature correction,
-//   acc_logged = R_ahrs ((acc_board - INS_ACCOFFS) .* INS_ACCSCAL),
-//   gyr_logged = R_ahrs (gyr_board - INS_GYROFFS),
-// R_ahrs the AHRS_ORIENTATION rotation (identity for 0), per instance INS_ACC/ACC2/ACC3 and
-// INS_GYR/GYR2/GYR3. With AHRS_ORIENTATION = 0 the sensor's own output is recovered as
-//   acc_board = acc_logged ./ INS_ACCSCAL + INS_ACCOFFS,  gyr_board = gyr_logged + INS_GYROFFS,
-// so that plumb calibrates the sensor, not the corrected signal. Not undone (and said in the
-// session's warnings): a non-zero AHRS_ORIENTATION, and the temperature calibration when
-// INS_TCALn_ENABLE is 1.
+// ArduPilot logs IMU samples (IMU, ACC/GYR, ISBD) already corrected with the parameters of the
+// same log (ardupilot_correction.h has the exact steps): temperature calibration INS_TCALn
+// (when INS_TCALn_ENABLE = 1), offsets and scales INS_ACC*OFFS/SCAL, INS_GYR*OFFS, and the
+// board rotation R_board of AHRS_ORIENTATION:
+//   acc_logged = R_board ((acc_board - Ptc_a(T)) - INS_ACCOFFS) .* INS_ACCSCAL)
+//   gyr_logged = R_board (gyr_board - Ptc_g(T) - INS_GYROFFS)
+// with Ptc(T) = P(clamp(T) - 35) - P(clamp(T_cal) - 35). Undone in reverse order:
+//   a = R_board^T acc_logged;  a = a ./ INS_ACCSCAL + INS_ACCOFFS;  acc_board = a + Ptc_a(T)
+//   g = R_board^T gyr_logged;  g = g + INS_GYROFFS;                gyr_board = g + Ptc_g(T)
+// so that plumb calibrates the sensor, not the corrected signal. Not undone, and said in the
+// session's warnings with the reason: a custom or unknown AHRS_ORIENTATION (then nothing is
+// undone), missing parameters (that step is skipped), the temperature step for a stream
+// without temperature (ACC/GYR/ISBD) or with INS_TCALn_* parameters missing. Every undone
+// step is stated in the warnings with the parameter values used.
 #pragma once
 
 #include <optional>
@@ -19,6 +23,7 @@
 
 #include "plumb/core/session.h"
 #include "plumb/io/dataflash.h"
+#include "plumb/io/flight_log.h"
 
 namespace plumb::io {
 
@@ -34,8 +39,12 @@ struct ArdupilotSessionOptions {
 /// metres, changes gravity by about 1e-5 relative). nullopt without such fixes.
 std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log);
 
-/// The session of one IMU instance of a decoded log. Throws plumb::InputError naming the log
-/// when the instance is absent or the window holds fewer than 2 samples.
+/// The session of one IMU stream of a decoded log (see DataflashStream for the selection and
+/// ArdupilotSession's file comment for the undo). Throws plumb::InputError naming the log when
+/// the stream is absent or gyroscope-only, or the window holds fewer than 2 samples.
+Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection);
+
+/// Compatibility: the default stream of options.imu (same as the selection with stream "").
 Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions& options);
 
 /// True when the file starts with a DataFlash record header (0xA3 0x95).

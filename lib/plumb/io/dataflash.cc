@@ -8,19 +8,20 @@
 #include <limits>
 
 #include "plumb/core/error.h"
+#include "plumb/io/dataflash_internal.h"
 
 namespace plumb::io {
 namespace {
 
 constexpr std::uint8_t kHead1 = 0xA3;
 constexpr std::uint8_t kHead2 = 0x95;
-constexpr std::uint8_t kFmtType = 128;
-constexpr std::size_t kHeaderSize = 3;
-constexpr std::size_t kFmtLength = 89;
+constexpr std::uint8_t kFmtType = detail::kDataflashFmtType;
+constexpr std::size_t kHeaderSize = detail::kDataflashHeaderSize;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// Size in bytes of a format character, 0 when unknown.
-std::size_t FormatSize(char c) {
+}  // namespace
+
+std::size_t detail::DataflashFormatSize(char c) {
   switch (c) {
     case 'b': case 'B': case 'M': return 1;
     case 'h': case 'H': case 'c': case 'C': return 2;
@@ -31,6 +32,8 @@ std::size_t FormatSize(char c) {
     default: return 0;
   }
 }
+
+namespace {
 
 template <typename T>
 T Load(const std::uint8_t* p) {
@@ -58,10 +61,11 @@ std::vector<std::string> SplitColumns(const std::string& text) {
   return out;
 }
 
-/// Builds a type from FMT fields; counts mismatches and unknown characters in `w`.
-DataflashType MakeType(std::uint8_t id, std::size_t length, const std::string& name,
-                       const std::string& format, const std::string& columns,
-                       DataflashWarnings* w) {
+}  // namespace
+
+DataflashType detail::MakeDataflashType(std::uint8_t id, std::size_t length,
+                                        const std::string& name, const std::string& format,
+                                        const std::string& columns, DataflashWarnings* w) {
   DataflashType t;
   t.id = id;
   t.name = name;
@@ -72,7 +76,7 @@ DataflashType MakeType(std::uint8_t id, std::size_t length, const std::string& n
   std::size_t offset = 0;
   bool known = true;
   for (std::size_t k = 0; k < format.size(); ++k) {
-    const std::size_t size = FormatSize(format[k]);
+    const std::size_t size = DataflashFormatSize(format[k]);
     if (size == 0) {
       known = false;
       break;
@@ -95,14 +99,20 @@ DataflashType MakeType(std::uint8_t id, std::size_t length, const std::string& n
   return t;
 }
 
+DataflashType detail::DataflashFmtType(DataflashWarnings* w) {
+  return MakeDataflashType(kFmtType, detail::kDataflashFmtLength, "FMT", "BBnNZ",
+                           "Type,Length,Name,Format,Columns", w);
+}
+
+namespace {
+
 /// The one-pass decoder state.
 class Parser {
  public:
   Parser(const std::uint8_t* data, std::size_t size, DataflashLog* log)
       : data_(data), size_(size), log_(log) {
     index_.fill(-1);
-    AddType(MakeType(kFmtType, kFmtLength, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns",
-                     &log_->warnings));
+    AddType(detail::DataflashFmtType(&log_->warnings));
   }
 
   void Run() {
@@ -175,7 +185,7 @@ class Parser {
       if (t.length != length || t.name != name || t.format != format) ++w.fmt_conflicts;
       return;
     }
-    AddType(MakeType(id, length, name, format, columns, &w));
+    AddType(detail::MakeDataflashType(id, length, name, format, columns, &w));
   }
 
   const std::uint8_t* data_;
@@ -197,7 +207,10 @@ void ApplyUnits(DataflashLog* log) {
     const int label = u->ColumnIndex("Label");
     if (id >= 0 && label >= 0) {
       for (std::size_t r = 0; r < u->rows; ++r) {
-        units[static_cast<char>(u->Value(r, id))] = u->Text(r, label);
+        const double key = u->Value(r, id);
+        if (key >= -128 && key < 256) {
+          units[static_cast<char>(static_cast<int>(key))] = u->Text(r, label);
+        }
       }
     }
   }
@@ -206,7 +219,10 @@ void ApplyUnits(DataflashLog* log) {
     const int mult = m->ColumnIndex("Mult");
     if (id >= 0 && mult >= 0) {
       for (std::size_t r = 0; r < m->rows; ++r) {
-        mults[static_cast<char>(m->Value(r, id))] = m->Value(r, mult);
+        const double key = m->Value(r, id);
+        if (key >= -128 && key < 256) {
+          mults[static_cast<char>(static_cast<int>(key))] = m->Value(r, mult);
+        }
       }
     }
   }
@@ -240,6 +256,15 @@ void CollectParams(DataflashLog* log) {
     log->params[parm->Text(r, name)] = parm->Value(r, value);
   }
 }
+
+}  // namespace
+
+void detail::FinishDataflashLog(DataflashLog* log) {
+  ApplyUnits(log);
+  CollectParams(log);
+}
+
+namespace {
 
 /// Rows of `type` that belong to IMU `instance` (all rows when `instance_col` < 0).
 std::vector<std::size_t> InstanceRows(const DataflashType& type, int instance_col,
@@ -343,7 +368,8 @@ std::vector<double> DataflashType::Column(std::string_view column) const {
 
 bool DataflashWarnings::any() const {
   return bytes_skipped || truncated_records || fmt_length_mismatches || fmt_conflicts ||
-         fmt_invalid || fmt_unknown_chars;
+         fmt_invalid || fmt_unknown_chars || text_header_lines || text_bad_lines ||
+         text_mode_names;
 }
 
 std::vector<std::string> DataflashWarnings::Describe() const {
@@ -368,6 +394,19 @@ std::vector<std::string> DataflashWarnings::Describe() const {
   if (fmt_unknown_chars) {
     out.push_back(std::to_string(fmt_unknown_chars) +
                   " FMT(s) with an unknown format character (columns after it not decoded)");
+  }
+  if (text_header_lines) {
+    out.push_back("ignored " + std::to_string(text_header_lines) +
+                  " header line(s) before the first FMT line");
+  }
+  if (text_bad_lines) {
+    out.push_back("skipped " + std::to_string(text_bad_lines) +
+                  " malformed line(s) (first: line " + std::to_string(text_first_bad_line) +
+                  ": " + text_first_bad_what + ")");
+  }
+  if (text_mode_names) {
+    out.push_back(std::to_string(text_mode_names) +
+                  " flight mode(s) written as a name, stored as mode number 255");
   }
   return out;
 }
@@ -399,8 +438,7 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
                      "no FMT record (0xA3 0x95 0x80) in " + std::to_string(size) +
                          " bytes: not an ArduPilot DataFlash .bin log");
   }
-  ApplyUnits(&log);
-  CollectParams(&log);
+  detail::FinishDataflashLog(&log);
   return log;
 }
 
@@ -479,7 +517,15 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
                      type->name + " has no TimeUS/TimeMS or AccX/AccY/AccZ column");
   }
   const std::vector<std::size_t> rows = InstanceRows(*type, instance_col, instance);
-  if (rows.empty()) throw InputError(log.source, "", "no " + type->name + " rows for " + what);
+  if (type->rows == 0) {
+    throw InputError(log.source, "",
+                     "the log defines " + type->name + " (FMT) but holds no " + type->name +
+                         " rows: no IMU samples were logged (LOG_BITMASK without IMU?)");
+  }
+  if (rows.empty()) {
+    throw InputError(log.source, "", "no " + type->name + " rows with I == " +
+                                         std::to_string(instance) + " for " + what);
+  }
 
   ImuSeries s;
   s.reserve(rows.size());

@@ -31,12 +31,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/io/flight_log.h"
 
 namespace plumb::io {
 
@@ -88,6 +90,12 @@ struct DataflashWarnings {
   std::size_t fmt_conflicts = 0;          ///< later FMTs differing from the first; ignored
   std::size_t fmt_invalid = 0;            ///< FMTs with length < 3 (ignored)
   std::size_t fmt_unknown_chars = 0;      ///< FMTs with an unknown format character
+  // Text logs (.log) only:
+  std::size_t text_header_lines = 0;      ///< non-blank lines before the first FMT line, ignored
+  std::size_t text_bad_lines = 0;         ///< malformed lines after the first FMT, skipped
+  std::size_t text_first_bad_line = 0;    ///< 1-based number of the first one (0: none)
+  std::string text_first_bad_what;        ///< what was wrong with it
+  std::size_t text_mode_names = 0;        ///< 'M' fields holding a mode name, stored as 255
 
   bool any() const;
   /// One readable line per non-zero count.
@@ -116,6 +124,39 @@ DataflashLog ReadDataflash(const std::string& path);
 DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
                             const std::string& source);
 
+/// Reads and decodes an ArduPilot TEXT log (.log, as Mission Planner writes it) into the same
+/// DataflashLog a .bin gives; see ParseDataflashText. Throws plumb::InputError(path, "", what)
+/// when the file cannot be read, and as ParseDataflashText.
+DataflashLog ReadDataflashText(const std::string& path);
+
+/// Decodes a text log held in memory; `source` names it in errors.
+///
+/// Format: one record per line, fields separated by commas (", " or ","), the message name
+/// first: `FMT, <type>, <length>, <name>, <format>, <col1>,<col2>,...` defines a type (the
+/// column list is the rest of the line; the FMT of FMT may omit "Columns"), `PARM, NAME, 1.5`,
+/// `IMU, 95892, 0.00033, ...`. Values are written already scaled (c/C/e/E in units of 0.01
+/// of the stored integer, L in degrees), flight modes ('M') may be names, NaN as "NaN".
+///
+/// Decoding contract (same storage as the binary reader, so DataflashType::Value/Column/Text
+/// work unchanged): each row's values are encoded into the binary body layout of its FMT
+/// (body = FMT length - 3 bytes, fields that do not fit the length dropped, zero padding):
+/// integers must be integral and in the type's range; c/C/e/E are stored as round(v * 100),
+/// L as round(v * 1e7); f is the float nearest to the text's double, d the double, NaN kept;
+/// n/N/Z text is stored up to the field width; 'a' arrays are stored as zeros; a non-numeric
+/// 'M' (a mode name) is stored as 255 and counted. A last text column (n/N/Z) takes the rest
+/// of the line, commas included (MSG texts). Lines before the first FMT line are header
+/// lines ("ArduCopter V3.1", "Free RAM: ..."), ignored and counted. After it, a line whose
+/// name is not a defined type, with a wrong field count or a value that does not parse or fit
+/// is skipped and counted with the number of the first one, never fatal. FMT lines follow the
+/// binary rules (first definition of a type id or name wins, length < 3 ignored, ...).
+/// Throws plumb::InputError(source, "line N", what) when there is no FMT line at all.
+DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::string& source);
+
+/// True when the file looks like a text DataFlash log: no binary header (0xA3 0x95) at the
+/// start, only printable text, and a line starting with "FMT," among the first 16 non-blank
+/// lines of its first 8 KiB (after a header such as "ArduCopter V3.1" or "Free RAM: 1044").
+bool LooksLikeDataflashText(const std::string& path);
+
 /// One IMU instance available in a log.
 struct DataflashImuInfo {
   int instance = 0;          ///< 0-based: IMU / I==0 is 0, IMU2 / I==1 is 1, ...
@@ -136,5 +177,42 @@ std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log);
 /// plumb::InputError naming the log when the instance has no samples or the message lacks a
 /// time or Acc column.
 ImuSeries ImuFromDataflash(const DataflashLog& log, int instance);
+
+/// Every IMU stream of a DataFlash log (binary or text), in this order per instance:
+///  * "IMU" (rows with I == k) or "IMU", "IMU2", "IMU3" (k = 0, 1, 2): accelerometer and
+///    gyroscope (and temperature from T/Temp) at the logging rate, after ArduPilot's low-pass
+///    filters. Listed even with zero rows when the FMT defines it (samples = 0).
+///  * "ACC" / "GYR" (rows with I == k; 3.x logs: "ACC1".."ACC3", "GYR1".."GYR3"): every
+///    sensor sample before filtering (INS_RAW_LOG_OPT / LOG_BITMASK IMU_RAW), times from
+///    SampleUS. Choice made here: when ACC and GYR of an instance have the same number of
+///    samples and each i-th pair is less than half a median gyro interval apart, they are also
+///    offered paired as one stream "ACC+GYR" (accelerometer times); otherwise only separately:
+///    "ACC" accelerometer-only, "GYR" gyroscope-only.
+///  * "ISBD_ACC" / "ISBD_GYR": the batch sampler (ISBH header + ISBD data): sensor type 0 =
+///    accelerometer, 1 = gyroscope, per ISBH instance; sample j of a batch (j = ISBD seqno * 32
+///    + position) at SampleUS * 1e-6 + j / smp_rate s, value = int16 / mul. Accelerometer-only
+///    or gyroscope-only; rate_hz is the median ISBH smp_rate (batches are not contiguous).
+///    With INS_LOG_BAT_OPT post-filter logging ArduPilot logs filtered samples and may offset
+///    the instance by the sensor count; they are listed as logged.
+/// ArduPilot computes ACC/GYR/ISBD from the same corrected sample as IMU
+/// (AP_InertialSensor_Backend: _rotate_and_correct_accel/_gyro run before the raw-sample
+/// notification that logs them), so `applied` is the same INS_* correction for all; the
+/// filters are not part of it. `undoable` is true when the log holds every parameter of that
+/// correction, AHRS_ORIENTATION is a known rotation and, when INS_TCALn_ENABLE = 1, the
+/// stream has a temperature.
+std::vector<ImuStreamInfo> DataflashImuStreams(const DataflashLog& log);
+
+/// The samples of the stream `selection` names (stream + imu; an empty stream means the
+/// default for `selection.imu`: IMU, else ACC+GYR, else ACC, else ISBD_ACC), inside the time
+/// window [from_s, to_s], AS LOGGED (nothing undone; see ArdupilotSession). Accelerometer-only
+/// streams give an empty gyr. Gyroscope-only streams (GYR, ISBD_GYR) are listed but cannot
+/// be selected: plumb needs accelerometer samples (plumb::InputError says so). Samples whose
+/// time does not increase are dropped (see ImuFromDataflash). Throws plumb::InputError naming
+/// the log when the stream is absent, gyroscope-only or has no samples in the window.
+ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& selection);
+
+/// The stream DataflashStream would read for `selection`, or nullopt.
+std::optional<ImuStreamInfo> FindDataflashStream(const DataflashLog& log,
+                                                 const FlightLogSelection& selection);
 
 }  // namespace plumb::io

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "plumb/core/error.h"
-#include "plumb/io/ardupilot_params.h"
+#include "plumb/io/ardupilot_correction.h"
 
 namespace plumb::io {
 namespace {
@@ -230,9 +230,9 @@ ImuStreamInfo Describe(const StreamData& d, const MavlinkVehicle& v,
   info.has_temperature = std::any_of(d.samples.begin(), d.samples.end(),
                                      [](const Sample& s) { return s.has_temp; });
   if (v.autopilot == kMavAutopilotArdupilotMega) {
-    info.applied = InsAppliedDescription(d.instance);
-    const InsCorrection c = InsCorrectionFromParams(params, d.instance);
-    info.undoable = c.AccUndoable() && c.GyrUndoable();
+    const ArdupilotCorrection c = ArdupilotCorrectionFor(params, d.instance);
+    info.applied = c.Describe(true, true);
+    info.undoable = c.Undoable(true, true, info.has_temperature);
   } else if (d.kind == Kind::kRaw) {
     info.applied = "";
   } else {
@@ -468,10 +468,11 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
                      "fewer than 2 samples in the time window");
   }
 
-  // ArduPilot's correction, undone (ardupilot_params.h has the equations).
+  // ArduPilot's correction, undone (ardupilot_correction.h has the equations).
   if (ardupilot) {
     const std::vector<std::string> undo =
-        UndoInsCorrection(params, d.instance, selection.undo_correction, who, &out);
+        UndoArdupilotCorrection(ArdupilotCorrectionFor(params, d.instance),
+                                selection.undo_correction, who, &out);
     s.warnings.insert(s.warnings.end(), undo.begin(), undo.end());
   } else if (!info.applied.empty()) {
     s.warnings.push_back(who + "calibrated by " + AutopilotName(v.autopilot) +

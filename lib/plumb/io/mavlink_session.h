@@ -26,7 +26,7 @@
 // FlightLogSelection::from_s/to_s use the same times.
 // ArduPilot's correction: on ArduPilot the samples are corrected with INS_ACC*OFFS/SCAL and
 // INS_GYR*OFFS (instance 0 = RAW_IMU / SCALED_IMU, 1 = SCALED_IMU2, 2 = SCALED_IMU3); the
-// session undoes it from the PARAM_VALUE messages (ardupilot_params.h has the equations).
+// session undoes it from the PARAM_VALUE messages (ardupilot_correction.h has the equations).
 #pragma once
 
 #include <cstdint>
@@ -61,10 +61,9 @@ std::optional<MavlinkVehicle> TlogVehicle(const MavlinkLog& log);
 
 /// Every IMU stream of the vehicle (see the file comment), ordered RAW_IMU, SCALED_IMU,
 /// SCALED_IMU2, SCALED_IMU3, HIGHRES_IMU, then by instance. `applied` is
-/// InsAppliedDescription(instance) on ArduPilot, "" for RAW_IMU of other autopilots (raw
-/// counts) and "autopilot calibration (unknown)" for their scaled messages; `undoable` is true
-/// on ArduPilot when the log's parameters hold the instance's INS_* values and
-/// AHRS_ORIENTATION is 0.
+/// ArdupilotCorrection::Describe on ArduPilot (INS_* offsets/scales, AHRS_ORIENTATION,
+/// INS_TCAL), "" for RAW_IMU of other autopilots (raw counts) and "autopilot calibration
+/// (unknown)" for their scaled messages; `undoable` is ArdupilotCorrection::Undoable.
 std::vector<ImuStreamInfo> TlogImuStreams(const MavlinkLog& log);
 
 /// The site from the vehicle's GPS_RAW_INT with fix_type >= 3: the median latitude and
