@@ -1,7 +1,8 @@
-// plumb info LOG [--json FILE] — what is inside a flight log: each IMU instance with its sample
-// count, rate, time span and temperature range, its still periods, the site from the GPS, the
-// calibration parameters in force, and what the reader skipped (issue 5; ArduPilot DataFlash
-// logs so far).
+// plumb info LOG [--json FILE] — what is inside a flight log (ArduPilot DataFlash .bin or text
+// .log, MAVLink .tlog, PX4 ULog .ulg, recognised by content): each IMU stream with its sample
+// count, rate, time span, temperature range, what the firmware applied and whether plumb can
+// undo it, its still periods, the site from the GPS, the calibration parameters in force, the
+// message counts and what the reader skipped (issue 5).
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -10,8 +11,7 @@
 
 #include "commands.h"
 #include "plumb/core/error.h"
-#include "plumb/io/ardupilot_session.h"
-#include "plumb/io/dataflash.h"
+#include "plumb/io/flight_log_file.h"
 #include "plumb/report/json_report.h"
 #include "plumb/segmentation/still_detector.h"
 
@@ -23,20 +23,44 @@ struct InfoArgs {
   std::string json_path;  ///< --json FILE
 };
 
-/// The calibration parameters a log's IMU samples were corrected with (ArduPilot).
-bool IsCalibrationParameter(const std::string& name) {
-  for (const char* prefix : {"INS_ACC", "INS_GYR", "INS_TCAL", "AHRS_ORIENTATION"}) {
-    if (name.rfind(prefix, 0) == 0) return true;
+/// The still periods of one stream (as logged; the same detector calibrate uses, 5 s at
+/// least), into `j["still"]`, printed as they are found.
+void DescribeStillPeriods(const io::FlightLog& log, const io::ImuStreamInfo& info,
+                          nlohmann::json& j) {
+  nlohmann::json still = nlohmann::json::array();
+  try {
+    io::FlightLogSelection pick;
+    pick.imu = info.instance;
+    pick.stream = info.name;
+    pick.undo_correction = false;
+    const Session s = log.Select(pick);
+    segmentation::StillDetectorOptions detector;
+    detector.min_still_s = 5.0;
+    const auto seg = segmentation::DetectStillSegments(s.series, detector);
+    for (const auto& p : seg.segments) {
+      still.push_back({{"t_start_s", s.series.t_s[p.begin]}, {"t_end_s", s.series.t_s[p.end - 1]}});
+      std::cout << "    still " << s.series.t_s[p.begin] << " .. " << s.series.t_s[p.end - 1]
+                << " s\n";
+    }
+    if (s.series.has_temperature()) {
+      const auto [lo, hi] = std::minmax_element(s.series.temp_c.begin(), s.series.temp_c.end());
+      j["temp_min_c"] = *lo;
+      j["temp_max_c"] = *hi;
+      std::cout << "    temperature " << *lo << " .. " << *hi << " degC\n";
+    }
+  } catch (const Error& e) {
+    j["still_note"] = e.what();
+    std::cout << "    still periods: " << e.what() << "\n";
   }
-  return false;
+  j["still"] = still;
 }
 
 class InfoCommand : public Command {
  public:
   explicit InfoCommand(CLI::App& parent) {
     app_ = parent.add_subcommand(
-        "info", "What is inside a flight log (ArduPilot DataFlash .bin): IMU instances, still "
-                "periods, the site from GPS, the calibration parameters in force");
+        "info", "What is inside a flight log (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg): IMU "
+                "streams, still periods, the site from GPS, the calibration parameters in force");
     app_->add_option("LOG", args_.log_path, "The log file")->required()->type_name("LOG");
     app_->add_option("--json", args_.json_path, "Also write it as JSON to FILE (atomically)")
         ->type_name("FILE");
@@ -44,81 +68,68 @@ class InfoCommand : public Command {
 
   int Run() override {
     const InfoArgs& a = args_;
-    if (!io::LooksLikeDataflash(a.log_path)) {
-      throw InputError(a.log_path, "byte 0",
-                       "not an ArduPilot DataFlash log (no 0xA3 0x95 record header); plumb "
-                       "info reads .bin logs so far");
-    }
-    const io::DataflashLog log = io::ReadDataflash(a.log_path);
+    const io::FlightLog log = io::FlightLog::Open(a.log_path);
+    const io::FlightLogSummary summary = log.Summary();
     nlohmann::json doc;
     doc["log"] = a.log_path;
-    doc["format"] = "ardupilot-dataflash";
-    doc["size_bytes"] = log.size_bytes;
-    std::cout << a.log_path << ": ArduPilot DataFlash, " << log.size_bytes << " bytes\n";
+    doc["format"] = summary.format;
+    doc["format_detail"] = summary.format_detail;
+    doc["size_bytes"] = summary.size_bytes;
+    std::cout << a.log_path << ": " << summary.format_detail << " (" << summary.format << "), "
+              << summary.size_bytes << " bytes\n";
 
     doc["imus"] = nlohmann::json::array();
-    for (const auto& imu : io::DataflashImuInstances(log)) {
-      const ImuSeries s = io::ImuFromDataflash(log, imu.instance);
-      nlohmann::json j = {{"name", imu.message},
+    for (const io::ImuStreamInfo& imu : summary.imus) {
+      nlohmann::json j = {{"name", imu.name},
                           {"instance", imu.instance},
-                          {"samples", s.size()},
+                          {"samples", imu.samples},
                           {"rate_hz", report::Number(imu.rate_hz)},
-                          {"t_start_s", s.t_s.front()},
-                          {"t_end_s", s.t_s.back()}};
-      std::cout << "IMU instance " << imu.instance << " (" << imu.message << "): " << s.size()
-                << " samples, " << std::setprecision(4) << imu.rate_hz << " Hz, "
-                << s.t_s.front() << " .. " << s.t_s.back() << " s";
-      if (s.has_temperature()) {
-        const auto [lo, hi] = std::minmax_element(s.temp_c.begin(), s.temp_c.end());
-        j["temp_min_c"] = *lo;
-        j["temp_max_c"] = *hi;
-        std::cout << ", " << *lo << " .. " << *hi << " degC";
+                          {"t_start_s", imu.t_start_s},
+                          {"t_end_s", imu.t_end_s},
+                          {"has_accel", imu.has_accel},
+                          {"has_gyro", imu.has_gyro},
+                          {"has_temperature", imu.has_temperature},
+                          {"applied", imu.applied},
+                          {"undoable", imu.undoable}};
+      const char* contents = imu.has_accel && imu.has_gyro ? "accel+gyro"
+                             : imu.has_accel             ? "accel only"
+                                                         : "gyro only";
+      std::cout << "IMU instance " << imu.instance << ", " << imu.name << " (" << contents
+                << "): " << imu.samples << " samples";
+      if (imu.samples > 0) {
+        std::cout << ", " << std::setprecision(5) << imu.rate_hz << " Hz, " << std::setprecision(7)
+                  << imu.t_start_s << " .. " << imu.t_end_s << " s";
       }
-      std::cout << "\n";
-      // Still periods, from the accelerometer (a vehicle on the ground vibrates the gyroscope
-      // little, but a log may hold engine runs), 5 s at least.
-      segmentation::StillDetectorOptions detector;
-      detector.use_gyro = false;
-      detector.min_still_s = 5.0;
-      nlohmann::json still = nlohmann::json::array();
-      try {
-        const auto seg = segmentation::DetectStillSegments(s, detector);
-        for (const auto& p : seg.segments) {
-          still.push_back({{"t_start_s", s.t_s[p.begin]}, {"t_end_s", s.t_s[p.end - 1]}});
-          std::cout << "  still " << s.t_s[p.begin] << " .. " << s.t_s[p.end - 1] << " s\n";
-        }
-      } catch (const Error& e) {
-        j["still_note"] = e.what();
-        std::cout << "  still periods: " << e.what() << "\n";
-      }
-      j["still"] = still;
+      std::cout << "\n    applied by the firmware: "
+                << (imu.applied.empty() ? "nothing (raw sensor output)" : imu.applied)
+                << (imu.applied.empty() ? "" : imu.undoable ? " (plumb undoes it)"
+                                                            : " (plumb cannot undo it all)")
+                << "\n";
+      if (imu.has_accel && imu.samples >= 2) DescribeStillPeriods(log, imu, j);
       doc["imus"].push_back(j);
     }
 
-    const auto site = io::SiteFromDataflash(log);
-    if (site) {
-      doc["site"] = {{"lat_deg", site->lat_deg}, {"lon_deg", site->lon_deg},
-                     {"height_m", site->height_m}, {"source", site->source}};
-      std::cout << "site (GPS, median of 3D fixes): " << std::setprecision(8) << site->lat_deg
-                << " deg, " << site->lon_deg << " deg, " << std::setprecision(4)
-                << site->height_m << " m\n";
+    if (summary.site) {
+      const SiteInput& site = *summary.site;
+      doc["site"] = {{"lat_deg", site.lat_deg}, {"lon_deg", site.lon_deg},
+                     {"height_m", site.height_m}, {"source", site.source}};
+      std::cout << "site (GPS, median of 3D fixes): " << std::setprecision(8) << site.lat_deg
+                << " deg, " << site.lon_deg << " deg, " << std::setprecision(4)
+                << site.height_m << " m\n";
     } else {
       doc["site"] = nullptr;
-      std::cout << "site: no GPS 3D fix in the log\n";
+      std::cout << "site: no GPS 3D fix in the log (give --lat --lon --height to calibrate)\n";
     }
 
     nlohmann::json params = nlohmann::json::object();
-    for (const auto& [name, value] : log.params) {
-      if (IsCalibrationParameter(name)) params[name] = value;
-    }
+    for (const auto& [name, value] : summary.params) params[name] = report::Number(value);
     doc["params"] = params;
-    std::cout << "calibration parameters in force: " << params.size()
-              << " (INS_ACC*, INS_GYR*, INS_TCAL*, AHRS_ORIENTATION)\n";
+    std::cout << "calibration parameters in force: " << summary.params.size() << "\n";
     nlohmann::json messages = nlohmann::json::object();
-    for (const auto& [name, count] : log.MessageCounts()) messages[name] = count;
+    for (const auto& [name, count] : summary.messages) messages[name] = count;
     doc["messages"] = messages;
-    doc["warnings"] = log.warnings.Describe();
-    for (const auto& w : log.warnings.Describe()) std::cout << "warning: " << w << "\n";
+    doc["warnings"] = summary.warnings;
+    for (const auto& w : summary.warnings) std::cout << "warning: " << w << "\n";
     if (!a.json_path.empty()) {
       report::WriteJson(a.json_path, doc);
       std::cout << "wrote " << a.json_path << "\n";

@@ -260,6 +260,18 @@ TEST(StillDetector, VibrationBurstsInOnePoseAreJoined) {
   EXPECT_GT(series.t_s[joined.segments[0].end - 1] - series.t_s.front(), 39.0);
 }
 
+TEST(StillDetector, ATurnOutAndBackIsNotJoined) {
+  // Picked up, tilted 30 degrees and put back: the mean rate over the gap is zero and the
+  // accelerometer means agree, but the attitude went away and came back (pyulog's sample.ulg
+  // has such a knock): the excursion test keeps the two runs apart.
+  const double tilt = 30.0 * kPi / 180.0;
+  const ImuSeries series = testing::MakeSession(
+      {Still(15.0), SmoothTurn(1.5, Vec3::UnitX(), tilt), SmoothTurn(1.5, Vec3::UnitX(), -tilt),
+       Still(15.0)},
+      {});
+  EXPECT_EQ(DetectStillSegments(series).segments.size(), 2U);
+}
+
 TEST(StillDetector, AFullTurnBackToTheSamePoseIsNotJoined) {
   // A full roll back to the same attitude leaves the accelerometer means of the two poses
   // equal: only the gyroscope's mean rate over the gap tells that the vehicle turned.

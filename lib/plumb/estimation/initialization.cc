@@ -104,6 +104,11 @@ double GuessGyroScale(const ImuSeries& series,
     }
     if (angle > 0.35 && raw.norm() > 0) ratios.push_back(angle / raw.norm());
   }
+  // No interval turns enough to tell the scale. In SI units (rad/s) the nominal scale 1 is
+  // the right start: a search over a turn-and-back or a small bump finds a spurious minimum
+  // (0.11 on pyulog's sample.ulg, whose two still poses are joined by a knock) that the fit
+  // then cannot leave. Unscaled output (counts) has no nominal: search.
+  if (ratios.empty() && series.gyr_unit == "rad/s") return 1.0;
   double best = 0.0;
   if (!ratios.empty()) {
     std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());

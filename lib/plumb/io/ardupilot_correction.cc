@@ -158,10 +158,6 @@ std::string Format(double v) {
   return out.str();
 }
 
-/// "INS_ACC", "INS_ACC2", ... for kind "ACC"; "INS_GYR", ... for "GYR".
-std::string Prefix(const std::string& kind, int instance) {
-  return "INS_" + kind + (instance == 0 ? "" : std::to_string(instance + 1));
-}
 
 /// Step 1 of the undo: board = R_board^T logged.
 void UndoRotation(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<std::string>* warnings) {

@@ -428,6 +428,30 @@ Vec3 VarianceOfMean(const SpanStats& span, const Vec3& noise_sigma, const Vec3& 
   return var.cwiseProduct(tau_int) / std::max(span.n, 1.0);
 }
 
+/// The largest angle the gyroscope turns away from the start of samples [begin, end), rad:
+/// max_k |sum_{i<k} (omega_i - still_rate) dt_i| (small-angle accumulation, enough to tell a
+/// vibration, milliradians, from a turn and back, radians).
+double MaxExcursion(const ImuSeries& series, std::size_t begin, std::size_t end,
+                    const Vec3& still_rate) {
+  Vec3 angle = Vec3::Zero();
+  double largest = 0.0;
+  for (std::size_t i = begin; i < end && i + 1 < series.size(); ++i) {
+    angle += (series.gyr[i].cast<double>() - still_rate) * (series.t_s[i + 1] - series.t_s[i]);
+    largest = std::max(largest, angle.norm());
+  }
+  return largest;
+}
+
+/// What a vibration of the gap's own scatter can turn by chance: five standard deviations of
+/// its random walk over the gap, kept within [0.5, 3] degrees, rad. The upper bound matters:
+/// a real turn has a large scatter too, and a still vehicle shaking does not turn 3 degrees.
+double ExcursionLimit(const SpanStats& rate, const Vec3& tau_int, double dt_s) {
+  const double walk =
+      std::sqrt(rate.variance.cwiseProduct(tau_int).maxCoeff() * std::max(rate.n, 1.0)) * dt_s;
+  constexpr double kDegree_rad = 3.14159265358979323846 / 180.0;
+  return std::clamp(5.0 * walk, 0.5 * kDegree_rad, 3.0 * kDegree_rad);
+}
+
 /// Joins consecutive still runs whose samples in between show the same pose: a vehicle
 /// standing still but vibrating (engine, wind, a hand on the airframe) fails the window
 /// variance test in bursts and would otherwise be cut into several "poses" joined by
@@ -437,8 +461,10 @@ Vec3 VarianceOfMean(const SpanStats& span, const Vec3& noise_sigma, const Vec3& 
 ///  - the accelerometer means of a and b agree (variance of each mean from the still noise,
 ///    plus the rate allowance's analogue: one per-sample noise sigma per axis);
 ///  - the gap's accelerometer mean agrees with theirs (the gap's own variance of its mean);
-///  - the gap's mean rate is the still rate (the gap's own variance): any turn, even one back
-///    to the same attitude, has a mean rate far outside it. Without the gyroscope (none, or
+///  - the gap's mean rate is the still rate (the gap's own variance), and the angle the
+///    gyroscope turns away from the first run's attitude anywhere in the gap stays within
+///    what the gap's own scatter walks by chance (5 sigma, within 0.5-3 degrees): a turn, even
+///    one back to the same attitude (its mean rate can be zero), fails. Without the gyroscope (none, or
 ///    use_gyro off) runs are never joined, and neither across a time gap (missing samples
 ///    over half a window).
 /// A gap holding a pure translation and back also passes: its mean specific force is the
@@ -476,7 +502,9 @@ std::vector<Run> JoinSamePose(const ImuSeries& series, const std::vector<Run>& r
       const SpanStats rate = Stats(series.gyr, out.back().end, next.begin);
       const Vec3 var_rate = VarianceOfMean(rate, noise.gyr_sigma, noise.gyr_tau_int, true);
       same = MeanDistance(rate.mean, var_rate, noise.gyr_still_rate, Vec3::Zero(),
-                          RateAllowance(noise, options)) <= threshold;
+                          RateAllowance(noise, options)) <= threshold &&
+             MaxExcursion(series, out.back().end, next.begin, noise.gyr_still_rate) <=
+                 ExcursionLimit(rate, noise.gyr_tau_int, dt_s);
     }
     if (same) {
       out.back().end = next.end;
