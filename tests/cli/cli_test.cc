@@ -396,9 +396,11 @@ TEST(Cli, CalibratesAStillArdupilotLogAndSaysWhatOnePoseCannotDetermine) {
   if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
   TempDir dir;
   const std::string out = dir.File("log.json");
-  const ToolRun run = Plumb({"calibrate", log, "--min-still", "10", "--json", out}, dir);
+  // The default still detector: the vibrating still log is one pose (runs joined).
+  const ToolRun run = Plumb({"calibrate", log, "--json", out}, dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_TRUE(Contains(run.out, "(IMU instance 0)")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "still segments: 1 detected")) << run.out;
   EXPECT_TRUE(Contains(run.out, "accelerometer reconstructed as logged ./ INS_ACCSCAL")) << run.out;
   EXPECT_TRUE(Contains(run.out, "(gps)")) << run.out;
   const json doc = ReadJson(out);
@@ -425,9 +427,10 @@ TEST(Cli, InfoDescribesAnArdupilotLog) {
   const std::string out = dir.File("info.json");
   const ToolRun run = Plumb({"info", log, "--json", out}, dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_TRUE(Contains(run.out, "IMU instance 1 (IMU2)")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "IMU instance 1, IMU2 (accel+gyro)")) << run.out;
   const json doc = ReadJson(out);
-  ASSERT_EQ(doc["imus"].size(), 2u);
+  ASSERT_EQ(doc["imus"].size(), 3u);  // IMU, IMU2, and IMU3 defined without rows
+  EXPECT_EQ(doc["imus"][2]["samples"], 0);
   for (const char* key : {"name", "instance", "samples", "rate_hz", "t_start_s", "t_end_s"}) {
     EXPECT_TRUE(doc["imus"][0].contains(key)) << key;
   }
@@ -440,7 +443,8 @@ TEST(Cli, InfoDescribesAnArdupilotLog) {
   std::ofstream(csv) << "time_s,acc_x,acc_y,acc_z\n0,0,0,-9.8\n";
   const ToolRun bad = Plumb({"info", csv}, dir);
   EXPECT_NE(bad.exit_code, 0);
-  EXPECT_TRUE(Contains(bad.err, "not an ArduPilot DataFlash log")) << bad.err;
+  EXPECT_TRUE(Contains(bad.err, "not a flight log plumb reads")) << bad.err;
+  EXPECT_TRUE(Contains(bad.err, csv)) << bad.err;
 }
 
 }  // namespace
