@@ -17,14 +17,11 @@
 namespace plumb::io {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
 std::string SharedLog(const std::string& name) {
-  return std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/" + name;
+  return testing::SharedLogPath("ardupilot", name);
 }
 
-#define SKIP_IF_ABSENT(path) \
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << (path)
+using Bytes = std::vector<std::uint8_t>;
 
 void PutFixed(Bytes* out, const std::string& text, std::size_t width) {
   for (std::size_t k = 0; k < width; ++k) out->push_back(k < text.size() ? text[k] : 0);
@@ -132,7 +129,7 @@ TEST(DataflashStreams, StreamsSayWhatArduPilotAppliedAndWhetherItCanBeUndone) {
 
 TEST(DataflashStreams, BatchSamplerMatchesIndependentDecoder) {
   const std::string path = SharedLog("copter462_truncated_isbd.bin");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   std::ifstream in(std::string(PLUMB_SOURCE_DIR) +
                    "/tests/data/ardupilot/copter462_truncated_isbd.bin.golden.json");
   const nlohmann::json golden = nlohmann::json::parse(in)["isbd"]["1/0"];
@@ -197,7 +194,7 @@ TEST(DataflashStreams, BatchSamplerValuesAreInt16OverMultiplier) {
 
 TEST(DataflashStreams, OldFormatImuAndImu2AreInstancesZeroAndOne) {
   const std::string path = SharedLog("plane408_centre_point.BIN");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const DataflashLog log = ReadDataflash(path);
   FlightLogSelection imu2;
   imu2.stream = "IMU2";  // names its instance by itself

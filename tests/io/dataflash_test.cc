@@ -16,35 +16,22 @@
 #include <string>
 #include <vector>
 
+#include "io_test_util.h"
 #include "plumb/core/error.h"
 #include "plumb/io/dataflash.h"
 
 namespace plumb::io {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
+using testing::ReadBytes;
 std::string SharedLog(const std::string& name) {
-  return std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/" + name;
+  return testing::SharedLogPath("ardupilot", name);
 }
-
-std::string GoldenFile(const std::string& name) {
-  return std::string(PLUMB_SOURCE_DIR) + "/tests/data/ardupilot/" + name + ".golden.json";
-}
-
-#define SKIP_IF_ABSENT(path) \
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << (path)
-
-Bytes ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 nlohmann::json ReadGolden(const std::string& name) {
-  std::ifstream in(GoldenFile(name));
-  EXPECT_TRUE(in.good()) << GoldenFile(name);
-  return nlohmann::json::parse(in, nullptr, true, false);
+  return testing::ReadGoldenJson("ardupilot", name);
 }
+
+using Bytes = std::vector<std::uint8_t>;
 
 // Every input byte is in a decoded record, skipped, or in the dropped truncated record.
 void ExpectBytesAccounted(const DataflashLog& log) {
@@ -136,7 +123,7 @@ class DataflashRealLog : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(DataflashRealLog, MatchesIndependentDecoder) {
   const std::string path = SharedLog(GetParam());
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const nlohmann::json golden = ReadGolden(GetParam());
   const DataflashLog log = ReadDataflash(path);
   ExpectCountsMatchGolden(log, golden);
@@ -155,7 +142,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(Dataflash, ColumnUnitsComeFromFmtuUnitMult) {
   const std::string path = SharedLog("copter462_truncated_isbd.bin");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const DataflashLog log = ReadDataflash(path);
   const DataflashType* imu = log.Find("IMU");
   ASSERT_NE(imu, nullptr);
@@ -181,7 +168,7 @@ void ExpectPrefixOf(const DataflashLog& part, const DataflashLog& whole) {
 
 TEST(Dataflash, TruncatedCopyKeepsEveryCompleteRecord) {
   const std::string path = SharedLog("copter364_fmuv5.bin");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes full = ReadBytes(path);
   const DataflashLog whole = ParseDataflash(full.data(), full.size(), path);
   ASSERT_FALSE(whole.warnings.any());
@@ -199,7 +186,7 @@ TEST(Dataflash, TruncatedCopyKeepsEveryCompleteRecord) {
 
 TEST(Dataflash, EveryTruncationOfASmallLogDecodesItsPrefix) {
   const std::string path = SharedLog("plane382_pymavlink_test.BIN");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes full = ReadBytes(path);
   const DataflashLog whole = ParseDataflash(full.data(), full.size(), path);
   std::mt19937_64 rng(20240505);
@@ -215,7 +202,7 @@ TEST(Dataflash, EveryTruncationOfASmallLogDecodesItsPrefix) {
 
 TEST(Dataflash, GarbledCopyKeepsGoodRecordsAndCountsSkippedBytes) {
   const std::string path = SharedLog("copter36_chibios.bin");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes clean = ReadBytes(path);
   const DataflashLog whole = ParseDataflash(clean.data(), clean.size(), path);
   Bytes garbled = clean;
@@ -238,7 +225,7 @@ TEST(Dataflash, GarbledCopyKeepsGoodRecordsAndCountsSkippedBytes) {
 
 TEST(Dataflash, RandomlyDamagedLogsNeverCrash) {
   const std::string path = SharedLog("copter462_truncated_isbd.bin");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes clean = ReadBytes(path);
   std::mt19937_64 rng(7);
   std::uniform_int_distribution<std::size_t> where(0, clean.size() - 1);
@@ -399,7 +386,7 @@ TEST(Dataflash, ImuInstancesFromTheIField) {
 
 TEST(Dataflash, ReportsReadSpeed) {
   const std::string path = SharedLog("copter36_chibios.bin");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes one = ReadBytes(path);
   Bytes big;
   for (int k = 0; k < 30; ++k) Append(&big, one);

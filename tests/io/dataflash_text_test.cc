@@ -20,19 +20,11 @@ namespace plumb::io {
 namespace {
 
 std::string SharedLog(const std::string& name) {
-  return std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/" + name;
+  return testing::SharedLogPath("ardupilot", name);
 }
-
 nlohmann::json ReadGolden(const std::string& name) {
-  const std::string path =
-      std::string(PLUMB_SOURCE_DIR) + "/tests/data/ardupilot/" + name + ".golden.json";
-  std::ifstream in(path);
-  EXPECT_TRUE(in.good()) << path;
-  return nlohmann::json::parse(in);
+  return testing::ReadGoldenJson("ardupilot", name);
 }
-
-#define SKIP_IF_ABSENT(path) \
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << (path)
 
 DataflashLog Parse(const std::string& text) {
   return ParseDataflashText(text.data(), text.size(), "built.log");
@@ -97,7 +89,7 @@ class DataflashTextRealLog : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(DataflashTextRealLog, MatchesIndependentDecoder) {
   const std::string path = SharedLog(GetParam());
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   EXPECT_TRUE(LooksLikeDataflashText(path));
   EXPECT_FALSE(LooksLikeDataflash(path));
   const nlohmann::json golden = ReadGolden(GetParam());
@@ -112,14 +104,14 @@ INSTANTIATE_TEST_SUITE_P(BothLogs, DataflashTextRealLog,
 
 TEST(DataflashText, BinaryLogsAreNotTextLogs) {
   const std::string path = SharedLog("plane382_pymavlink_test.BIN");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   EXPECT_FALSE(LooksLikeDataflashText(path));
   EXPECT_FALSE(LooksLikeDataflashText("/nonexistent/plumb/log.log"));
 }
 
 TEST(DataflashText, LogWithImuFmtButNoRowsSaysSoClearly) {
   const std::string path = SharedLog("copter31_no_imu_rows.log");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const DataflashLog log = ReadDataflashText(path);
   const std::vector<ImuStreamInfo> streams = DataflashImuStreams(log);
   ASSERT_EQ(streams.size(), 1u);
@@ -133,7 +125,7 @@ TEST(DataflashText, LogWithImuFmtButNoRowsSaysSoClearly) {
 
 TEST(DataflashText, NanLogGivesASessionWithTheInsCorrectionUndone) {
   const std::string path = SharedLog("copter311_nan.log");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const DataflashLog log = ReadDataflashText(path);
   FlightLogSelection second;
   second.imu = 1;
@@ -269,7 +261,7 @@ TEST(DataflashText, InputWithoutFmtIsAnInputError) {
 
 TEST(DataflashText, RandomlyDamagedLogsNeverCrash) {
   const std::string path = SharedLog("copter311_nan.log");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   std::ifstream in(path, std::ios::binary);
   const std::string clean((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::mt19937_64 rng(11);

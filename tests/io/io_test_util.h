@@ -6,9 +6,13 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "plumb/core/error.h"
 
@@ -32,6 +36,32 @@ void ExpectInputError(Read read, const std::string& file, const std::string& whe
           << "message: " << e.what() << "\nmissing: " << part;
     }
   }
+}
+
+/// Skips the test, with the reason, when the shared-data file `path` is absent.
+#define PLUMB_SKIP_IF_ABSENT(path) \
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << (path)
+
+/// ../shared/data/<folder>/<name>.
+inline std::string SharedLogPath(const std::string& folder, const std::string& name) {
+  return std::string(PLUMB_SHARED_DATA_DIR) + "/" + folder + "/" + name;
+}
+
+/// The golden JSON tests/data/<folder>/<name>.golden.json (see the README there for how each
+/// was decoded independently).
+inline nlohmann::json ReadGoldenJson(const std::string& folder, const std::string& name) {
+  const std::string path =
+      std::string(PLUMB_SOURCE_DIR) + "/tests/data/" + folder + "/" + name + ".golden.json";
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  return nlohmann::json::parse(in);
+}
+
+/// Every byte of the file at `path` (empty when it cannot be read).
+inline std::vector<std::uint8_t> ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in),
+                                   std::istreambuf_iterator<char>());
 }
 
 }  // namespace plumb::io::testing

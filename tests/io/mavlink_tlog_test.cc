@@ -27,6 +27,8 @@
 namespace plumb::io {
 namespace {
 
+using testing::ReadBytes;
+
 using Bytes = std::vector<std::uint8_t>;
 
 const std::string kLogName = "plane385_disarmed.tlog";
@@ -34,14 +36,6 @@ const std::string kLog = std::string(PLUMB_SHARED_DATA_DIR) + "/mavlink/" + kLog
 const std::string kGolden =
     std::string(PLUMB_SOURCE_DIR) + "/tests/data/mavlink/" + kLogName + ".golden.json";
 constexpr std::uint64_t kT0_us = 1532076292000000ull;  // 2018-07-20, a plausible tlog time
-
-#define SKIP_IF_ABSENT(path) \
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << (path)
-
-Bytes ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 nlohmann::json ReadGolden() {
   std::ifstream in(kGolden);
@@ -233,7 +227,7 @@ void ExpectGpsEq(const MavlinkGpsRawInt& r, const nlohmann::json& g) {
 }
 
 TEST(MavlinkTlog, RealLogMatchesIndependentDecoder) {
-  SKIP_IF_ABSENT(kLog);
+  PLUMB_SKIP_IF_ABSENT(kLog);
   const nlohmann::json g = ReadGolden();
   const MavlinkLog log = ReadTlog(kLog);
   EXPECT_EQ(log.size_bytes, g["size_bytes"].get<std::size_t>());
@@ -280,7 +274,7 @@ TEST(MavlinkTlog, RealLogMatchesIndependentDecoder) {
 // --- damaged copies of the real log -------------------------------------------------------------
 
 TEST(MavlinkTlog, FlippedPayloadByteFailsTheCrcAndCostsOneFrame) {
-  SKIP_IF_ABSENT(kLog);
+  PLUMB_SKIP_IF_ABSENT(kLog);
   Bytes b = ReadBytes(kLog);
   const MavlinkLog clean = Parse(b);
   // The 10th RAW_IMU record: find it by walking the v1 records of this all-v1 file.
@@ -308,7 +302,7 @@ TEST(MavlinkTlog, FlippedPayloadByteFailsTheCrcAndCostsOneFrame) {
 }
 
 TEST(MavlinkTlog, EveryTruncationKeepsTheCompleteRecords) {
-  SKIP_IF_ABSENT(kLog);
+  PLUMB_SKIP_IF_ABSENT(kLog);
   const Bytes b = ReadBytes(kLog);
   const MavlinkLog clean = Parse(b);
   for (std::size_t cut = 40; cut < b.size(); cut += 997) {
@@ -329,7 +323,7 @@ TEST(MavlinkTlog, EveryTruncationKeepsTheCompleteRecords) {
 }
 
 TEST(MavlinkTlog, GarbageBetweenRecordsIsSkippedAndCounted) {
-  SKIP_IF_ABSENT(kLog);
+  PLUMB_SKIP_IF_ABSENT(kLog);
   const Bytes b = ReadBytes(kLog);
   const MavlinkLog clean = Parse(b);
   // Insert runs of random bytes (including start bytes) every ~5000 bytes at record starts.
@@ -367,7 +361,7 @@ TEST(MavlinkTlog, GarbageBetweenRecordsIsSkippedAndCounted) {
 }
 
 TEST(MavlinkTlog, RandomBitFlipsNeverCrashAndKeepMostRecords) {
-  SKIP_IF_ABSENT(kLog);
+  PLUMB_SKIP_IF_ABSENT(kLog);
   const Bytes b = ReadBytes(kLog);
   const MavlinkLog clean = Parse(b);
   std::mt19937_64 rng(77);
@@ -610,7 +604,7 @@ TEST(MavlinkSession, Wrapped32BitMicrosecondsAreUnwrapped) {
 // --- the real log as a session ------------------------------------------------------------------
 
 TEST(MavlinkSession, RealLogStreamsAndSessions) {
-  SKIP_IF_ABSENT(kLog);
+  PLUMB_SKIP_IF_ABSENT(kLog);
   const MavlinkLog log = ReadTlog(kLog);
   EXPECT_TRUE(LooksLikeTlog(kLog));
   const std::vector<ImuStreamInfo> streams = TlogImuStreams(log);

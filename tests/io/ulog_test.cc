@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "io_test_util.h"
 #include "plumb/core/error.h"
 #include "plumb/io/px4_session.h"
 #include "plumb/io/ulog.h"
@@ -22,29 +23,15 @@
 namespace plumb::io {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
+using testing::ReadBytes;
 std::string SharedLog(const std::string& name) {
-  return std::string(PLUMB_SHARED_DATA_DIR) + "/px4/" + name;
+  return testing::SharedLogPath("px4", name);
 }
-
-std::string GoldenFile(const std::string& name) {
-  return std::string(PLUMB_SOURCE_DIR) + "/tests/data/px4/" + name + ".golden.json";
-}
-
-#define SKIP_IF_ABSENT(path) \
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << (path)
-
-Bytes ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 nlohmann::json ReadGolden(const std::string& name) {
-  std::ifstream in(GoldenFile(name));
-  EXPECT_TRUE(in.good()) << GoldenFile(name);
-  return nlohmann::json::parse(in);
+  return testing::ReadGoldenJson("px4", name);
 }
+
+using Bytes = std::vector<std::uint8_t>;
 
 std::size_t Topics(const ULog& log, const std::string& name, int multi_id) {
   const ULogTopic* t = log.Find(name, multi_id);
@@ -149,7 +136,7 @@ class ULogRealLog : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(ULogRealLog, MatchesIndependentDecoder) {
   const std::string path = SharedLog(GetParam());
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const nlohmann::json golden = ReadGolden(GetParam());
   const ULog log = ReadULog(path);
   ExpectHeaderMatchesGolden(log, golden);
@@ -168,7 +155,7 @@ INSTANTIATE_TEST_SUITE_P(AllUlg, ULogRealLog,
 
 TEST(ULog, TaggedLoggingDefaultParamsAndLooksLike) {
   const std::string path = SharedLog("sample_logging_tagged_and_default_params.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const ULog log = ReadULog(path);
   bool tagged = false;
   for (const ULogText& t : log.texts) tagged = tagged || t.tag >= 0;
@@ -176,7 +163,7 @@ TEST(ULog, TaggedLoggingDefaultParamsAndLooksLike) {
   ASSERT_FALSE(log.default_params.empty());
   EXPECT_NE(log.default_params.front().default_types, 0);
   EXPECT_TRUE(LooksLikeULog(path));
-  EXPECT_FALSE(LooksLikeULog(GoldenFile("sample.ulg")));
+  EXPECT_FALSE(LooksLikeULog(std::string(PLUMB_SOURCE_DIR) + "/tests/data/px4/sample.ulg.golden.json"));
 }
 
 // --- damaged copies of real logs -------------------------------------------------------------
@@ -193,7 +180,7 @@ void ExpectPrefixOf(const ULog& part, const ULog& whole) {
 
 TEST(ULog, EveryTruncationDecodesItsPrefix) {
   const std::string path = SharedLog("sample_log_small.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes full = ReadBytes(path);
   const ULog whole = ParseULog(full.data(), full.size(), path);
   std::mt19937_64 rng(20240611);
@@ -213,7 +200,7 @@ TEST(ULog, EveryTruncationDecodesItsPrefix) {
 
 TEST(ULog, GarbledCopyResynchronisesAndCountsSkippedBytes) {
   const std::string path = SharedLog("sample_log_small.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes clean = ReadBytes(path);
   const ULog whole = ParseULog(clean.data(), clean.size(), path);
   Bytes garbled = clean;
@@ -237,7 +224,7 @@ TEST(ULog, GarbledCopyResynchronisesAndCountsSkippedBytes) {
 // definitions section (on chains of valid headers) and in the data section.
 TEST(ULog, DamagedCopyMatchesIndependentDecoder) {
   const std::string path = SharedLog("sample_log_small.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   Bytes data = ReadBytes(path);
   for (std::size_t offset : {std::size_t{5202}, std::size_t{30012}, std::size_t{61026}}) {
     data[offset] ^= 0x5A;
@@ -255,7 +242,7 @@ TEST(ULog, DamagedCopyMatchesIndependentDecoder) {
 // Flips bits anywhere (header and definitions included), then runs everything the CLI runs.
 TEST(ULog, BitFlippedLogsNeverCrash) {
   const std::string path = SharedLog("sample_appended_multiple.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const Bytes clean = ReadBytes(path);
   std::mt19937_64 rng(7);
   std::uniform_int_distribution<std::size_t> where(0, clean.size() - 1);
@@ -525,7 +512,7 @@ double MeanNorm(const std::vector<Vec3f>& v) {
 
 TEST(ULogSession, SampleUlgStillPeriodAfterUndoingTheCalibration) {
   const std::string path = SharedLog("sample.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const ULog log = ReadULog(path);
   const std::vector<ImuStreamInfo> streams = ULogImuStreams(log);
   ASSERT_EQ(streams.size(), 1u);
@@ -574,7 +561,7 @@ TEST(ULogSession, SampleUlgStillPeriodAfterUndoingTheCalibration) {
 
 TEST(ULogSession, SmallLogStreamsSiteAndRawSensorAccel) {
   const std::string path = SharedLog("sample_log_small.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const ULog log = ReadULog(path);
   std::map<std::string, int> per_name;
   for (const ImuStreamInfo& s : ULogImuStreams(log)) {
@@ -626,7 +613,7 @@ TEST(ULogSession, SmallLogStreamsSiteAndRawSensorAccel) {
 // vehicle_imu: mean specific force = delta_velocity / dt, checked against the raw fields.
 TEST(ULogSession, VehicleImuIsDeltaOverDt) {
   const std::string path = SharedLog("sample_px4_events.ulg");
-  SKIP_IF_ABSENT(path);
+  PLUMB_SKIP_IF_ABSENT(path);
   const ULog log = ReadULog(path);
   FlightLogSelection sel;
   sel.stream = "vehicle_imu";

@@ -8,18 +8,10 @@
 #include <sstream>
 
 #include "plumb/core/error.h"
+#include "plumb/io/log_common.h"
 #include "plumb/io/ardupilot_correction.h"
 
 namespace plumb::io {
-namespace {
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-}  // namespace
-
 std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
   const DataflashType* gps = log.Find("GPS");
   if (gps == nullptr) return std::nullopt;
@@ -39,13 +31,7 @@ std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
     lngs.push_back(lo);
     alts.push_back(alt >= 0 ? gps->Value(r, static_cast<std::size_t>(alt)) : 0.0);
   }
-  if (lats.empty()) return std::nullopt;
-  SiteInput site;
-  site.lat_deg = Median(lats);
-  site.lon_deg = Median(lngs);
-  site.height_m = Median(alts);
-  site.source = "gps";
-  return site;
+  return MedianSite(std::move(lats), std::move(lngs), std::move(alts));
 }
 
 Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection) {

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "plumb/core/error.h"
+#include "plumb/io/log_common.h"
 #include "plumb/io/dataflash_internal.h"
 
 namespace plumb::io {
@@ -443,17 +444,7 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
 }
 
 DataflashLog ReadDataflash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(path, "byte 0", "cannot open the DataFlash log for reading");
-  const std::streamoff end = in.tellg();
-  if (end < 0) throw InputError(path, "byte 0", "cannot determine the file size");
-  std::vector<std::uint8_t> buffer(static_cast<std::size_t>(end));
-  in.seekg(0);
-  if (!buffer.empty() &&
-      !in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(end))) {
-    throw InputError(path, "byte " + std::to_string(in.gcount()),
-                     "read failed before the end of the file");
-  }
+  const std::vector<std::uint8_t> buffer = ReadBinaryFile(path, "DataFlash log");
   return ParseDataflash(buffer.data(), buffer.size(), path);
 }
 

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "plumb/core/error.h"
+#include "plumb/io/log_common.h"
 #include "plumb/io/ardupilot_correction.h"
 
 namespace plumb::io {
@@ -170,11 +171,6 @@ std::string AutopilotName(int autopilot) {
   if (autopilot == kMavAutopilotPx4) return "PX4";
   if (autopilot < 0) return "unknown autopilot (no HEARTBEAT)";
   return "MAV_AUTOPILOT " + std::to_string(autopilot);
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 /// Every (kind, instance) stream of `v`, with its samples in session units.
@@ -374,13 +370,7 @@ std::optional<SiteInput> SiteFromTlog(const MavlinkLog& log) {
     lons.push_back(lon);
     alts.push_back(g.alt_mm * kMilli);
   }
-  if (lats.empty()) return std::nullopt;
-  SiteInput site;
-  site.lat_deg = Median(lats);
-  site.lon_deg = Median(lons);
-  site.height_m = Median(alts);
-  site.source = "gps";
-  return site;
+  return MedianSite(std::move(lats), std::move(lons), std::move(alts));
 }
 
 std::map<std::string, double> TlogParams(const MavlinkLog& log) {

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "plumb/core/error.h"
+#include "plumb/io/log_common.h"
 
 namespace plumb::io {
 namespace {
@@ -510,17 +511,7 @@ MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::stri
 }
 
 MavlinkLog ReadTlog(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(path, "byte 0", "cannot open the MAVLink tlog for reading");
-  const std::streamoff end = in.tellg();
-  if (end < 0) throw InputError(path, "byte 0", "cannot determine the file size");
-  std::vector<std::uint8_t> buffer(static_cast<std::size_t>(end));
-  in.seekg(0);
-  if (!buffer.empty() &&
-      !in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(end))) {
-    throw InputError(path, "byte " + std::to_string(in.gcount()),
-                     "read failed before the end of the file");
-  }
+  const std::vector<std::uint8_t> buffer = ReadBinaryFile(path, "MAVLink tlog");
   return ParseTlog(buffer.data(), buffer.size(), path);
 }
 

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "plumb/core/error.h"
+#include "plumb/io/log_common.h"
 
 namespace plumb::io {
 namespace {
@@ -609,11 +610,6 @@ ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries
   return info;
 }
 
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 std::vector<ImuStreamInfo> ULogImuStreams(const ULog& log) {
@@ -653,13 +649,7 @@ std::optional<SiteInput> SiteFromULog(const ULog& log) {
       alts.push_back(std::isfinite(h) ? h : 0.0);
     }
   }
-  if (lats.empty()) return std::nullopt;
-  SiteInput site;
-  site.lat_deg = Median(lats);
-  site.lon_deg = Median(lons);
-  site.height_m = Median(alts);
-  site.source = "gps";
-  return site;
+  return MedianSite(std::move(lats), std::move(lons), std::move(alts));
 }
 
 std::map<std::string, double> ULogParams(const ULog& log) {

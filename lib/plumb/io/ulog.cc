@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "plumb/core/error.h"
+#include "plumb/io/log_common.h"
 
 namespace plumb::io {
 namespace {
@@ -711,17 +712,7 @@ ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& so
 }
 
 ULog ReadULog(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(path, "byte 0", "cannot open the ULog file for reading");
-  const std::streamoff end = in.tellg();
-  if (end < 0) throw InputError(path, "byte 0", "cannot determine the file size");
-  std::vector<std::uint8_t> buffer(static_cast<std::size_t>(end));
-  in.seekg(0);
-  if (!buffer.empty() &&
-      !in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(end))) {
-    throw InputError(path, "byte " + std::to_string(in.gcount()),
-                     "read failed before the end of the file");
-  }
+  const std::vector<std::uint8_t> buffer = ReadBinaryFile(path, "ULog file");
   return ParseULog(buffer.data(), buffer.size(), path);
 }
 

@@ -1,0 +1,26 @@
+// plumb/io/log_common.h — pieces every flight-log reader shares: reading the whole file, and
+// the site from a log's GPS fixes.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plumb/core/session.h"
+
+namespace plumb::io {
+
+/// The whole file at `path` in memory. `what` names the format in errors ("DataFlash log",
+/// "ULog file", ...). Throws plumb::InputError(path, "byte N", ...) when the file cannot be
+/// opened, sized or read to its end.
+std::vector<std::uint8_t> ReadBinaryFile(const std::string& path, const std::string& what);
+
+/// The site from a log's GPS fixes with a 3D fix: the median latitude (deg, [-90, 90]),
+/// longitude (deg, [-180, 180]) and height (m; logs give the altitude above mean sea level,
+/// used as the height: the geoid separation, tens of metres, changes gravity by about 1e-5
+/// relative), source "gps". The three vectors have one entry per fix. nullopt when empty.
+std::optional<SiteInput> MedianSite(std::vector<double> lat_deg, std::vector<double> lon_deg,
+                                    std::vector<double> height_m);
+
+}  // namespace plumb::io
