@@ -9,6 +9,7 @@
 
 #include "commands.h"
 #include "export_options.h"
+#include "fit_options.h"
 #include "input_options.h"
 #include "paper_methods.h"
 #include "plumb/core/error.h"
@@ -29,14 +30,9 @@ struct CalibrateArgs {
   InputArgs input;
   SiteArgs site;
   std::string method = "generalized";
-  std::string model = "base";
+  FitArgs fit;                ///< --model, --strict, --heading, --level-north, --temp-ref
   std::string json_path;      ///< --json FILE
   SegmentArgs segments;       ///< --segments FILE or the still detector's options
-  bool strict = false;        ///< fail when the data cannot determine every parameter
-  double heading_deg = 0.0;   ///< --heading: first still pose's x axis from north, degrees
-  CLI::Option* heading = nullptr;
-  bool level_north = false;       ///< first still pose is level with x north (known attitude)
-  double temp_ref_c = 25.0;       ///< reference temperature of the temperature terms, degC
   std::string baseline;           ///< --baseline SPEC: also fit this model, side by side
   ExportArgs exports;             ///< --export FORMAT=FILE, --export-imu, --kalibr-topic
 };
@@ -56,27 +52,12 @@ class CalibrateCommand : public Command {
                      "needs --lat --lon)")
         ->check(CLI::IsMember({"generalized", "paper-benchmark", "paper-static"}))
         ->capture_default_str();
-    app_->add_option("--model", a.model,
-                     "Error model spec: base, paper, or base+EFFECT[:OPTION]+... "
-                     "(see 'plumb effects')")
-        ->capture_default_str();
+    AddModelOption(app_, a.fit);
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
     app_->add_option("--json", a.json_path, "Write the result as JSON to FILE (atomically)")
         ->type_name("FILE");
-    app_->add_flag("--strict", a.strict,
-                   "Fail (exit 1) when the data cannot determine every parameter of the model, "
-                   "instead of reporting the unobservable directions");
-    a.heading = app_->add_option("--heading", a.heading_deg,
-                                 "Heading of the first still pose's x axis from north, degrees "
-                                 "(0 = x north); otherwise the heading is an arbitrary gauge");
-    auto* level = app_->add_flag("--level-north", a.level_north,
-                                 "The first still pose is level with x north (the paper's pose): "
-                                 "its attitude is known and held");
-    level->excludes(a.heading);
-    app_->add_option("--temp-ref", a.temp_ref_c,
-                     "Reference temperature of the temperature terms, degC")
-        ->capture_default_str();
+    AddFitOptions(app_, a.fit);
     app_->add_option("--baseline", a.baseline,
                      "Also fit this model spec (e.g. base) on the same segments and print both "
                      "fits side by side: chi2/dof, per-axis RMS, and the parameters the model "
@@ -105,29 +86,13 @@ class CalibrateCommand : public Command {
     if (!exports.empty()) CheckExportable(series);
 
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
-    std::vector<StillSegment> segments = seg.segments;
-    if (a.level_north && !segments.empty()) segments.front().known_R_n_b = Quat::Identity();
-
-    const std::optional<double> gravity = a.site.fixed_gravity();
-    const geo::Site site = ResolveSite(a.site, session.site, gravity);
-    if (gravity && site.known) {
-      session.warnings.push_back("gravity fixed at " + std::to_string(*gravity) +
-                                 " m/s^2 by --gravity instead of WGS84 normal gravity");
-    }
-
-    model::Model model = model::Model::Parse(a.model);
-    model.t_ref_s = series.t_s.front();
-    model.temp_ref_c = a.temp_ref_c;
-
-    estimation::CalibrationOptions options;
+    FitSetup fit = PrepareFit(session, seg, a.site, a.fit);
+    const std::vector<StillSegment>& segments = fit.segments;
+    const geo::Site& site = fit.site;
+    const model::Model& model = fit.model;
+    estimation::CalibrationOptions& options = fit.options;
     options.method = a.method;
-    if (a.heading->count() > 0) options.first_heading_deg = a.heading_deg;
-    if (a.strict) options.on_insufficient = estimation::InsufficientData::kError;
-
-    std::cout << session.source << ": " << series.size() << " samples, " << series.duration_s()
-              << " s" << (series.has_gyro() ? "" : ", no gyroscope")
-              << (series.has_temperature() ? ", with temperature" : "") << "\n";
-    for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+    PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose) << "\n";
 
     const estimation::CalibrationResult result =

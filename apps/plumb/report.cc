@@ -16,6 +16,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "fit_options.h"
 #include "input_options.h"
 #include "plumb/core/error.h"
 #include "plumb/diagnostics/diagnose.h"
@@ -39,16 +40,11 @@ struct ReportArgs {
   InputArgs input;
   SiteArgs site;
   SegmentArgs segments;
-  std::string model = "base";
+  FitArgs fit;                      ///< --model, --strict, --heading, --level-north, --temp-ref
   std::string out_dir;              ///< --out DIR: created when missing
   bool diagnose = true;             ///< --diagnose / --no-diagnose
   double significance = 0.01;       ///< level of the score test, (0, 0.5)
   int confirm = 3;                  ///< refit the best N significant candidates, >= 0
-  bool strict = false;              ///< fail when the data cannot determine every parameter
-  double heading_deg = 0.0;         ///< --heading: first still pose's x from north, degrees
-  CLI::Option* heading = nullptr;
-  bool level_north = false;         ///< first still pose level with x north (known attitude)
-  double temp_ref_c = 25.0;         ///< reference temperature of temperature terms, degC
   bool no_figures = false;          ///< --no-figures: do not draw (nor write figure data)
   std::string gnuplot = "gnuplot";  ///< --gnuplot PROGRAM
 };
@@ -108,10 +104,7 @@ class ReportCommand : public Command {
                      "diagnose.json, residuals.csv, figures.gp, its CSV data and the PNGs")
         ->type_name("DIR")
         ->required();
-    app_->add_option("--model", a.model,
-                     "Error model spec: base, paper, or base+EFFECT[:OPTION]+... "
-                     "(see 'plumb effects')")
-        ->capture_default_str();
+    AddModelOption(app_, a.fit);
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
     app_->add_flag("--diagnose,!--no-diagnose", a.diagnose,
@@ -125,18 +118,7 @@ class ReportCommand : public Command {
                      "Refit the model with each of the best N significant effects")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
-    app_->add_flag("--strict", a.strict,
-                   "Fail (exit 1) when the data cannot determine every parameter of the model");
-    a.heading = app_->add_option("--heading", a.heading_deg,
-                                 "Heading of the first still pose's x axis from north, degrees "
-                                 "(0 = x north); otherwise the heading is an arbitrary gauge");
-    auto* level = app_->add_flag("--level-north", a.level_north,
-                                 "The first still pose is level with x north: its attitude is "
-                                 "known and held");
-    level->excludes(a.heading);
-    app_->add_option("--temp-ref", a.temp_ref_c,
-                     "Reference temperature of the temperature terms, degC")
-        ->capture_default_str();
+    AddFitOptions(app_, a.fit);
     app_->add_flag("--no-figures", a.no_figures, "Write the page without figures (no gnuplot)");
     app_->add_option("--gnuplot", a.gnuplot,
                      "The gnuplot program (a name looked up on PATH, or a path)")
@@ -150,25 +132,12 @@ class ReportCommand : public Command {
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
-    std::vector<StillSegment> segments = seg.segments;
-    if (a.level_north && !segments.empty()) segments.front().known_R_n_b = Quat::Identity();
-    const std::optional<double> gravity = a.site.fixed_gravity();
-    const geo::Site site = ResolveSite(a.site, session.site, gravity);
-    if (gravity && site.known) {
-      session.warnings.push_back("gravity fixed at " + std::to_string(*gravity) +
-                                 " m/s^2 by --gravity instead of WGS84 normal gravity");
-    }
-    model::Model model = model::Model::Parse(a.model);
-    model.t_ref_s = series.t_s.front();
-    model.temp_ref_c = a.temp_ref_c;
-    estimation::CalibrationOptions options;
-    if (a.heading->count() > 0) options.first_heading_deg = a.heading_deg;
-    if (a.strict) options.on_insufficient = estimation::InsufficientData::kError;
-
-    std::cout << session.source << ": " << series.size() << " samples, " << series.duration_s()
-              << " s" << (series.has_gyro() ? "" : ", no gyroscope")
-              << (series.has_temperature() ? ", with temperature" : "") << "\n";
-    for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+    const FitSetup fit = PrepareFit(session, seg, a.site, a.fit);
+    const std::vector<StillSegment>& segments = fit.segments;
+    const geo::Site& site = fit.site;
+    const model::Model& model = fit.model;
+    const estimation::CalibrationOptions& options = fit.options;
+    PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose);
 
     const estimation::CalibrationResult result =

@@ -1,0 +1,63 @@
+// See fit_options.h.
+#include "fit_options.h"
+
+#include <iostream>
+#include <optional>
+
+namespace plumb::cli {
+
+void AddModelOption(CLI::App* app, FitArgs& a) {
+  app->add_option("--model", a.model,
+                  "Error model spec: base, paper, or base+EFFECT[:OPTION]+... "
+                  "(see 'plumb effects')")
+      ->capture_default_str();
+}
+
+void AddFitOptions(CLI::App* app, FitArgs& a) {
+  app->add_flag("--strict", a.strict,
+                "Fail (exit 1) when the data cannot determine every parameter of the model, "
+                "instead of reporting the unobservable directions");
+  a.heading = app->add_option("--heading", a.heading_deg,
+                              "Heading of the first still pose's x axis from north, degrees "
+                              "(0 = x north); otherwise the heading is an arbitrary gauge");
+  auto* level = app->add_flag("--level-north", a.level_north,
+                              "The first still pose is level with x north (the paper's pose): "
+                              "its attitude is known and held");
+  level->excludes(a.heading);
+  app->add_option("--temp-ref", a.temp_ref_c,
+                  "Reference temperature of the temperature terms, degC")
+      ->capture_default_str();
+}
+
+FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
+                    const SiteArgs& site_args, const FitArgs& fit) {
+  FitSetup out;
+  out.segments = segmentation.segments;
+  if (fit.level_north && !out.segments.empty()) {
+    out.segments.front().known_R_n_b = Quat::Identity();
+  }
+  const std::optional<double> gravity = site_args.fixed_gravity();
+  out.site = ResolveSite(site_args, session.site, gravity);
+  if (gravity && out.site.known) {
+    session.warnings.push_back("gravity fixed at " + std::to_string(*gravity) +
+                               " m/s^2 by --gravity instead of WGS84 normal gravity");
+  }
+  out.model = model::Model::Parse(fit.model);
+  out.model.t_ref_s = session.series.t_s.front();
+  out.model.temp_ref_c = fit.temp_ref_c;
+  if (fit.heading != nullptr && fit.heading->count() > 0) {
+    out.options.first_heading_deg = fit.heading_deg;
+  }
+  if (fit.strict) out.options.on_insufficient = estimation::InsufficientData::kError;
+  return out;
+}
+
+void PrintSession(const Session& session) {
+  const ImuSeries& series = session.series;
+  std::cout << session.source << ": " << series.size() << " samples, " << series.duration_s()
+            << " s" << (series.has_gyro() ? "" : ", no gyroscope")
+            << (series.has_temperature() ? ", with temperature" : "") << "\n";
+  for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+}
+
+}  // namespace plumb::cli

@@ -1,0 +1,52 @@
+// The options of a generalized fit that `calibrate` and `report` share (--model, --strict,
+// --heading, --level-north, --temp-ref), and the steps both take from a session to the
+// calibration's inputs: segments, site, model and options.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "plumb/core/segment.h"
+#include "plumb/core/session.h"
+#include "plumb/estimation/options.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+#include "plumb/segmentation/still_detector.h"
+#include "site_options.h"
+
+namespace plumb::cli {
+
+struct FitArgs {
+  std::string model = "base";      ///< --model SPEC
+  bool strict = false;             ///< --strict: fail when the data cannot determine the model
+  double heading_deg = 0.0;        ///< --heading: first still pose's x axis from north, degrees
+  CLI::Option* heading = nullptr;  ///< set when --heading was given
+  bool level_north = false;        ///< --level-north: first still pose level, x north (known)
+  double temp_ref_c = 25.0;        ///< --temp-ref: reference of the temperature terms, degC
+};
+
+/// Registers --model on `app`.
+void AddModelOption(CLI::App* app, FitArgs& args);
+
+/// Registers --strict, --heading, --level-north and --temp-ref on `app`.
+void AddFitOptions(CLI::App* app, FitArgs& args);
+
+/// Everything Calibrate() takes besides the samples.
+struct FitSetup {
+  std::vector<StillSegment> segments;  ///< the detected or given segments, first one known
+                                       ///< level x north with --level-north
+  geo::Site site;                      ///< from the flags, else the log's GPS, else none
+  model::Model model;                  ///< parsed --model, time and temperature references set
+  estimation::CalibrationOptions options;  ///< heading and strictness from the flags
+};
+
+/// The fit's inputs for `session` and its segmentation; adds to session.warnings when
+/// --gravity overrides WGS84 gravity at a known site.
+FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
+                    const SiteArgs& site_args, const FitArgs& fit);
+
+/// "<source>: N samples, T s[, no gyroscope][, with temperature]" and the session's warnings.
+void PrintSession(const Session& session);
+
+}  // namespace plumb::cli
