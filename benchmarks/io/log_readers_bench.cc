@@ -19,9 +19,7 @@
 #include <vector>
 
 #include "plumb/io/dataflash.h"
-#include "plumb/io/mavlink_session.h"
 #include "plumb/io/mavlink_tlog.h"
-#include "plumb/io/px4_session.h"
 #include "plumb/io/ulog.h"
 
 namespace {
@@ -70,24 +68,32 @@ void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t samples
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
 }
 
-/// ArduPilot DataFlash .bin: decode the log and every IMU instance's samples.
-void BM_ReadDataflash(benchmark::State& state, const std::string& relative) {
+/// Reads the repeated copy of `relative` once per iteration with `read`, which returns the
+/// number of IMU samples it decoded.
+template <typename Read>
+void ReadRepeated(benchmark::State& state, const std::string& relative, Read read) {
   const RepeatedLog* log = Repeated(relative);
   if (log == nullptr) {
     state.SkipWithError(("shared data absent: " + relative).c_str());
     return;
   }
   std::size_t samples = 0;
-  for (auto _ : state) {
-    const plumb::io::DataflashLog decoded = plumb::io::ReadDataflash(log->path());
-    samples = 0;
+  for (auto _ : state) samples = read(log->path());
+  SetCounters(state, std::filesystem::file_size(log->path()), samples);
+}
+
+/// ArduPilot DataFlash .bin: decode the log and every IMU instance's samples.
+void BM_ReadDataflash(benchmark::State& state, const std::string& relative) {
+  ReadRepeated(state, relative, [](const std::string& path) {
+    const plumb::io::DataflashLog decoded = plumb::io::ReadDataflash(path);
+    std::size_t samples = 0;
     for (const auto& imu : plumb::io::DataflashImuInstances(decoded)) {
       const plumb::ImuSeries s = plumb::io::ImuFromDataflash(decoded, imu.instance);
       samples += s.size();
       benchmark::DoNotOptimize(s.acc.data());
     }
-  }
-  SetCounters(state, std::filesystem::file_size(log->path()), samples);
+    return samples;
+  });
 }
 BENCHMARK_CAPTURE(BM_ReadDataflash, copter36_chibios, std::string("ardupilot/copter36_chibios.bin"))
     ->Unit(benchmark::kMillisecond)
@@ -97,45 +103,31 @@ BENCHMARK_CAPTURE(BM_ReadDataflash, plane408_centre_point,
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// MAVLink .tlog: every frame's CRC checked, the IMU messages decoded, then every IMU stream
-/// as a session (units, time) without undoing the calibration.
+/// MAVLink .tlog: every frame's CRC checked and the IMU messages decoded.
 void BM_ReadTlog(benchmark::State& state, const std::string& relative) {
-  const RepeatedLog* log = Repeated(relative);
-  if (log == nullptr) {
-    state.SkipWithError(("shared data absent: " + relative).c_str());
-    return;
-  }
-  std::size_t samples = 0;
-  for (auto _ : state) {
-    const plumb::io::MavlinkLog decoded = plumb::io::ReadTlog(log->path());
-    samples = decoded.raw_imu.size() + decoded.scaled_imu2.size() + decoded.scaled_imu3.size();
+  ReadRepeated(state, relative, [](const std::string& path) {
+    const plumb::io::MavlinkLog decoded = plumb::io::ReadTlog(path);
     benchmark::DoNotOptimize(decoded.raw_imu.data());
-  }
-  SetCounters(state, std::filesystem::file_size(log->path()), samples);
+    return decoded.raw_imu.size() + decoded.scaled_imu2.size() + decoded.scaled_imu3.size();
+  });
 }
 BENCHMARK_CAPTURE(BM_ReadTlog, plane385_disarmed, std::string("mavlink/plane385_disarmed.tlog"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// PX4 ULog: decode the log (every topic) and build the sensor_combined session. A repeated
-/// ULog is one header and definitions followed by the data of every copy read as data
-/// (later copies' headers are resynchronised over), so the bytes are all walked.
+/// PX4 ULog: decode the log (every topic). A repeated ULog is one header and definitions
+/// followed by the data of every copy (later copies' headers are resynchronised over), so the
+/// bytes are all walked.
 void BM_ReadULog(benchmark::State& state, const std::string& relative) {
-  const RepeatedLog* log = Repeated(relative);
-  if (log == nullptr) {
-    state.SkipWithError(("shared data absent: " + relative).c_str());
-    return;
-  }
-  std::size_t samples = 0;
-  for (auto _ : state) {
-    const plumb::io::ULog decoded = plumb::io::ReadULog(log->path());
-    samples = 0;
+  ReadRepeated(state, relative, [](const std::string& path) {
+    const plumb::io::ULog decoded = plumb::io::ReadULog(path);
+    std::size_t samples = 0;
     for (const auto& topic : decoded.topics) {
       if (topic.name == "sensor_combined") samples += topic.rows;
     }
     benchmark::DoNotOptimize(decoded.topics.data());
-  }
-  SetCounters(state, std::filesystem::file_size(log->path()), samples);
+    return samples;
+  });
 }
 BENCHMARK_CAPTURE(BM_ReadULog, sample, std::string("px4/sample.ulg"))
     ->Unit(benchmark::kMillisecond)
