@@ -22,6 +22,10 @@ void AddExportOptions(CLI::App* app, ExportArgs& a) {
                                  "(ArduPilot 0..2: INS_ACC, INS_ACC2, INS_ACC3; PX4 0..3: "
                                  "CAL_ACC0..3); default: --imu")
                      ->check(CLI::NonNegativeNumber);
+  app->add_flag("--export-undetermined", a.undetermined,
+                "Write ArduPilot/PX4 parameters even when the session leaves the plumb "
+                "parameters they come from undetermined (one still pose, say): those values are "
+                "the ones plumb held, not measured, and replace the vehicle's");
   app->add_option("--kalibr-topic", a.rostopic, "rostopic written in Kalibr's imu.yaml")
       ->capture_default_str();
 }
@@ -60,6 +64,7 @@ nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const Expo
   exporter::ExportOptions options;
   options.imu = a.imu_option != nullptr && a.imu_option->count() > 0 ? a.imu : imu;
   options.rostopic = a.rostopic;
+  options.allow_undetermined = a.undetermined;
   for (const ExportRequest& r : requests) {
     const exporter::ExportOutput e = exporter::Export(r.format, result, series, options);
     io::WriteFileAtomic(r.path, e.text);

@@ -19,6 +19,7 @@ struct ExportArgs {
   int imu = 0;                       ///< --export-imu N: instance in parameter names, >= 0
   CLI::Option* imu_option = nullptr; ///< to tell whether --export-imu was given
   std::string rostopic = "/imu0";    ///< --kalibr-topic: Kalibr's rostopic
+  bool undetermined = false;         ///< --export-undetermined: write undetermined values too
 };
 
 /// One requested export.
@@ -27,7 +28,7 @@ struct ExportRequest {
   std::string path;    ///< file to write (atomically)
 };
 
-/// Registers --export, --export-imu and --kalibr-topic.
+/// Registers --export, --export-imu, --export-undetermined and --kalibr-topic.
 void AddExportOptions(CLI::App* app, ExportArgs& args);
 
 /// The requests of --export; throws UsageError for a missing '=', an empty file or an

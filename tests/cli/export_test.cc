@@ -112,9 +112,17 @@ TEST(ExportCli, ArdupilotLogAsLoggedIsRefusedForFirmwareFormats) {
   const ToolRun refused = Plumb({"calibrate", log, "--as-logged", "--export", "px4=" + param}, dir);
   EXPECT_EQ(refused.exit_code, 2) << refused.out << refused.err;
   EXPECT_TRUE(Contains(refused.err, "--as-logged")) << refused.err;
-  // Without it: the log's second IMU, named after its instance by default.
-  const ToolRun run = Plumb({"calibrate", log, "--imu", "1", "--min-still", "10", "--export",
-                             "ardupilot=" + param},
+  // Without it: one still pose does not determine the offsets and scales: refused, naming
+  // them, and nothing written.
+  const ToolRun one_pose = Plumb({"calibrate", log, "--imu", "1", "--export",
+                                  "ardupilot=" + param},
+                                 dir);
+  EXPECT_EQ(one_pose.exit_code, 1) << one_pose.out;
+  EXPECT_TRUE(Contains(one_pose.err, "does not determine accel.matrix.xx")) << one_pose.err;
+  EXPECT_FALSE(std::filesystem::exists(param));
+  // Asked to anyway: the log's second IMU, named after its instance by default.
+  const ToolRun run = Plumb({"calibrate", log, "--imu", "1", "--export", "ardupilot=" + param,
+                             "--export-undetermined"},
                             dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto p = ReadParam(param);

@@ -37,9 +37,40 @@ json ParametersJson(const ParameterSet& set) {
   return out;
 }
 
+/// True for the plumb parameters that firmware values come from: the accelerometer matrix's
+/// diagonal (its scales) and biases, the gyroscope biases and the temperature terms.
+bool FeedsFirmware(const std::string& name) {
+  for (const char* exact : {"accel.matrix.xx", "accel.matrix.yy", "accel.matrix.zz"}) {
+    if (name == exact) return true;
+  }
+  for (const char* prefix : {"accel.bias.", "gyro.bias.", "accel_temperature_bias.",
+                             "gyro_temperature_bias."}) {
+    if (name.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+
+/// Refuses to write firmware values from parameters the session does not determine.
+void CheckDetermined(const std::string& format, const estimation::CalibrationResult& r,
+                     const ExportOptions& options) {
+  if (options.allow_undetermined) return;
+  std::string missing;
+  for (const auto& p : r.parameters) {
+    if (p.fixed || p.observable || !FeedsFirmware(p.name)) continue;
+    missing += (missing.empty() ? "" : ", ") + p.name;
+  }
+  if (missing.empty()) return;
+  throw Error("--export " + format + ": the session does not determine " + missing +
+              ", which the firmware parameters come from; writing them would replace the "
+              "vehicle's values with ones plumb held, not measured. Record more poses (six "
+              "faces or more, joined by turns), or give --export-undetermined to write them "
+              "anyway");
+}
+
 /// A firmware format: parameters, their read-back correction, and the report.
 ExportOutput Firmware(const std::string& format, const estimation::CalibrationResult& r,
                       const ImuSeries& series, const ExportOptions& options) {
+  CheckDetermined(format, r, options);
   const FirmwareCorrection target = BestDiagonal(r, SessionTemperatureRange(series));
   ExportOutput out;
   out.format = format;

@@ -26,6 +26,11 @@ struct ExportOptions {
   int imu = 0;                     ///< IMU instance for parameter names, 0-based (ArduPilot 0..2,
                                    ///< PX4 0..3)
   std::string rostopic = "/imu0";  ///< Kalibr's rostopic
+  /// Write firmware parameters even when the session does not determine the plumb parameters
+  /// they come from (accelerometer diagonal and biases, gyroscope biases, temperature terms).
+  /// Off: Export() refuses, naming them — a single still pose would otherwise overwrite the
+  /// vehicle's offsets and scales with values held at nominal, not measured.
+  bool allow_undetermined = false;
 };
 
 /// The formats Export() knows, in the order above.
@@ -39,8 +44,9 @@ struct ExportOutput {
 };
 
 /// Builds one format for the calibration `result` of the session `series`. Throws
-/// plumb::Error for an unknown format, outputs not in SI (counts), or an instance the
-/// target has no parameters for.
+/// plumb::Error for an unknown format, outputs not in SI (counts), an instance the target has
+/// no parameters for, or (firmware formats, unless options.allow_undetermined) parameters the
+/// firmware values come from that the session leaves undetermined.
 ExportOutput Export(const std::string& format, const estimation::CalibrationResult& result,
                     const ImuSeries& series, const ExportOptions& options);
 
