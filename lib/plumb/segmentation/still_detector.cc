@@ -391,22 +391,25 @@ struct SpanStats {
   double n = 0.0;
 };
 
-SpanStats Stats(const std::vector<Vec3f>& triad, std::size_t begin, std::size_t end) {
+/// Mean and sample variance from a span's block moments (sums about `reference`): the runs
+/// and gaps the detector produces start and end on block boundaries, so no sample is read
+/// again.
+SpanStats Stats(const TriadMoments& m, const Vec3& reference, std::size_t begin,
+                std::size_t end) {
   SpanStats out;
   out.n = static_cast<double>(end - begin);
   if (end <= begin) return out;
-  const Vec3 reference = triad[begin].cast<double>();
-  Vec3 sum = Vec3::Zero(), sum_sq = Vec3::Zero();
-  for (std::size_t i = begin; i < end; ++i) {
-    const Vec3 d = triad[i].cast<double>() - reference;
-    sum += d;
-    sum_sq += d.cwiseProduct(d);
-  }
-  out.mean = reference + sum / out.n;
-  if (out.n > 1.0) {
-    out.variance = ((sum_sq - sum.cwiseProduct(sum) / out.n) / (out.n - 1.0)).cwiseMax(0.0);
-  }
+  out.mean = reference + m.sum / out.n;
+  if (out.n > 1.0) out.variance = m.Scatter(out.n) / (out.n - 1.0);
   return out;
+}
+
+SpanStats AccStats(const BlockMoments& blocks, std::size_t begin, std::size_t end) {
+  return Stats(blocks.AccOver(begin, end), blocks.acc_reference(), begin, end);
+}
+
+SpanStats GyrStats(const BlockMoments& blocks, std::size_t begin, std::size_t end) {
+  return Stats(blocks.GyrOver(begin, end), blocks.gyr_reference(), begin, end);
 }
 
 /// sum_axes (a - b)^2 / (var_a + var_b + allowance^2): chi^2(3) when a and b estimate the same
@@ -469,16 +472,17 @@ double ExcursionLimit(const SpanStats& rate, const Vec3& tau_int, double dt_s) {
 ///    over half a window).
 /// A gap holding a pure translation and back also passes: its mean specific force is the
 /// still one (the velocity change is zero), so the joined segment's mean is unbiased.
-std::vector<Run> JoinSamePose(const ImuSeries& series, const std::vector<Run>& runs,
+std::vector<Run> JoinSamePose(const ImuSeries& series, const BlockMoments& blocks,
+                              const std::vector<Run>& runs,
                               const NoiseEstimate& noise, const StillDetectorOptions& options,
                               double dt_s, double max_gap_s, std::size_t& joined) {
   joined = 0;
   // Without the gyroscope a turn about the vertical keeps the accelerometer means: never join.
-  const bool gyro = noise.has_gyro && series.has_gyro() && options.use_gyro;
+  const bool gyro = noise.has_gyro && blocks.has_gyro() && options.use_gyro;
   if (runs.size() < 2 || !options.join_same_pose || !gyro) return runs;
   const double threshold = signal::ChiSquareQuantile(1.0 - options.false_alarm, 3.0);
   std::vector<Run> out{runs.front()};
-  SpanStats a = Stats(series.acc, runs.front().begin, runs.front().end);
+  SpanStats a = AccStats(blocks, runs.front().begin, runs.front().end);
   for (std::size_t k = 1; k < runs.size(); ++k) {
     const Run& next = runs[k];
     // A time gap (missing samples, over max_gap_s) between the runs is never joined.
@@ -486,11 +490,21 @@ std::vector<Run> JoinSamePose(const ImuSeries& series, const std::vector<Run>& r
     const double expected_s = static_cast<double>(next.begin - out.back().end + 1) * dt_s;
     if (gap_s > expected_s + max_gap_s) {
       out.push_back(next);
-      a = Stats(series.acc, next.begin, next.end);
+      a = AccStats(blocks, next.begin, next.end);
       continue;
     }
-    const SpanStats b = Stats(series.acc, next.begin, next.end);
-    const SpanStats gap = Stats(series.acc, out.back().end, next.begin);
+    // Runs and gaps lie on block boundaries; a gap holding a non-finite sample is not joined.
+    const auto aligned = [&](std::size_t i) {
+      return i % blocks.block() == 0 || i == blocks.samples();
+    };
+    if (!aligned(out.back().end) || !aligned(next.begin) || !aligned(next.end) ||
+        blocks.NonfiniteOver(out.back().end, next.begin) > 0) {
+      out.push_back(next);
+      a = AccStats(blocks, next.begin, next.end);
+      continue;
+    }
+    const SpanStats b = AccStats(blocks, next.begin, next.end);
+    const SpanStats gap = AccStats(blocks, out.back().end, next.begin);
     const Vec3 var_a = VarianceOfMean(a, noise.acc_sigma, noise.acc_tau_int, false);
     const Vec3 var_b = VarianceOfMean(b, noise.acc_sigma, noise.acc_tau_int, false);
     const Vec3 var_gap = VarianceOfMean(gap, noise.acc_sigma, noise.acc_tau_int, true);
@@ -499,7 +513,7 @@ std::vector<Run> JoinSamePose(const ImuSeries& series, const std::vector<Run>& r
                 MeanDistance(gap.mean, var_gap, 0.5 * (a.mean + b.mean), 0.25 * (var_a + var_b),
                              noise.acc_sigma) <= threshold;
     if (same) {
-      const SpanStats rate = Stats(series.gyr, out.back().end, next.begin);
+      const SpanStats rate = GyrStats(blocks, out.back().end, next.begin);
       const Vec3 var_rate = VarianceOfMean(rate, noise.gyr_sigma, noise.gyr_tau_int, true);
       same = MeanDistance(rate.mean, var_rate, noise.gyr_still_rate, Vec3::Zero(),
                           RateAllowance(noise, options)) <= threshold &&
@@ -508,7 +522,7 @@ std::vector<Run> JoinSamePose(const ImuSeries& series, const std::vector<Run>& r
     }
     if (same) {
       out.back().end = next.end;
-      a = Stats(series.acc, out.back().begin, out.back().end);
+      a = AccStats(blocks, out.back().begin, out.back().end);
       ++joined;
     } else {
       out.push_back(next);
@@ -831,7 +845,7 @@ SegmentationResult DetectStillSegments(const ImuSeries& series,
 
   // 3. Still runs: runs showing the same pose joined, trimmed, then kept when long enough.
   std::size_t joined = 0;
-  const std::vector<Run> runs = JoinSamePose(series, found.runs, noise, options, dt_s, 0.5 * options.window_s, joined);
+  const std::vector<Run> runs = JoinSamePose(series, blocks, found.runs, noise, options, dt_s, 0.5 * options.window_s, joined);
   if (joined > 0) {
     report.notes.push_back(
         "joined " + std::to_string(joined) + " pairs of still runs: the samples between them "
