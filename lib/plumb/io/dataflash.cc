@@ -110,8 +110,11 @@ namespace {
 /// The one-pass decoder state.
 class Parser {
  public:
-  Parser(const std::uint8_t* data, std::size_t size, DataflashLog* log)
-      : data_(data), size_(size), log_(log) {
+  /// `expected_rows`: records per type id from a counting pass (to size each type's storage
+  /// once), or nullptr for a counting pass itself, which stores no bodies.
+  Parser(const std::uint8_t* data, std::size_t size, DataflashLog* log,
+         const std::array<std::size_t, 256>* expected_rows)
+      : data_(data), size_(size), log_(log), expected_rows_(expected_rows) {
     index_.fill(-1);
     AddType(detail::DataflashFmtType(&log_->warnings));
   }
@@ -128,7 +131,7 @@ class Parser {
             return;
           }
           const std::uint8_t* body = data_ + pos + kHeaderSize;
-          t.bodies.insert(t.bodies.end(), body, body + t.body_size);
+          if (expected_rows_ != nullptr) t.bodies.insert(t.bodies.end(), body, body + t.body_size);
           ++t.rows;
           pos += t.length;
           if (t.id == kFmtType) HandleFmt(body, t.body_size);
@@ -150,6 +153,7 @@ class Parser {
 
  private:
   void AddType(DataflashType t) {
+    if (expected_rows_ != nullptr) t.bodies.reserve((*expected_rows_)[t.id] * t.body_size);
     index_[t.id] = static_cast<int>(log_->types.size());
     log_->types.push_back(std::move(t));
   }
@@ -192,6 +196,7 @@ class Parser {
   const std::uint8_t* data_;
   std::size_t size_;
   DataflashLog* log_;
+  const std::array<std::size_t, 256>* expected_rows_;
   std::array<int, 256> index_;
   std::size_t last_skip_ = 0;
 };
@@ -432,7 +437,16 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
   DataflashLog log;
   log.source = source;
   log.size_bytes = size;
-  Parser parser(data, size, &log);
+  // Two passes: the first counts the records of each type (no copy), so that the second
+  // copies every body once into storage of the right size (no reallocation).
+  std::array<std::size_t, 256> rows{};
+  {
+    DataflashLog counted;
+    Parser counter(data, size, &counted, nullptr);
+    counter.Run();
+    for (const DataflashType& t : counted.types) rows[t.id] = t.rows;
+  }
+  Parser parser(data, size, &log, &rows);
   parser.Run();
   if (log.types.front().rows == 0) {
     throw InputError(source, "byte 0",
@@ -444,8 +458,8 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
 }
 
 DataflashLog ReadDataflash(const std::string& path) {
-  const std::vector<std::uint8_t> buffer = ReadBinaryFile(path, "DataFlash log");
-  return ParseDataflash(buffer.data(), buffer.size(), path);
+  const LogFile file(path, "DataFlash log");
+  return ParseDataflash(file.data(), file.size(), path);
 }
 
 std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {

@@ -11,10 +11,26 @@
 
 namespace plumb::io {
 
-/// The whole file at `path` in memory. `what` names the format in errors ("DataFlash log",
-/// "ULog file", ...). Throws plumb::InputError(path, "byte N", ...) when the file cannot be
-/// opened, sized or read to its end.
-std::vector<std::uint8_t> ReadBinaryFile(const std::string& path, const std::string& what);
+/// The whole file at `path`, read-only in memory: mapped (mmap, read ahead sequentially) when
+/// the system can, else read into a buffer. `what` names the format in errors ("DataFlash
+/// log", "ULog file", ...). The constructor throws plumb::InputError(path, "byte N", ...) when
+/// the file cannot be opened, sized or read to its end. Not copyable.
+class LogFile {
+ public:
+  LogFile(const std::string& path, const std::string& what);
+  ~LogFile();
+  LogFile(const LogFile&) = delete;
+  LogFile& operator=(const LogFile&) = delete;
+
+  const std::uint8_t* data() const { return data_; }
+  std::size_t size() const { return size_; }
+
+ private:
+  const std::uint8_t* data_ = nullptr;
+  std::size_t size_ = 0;
+  void* mapping_ = nullptr;             ///< the mmap'ed region, or nullptr
+  std::vector<std::uint8_t> buffer_;    ///< the bytes when not mapped
+};
 
 /// The site from a log's GPS fixes with a 3D fix: the median latitude (deg, [-90, 90]),
 /// longitude (deg, [-180, 180]) and height (m; logs give the altitude above mean sea level,

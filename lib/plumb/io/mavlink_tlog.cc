@@ -511,8 +511,8 @@ MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::stri
 }
 
 MavlinkLog ReadTlog(const std::string& path) {
-  const std::vector<std::uint8_t> buffer = ReadBinaryFile(path, "MAVLink tlog");
-  return ParseTlog(buffer.data(), buffer.size(), path);
+  const LogFile file(path, "MAVLink tlog");
+  return ParseTlog(file.data(), file.size(), path);
 }
 
 }  // namespace plumb::io

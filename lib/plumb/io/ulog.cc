@@ -712,8 +712,8 @@ ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& so
 }
 
 ULog ReadULog(const std::string& path) {
-  const std::vector<std::uint8_t> buffer = ReadBinaryFile(path, "ULog file");
-  return ParseULog(buffer.data(), buffer.size(), path);
+  const LogFile file(path, "ULog file");
+  return ParseULog(file.data(), file.size(), path);
 }
 
 }  // namespace plumb::io
