@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "dataflash_builder.h"
 #include "io_test_util.h"
 #include "plumb/core/error.h"
 #include "plumb/io/dataflash.h"
@@ -21,29 +22,12 @@ std::string SharedLog(const std::string& name) {
   return testing::SharedLogPath("ardupilot", name);
 }
 
-using Bytes = std::vector<std::uint8_t>;
+using testing::Bytes;
 
-void PutFixed(Bytes* out, const std::string& text, std::size_t width) {
-  for (std::size_t k = 0; k < width; ++k) out->push_back(k < text.size() ? text[k] : 0);
-}
-
-Bytes FmtRecord(std::uint8_t type, std::uint8_t length, const std::string& name,
-                const std::string& format, const std::string& columns) {
-  Bytes r = {0xA3, 0x95, 128, type, length};
-  PutFixed(&r, name, 4);
-  PutFixed(&r, format, 16);
-  PutFixed(&r, columns, 64);
-  return r;
-}
-
-template <typename T>
-void Put(Bytes* out, T value) {
-  std::uint8_t raw[sizeof(T)];
-  std::memcpy(raw, &value, sizeof(T));
-  out->insert(out->end(), raw, raw + sizeof(T));
-}
-
-void Append(Bytes* out, const Bytes& more) { out->insert(out->end(), more.begin(), more.end()); }
+using testing::Append;
+using testing::FmtRecord;
+using testing::Put;
+using testing::PutFixed;
 
 // ACC/GYR as ArduPilot 4.x logs them ("QBQfff": TimeUS, I, SampleUS, X, Y, Z), 1 kHz.
 constexpr std::uint8_t kAcc = 161, kGyr = 162;

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "dataflash_builder.h"
 #include "io_test_util.h"
 #include "plumb/core/error.h"
 #include "plumb/io/dataflash.h"
@@ -31,7 +32,7 @@ nlohmann::json ReadGolden(const std::string& name) {
   return testing::ReadGoldenJson("ardupilot", name);
 }
 
-using Bytes = std::vector<std::uint8_t>;
+using testing::Bytes;
 
 // Every input byte is in a decoded record, skipped, or in the dropped truncated record.
 void ExpectBytesAccounted(const DataflashLog& log) {
@@ -274,27 +275,10 @@ TEST(Dataflash, InputWithoutFmtIsAnInputError) {
 
 // --- hand-built logs -------------------------------------------------------------------------
 
-void PutFixed(Bytes* out, const std::string& text, std::size_t width) {
-  for (std::size_t k = 0; k < width; ++k) out->push_back(k < text.size() ? text[k] : 0);
-}
-
-Bytes FmtRecord(std::uint8_t type, std::uint8_t length, const std::string& name,
-                const std::string& format, const std::string& columns) {
-  Bytes r = {0xA3, 0x95, 128, type, length};
-  PutFixed(&r, name, 4);
-  PutFixed(&r, format, 16);
-  PutFixed(&r, columns, 64);
-  return r;
-}
-
-template <typename T>
-void Put(Bytes* out, T value) {
-  std::uint8_t raw[sizeof(T)];
-  std::memcpy(raw, &value, sizeof(T));
-  out->insert(out->end(), raw, raw + sizeof(T));
-}
-
-void Append(Bytes* out, const Bytes& more) { out->insert(out->end(), more.begin(), more.end()); }
+using testing::Append;
+using testing::FmtRecord;
+using testing::Put;
+using testing::PutFixed;
 
 TEST(Dataflash, DecodesEveryFormatCharacterWithItsScale) {
   Bytes log = FmtRecord(200, 3 + 1 + 2 + 2 + 4 + 4 + 4 + 8 + 8 + 4, "TST", "bcCeLfdQn",
