@@ -42,6 +42,7 @@ void DescribeStillPeriods(const io::FlightLog& log, const io::ImuStreamInfo& inf
       std::cout << "    still " << s.series.t_s[p.begin] << " .. " << s.series.t_s[p.end - 1]
                 << " s\n";
     }
+    if (seg.segments.empty()) std::cout << "    still: no still period of 5 s or more\n";
     if (s.series.has_temperature()) {
       const auto [lo, hi] = std::minmax_element(s.series.temp_c.begin(), s.series.temp_c.end());
       j["temp_min_c"] = *lo;
