@@ -84,6 +84,15 @@ class CalibrateCommand : public Command {
     const ImuSeries& series = session.series;
     if (a.method != "generalized") return RunPaperMethod(session);
     if (!exports.empty()) CheckExportable(series);
+    if (firmware && !session.firmware_left.empty()) {
+      std::string left;
+      for (const std::string& l : session.firmware_left) left += "\n  " + l;
+      throw Error("--export: the samples still carry corrections the flight controller "
+                  "applied and plumb could not undo:" + left +
+                  "\nparameters calibrated from them would replace those corrections instead "
+                  "of adding to them; export kalibr only, or use a log whose parameters state "
+                  "the correction");
+    }
 
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
     FitSetup fit = PrepareFit(session, seg, a.site, a.fit);

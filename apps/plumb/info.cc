@@ -14,6 +14,7 @@
 #include "plumb/io/flight_log_file.h"
 #include "plumb/report/json_report.h"
 #include "plumb/segmentation/still_detector.h"
+#include "segment_options.h"
 
 namespace plumb::cli {
 namespace {
@@ -23,8 +24,9 @@ struct InfoArgs {
   std::string json_path;  ///< --json FILE
 };
 
-/// The still periods of one stream (as logged; the same detector calibrate uses, 5 s at
-/// least), into `j["still"]`, printed as they are found.
+/// The still periods of one stream, into `j["still"]`, printed as they are found: the still
+/// segments `plumb calibrate LOG --imu N --stream NAME` would use (the same detector with its
+/// default options, on the samples with the firmware's correction undone where it can be).
 void DescribeStillPeriods(const io::FlightLog& log, const io::ImuStreamInfo& info,
                           nlohmann::json& j) {
   nlohmann::json still = nlohmann::json::array();
@@ -32,17 +34,14 @@ void DescribeStillPeriods(const io::FlightLog& log, const io::ImuStreamInfo& inf
     io::FlightLogSelection pick;
     pick.imu = info.instance;
     pick.stream = info.name;
-    pick.undo_correction = false;
     const Session s = log.Select(pick);
-    segmentation::StillDetectorOptions detector;
-    detector.min_still_s = 5.0;
-    const auto seg = segmentation::DetectStillSegments(s.series, detector);
+    const auto seg = FindSegments(s.series, SegmentArgs{});
     for (const auto& p : seg.segments) {
       still.push_back({{"t_start_s", s.series.t_s[p.begin]}, {"t_end_s", s.series.t_s[p.end - 1]}});
       std::cout << "    still " << s.series.t_s[p.begin] << " .. " << s.series.t_s[p.end - 1]
                 << " s\n";
     }
-    if (seg.segments.empty()) std::cout << "    still: no still period of 5 s or more\n";
+    if (seg.segments.empty()) std::cout << "    still: no still period of 2 s or more\n";
     if (s.series.has_temperature()) {
       const auto [lo, hi] = std::minmax_element(s.series.temp_c.begin(), s.series.temp_c.end());
       j["temp_min_c"] = *lo;

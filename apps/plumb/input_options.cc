@@ -172,6 +172,7 @@ void Append(Session& joined, Session next) {
   a.temp_c.insert(a.temp_c.end(), b.temp_c.begin(), b.temp_c.end());
   joined.source += " " + next.source;
   for (auto& w : next.warnings) joined.warnings.push_back(next.source + ": " + w);
+  for (auto& l : next.firmware_left) joined.firmware_left.push_back(next.source + ": " + l);
   if (!joined.site) joined.site = next.site;
 }
 

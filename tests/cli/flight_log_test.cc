@@ -3,9 +3,14 @@
 // firmware's correction undone and said, and clear errors for a stream that is not there.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "run_tool.h"
 
@@ -143,6 +148,41 @@ TEST(FlightLogCli, AnArdupilotLogWithoutImuRowsSaysSo) {
   const ToolRun run = Plumb({"calibrate", log}, dir);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_TRUE(Contains(run.err, "no IMU rows")) << run.err;
+}
+
+/// A copy of `log` in `dir` whose PARM AHRS_ORIENTATION (name field of 16 characters, then
+/// the float value) reads `value`.
+std::string WithOrientation(const std::string& log, float value, TempDir& dir) {
+  std::ifstream in(log, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  const std::string name = "AHRS_ORIENTATION";
+  const auto it = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
+  EXPECT_NE(it, bytes.end());
+  if (it != bytes.end()) std::memcpy(&*(it + 16), &value, sizeof value);
+  const std::string out = dir.File("custom_orientation.bin");
+  std::ofstream(out, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return out;
+}
+
+TEST(FlightLogCli, NoFirmwareExportFromSamplesStillCarryingTheFirmwaresCorrection) {
+  // A custom board orientation (101) cannot be undone: the samples keep ArduPilot's whole
+  // correction, so parameters fitted to them would replace it: refused before calibrating.
+  const std::string log = Shared("ardupilot/plane408_centre_point.BIN");
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  const std::string custom = WithOrientation(log, 101.0f, dir);
+  const std::string param = dir.File("out.param");
+  const ToolRun run = Plumb({"calibrate", custom, "--export", "ardupilot=" + param,
+                             "--export-undetermined"},
+                            dir);
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  EXPECT_TRUE(Contains(run.err, "could not undo")) << run.err;
+  EXPECT_TRUE(Contains(run.err, "INS_ACCOFFS")) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(param));
+  // Kalibr's noise model does not depend on it: allowed.
+  const ToolRun kalibr = Plumb({"calibrate", custom, "--export", "kalibr=" + dir.File("imu.yaml")},
+                               dir);
+  EXPECT_EQ(kalibr.exit_code, 0) << kalibr.err;
 }
 
 }  // namespace

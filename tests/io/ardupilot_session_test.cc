@@ -239,6 +239,25 @@ TEST(ArdupilotSession, CustomOrientationIsNotUndoneAndSaysSo) {
   }
   EXPECT_TRUE(said);
   EXPECT_FALSE(DataflashImuStreams(log)[0].undoable);
+  ASSERT_EQ(s.firmware_left.size(), 1u);  // the whole correction stays in the samples
+  EXPECT_NE(s.firmware_left[0].find("INS_ACCOFFS"), std::string::npos) << s.firmware_left[0];
+}
+
+TEST(ArdupilotSession, ANonFiniteParameterIsNotUsedAndSaysWhatStays) {
+  std::map<std::string, double> params = CalibrationParams(0);
+  params["INS_ACCSCAL_Y"] = std::nan("");
+  const std::vector<std::array<double, 7>> rows = {{0.1, 0.2, 0.3, 1, 2, -9.8, 30},
+                                                   {0.1, 0.2, 0.3, 1, 2, -9.8, 30}};
+  const std::string text = SyntheticLog(params, rows);
+  const DataflashLog log = ParseDataflashText(text.data(), text.size(), "nan.log");
+  EXPECT_FALSE(ArdupilotCorrectionFor(log.params, 0).acc_scale.has_value());
+  const Session s = ArdupilotSession(log, FlightLogSelection{});
+  EXPECT_TRUE(s.series.acc[0].allFinite());
+  bool acc_left = false;
+  for (const auto& l : s.firmware_left) {
+    acc_left = acc_left || l.find("INS_ACCOFFS/INS_ACCSCAL") != std::string::npos;
+  }
+  EXPECT_TRUE(acc_left);
 }
 
 TEST(ArdupilotSession, TemperatureCalibrationWithoutTemperatureIsSaid) {

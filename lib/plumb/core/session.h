@@ -25,6 +25,11 @@ struct Session {
   std::vector<StillSegment> given_segments;  ///< stated by the user; empty means detect
   std::optional<SiteInput> site;
   std::vector<std::string> warnings;         ///< what the reader skipped or repaired
+  /// What a flight controller applied to these samples that the reader did not undo (e.g.
+  /// "ArduPilot INS_ACC2OFFS/INS_ACC2SCAL"); empty when the samples are the sensor's own
+  /// output, raw or fully reconstructed. Firmware parameters calibrated from samples that
+  /// still carry a correction would replace it instead of adding to it.
+  std::vector<std::string> firmware_left;
 };
 
 }  // namespace plumb

@@ -100,7 +100,7 @@ std::optional<Vec3> Triad(const std::map<std::string, double>& params, const std
   const char* axes[3] = {"_X", "_Y", "_Z"};
   for (int i = 0; i < 3; ++i) {
     const auto value = Param(params, name + axes[i]);
-    if (!value) return std::nullopt;
+    if (!value || !std::isfinite(*value)) return std::nullopt;  // NaN is as good as absent
     v[i] = *value;
   }
   return v;
@@ -309,12 +309,17 @@ ArdupilotCorrection ArdupilotCorrectionFor(const std::map<std::string, double>& 
 }
 
 std::vector<std::string> UndoArdupilotCorrection(const ArdupilotCorrection& c, bool undo,
-                                                 const std::string& who, ImuSeries* series) {
+                                                 const std::string& who, ImuSeries* series,
+                                                 std::vector<std::string>* left) {
   std::vector<std::string> lines;
   std::vector<std::string>* warnings = &lines;
   const std::string applied = c.Describe(true, series->has_gyro());
+  auto leave = [&](const std::string& what) {
+    if (left != nullptr) left->push_back(who + "ArduPilot " + what);
+  };
   if (!undo) {
     warnings->push_back(who + "samples taken as logged (ArduPilot applied " + applied + ")");
+    leave(applied);
     return lines;
   }
   if (!c.R_board) {
@@ -322,11 +327,22 @@ std::vector<std::string> UndoArdupilotCorrection(const ArdupilotCorrection& c, b
                           ArdupilotRotationName(c.orientation) +
                           ") is not a rotation plumb knows: ArduPilot's correction (" + applied +
                           ") is not undone, samples taken as logged");
+    leave(applied);
     return lines;
   }
   UndoRotation(c, who, series, warnings);
   UndoOffsets(c, who, series, warnings);
   UndoTempCal(c, who, series, warnings);
+  const std::string acc = Prefix("ACC", c.instance);
+  if (!c.acc_offset || !c.acc_scale) {
+    leave(acc + "OFFS/" + acc + "SCAL (missing or not finite in the log)");
+  }
+  if (series->has_gyro() && !c.gyr_offset) {
+    leave(Prefix("GYR", c.instance) + "OFFS (missing or not finite in the log)");
+  }
+  if (c.tcal_enable == 1 && (!c.tcal || !series->has_temperature())) {
+    leave("INS_TCAL" + std::to_string(c.instance + 1) + " temperature calibration");
+  }
   return lines;
 }
 

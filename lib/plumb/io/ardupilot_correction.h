@@ -89,9 +89,12 @@ ArdupilotCorrection ArdupilotCorrectionFor(const std::map<std::string, double>& 
 /// series->temp_c), in the order the inverse needs: board = R_board^T logged, then
 /// acc ./ SCAL + OFFS and gyr + OFFS, then the temperature calibration added back. Returns one
 /// line per decision, each starting with `who` (e.g. "IMU of IMU instance 0: "), naming the
-/// parameters and values used and what was left as logged. Shared by every reader of
-/// ArduPilot data (DataFlash .bin/.log, MAVLink .tlog).
+/// parameters and values used and what was left as logged. `left`, when given, receives one
+/// line per part of the correction that stays in the samples (not undone, or its parameters
+/// missing or not finite); see Session::firmware_left. Shared by every reader of ArduPilot
+/// data (DataFlash .bin/.log, MAVLink .tlog).
 std::vector<std::string> UndoArdupilotCorrection(const ArdupilotCorrection& c, bool undo,
-                                                 const std::string& who, ImuSeries* series);
+                                                 const std::string& who, ImuSeries* series,
+                                                 std::vector<std::string>* left = nullptr);
 
 }  // namespace plumb::io

@@ -49,7 +49,8 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
   }
   const ArdupilotCorrection correction = ArdupilotCorrectionFor(log.params, instance);
   const std::vector<std::string> undone =
-      UndoArdupilotCorrection(correction, selection.undo_correction, label + ": ", &s.series);
+      UndoArdupilotCorrection(correction, selection.undo_correction, label + ": ", &s.series,
+                              &s.firmware_left);
   s.warnings.insert(s.warnings.end(), undone.begin(), undone.end());
   s.site = SiteFromDataflash(log);
   return s;

@@ -462,11 +462,12 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
   if (ardupilot) {
     const std::vector<std::string> undo =
         UndoArdupilotCorrection(ArdupilotCorrectionFor(params, d.instance),
-                                selection.undo_correction, who, &out);
+                                selection.undo_correction, who, &out, &s.firmware_left);
     s.warnings.insert(s.warnings.end(), undo.begin(), undo.end());
   } else if (!info.applied.empty()) {
     s.warnings.push_back(who + "calibrated by " + AutopilotName(v.autopilot) +
                          " in a way the tlog does not state: samples taken as sent");
+    s.firmware_left.push_back(who + info.applied);
   } else {
     s.warnings.push_back(who + "raw sensor output as sent");
   }

@@ -367,8 +367,8 @@ std::optional<Correction> FindCorrection(const ULog& log, const StreamSource& sr
     c.offset[i] = *off;
     c.scale[i] = Param(log, c.prefix + "_" + axes[i] + "SCALE").value_or(1.0);
   }
-  if ((c.scale.array() == 0.0).any()) {
-    *why = c.prefix + " has a zero scale";
+  if ((c.scale.array() == 0.0).any() || !c.scale.allFinite() || !c.offset.allFinite()) {
+    *why = c.prefix + " has a zero or non-finite scale or offset";
     return std::nullopt;
   }
   const auto cal_rot = Param(log, c.prefix + "_ROT");
@@ -513,6 +513,7 @@ void UndoCorrection(const ULog& log, const StreamSource& src, Session* s) {
     if (!c) {
       s->warnings.push_back(who + what + " taken as logged (calibrated by PX4; not undone: " +
                             why + ")");
+      s->firmware_left.push_back(who + "PX4 " + what + " calibration (" + why + ")");
       continue;
     }
     // Thermal compensation (TC_A_ENABLE / TC_G_ENABLE = 1) at the sensor's logged temperature.
@@ -529,6 +530,7 @@ void UndoCorrection(const ULog& log, const StreamSource& src, Session* s) {
                               Integer(c->device_id) + " in the log";
         s->warnings.push_back(who + tc + " = 1: PX4's thermal " + what +
                               " correction is in the samples and NOT undone (" + tc_why + ")");
+        s->firmware_left.push_back(who + "PX4 thermal " + what + " correction (" + tc_why + ")");
         thermal.reset();
       } else {
         thermal_text = " + thermal offset " + thermal->prefix + "_X0..X3 (X0 " +
@@ -715,6 +717,7 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   } else if (!selection.undo_correction) {
     s.warnings.push_back(who + "samples taken as logged (calibrated by PX4 with " +
                          infos[chosen].applied + ")");
+    s.firmware_left.push_back(who + "PX4 " + infos[chosen].applied);
   } else {
     UndoCorrection(log, *src, &s);
     WarnParamChanges(log, &s);
