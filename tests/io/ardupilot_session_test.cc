@@ -243,6 +243,27 @@ TEST(ArdupilotSession, CustomOrientationIsNotUndoneAndSaysSo) {
   EXPECT_NE(s.firmware_left[0].find("INS_ACCOFFS"), std::string::npos) << s.firmware_left[0];
 }
 
+TEST(ArdupilotSession, ACorrectionChangedDuringTheLogIsSaid) {
+  const std::vector<std::array<double, 7>> rows = {{0.1, 0.2, 0.3, 1, 2, -9.8, 30},
+                                                   {0.1, 0.2, 0.3, 1, 2, -9.8, 30}};
+  std::string text = SyntheticLog(CalibrationParams(0), rows);
+  text += "PARM, INS_ACCOFFS_X, 0.75\n";  // recalibrated while logging
+  const DataflashLog log = ParseDataflashText(text.data(), text.size(), "recal.log");
+  const Session s = ArdupilotSession(log, FlightLogSelection{});
+  bool said = false;
+  for (const auto& w : s.warnings) {
+    said = said || (w.find("changed during the log (INS_ACCOFFS_X)") != std::string::npos);
+  }
+  EXPECT_TRUE(said);
+  const Session same = ArdupilotSession(
+      [&] {
+        const std::string t = SyntheticLog(CalibrationParams(0), rows);
+        return ParseDataflashText(t.data(), t.size(), "steady.log");
+      }(),
+      FlightLogSelection{});
+  for (const auto& w : same.warnings) EXPECT_EQ(w.find("changed during the log"), std::string::npos);
+}
+
 TEST(ArdupilotSession, ANonFiniteParameterIsNotUsedAndSaysWhatStays) {
   std::map<std::string, double> params = CalibrationParams(0);
   params["INS_ACCSCAL_Y"] = std::nan("");

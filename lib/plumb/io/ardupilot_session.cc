@@ -2,6 +2,8 @@
 #include "plumb/io/ardupilot_session.h"
 
 #include <algorithm>
+#include <vector>
+#include <map>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -12,6 +14,40 @@
 #include "plumb/io/ardupilot_correction.h"
 
 namespace plumb::io {
+namespace {
+
+/// Warns when a parameter of ArduPilot's IMU correction takes more than one value in the log's
+/// PARM records: the undo uses the last value for every sample, so samples logged before a
+/// recalibration are reconstructed with the later values.
+void WarnCorrectionChanges(const DataflashLog& log, const std::string& who,
+                           std::vector<std::string>* warnings) {
+  const DataflashType* parm = log.Find("PARM");
+  if (parm == nullptr) return;
+  const int name_col = parm->ColumnIndex("Name");
+  const int value_col = parm->ColumnIndex("Value");
+  if (name_col < 0 || value_col < 0) return;
+  std::map<std::string, std::vector<double>> values;
+  for (std::size_t r = 0; r < parm->rows; ++r) {
+    const std::string name = parm->Text(r, static_cast<std::size_t>(name_col));
+    const bool correction = name.rfind("INS_ACC", 0) == 0 || name.rfind("INS_GYR", 0) == 0 ||
+                            name.rfind("INS_TCAL", 0) == 0 || name == "AHRS_ORIENTATION";
+    if (!correction) continue;
+    const double v = parm->Value(r, static_cast<std::size_t>(value_col));
+    std::vector<double>& seen = values[name];
+    if (std::find(seen.begin(), seen.end(), v) == seen.end()) seen.push_back(v);
+  }
+  std::string changed;
+  for (const auto& [name, seen] : values) {
+    if (seen.size() > 1) changed += (changed.empty() ? "" : ", ") + name;
+  }
+  if (!changed.empty()) {
+    warnings->push_back(who + "parameters of ArduPilot's correction changed during the log (" +
+                        changed + "): the last values are used for every sample");
+  }
+}
+
+}  // namespace
+
 std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
   const DataflashType* gps = log.Find("GPS");
   if (gps == nullptr) return std::nullopt;
@@ -52,6 +88,7 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
       UndoArdupilotCorrection(correction, selection.undo_correction, label + ": ", &s.series,
                               &s.firmware_left);
   s.warnings.insert(s.warnings.end(), undone.begin(), undone.end());
+  WarnCorrectionChanges(log, label + ": ", &s.warnings);
   s.site = SiteFromDataflash(log);
   return s;
 }

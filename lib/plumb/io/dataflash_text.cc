@@ -283,7 +283,13 @@ class TextParser {
       ++w.fmt_conflicts;  // a second type id under a known name: lines could not tell them apart
       return;
     }
-    AddType(detail::MakeDataflashType(id, length, name, format, columns, &w));
+    DataflashType t = detail::MakeDataflashType(id, length, name, format, columns, &w);
+    // A text row stores only the bytes its columns occupy: an FMT claiming a long record for
+    // a short format must not make each short line cost the claimed length in memory.
+    std::size_t used = 0;
+    for (const DataflashColumn& c : t.columns) used = std::max(used, c.offset + c.size);
+    t.body_size = std::min(t.body_size, used);
+    AddType(std::move(t));
   }
 
   const char* data_;
