@@ -100,6 +100,11 @@ class InfoCommand : public Command {
         std::cout << ", " << std::setprecision(5) << imu.rate_hz << " Hz, " << std::setprecision(7)
                   << imu.t_start_s << " .. " << imu.t_end_s << " s";
       }
+      if (imu.samples == 0) {
+        std::cout << " (declared by the log's formats, no rows)\n";
+        doc["imus"].push_back(j);
+        continue;
+      }
       std::cout << "\n    applied by the firmware: "
                 << (imu.applied.empty() ? "nothing (raw sensor output)" : imu.applied)
                 << (imu.applied.empty() ? "" : imu.undoable ? " (plumb undoes it)"

@@ -187,8 +187,9 @@ ParameterSet ArdupilotParameters(const FirmwareCorrection& fw, int imu) {
     set.parameters.push_back({"INS_GYR" + n + "_CALTEMP", cal_gyr, false});
   }
   set.notes.push_back("tcal(T) = p(clamp(T) - 35) - p(clamp(CALTEMP) - 35), p(d) = (C1 + (C2 + "
-                      "C3 d) d) d * 1e-6 (AP_InertialSensor_tempcal.cpp); valid when the log plumb "
-                      "calibrated had INS_TCAL" + n + "_ENABLE = 0");
+                      "C3 d) d) d * 1e-6 (AP_InertialSensor_tempcal.cpp); valid for samples "
+                      "with no temperature correction left in them (INS_TCAL" + n +
+                      "_ENABLE = 0 in the log, or its correction undone by plumb)");
   return set;
 }
 
