@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "fit_options.h"
 #include "input_options.h"
 #include "plumb/core/error.h"
 #include "plumb/diagnostics/diagnose.h"
@@ -29,15 +30,12 @@ struct DiagnoseArgs {
   InputArgs input;
   SiteArgs site;
   SegmentArgs segments;
-  std::string model = "base";
+  FitArgs fit;                          ///< --model, --heading, --temp-ref (fit_options.h)
   std::string json_path;                ///< --json FILE
   std::string residuals_path;           ///< --residuals FILE: per-sample residuals, CSV
   double significance = 0.01;           ///< level of the score test, (0, 0.5)
   int confirm = 3;                      ///< refit the best N significant candidates, >= 0
   std::vector<std::string> candidates;  ///< --candidates: effect names (default: catalogue)
-  double heading_deg = 0.0;             ///< --heading: first still pose's x from north, deg
-  CLI::Option* heading = nullptr;
-  double temp_ref_c = 25.0;             ///< reference temperature of temperature terms, degC
 };
 
 class DiagnoseCommand : public Command {
@@ -49,7 +47,7 @@ class DiagnoseCommand : public Command {
         "effect not in the model, ranked, the best confirmed by refitting");
     DiagnoseArgs& a = args_;
     AddInputOptions(app_, a.input);
-    app_->add_option("--model", a.model, "The model to diagnose (a spec, see 'plumb effects')")
+    app_->add_option("--model", a.fit.model, "The model to diagnose (a spec, see 'plumb effects')")
         ->capture_default_str();
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
@@ -73,9 +71,9 @@ class DiagnoseCommand : public Command {
                      "Test only these effects (NAME or NAME:OPTION, comma-separated); default: "
                      "every catalogue effect not in the model")
         ->delimiter(',');
-    a.heading = app_->add_option("--heading", a.heading_deg,
+    a.fit.heading = app_->add_option("--heading", a.fit.heading_deg,
                                  "Heading of the first still pose's x axis from north, degrees");
-    app_->add_option("--temp-ref", a.temp_ref_c,
+    app_->add_option("--temp-ref", a.fit.temp_ref_c,
                      "Reference temperature of the temperature terms, degC")
         ->capture_default_str();
     AddSegmentOptions(app_, a.segments);
@@ -86,21 +84,17 @@ class DiagnoseCommand : public Command {
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
-    const std::optional<double> gravity = a.site.fixed_gravity();
-    const geo::Site site = ResolveSite(a.site, session.site, gravity);
-    model::Model model = model::Model::Parse(a.model);
-    model.t_ref_s = series.t_s.front();
-    model.temp_ref_c = a.temp_ref_c;
+    const FitSetup fit = PrepareFit(session, seg, a.site, a.fit);
+    const geo::Site& site = fit.site;
+    const model::Model& model = fit.model;
     diagnostics::DiagnoseOptions options;
     options.significance = a.significance;
     options.confirm = a.confirm;
     options.candidates = a.candidates;
+    options.calibration = fit.options;
     options.calibration.method = "generalized";
-    if (a.heading->count() > 0) options.calibration.first_heading_deg = a.heading_deg;
 
-    std::cout << session.source << ": " << series.size() << " samples, " << series.duration_s()
-              << " s" << (series.has_temperature() ? ", with temperature" : "") << "\n";
-    for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+    PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose)
               << "\n";
     const diagnostics::Diagnosis d =

@@ -1,25 +1,25 @@
 // libFuzzer target: any byte sequence as an ArduPilot DataFlash .bin log. Decoding, listing
-// the IMU streams and reading every one of them must either succeed or throw plumb::Error;
-// never crash, hang or read out of bounds (build with -fsanitize=fuzzer,address,undefined).
+// the IMU streams and making each one a session (ArduPilot's correction undone) must either
+// succeed or throw plumb::Error; never crash, hang or read out of bounds (build with
+// -fsanitize=fuzzer,address,undefined).
 #include <cstddef>
 #include <cstdint>
 
 #include "plumb/core/error.h"
+#include "plumb/io/ardupilot_session.h"
 #include "plumb/io/dataflash.h"
 #include "plumb/io/flight_log.h"
+
+#include "select_every_stream.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const plumb::io::DataflashLog log = plumb::io::ParseDataflash(data, size, "fuzz.bin");
-    for (const plumb::io::ImuStreamInfo& info : plumb::io::DataflashImuStreams(log)) {
-      plumb::io::FlightLogSelection selection;
-      selection.imu = info.instance;
-      selection.stream = info.name;
-      try {
-        plumb::io::DataflashStream(log, selection);
-      } catch (const plumb::Error&) {
-      }
-    }
+    plumb::fuzz::SelectEveryStream(
+        plumb::io::DataflashImuStreams(log),
+        [&](const plumb::io::FlightLogSelection& selection) {
+          (void)plumb::io::ArdupilotSession(log, selection);
+        });
   } catch (const plumb::Error&) {
   }
   return 0;

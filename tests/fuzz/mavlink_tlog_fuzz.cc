@@ -14,20 +14,18 @@
 #include "plumb/io/mavlink_session.h"
 #include "plumb/io/mavlink_tlog.h"
 
+#include "select_every_stream.h"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
     const plumb::io::MavlinkLog log = plumb::io::ParseTlog(data, size, "fuzz.tlog");
     (void)plumb::io::TlogParams(log);
     (void)plumb::io::SiteFromTlog(log);
-    for (const plumb::io::ImuStreamInfo& info : plumb::io::TlogImuStreams(log)) {
-      plumb::io::FlightLogSelection selection;
-      selection.imu = info.instance;
-      selection.stream = info.name;
-      try {
-        (void)plumb::io::TlogSession(log, selection);
-      } catch (const plumb::Error&) {
-      }
-    }
+    plumb::fuzz::SelectEveryStream(
+        plumb::io::TlogImuStreams(log),
+        [&](const plumb::io::FlightLogSelection& selection) {
+          (void)plumb::io::TlogSession(log, selection);
+        });
   } catch (const plumb::Error&) {
   }
   return 0;

@@ -11,21 +11,19 @@
 #include "plumb/io/px4_session.h"
 #include "plumb/io/ulog.h"
 
+#include "select_every_stream.h"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
     const plumb::io::ULog log = plumb::io::ParseULog(data, size, "fuzz");
     (void)log.warnings.Describe();
     (void)plumb::io::SiteFromULog(log);
     (void)plumb::io::ULogParams(log);
-    for (const plumb::io::ImuStreamInfo& info : plumb::io::ULogImuStreams(log)) {
-      plumb::io::FlightLogSelection selection;
-      selection.imu = info.instance;
-      selection.stream = info.name;
-      try {
-        (void)plumb::io::ULogSession(log, selection);
-      } catch (const plumb::Error&) {
-      }
-    }
+    plumb::fuzz::SelectEveryStream(
+        plumb::io::ULogImuStreams(log),
+        [&](const plumb::io::FlightLogSelection& selection) {
+          (void)plumb::io::ULogSession(log, selection);
+        });
   } catch (const plumb::Error&) {
   }
   return 0;

@@ -158,13 +158,7 @@ class Parser {
     log_->types.push_back(std::move(t));
   }
 
-  void Skip(std::size_t pos) {
-    DataflashWarnings& w = log_->warnings;
-    if (w.bytes_skipped == 0) w.first_skip_offset = pos;
-    if (w.bytes_skipped == 0 || pos != last_skip_ + 1) ++w.skip_runs;
-    ++w.bytes_skipped;
-    last_skip_ = pos;
-  }
+  void Skip(std::size_t pos) { CountSkipped(log_->warnings, pos, pos + 1, skip_end_); }
 
   void Truncated(std::size_t bytes) {
     ++log_->warnings.truncated_records;
@@ -198,7 +192,7 @@ class Parser {
   DataflashLog* log_;
   const std::array<std::size_t, 256>* expected_rows_;
   std::array<int, 256> index_;
-  std::size_t last_skip_ = 0;
+  std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
 
 /// Fills column units and multipliers from FMTU (FmtType, UnitIds, MultIds), UNIT (Id, Label)

@@ -32,6 +32,17 @@ class LogFile {
   std::vector<std::uint8_t> buffer_;    ///< the bytes when not mapped
 };
 
+/// Counts the bytes [from, to) as skipped in a reader's warnings `w` (any struct with
+/// bytes_skipped, skip_runs and first_skip_offset): a new run unless `from` is `skip_end`, the
+/// end of the previous skipped range, which is then moved to `to` (from <= to).
+template <typename Warnings>
+void CountSkipped(Warnings& w, std::size_t from, std::size_t to, std::size_t& skip_end) {
+  if (w.bytes_skipped == 0) w.first_skip_offset = from;
+  if (w.bytes_skipped == 0 || from != skip_end) ++w.skip_runs;
+  w.bytes_skipped += to - from;
+  skip_end = to;
+}
+
 /// The site from a log's GPS fixes with a 3D fix: the median latitude (deg, [-90, 90]),
 /// longitude (deg, [-180, 180]) and height (m; logs give the altitude above mean sea level,
 /// used as the height: the geoid separation, tens of metres, changes gravity by about 1e-5

@@ -287,11 +287,7 @@ class Parser {
 
   /// Counts bytes [from, to) as skipped.
   void SkipTo(std::size_t from, std::size_t to) {
-    MavlinkWarnings& w = log_->warnings;
-    if (w.bytes_skipped == 0) w.first_skip_offset = from;
-    if (w.bytes_skipped == 0 || from != skip_end_) ++w.skip_runs;
-    w.bytes_skipped += to - from;
-    skip_end_ = to;
+    CountSkipped(log_->warnings, from, to, skip_end_);
   }
 
   void Accept(const Frame& f, bool checked) {

@@ -561,13 +561,7 @@ class Parser {
     log_->texts.push_back(std::move(t));
   }
 
-  void Skip(std::size_t pos) {
-    ULogWarnings& w = log_->warnings;
-    if (w.bytes_skipped == 0) w.first_skip_offset = pos;
-    if (w.bytes_skipped == 0 || pos != last_skip_ + 1) ++w.skip_runs;
-    ++w.bytes_skipped;
-    last_skip_ = pos;
-  }
+  void Skip(std::size_t pos) { CountSkipped(log_->warnings, pos, pos + 1, skip_end_); }
 
   void Truncated(std::size_t bytes) {
     ++log_->warnings.truncated_records;
@@ -582,7 +576,7 @@ class Parser {
   std::vector<std::size_t> expected_bytes_;   // PreScan() D body bytes per msg_id, or empty
   FormatResolver resolver_;
   bool in_definitions_ = true;
-  std::size_t last_skip_ = 0;
+  std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
 
 }  // namespace
