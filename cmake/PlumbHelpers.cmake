@@ -1,13 +1,30 @@
-# plumb_module(NAME SOURCES ... DEPS ...): one library per folder under lib/plumb/,
-# exported as plumb::NAME. Headers are included as <plumb/NAME/header.h>.
+# plumb_module(NAME [DIR PATH] SOURCES ... DEPS ... [PRIVATE_DEPS ...]): one library per folder
+# under lib/plumb/ (DIR, default NAME: e.g. `io/common` for module io_common), exported as
+# plumb::NAME. Headers are included as <plumb/DIR/header.h>.
+#
+# Layering the build enforces: a module's include root holds only its own folder. At configure
+# time the build tree gets `include/NAME/plumb/DIR`, a link to lib/plumb/DIR, and that root
+# (not lib/) is the module's include directory. A source therefore finds the headers of its own
+# module and of the modules it links (DEPS, and what they link publicly) and no others: an
+# include of a module it does not declare fails to compile (tests/layering checks this).
 function(plumb_module name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "DIR" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  if(NOT ARG_DIR)
+    set(ARG_DIR ${name})
+  endif()
+  set(_root ${PROJECT_BINARY_DIR}/include/${name})
+  set(_link ${_root}/plumb/${ARG_DIR})
+  get_filename_component(_parent ${_link} DIRECTORY)
+  file(MAKE_DIRECTORY ${_parent})
+  if(NOT IS_SYMLINK ${_link})
+    file(CREATE_LINK ${PROJECT_SOURCE_DIR}/lib/plumb/${ARG_DIR} ${_link} SYMBOLIC)
+  endif()
   add_library(plumb_${name} ${ARG_SOURCES})
   add_library(plumb::${name} ALIAS plumb_${name})
   set_target_properties(plumb_${name} PROPERTIES EXPORT_NAME ${name}
                         POSITION_INDEPENDENT_CODE ON)
   target_include_directories(plumb_${name} PUBLIC
-    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/lib>
+    $<BUILD_INTERFACE:${_root}>
     $<INSTALL_INTERFACE:include>)
   target_link_libraries(plumb_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   target_compile_options(plumb_${name} PRIVATE -Wall -Wextra)

@@ -1,0 +1,32 @@
+// plumb/core/units.h — the one place for physical constants and unit conversions.
+//
+// Inside plumb every quantity is SI (SPEC section 1): m/s^2, rad/s, s, degC. Other units
+// appear only at the edges (readers, exporters, printed tables), converted with these
+// constants. Multiply to convert: `angle_deg * kRadPerDeg` is in rad, `rate * kDegPerHPerRadPerS`
+// is in deg/h.
+#pragma once
+
+namespace plumb::units {
+
+/// pi, to double precision.
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kTwoPi = 2.0 * kPi;
+
+/// Degrees and radians.
+inline constexpr double kRadPerDeg = kPi / 180.0;
+inline constexpr double kDegPerRad = 180.0 / kPi;
+
+/// Standard gravity g0 (CGPM 1901, ISO 80000-3), m/s^2: the "g" of datasheets and of
+/// firmware units (mg, mG); not local gravity, which plumb takes from the site (geo::Site).
+inline constexpr double kStandardGravity = 9.80665;
+/// m/s^2 per milli-g.
+inline constexpr double kMilliG = kStandardGravity * 1e-3;
+
+/// Earth's rotation rate relative to inertial space (WGS84 / GRS80 value), rad/s.
+inline constexpr double kEarthRate = 7.292115e-5;
+
+/// Seconds per hour, and deg/h per rad/s (the unit gyroscope biases are quoted in).
+inline constexpr double kSecondsPerHour = 3600.0;
+inline constexpr double kDegPerHourPerRadPerS = kDegPerRad * kSecondsPerHour;
+
+}  // namespace plumb::units
