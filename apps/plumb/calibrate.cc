@@ -128,7 +128,7 @@ class CalibrateCommand : public Command {
       if (!a.input.acc_file.empty()) inputs.push_back(a.input.acc_file + "," + a.input.gyr_file);
       nlohmann::json doc = report::CalibrationJson(result, seg, inputs, session.warnings);
       if (baseline) {
-        doc["baseline"] = {{"model", baseline->model.spec()},
+        doc["baseline"] = {{"model", baseline->calibration.model.spec()},
                            {"fit", report::ToJson(*baseline)["fit"]},
                            {"chi2_drop", baseline->fit.chi2 - result.fit.chi2}};
       }

@@ -112,7 +112,7 @@ class DiagnoseCommand : public Command {
                 << report::BeforeAfterSummary(velocity ? *d.fit_with_velocity : d.fit,
                                               *best->refit);
     }
-    for (const auto& w : d.fit.warnings) std::cout << "warning: " << w << "\n";
+    for (const auto& w : d.fit.fit.warnings) std::cout << "warning: " << w << "\n";
 
     if (!a.json_path.empty()) {
       report::WriteJson(a.json_path, report::DiagnosisJson(d, ra));

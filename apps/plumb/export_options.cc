@@ -66,7 +66,7 @@ nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const Expo
   options.rostopic = a.rostopic;
   options.allow_undetermined = a.undetermined;
   for (const ExportRequest& r : requests) {
-    const exporter::ExportOutput e = exporter::Export(r.format, result, series, options);
+    const exporter::ExportOutput e = exporter::Export(r.format, result.calibration, series, result.fit.still, options);
     io::WriteFileAtomic(r.path, e.text);
     out << "\n";
     for (const std::string& line : e.lines) out << line << "\n";

@@ -232,8 +232,8 @@ class PaperCommand : public Command {
     if (si) {
       check_b = paper::CheckDatasheet(part, b.F, b.b_a, b.E, b.b_g, true);
       check_s = paper::CheckDatasheet(part, s.F, s.b_a, s.E, s.b_g, s.has_gyro);
-      check_bb = paper::CheckDatasheet(part, bb.result.accel_matrix, bb.result.accel_bias,
-                                       bb.result.gyro_matrix, bb.result.gyro_bias, true);
+      check_bb = paper::CheckDatasheet(part, bb.result.calibration.AccelMatrix(), bb.result.calibration.AccelBias(),
+                                       bb.result.calibration.GyroMatrix(), bb.result.calibration.GyroBias(), true);
     }
 
     std::filesystem::create_directories(a.out_dir);
@@ -291,17 +291,17 @@ class PaperCommand : public Command {
     }
     auto chi = [](const estimation::CalibrationResult& r) {
       return Num(r.fit.chi2 / std::max(1, r.fit.dof), 3) + " (" + std::to_string(r.fit.dof) +
-             " dof), rank " + std::to_string(r.observability.rank) + " of " +
-             std::to_string(r.observability.num_unknowns);
+             " dof), rank " + std::to_string(r.calibration.observability.rank) + " of " +
+             std::to_string(r.calibration.observability.num_unknowns);
     };
     md << "Backend, benchmark configuration (" << bb.model_spec << "): chi2/dof " << chi(bb.result)
-       << "; unobservable: " << bb.result.observability.unobservable.size() << " directions.\n\n";
+       << "; unobservable: " << bb.result.calibration.observability.unobservable.size() << " directions.\n\n";
     md << "Backend, static configuration (the paper's constants held): chi2/dof " << chi(sb.fixed)
-       << "; " << sb.fixed.observability.unobservable.size()
+       << "; " << sb.fixed.calibration.observability.unobservable.size()
        << " unobservable directions:";
-    for (const auto& u : sb.fixed.observability.unobservable) md << " `" << u << "`;";
+    for (const auto& u : sb.fixed.calibration.observability.unobservable) md << " `" << u << "`;";
     md << " determined:";
-    for (const auto& c : sb.fixed.observability.determined) {
+    for (const auto& c : sb.fixed.calibration.observability.determined) {
       md << " `" << c.text << "` = " << Num(c.value) << " +- " << Num(c.sigma) << ";";
     }
     md << " the paper's constants freed, unobservable:";

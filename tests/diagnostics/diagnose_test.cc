@@ -39,6 +39,7 @@
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
 #include "plumb/signal/chi_square.h"
+#include "plumb/report/calibration_text.h"
 
 namespace plumb::diagnostics {
 namespace {
@@ -133,7 +134,7 @@ Diagnosis DiagnoseSession(const Session& s, const model::Model& model) {
 
 const estimation::ParameterEstimate* FindParameter(const estimation::CalibrationResult& r,
                                                    const std::string& name) {
-  for (const auto& p : r.parameters) {
+  for (const auto& p : r.calibration.parameters) {
     if (p.name == name) return &p;
   }
   return nullptr;
@@ -180,12 +181,12 @@ TEST_P(HiddenEffect, RankedFirstSignificantAndRecoveredByTheRefit) {
   std::cout << GetParam().effect << ": base chi2/dof " << d.fit.fit.chi2_dof()
             << ", LM " << it->lm << ", refit chi2/dof " << refit.fit.chi2_dof() << " on "
             << refit.fit.dof << " dof (99% band " << lo << " .. " << hi << ")\n";
-  EXPECT_GT(refit.fit.chi2_dof(), lo) << refit.FullReport();
-  EXPECT_LT(refit.fit.chi2_dof(), hi) << refit.FullReport();
+  EXPECT_GT(refit.fit.chi2_dof(), lo) << report::FullReport(refit);
+  EXPECT_LT(refit.fit.chi2_dof(), hi) << report::FullReport(refit);
   for (const auto& [name, truth] : TrueValues(spec.hidden)) {
     const estimation::ParameterEstimate* p = FindParameter(refit, name);
     ASSERT_NE(p, nullptr) << name;
-    ASSERT_TRUE(p->observable) << name << "\n" << refit.FullReport();
+    ASSERT_TRUE(p->observable) << name << "\n" << report::FullReport(refit);
     EXPECT_LT(std::abs(p->value - truth), 3.0 * p->sigma)
         << name << ": truth " << truth << ", estimate " << p->value << " +- " << p->sigma;
   }
@@ -301,8 +302,8 @@ TEST(Diagnose, TwoHiddenEffectsAreFoundInTwoRounds) {
   ASSERT_TRUE(next.refit.has_value()) << second.BriefReport();
   const estimation::CalibrationResult& both = *next.refit;
   const auto [lo, hi] = Chi2DofBand(both.fit.dof);
-  EXPECT_GT(both.fit.chi2_dof(), lo) << both.FullReport();
-  EXPECT_LT(both.fit.chi2_dof(), hi) << both.FullReport();
+  EXPECT_GT(both.fit.chi2_dof(), lo) << report::FullReport(both);
+  EXPECT_LT(both.fit.chi2_dof(), hi) << report::FullReport(both);
   for (const auto& [name, truth] : TrueValues(spec.hidden)) {
     const estimation::ParameterEstimate* p = FindParameter(both, name);
     ASSERT_NE(p, nullptr) << name;

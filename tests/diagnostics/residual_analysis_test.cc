@@ -92,8 +92,8 @@ TEST(ResidualAnalysis, PredictionsReproduceTheBackend) {
   const Scenario s = SimulateAndFit(setup, sim::MultiPose(16, 5.0, 2.0, 7));
   const ImuSeries& series = s.sim.session.series;
   const ResidualAnalysis a = AnalyseResiduals(series, s.fit);
-  ASSERT_EQ(a.still.size(), s.fit.still.size());
-  ASSERT_EQ(a.motion.size(), s.fit.motion.size());
+  ASSERT_EQ(a.still.size(), s.fit.fit.still.size());
+  ASSERT_EQ(a.motion.size(), s.fit.fit.motion.size());
   std::size_t samples = 0, strided = 0;
   for (const auto& c : a.still) {
     ASSERT_TRUE(c.has_acc && c.has_gyr);
@@ -101,7 +101,7 @@ TEST(ResidualAnalysis, PredictionsReproduceTheBackend) {
       EXPECT_NEAR(c.acc_predicted[i] + c.acc_residual[i], c.acc_measured[i], 1e-9) << c.label;
       EXPECT_NEAR(c.gyr_predicted[i] + c.gyr_residual[i], c.gyr_measured[i], 1e-12) << c.label;
     }
-    const StillSegment& seg = s.fit.still[c.index].segment;
+    const StillSegment& seg = s.fit.fit.still[c.index].segment;
     samples += seg.count();
     strided += (seg.count() + 9) / 10;
     // The per-sample residuals average to the segment's residual (base model: the prediction
@@ -195,7 +195,7 @@ TEST(ResidualAnalysis, AllanRatioNearOneOnWhiteNoise) {
   const Scenario s = SimulateAndFit(setup, LongStill(41, 900.0));
   const ResidualAnalysis a = AnalyseResiduals(s.sim.session.series, s.fit);
   ASSERT_EQ(a.allan_segments.size(), 1u);
-  EXPECT_EQ(s.fit.still[a.allan_segments[0]].segment.label, "long");
+  EXPECT_EQ(s.fit.fit.still[a.allan_segments[0]].segment.label, "long");
   ASSERT_EQ(a.allan.size(), 6u);
   // At m_max = n / 8 the estimate has about 10 degrees of freedom: single ratios spread over
   // 0.6-1.6 (six seeds), their mean over 0.97-1.11.

@@ -9,6 +9,7 @@
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
 #include "plumb/signal/chi_square.h"
+#include "plumb/report/calibration_text.h"
 
 namespace plumb::estimation {
 namespace {
@@ -42,8 +43,8 @@ Outcome CalibrateMultiPose(std::uint64_t seed, const std::string& spec = "base",
 double WorstNormalisedError(const Outcome& o) {
   const auto truth = model::ReportedValues(o.sim.model, o.sim.truth);
   double worst = 0;
-  for (std::size_t i = 0; i < o.result.parameters.size(); ++i) {
-    const auto& p = o.result.parameters[i];
+  for (std::size_t i = 0; i < o.result.calibration.parameters.size(); ++i) {
+    const auto& p = o.result.calibration.parameters[i];
     if (p.fixed || !p.observable) continue;
     worst = std::max(worst, std::abs(p.value - truth[i]) / p.sigma);
   }
@@ -53,30 +54,30 @@ double WorstNormalisedError(const Outcome& o) {
 TEST(CalibrateSimulated, MultiPoseRecoversTruthWithin3Sigma) {
   const Outcome o = CalibrateMultiPose(11);
   EXPECT_TRUE(o.result.fit.converged) << o.result.fit.solver_report;
-  EXPECT_EQ(o.result.observability.rank, o.result.observability.num_unknowns)
-      << o.result.FullReport();
-  EXPECT_LT(WorstNormalisedError(o), 3.5) << o.result.FullReport();
+  EXPECT_EQ(o.result.calibration.observability.rank, o.result.calibration.observability.num_unknowns)
+      << report::FullReport(o.result);
+  EXPECT_LT(WorstNormalisedError(o), 3.5) << report::FullReport(o.result);
 }
 
 TEST(CalibrateSimulated, MultiPoseChi2PerDofNearOne) {
   const Outcome o = CalibrateMultiPose(12);
-  EXPECT_GT(o.result.fit.chi2_dof(), 0.5) << o.result.FullReport();
-  EXPECT_LT(o.result.fit.chi2_dof(), 1.6) << o.result.FullReport();
+  EXPECT_GT(o.result.fit.chi2_dof(), 0.5) << report::FullReport(o.result);
+  EXPECT_LT(o.result.fit.chi2_dof(), 1.6) << report::FullReport(o.result);
 }
 
 /// Normalised estimation error squared e^T P^-1 e over the free parameters.
 double Nees(const Outcome& o) {
   const auto truth = model::ReportedValues(o.sim.model, o.sim.truth);
   std::vector<Eigen::Index> free;
-  for (std::size_t i = 0; i < o.result.parameters.size(); ++i) {
-    if (!o.result.parameters[i].fixed) free.push_back(static_cast<Eigen::Index>(i));
+  for (std::size_t i = 0; i < o.result.calibration.parameters.size(); ++i) {
+    if (!o.result.calibration.parameters[i].fixed) free.push_back(static_cast<Eigen::Index>(i));
   }
   const auto n = static_cast<Eigen::Index>(free.size());
   Eigen::VectorXd e(n);
   Eigen::MatrixXd P(n, n);
   for (Eigen::Index a = 0; a < n; ++a) {
-    e[a] = o.result.parameters[static_cast<std::size_t>(free[a])].value - truth[static_cast<std::size_t>(free[a])];
-    for (Eigen::Index b = 0; b < n; ++b) P(a, b) = o.result.covariance(free[a], free[b]);
+    e[a] = o.result.calibration.parameters[static_cast<std::size_t>(free[a])].value - truth[static_cast<std::size_t>(free[a])];
+    for (Eigen::Index b = 0; b < n; ++b) P(a, b) = o.result.calibration.covariance(free[a], free[b]);
   }
   return e.dot(P.ldlt().solve(e));
 }
@@ -117,13 +118,13 @@ TEST(CalibrateSimulated, CeresCovarianceEqualsThePseudoInverse) {
     pinv.use_ceres_covariance = false;
     const CalibrationResult a = Calibrate(s.session.series, segments, s.model, s.site);
     const CalibrationResult b = Calibrate(s.session.series, segments, s.model, s.site, pinv);
-    EXPECT_EQ(a.sigma_source, "ceres::Covariance (DENSE_SVD)");
-    EXPECT_EQ(b.sigma_source, "pseudo-inverse");
+    EXPECT_EQ(a.calibration.sigma_source, "ceres::Covariance (DENSE_SVD)");
+    EXPECT_EQ(b.calibration.sigma_source, "pseudo-inverse");
     int compared = 0;
-    for (std::size_t i = 0; i < a.parameters.size(); ++i) {
-      if (!a.parameters[i].observable || a.parameters[i].fixed) continue;
-      EXPECT_NEAR(a.parameters[i].sigma, b.parameters[i].sigma, 1e-6 * b.parameters[i].sigma)
-          << a.parameters[i].name;
+    for (std::size_t i = 0; i < a.calibration.parameters.size(); ++i) {
+      if (!a.calibration.parameters[i].observable || a.calibration.parameters[i].fixed) continue;
+      EXPECT_NEAR(a.calibration.parameters[i].sigma, b.calibration.parameters[i].sigma, 1e-6 * b.calibration.parameters[i].sigma)
+          << a.calibration.parameters[i].name;
       ++compared;
     }
     if (segments.size() > 1) EXPECT_EQ(compared, 21);  // one pose: nothing alone is observable
@@ -143,7 +144,7 @@ CalibrationResult CalibratePaperStatic() {
 }
 
 bool IsObservable(const CalibrationResult& r, const std::string& name) {
-  for (const auto& p : r.parameters) {
+  for (const auto& p : r.calibration.parameters) {
     if (p.name == name) return p.observable;
   }
   ADD_FAILURE() << "no parameter " << name;
@@ -156,24 +157,24 @@ TEST(CalibrateSimulated, OneLevelPoseNamesWhatItCannotDetermine) {
   EXPECT_FALSE(IsObservable(r, "accel.matrix.zz"));
   EXPECT_FALSE(IsObservable(r, "accel.matrix.xx"));  // x never sees gravity
   EXPECT_FALSE(IsObservable(r, "gyro.matrix.yy"));   // no rate about y (east) at all
-  EXPECT_LT(r.observability.rank, r.observability.num_unknowns);
+  EXPECT_LT(r.calibration.observability.rank, r.calibration.observability.num_unknowns);
   bool found = false;
-  for (const auto& u : r.observability.unobservable) {
+  for (const auto& u : r.calibration.observability.unobservable) {
     found = found || u.find("accel.bias.z") != std::string::npos;
   }
-  EXPECT_TRUE(found) << r.FullReport();
+  EXPECT_TRUE(found) << report::FullReport(r);
 }
 
 TEST(CalibrateSimulated, OneLevelPoseDeterminesTheZCombination) {
   const CalibrationResult r = CalibratePaperStatic();
   bool found = false;
-  for (const auto& c : r.observability.determined) {
+  for (const auto& c : r.calibration.observability.determined) {
     if (c.text.rfind("accel.bias.z - 9.7", 0) == 0) {
       found = true;
       EXPECT_GT(c.sigma, 0.0);
     }
   }
-  EXPECT_TRUE(found) << r.FullReport();
+  EXPECT_TRUE(found) << report::FullReport(r);
 }
 
 TEST(CalibrateSimulated, OneLevelPoseReportsSigmaForWhatItCan) {
@@ -181,9 +182,9 @@ TEST(CalibrateSimulated, OneLevelPoseReportsSigmaForWhatItCan) {
   // With a known level attitude the x and y accelerometer biases are measured directly
   // (F upper triangular: y_x = F_xz f_z + b_x, so b_x trades with F_xz: both unobservable);
   // the determined combinations carry the sigma instead. At least one combination per axis.
-  EXPECT_GE(r.observability.determined.size(), 3u) << r.FullReport();
-  if (std::getenv("PLUMB_PRINT")) std::cout << r.FullReport();
-  for (const auto& c : r.observability.determined) EXPECT_TRUE(std::isfinite(c.sigma));
+  EXPECT_GE(r.calibration.observability.determined.size(), 3u) << report::FullReport(r);
+  if (std::getenv("PLUMB_PRINT")) std::cout << report::FullReport(r);
+  for (const auto& c : r.calibration.observability.determined) EXPECT_TRUE(std::isfinite(c.sigma));
 }
 
 }  // namespace

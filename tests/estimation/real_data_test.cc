@@ -10,6 +10,7 @@
 #include "plumb/estimation/calibrator.h"
 #include "plumb/io/text_table.h"
 #include "plumb/segmentation/still_detector.h"
+#include "plumb/report/calibration_text.h"
 
 namespace plumb::estimation {
 namespace {
@@ -41,7 +42,7 @@ CalibrationResult CalibrateImuTk() {
 TEST(RealData, ImuTkMatchesImuTksAnswer) {
   if (!Exists(kShared + "/multipose/imu_tk/xsens_acc.mat")) GTEST_SKIP() << "shared data absent";
   const CalibrationResult r = CalibrateImuTk();
-  if (std::getenv("PLUMB_PRINT")) std::cout << r.FullReport();
+  if (std::getenv("PLUMB_PRINT")) std::cout << report::FullReport(r);
   EXPECT_TRUE(r.fit.converged) << r.fit.solver_report;
   // imu_tk's answer (full_precision_params.txt): calibrated = T K (raw - B), so the forward
   // matrix is (T K)^-1 in counts per m/s^2 and the bias is B.
@@ -56,15 +57,15 @@ TEST(RealData, ImuTkMatchesImuTksAnswer) {
   const Mat3 F_tk = (T_a * K_a).inverse();
   const Mat3 E_tk = (T_g * K_g).inverse();
   if (std::getenv("PLUMB_PRINT")) {
-    std::cout << "F plumb\n" << r.accel_matrix << "\nF imu_tk\n" << F_tk << "\nb plumb "
-              << r.accel_bias.transpose() << "\nb imu_tk " << B_a.transpose() << "\nE plumb\n"
-              << r.gyro_matrix << "\nE imu_tk\n" << E_tk << "\nbg plumb " << r.gyro_bias.transpose()
+    std::cout << "F plumb\n" << r.calibration.AccelMatrix() << "\nF imu_tk\n" << F_tk << "\nb plumb "
+              << r.calibration.AccelBias().transpose() << "\nb imu_tk " << B_a.transpose() << "\nE plumb\n"
+              << r.calibration.GyroMatrix() << "\nE imu_tk\n" << E_tk << "\nbg plumb " << r.calibration.GyroBias().transpose()
               << "\nbg imu_tk " << B_g.transpose() << "\n";
   }
-  EXPECT_LT((r.accel_matrix - F_tk).norm() / F_tk.norm(), 2e-3);
-  EXPECT_LT((r.accel_bias - B_a).norm(), 10.0);  // counts, of ~33000
-  EXPECT_LT((r.gyro_matrix - E_tk).norm() / E_tk.norm(), 2e-2);
-  EXPECT_LT((r.gyro_bias - B_g).norm(), 10.0);
+  EXPECT_LT((r.calibration.AccelMatrix() - F_tk).norm() / F_tk.norm(), 2e-3);
+  EXPECT_LT((r.calibration.AccelBias() - B_a).norm(), 10.0);  // counts, of ~33000
+  EXPECT_LT((r.calibration.GyroMatrix() - E_tk).norm() / E_tk.norm(), 2e-2);
+  EXPECT_LT((r.calibration.GyroBias() - B_g).norm(), 10.0);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "plumb/core/error.h"
+#include "plumb/estimation/result.h"
 #include "plumb/export/export.h"
 #include "plumb/export/firmware.h"
 #include "plumb/export/formats.h"
@@ -22,7 +23,7 @@ constexpr double kG = 9.80665;
 
 /// A hand-made calibration: `spec`'s model with the given blocks, one still segment per
 /// specific force in `f_b` (100 samples each, noise-free outputs from the model), segment k at
-/// temperature temps[k]. The series holds those samples; r.still their means.
+/// temperature temps[k]. The series holds those samples; r.fit.still their means.
 struct Session {
   estimation::CalibrationResult r;
   ImuSeries series;
@@ -31,21 +32,19 @@ struct Session {
 Session MakeSession(const std::string& spec, const model::ParameterBlocks& theta,
                     const std::vector<Vec3>& f_b, const std::vector<double>& temps_c) {
   Session s;
-  s.r.model = model::Model::Parse(spec);
-  s.r.model.t_ref_s = 0.0;
-  s.r.model.temp_ref_c = 25.0;
-  s.r.theta = theta;
-  s.r.has_gyro = s.r.model.has_gyro();
+  s.r.calibration.model = model::Model::Parse(spec);
+  s.r.calibration.model.t_ref_s = 0.0;
+  s.r.calibration.model.temp_ref_c = 25.0;
+  s.r.calibration.theta = theta;
+  s.r.calibration.has_gyro = s.r.calibration.model.has_gyro();
   const std::size_t per = 100;
   const double dt = 0.01;
   for (std::size_t k = 0; k < f_b.size(); ++k) {
     model::SensorInput<double> in;
     in.f_b = f_b[k];
     in.omega_b = Vec3(1e-5, -2e-5, 3e-5) * static_cast<double>(k + 1);
-    in.dtemp_c = temps_c[k] - s.r.model.temp_ref_c;
-    const auto out = s.r.model.Predict(s.r.theta, in);
-    s.r.accel_matrix = out.F;
-    s.r.gyro_matrix = out.E;
+    in.dtemp_c = temps_c[k] - s.r.calibration.model.temp_ref_c;
+    const auto out = s.r.calibration.model.Predict(s.r.calibration.theta, in);
     estimation::StillSegmentFit fit;
     fit.segment.begin = s.series.size();
     for (std::size_t i = 0; i < per; ++i) {
@@ -58,12 +57,8 @@ Session MakeSession(const std::string& spec, const model::ParameterBlocks& theta
     fit.t_mid_s = 0.0;  // no time-dependent terms in these models
     fit.acc_mean = out.acc;
     fit.gyr_mean = out.gyr;
-    s.r.still.push_back(fit);
+    s.r.fit.still.push_back(fit);
   }
-  // Biases: the model's value at zero input and the reference temperature.
-  const auto zero = s.r.model.Predict(s.r.theta, model::SensorInput<double>{});
-  s.r.accel_bias = zero.acc;
-  s.r.gyro_bias = zero.gyr;
   return s;
 }
 
@@ -222,7 +217,7 @@ TEST(Evaluate, DiagonalModelLeavesNoErrorThroughEitherFile) {
   const std::vector<double> temps = {20, 24, 29, 33, 38, 45};
   const Session s = MakeSession("base+accel_temperature_bias:2", theta, SixFaces(), temps);
   for (const char* format : {"ardupilot", "px4"}) {
-    const ExportOutput out = Export(format, s.r, s.series, ExportOptions{});
+    const ExportOutput out = Export(format, s.r.calibration, s.series, s.r.fit.still, ExportOptions{});
     const auto& a = out.json["accel_still"];
     EXPECT_EQ(a["segments"].get<int>(), 6);
     for (int i = 0; i < 3; ++i) {
@@ -240,9 +235,9 @@ TEST(Evaluate, OffDiagonalTermMatchesTheHandComputation) {
   theta[0][1] = 0.01;  // F_xy: y_a,x = f_x + 0.01 f_y
   const std::vector<Vec3> f = {Vec3(0, 0, -kG), Vec3(0, -kG, 0), Vec3(0, kG, 0)};
   const Session s = MakeSession("base", theta, f, {25, 25, 25});
-  const FirmwareCorrection fw = BestDiagonal(s.r, SessionTemperatureRange(s.series));
+  const FirmwareCorrection fw = BestDiagonal(s.r.calibration, SessionTemperatureRange(s.series));
   EXPECT_NEAR((fw.accel.scale - Vec3::Ones()).norm(), 0.0, 1e-15);  // diag(F^-1) = 1
-  const ExportReport rep = Evaluate(s.r, s.series, fw, "ardupilot", true);
+  const ExportReport rep = Evaluate(s.r.calibration, s.series, s.r.fit.still, fw, "ardupilot", true);
   // Firmware: y - b = F f, plumb: f, so the x error is 0.01 f_y: 0, -0.01 g, +0.01 g.
   EXPECT_NEAR(rep.accel_still.rms.x(), 0.01 * kG * std::sqrt(2.0 / 3.0), 1e-6);
   EXPECT_NEAR(rep.accel_still.max_abs.x(), 0.01 * kG, 1e-6);
@@ -258,7 +253,7 @@ TEST(Evaluate, EffectsTheTargetHasNoParameterForAreListed) {
   const Session s = MakeSession("base+gyro_g_sensitivity", theta, SixFaces(),
                                 std::vector<double>(6, 25.0));
   const ExportReport rep =
-      Evaluate(s.r, s.series, BestDiagonal(s.r, SessionTemperatureRange(s.series)), "px4", true);
+      Evaluate(s.r.calibration, s.series, s.r.fit.still, BestDiagonal(s.r.calibration, SessionTemperatureRange(s.series)), "px4", true);
   ASSERT_EQ(rep.dropped.size(), 1u);
   EXPECT_EQ(rep.dropped[0].effect, "gyro_g_sensitivity");
   EXPECT_EQ(rep.dropped[0].values[0], 1e-4);
@@ -269,10 +264,10 @@ TEST(Evaluate, EffectsTheTargetHasNoParameterForAreListed) {
 TEST(Evaluate, CountsAreRefused) {
   Session s = MakeSession("base", model::Model::Parse("base").ZeroParameters(), SixFaces(),
                           std::vector<double>(6, 25.0));
-  s.r.acc_unit = "counts";
-  EXPECT_THROW(BestDiagonal(s.r, TemperatureRange{}), Error);
-  EXPECT_THROW(KalibrNoise(s.r, s.series, "/imu0"), Error);
-  EXPECT_THROW(Export("ardupilot", s.r, s.series, ExportOptions{}), Error);
+  s.r.calibration.acc_unit = "counts";
+  EXPECT_THROW(BestDiagonal(s.r.calibration, TemperatureRange{}), Error);
+  EXPECT_THROW(KalibrNoise(s.r.calibration, s.series, s.r.fit.still, "/imu0"), Error);
+  EXPECT_THROW(Export("ardupilot", s.r.calibration, s.series, s.r.fit.still, ExportOptions{}), Error);
 }
 
 // ---- Kalibr ----------------------------------------------------------------------------------
@@ -300,9 +295,9 @@ TEST(Kalibr, WhiteNoiseDensityMatchesTheAllanDeviationAtOneSecond) {
   std::mt19937_64 rng(7);
   std::normal_distribution<double> n(0.0, 1.0);
   Session s;
-  s.r.model = model::Model::Parse("base");
-  s.r.theta = s.r.model.ZeroParameters();
-  s.r.has_gyro = true;
+  s.r.calibration.model = model::Model::Parse("base");
+  s.r.calibration.theta = s.r.calibration.model.ZeroParameters();
+  s.r.calibration.has_gyro = true;
   for (int i = 0; i < 12000; ++i) {
     s.series.t_s.push_back(i * dt);
     s.series.acc.push_back(Vec3f(sigma_a * n(rng), sigma_a * n(rng), -kG + sigma_a * n(rng)));
@@ -311,10 +306,10 @@ TEST(Kalibr, WhiteNoiseDensityMatchesTheAllanDeviationAtOneSecond) {
   estimation::StillSegmentFit fit;
   fit.segment.begin = 0;
   fit.segment.end = s.series.size();
-  s.r.still.push_back(fit);
-  s.r.noise_acc = Vec3::Constant(sigma_a);
-  s.r.noise_gyr = Vec3::Constant(sigma_g);
-  const KalibrImu imu = KalibrNoise(s.r, s.series, "/imu0");
+  s.r.fit.still.push_back(fit);
+  s.r.calibration.noise.acc = Vec3::Constant(sigma_a);
+  s.r.calibration.noise.gyr = Vec3::Constant(sigma_g);
+  const KalibrImu imu = KalibrNoise(s.r.calibration, s.series, s.r.fit.still, "/imu0");
   EXPECT_NEAR(imu.update_rate_hz, 100.0, 1e-6);
   EXPECT_TRUE(imu.accel.low_from_allan);
   EXPECT_NEAR(imu.accel.white_sample.x(), sigma_a * std::sqrt(dt), 1e-15);
@@ -346,19 +341,19 @@ TEST(Kalibr, ShortSegmentsFallBackToTheAutocorrelationTime) {
   std::mt19937_64 rng(11);
   std::normal_distribution<double> n(0.0, sigma);
   Session s;
-  s.r.model = model::Model::Parse("base");
-  s.r.model.DropGyro();
-  s.r.theta = s.r.model.ZeroParameters();
+  s.r.calibration.model = model::Model::Parse("base");
+  s.r.calibration.model.DropGyro();
+  s.r.calibration.theta = s.r.calibration.model.ZeroParameters();
   for (int i = 0; i < 400; ++i) {
     s.series.t_s.push_back(i * dt);
     s.series.acc.push_back(Vec3f(n(rng), n(rng), -kG + n(rng)));
   }
   estimation::StillSegmentFit fit;
   fit.segment.end = s.series.size();
-  s.r.still.push_back(fit);
-  s.r.noise_acc = Vec3::Constant(sigma);
-  s.r.tau_acc = tau;
-  const KalibrImu imu = KalibrNoise(s.r, s.series, "/imu");
+  s.r.fit.still.push_back(fit);
+  s.r.calibration.noise.acc = Vec3::Constant(sigma);
+  s.r.calibration.noise.tau_acc = tau;
+  const KalibrImu imu = KalibrNoise(s.r.calibration, s.series, s.r.fit.still, "/imu");
   EXPECT_FALSE(imu.accel.low_from_allan);
   EXPECT_NEAR(imu.accelerometer_noise_density(), sigma * std::sqrt(tau * dt), 1e-15);
   EXPECT_FALSE(imu.has_gyro);

@@ -32,6 +32,7 @@
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
+#include "plumb/report/calibration_text.h"
 #include "support/effect_battery.h"
 
 // The factory that PLUMB_DEFINE_EFFECT(accel_scale_temperature, ...) defines in
@@ -155,7 +156,7 @@ const Demonstration& WarmingSession() {
 /// Estimate of `name` in a result (fails the test when absent).
 estimation::ParameterEstimate Find(const estimation::CalibrationResult& r,
                                    const std::string& name) {
-  for (const auto& p : r.parameters) {
+  for (const auto& p : r.calibration.parameters) {
     if (p.name == name) return p;
   }
   ADD_FAILURE() << "no parameter " << name;
@@ -183,8 +184,8 @@ TEST(ScaleTemperatureSession, PrintsTheDemonstration) {
   const Demonstration& d = WarmingSession();
   std::cout << "[ summary  ] " << Summary(d) << "\n";
   if (std::getenv("PLUMB_PRINT")) {
-    std::cout << "--- base ---\n" << d.base.FullReport() << "--- " << kSpec << " ---\n"
-              << d.extended.FullReport();
+    std::cout << "--- base ---\n" << report::FullReport(d.base) << "--- " << kSpec << " ---\n"
+              << report::FullReport(d.extended);
   }
   EXPECT_TRUE(d.base.fit.converged) << d.base.fit.solver_report;
   EXPECT_TRUE(d.extended.fit.converged) << d.extended.fit.solver_report;
@@ -199,8 +200,8 @@ TEST(ScaleTemperatureSession, ExtendedModelFitsToTheNoise) {
   const Demonstration& d = WarmingSession();
   EXPECT_GT(d.extended.fit.chi2_dof(), 0.5) << Summary(d);
   EXPECT_LT(d.extended.fit.chi2_dof(), 1.6) << Summary(d);
-  EXPECT_EQ(d.extended.observability.rank, d.extended.observability.num_unknowns)
-      << d.extended.FullReport();
+  EXPECT_EQ(d.extended.calibration.observability.rank, d.extended.calibration.observability.num_unknowns)
+      << report::FullReport(d.extended);
 }
 
 TEST(ScaleTemperatureSession, ExtendedModelRecoversTheDriftWithin3Sigma) {
@@ -219,9 +220,9 @@ TEST(ScaleTemperatureSession, ExtendedModelRecoversTheDriftWithin3Sigma) {
 TEST(ScaleTemperatureSession, ExtendedModelRecoversTheBaseParametersWithin3Point5Sigma) {
   const Demonstration& d = WarmingSession();
   const auto truth = model::ReportedValues(d.sim.model, d.sim.truth);
-  ASSERT_EQ(truth.size(), d.extended.parameters.size());
+  ASSERT_EQ(truth.size(), d.extended.calibration.parameters.size());
   for (std::size_t i = 0; i < truth.size(); ++i) {
-    const auto& p = d.extended.parameters[i];
+    const auto& p = d.extended.calibration.parameters[i];
     if (p.fixed || !p.observable) continue;
     EXPECT_LT(std::abs(p.value - truth[i]), 3.5 * p.sigma) << p.name;
   }

@@ -22,9 +22,9 @@ namespace {
 
 const estimation::ParameterEstimate& Find(const estimation::CalibrationResult& r,
                                           const std::string& name) {
-  const auto it = std::find_if(r.parameters.begin(), r.parameters.end(),
+  const auto it = std::find_if(r.calibration.parameters.begin(), r.calibration.parameters.end(),
                                [&](const estimation::ParameterEstimate& p) { return p.name == name; });
-  if (it == r.parameters.end()) throw std::runtime_error("no parameter " + name);
+  if (it == r.calibration.parameters.end()) throw std::runtime_error("no parameter " + name);
   return *it;
 }
 
@@ -66,7 +66,7 @@ TEST(PaperBackend, BenchmarkConfigurationRecoversTheTruthWithinItsSigma) {
       CalibratePaperBenchmarkOnBackend(s.session.series, closed, s.site);
 
   EXPECT_EQ(b.model_spec, "accel_linear:full+gyro_linear+gyro_bias_drift");
-  EXPECT_EQ(b.result.observability.unobservable.size(), 0u);
+  EXPECT_EQ(b.result.calibration.observability.unobservable.size(), 0u);
   // Known-tilt still periods and 12 turns at known rates.
   const auto turning = std::count_if(b.segments.begin(), b.segments.end(),
                                      [](const StillSegment& seg) { return seg.spinning(); });
@@ -77,7 +77,7 @@ TEST(PaperBackend, BenchmarkConfigurationRecoversTheTruthWithinItsSigma) {
   const auto true_values = model::ReportedValues(true_model, truth);
   double sum_sq = 0.0;
   int n = 0;
-  for (const auto& p : b.result.parameters) {
+  for (const auto& p : b.result.calibration.parameters) {
     double value = 0.0;  // the truth of the full F's lower triangle is 0
     if (const auto where = true_model.FindParameter(p.name)) {
       int flat = 0;
@@ -122,11 +122,11 @@ TEST(PaperBackend, GeneralizedMethodOnThePaperScheduleRecoversTheTruth) {
   model.t_ref_s = s.session.series.t_s.front();
   const estimation::CalibrationResult r =
       estimation::Calibrate(s.session.series, segments, model, s.site, options);
-  EXPECT_TRUE(r.observability.unobservable.empty());
+  EXPECT_TRUE(r.calibration.observability.unobservable.empty());
   const auto true_values = model::ReportedValues(true_model, truth);
-  ASSERT_EQ(true_values.size(), r.parameters.size());
-  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
-    const auto& p = r.parameters[i];
+  ASSERT_EQ(true_values.size(), r.calibration.parameters.size());
+  for (std::size_t i = 0; i < r.calibration.parameters.size(); ++i) {
+    const auto& p = r.calibration.parameters[i];
     ASSERT_TRUE(p.observable) << p.name;
     EXPECT_LT(std::abs(p.value - true_values[i]), 3.0 * p.sigma)
         << p.name << " = " << p.value << " +- " << p.sigma << ", truth " << true_values[i];
@@ -158,12 +158,12 @@ TEST(PaperBackend, StaticConfigurationMarksWhatOneLevelPoseCannotDetermine) {
     EXPECT_TRUE(std::isnan(Find(b.fixed, name).sigma)) << name;
   }
   for (const auto& name : PaperStaticFixedParameters()) EXPECT_TRUE(Find(b.fixed, name).fixed);
-  EXPECT_EQ(b.fixed.observability.unobservable.size(), 6u);
-  ASSERT_EQ(b.fixed.observability.determined.size(), 6u);
+  EXPECT_EQ(b.fixed.calibration.observability.unobservable.size(), 6u);
+  ASSERT_EQ(b.fixed.calibration.observability.determined.size(), 6u);
   // accel.bias.x - g accel.matrix.xz is the level x output: 0.10 - 9.78 * 0.01 with the
   // truth above, determined to about the noise of the mean.
   bool found = false;
-  for (const auto& c : b.fixed.observability.determined) {
+  for (const auto& c : b.fixed.calibration.observability.determined) {
     if (c.text.find("accel.bias.x") == std::string::npos) continue;
     found = true;
     EXPECT_GT(c.sigma, 0.0);
@@ -189,14 +189,14 @@ TEST(PaperBackend, ImucalFerrarisSessionOnTheBackend) {
   // Six faces (no site: headings held) and three 360 deg turns: every parameter determined,
   // and the accelerometer is the closed form's (the same six means, least squares instead of
   // differences) to the noise.
-  EXPECT_TRUE(b.result.observability.unobservable.empty());
-  for (const auto& p : b.result.parameters) {
+  EXPECT_TRUE(b.result.calibration.observability.unobservable.empty());
+  for (const auto& p : b.result.calibration.parameters) {
     if (p.fixed) continue;
     EXPECT_TRUE(p.observable) << p.name;
   }
-  EXPECT_LT((b.result.accel_matrix - closed.F).cwiseAbs().maxCoeff(), 2e-3);
-  EXPECT_LT((b.result.accel_bias - closed.b_a).cwiseAbs().maxCoeff(), 2e-2);
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(b.result.gyro_matrix(i, i), closed.E(i, i), 1e-2);
+  EXPECT_LT((b.result.calibration.AccelMatrix() - closed.F).cwiseAbs().maxCoeff(), 2e-3);
+  EXPECT_LT((b.result.calibration.AccelBias() - closed.b_a).cwiseAbs().maxCoeff(), 2e-2);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(b.result.calibration.GyroMatrix()(i, i), closed.E(i, i), 1e-2);
 }
 
 }  // namespace

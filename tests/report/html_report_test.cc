@@ -56,7 +56,7 @@ TEST(HtmlReport, EscapesFileNamesWarningsAndTheCommand) {
 TEST(HtmlReport, ListsEveryParameterWithSigmaOrStatus) {
   PageParts parts;
   const std::string page = parts.Page();
-  for (const auto& p : parts.result.parameters) {
+  for (const auto& p : parts.result.calibration.parameters) {
     EXPECT_TRUE(Contains(page, "<td><code>" + p.name + "</code></td>")) << p.name;
   }
   // accel.bias.x: value 0.01 * its index, sigma 1e-3, unit "u<index>".

@@ -83,8 +83,8 @@ TEST(JsonReport, HasEverySpecKey) {
 TEST(JsonReport, ForwardQuantitiesAreWrittenAsGiven) {
   const auto r = MakeResult();
   const json doc = ToJson(r);
-  EXPECT_TRUE(ReadMatrix(doc["accel"]["matrix"]).isApprox(r.accel_matrix, 1e-15));
-  EXPECT_TRUE(ReadMatrix(doc["gyro"]["matrix"]).isApprox(r.gyro_matrix, 1e-15));
+  EXPECT_TRUE(ReadMatrix(doc["accel"]["matrix"]).isApprox(r.calibration.AccelMatrix(), 1e-15));
+  EXPECT_TRUE(ReadMatrix(doc["gyro"]["matrix"]).isApprox(r.calibration.GyroMatrix(), 1e-15));
   EXPECT_DOUBLE_EQ(doc["accel"]["bias"][2].get<double>(), 0.3);
   EXPECT_DOUBLE_EQ(doc["gyro"]["bias"][1].get<double>(), 0.02);
 }
@@ -107,7 +107,7 @@ TEST(JsonReport, UnobservableAndFixedSigmasAndNaNBecomeNull) {
 TEST(JsonReport, TextNeverHoldsNaNAndParsesBack) {
   auto r = MakeResult();
   r.fit.rms_motion = Vec3::Constant(std::numeric_limits<double>::infinity());
-  r.noise_acc.x() = std::numeric_limits<double>::quiet_NaN();
+  r.calibration.noise.acc.x() = std::numeric_limits<double>::quiet_NaN();
   const std::string text = ToJson(r).dump();
   EXPECT_EQ(text.find("NaN"), std::string::npos);
   EXPECT_EQ(text.find("nan"), std::string::npos);
@@ -135,7 +135,7 @@ TEST(JsonReport, CorrectionInvertsTheForwardModel) {
 
 TEST(JsonReport, SingularForwardMatrixGivesNullCorrection) {
   auto r = MakeResult();
-  r.accel_matrix.row(2).setZero();
+  r.calibration.theta[0][5] = -1.0;  // F(2, 2) = 1 + block[5] = 0: F singular
   const json doc = ToJson(r);
   EXPECT_TRUE(doc["accel"]["correction"]["matrix"].is_null());
 }
@@ -151,7 +151,7 @@ TEST(JsonReport, NoSiteHasNullCoordinatesAndSourceNone) {
 
 TEST(JsonReport, GivenSiteIsWrittenInDegrees) {
   auto r = MakeResult();
-  r.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
+  r.calibration.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
   const json site = ToJson(r)["site"];
   EXPECT_DOUBLE_EQ(site["lat_deg"].get<double>(), 51.64);
   EXPECT_DOUBLE_EQ(site["lon_deg"].get<double>(), -1.2);
@@ -186,7 +186,7 @@ TEST(JsonReport, SegmentsCarryResidualsAndAttitude) {
   EXPECT_DOUBLE_EQ(s["t_mid_s"].get<double>(), 101.25);
   EXPECT_DOUBLE_EQ(s["acc_whitened"][2].get<double>(), 1.5);
   EXPECT_DOUBLE_EQ(s["gyr_residual"][2].get<double>(), -3e-5);
-  const Quat& q = r.still[1].R_n_b;
+  const Quat& q = r.fit.still[1].R_n_b;
   EXPECT_DOUBLE_EQ(s["attitude_quaternion_wxyz"][0].get<double>(), q.w());
   EXPECT_DOUBLE_EQ(s["attitude_quaternion_wxyz"][3].get<double>(), q.z());
   EXPECT_EQ(s["attitude_known"], false);
@@ -195,7 +195,7 @@ TEST(JsonReport, SegmentsCarryResidualsAndAttitude) {
 
 TEST(JsonReport, AccelerometerOnlyResultHasNullGyro) {
   auto r = MakeResult();
-  r.has_gyro = false;
+  r.calibration.has_gyro = false;
   const json doc = ToJson(r);
   EXPECT_TRUE(doc["gyro"].is_null());
   EXPECT_TRUE(doc["fit"]["residual_rms"]["gyro"].is_null());
@@ -254,7 +254,7 @@ TEST(JsonReport, WriteJsonToAMissingFolderThrowsNamingThePath) {
 TEST(JsonReport, WriteJsonReplacesInvalidUtf8InLabels) {
   testing::TempDir dir;
   auto r = MakeResult();
-  r.still[0].segment.label = "bad \xff label";
+  r.fit.still[0].segment.label = "bad \xff label";
   const std::string path = dir.File("result.json");
   WriteJson(path, ToJson(r));
   std::ifstream in(path);

@@ -22,10 +22,10 @@ namespace plumb::report::testing {
 /// is NaN.
 inline estimation::CalibrationResult MakeResult() {
   estimation::CalibrationResult r;
-  r.model = model::Model::Parse("base+gyro_g_sensitivity");
-  r.model.t_ref_s = 100.0;
-  r.has_gyro = true;
-  const auto names = r.model.ParameterNames();
+  r.calibration.model = model::Model::Parse("base+gyro_g_sensitivity");
+  r.calibration.model.t_ref_s = 100.0;
+  r.calibration.has_gyro = true;
+  const auto names = r.calibration.model.ParameterNames();
   for (std::size_t i = 0; i < names.size(); ++i) {
     estimation::ParameterEstimate p;
     p.name = names[i];
@@ -40,12 +40,15 @@ inline estimation::CalibrationResult MakeResult() {
       p.fixed = true;
       p.sigma = std::numeric_limits<double>::quiet_NaN();
     }
-    r.parameters.push_back(p);
+    r.calibration.parameters.push_back(p);
   }
-  r.accel_matrix << 1.01, 0.02, 0.03, 0.0, 0.98, -0.01, 0.0, 0.0, 1.02;
-  r.accel_bias = Vec3(0.1, -0.2, 0.3);
-  r.gyro_matrix << 1.001, 0.002, -0.003, 0.004, 0.995, 0.001, -0.002, 0.003, 1.004;
-  r.gyro_bias = Vec3(0.01, 0.02, -0.03);
+  // F = [1.01 0.02 0.03; 0 0.98 -0.01; 0 0 1.02], b_a = (0.1, -0.2, 0.3); E = [1.001 0.002
+  // -0.003; 0.004 0.995 0.001; -0.002 0.003 1.004], b_g = (0.01, 0.02, -0.03): the blocks of
+  // accel_linear and gyro_linear hold F - I and E - I (model/effects/*_linear.h).
+  r.calibration.theta = r.calibration.model.ZeroParameters();
+  r.calibration.theta[0] = {0.01, 0.02, 0.03, -0.02, -0.01, 0.02, 0.1, -0.2, 0.3};
+  r.calibration.theta[1] = {0.001, 0.002, -0.003, 0.004, -0.005, 0.001, -0.002, 0.003, 0.004,
+                            0.01,  0.02,  -0.03};
   r.fit.chi2 = 12.5;
   r.fit.dof = 0;
   r.fit.num_residuals = 18;
@@ -53,11 +56,11 @@ inline estimation::CalibrationResult MakeResult() {
   r.fit.motion_segments = 1;
   r.fit.converged = true;
   r.fit.iterations = 7;
-  r.observability.rank = 40;
-  r.observability.num_unknowns = 41;
-  r.observability.unobservable = {"9.81 accel.bias.z + 1 accel.matrix.zz"};
-  r.observability.determined = {{"accel.bias.z - 9.81 accel.matrix.zz", 0.5, 0.01}};
-  r.site = geo::Site::Unknown();
+  r.calibration.observability.rank = 40;
+  r.calibration.observability.num_unknowns = 41;
+  r.calibration.observability.unobservable = {"9.81 accel.bias.z + 1 accel.matrix.zz"};
+  r.calibration.observability.determined = {{"accel.bias.z - 9.81 accel.matrix.zz", 0.5, 0.01}};
+  r.calibration.site = geo::Site::Unknown();
   for (int k = 0; k < 2; ++k) {
     estimation::StillSegmentFit s;
     s.segment.begin = static_cast<std::size_t>(100 * k);
@@ -70,7 +73,7 @@ inline estimation::CalibrationResult MakeResult() {
     s.gyr_whitened = Vec3(0.1, 0.2, -0.3);
     s.R_n_b = Quat(Eigen::AngleAxisd(0.5 * k, Vec3::UnitZ()));
     s.attitude_known = k == 0;
-    r.still.push_back(s);
+    r.fit.still.push_back(s);
   }
   estimation::MotionFit m;
   m.from = 0;
@@ -78,10 +81,10 @@ inline estimation::CalibrationResult MakeResult() {
   m.duration_s = 2.5;
   m.rotation_residual = Vec3(1e-4, 0, -1e-4);
   m.whitened = Vec3(0.3, 0, -0.3);
-  r.motion.push_back(m);
-  r.noise_acc = Vec3(0.01, 0.01, 0.012);
-  r.noise_gyr = Vec3(7e-4, 7e-4, 8e-4);
-  r.warnings = {"no site given"};
+  r.fit.motion.push_back(m);
+  r.calibration.noise.acc = Vec3(0.01, 0.01, 0.012);
+  r.calibration.noise.gyr = Vec3(7e-4, 7e-4, 8e-4);
+  r.fit.warnings = {"no site given"};
   return r;
 }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "plumb/report/version.h"
+#include "plumb/report/calibration_text.h"
 #include "report_test_util.h"
 
 namespace plumb::report {
@@ -13,8 +14,8 @@ bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-estimation::FitSummary Fit(double chi2, int dof) {
-  estimation::FitSummary f;
+estimation::FitReport Fit(double chi2, int dof) {
+  estimation::FitReport f;
   f.chi2 = chi2;
   f.dof = dof;
   return f;
@@ -42,7 +43,7 @@ TEST(Summary, CalibrationSummaryIsHeaderThenFullReport) {
   const std::string text = CalibrationSummary(r);
   EXPECT_EQ(text.rfind("plumb " + Version() + " calibrate", 0), 0u) << text;
   EXPECT_TRUE(Contains(text, "1 unobservable direction"));
-  EXPECT_TRUE(Contains(text, r.FullReport()));
+  EXPECT_TRUE(Contains(text, report::FullReport(r)));
 }
 
 TEST(Summary, GivenSegmentsNameTheirFile) {

@@ -49,7 +49,7 @@ double OutputScale(const model::EffectInfo& info, std::size_t i, const ImuSeries
   const std::string& out = accel ? series.acc_unit : series.gyr_unit;
   const std::string in = accel ? "m/s^2" : "rad/s";
   if (out == in || !info.ScalesWithOutput(static_cast<int>(i))) return 1.0;
-  const Mat3& M = accel ? fit.accel_matrix : fit.gyro_matrix;
+  const Mat3& M = accel ? fit.calibration.AccelMatrix() : fit.calibration.GyroMatrix();
   return M.diagonal().cwiseAbs().mean();
 }
 
@@ -57,14 +57,14 @@ double OutputScale(const model::EffectInfo& info, std::size_t i, const ImuSeries
 estimation::CalibrationResult StripProbes(estimation::CalibrationResult fit,
                                           const model::Model& model) {
   const auto n = static_cast<Eigen::Index>(model.num_parameters());
-  fit.parameters.resize(static_cast<std::size_t>(n));
-  fit.covariance = Eigen::MatrixXd(fit.covariance.topLeftCorner(n, n));
-  fit.theta.resize(static_cast<std::size_t>(model.num_terms()));
+  fit.calibration.parameters.resize(static_cast<std::size_t>(n));
+  fit.calibration.covariance = Eigen::MatrixXd(fit.calibration.covariance.topLeftCorner(n, n));
+  fit.calibration.theta.resize(static_cast<std::size_t>(model.num_terms()));
   model::Model own = model;
-  own.t_ref_s = fit.model.t_ref_s;
-  own.temp_ref_c = fit.model.temp_ref_c;
-  fit.model = own;
-  fit.probes.reset();
+  own.t_ref_s = fit.calibration.model.t_ref_s;
+  own.temp_ref_c = fit.calibration.model.temp_ref_c;
+  fit.calibration.model = own;
+  fit.fit.probes.reset();
   return fit;
 }
 
@@ -126,14 +126,14 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     fit_motion = estimation::Calibrate(series, segments, probed_motion, site, with);
     d.fit_with_velocity = StripProbes(*fit_motion, model);
   }
-  if (!fit.probes && !fit_motion) return d;
-  d.num_residuals = fit.probes ? static_cast<int>(fit.probes->r.size()) : 0;
+  if (!fit.fit.probes && !fit_motion) return d;
+  d.num_residuals = fit.fit.probes ? static_cast<int>(fit.fit.probes->r.size()) : 0;
 
   std::vector<Eigen::MatrixXd> bases;
   for (std::size_t ci = 0; ci < tested.size(); ++ci) {
     const CandidateSpec& c = tested[ci];
     const estimation::CalibrationResult* source = needs_motion[ci] ? (fit_motion ? &*fit_motion : nullptr) : &fit;
-    if (source == nullptr || !source->probes) {
+    if (source == nullptr || !source->fit.probes) {
       // No motion between the poses: nothing excites it.
       Candidate cand;
       cand.effect = c.name;
@@ -152,7 +152,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
       bases.emplace_back();
       continue;
     }
-    const estimation::ProbeJacobian& p = *source->probes;
+    const estimation::ProbeJacobian& p = *source->fit.probes;
     const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
     double dispersion = 1.0;
     if (needs_motion[ci]) {
@@ -165,7 +165,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
       }
       if (rows > 0) dispersion = std::max(1.0, ss / rows);
     }
-    const int term = source->model.FindTerm(c.name);
+    const int term = source->calibration.model.FindTerm(c.name);
     std::vector<Eigen::Index> cols;
     for (std::size_t j = 0; j < p.probe_term.size(); ++j) {
       if (p.probe_term[j] == term) cols.push_back(static_cast<Eigen::Index>(j));
@@ -173,7 +173,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     Eigen::MatrixXd Z(p.Z.rows(), static_cast<Eigen::Index>(cols.size()));
     std::vector<std::string> names;
     std::vector<double> typical;
-    const auto& info = source->model.terms()[static_cast<std::size_t>(term)].effect->info();
+    const auto& info = source->calibration.model.terms()[static_cast<std::size_t>(term)].effect->info();
     for (std::size_t k = 0; k < cols.size(); ++k) {
       Z.col(static_cast<Eigen::Index>(k)) = p.Z.col(cols[k]);
       names.push_back(p.probe_names[static_cast<std::size_t>(cols[k])]);
@@ -237,7 +237,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
 std::string Diagnosis::BriefReport() const {
   std::ostringstream out;
   const auto& f = fit.fit;
-  out << "model " << fit.model.spec() << ": chi2 " << Fixed(f.chi2, 1) << " on " << f.dof
+  out << "model " << fit.calibration.model.spec() << ": chi2 " << Fixed(f.chi2, 1) << " on " << f.dof
       << " dof, chi2/dof " << Fixed(f.chi2_dof(), 3) << "\n";
   out << "candidates (score test at the current fit; significant at " << significance
       << "; evidence = LM - q ln N, N = " << num_residuals << "):\n";
@@ -310,7 +310,7 @@ std::string Diagnosis::BriefReport() const {
     out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
   } else {
     out << "best: " << best->effect << (best->option.empty() ? "" : ":" + best->option)
-        << " -> refit with --model " << SpecWith(fit.model, best->effect, best->option) << "\n";
+        << " -> refit with --model " << SpecWith(fit.calibration.model, best->effect, best->option) << "\n";
   }
   return out.str();
 }

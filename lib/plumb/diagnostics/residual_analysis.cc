@@ -50,17 +50,17 @@ model::SensorInput<double> StillInput(const CalibrationResult& fit, const StillS
                                       double t_s, double temp_c) {
   model::SensorInput<double> in;
   in.R_b_n = s.R_n_b.toRotationMatrix().transpose();
-  in.f_b = in.R_b_n * (-fit.site.g_n);
-  in.omega_b = in.R_b_n * fit.site.omega_ie_n + s.segment.known_omega_eb_b.value_or(Vec3::Zero());
-  in.dt_s = t_s - fit.model.t_ref_s;
-  in.dtemp_c = std::isfinite(temp_c) ? temp_c - fit.model.temp_ref_c : 0.0;
+  in.f_b = in.R_b_n * (-fit.calibration.site.g_n);
+  in.omega_b = in.R_b_n * fit.calibration.site.omega_ie_n + s.segment.known_omega_eb_b.value_or(Vec3::Zero());
+  in.dt_s = t_s - fit.calibration.model.t_ref_s;
+  in.dtemp_c = std::isfinite(temp_c) ? temp_c - fit.calibration.model.temp_ref_c : 0.0;
   return in;
 }
 
 /// Model::Predict on the fit's blocks.
 struct Predictor {
-  explicit Predictor(const CalibrationResult& fit) : model(&fit.model) {
-    for (const auto& b : fit.theta) blocks.push_back(b.data());
+  explicit Predictor(const CalibrationResult& fit) : model(&fit.calibration.model) {
+    for (const auto& b : fit.calibration.theta) blocks.push_back(b.data());
   }
   model::SensorOutput<double> operator()(const model::SensorInput<double>& in) const {
     return model->Predict<double>(blocks.data(), in);
@@ -71,7 +71,7 @@ struct Predictor {
 
 SegmentComparison CompareSegment(const ImuSeries& series, const CalibrationResult& fit,
                                  const Predictor& predict, std::size_t k, bool still_gyro) {
-  const StillSegmentFit& s = fit.still[k];
+  const StillSegmentFit& s = fit.fit.still[k];
   const signal::SegmentStats stats = signal::ComputeSegmentStats(series, s.segment);
   SegmentComparison c;
   c.index = k;
@@ -104,9 +104,9 @@ SegmentComparison CompareSegment(const ImuSeries& series, const CalibrationResul
 
 MotionComparison CompareMotion(const ImuSeries& series, const CalibrationResult& fit,
                                std::size_t k) {
-  const estimation::MotionFit& m = fit.motion[k];
-  const StillSegmentFit& a = fit.still[m.from];
-  const StillSegmentFit& b = fit.still[m.to];
+  const estimation::MotionFit& m = fit.fit.motion[k];
+  const StillSegmentFit& a = fit.fit.still[m.from];
+  const StillSegmentFit& b = fit.fit.still[m.to];
   MotionComparison c;
   c.index = k;
   c.from = m.from;
@@ -122,9 +122,9 @@ MotionComparison CompareMotion(const ImuSeries& series, const CalibrationResult&
   c.whitened_norm = m.whitened.norm();
   // Rates from the raw gyroscope through the fit's linear part; angular acceleration by
   // central differences, as the backend forms alpha_b.
-  const Mat3 E_inv = fit.gyro_matrix.inverse();
+  const Mat3 E_inv = fit.calibration.GyroMatrix().inverse();
   auto rate = [&](std::size_t i) {
-    return Vec3(E_inv * (series.gyr[i].cast<double>() - fit.gyro_bias));
+    return Vec3(E_inv * (series.gyr[i].cast<double>() - fit.calibration.GyroBias()));
   };
   for (std::size_t i = first; i <= last; ++i) {
     const Vec3 w = rate(i);
@@ -147,7 +147,7 @@ struct SegmentSamples {
 
 SegmentSamples PredictSamples(const ImuSeries& series, const CalibrationResult& fit,
                               const Predictor& predict, const SegmentComparison& c) {
-  const StillSegmentFit& s = fit.still[c.index];
+  const StillSegmentFit& s = fit.fit.still[c.index];
   SegmentSamples out;
   const Vec3 none = Vec3::Constant(kNaN);
   for (std::size_t i = s.segment.begin; i < s.segment.end; ++i) {
@@ -164,7 +164,7 @@ SegmentSamples PredictSamples(const ImuSeries& series, const CalibrationResult& 
 void AppendSamples(const ImuSeries& series, const CalibrationResult& fit,
                    const SegmentComparison& c, const SegmentSamples& s, std::size_t stride,
                    SampleResiduals& out) {
-  const std::size_t begin = fit.still[c.index].segment.begin;
+  const std::size_t begin = fit.fit.still[c.index].segment.begin;
   for (std::size_t j = 0; j < s.acc_residual.size(); j += stride) {
     out.sample.push_back(begin + j);
     out.segment.push_back(c.index);
@@ -173,8 +173,8 @@ void AppendSamples(const ImuSeries& series, const CalibrationResult& fit,
     out.acc_residual.push_back(s.acc_residual[j]);
     out.gyr_predicted.push_back(s.gyr_predicted[j]);
     out.gyr_residual.push_back(s.gyr_residual[j]);
-    out.acc_normalised.push_back(s.acc_residual[j].cwiseQuotient(fit.noise_acc));
-    out.gyr_normalised.push_back(s.gyr_residual[j].cwiseQuotient(fit.noise_gyr));
+    out.acc_normalised.push_back(s.acc_residual[j].cwiseQuotient(fit.calibration.noise.acc));
+    out.gyr_normalised.push_back(s.gyr_residual[j].cwiseQuotient(fit.calibration.noise.gyr));
   }
 }
 
@@ -193,7 +193,7 @@ void AddRange(WorstRange::Kind kind, std::size_t index, double t0, double t1, st
 
 /// Sums of the residual over one stretch of a long still segment.
 struct Stretch {
-  std::size_t index = 0;  ///< fit.still index
+  std::size_t index = 0;  ///< fit.fit.still index
   double t0_s = 0, t1_s = 0;
   std::string label;
   Vec3 acc = Vec3::Zero(), gyr = Vec3::Zero();  ///< sums of the residuals, series' units
@@ -206,7 +206,7 @@ void AddStretches(const ImuSeries& series, const CalibrationResult& fit,
                   std::vector<Stretch>& out) {
   const double length_s = c.t_end_s - c.t_begin_s;
   const auto blocks = static_cast<std::size_t>(std::floor(length_s / stretch_s));
-  const std::size_t n = s.acc_residual.size(), begin = fit.still[c.index].segment.begin;
+  const std::size_t n = s.acc_residual.size(), begin = fit.fit.still[c.index].segment.begin;
   for (std::size_t b = 0; blocks >= 2 && b < blocks; ++b) {
     const std::size_t i0 = n * b / blocks, i1 = n * (b + 1) / blocks;
     Stretch st{c.index, series.t_s[begin + i0], series.t_s[begin + i1 - 1], c.label};
@@ -359,13 +359,13 @@ std::vector<Signature> Signatures(const ResidualAnalysis& a, double t0_s, bool t
 std::pair<std::vector<std::size_t>, std::vector<std::size_t>> AllanPlan(
     const CalibrationResult& fit, const ResidualAnalysisOptions& o) {
   std::size_t longest = 0;
-  for (const auto& s : fit.still) {
+  for (const auto& s : fit.fit.still) {
     if (!s.segment.spinning()) longest = std::max(longest, s.segment.count());
   }
   std::vector<std::size_t> segments;
   std::size_t shortest = longest;
-  for (std::size_t k = 0; k < fit.still.size(); ++k) {
-    const StillSegment& seg = fit.still[k].segment;
+  for (std::size_t k = 0; k < fit.fit.still.size(); ++k) {
+    const StillSegment& seg = fit.fit.still[k].segment;
     const double fraction = static_cast<double>(seg.count()) / static_cast<double>(longest);
     if (seg.spinning() || fraction < o.allan_length_fraction) continue;
     segments.push_back(k);
@@ -419,8 +419,8 @@ std::vector<ResidualAllan> FinishAllan(const CalibrationResult& fit,
     ResidualAllan a;
     a.residual = accel ? ResidualKind::kStillAccel : ResidualKind::kStillGyro;
     a.axis = axis;
-    a.fit_sigma = (accel ? fit.noise_acc[axis] : fit.noise_gyr[axis]) *
-                  std::sqrt(accel ? fit.tau_acc : fit.tau_gyr);
+    a.fit_sigma = (accel ? fit.calibration.noise.acc[axis] : fit.calibration.noise.gyr[axis]) *
+                  std::sqrt(accel ? fit.calibration.noise.tau_acc : fit.calibration.noise.tau_gyr);
     for (std::size_t j = 0; j < sizes.size(); ++j) {
       a.tau_s.push_back(static_cast<double>(sizes[j]) * dt_s);
       a.adev.push_back(std::sqrt(weighted[c][j] / terms[c][j]));
@@ -452,23 +452,23 @@ const char* ResidualKindName(ResidualKind kind) {
 ResidualAnalysis AnalyseResiduals(const ImuSeries& series, const CalibrationResult& fit,
                                   const ResidualAnalysisOptions& options) {
   Validate(options);
-  if (fit.has_gyro && !series.has_gyro()) {
+  if (fit.calibration.has_gyro && !series.has_gyro()) {
     throw Error("residual analysis: the fit has a gyroscope but the series has none");
   }
-  for (const auto& m : fit.motion) {
-    if (m.from >= fit.still.size() || m.to >= fit.still.size()) {
+  for (const auto& m : fit.fit.motion) {
+    if (m.from >= fit.fit.still.size() || m.to >= fit.fit.still.size()) {
       throw Error("residual analysis: motion interval " + std::to_string(m.from) + "->" +
                   std::to_string(m.to) + " names a still segment the fit does not have");
     }
   }
-  for (const auto& s : fit.still) {
+  for (const auto& s : fit.fit.still) {
     if (s.segment.begin >= s.segment.end || s.segment.end > series.size()) {
       throw Error("residual analysis: still segment '" + s.segment.label + "' [" +
                   std::to_string(s.segment.begin) + ", " + std::to_string(s.segment.end) +
                   ") is outside the " + std::to_string(series.size()) + " samples");
     }
   }
-  const bool still_gyro = fit.has_gyro && fit.fit.rms_gyr.squaredNorm() > 0;
+  const bool still_gyro = fit.calibration.has_gyro && fit.fit.rms_gyr.squaredNorm() > 0;
   const Predictor predict(fit);
   ResidualAnalysis a;
   std::vector<WorstRange> ranges;
@@ -479,7 +479,7 @@ ResidualAnalysis AnalyseResiduals(const ImuSeries& series, const CalibrationResu
   std::vector<std::vector<double>> weighted(6, std::vector<double>(sizes.size(), 0.0));
   std::vector<std::vector<double>> terms = weighted;
 
-  for (std::size_t k = 0; k < fit.still.size(); ++k) {
+  for (std::size_t k = 0; k < fit.fit.still.size(); ++k) {
     const SegmentComparison c = CompareSegment(series, fit, predict, k, still_gyro);
     const SegmentSamples s = PredictSamples(series, fit, predict, c);
     AppendSamples(series, fit, c, s, options.sample_stride, a.samples);
@@ -493,7 +493,7 @@ ResidualAnalysis AnalyseResiduals(const ImuSeries& series, const CalibrationResu
              gyro_worse ? c.gyr_whitened : c.acc_whitened, ranges);
     a.still.push_back(c);
   }
-  for (std::size_t k = 0; k < fit.motion.size(); ++k) {
+  for (std::size_t k = 0; k < fit.fit.motion.size(); ++k) {
     const MotionComparison m = CompareMotion(series, fit, k);
     AddRange(WorstRange::Kind::kMotion, k, m.t_begin_s, m.t_end_s,
              "motion " + std::to_string(m.from) + "->" + std::to_string(m.to),
@@ -502,8 +502,8 @@ ResidualAnalysis AnalyseResiduals(const ImuSeries& series, const CalibrationResu
   }
   if (!sizes.empty()) a.allan = FinishAllan(fit, sizes, dt_s, weighted, terms);
   // Stretches against the white level of the residual (the fit's when there is no Allan).
-  Vec3 white_acc = fit.noise_acc * std::sqrt(fit.tau_acc);
-  Vec3 white_gyr = fit.noise_gyr * std::sqrt(fit.tau_gyr);
+  Vec3 white_acc = fit.calibration.noise.acc * std::sqrt(fit.calibration.noise.tau_acc);
+  Vec3 white_gyr = fit.calibration.noise.gyr * std::sqrt(fit.calibration.noise.tau_gyr);
   for (const auto& x : a.allan) {
     (x.residual == ResidualKind::kStillAccel ? white_acc : white_gyr)[x.axis] = x.sigma_white;
   }

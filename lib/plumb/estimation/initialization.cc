@@ -1,6 +1,9 @@
 #include "plumb/estimation/initialization.h"
 
 #include "plumb/core/so3.h"
+#include "plumb/core/units.h"
+#include "plumb/model/effects/accel_linear.h"
+#include "plumb/model/effects/gyro_linear.h"
 
 #include <Eigen/QR>
 #include <Eigen/SVD>
@@ -138,6 +141,76 @@ double GuessGyroScale(const ImuSeries& series,
     }
   }
   return std::pow(10.0, 0.5 * (a + b));
+}
+
+Vec3 StartingValues::Down(const StillPose& pose) const {
+  return Vec3(-(pose.stats.acc_mean - accel.bias) / accel.scale).normalized();
+}
+
+namespace {
+
+/// The gyroscope's starting bias (mean still output) and scalar scale (GuessGyroScale over
+/// the motion intervals).
+void GuessGyro(const ImuSeries& series, const StillSet& set, StartingValues& start) {
+  const auto at_rest = set.AtRestMeans(true);
+  for (const auto& m : at_rest) start.gyro_bias += m / static_cast<double>(at_rest.size());
+  std::vector<std::pair<std::size_t, std::size_t>> intervals;
+  std::vector<Vec3> before, after;
+  for (const auto& m : set.motions) {
+    intervals.emplace_back(m.first, m.last);
+    before.push_back(start.Down(set.poses[m.from]));
+    after.push_back(start.Down(set.poses[m.from + 1]));
+  }
+  start.gyro_rad_per_unit = GuessGyroScale(series, intervals, before, after, start.gyro_bias);
+}
+
+/// Starting attitudes: tilt from gravity, heading carried along each chain.
+void InitialAttitudes(const ImuSeries& series, const StartingValues& start,
+                      std::optional<double> first_heading_deg, StillSet& set) {
+  auto& poses = set.poses;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    StillPose& s = poses[k];
+    if (s.known || s.heading_only) {
+      s.set_R_n_b(*s.segment.known_R_n_b);
+      continue;
+    }
+    if (k > 0 && set.joined_to_previous[k]) {
+      const MotionInterval& m = set.MotionInto(k);
+      const Quat dR = IntegrateRaw(series, m.first, m.last, start.gyro_bias,
+                                   start.gyro_rad_per_unit);
+      s.set_R_n_b(CorrectTilt(poses[k - 1].R_n_b() * dR, start.Down(s)));
+    } else {
+      const double heading =
+          (k == 0 && first_heading_deg) ? *first_heading_deg * units::kRadPerDeg : 0.0;
+      s.set_R_n_b(AttitudeFromDown(start.Down(s), heading));
+    }
+  }
+}
+
+}  // namespace
+
+StartingValues Initialize(const ImuSeries& series, const model::Model& model, double g,
+                          bool has_gyro, std::optional<double> first_heading_deg, StillSet& set,
+                          model::ParameterBlocks& theta) {
+  StartingValues start;
+  start.accel = GuessAccel(set.AtRestMeans(false), g);
+  model::accel_linear::SetIsotropic(theta[static_cast<std::size_t>(model.BaseTerm(model::Sensor::kAccel))],
+                                    start.accel.scale, start.accel.bias);
+  if (has_gyro) {
+    GuessGyro(series, set, start);
+    model::gyro_linear::SetIsotropic(
+        theta[static_cast<std::size_t>(model.BaseTerm(model::Sensor::kGyro))],
+        start.gyro_rad_per_unit, start.gyro_bias);
+  }
+  // Fixed parameters are held at their nominal values, whatever the guesses above say.
+  for (int t = 0; t < model.num_terms(); ++t) {
+    const auto& fixed = model.terms()[static_cast<std::size_t>(t)].fixed;
+    for (std::size_t i = 0; i < fixed.size(); ++i) {
+      if (fixed[i]) theta[static_cast<std::size_t>(t)][i] = 0.0;
+    }
+  }
+  InitialAttitudes(series, start, first_heading_deg, set);
+  return start;
 }
 
 }  // namespace plumb::estimation

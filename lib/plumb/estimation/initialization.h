@@ -11,10 +11,13 @@
 //    rate (so raw counts need no unit option).
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "plumb/core/imu_series.h"
 #include "plumb/core/types.h"
+#include "plumb/estimation/still_set.h"
+#include "plumb/model/model.h"
 
 namespace plumb::estimation {
 
@@ -50,5 +53,24 @@ double GuessGyroScale(const ImuSeries& series,
                       const std::vector<std::pair<std::size_t, std::size_t>>& intervals,
                       const std::vector<Vec3>& down_before, const std::vector<Vec3>& down_after,
                       const Vec3& bias);
+
+/// The starting values of stage 3 (file comment).
+struct StartingValues {
+  AccelGuess accel;
+  double gyro_rad_per_unit = 1.0;  ///< scalar gyroscope scale s, rad/s per sensor unit
+  Vec3 gyro_bias = Vec3::Zero();   ///< mean still gyroscope output, sensor units
+
+  /// Unit "down" in the body frame of a pose, from its accelerometer mean through `accel`.
+  Vec3 Down(const StillPose& pose) const;
+};
+
+/// Stage 3: starting values. Sets the base effects' blocks of `theta` (model.ZeroParameters()
+/// on entry) from the closed forms, holds every fixed parameter at its nominal value, and sets
+/// each pose's attitude: known ones as given, the others tilted from gravity with the heading
+/// carried along each motion-joined chain by the integrated gyroscope (a chain's first pose:
+/// `first_heading_deg` for the first pose when stated, else 0).
+StartingValues Initialize(const ImuSeries& series, const model::Model& model, double g,
+                          bool has_gyro, std::optional<double> first_heading_deg, StillSet& set,
+                          model::ParameterBlocks& theta);
 
 }  // namespace plumb::estimation

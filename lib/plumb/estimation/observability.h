@@ -22,7 +22,7 @@
 
 #include <Eigen/Core>
 
-#include "plumb/estimation/result.h"
+#include "plumb/estimation/calibration.h"
 
 namespace plumb::estimation {
 

@@ -51,11 +51,11 @@ bool FeedsFirmware(const std::string& name) {
 }
 
 /// Refuses to write firmware values from parameters the session does not determine.
-void CheckDetermined(const std::string& format, const estimation::CalibrationResult& r,
+void CheckDetermined(const std::string& format, const estimation::Calibration& c,
                      const ExportOptions& options) {
   if (options.allow_undetermined) return;
   std::string missing;
-  for (const auto& p : r.parameters) {
+  for (const auto& p : c.parameters) {
     if (p.fixed || p.observable || !FeedsFirmware(p.name)) continue;
     missing += (missing.empty() ? "" : ", ") + p.name;
   }
@@ -68,10 +68,11 @@ void CheckDetermined(const std::string& format, const estimation::CalibrationRes
 }
 
 /// A firmware format: parameters, their read-back correction, and the report.
-ExportOutput Firmware(const std::string& format, const estimation::CalibrationResult& r,
-                      const ImuSeries& series, const ExportOptions& options) {
-  CheckDetermined(format, r, options);
-  const FirmwareCorrection target = BestDiagonal(r, SessionTemperatureRange(series));
+ExportOutput Firmware(const std::string& format, const estimation::Calibration& c,
+                      const ImuSeries& series, const std::vector<estimation::StillSegmentFit>& still,
+                      const ExportOptions& options) {
+  CheckDetermined(format, c, options);
+  const FirmwareCorrection target = BestDiagonal(c, SessionTemperatureRange(series));
   ExportOutput out;
   out.format = format;
   ParameterSet set;
@@ -85,7 +86,7 @@ ExportOutput Firmware(const std::string& format, const estimation::CalibrationRe
     out.text = Px4ParamsFile(set);
     applied = Px4Correction(ReadPx4ParamsFile(out.text, format), options.imu);
   }
-  ExportReport report = Evaluate(r, series, applied, format, /*keeps_temperature=*/true);
+  ExportReport report = Evaluate(c, series, still, applied, format, /*keeps_temperature=*/true);
   report.notes.insert(report.notes.end(), set.notes.begin(), set.notes.end());
   report.notes.push_back("axes as plumb calibrated them (the log's board frame); the firmware "
                          "applies its board rotation after this correction");
@@ -96,11 +97,12 @@ ExportOutput Firmware(const std::string& format, const estimation::CalibrationRe
   return out;
 }
 
-ExportOutput Kalibr(const estimation::CalibrationResult& r, const ImuSeries& series,
+ExportOutput Kalibr(const estimation::Calibration& c, const ImuSeries& series,
+                    const std::vector<estimation::StillSegmentFit>& still,
                     const ExportOptions& options) {
   ExportOutput out;
   out.format = "kalibr";
-  const KalibrImu imu = KalibrNoise(r, series, options.rostopic);
+  const KalibrImu imu = KalibrNoise(c, series, still, options.rostopic);
   out.text = KalibrYaml(imu);
   char buf[256];
   std::snprintf(buf, sizeof buf,
@@ -138,15 +140,16 @@ const std::vector<std::string>& ExportFormats() {
   return formats;
 }
 
-ExportOutput Export(const std::string& format, const estimation::CalibrationResult& r,
-                    const ImuSeries& series, const ExportOptions& options) {
-  if (format == "ardupilot" || format == "px4") return Firmware(format, r, series, options);
-  if (format == "kalibr") return Kalibr(r, series, options);
+ExportOutput Export(const std::string& format, const estimation::Calibration& c,
+                    const ImuSeries& series, const std::vector<estimation::StillSegmentFit>& still,
+                    const ExportOptions& options) {
+  if (format == "ardupilot" || format == "px4") return Firmware(format, c, series, still, options);
+  if (format == "kalibr") return Kalibr(c, series, still, options);
   if (format == "json") {
     ExportOutput out;
     out.format = format;
     for (const char* f : {"ardupilot", "px4", "kalibr"}) {
-      ExportOutput one = Export(f, r, series, options);
+      ExportOutput one = Export(f, c, series, still, options);
       out.json[f] = one.json;
       out.lines.insert(out.lines.end(), one.lines.begin(), one.lines.end());
     }

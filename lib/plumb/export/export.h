@@ -15,7 +15,8 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
-#include "plumb/estimation/result.h"
+#include "plumb/estimation/calibration.h"
+#include "plumb/estimation/fit_report.h"
 #include "plumb/export/firmware.h"
 #include "plumb/export/formats.h"
 #include "plumb/export/kalibr.h"
@@ -43,12 +44,16 @@ struct ExportOutput {
   nlohmann::json json;             ///< parameters and report, for "export" in calibrate's JSON
 };
 
-/// Builds one format for the calibration `result` of the session `series`. Throws
+/// Builds one format for the calibration `calibration` of the session `series`, whose still
+/// segments as the fit saw them (`still`, CalibrationResult::fit.still) measure the error the
+/// format leaves. Export depends on what the calibration is, not on how the fit went. Throws
 /// plumb::Error for an unknown format, outputs not in SI (counts), an instance the target has
 /// no parameters for, or (firmware formats, unless options.allow_undetermined) parameters the
 /// firmware values come from that the session leaves undetermined.
-ExportOutput Export(const std::string& format, const estimation::CalibrationResult& result,
-                    const ImuSeries& series, const ExportOptions& options);
+ExportOutput Export(const std::string& format, const estimation::Calibration& calibration,
+                    const ImuSeries& series,
+                    const std::vector<estimation::StillSegmentFit>& still,
+                    const ExportOptions& options);
 
 /// JSON of a report: errors in SI and in mg / deg/h, per-input matrices, dropped effects.
 nlohmann::json ToJson(const ExportReport& report);

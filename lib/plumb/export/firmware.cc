@@ -24,13 +24,13 @@ double Binomial(int k, int j) {
 
 /// The temperature polynomial of the model's term `name` (accel_temperature_bias or
 /// gyro_temperature_bias), about the model's reference temperature; false when absent.
-bool ModelThermal(const estimation::CalibrationResult& r, const std::string& name,
+bool ModelThermal(const estimation::Calibration& c, const std::string& name,
                   TemperaturePolynomial& out) {
-  const int term = r.model.FindTerm(name);
+  const int term = c.model.FindTerm(name);
   if (term < 0) return false;
-  const std::vector<double>& block = r.theta[static_cast<std::size_t>(term)];
+  const std::vector<double>& block = c.theta[static_cast<std::size_t>(term)];
   out = TemperaturePolynomial{};
-  out.t0_c = r.model.temp_ref_c;
+  out.t0_c = c.model.temp_ref_c;
   const std::size_t order = block.size() / 3;  // 3 values per order, lowest order first
   for (std::size_t k = 0; k < order && k < 3; ++k) {
     out.c[k + 1] = Vec3(block[3 * k], block[3 * k + 1], block[3 * k + 2]);
@@ -100,24 +100,24 @@ TemperatureRange SessionTemperatureRange(const ImuSeries& series) {
   return range;
 }
 
-FirmwareCorrection BestDiagonal(const estimation::CalibrationResult& r,
+FirmwareCorrection BestDiagonal(const estimation::Calibration& c,
                                 const TemperatureRange& range) {
-  if (r.acc_unit != "m/s^2" || (r.has_gyro && r.gyr_unit != "rad/s")) {
-    throw Error("the session's samples are in " + r.acc_unit + " and " + r.gyr_unit +
+  if (c.acc_unit != "m/s^2" || (c.has_gyro && c.gyr_unit != "rad/s")) {
+    throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: firmware parameters act on SI sensor output, so "
                 "plumb cannot export them; give the sensor's scale (--acc-scale, --gyr-scale) "
                 "to calibrate in SI");
   }
   FirmwareCorrection fw;
-  fw.has_gyro = r.has_gyro;
-  const Mat3 F_inv = r.accel_matrix.inverse();
+  fw.has_gyro = c.has_gyro;
+  const Mat3 F_inv = c.AccelMatrix().inverse();
   fw.accel.scale = F_inv.diagonal();
-  fw.accel.offset = r.accel_bias;
-  fw.gyro.offset = r.gyro_bias;  // no gyro scale in either firmware: S = 1
+  fw.accel.offset = c.AccelBias();
+  fw.gyro.offset = c.GyroBias();  // no gyro scale in either firmware: S = 1
   const std::pair<const char*, DiagonalCorrection*> thermal[] = {
       {"accel_temperature_bias", &fw.accel}, {"gyro_temperature_bias", &fw.gyro}};
   for (const auto& [name, sensor] : thermal) {
-    if (!ModelThermal(r, name, sensor->thermal)) continue;
+    if (!ModelThermal(c, name, sensor->thermal)) continue;
     if (!range.known()) {
       throw Error(std::string("the model has ") + name +
                   " but the session has no temperature: no range to export it over");
@@ -129,28 +129,29 @@ FirmwareCorrection BestDiagonal(const estimation::CalibrationResult& r,
   return fw;
 }
 
-ExportReport Evaluate(const estimation::CalibrationResult& r, const ImuSeries& series,
+ExportReport Evaluate(const estimation::Calibration& c, const ImuSeries& series,
+                      const std::vector<estimation::StillSegmentFit>& still,
                       const FirmwareCorrection& fw, const std::string& target,
                       bool keeps_temperature) {
   ExportReport rep;
   rep.target = target;
-  rep.has_gyro = r.has_gyro && fw.has_gyro;
-  rep.accel_per_input = fw.accel.scale.asDiagonal() * r.accel_matrix - Mat3::Identity();
+  rep.has_gyro = c.has_gyro && fw.has_gyro;
+  rep.accel_per_input = fw.accel.scale.asDiagonal() * c.AccelMatrix() - Mat3::Identity();
   rep.gyro_per_input = rep.has_gyro
-                           ? Mat3(fw.gyro.scale.asDiagonal() * r.gyro_matrix - Mat3::Identity())
+                           ? Mat3(fw.gyro.scale.asDiagonal() * c.GyroMatrix() - Mat3::Identity())
                            : Mat3::Zero();
 
   Vec3 sum_a = Vec3::Zero(), sum_g = Vec3::Zero();
-  for (const estimation::StillSegmentFit& s : r.still) {
+  for (const estimation::StillSegmentFit& s : still) {
     if (s.segment.spinning() || s.segment.end > series.size() || s.segment.count() == 0) continue;
     const signal::SegmentStats stats = signal::ComputeSegmentStats(series, s.segment);
     model::SensorInput<double> in;
-    in.dt_s = s.t_mid_s - r.model.t_ref_s;
-    in.dtemp_c = std::isfinite(stats.temp_mean_c) ? stats.temp_mean_c - r.model.temp_ref_c : 0.0;
+    in.dt_s = s.t_mid_s - c.model.t_ref_s;
+    in.dtemp_c = std::isfinite(stats.temp_mean_c) ? stats.temp_mean_c - c.model.temp_ref_c : 0.0;
     in.R_b_n = s.R_n_b.toRotationMatrix().transpose();
     const Vec3 y_g = rep.has_gyro ? s.gyr_mean : Vec3::Zero();
-    const auto [f_b, omega_b] = r.model.Correct(r.theta, s.acc_mean, y_g, in);
-    const double temp_c = std::isfinite(stats.temp_mean_c) ? stats.temp_mean_c : r.model.temp_ref_c;
+    const auto [f_b, omega_b] = c.model.Correct(c.theta, s.acc_mean, y_g, in);
+    const double temp_c = std::isfinite(stats.temp_mean_c) ? stats.temp_mean_c : c.model.temp_ref_c;
     const Vec3 e_a = fw.accel.Apply(s.acc_mean, temp_c) - f_b;
     sum_a += e_a.cwiseAbs2();
     rep.accel_still.max_abs = rep.accel_still.max_abs.cwiseMax(e_a.cwiseAbs());
@@ -167,10 +168,10 @@ ExportReport Evaluate(const estimation::CalibrationResult& r, const ImuSeries& s
   }
   if (rep.gyro_still.segments > 0) rep.gyro_still.rms = (sum_g / rep.gyro_still.segments).cwiseSqrt();
 
-  const std::vector<std::string> names = r.model.ParameterNames();
-  const std::vector<double> values = model::ReportedValues(r.model, r.theta);
+  const std::vector<std::string> names = c.model.ParameterNames();
+  const std::vector<double> values = model::ReportedValues(c.model, c.theta);
   std::size_t first = 0;
-  for (const model::ModelTerm& term : r.model.terms()) {
+  for (const model::ModelTerm& term : c.model.terms()) {
     const model::EffectInfo& info = term.effect->info();
     const std::size_t n = static_cast<std::size_t>(info.size());
     const bool kept = info.linear_stage || (keeps_temperature && IsTemperatureTerm(info.name));
@@ -189,8 +190,8 @@ ExportReport Evaluate(const estimation::CalibrationResult& r, const ImuSeries& s
     first += n;
   }
   if (rep.accel_still.segments == 0) rep.notes.push_back("no still segment to measure the error on");
-  if (!r.observability.unobservable.empty()) {
-    rep.notes.push_back(std::to_string(r.observability.unobservable.size()) +
+  if (!c.observability.unobservable.empty()) {
+    rep.notes.push_back(std::to_string(c.observability.unobservable.size()) +
                         " direction(s) of the parameters are not determined by this session (see "
                         "the observability report): the exported values are one of many that "
                         "fit it equally, right for poses like the session's only");

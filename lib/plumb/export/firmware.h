@@ -29,7 +29,8 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/core/types.h"
-#include "plumb/estimation/result.h"
+#include "plumb/estimation/calibration.h"
+#include "plumb/estimation/fit_report.h"
 
 namespace plumb::exporter {
 
@@ -83,7 +84,7 @@ TemperatureRange SessionTemperatureRange(const ImuSeries& series);
 /// plumb's calibration reduced to the firmware form (file comment). Throws plumb::Error when
 /// the outputs are not in SI (counts: firmware parameters would be meaningless) or when the
 /// model has a temperature term but the session no temperature.
-FirmwareCorrection BestDiagonal(const estimation::CalibrationResult& result,
+FirmwareCorrection BestDiagonal(const estimation::Calibration& calibration,
                                 const TemperatureRange& range);
 
 /// Per-axis error of a correction against plumb's full one over the still segments.
@@ -121,10 +122,12 @@ struct ExportReport {
   std::vector<std::string> Lines() const;
 };
 
-/// The error left by `firmware` against plumb's full correction on the session (the still
-/// segments of `result`, temperatures from `series`), and the effects it drops. `target`
-/// names it in the report; `keeps_temperature`: the target carries temperature polynomials.
-ExportReport Evaluate(const estimation::CalibrationResult& result, const ImuSeries& series,
+/// The error left by `firmware` against plumb's full correction on the session (its still
+/// segments as the fit saw them, `still`; temperatures from `series`), and the effects it
+/// drops. `target` names it in the report; `keeps_temperature`: the target carries
+/// temperature polynomials.
+ExportReport Evaluate(const estimation::Calibration& calibration, const ImuSeries& series,
+                      const std::vector<estimation::StillSegmentFit>& still,
                       const FirmwareCorrection& firmware, const std::string& target,
                       bool keeps_temperature);
 

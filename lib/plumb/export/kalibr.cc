@@ -16,9 +16,9 @@ constexpr double kRandomWalkSlope = 0.4;      // log-log slope taken as the +1/2
 constexpr std::size_t kMaxClusterFraction = 3;  // clusters up to a third of the segment
 
 /// The longest still segment that is not turning, or nullptr.
-const StillSegment* LongestStill(const estimation::CalibrationResult& r, std::size_t n) {
+const StillSegment* LongestStill(const std::vector<estimation::StillSegmentFit>& still, std::size_t n) {
   const StillSegment* best = nullptr;
-  for (const auto& s : r.still) {
+  for (const auto& s : still) {
     if (s.segment.spinning() || s.segment.end > n || s.segment.count() < 2) continue;
     if (!best || s.segment.count() > best->count()) best = &s.segment;
   }
@@ -88,10 +88,11 @@ std::string Num(double value) {
 
 }  // namespace
 
-KalibrImu KalibrNoise(const estimation::CalibrationResult& r, const ImuSeries& series,
+KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
+                      const std::vector<estimation::StillSegmentFit>& still,
                       const std::string& rostopic) {
-  if (r.acc_unit != "m/s^2" || (r.has_gyro && r.gyr_unit != "rad/s")) {
-    throw Error("the session's samples are in " + r.acc_unit + " and " + r.gyr_unit +
+  if (c.acc_unit != "m/s^2" || (c.has_gyro && c.gyr_unit != "rad/s")) {
+    throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: Kalibr's noise densities are in SI, so plumb cannot "
                 "export them; give the sensor's scale (--acc-scale, --gyr-scale)");
   }
@@ -100,12 +101,12 @@ KalibrImu KalibrNoise(const estimation::CalibrationResult& r, const ImuSeries& s
   KalibrImu imu;
   imu.rostopic = rostopic;
   imu.update_rate_hz = 1.0 / dt_s;
-  imu.has_gyro = r.has_gyro && series.has_gyro();
-  const StillSegment* seg = LongestStill(r, series.size());
+  imu.has_gyro = c.has_gyro && series.has_gyro();
+  const StillSegment* seg = LongestStill(still, series.size());
   imu.longest_still_s = seg ? static_cast<double>(seg->count()) * dt_s : 0.0;
-  imu.accel = Measure(series, signal::Sensor::kAccel, r.noise_acc, r.tau_acc, dt_s, seg);
+  imu.accel = Measure(series, signal::Sensor::kAccel, c.noise.acc, c.noise.tau_acc, dt_s, seg);
   if (imu.has_gyro) {
-    imu.gyro = Measure(series, signal::Sensor::kGyro, r.noise_gyr, r.tau_gyr, dt_s, seg);
+    imu.gyro = Measure(series, signal::Sensor::kGyro, c.noise.gyr, c.noise.tau_gyr, dt_s, seg);
   }
   imu.notes.push_back("Kalibr's imu.yaml holds the noise model only: plumb's scale, "
                       "misalignment, biases and effects are not in it (Kalibr estimates its own "

@@ -31,7 +31,8 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
-#include "plumb/estimation/result.h"
+#include "plumb/estimation/calibration.h"
+#include "plumb/estimation/fit_report.h"
 #include "plumb/export/firmware.h"
 
 namespace plumb::exporter {
@@ -60,9 +61,12 @@ struct KalibrImu {
   double gyroscope_random_walk() const { return gyro.walk.maxCoeff(); }
 };
 
-/// The noise of the session (file comment). Throws plumb::Error when the outputs are not in
-/// SI or the series has fewer than two samples.
-KalibrImu KalibrNoise(const estimation::CalibrationResult& result, const ImuSeries& series,
+/// The noise of the session (file comment): the calibration's noise levels, checked with the
+/// Allan deviation of the longest of the session's still segments `still` that is not
+/// turning. Throws plumb::Error when the outputs are not in SI or the series has fewer than
+/// two samples.
+KalibrImu KalibrNoise(const estimation::Calibration& calibration, const ImuSeries& series,
+                      const std::vector<estimation::StillSegmentFit>& still,
                       const std::string& rostopic);
 
 /// Kalibr's imu.yaml text (comments say which values are upper bounds).

@@ -44,7 +44,7 @@ Model Model::Parse(const std::string& spec) {
       m.Add(token.substr(0, colon), colon == std::string::npos ? "" : token.substr(colon + 1));
     }
   }
-  if (m.FindTerm("accel_linear") < 0) {
+  if (m.BaseTerm(Sensor::kAccel) < 0) {
     throw Error("model spec '" + spec + "' lacks the base accelerometer; start it with 'base'");
   }
   return m;
@@ -116,7 +116,15 @@ void Model::DropGyro() {
   spec_ += " (accelerometer only)";
 }
 
-bool Model::has_gyro() const { return FindTerm("gyro_linear") >= 0; }
+bool Model::has_gyro() const { return BaseTerm(Sensor::kGyro) >= 0; }
+
+int Model::BaseTerm(Sensor sensor) const {
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const auto& info = terms_[i].effect->info();
+    if (info.linear_stage && info.sensor == sensor) return static_cast<int>(i);
+  }
+  return -1;
+}
 bool Model::has_effect(const std::string& name) const { return FindTerm(name) >= 0; }
 
 int Model::FindTerm(const std::string& name) const {

@@ -51,6 +51,9 @@ class Model {
   bool has_effect(const std::string& name) const;
   /// Index of the term with this effect name, or -1.
   int FindTerm(const std::string& name) const;
+  /// Index of the base (linear-stage) term of `sensor` (accel_linear, gyro_linear), or -1.
+  /// Whether a term is a base effect is asked of the effect (EffectInfo::linear_stage).
+  int BaseTerm(Sensor sensor) const;
 
   /// Adds an effect (its block starts at zero); throws if already present.
   void Add(const std::string& name, const std::string& option = "");

@@ -59,7 +59,7 @@ std::vector<std::string> Registry::Names() const {
 std::vector<std::string> Registry::CatalogueNames() const {
   std::vector<std::string> names;
   for (const auto& e : entries_) {
-    if (e.name != "accel_linear" && e.name != "gyro_linear") names.push_back(e.name);
+    if (!e.factory("")->info().linear_stage) names.push_back(e.name);
   }
   return names;
 }

@@ -25,7 +25,8 @@ class Registry {
   std::unique_ptr<Effect> Make(const std::string& name, const std::string& option = "") const;
   /// Every registered name, in registration order.
   std::vector<std::string> Names() const;
-  /// The catalogue effects: every name except the base ones (accel_linear, gyro_linear).
+  /// The catalogue effects: every name except the base ones (those whose EffectInfo says
+  /// linear_stage: accel_linear, gyro_linear), each asked with its default option.
   std::vector<std::string> CatalogueNames() const;
 
  private:

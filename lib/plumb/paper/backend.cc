@@ -102,9 +102,9 @@ PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::s
   options.method = "paper-static (backend, the paper's constants freed)";
   out.freed = estimation::Calibrate(series, segments, freed, site, options);
   for (const auto& name : PaperStaticFixedParameters()) {
-    const auto it = std::find_if(out.freed.parameters.begin(), out.freed.parameters.end(),
+    const auto it = std::find_if(out.freed.calibration.parameters.begin(), out.freed.calibration.parameters.end(),
                                  [&](const estimation::ParameterEstimate& p) { return p.name == name; });
-    if (it == out.freed.parameters.end()) continue;  // no gyroscope in the data
+    if (it == out.freed.calibration.parameters.end()) continue;  // no gyroscope in the data
     (it->observable ? out.fixed_observable : out.fixed_unobservable).push_back(name);
   }
   return out;

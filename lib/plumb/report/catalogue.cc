@@ -15,8 +15,6 @@ std::vector<std::string> Selected(const model::Registry& registry, const std::st
   return {only};
 }
 
-bool IsBase(const std::string& name) { return name == "accel_linear" || name == "gyro_linear"; }
-
 std::vector<std::string> ExcitationList(const model::Excitation& e) {
   std::vector<std::string> out;
   if (e.still_orientations) out.push_back("still poses in several orientations");
@@ -35,7 +33,7 @@ std::string Join(const std::vector<std::string>& items) {
 
 std::string EffectText(const model::EffectInfo& info) {
   std::ostringstream os;
-  os << info.name << (IsBase(info.name) ? " (base)" : "") << " ["
+  os << info.name << (info.linear_stage ? " (base)" : "") << " ["
      << (info.sensor == model::Sensor::kAccel ? "accelerometer" : "gyroscope") << "]\n";
   os << "  term:  " << info.term << "\n";
   const auto needs = ExcitationList(info.excitation);
@@ -76,7 +74,7 @@ nlohmann::json CatalogueJson(const model::Registry& registry, const std::string&
           {{"name", info.ParameterName(i)}, {"unit", p.unit}, {"typical", Number(p.typical)}});
     }
     out.push_back({{"name", info.name},
-                   {"base", IsBase(info.name)},
+                   {"base", info.linear_stage},
                    {"sensor", info.sensor == model::Sensor::kAccel ? "accel" : "gyro"},
                    {"term", info.term},
                    {"excitation", ExcitationList(info.excitation)},

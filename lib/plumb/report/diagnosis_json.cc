@@ -35,9 +35,9 @@ nlohmann::json ToJson(const diagnostics::Candidate& c) {
   j["not_identifiable"] = confounded;
   j["indistinguishable_from"] = c.indistinguishable_from;
   if (c.refit) {
-    j["refit"] = {{"model", c.refit->model.spec()}, {"fit", ToJson(*c.refit)["fit"]}};
+    j["refit"] = {{"model", c.refit->calibration.model.spec()}, {"fit", ToJson(*c.refit)["fit"]}};
     nlohmann::json added = nlohmann::json::array();
-    for (const auto& p : c.refit->parameters) {
+    for (const auto& p : c.refit->calibration.parameters) {
       if (p.name.rfind(c.effect + ".", 0) != 0) continue;
       added.push_back({{"name", p.name}, {"value", Number(p.value)},
                        {"sigma", Number(p.sigma)}, {"observable", p.observable},
@@ -104,7 +104,7 @@ nlohmann::json DiagnosisJson(const diagnostics::Diagnosis& d,
                              const diagnostics::ResidualAnalysis& ra) {
   nlohmann::json doc;
   const nlohmann::json fit = ToJson(d.fit);
-  doc["model"] = d.fit.model.spec();
+  doc["model"] = d.fit.calibration.model.spec();
   doc["fit"] = fit["fit"];
   doc["significance"] = d.significance;
   doc["num_residuals"] = d.num_residuals;
@@ -116,7 +116,7 @@ nlohmann::json DiagnosisJson(const diagnostics::Diagnosis& d,
   }
   doc["compare"] = ToJson(ra);
   doc["site"] = fit["site"];
-  doc["warnings"] = d.fit.warnings;
+  doc["warnings"] = d.fit.fit.warnings;
   return doc;
 }
 

@@ -257,7 +257,7 @@ void AllanFigure(const ImuSeries& series, const estimation::CalibrationResult& f
   }
   std::string labels;
   for (std::size_t k : a.allan_segments) {
-    if (k < fit.still.size()) labels += (labels.empty() ? "'" : ", '") + fit.still[k].segment.label + "'";
+    if (k < fit.fit.still.size()) labels += (labels.empty() ? "'" : ", '") + fit.fit.still[k].segment.label + "'";
   }
   plan.job.script += Begin(o, "allan.png", panels) +
                      "set logscale xy\nset format y '%g'\nset xlabel 'cluster time tau (s)'\n" +

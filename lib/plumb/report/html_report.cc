@@ -90,12 +90,12 @@ std::string SummarySection(const estimation::CalibrationResult& r,
                     std::string(good ? "ok" : "bad") + "\">" + HtmlEscape(FitVerdict(r.fit)) +
                     "</p>\n<ul>\n";
   int free = 0;
-  for (const auto& p : r.parameters) free += p.fixed ? 0 : 1;
-  out += "<li>" + std::to_string(free) + " parameters fitted (model " + Code(r.model.spec()) +
-         ", method " + HtmlEscape(r.method) + ") on " + std::to_string(r.fit.still_segments) +
+  for (const auto& p : r.calibration.parameters) free += p.fixed ? 0 : 1;
+  out += "<li>" + std::to_string(free) + " parameters fitted (model " + Code(r.calibration.model.spec()) +
+         ", method " + HtmlEscape(r.calibration.method) + ") on " + std::to_string(r.fit.still_segments) +
          " still segments and " + std::to_string(r.fit.motion_segments) +
          " motion intervals.</li>\n";
-  const std::size_t lost = r.observability.unobservable.size();
+  const std::size_t lost = r.calibration.observability.unobservable.size();
   out += lost == 0 ? std::string("<li>Every parameter is determined by the data.</li>\n")
                    : "<li class=\"warn\">" + std::to_string(lost) +
                          " unobservable direction" + (lost > 1 ? "s" : "") +
@@ -149,7 +149,7 @@ std::string InputSection(const InputSummary& in, const segmentation::Segmentatio
   out += KeyRow("temperature", in.has_temperature ? G3(in.temp_min_c) + " to " +
                                                         G3(in.temp_max_c) + " degC"
                                                   : std::string("none"));
-  out += KeyRow("site", SiteHtml(r.site));
+  out += KeyRow("site", SiteHtml(r.calibration.site));
   const std::string how = seg.report.method == "given"
                               ? "given" + (extras.segments_source.empty()
                                                ? std::string()
@@ -163,13 +163,13 @@ std::string InputSection(const InputSummary& in, const segmentation::Segmentatio
 }
 
 std::string ModelSection(const estimation::CalibrationResult& r) {
-  std::string out = "<h2 id=\"model\">Model</h2>\n<p>Spec " + Code(r.model.spec()) +
-                    ", method " + HtmlEscape(r.method) + "; reference time " +
-                    G6(r.model.t_ref_s) + " s, reference temperature " +
-                    G6(r.model.temp_ref_c) + " degC. Forward model y_a = F f_b + b_a + "
+  std::string out = "<h2 id=\"model\">Model</h2>\n<p>Spec " + Code(r.calibration.model.spec()) +
+                    ", method " + HtmlEscape(r.calibration.method) + "; reference time " +
+                    G6(r.calibration.model.t_ref_s) + " s, reference temperature " +
+                    G6(r.calibration.model.temp_ref_c) + " degC. Forward model y_a = F f_b + b_a + "
                     "(effects), y_g = E omega_b + b_g + (effects), body frame FRD.</p>\n<table>\n" +
                     HeaderRow({"effect", "term in the forward model", "parameters"});
-  for (const auto& term : r.model.terms()) {
+  for (const auto& term : r.calibration.model.terms()) {
     const auto& info = term.effect->info();
     out += "<tr>" + Td(Code(info.name + (info.option.empty() ? "" : ":" + info.option))) +
            Td(Code(info.term)) + TdNum(std::to_string(info.size())) + "</tr>\n";
@@ -190,13 +190,13 @@ std::string FitSection(const estimation::CalibrationResult& r) {
   out += KeyRow("solver", std::string(f.converged ? "converged" : "<span class=\"warn\">not "
                                                                   "converged</span>") +
                               " after " + std::to_string(f.iterations) + " iterations");
-  out += KeyRow("sigmas from", HtmlEscape(r.sigma_source.empty() ? "n/a" : r.sigma_source));
+  out += KeyRow("sigmas from", HtmlEscape(r.calibration.sigma_source.empty() ? "n/a" : r.calibration.sigma_source));
   out += "</table>\n<p>Residual RMS per axis (measured minus predicted):</p>\n<table>\n" +
          HeaderRow({"residual", "unit", "x", "y", "z"});
-  out += "<tr>" + Td("still accelerometer") + Td(HtmlEscape(r.acc_unit)) + VecCells(f.rms_acc) +
+  out += "<tr>" + Td("still accelerometer") + Td(HtmlEscape(r.calibration.acc_unit)) + VecCells(f.rms_acc) +
          "</tr>\n";
-  if (r.has_gyro) {
-    out += "<tr>" + Td("still gyroscope") + Td(HtmlEscape(r.gyr_unit)) + VecCells(f.rms_gyr) +
+  if (r.calibration.has_gyro) {
+    out += "<tr>" + Td("still gyroscope") + Td(HtmlEscape(r.calibration.gyr_unit)) + VecCells(f.rms_gyr) +
            "</tr>\n";
   }
   if (f.motion_segments > 0) {
@@ -205,11 +205,11 @@ std::string FitSection(const estimation::CalibrationResult& r) {
   if (f.velocity_segments > 0) {
     out += "<tr>" + Td("motion velocity") + Td("m/s") + VecCells(f.rms_velocity) + "</tr>\n";
   }
-  out += "<tr>" + Td("noise per sample, accelerometer") + Td(HtmlEscape(r.acc_unit)) +
-         VecCells(r.noise_acc) + "</tr>\n";
-  if (r.has_gyro) {
-    out += "<tr>" + Td("noise per sample, gyroscope") + Td(HtmlEscape(r.gyr_unit)) +
-           VecCells(r.noise_gyr) + "</tr>\n";
+  out += "<tr>" + Td("noise per sample, accelerometer") + Td(HtmlEscape(r.calibration.acc_unit)) +
+         VecCells(r.calibration.noise.acc) + "</tr>\n";
+  if (r.calibration.has_gyro) {
+    out += "<tr>" + Td("noise per sample, gyroscope") + Td(HtmlEscape(r.calibration.gyr_unit)) +
+           VecCells(r.calibration.noise.gyr) + "</tr>\n";
   }
   return out + "</table>\n";
 }
@@ -232,7 +232,7 @@ std::string ParameterSection(const estimation::CalibrationResult& r) {
                     "(sample units for biases and additive terms); sigma is one standard "
                     "deviation.</p>\n<table>\n" +
                     HeaderRow({"parameter", "value", "sigma", "unit", "status"});
-  for (const auto& p : r.parameters) {
+  for (const auto& p : r.calibration.parameters) {
     const std::string status = p.fixed ? "fixed" : !p.observable ? "unobservable" : "";
     out += "<tr>" + Td(Code(p.name)) + TdNum(G6(p.value)) +
            TdNum(p.fixed || !p.observable ? "&ndash;" : "&plusmn; " + G2(p.sigma)) +
@@ -273,8 +273,8 @@ std::string SensorMatrices(const std::string& sensor, const std::string& m, cons
 
 std::string MatrixSection(const estimation::CalibrationResult& r) {
   std::string out = "<h2 id=\"correction\">Forward model and correction</h2>\n";
-  out += SensorMatrices("Accelerometer", "F", "b_a", r.accel_matrix, r.accel_bias);
-  if (r.has_gyro) out += SensorMatrices("Gyroscope", "E", "b_g", r.gyro_matrix, r.gyro_bias);
+  out += SensorMatrices("Accelerometer", "F", "b_a", r.calibration.AccelMatrix(), r.calibration.AccelBias());
+  if (r.calibration.has_gyro) out += SensorMatrices("Gyroscope", "E", "b_g", r.calibration.GyroMatrix(), r.calibration.GyroBias());
   return out;
 }
 
@@ -308,7 +308,7 @@ std::string DirectionWords(const std::string& direction) {
 }
 
 std::string ObservabilitySection(const estimation::CalibrationResult& r) {
-  const auto& o = r.observability;
+  const auto& o = r.calibration.observability;
   std::string out = "<h2 id=\"observability\">Observability</h2>\n<p>Rank " +
                     std::to_string(o.rank) + " of " + std::to_string(o.num_unknowns) +
                     " unknowns (parameters and attitudes).</p>\n";
@@ -427,8 +427,8 @@ std::string WorstSection(const diagnostics::ResidualAnalysis& a) {
 
 std::string TailSection(const estimation::CalibrationResult& r, const PageExtras& extras) {
   std::string out;
-  if (!r.warnings.empty()) {
-    out += "<h2 id=\"warnings\">Warnings</h2>\n" + List(r.warnings, "warn");
+  if (!r.fit.warnings.empty()) {
+    out += "<h2 id=\"warnings\">Warnings</h2>\n" + List(r.fit.warnings, "warn");
   }
   if (!extras.files.empty()) {
     out += "<h2 id=\"files\">Files</h2>\n<ul>\n";

@@ -12,16 +12,12 @@ namespace {
 
 using nlohmann::json;
 
-bool IsBaseEffect(const std::string& name) {
-  return name == "accel_linear" || name == "gyro_linear";
-}
-
 /// Names of the model's non-base effects, for the correction's note.
 std::vector<std::string> ExtraEffects(const model::Model& model, model::Sensor sensor) {
   std::vector<std::string> out;
   for (const auto& term : model.terms()) {
     const auto& info = term.effect->info();
-    if (!IsBaseEffect(info.name) && info.sensor == sensor) out.push_back(info.name);
+    if (!info.linear_stage && info.sensor == sensor) out.push_back(info.name);
   }
   return out;
 }
@@ -88,11 +84,11 @@ json EffectJson(const model::EffectInfo& info,
 
 json EffectsJson(const estimation::CalibrationResult& r) {
   std::map<std::string, const estimation::ParameterEstimate*> by_name;
-  for (const auto& p : r.parameters) by_name[p.name] = &p;
+  for (const auto& p : r.calibration.parameters) by_name[p.name] = &p;
   json effects = json::object();
-  for (const auto& term : r.model.terms()) {
+  for (const auto& term : r.calibration.model.terms()) {
     const auto& info = term.effect->info();
-    if (!IsBaseEffect(info.name)) effects[info.name] = EffectJson(info, by_name);
+    if (!info.linear_stage) effects[info.name] = EffectJson(info, by_name);
   }
   return effects;
 }
@@ -100,7 +96,7 @@ json EffectsJson(const estimation::CalibrationResult& r) {
 json FitJson(const estimation::CalibrationResult& r) {
   const auto& f = r.fit;
   json rms{{"accel", Vector(f.rms_acc)},
-           {"gyro", r.has_gyro ? Vector(f.rms_gyr) : json(nullptr)},
+           {"gyro", r.calibration.has_gyro ? Vector(f.rms_gyr) : json(nullptr)},
            {"motion", f.motion_segments > 0 ? Vector(f.rms_motion) : json(nullptr)}};
   return json{{"chi2", Number(f.chi2)},
               {"dof", f.dof},
@@ -136,10 +132,10 @@ json SiteJson(const geo::Site& site) {
 }
 
 json NoiseJson(const estimation::CalibrationResult& r) {
-  return json{{"accel", Vector(r.noise_acc)},
-              {"gyro", r.has_gyro ? Vector(r.noise_gyr) : json(nullptr)},
-              {"tau_accel", Number(r.tau_acc)},
-              {"tau_gyro", r.has_gyro ? Number(r.tau_gyr) : json(nullptr)},
+  return json{{"accel", Vector(r.calibration.noise.acc)},
+              {"gyro", r.calibration.has_gyro ? Vector(r.calibration.noise.gyr) : json(nullptr)},
+              {"tau_accel", Number(r.calibration.noise.tau_acc)},
+              {"tau_gyro", r.calibration.has_gyro ? Number(r.calibration.noise.tau_gyr) : json(nullptr)},
               {"units", "sensor units per sample; tau in samples"}};
 }
 
@@ -221,10 +217,10 @@ json Matrix(const Mat3& m) {
 json ToJson(const estimation::CalibrationResult& r) {
   json doc;
   doc["plumb_version"] = Version();
-  doc["method"] = r.method;
-  doc["model"] = r.model.spec();
-  doc["model_reference"] = {{"t_ref_s", Number(r.model.t_ref_s)},
-                            {"temp_ref_c", Number(r.model.temp_ref_c)}};
+  doc["method"] = r.calibration.method;
+  doc["model"] = r.calibration.model.spec();
+  doc["model_reference"] = {{"t_ref_s", Number(r.calibration.model.t_ref_s)},
+                            {"temp_ref_c", Number(r.calibration.model.temp_ref_c)}};
   doc["convention"] = {
       {"frame", "body = accelerometer-defined, FRD; navigation NED; SI units"},
       {"accel",
@@ -233,26 +229,26 @@ json ToJson(const estimation::CalibrationResult& r) {
       {"gyro",
        "forward: y_g = matrix omega_b + bias + effects; correction: omega_b = "
        "correction.matrix (y_g - correction.offset)"}};
-  doc["accel"] = Sensor(r.accel_matrix, r.accel_bias,
-                        Correction(r.accel_matrix, r.accel_bias, "f_b = matrix (y_a - offset)",
-                                   ExtraEffects(r.model, model::Sensor::kAccel)));
+  doc["accel"] = Sensor(r.calibration.AccelMatrix(), r.calibration.AccelBias(),
+                        Correction(r.calibration.AccelMatrix(), r.calibration.AccelBias(), "f_b = matrix (y_a - offset)",
+                                   ExtraEffects(r.calibration.model, model::Sensor::kAccel)));
   doc["gyro"] =
-      r.has_gyro ? Sensor(r.gyro_matrix, r.gyro_bias,
-                          Correction(r.gyro_matrix, r.gyro_bias, "omega_b = matrix (y_g - offset)",
-                                     ExtraEffects(r.model, model::Sensor::kGyro)))
+      r.calibration.has_gyro ? Sensor(r.calibration.GyroMatrix(), r.calibration.GyroBias(),
+                          Correction(r.calibration.GyroMatrix(), r.calibration.GyroBias(), "omega_b = matrix (y_g - offset)",
+                                     ExtraEffects(r.calibration.model, model::Sensor::kGyro)))
                  : json(nullptr);
   doc["effects"] = EffectsJson(r);
   doc["parameters"] = json::array();
-  for (const auto& p : r.parameters) doc["parameters"].push_back(ParameterJson(p));
+  for (const auto& p : r.calibration.parameters) doc["parameters"].push_back(ParameterJson(p));
   doc["fit"] = FitJson(r);
-  doc["observability"] = ObservabilityJson(r.observability);
-  doc["site"] = SiteJson(r.site);
+  doc["observability"] = ObservabilityJson(r.calibration.observability);
+  doc["site"] = SiteJson(r.calibration.site);
   doc["noise"] = NoiseJson(r);
   doc["segments"] = json::array();
-  for (const auto& s : r.still) doc["segments"].push_back(StillJson(s, r.has_gyro));
+  for (const auto& s : r.fit.still) doc["segments"].push_back(StillJson(s, r.calibration.has_gyro));
   doc["motion"] = json::array();
-  for (const auto& m : r.motion) doc["motion"].push_back(MotionJson(m));
-  doc["warnings"] = r.warnings;
+  for (const auto& m : r.fit.motion) doc["motion"].push_back(MotionJson(m));
+  doc["warnings"] = r.fit.warnings;
   return doc;
 }
 
@@ -280,7 +276,7 @@ json CalibrationJson(const estimation::CalibrationResult& result,
   doc["segmentation"] = ToJson(segmentation);
   doc["inputs"] = inputs;
   std::vector<std::string> warnings = input_warnings;
-  warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
+  warnings.insert(warnings.end(), result.fit.warnings.begin(), result.fit.warnings.end());
   doc["warnings"] = warnings;
   return doc;
 }

@@ -68,7 +68,7 @@ std::string SegmentationSummary(const segmentation::SegmentationResult& s,
   return os.str();
 }
 
-std::string FitVerdict(const estimation::FitSummary& fit) {
+std::string FitVerdict(const estimation::FitReport& fit) {
   if (fit.dof <= 0) {
     return "no degrees of freedom left: the fit cannot be judged (record more still poses)";
   }
@@ -87,12 +87,12 @@ std::string FitVerdict(const estimation::FitSummary& fit) {
 
 std::string CalibrationSummary(const estimation::CalibrationResult& r) {
   std::ostringstream os;
-  os << "plumb " << Version() << " calibrate: method " << r.method << ", model " << r.model.spec()
+  os << "plumb " << Version() << " calibrate: method " << r.calibration.method << ", model " << r.calibration.model.spec()
      << "\n";
   os << FitVerdict(r.fit);
-  const std::size_t lost = r.observability.unobservable.size();
+  const std::size_t lost = r.calibration.observability.unobservable.size();
   if (lost > 0) os << "; " << lost << " unobservable direction" << (lost > 1 ? "s" : "");
-  os << "\n\n" << r.FullReport();
+  os << "\n\n" << FullReport(r);
   return os.str();
 }
 
@@ -104,13 +104,13 @@ std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
   };
   auto vec = [](const Vec3& v) { return Format("%.4g %.4g %.4g", v.x(), v.y(), v.z()); };
   os << "before and after (same segments):\n";
-  row("model", before.model.spec(), after.model.spec());
+  row("model", before.calibration.model.spec(), after.calibration.model.spec());
   row("chi2 / dof", Format("%.1f / %d", before.fit.chi2, before.fit.dof),
       Format("%.1f / %d", after.fit.chi2, after.fit.dof));
   row("chi2/dof", Format("%.3f", before.fit.chi2_dof()), Format("%.3f", after.fit.chi2_dof()));
-  row("accel RMS (" + before.acc_unit + ")", vec(before.fit.rms_acc), vec(after.fit.rms_acc));
-  if (before.has_gyro && after.has_gyro) {
-    row("gyro RMS (" + before.gyr_unit + ")", vec(before.fit.rms_gyr), vec(after.fit.rms_gyr));
+  row("accel RMS (" + before.calibration.acc_unit + ")", vec(before.fit.rms_acc), vec(after.fit.rms_acc));
+  if (before.calibration.has_gyro && after.calibration.has_gyro) {
+    row("gyro RMS (" + before.calibration.gyr_unit + ")", vec(before.fit.rms_gyr), vec(after.fit.rms_gyr));
     if (before.fit.motion_segments > 0) {
       row("motion RMS (rad)", vec(before.fit.rms_motion), vec(after.fit.rms_motion));
     }
@@ -120,8 +120,8 @@ std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
   }
   os << "  chi2 fell by " << Format("%.1f", before.fit.chi2 - after.fit.chi2) << "\n";
   bool header = false;
-  for (const auto& p : after.parameters) {
-    const bool known = std::any_of(before.parameters.begin(), before.parameters.end(),
+  for (const auto& p : after.calibration.parameters) {
+    const bool known = std::any_of(before.calibration.parameters.begin(), before.calibration.parameters.end(),
                                    [&](const estimation::ParameterEstimate& q) { return q.name == p.name; });
     if (known || p.fixed) continue;
     if (!header) os << "parameters added:\n";

@@ -3,12 +3,13 @@
 //
 // SegmentationSummary: how many still segments, how they were found, the thresholds and the
 // noise they came from. CalibrationSummary: a two-line header (version, method, model, and a
-// verdict on chi^2/dof against its spread) followed by CalibrationResult::FullReport().
+// verdict on chi^2/dof against its spread) followed by FullReport() (calibration_text.h).
 #pragma once
 
 #include <string>
 
 #include "plumb/estimation/result.h"
+#include "plumb/report/calibration_text.h"
 #include "plumb/segmentation/still_detector.h"
 
 namespace plumb::report {
@@ -20,7 +21,7 @@ std::string SegmentationSummary(const segmentation::SegmentationResult& segmenta
 
 /// One line judging chi^2/dof: consistent with the noise when within 3 standard deviations of
 /// 1 (the standard deviation of chi^2/dof is sqrt(2 / dof)), otherwise what it suggests.
-std::string FitVerdict(const estimation::FitSummary& fit);
+std::string FitVerdict(const estimation::FitReport& fit);
 
 /// Header plus the full report of the result.
 std::string CalibrationSummary(const estimation::CalibrationResult& result);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "plumb/core/so3.h"
+#include "plumb/model/effects/gyro_linear.h"
 
 namespace plumb::residuals {
 using so3::Skew;
@@ -62,16 +63,13 @@ void MotionResidual::CorrectedRates(double const* const* theta, bool linear,
 
   if (linear) {
     // w = E^-1 (y - b_g): dw/db_g = -E^-1, dw/dE_rc = -E^-1 e_r w_c.
-    const int g = model_->FindTerm("gyro_linear");
+    const int g = model_->BaseTerm(model::Sensor::kGyro);
     const int off = g >= 0 ? block_offset_[static_cast<std::size_t>(g)] : 0;
     for (std::size_t i = 0; i < n; ++i) {
       (*w)[i] = E_inv * (s_.gyr[i] - b_g);
       if (!W || g < 0) continue;
-      auto& Wi = (*W)[i];
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) Wi.col(off + 3 * r + c) = -E_inv.col(r) * (*w)[i][c];
-      }
-      Wi.block<3, 3>(0, off + 9) = -E_inv;
+      model::gyro_linear::SubtractRateJacobian(
+          E_inv, (*w)[i], (*W)[i].middleCols(off, model::gyro_linear::kSize));
     }
     return;
   }
@@ -135,7 +133,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   Mat3 E_inv = Mat3::Identity();
   int gyro_offset = -1;
   if (closed_form && want_jacobians) {
-    const int g = model_->FindTerm("gyro_linear");
+    const int g = model_->BaseTerm(model::Sensor::kGyro);
     if (g >= 0) {
       gyro_offset = block_offset_[static_cast<std::size_t>(g)];
       E_inv = model_->Predict(theta, model::SensorInput<double>()).E.inverse();
@@ -149,11 +147,8 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
       return;
     }
     if (gyro_offset < 0) return;
-    const Mat3 KM = K * E_inv;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) out.col(gyro_offset + 3 * r + c) -= KM.col(r) * w[i][c];
-    }
-    out.middleCols<3>(gyro_offset + 9) -= KM;
+    model::gyro_linear::SubtractRateJacobian(
+        K * E_inv, w[i], out.middleCols(gyro_offset, model::gyro_linear::kSize));
   };
 
   const Vec3 omega_k = R_k.transpose() * omega_ie_n_;  // Earth rate in b_k

@@ -3,17 +3,15 @@
 //   y_a = F f_b + b_a,   F upper triangular (sensor and body x axes coincide, body y lies in
 //                        the sensor x-y plane), b_a the bias.
 //
-// Parameter block (9 values; zero = identity F, no bias):
-//   [0..5] F - I, upper triangle row-major: matrix.xx, matrix.xy, matrix.xz, matrix.yy,
-//          matrix.yz, matrix.zz (dimensionless; the diagonals are reported as 1 + value)
-//   [6..8] b_a: bias.x, bias.y, bias.z (m/s^2)
+// Parameter block: see accel_linear.h, which owns its layout.
 //
 // Option "full": F full 3x3, for a frame that the data defines by known attitudes (the
 // paper's benchmark platform, whose faces give the axes) rather than by the accelerometer
-// itself. Three more values: [9..11] matrix.yx, matrix.zx, matrix.zy (dimensionless). Without
+// itself. Three more values: matrix.yx, matrix.zx, matrix.zy (dimensionless). Without
 // known attitudes, a full F is not determined (a rotation of the frame changes no prediction).
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
+#include "plumb/model/effects/accel_linear.h"
 
 namespace plumb::model {
 namespace {
@@ -51,19 +49,8 @@ class AccelLinear : public EffectBase<AccelLinear> {
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
-    Mat3T<T> F = Mat3T<T>::Identity();
-    F(0, 0) += theta[0];
-    F(0, 1) = theta[1];
-    F(0, 2) = theta[2];
-    F(1, 1) += theta[3];
-    F(1, 2) = theta[4];
-    F(2, 2) += theta[5];
-    if (full_) {
-      F(1, 0) = theta[9];
-      F(2, 0) = theta[10];
-      F(2, 1) = theta[11];
-    }
-    Eigen::Map<const Vec3T<T>> b_a(theta + 6);
+    const Mat3T<T> F = accel_linear::Matrix(theta, full_);
+    Eigen::Map<const Vec3T<T>> b_a(theta + accel_linear::kBias);
     out.F = F;
     out.acc = F * in.f_b + b_a;
   }

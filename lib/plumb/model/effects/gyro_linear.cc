@@ -6,12 +6,10 @@
 // Option "triangular": the paper's upper-triangular E (matrix.yx, matrix.zx, matrix.zy held
 // at zero).
 //
-// Parameter block (12 values; zero = identity E, no bias):
-//   [0..8]  E - I row-major: matrix.xx, matrix.xy, ..., matrix.zz (dimensionless; diagonals
-//           reported as 1 + value)
-//   [9..11] b_g: bias.x, bias.y, bias.z (rad/s)
+// Parameter block: see gyro_linear.h, which owns its layout.
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
+#include "plumb/model/effects/gyro_linear.h"
 
 namespace plumb::model {
 namespace {
@@ -47,11 +45,8 @@ class GyroLinear : public EffectBase<GyroLinear> {
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
-    Mat3T<T> E = Mat3T<T>::Identity();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) E(r, c) += theta[3 * r + c];
-    }
-    Eigen::Map<const Vec3T<T>> b_g(theta + 9);
+    const Mat3T<T> E = gyro_linear::Matrix(theta);
+    Eigen::Map<const Vec3T<T>> b_g(theta + gyro_linear::kBias);
     out.E = E;
     out.gyr = E * in.omega_b + b_g;
   }

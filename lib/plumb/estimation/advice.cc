@@ -1,0 +1,74 @@
+#include "plumb/estimation/advice.h"
+
+#include <string>
+
+#include "plumb/core/error.h"
+#include "plumb/estimation/calibrator.h"
+
+namespace plumb::estimation {
+namespace {
+
+/// "the data cannot determine ...; <what to record>", or "" when every parameter is determined.
+std::string Undetermined(const Calibration& calibration, const StillSet& still,
+                         const FitReport& fit) {
+  bool accel_short = false, gyro_short = false;
+  std::vector<std::string> lost;
+  for (const auto& p : calibration.parameters) {
+    if (p.fixed || p.observable) continue;
+    lost.push_back(p.name);
+    accel_short = accel_short || p.name.rfind("accel.", 0) == 0;
+    gyro_short = gyro_short || p.name.rfind("gyro.", 0) == 0;
+  }
+  if (lost.empty()) return "";
+  std::vector<std::string> advice;
+  if (accel_short) {
+    const int orientations = CountDistinctOrientations(still.AtRestMeans(false));
+    advice.push_back("the base accelerometer model needs still poses in at least 9 distinct "
+                     "orientations (fewer when attitudes are known); found " +
+                     std::to_string(orientations));
+  }
+  if (gyro_short) {
+    advice.push_back("the gyroscope matrix needs turns about three independent axes between still "
+                     "poses; found " + std::to_string(fit.motion_segments) + " motion intervals" +
+                     (calibration.has_gyro && !calibration.site.known
+                          ? " (and no site: Earth rate unused)"
+                          : ""));
+  }
+  std::string list;
+  for (const auto& name : lost) list += (list.empty() ? "" : ", ") + name;
+  std::string message = "the data cannot determine " + list;
+  for (const auto& a : advice) message += "; " + a;
+  return message;
+}
+
+}  // namespace
+
+void AddAdvice(const Calibration& calibration, const StillSet& still,
+               const CalibrationOptions& options, FitReport& fit) {
+  const geo::Site& site = calibration.site;
+  const std::string undetermined = Undetermined(calibration, still, fit);
+  if (!undetermined.empty()) {
+    if (options.on_insufficient == InsufficientData::kError) {
+      throw InsufficientDataError(undetermined);
+    }
+    fit.warnings.push_back(undetermined);
+  }
+  if (!site.known) {
+    fit.warnings.push_back(
+        "no site given: gravity fixed at " + std::to_string(site.gravity()) + " m/s^2" +
+        (calibration.has_gyro ? " and Earth rate left out; the accelerometer scale and the "
+                                "gyroscope bias depend on it"
+                              : "; the accelerometer scale depends on it") +
+        " (give --lat --lon --height)");
+  }
+  if (site.known && calibration.has_gyro && !still.AnyAttitudeKnown() &&
+      !options.first_heading_deg) {
+    fit.warnings.push_back(
+        "the heading of the first still pose is held at 0 (x north) as the gauge; with a site, "
+        "Earth rate (" + std::to_string(site.omega_ie_n.head<2>().norm()) +
+        " rad/s horizontal) is predicted for that heading: state it (--heading DEG or "
+        "--level-north) or the gyroscope biases absorb up to that much");
+  }
+}
+
+}  // namespace plumb::estimation

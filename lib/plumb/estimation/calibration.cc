@@ -1,0 +1,28 @@
+#include "plumb/estimation/calibration.h"
+
+#include "plumb/model/effects/accel_linear.h"
+#include "plumb/model/effects/gyro_linear.h"
+
+namespace plumb::estimation {
+
+Mat3 Calibration::AccelMatrix() const {
+  return model.Predict(theta, model::SensorInput<double>()).F;
+}
+
+Vec3 Calibration::AccelBias() const {
+  const int t = model.BaseTerm(model::Sensor::kAccel);
+  return t < 0 ? Vec3::Zero() : model::accel_linear::Bias(theta[static_cast<std::size_t>(t)]);
+}
+
+Mat3 Calibration::GyroMatrix() const {
+  if (!has_gyro) return Mat3::Identity();
+  return model.Predict(theta, model::SensorInput<double>()).E;
+}
+
+Vec3 Calibration::GyroBias() const {
+  const int t = model.BaseTerm(model::Sensor::kGyro);
+  if (!has_gyro || t < 0) return Vec3::Zero();
+  return model::gyro_linear::Bias(theta[static_cast<std::size_t>(t)]);
+}
+
+}  // namespace plumb::estimation

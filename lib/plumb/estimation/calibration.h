@@ -1,0 +1,87 @@
+// plumb/estimation/calibration.h — what a calibration *is* (SPEC sections 1-3 and 6): the
+// model, its named parameters with values, sigmas and full covariance, what the data could
+// not determine, the site and the sensor noise. How the fit that produced it went (segments,
+// residuals, chi^2, warnings) is in fit_report.h; CalibrationResult (result.h) holds both.
+//
+// Exporters, peers and the Python module depend on this type only.
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "plumb/core/types.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+
+namespace plumb::estimation {
+
+/// One scalar model parameter as reported.
+struct ParameterEstimate {
+  std::string name;   ///< e.g. "accel.bias.x", "gyro_g_sensitivity.G.xy"
+  std::string unit;   ///< e.g. "m/s^2"
+  double value = 0;   ///< reported value (nominal + block value), SI
+  /// One standard deviation; NaN when not observable or held fixed.
+  double sigma = std::numeric_limits<double>::quiet_NaN();
+  bool observable = true;  ///< false: the data cannot determine it (see Observability)
+  bool fixed = false;      ///< held at its value by the model or method
+};
+
+/// A linear combination of parameters, as text, with its value and sigma.
+struct Combination {
+  std::string text;  ///< e.g. "accel.bias.z - 9.78 accel.matrix.zz"
+  double value = 0;
+  double sigma = 0;
+};
+
+struct Observability {
+  int rank = 0;            ///< numerical rank of the column-scaled whitened Jacobian
+  int num_unknowns = 0;    ///< free tangent-space unknowns (model parameters and attitudes)
+  /// Null-space directions, each "a p1 + b p2 ...": moving the parameters along it changes
+  /// no prediction.
+  std::vector<std::string> unobservable;
+  /// Combinations of unobservable parameters that the data does determine.
+  std::vector<Combination> determined;
+  /// Smallest kept and largest dropped relative singular values (diagnostics).
+  double smallest_kept = 0, largest_dropped = 0;
+};
+
+/// The sensor noise the fit was whitened with, measured on the session's still segments.
+struct NoiseLevels {
+  Vec3 acc = Vec3::Zero();  ///< accelerometer noise per sample, sensor units
+  Vec3 gyr = Vec3::Zero();  ///< gyroscope noise per sample, sensor units
+  /// Integrated autocorrelation times used (the largest over the axes), samples (>= 1).
+  double tau_acc = 1, tau_gyr = 1;
+};
+
+struct Calibration {
+  /// Label of the method ("generalized", or a paper method run on the backend).
+  std::string method = "generalized";
+  model::Model model;
+  model::ParameterBlocks theta;  ///< solved parameter blocks, one per model term
+  /// Every parameter of the model, in model order (model::Model::ParameterNames()).
+  std::vector<ParameterEstimate> parameters;
+  /// Covariance of the reported parameters, in `parameters` order (SI units squared). Rows
+  /// and columns of fixed parameters are zero; for unobservable ones it is the pseudo-inverse
+  /// (minimum-norm) value and is meaningless on its own: use `observability.determined`.
+  Eigen::MatrixXd covariance;
+  /// Where the covariance came from: "ceres::Covariance (DENSE_SVD)" or "pseudo-inverse".
+  std::string sigma_source;
+  Observability observability;
+  geo::Site site;
+  NoiseLevels noise;
+  bool has_gyro = false;
+  std::string acc_unit = "m/s^2";  ///< units of the accelerometer samples (see ImuSeries)
+  std::string gyr_unit = "rad/s";
+
+  /// The forward quantities of SPEC section 1, from the base effects' blocks: F (sensor units
+  /// per m/s^2), b_a (sensor units), E (sensor units per rad/s), b_g (sensor units). Without a
+  /// gyroscope E = I and b_g = 0.
+  Mat3 AccelMatrix() const;
+  Vec3 AccelBias() const;
+  Mat3 GyroMatrix() const;
+  Vec3 GyroBias() const;
+};
+
+}  // namespace plumb::estimation

@@ -1,0 +1,391 @@
+#include "plumb/estimation/calibration_problem.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+
+#include "plumb/residuals/manifolds.h"
+#include "plumb/residuals/motion_residual.h"
+#include "plumb/residuals/still_residuals.h"
+#include "plumb/residuals/velocity_residual.h"
+
+namespace plumb::estimation {
+namespace {
+
+/// Dense copy of a Ceres CRS matrix.
+Eigen::MatrixXd Dense(const ceres::CRSMatrix& crs) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int idx = crs.rows[static_cast<std::size_t>(row)];
+         idx < crs.rows[static_cast<std::size_t>(row) + 1]; ++idx) {
+      out(row, crs.cols[static_cast<std::size_t>(idx)]) = crs.values[static_cast<std::size_t>(idx)];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model model,
+                                       const geo::Site& site, StillSet still,
+                                       model::ParameterBlocks theta, const NoiseModel& noise,
+                                       const StartingValues& start,
+                                       const CalibrationOptions& options)
+    : series_(series),
+      model_(std::move(model)),
+      site_(site),
+      options_(options),
+      still_(std::move(still)),
+      theta_(std::move(theta)),
+      noise_(noise),
+      start_(start) {
+  has_gyro_ = model_.has_gyro();
+  still_gyro_ = has_gyro_ && options_.use_still_gyro;
+  bool needs_velocity = false;
+  for (const auto& term : model_.terms()) {
+    needs_velocity = needs_velocity || term.effect->info().excitation.angular_acceleration;
+  }
+  const bool motion_on = options_.use_motion && has_gyro_;
+  velocity_on_ = motion_on && options_.accel_in_motion.value_or(needs_velocity);
+  SetMeasurements(noise);
+  SetMotionSamples();
+  velocity_info_.assign(still_.motions.size(), Vec3::Ones());
+  SetMotionWeights(Mat3::Identity() / start_.gyro_rad_per_unit,
+                   Mat3::Identity() * start_.accel.scale);
+}
+
+void CalibrationProblem::SetMeasurements(const NoiseModel& noise) {
+  for (auto& s : still_.poses) {
+    const double n = static_cast<double>(s.stats.count);
+    residuals::StillMeasurement m;
+    m.dt_s = s.stats.t_mid_s - model_.t_ref_s;
+    m.dtemp_c = std::isfinite(s.stats.temp_mean_c) ? s.stats.temp_mean_c - model_.temp_ref_c : 0.0;
+    m.mean = s.stats.acc_mean;
+    for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_acc[i]) / noise.sigma_acc[i];
+    s.acc_measurement = m;
+    if (still_gyro_) {
+      m.mean = s.stats.gyr_mean;
+      for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_gyr[i]) / noise.sigma_gyr[i];
+      s.gyr_measurement = m;
+    }
+  }
+}
+
+void CalibrationProblem::SetMotionSamples() {
+  const ImuSeries& series = series_;
+  for (const auto& mo : still_.motions) {
+    residuals::MotionSamples ms;
+    std::vector<Vec3> dy;
+    for (std::size_t i = mo.first; i <= mo.last; ++i) {
+      ms.dt_s.push_back(series.t_s[i] - model_.t_ref_s);
+      ms.acc.push_back(series.acc[i].cast<double>());
+      ms.gyr.push_back(series.gyr[i].cast<double>());
+      ms.dtemp_c.push_back(series.has_temperature() ? series.temp_c[i] - model_.temp_ref_c : 0.0);
+      const std::size_t a = i > 0 ? i - 1 : i, b = std::min(i + 1, series.size() - 1);
+      const double h = series.t_s[b] - series.t_s[a];
+      dy.push_back(h > 0 ? Vec3((series.gyr[b] - series.gyr[a]).cast<double>() / h) : Vec3::Zero());
+    }
+    ms.alpha_b.resize(dy.size());
+    motion_samples_.push_back(std::move(ms));
+    output_rate_.push_back(std::move(dy));
+  }
+}
+
+// The angular acceleration input of the effects (time_offset, accel_size_effect) is the
+// derivative of the corrected rate, E^-1 d y_g / dt (central differences). The velocity
+// residual's variance: accelerometer noise summed over the steps, and gravity tilted by the
+// attitude random walk of the gyroscope noise (mean over the axes), which moves the velocity
+// only across gravity: d, the direction of gravity in the body at the start.
+void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
+  const auto& motions = still_.motions;
+  const Mat3 E_inv = E.inverse();
+  const Mat3 F_inv = F.inverse();
+  const Mat3 cov_f = F_inv * noise_.sigma_acc.cwiseAbs2().asDiagonal() * F_inv.transpose();
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    for (std::size_t i = 0; i < output_rate_[k].size(); ++i) {
+      motion_samples_[k].alpha_b[i] = E_inv * output_rate_[k][i];
+    }
+  }
+  const Mat3 cov_rate = E_inv * noise_.sigma_gyr.cwiseAbs2().asDiagonal() * E_inv.transpose();
+  const double g = site_.gravity();
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    const auto& mo = motions[k];
+    const double steps = static_cast<double>(mo.last - mo.first);
+    const double dt = (series_.t_s[mo.last] - series_.t_s[mo.first]) / std::max(1.0, steps);
+    for (int i = 0; i < 3; ++i) {
+      const double sigma_rate = std::sqrt(cov_rate(i, i));  // rad/s per sample
+      motion_samples_[k].sqrt_info[i] =
+          1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * noise_.tau_gyr[i]));
+    }
+    const double n = std::max(1.0, steps);
+    const double var_w = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();
+    const Vec3 d = start_.Down(still_.poses[mo.from]);
+    for (int i = 0; i < 3; ++i) {
+      const double across = std::max(0.0, 1.0 - d[i] * d[i]);
+      const double var_v = cov_f(i, i) * noise_.tau_acc[i] * dt * dt * n +
+                           across * g * g * var_w * dt * dt * dt * dt * n * n * n / 3.0;
+      velocity_info_[k][i] = 1.0 / std::sqrt(var_v);
+    }
+  }
+}
+
+void CalibrationProblem::SetMotionWeightsFromSolution() {
+  const auto linear = model_.Predict(theta_, model::SensorInput<double>());
+  SetMotionWeights(linear.E, linear.F);
+}
+
+void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
+                                            const std::vector<ParameterIndex>& held_extra,
+                                            bool free_probes) {
+  ceres::Problem* problem = built.problem.get();
+  for (int t = 0; t < model_.num_terms(); ++t) {
+    auto& block = theta_[static_cast<std::size_t>(t)];
+    const auto& term = model_.terms()[static_cast<std::size_t>(t)];
+    problem->AddParameterBlock(block.data(), static_cast<int>(block.size()));
+    if (free_probes && term.probe) continue;
+    std::vector<int> held;
+    for (std::size_t i = 0; i < term.fixed.size(); ++i) {
+      const bool extra = std::find(held_extra.begin(), held_extra.end(),
+                                   std::make_pair(t, static_cast<int>(i))) != held_extra.end();
+      if (term.fixed[i] || extra) held.push_back(static_cast<int>(i));
+    }
+    if (held.size() == block.size()) {
+      problem->SetParameterBlockConstant(block.data());
+    } else if (!held.empty()) {
+      built.manifolds.push_back(
+          std::make_unique<ceres::SubsetManifold>(static_cast<int>(block.size()), held));
+      problem->SetManifold(block.data(), built.manifolds.back().get());
+    }
+  }
+  for (auto& s : still_.poses) {
+    problem->AddParameterBlock(s.q.data(), 4);
+    if (s.known) {
+      problem->SetParameterBlockConstant(s.q.data());
+    } else {
+      built.manifolds.push_back(s.heading_only ? residuals::HeadingManifold()
+                                : s.chain_head ? residuals::TiltManifold()
+                                               : residuals::AttitudeManifold());
+      problem->SetManifold(s.q.data(), built.manifolds.back().get());
+    }
+  }
+}
+
+void CalibrationProblem::AddResiduals(BuiltProblem& built) {
+  using residuals::StillResidual;
+  ceres::Problem* problem = built.problem.get();
+  const auto acc_terms = StillResidual::TermsOf(model_, model::Sensor::kAccel);
+  const auto gyr_terms = StillResidual::TermsOf(model_, model::Sensor::kGyro);
+  auto blocks_of = [&](const std::vector<int>& terms, double* q) {
+    std::vector<double*> blocks = {q};
+    for (int t : terms) blocks.push_back(theta_[static_cast<std::size_t>(t)].data());
+    return blocks;
+  };
+  for (auto& s : still_.poses) {
+    built.acc.push_back(
+        s.spinning ? nullptr
+                   : problem->AddResidualBlock(
+                         StillResidual::Create(model_, model::Sensor::kAccel, s.acc_measurement,
+                                               site_.g_n, site_.omega_ie_n),
+                         nullptr, blocks_of(acc_terms, s.q.data())));
+    built.gyr.push_back(
+        still_gyro_ ? problem->AddResidualBlock(
+                          StillResidual::Create(model_, model::Sensor::kGyro, s.gyr_measurement,
+                                                site_.g_n, site_.omega_ie_n,
+                                                s.segment.known_omega_eb_b.value_or(Vec3::Zero())),
+                          nullptr, blocks_of(gyr_terms, s.q.data()))
+                    : nullptr);
+  }
+  const auto& motions = still_.motions;
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    const auto& mo = motions[k];
+    std::vector<double*> blocks = {still_.poses[mo.from].q.data(),
+                                   still_.poses[mo.from + 1].q.data()};
+    for (auto& b : theta_) blocks.push_back(b.data());
+    built.motion.push_back(problem->AddResidualBlock(
+        residuals::MotionResidual::Create(model_, motion_samples_[k], site_.omega_ie_n), nullptr,
+        blocks));
+    if (velocity_on_) {
+      std::vector<double*> vblocks = {still_.poses[mo.from].q.data()};
+      for (auto& b : theta_) vblocks.push_back(b.data());
+      built.velocity.push_back(problem->AddResidualBlock(
+          residuals::VelocityResidual::Create(model_, motion_samples_[k], site_.g_n,
+                                              site_.omega_ie_n, velocity_info_[k]),
+          nullptr, vblocks));
+    }
+  }
+}
+
+BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
+                                       bool free_probes) {
+  BuiltProblem built;
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  built.problem = std::make_unique<ceres::Problem>(problem_options);
+  AddParameterBlocks(built, held, free_probes);
+  AddResiduals(built);
+  return built;
+}
+
+UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem) {
+  UnknownColumns out;
+  for (int t = 0; t < model_.num_terms(); ++t) {
+    auto& block = theta_[static_cast<std::size_t>(t)];
+    if (problem.IsParameterBlockConstant(block.data())) continue;
+    out.blocks.push_back(block.data());
+    const auto& term = model_.terms()[static_cast<std::size_t>(t)];
+    const auto& info = term.effect->info();
+    for (int i = 0; i < info.size(); ++i) {
+      if (term.fixed[static_cast<std::size_t>(i)]) continue;
+      out.names.push_back(info.ParameterName(i));
+      out.values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal +
+                           block[static_cast<std::size_t>(i)]);
+      out.is_model.push_back(true);
+      out.model_index.emplace_back(t, i);
+    }
+  }
+  const char* kTangentName[3] = {"north", "east", "down"};
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
+    auto& s = still_.poses[k];
+    if (s.known) continue;
+    out.blocks.push_back(s.q.data());
+    const int first = s.heading_only ? 2 : 0;
+    const int dims = s.heading_only ? 1 : s.chain_head ? 2 : 3;
+    for (int i = first; i < first + dims; ++i) {
+      out.names.push_back("attitude[" + std::to_string(k) + "]." + kTangentName[i]);
+      out.values.push_back(std::nan(""));
+      out.is_model.push_back(false);
+      out.model_index.emplace_back(-1, static_cast<int>(k));
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixXd CalibrationProblem::Jacobian(ceres::Problem& problem,
+                                             const UnknownColumns& columns, double* cost,
+                                             std::vector<double>* residuals) const {
+  ceres::Problem::EvaluateOptions eval;
+  eval.parameter_blocks = columns.blocks;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(eval, cost, residuals, nullptr, &crs);
+  return Dense(crs);
+}
+
+ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
+                                               const UnknownColumns& columns) {
+  ProbeJacobian out;
+  out.unknown_names = columns.names;
+  out.unknown_is_model = columns.is_model;
+  std::vector<double*> blocks = columns.blocks;
+  for (int t = 0; t < model_.num_terms(); ++t) {
+    const auto& term = model_.terms()[static_cast<std::size_t>(t)];
+    if (!term.probe) continue;
+    blocks.push_back(theta_[static_cast<std::size_t>(t)].data());
+    for (int i = 0; i < term.effect->info().size(); ++i) {
+      out.probe_names.push_back(term.effect->info().ParameterName(i));
+      out.probe_term.push_back(t);
+    }
+  }
+  ceres::Problem::EvaluateOptions eval;
+  eval.parameter_blocks = blocks;
+  auto add_rows = [&](ceres::ResidualBlockId id, ProbeJacobian::RowKind kind, int index) {
+    if (id == nullptr) return;
+    eval.residual_blocks.push_back(id);
+    for (int axis = 0; axis < 3; ++axis) {
+      out.row_kind.push_back(kind);
+      out.row_index.push_back(index);
+      out.row_axis.push_back(axis);
+    }
+  };
+  for (std::size_t k = 0; k < probe.acc.size(); ++k) {
+    add_rows(probe.acc[k], ProbeJacobian::RowKind::kStillAccel, static_cast<int>(k));
+    add_rows(probe.gyr[k], ProbeJacobian::RowKind::kStillGyro, static_cast<int>(k));
+  }
+  for (std::size_t k = 0; k < probe.motion.size(); ++k) {
+    add_rows(probe.motion[k], ProbeJacobian::RowKind::kMotion, static_cast<int>(k));
+  }
+  for (std::size_t k = 0; k < probe.velocity.size(); ++k) {
+    add_rows(probe.velocity[k], ProbeJacobian::RowKind::kVelocity, static_cast<int>(k));
+  }
+  std::vector<double> r;
+  ceres::CRSMatrix crs;
+  probe.problem->Evaluate(eval, nullptr, &r, nullptr, &crs);
+  const Eigen::MatrixXd all = Dense(crs);
+  const auto n_free = static_cast<Eigen::Index>(columns.names.size());
+  out.r = Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  out.J = all.leftCols(n_free);
+  out.Z = all.rightCols(all.cols() - n_free);
+  return out;
+}
+
+void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& fit) const {
+  const ceres::Problem& problem = *built.problem;
+  Vec3 ss_acc = Vec3::Zero(), ss_gyr = Vec3::Zero(), ss_mot = Vec3::Zero(), ss_vel = Vec3::Zero();
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
+    const StillPose& s = still_.poses[k];
+    StillSegmentFit f;
+    f.segment = s.segment;
+    f.t_mid_s = s.stats.t_mid_s;
+    f.count = s.stats.count;
+    f.acc_mean = s.stats.acc_mean;
+    if (has_gyro_) f.gyr_mean = s.stats.gyr_mean;
+    f.R_n_b = s.R_n_b();
+    f.attitude_known = s.known;
+    // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
+    double w[3];
+    if (built.acc[k]) {
+      problem.EvaluateResidualBlock(built.acc[k], false, nullptr, w, nullptr);
+      f.acc_whitened = Vec3(w[0], w[1], w[2]);
+      f.acc_residual = f.acc_whitened.cwiseQuotient(s.acc_measurement.sqrt_info);
+      ss_acc += f.acc_residual.cwiseAbs2();
+    }
+    if (built.gyr[k]) {
+      problem.EvaluateResidualBlock(built.gyr[k], false, nullptr, w, nullptr);
+      f.gyr_whitened = Vec3(w[0], w[1], w[2]);
+      f.gyr_residual = f.gyr_whitened.cwiseQuotient(s.gyr_measurement.sqrt_info);
+      ss_gyr += f.gyr_residual.cwiseAbs2();
+    }
+    fit.still.push_back(f);
+  }
+  const auto& motions = still_.motions;
+  for (std::size_t k = 0; k < motions.size(); ++k) {
+    const MotionInterval& mo = motions[k];
+    MotionFit f;
+    f.from = mo.from;
+    f.to = mo.from + 1;
+    f.duration_s = series_.t_s[mo.last] - series_.t_s[mo.first];
+    double w[3];
+    problem.EvaluateResidualBlock(built.motion[k], false, nullptr, w, nullptr);
+    f.whitened = Vec3(w[0], w[1], w[2]);
+    f.rotation_residual = f.whitened.cwiseQuotient(motion_samples_[k].sqrt_info);
+    ss_mot += f.rotation_residual.cwiseAbs2();
+    if (k < built.velocity.size()) {
+      problem.EvaluateResidualBlock(built.velocity[k], false, nullptr, w, nullptr);
+      f.has_velocity = true;
+      f.velocity_whitened = Vec3(w[0], w[1], w[2]);
+      f.velocity_residual = f.velocity_whitened.cwiseQuotient(velocity_info_[k]);
+      ss_vel += f.velocity_residual.cwiseAbs2();
+    }
+    fit.motion.push_back(f);
+  }
+  const double ns = static_cast<double>(still_.poses.size());
+  fit.rms_acc = (ss_acc / static_cast<double>(still_.AtRestMeans(false).size())).cwiseSqrt();
+  if (still_gyro_) fit.rms_gyr = (ss_gyr / ns).cwiseSqrt();
+  if (!motions.empty()) fit.rms_motion = (ss_mot / static_cast<double>(motions.size())).cwiseSqrt();
+  fit.velocity_segments = static_cast<int>(built.velocity.size());
+  if (fit.velocity_segments > 0) {
+    fit.rms_velocity = (ss_vel / static_cast<double>(fit.velocity_segments)).cwiseSqrt();
+  }
+}
+
+void CalibrationProblem::SaveValues() {
+  saved_theta_ = theta_;
+  saved_q_.clear();
+  for (const auto& s : still_.poses) saved_q_.push_back(s.q);
+}
+
+void CalibrationProblem::RestoreValues() {
+  theta_ = saved_theta_;
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) still_.poses[k].q = saved_q_[k];
+}
+
+}  // namespace plumb::estimation

@@ -1,0 +1,130 @@
+// plumb/estimation/calibration_problem.h — stage 4 of the backend: the least-squares problem.
+//
+// Unknowns: the model's parameter blocks (theta, one per term; fixed parameters held by a
+// SubsetManifold) and one attitude R_n_b per still pose (AttitudeManifold; TiltManifold for a
+// chain's heading gauge; HeadingManifold for a known tilt; constant when known). Residuals
+// (lib/plumb/residuals), each whitened by its square-root information:
+//   still accelerometer   y_a mean - predicted,            sqrt_info = sqrt(N / tau) / sigma_a
+//   still gyroscope       y_g mean - predicted (Earth rate, stated turn rate)
+//   motion                Log((R_k dR)^T R_k+1), dR the corrected rate integrated on SO(3)
+//   velocity (optional)   the accelerometer integrated while the IMU turns (lever arms, time
+//                         offset: effects whose excitation includes angular acceleration)
+// The problem owns the values (theta, the poses) that Ceres works on, so a ceres::Problem can
+// be built from them again (with other parameters held) and its residuals and Jacobians handed
+// out: the observability analysis, the covariance, diagnose's probe columns and the per-segment
+// residuals all read them here.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/estimation/fit_report.h"
+#include "plumb/estimation/initialization.h"
+#include "plumb/estimation/noise_model.h"
+#include "plumb/estimation/options.h"
+#include "plumb/estimation/still_set.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+#include "plumb/residuals/measurements.h"
+
+namespace plumb::estimation {
+
+/// A ceres::Problem built from the current values, with its residual blocks per still pose
+/// and motion interval (null where absent) and the manifolds it uses.
+struct BuiltProblem {
+  std::vector<std::unique_ptr<ceres::Manifold>> manifolds;  // outlives `problem` (declared first)
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<ceres::ResidualBlockId> acc, gyr;  ///< per still pose
+  std::vector<ceres::ResidualBlockId> motion;    ///< per motion interval
+  std::vector<ceres::ResidualBlockId> velocity;  ///< per motion interval, when used
+};
+
+/// The free unknowns of a built problem as Jacobian columns, in order: model parameters
+/// (term by term), then attitude tangents (pose by pose: north, east, down as free).
+struct UnknownColumns {
+  std::vector<double*> blocks;          ///< parameter blocks in column order
+  std::vector<std::string> names;       ///< per column, e.g. "accel.bias.x", "attitude[3].down"
+  std::vector<double> values;           ///< per column: reported value (NaN for attitudes)
+  std::vector<bool> is_model;           ///< per column: model parameter (else attitude)
+  std::vector<std::pair<int, int>> model_index;  ///< per column: (term, index) or (-1, pose)
+};
+
+/// A (term, index) pair naming one scalar model parameter.
+using ParameterIndex = std::pair<int, int>;
+
+class CalibrationProblem {
+ public:
+  /// `theta` and the poses' attitudes hold the starting values (Initialize); `start` gives
+  /// the starting linear parts for the first motion weights.
+  CalibrationProblem(const ImuSeries& series, model::Model model, const geo::Site& site,
+                     StillSet still, model::ParameterBlocks theta, const NoiseModel& noise,
+                     const StartingValues& start, const CalibrationOptions& options);
+  CalibrationProblem(const CalibrationProblem&) = delete;  // Ceres points into the values
+  CalibrationProblem& operator=(const CalibrationProblem&) = delete;
+
+  /// Whitening of the motion residuals (the white gyroscope noise carried through E^-1 and
+  /// integrated over the interval's steps) and of the velocity residuals, and the angular
+  /// acceleration input E^-1 d y_g / dt, from the linear parts E and F.
+  void SetMotionWeights(const Mat3& E, const Mat3& F);
+  /// Sets the motion weights from the current theta's linear parts (before the final solve,
+  /// so that chi^2 does not depend on the starting values).
+  void SetMotionWeightsFromSolution();
+
+  /// A problem on the current values. `held`: parameters held at their values besides the
+  /// model's fixed ones; `free_probes`: the probe terms' blocks are left free (for their
+  /// Jacobian columns only).
+  BuiltProblem Build(const std::vector<ParameterIndex>& held, bool free_probes = false);
+
+  /// The free unknowns of `problem` (built by Build) as columns.
+  UnknownColumns Columns(const ceres::Problem& problem);
+  /// Whitened residuals (optional) and Jacobian over `columns`, with the cost 0.5 r^T r.
+  Eigen::MatrixXd Jacobian(ceres::Problem& problem, const UnknownColumns& columns,
+                           double* cost, std::vector<double>* residuals) const;
+  /// The whitened residuals and Jacobian of `probe` (Build(..., true)) at the current values:
+  /// columns `columns` then every probe term's block.
+  ProbeJacobian ProbeColumns(const BuiltProblem& probe, const UnknownColumns& columns);
+  /// Per-segment and per-interval residuals of `built` at the current values, and their RMS,
+  /// into `fit`.
+  void ReportResiduals(const BuiltProblem& built, FitReport& fit) const;
+
+  const model::Model& model() const { return model_; }
+  const StillSet& still() const { return still_; }
+  const model::ParameterBlocks& theta() const { return theta_; }
+  /// Restores the values (theta and the attitudes) saved by SaveValues.
+  void SaveValues();
+  void RestoreValues();
+  /// The gyroscope is integrated between poses (there are motion intervals).
+  bool has_motion() const { return has_gyro_ && !still_.motions.empty(); }
+
+ private:
+  void SetMeasurements(const NoiseModel& noise);
+  void SetMotionSamples();
+  void AddParameterBlocks(BuiltProblem& built, const std::vector<ParameterIndex>& held,
+                          bool free_probes);
+  void AddResiduals(BuiltProblem& built);
+
+  const ImuSeries& series_;
+  model::Model model_;
+  geo::Site site_;
+  CalibrationOptions options_;
+  StillSet still_;
+  model::ParameterBlocks theta_;
+  NoiseModel noise_;
+  StartingValues start_;
+  bool has_gyro_ = false;
+  bool still_gyro_ = false;   // still gyroscope residuals are used
+  bool velocity_on_ = false;  // velocity residuals are used
+  std::vector<residuals::MotionSamples> motion_samples_;
+  std::vector<std::vector<Vec3>> output_rate_;  // per motion, per sample: d y_g / dt, units/s
+  std::vector<Vec3> velocity_info_;             // per motion: 1 / sigma of the velocity residual
+  model::ParameterBlocks saved_theta_;
+  std::vector<std::array<double, 4>> saved_q_;
+};
+
+}  // namespace plumb::estimation

@@ -1,0 +1,84 @@
+// plumb/estimation/fit_report.h — how a fit went (SPEC sections 3 and 6): chi^2 and degrees of
+// freedom, convergence, the residuals of every still segment and motion interval, warnings,
+// and (for diagnose) the probe columns. What the calibration is lives in calibration.h.
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plumb/core/segment.h"
+#include "plumb/core/types.h"
+
+namespace plumb::estimation {
+
+/// Residuals of one still segment, unwhitened (sensor units) and whitened.
+struct StillSegmentFit {
+  StillSegment segment;
+  double t_mid_s = 0;
+  std::size_t count = 0;             ///< samples in the segment
+  Vec3 acc_mean = Vec3::Zero();      ///< measured mean output, sensor units
+  Vec3 gyr_mean = Vec3::Zero();
+  Vec3 acc_residual = Vec3::Zero();  ///< measured minus predicted mean, sensor units
+  Vec3 gyr_residual = Vec3::Zero();
+  Vec3 acc_whitened = Vec3::Zero();
+  Vec3 gyr_whitened = Vec3::Zero();
+  Quat R_n_b = Quat::Identity();     ///< estimated (or known) attitude
+  bool attitude_known = false;
+};
+
+/// Residual of one motion interval, rad (unwhitened) and whitened.
+struct MotionFit {
+  std::size_t from = 0, to = 0;  ///< still segment indices
+  double duration_s = 0;
+  Vec3 rotation_residual = Vec3::Zero();
+  Vec3 whitened = Vec3::Zero();
+  bool has_velocity = false;              ///< a velocity residual was fitted
+  Vec3 velocity_residual = Vec3::Zero();  ///< velocity change over the interval, m/s
+  Vec3 velocity_whitened = Vec3::Zero();
+};
+
+/// The whitened problem at the optimum with the columns of the model's probe terms
+/// (model::Model::AddProbe), for the score test of plumb/diagnostics. Rows are the whitened
+/// residuals in the order still segment 0 (accelerometer, gyroscope), segment 1, ..., then the
+/// motion intervals; each row is labelled.
+struct ProbeJacobian {
+  Eigen::VectorXd r;  ///< whitened residuals (measured minus predicted), dimensionless
+  Eigen::MatrixXd J;  ///< d r / d(free unknowns: model parameters, then attitude tangents)
+  Eigen::MatrixXd Z;  ///< d r / d(probe parameters) at zero
+  std::vector<std::string> unknown_names;  ///< J's columns
+  std::vector<bool> unknown_is_model;      ///< J's columns: model parameter (else attitude)
+  std::vector<std::string> probe_names;    ///< Z's columns, e.g. "gyro_g_sensitivity.G.xy"
+  std::vector<int> probe_term;             ///< Z's columns: index of the term in the model
+  enum class RowKind { kStillAccel, kStillGyro, kMotion, kVelocity };
+  std::vector<RowKind> row_kind;  ///< per row
+  std::vector<int> row_index;     ///< per row: still segment or motion interval index
+  std::vector<int> row_axis;      ///< per row: 0, 1, 2
+};
+
+struct FitReport {
+  double chi2 = 0;   ///< sum of squared whitened residuals
+  int num_residuals = 0;
+  int dof = 0;       ///< residuals minus rank
+  double chi2_dof() const { return dof > 0 ? chi2 / dof : std::numeric_limits<double>::quiet_NaN(); }
+  Vec3 rms_acc = Vec3::Zero();  ///< RMS of still accelerometer residuals per axis, sensor units
+  Vec3 rms_gyr = Vec3::Zero();  ///< RMS of still gyroscope residuals per axis, sensor units
+  Vec3 rms_motion = Vec3::Zero();  ///< RMS of motion rotation residuals per axis, rad
+  Vec3 rms_velocity = Vec3::Zero();  ///< RMS of motion velocity residuals per axis, m/s
+  int still_segments = 0;
+  int motion_segments = 0;
+  int velocity_segments = 0;  ///< motion intervals with a velocity residual (accel in motion)
+  int iterations = 0;
+  bool converged = false;
+  std::string solver_report;  ///< ceres::Solver::Summary::BriefReport()
+
+  std::vector<StillSegmentFit> still;  ///< per still segment used, in time order
+  std::vector<MotionFit> motion;       ///< per motion interval integrated
+  std::vector<std::string> warnings;   ///< what the user must know, in words
+  /// Present when the model has probe terms.
+  std::optional<ProbeJacobian> probes;
+};
+
+}  // namespace plumb::estimation

@@ -1,0 +1,58 @@
+// plumb/estimation/solve.h — stage 5 of the backend: the solve, with a gauge for what the
+// data cannot determine.
+//
+// Levenberg-Marquardt (Ceres, dense QR). Where the data leaves directions unobservable the
+// solver could wander along them (or exploit ones that are observable only at the level of
+// rounding), so the fit is redone from the starting values with one parameter per null
+// direction (its row-echelon pivot, e.g. accel.matrix.zz for "9.78 accel.bias.z + 1
+// accel.matrix.zz") held at its start value. With motion intervals, the motion residuals'
+// whitening is set again from the first solution's E and F before the final solve, so chi^2
+// does not depend on the starting values.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <vector>
+
+#include "plumb/estimation/calibration_problem.h"
+#include "plumb/estimation/fit_report.h"
+#include "plumb/estimation/observability.h"
+#include "plumb/estimation/options.h"
+
+namespace plumb::estimation {
+
+/// Tolerances of a first, rough solve that another solve refines (options.function_tolerance
+/// and parameter_tolerance apply to the final one).
+inline constexpr double kRoughFunctionTolerance = 1e-6;
+inline constexpr double kRoughParameterTolerance = 1e-8;
+/// Gradient tolerance of every solve: small enough that the function and parameter
+/// tolerances decide convergence.
+inline constexpr double kGradientTolerance = 1e-14;
+
+/// One solve of `problem`; `rough` uses the rough tolerances. Adds its iterations to `fit`,
+/// records convergence and Ceres's brief report; throws plumb::Error when the solution is not
+/// usable.
+void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& options,
+           FitReport& fit);
+
+/// The observability analysis (observability.h) of `problem` at the current values: its free
+/// unknowns go to `columns`, the cost and whitened residuals (optional) to `cost` and
+/// `residuals`.
+ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
+                                const CalibrationOptions& options, UnknownColumns& columns,
+                                double* cost, std::vector<double>* residuals);
+
+/// The solved problem.
+struct Solution {
+  BuiltProblem all_free;  ///< every free unknown: for the analysis and the residuals
+  BuiltProblem held;      ///< with the null directions' pivots held (empty when there are none)
+  std::vector<ParameterIndex> held_parameters;  ///< those pivots
+  /// The problem the fit and its covariance were made on.
+  ceres::Problem& fitted() { return held_parameters.empty() ? *all_free.problem : *held.problem; }
+};
+
+/// Stage 5 (file comment): solves `calibration` in place.
+Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOptions& options,
+                        FitReport& fit);
+
+}  // namespace plumb::estimation

@@ -1,0 +1,75 @@
+// plumb/estimation/still_set.h — stage 1 of the backend (docs/reference/model.md, "The
+// method"): the still set.
+//
+// The still segments long enough to use, each with its statistics and its attitude unknown
+// R_n_b; which attitudes are known (held), known but for the heading (estimated through Earth
+// rate), or the heading gauge of their chain; and the motion intervals that join consecutive
+// segments, integrated by the motion residual.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/core/segment.h"
+#include "plumb/core/types.h"
+#include "plumb/estimation/options.h"
+#include "plumb/residuals/measurements.h"
+#include "plumb/signal/segment_stats.h"
+
+namespace plumb::estimation {
+
+/// One still segment as the solver sees it.
+struct StillPose {
+  StillSegment segment;
+  signal::SegmentStats stats;
+  /// The attitude unknown R_n_b, stored as Ceres and Eigen's coefficients() do: x, y, z, w.
+  std::array<double, 4> q{0, 0, 0, 1};
+  bool known = false;         ///< attitude held constant
+  bool heading_only = false;  ///< tilt known, heading estimated (residuals::HeadingManifold)
+  bool chain_head = false;    ///< heading held as the gauge (residuals::TiltManifold)
+  bool spinning = false;      ///< turning at a stated rate: gyroscope residual only
+  /// The segment means and their whitening (set by CalibrationProblem from the noise model).
+  residuals::StillMeasurement acc_measurement, gyr_measurement;
+
+  Quat R_n_b() const { return Quat(q[3], q[0], q[1], q[2]); }
+  void set_R_n_b(const Quat& R_n_b) { q = {R_n_b.x(), R_n_b.y(), R_n_b.z(), R_n_b.w()}; }
+};
+
+/// The samples [first, last] of the series between pose `from` and pose `from + 1`.
+struct MotionInterval {
+  std::size_t from = 0;
+  std::size_t first = 0, last = 0;
+};
+
+struct StillSet {
+  std::vector<StillPose> poses;          ///< in time order
+  std::vector<MotionInterval> motions;   ///< in time order
+  std::vector<bool> joined_to_previous;  ///< per pose: a motion interval leads into it
+
+  /// Mean accelerometer (or gyroscope) output of every pose at rest (not turning at a stated
+  /// rate), in pose order, sensor units.
+  std::vector<Vec3> AtRestMeans(bool gyro) const;
+  /// The segments of the poses at rest.
+  std::vector<StillSegment> AtRestSegments() const;
+  /// The motion interval that ends at pose k (requires joined_to_previous[k]).
+  const MotionInterval& MotionInto(std::size_t k) const;
+  /// Some pose's attitude is known, at least its tilt.
+  bool AnyAttitudeKnown() const;
+};
+
+/// Stage 1. The segments of at least options.min_segment_samples samples with their
+/// statistics; a known tilt with a free heading is estimated when `earth_rate_seen` (the still
+/// gyroscope residuals with a site), else held; with `motion_on`, consecutive segments closer
+/// than options.max_motion_s are joined by a motion interval. Throws plumb::Error for a
+/// segment outside the series, plumb::InsufficientDataError when no segment is usable or
+/// every one turns at a stated rate.
+StillSet MakeStillSet(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                      bool earth_rate_seen, bool motion_on, const CalibrationOptions& options);
+
+/// The gauge: the first pose of each motion-joined chain holds its heading unless a known
+/// attitude in the chain fixes it; without a gyroscope every pose's heading is held.
+void AssignHeadingGauge(StillSet& set, bool has_gyro);
+
+}  // namespace plumb::estimation

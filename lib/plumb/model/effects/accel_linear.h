@@ -1,0 +1,54 @@
+// plumb/model/effects/accel_linear.h — the parameter block of the base accelerometer effect,
+// owned here: nothing outside accel_linear.{h,cc} indexes it by hand.
+//
+//   y_a = F f_b + b_a      (SPEC section 2, the paper's Equation (1))
+//
+// Block layout (9 values, 12 with option "full"; all zero = F = I, no bias):
+//   [0..5]   F - I, upper triangle row-major: matrix.xx, matrix.xy, matrix.xz, matrix.yy,
+//            matrix.yz, matrix.zz (dimensionless; the diagonals are reported as 1 + value)
+//   [6..8]   b_a: bias.x, bias.y, bias.z (sensor output units; m/s^2 for SI input)
+//   [9..11]  option "full" only: matrix.yx, matrix.zx, matrix.zy (dimensionless)
+#pragma once
+
+#include <vector>
+
+#include "plumb/core/types.h"
+
+namespace plumb::model::accel_linear {
+
+inline constexpr int kSize = 9;       ///< values in the block (upper-triangular F)
+inline constexpr int kSizeFull = 12;  ///< values in the block with option "full"
+inline constexpr int kBias = 6;       ///< offset of b_a
+inline constexpr int kLower = 9;      ///< offset of the lower triangle (option "full")
+
+/// F from a block (`full`: the block has the lower triangle too).
+template <typename T>
+Mat3T<T> Matrix(const T* block, bool full) {
+  Mat3T<T> F = Mat3T<T>::Identity();
+  F(0, 0) += block[0];
+  F(0, 1) = block[1];
+  F(0, 2) = block[2];
+  F(1, 1) += block[3];
+  F(1, 2) = block[4];
+  F(2, 2) += block[5];
+  if (full) {
+    F(1, 0) = block[kLower + 0];
+    F(2, 0) = block[kLower + 1];
+    F(2, 1) = block[kLower + 2];
+  }
+  return F;
+}
+
+/// b_a of a block, sensor output units.
+inline Vec3 Bias(const std::vector<double>& block) {
+  return Vec3(block[kBias + 0], block[kBias + 1], block[kBias + 2]);
+}
+
+/// Sets the block to F = scale I (off-diagonals zero) and b_a = bias: the starting values of
+/// the fit (estimation/initialization.h).
+inline void SetIsotropic(std::vector<double>& block, double scale, const Vec3& bias) {
+  block[0] = block[3] = block[5] = scale - 1.0;
+  for (int i = 0; i < 3; ++i) block[static_cast<std::size_t>(kBias + i)] = bias[i];
+}
+
+}  // namespace plumb::model::accel_linear

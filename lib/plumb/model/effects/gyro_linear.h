@@ -1,0 +1,61 @@
+// plumb/model/effects/gyro_linear.h — the parameter block of the base gyroscope effect, owned
+// here: nothing outside gyro_linear.{h,cc} indexes it by hand.
+//
+//   y_g = E omega_b + b_g      (SPEC section 2, the paper's Equation (2))
+//
+// Block layout (12 values; all zero = E = I, no bias):
+//   [0..8]   E - I row-major: matrix.xx, matrix.xy, ..., matrix.zz (dimensionless; the
+//            diagonals are reported as 1 + value)
+//   [9..11]  b_g: bias.x, bias.y, bias.z (sensor output units; rad/s for SI input)
+// Option "triangular" (the paper's E) holds matrix.yx, matrix.zx, matrix.zy at zero.
+#pragma once
+
+#include <vector>
+
+#include "plumb/core/types.h"
+
+namespace plumb::model::gyro_linear {
+
+inline constexpr int kSize = 12;  ///< values in the block
+inline constexpr int kBias = 9;   ///< offset of b_g
+
+/// Offset of E(r, c) - [r == c] in the block.
+inline constexpr int MatrixIndex(int r, int c) { return 3 * r + c; }
+
+/// E from a block.
+template <typename T>
+Mat3T<T> Matrix(const T* block) {
+  Mat3T<T> E = Mat3T<T>::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) E(r, c) += block[MatrixIndex(r, c)];
+  }
+  return E;
+}
+
+/// b_g of a block, sensor output units.
+inline Vec3 Bias(const std::vector<double>& block) {
+  return Vec3(block[kBias + 0], block[kBias + 1], block[kBias + 2]);
+}
+
+/// Sets the block to E = (1 / rad_per_unit) I and b_g = bias: the starting values of the fit
+/// (`rad_per_unit`: the scalar gyroscope scale found by estimation/initialization.h, rad/s per
+/// sensor unit).
+inline void SetIsotropic(std::vector<double>& block, double rad_per_unit, const Vec3& bias) {
+  block[0] = block[4] = block[8] = 1.0 / rad_per_unit - 1.0;
+  for (int i = 0; i < 3; ++i) block[static_cast<std::size_t>(kBias + i)] = bias[i];
+}
+
+/// The corrected rate of the base model is omega = E^-1 (y_g - b_g), so
+///   d omega / d E_rc = -E^-1 e_r omega_c,   d omega / d b_g = -E^-1.
+/// Subtracts K d omega / d block from the block's 12 columns `cols` (3 x 12, e.g. a
+/// middleCols of a wider Jacobian), given KE_inv = K E^-1 and omega. With K = I and zero
+/// columns this writes d omega / d block itself.
+template <class Columns>
+void SubtractRateJacobian(const Mat3& KE_inv, const Vec3& omega, Columns&& cols) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) cols.col(MatrixIndex(r, c)) -= KE_inv.col(r) * omega[c];
+  }
+  cols.template middleCols<3>(kBias) -= KE_inv;
+}
+
+}  // namespace plumb::model::gyro_linear

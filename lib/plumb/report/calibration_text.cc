@@ -1,0 +1,79 @@
+#include "plumb/report/calibration_text.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace plumb::report {
+namespace {
+
+std::string Format(const char* fmt, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, a);
+  return buf;
+}
+
+std::string Vec(const Vec3& v, const char* fmt = "%.4g") {
+  return "(" + Format(fmt, v.x()) + ", " + Format(fmt, v.y()) + ", " + Format(fmt, v.z()) + ")";
+}
+
+}  // namespace
+
+std::string BriefReport(const estimation::CalibrationResult& result) {
+  const estimation::Calibration& c = result.calibration;
+  const estimation::FitReport& fit = result.fit;
+  std::ostringstream os;
+  os << "method " << c.method << ", model " << c.model.spec() << ": " << fit.still_segments
+     << " still segments, " << fit.motion_segments << " motion intervals\n";
+  os << "chi2 " << Format("%.6g", fit.chi2) << " on " << fit.dof << " dof, chi2/dof "
+     << Format("%.4g", fit.chi2_dof()) << "; rank " << c.observability.rank << " of "
+     << c.observability.num_unknowns << " unknowns; "
+     << (fit.converged ? "converged" : "NOT converged") << " in " << fit.iterations
+     << " iterations\n";
+  return os.str();
+}
+
+std::string FullReport(const estimation::CalibrationResult& result) {
+  const estimation::Calibration& c = result.calibration;
+  const estimation::FitReport& fit = result.fit;
+  std::ostringstream os;
+  os << BriefReport(result);
+  os << "site: " << (c.site.known ? Format("%.6f", c.site.lat_deg) + " deg, " +
+                                      Format("%.6f", c.site.lon_deg) + " deg, " +
+                                      Format("%.1f", c.site.height_m) + " m (" + c.site.source + ")"
+                                : std::string("none"))
+     << ", gravity " << Format("%.6f", c.site.gravity()) << " m/s^2\n";
+  os << "residual RMS per axis: accel " << Vec(fit.rms_acc) << " " << c.acc_unit;
+  if (c.has_gyro) os << ", gyro " << Vec(fit.rms_gyr) << " " << c.gyr_unit;
+  if (fit.motion_segments > 0) os << ", motion " << Vec(fit.rms_motion) << " rad";
+  os << "\nnoise per sample: accel " << Vec(c.noise.acc) << " " << c.acc_unit << " (tau "
+     << Format("%.2f", c.noise.tau_acc) << " samples)";
+  if (c.has_gyro) {
+    os << ", gyro " << Vec(c.noise.gyr) << " " << c.gyr_unit << " (tau " << Format("%.2f", c.noise.tau_gyr)
+       << ")";
+  }
+  os << "\n\n";
+  char line[160];
+  std::snprintf(line, sizeof line, "%-34s %15s %12s  %s\n", "parameter", "value", "sigma", "unit");
+  os << line;
+  for (const auto& p : c.parameters) {
+    std::string sigma = p.fixed ? "fixed" : !p.observable ? "unobservable" : Format("%.3g", p.sigma);
+    std::snprintf(line, sizeof line, "%-34s %15.8g %12s  %s\n", p.name.c_str(), p.value,
+                  sigma.c_str(), p.unit.c_str());
+    os << line;
+  }
+  if (!c.observability.unobservable.empty()) {
+    os << "\nunobservable directions (moving along them changes no prediction):\n";
+    for (const auto& u : c.observability.unobservable) os << "  " << u << "\n";
+  }
+  if (!c.observability.determined.empty()) {
+    os << "determined combinations:\n";
+    for (const auto& d : c.observability.determined) {
+      os << "  " << d.text << " = " << Format("%.8g", d.value) << " +- "
+         << Format("%.3g", d.sigma) << "\n";
+    }
+  }
+  for (const auto& w : fit.warnings) os << "warning: " << w << "\n";
+  return os.str();
+}
+
+}  // namespace plumb::report
