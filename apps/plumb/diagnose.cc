@@ -20,6 +20,7 @@
 #include "plumb/report/diagnosis_json.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"
+#include "plumb/report/diagnosis_text.h"
 #include "segment_options.h"
 #include "site_options.h"
 
@@ -103,7 +104,7 @@ class DiagnoseCommand : public Command {
     ra_options.significance = a.significance;
     const diagnostics::ResidualAnalysis ra = diagnostics::AnalyseResiduals(series, d.fit, ra_options);
     std::cout << "plumb diagnose: " << report::FitVerdict(d.fit.fit) << "\n"
-              << ra.BriefReport() << d.BriefReport();
+              << report::ResidualAnalysisText(ra) << report::DiagnosisText(d);
     const auto best = std::find_if(d.candidates.begin(), d.candidates.end(),
                                    [](const diagnostics::Candidate& c) { return c.refit.has_value(); });
     if (best != d.candidates.end()) {

@@ -30,6 +30,7 @@
 #include "plumb/report/html_report.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"
+#include "plumb/report/diagnosis_text.h"
 #include "segment_options.h"
 #include "site_options.h"
 
@@ -197,7 +198,7 @@ class ReportCommand : public Command {
     options.calibration.on_insufficient = estimation::InsufficientData::kReport;
     try {
       diagnostics::Diagnosis d = diagnostics::Diagnose(series, segments, model, site, options);
-      std::cout << d.BriefReport();
+      std::cout << report::DiagnosisText(d);
       return d;
     } catch (const Error& e) {
       std::cout << "warning: the diagnosis failed: " << e.what() << "\n";

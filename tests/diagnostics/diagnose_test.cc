@@ -40,6 +40,7 @@
 #include "plumb/sim/truth.h"
 #include "plumb/signal/chi_square.h"
 #include "plumb/report/calibration_text.h"
+#include "plumb/report/diagnosis_text.h"
 
 namespace plumb::diagnostics {
 namespace {
@@ -162,11 +163,11 @@ TEST_P(HiddenEffect, RankedFirstSignificantAndRecoveredByTheRefit) {
   const Diagnosis d = DiagnoseSession(s, s.base);
   ASSERT_FALSE(d.candidates.empty());
   const Candidate& best = d.candidates.front();
-  EXPECT_EQ(best.effect, GetParam().effect) << d.BriefReport();
-  EXPECT_TRUE(best.significant) << d.BriefReport();
+  EXPECT_EQ(best.effect, GetParam().effect) << report::DiagnosisText(d);
+  EXPECT_TRUE(best.significant) << report::DiagnosisText(d);
   const auto it = std::find_if(d.candidates.begin(), d.candidates.end(),
                                [&](const Candidate& c) { return c.effect == GetParam().effect; });
-  ASSERT_NE(it, d.candidates.end()) << d.BriefReport();
+  ASSERT_NE(it, d.candidates.end()) << report::DiagnosisText(d);
   for (const auto& n : it->not_identifiable) {
     ADD_FAILURE() << n.parameter << " not identifiable (ratio " << n.ratio << ", excited "
                   << n.excited << ")";
@@ -287,19 +288,19 @@ TEST(Diagnose, TwoHiddenEffectsAreFoundInTwoRounds) {
   ASSERT_FALSE(first.candidates.empty());
   const Candidate& found = first.candidates.front();
   ASSERT_TRUE(std::find(hidden.begin(), hidden.end(), found.effect) != hidden.end())
-      << first.BriefReport();
-  EXPECT_TRUE(found.significant) << first.BriefReport();
+      << report::DiagnosisText(first);
+  EXPECT_TRUE(found.significant) << report::DiagnosisText(first);
   const std::string other = found.effect == hidden[0] ? hidden[1] : hidden[0];
 
   const Diagnosis second =
       DiagnoseSession(s, WithReferences("base+" + found.effect, s.sim.model));
   ASSERT_FALSE(second.candidates.empty());
   const Candidate& next = second.candidates.front();
-  EXPECT_EQ(next.effect, other) << second.BriefReport();
-  EXPECT_TRUE(next.significant) << second.BriefReport();
+  EXPECT_EQ(next.effect, other) << report::DiagnosisText(second);
+  EXPECT_TRUE(next.significant) << report::DiagnosisText(second);
 
   // With both, the fit is back to the noise and both effects are recovered.
-  ASSERT_TRUE(next.refit.has_value()) << second.BriefReport();
+  ASSERT_TRUE(next.refit.has_value()) << report::DiagnosisText(second);
   const estimation::CalibrationResult& both = *next.refit;
   const auto [lo, hi] = Chi2DofBand(both.fit.dof);
   EXPECT_GT(both.fit.chi2_dof(), lo) << report::FullReport(both);
@@ -328,7 +329,7 @@ TEST(Diagnose, EffectsStillDataCannotExciteAreNotIdentifiable) {
   s.options.calibration.use_motion = false;
   const Diagnosis d = DiagnoseSession(s, s.base);
   EXPECT_EQ(d.fit.fit.motion_segments, 0);
-  const std::string report = d.BriefReport();
+  const std::string report = report::DiagnosisText(d);
   for (const std::string name : {"accel_size_effect", "time_offset"}) {
     const auto it = std::find_if(d.candidates.begin(), d.candidates.end(),
                                  [&](const Candidate& c) { return c.effect == name; });
@@ -363,8 +364,8 @@ TEST(Diagnose, EarthRateIsFoundWithoutASite) {
                                geo::Site::Unknown(s.sim.site.gravity()), s.options);
   ASSERT_FALSE(d.candidates.empty());
   const Candidate& best = d.candidates.front();
-  EXPECT_EQ(best.effect, "earth_rate") << d.BriefReport();
-  EXPECT_TRUE(best.significant) << d.BriefReport();
+  EXPECT_EQ(best.effect, "earth_rate") << report::DiagnosisText(d);
+  EXPECT_TRUE(best.significant) << report::DiagnosisText(d);
   ASSERT_TRUE(best.refit.has_value());
   const double lat = 51.64 * M_PI / 180.0, omega = 7.292115e-5;
   const estimation::ParameterEstimate* north = FindParameter(*best.refit, "earth_rate.omega.north");
@@ -402,10 +403,10 @@ TEST_P(SmallHiddenEffect, ScoreStatisticPredictsTheRefitsFall) {
   Session s = Simulate(spec);
   s.options.candidates = {GetParam().effect};
   const Diagnosis d = DiagnoseSession(s, s.base);
-  ASSERT_EQ(d.candidates.size(), 1u) << d.BriefReport();
+  ASSERT_EQ(d.candidates.size(), 1u) << report::DiagnosisText(d);
   const Candidate& c = d.candidates.front();
-  EXPECT_TRUE(c.significant) << d.BriefReport();
-  ASSERT_TRUE(c.refit_drop.has_value()) << d.BriefReport();
+  EXPECT_TRUE(c.significant) << report::DiagnosisText(d);
+  ASSERT_TRUE(c.refit_drop.has_value()) << report::DiagnosisText(d);
   std::cout << c.effect << ": LM " << c.lm << " (q " << c.dof << "), refit drop " << *c.refit_drop
             << ", relative difference " << (c.lm - *c.refit_drop) / *c.refit_drop << "\n";
   EXPECT_GT(c.lm, 15.0);   // of the order of the noise: a few tens,

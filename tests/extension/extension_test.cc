@@ -33,6 +33,7 @@
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
 #include "plumb/report/calibration_text.h"
+#include "plumb/report/diagnosis_text.h"
 #include "support/effect_battery.h"
 
 // The factory that PLUMB_DEFINE_EFFECT(accel_scale_temperature, ...) defines in
@@ -238,10 +239,10 @@ TEST(ScaleTemperatureSession, DiagnoseRanksTheUserEffectFirst) {
   options.confirm = 1;
   const diagnostics::Diagnosis dx = diagnostics::Diagnose(
       d.sim.session.series, segments, model::Model::Parse("base"), d.sim.site, options);
-  if (std::getenv("PLUMB_PRINT")) std::cout << dx.BriefReport();
+  if (std::getenv("PLUMB_PRINT")) std::cout << report::DiagnosisText(dx);
   ASSERT_FALSE(dx.candidates.empty());
   const diagnostics::Candidate& best = dx.candidates.front();
-  EXPECT_EQ(best.effect, "accel_scale_temperature") << dx.BriefReport();
+  EXPECT_EQ(best.effect, "accel_scale_temperature") << report::DiagnosisText(dx);
   EXPECT_TRUE(best.significant);
   ASSERT_TRUE(best.refit_drop.has_value());
   EXPECT_NEAR(*best.refit_drop, d.base.fit.chi2 - d.extended.fit.chi2, 1e-6 * d.base.fit.chi2);

@@ -68,12 +68,6 @@ estimation::CalibrationResult StripProbes(estimation::CalibrationResult fit,
   return fit;
 }
 
-std::string Fixed(double v, int precision) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(precision) << v;
-  return out.str();
-}
-
 }  // namespace
 
 std::string SpecWith(const model::Model& model, const std::string& effect,
@@ -232,87 +226,6 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     ++confirmed;
   }
   return d;
-}
-
-std::string Diagnosis::BriefReport() const {
-  std::ostringstream out;
-  const auto& f = fit.fit;
-  out << "model " << fit.calibration.model.spec() << ": chi2 " << Fixed(f.chi2, 1) << " on " << f.dof
-      << " dof, chi2/dof " << Fixed(f.chi2_dof(), 3) << "\n";
-  out << "candidates (score test at the current fit; significant at " << significance
-      << "; evidence = LM - q ln N, N = " << num_residuals << "):\n";
-  out << "  " << std::left << std::setw(26) << "effect" << std::right << std::setw(11) << "LM"
-      << std::setw(5) << "q" << std::setw(11) << "evidence" << std::setw(13) << "significant"
-      << std::setw(13) << "refit drop" << "\n";
-  for (const auto& c : candidates) {
-    if (!c.identifiable) continue;
-    const std::string name = c.effect + (c.option.empty() ? "" : ":" + c.option);
-    out << "  " << std::left << std::setw(26) << name << std::right << std::setw(11)
-        << Fixed(c.lm, 1) << std::setw(5) << c.dof << std::setw(11) << Fixed(c.evidence, 1)
-        << std::setw(13) << (c.significant ? "yes" : "no") << std::setw(13)
-        << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-"));
-    for (const auto& other : c.indistinguishable_from) out << "  (same as " << other << " here)";
-    if (c.dispersion > 1.0) {
-      out << "  (LM / " << std::setprecision(3) << c.dispersion
-          << ": the velocity residuals' misfit)";
-    }
-    out << "\n";
-  }
-  bool header = false;
-  for (const auto& c : candidates) {
-    if (c.identifiable) continue;
-    if (!header) out << "not identifiable from this data (cannot be judged here; not absent):\n";
-    header = true;
-    out << "  " << c.effect << ": ";
-    std::vector<std::string> unexcited, confounders, weak;
-    std::vector<const Confounding*> weak_columns;
-    for (const auto& n : c.not_identifiable) {
-      if (!n.excited) unexcited.push_back(n.parameter);
-      if (n.too_weak) weak_columns.push_back(&n);
-      for (const auto& k : n.confounders) {
-        if (std::find(confounders.begin(), confounders.end(), k) == confounders.end()) {
-          confounders.push_back(k);
-        }
-      }
-    }
-    if (weak_columns.size() <= 2) {
-      for (const Confounding* n : weak_columns) {
-        std::ostringstream w;
-        w << n->parameter << " only to +-" << std::setprecision(2) << n->sigma << " (typical "
-          << n->typical << ")";
-        weak.push_back(w.str());
-      }
-    } else {
-      double least = weak_columns.front()->sigma / weak_columns.front()->typical;
-      for (const Confounding* n : weak_columns) least = std::min(least, n->sigma / n->typical);
-      std::ostringstream w;
-      w << weak_columns.size() << " of " << c.num_parameters << " parameters only to "
-        << std::setprecision(2) << least << " times their typical size or worse";
-      weak.push_back(w.str());
-    }
-    if (!unexcited.empty()) {
-      out << unexcited.size() << " of " << c.num_parameters << " parameters not excited by this data";
-    }
-    if (!confounders.empty()) {
-      out << (unexcited.empty() ? "" : "; ") << "confounded with";
-      for (const auto& k : confounders) out << " " << k;
-    }
-    if (!weak.empty()) {
-      out << (unexcited.empty() && confounders.empty() ? "" : "; ") << "this data determines";
-      for (std::size_t k = 0; k < weak.size(); ++k) out << (k ? ", " : " ") << weak[k];
-    }
-    out << "\n";
-  }
-  for (const auto& s : skipped) out << "skipped " << s.effect << ": " << s.reason << "\n";
-  const auto best = std::find_if(candidates.begin(), candidates.end(),
-                                 [](const Candidate& c) { return c.significant; });
-  if (best == candidates.end()) {
-    out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
-  } else {
-    out << "best: " << best->effect << (best->option.empty() ? "" : ":" + best->option)
-        << " -> refit with --model " << SpecWith(fit.calibration.model, best->effect, best->option) << "\n";
-  }
-  return out.str();
 }
 
 }  // namespace plumb::diagnostics

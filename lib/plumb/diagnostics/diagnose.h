@@ -17,7 +17,7 @@
 //
 // Example:
 //   Diagnosis d = Diagnose(series, segments, model::Model::Parse("base"), site, {});
-//   std::cout << d.BriefReport();
+//   std::cout << report::DiagnosisText(d);   // plumb/report/diagnosis_text.h
 #pragma once
 
 #include <optional>
@@ -91,9 +91,6 @@ struct Diagnosis {
   std::vector<Skipped> skipped;
   double significance = 0.01;
   int num_residuals = 0;                ///< N of the evidence penalty
-
-  /// A terminal summary a person reads in ten seconds.
-  std::string BriefReport() const;
 };
 
 /// Runs the diagnosis. Throws what estimation::Calibrate throws, and plumb::Error for an

@@ -530,44 +530,4 @@ ResidualAnalysis AnalyseResiduals(const ImuSeries& series, const CalibrationResu
   return a;
 }
 
-std::string ResidualAnalysis::BriefReport(std::size_t max_signatures) const {
-  std::ostringstream out;
-  out << std::setprecision(3);
-  const char* axes = "xyz";
-  out << "where the model fails (whitened residual, ~N(0,1) per axis when it is complete):\n";
-  for (const auto& w : worst) {
-    out << "  " << w.name << ": " << ResidualKindName(w.residual) << "." << axes[w.axis] << " "
-        << w.score << " sigma\n";
-  }
-  std::vector<const Signature*> sig;
-  for (const auto& s : signatures) {
-    if (s.significant) sig.push_back(&s);
-  }
-  std::sort(sig.begin(), sig.end(), [](const Signature* a, const Signature* b) {
-    return std::abs(a->correlation) > std::abs(b->correlation);
-  });
-  if (sig.empty()) {
-    out << "no residual signature is significant (" << num_tests << " tests, p < "
-        << p_threshold << " each)\n";
-  } else {
-    out << "residual signatures (" << sig.size() << " of " << num_tests
-        << " significant, p < " << p_threshold << " each; strongest first):\n";
-    for (std::size_t k = 0; k < sig.size() && k < max_signatures; ++k) {
-      const Signature& s = *sig[k];
-      out << "  " << ResidualKindName(s.residual) << "." << axes[s.axis] << " against "
-          << s.regressor << ": r = " << s.correlation << ", slope " << s.slope_residual
-          << " +- " << s.slope_residual_sigma << " per " << s.unit << " (" << s.points
-          << " points)\n";
-    }
-  }
-  for (const auto& a : allan) {
-    if (a.ratio <= 3.0) continue;
-    out << "  Allan deviation of the " << ResidualKindName(a.residual) << "." << axes[a.axis]
-        << " residual is " << a.ratio << " x the white-noise line at "
-        << (a.tau_s.empty() ? 0.0 : a.tau_s.back())
-        << " s: a slow effect (drift, temperature, random walk) is left\n";
-  }
-  return out.str();
-}
-
 }  // namespace plumb::diagnostics

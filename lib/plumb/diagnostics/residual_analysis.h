@@ -195,10 +195,6 @@ struct ResidualAnalysis {
   /// still segments in allan_segments (indices in fit.still).
   std::vector<ResidualAllan> allan;
   std::vector<std::size_t> allan_segments;
-
-  /// Where the model fails, for a terminal: the worst ranges, the significant signatures
-  /// (strongest first, at most `max_signatures`) and the Allan ratios above 3.
-  std::string BriefReport(std::size_t max_signatures = 6) const;
 };
 
 /// Compares `fit` (a result of estimation::Calibrate on `series`) with the measurements.

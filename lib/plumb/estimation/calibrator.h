@@ -11,7 +11,7 @@
 //   auto site = geo::Site::At(51.64, -1.2, 100, "flags");
 //   auto model = model::Model::Parse("base");
 //   CalibrationResult r = Calibrate(session.series, segments, model, site, {});
-//   std::cout << r.BriefReport();
+//   std::cout << report::FullReport(r);   // plumb/report/calibration_text.h
 #pragma once
 
 #include <vector>

@@ -1,0 +1,146 @@
+#include "plumb/report/diagnosis_text.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <vector>
+
+namespace plumb::report {
+namespace {
+
+std::string Fixed(double v, int precision) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(precision) << v;
+  return out.str();
+}
+
+}  // namespace
+
+std::string DiagnosisText(const diagnostics::Diagnosis& d) {
+  using diagnostics::Confounding;
+  using diagnostics::Candidate;
+  std::ostringstream out;
+  const auto& f = d.fit.fit;
+  out << "model " << d.fit.calibration.model.spec() << ": chi2 " << Fixed(f.chi2, 1) << " on " << f.dof
+      << " dof, chi2/dof " << Fixed(f.chi2_dof(), 3) << "\n";
+  out << "candidates (score test at the current fit; significant at " << d.significance
+      << "; evidence = LM - q ln N, N = " << d.num_residuals << "):\n";
+  out << "  " << std::left << std::setw(26) << "effect" << std::right << std::setw(11) << "LM"
+      << std::setw(5) << "q" << std::setw(11) << "evidence" << std::setw(13) << "significant"
+      << std::setw(13) << "refit drop" << "\n";
+  for (const auto& c : d.candidates) {
+    if (!c.identifiable) continue;
+    const std::string name = c.effect + (c.option.empty() ? "" : ":" + c.option);
+    out << "  " << std::left << std::setw(26) << name << std::right << std::setw(11)
+        << Fixed(c.lm, 1) << std::setw(5) << c.dof << std::setw(11) << Fixed(c.evidence, 1)
+        << std::setw(13) << (c.significant ? "yes" : "no") << std::setw(13)
+        << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-"));
+    for (const auto& other : c.indistinguishable_from) out << "  (same as " << other << " here)";
+    if (c.dispersion > 1.0) {
+      out << "  (LM / " << std::setprecision(3) << c.dispersion
+          << ": the velocity residuals' misfit)";
+    }
+    out << "\n";
+  }
+  bool header = false;
+  for (const auto& c : d.candidates) {
+    if (c.identifiable) continue;
+    if (!header) out << "not identifiable from this data (cannot be judged here; not absent):\n";
+    header = true;
+    out << "  " << c.effect << ": ";
+    std::vector<std::string> unexcited, confounders, weak;
+    std::vector<const Confounding*> weak_columns;
+    for (const auto& n : c.not_identifiable) {
+      if (!n.excited) unexcited.push_back(n.parameter);
+      if (n.too_weak) weak_columns.push_back(&n);
+      for (const auto& k : n.confounders) {
+        if (std::find(confounders.begin(), confounders.end(), k) == confounders.end()) {
+          confounders.push_back(k);
+        }
+      }
+    }
+    if (weak_columns.size() <= 2) {
+      for (const Confounding* n : weak_columns) {
+        std::ostringstream w;
+        w << n->parameter << " only to +-" << std::setprecision(2) << n->sigma << " (typical "
+          << n->typical << ")";
+        weak.push_back(w.str());
+      }
+    } else {
+      double least = weak_columns.front()->sigma / weak_columns.front()->typical;
+      for (const Confounding* n : weak_columns) least = std::min(least, n->sigma / n->typical);
+      std::ostringstream w;
+      w << weak_columns.size() << " of " << c.num_parameters << " parameters only to "
+        << std::setprecision(2) << least << " times their typical size or worse";
+      weak.push_back(w.str());
+    }
+    if (!unexcited.empty()) {
+      out << unexcited.size() << " of " << c.num_parameters << " parameters not excited by this data";
+    }
+    if (!confounders.empty()) {
+      out << (unexcited.empty() ? "" : "; ") << "confounded with";
+      for (const auto& k : confounders) out << " " << k;
+    }
+    if (!weak.empty()) {
+      out << (unexcited.empty() && confounders.empty() ? "" : "; ") << "this data determines";
+      for (std::size_t k = 0; k < weak.size(); ++k) out << (k ? ", " : " ") << weak[k];
+    }
+    out << "\n";
+  }
+  for (const auto& s : d.skipped) out << "skipped " << s.effect << ": " << s.reason << "\n";
+  const auto best = std::find_if(d.candidates.begin(), d.candidates.end(),
+                                 [](const Candidate& c) { return c.significant; });
+  if (best == d.candidates.end()) {
+    out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
+  } else {
+    out << "best: " << best->effect << (best->option.empty() ? "" : ":" + best->option)
+        << " -> refit with --model " << diagnostics::SpecWith(d.fit.calibration.model, best->effect, best->option) << "\n";
+  }
+  return out.str();
+}
+
+std::string ResidualAnalysisText(const diagnostics::ResidualAnalysis& ra,
+                                 std::size_t max_signatures) {
+  using diagnostics::ResidualKindName;
+  using diagnostics::Signature;
+  std::ostringstream out;
+  out << std::setprecision(3);
+  const char* axes = "xyz";
+  out << "where the model fails (whitened residual, ~N(0,1) per axis when it is complete):\n";
+  for (const auto& w : ra.worst) {
+    out << "  " << w.name << ": " << ResidualKindName(w.residual) << "." << axes[w.axis] << " "
+        << w.score << " sigma\n";
+  }
+  std::vector<const Signature*> sig;
+  for (const auto& s : ra.signatures) {
+    if (s.significant) sig.push_back(&s);
+  }
+  std::sort(sig.begin(), sig.end(), [](const Signature* a, const Signature* b) {
+    return std::abs(a->correlation) > std::abs(b->correlation);
+  });
+  if (sig.empty()) {
+    out << "no residual signature is significant (" << ra.num_tests << " tests, p < "
+        << ra.p_threshold << " each)\n";
+  } else {
+    out << "residual signatures (" << sig.size() << " of " << ra.num_tests
+        << " significant, p < " << ra.p_threshold << " each; strongest first):\n";
+    for (std::size_t k = 0; k < sig.size() && k < max_signatures; ++k) {
+      const Signature& s = *sig[k];
+      out << "  " << ResidualKindName(s.residual) << "." << axes[s.axis] << " against "
+          << s.regressor << ": r = " << s.correlation << ", slope " << s.slope_residual
+          << " +- " << s.slope_residual_sigma << " per " << s.unit << " (" << s.points
+          << " points)\n";
+    }
+  }
+  for (const auto& a : ra.allan) {
+    if (a.ratio <= 3.0) continue;
+    out << "  Allan deviation of the " << ResidualKindName(a.residual) << "." << axes[a.axis]
+        << " residual is " << a.ratio << " x the white-noise line at "
+        << (a.tau_s.empty() ? 0.0 : a.tau_s.back())
+        << " s: a slow effect (drift, temperature, random walk) is left\n";
+  }
+  return out.str();
+}
+
+}  // namespace plumb::report

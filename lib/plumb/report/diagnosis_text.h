@@ -1,0 +1,23 @@
+// plumb/report/diagnosis_text.h — what `plumb diagnose` prints on a terminal (the library
+// formats; only the command prints): where the model fails and which effect it misses.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "plumb/diagnostics/diagnose.h"
+#include "plumb/diagnostics/residual_analysis.h"
+
+namespace plumb::report {
+
+/// The candidates of a diagnosis, a summary a person reads in ten seconds: the ranked
+/// identifiable candidates with LM, evidence and refit drop, the ones this data cannot judge
+/// and why, and the best candidate's refit command.
+std::string DiagnosisText(const diagnostics::Diagnosis& diagnosis);
+
+/// Where the model fails: the worst ranges, the significant signatures (strongest first, at
+/// most `max_signatures`) and the Allan ratios above 3.
+std::string ResidualAnalysisText(const diagnostics::ResidualAnalysis& analysis,
+                                 std::size_t max_signatures = 6);
+
+}  // namespace plumb::report
