@@ -96,7 +96,8 @@ class CalibrationProblem {
   const model::Model& model() const { return model_; }
   const StillSet& still() const { return still_; }
   const model::ParameterBlocks& theta() const { return theta_; }
-  /// Restores the values (theta and the attitudes) saved by SaveValues.
+  /// Saves the current values (theta and the attitudes), and puts them back (the solve's
+  /// restart from the starting values, solve.h).
   void SaveValues();
   void RestoreValues();
   /// The gyroscope is integrated between poses (there are motion intervals).
