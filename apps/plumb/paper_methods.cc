@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "plumb/core/units.h"
 #include "plumb/paper/backend.h"
 #include "plumb/paper/static_procedure.h"
 #include "plumb/report/json_report.h"
@@ -63,7 +64,7 @@ int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& s
     std::cout << "  " << kAxisName[j] << " parallel: '"
               << r.still[r.parallel_index[j]].segment.label << "', antiparallel: '"
               << r.still[r.antiparallel_index[j]].segment.label << "', turns total "
-              << r.total_angle_rad[j] * 180.0 / 3.14159265358979323846 << " deg\n";
+              << r.total_angle_rad[j] * 180.0 / units::kPi << " deg\n";
   }
   std::cout << "Paper's convention (a_s = F a_p + b, a_p the gravity vector):\n";
   PrintVector("accelerometer bias, Eq. (3), " + au + ":", r.accel_bias);

@@ -1,5 +1,7 @@
 #include "site_options.h"
 
+#include "plumb/core/units.h"
+
 namespace plumb::cli {
 
 void AddSiteOptions(CLI::App* app, SiteArgs& args) {
@@ -24,7 +26,7 @@ geo::Site ResolveSite(const SiteArgs& args, const std::optional<SiteInput>& from
   } else if (from_log) {
     site = geo::Site::At(*from_log);
   } else {
-    return geo::Site::Unknown(gravity_m_s2.value_or(9.80665));
+    return geo::Site::Unknown(gravity_m_s2.value_or(units::kStandardGravity));
   }
   if (gravity_m_s2) site.g_n = Vec3(0.0, 0.0, *gravity_m_s2);
   return site;

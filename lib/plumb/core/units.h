@@ -2,8 +2,8 @@
 //
 // Inside plumb every quantity is SI (SPEC section 1): m/s^2, rad/s, s, degC. Other units
 // appear only at the edges (readers, exporters, printed tables), converted with these
-// constants. Multiply to convert: `angle_deg * kRadPerDeg` is in rad, `rate * kDegPerHPerRadPerS`
-// is in deg/h.
+// constants. Multiply to convert: `angle_deg * kRadPerDeg` is in rad,
+// `rate * kDegPerHourPerRadPerS` is in deg/h.
 #pragma once
 
 namespace plumb::units {

@@ -49,7 +49,7 @@ double OutputScale(const model::EffectInfo& info, std::size_t i, const ImuSeries
   const std::string& out = accel ? series.acc_unit : series.gyr_unit;
   const std::string in = accel ? "m/s^2" : "rad/s";
   if (out == in || !info.ScalesWithOutput(static_cast<int>(i))) return 1.0;
-  const Mat3& M = accel ? fit.calibration.AccelMatrix() : fit.calibration.GyroMatrix();
+  const Mat3 M = accel ? fit.calibration.AccelMatrix() : fit.calibration.GyroMatrix();
   return M.diagonal().cwiseAbs().mean();
 }
 
@@ -68,6 +68,177 @@ estimation::CalibrationResult StripProbes(estimation::CalibrationResult fit,
   return fit;
 }
 
+/// The candidates asked for: options.candidates, or the whole catalogue.
+std::vector<CandidateSpec> WantedCandidates(const DiagnoseOptions& options) {
+  std::vector<CandidateSpec> wanted;
+  if (options.candidates.empty()) {
+    for (const auto& name : model::Registry::Global().CatalogueNames()) {
+      wanted.push_back({name, ""});
+    }
+  } else {
+    for (const auto& text : options.candidates) wanted.push_back(ParseCandidate(text));
+  }
+  return wanted;
+}
+
+/// The candidates to test, as probes of two fits: those seen by the model's own residuals,
+/// and those that need the accelerometer during motion (velocity residuals), tested in a fit
+/// that has them.
+struct ProbePlan {
+  model::Model probed;
+  model::Model probed_motion;
+  std::vector<CandidateSpec> tested;
+  std::vector<bool> needs_motion;  ///< per tested candidate: probed in probed_motion
+};
+
+/// Adds each wanted candidate the data can carry as a probe; the others go to `skipped`.
+ProbePlan PlanProbes(const std::vector<CandidateSpec>& wanted, const ImuSeries& series,
+                     const geo::Site& site, const model::Model& model,
+                     std::vector<Skipped>& skipped) {
+  ProbePlan plan{model, model, {}, {}};
+  for (const auto& c : wanted) {
+    const auto effect = model::Registry::Global().Make(c.name, c.option);
+    if (model.has_effect(c.name)) continue;
+    const std::string why = Unsupported(effect->info(), series, site, model);
+    if (!why.empty()) {
+      skipped.push_back({c.name, why});
+      continue;
+    }
+    const bool motion = effect->info().excitation.angular_acceleration;
+    (motion ? plan.probed_motion : plan.probed).AddProbe(c.name, c.option);
+    plan.tested.push_back(c);
+    plan.needs_motion.push_back(motion);
+  }
+  return plan;
+}
+
+// The two functions below append a candidate and its basis (the residual directions it
+// explains; empty when it was not tested) to `candidates` and `bases`, in the same order.
+
+/// A candidate its probe fit could not test (no motion between the poses: nothing excites
+/// it): not identifiable, every parameter unexcited.
+void AddUnexcited(const CandidateSpec& c, std::vector<Candidate>& candidates,
+                  std::vector<Eigen::MatrixXd>& bases) {
+  Candidate cand;
+  cand.effect = c.name;
+  cand.option = c.option;
+  cand.identifiable = false;
+  const auto effect = model::Registry::Global().Make(c.name, c.option);
+  cand.num_parameters = effect->info().size();
+  for (int i = 0; i < effect->info().size(); ++i) {
+    Confounding n;
+    n.parameter = effect->info().ParameterName(i);
+    n.excited = false;
+    n.typical = effect->info().parameters[static_cast<std::size_t>(i)].typical;
+    cand.not_identifiable.push_back(n);
+  }
+  candidates.push_back(std::move(cand));
+  bases.emplace_back();
+}
+
+/// The velocity residuals' chi^2 per residual in a probe fit when above 1, else 1.
+double VelocityDispersion(const estimation::ProbeJacobian& p) {
+  double ss = 0.0;
+  int rows = 0;
+  for (std::size_t row = 0; row < p.row_kind.size(); ++row) {
+    if (p.row_kind[row] != estimation::ProbeJacobian::RowKind::kVelocity) continue;
+    ss += p.r(static_cast<Eigen::Index>(row)) * p.r(static_cast<Eigen::Index>(row));
+    ++rows;
+  }
+  return rows > 0 ? std::max(1.0, ss / rows) : 1.0;
+}
+
+/// The score test of one candidate in its probe fit `source`: its columns of the probe
+/// Jacobian Z with their typical sizes (in the fit's units), LM (divided by the velocity
+/// residuals' dispersion when tested with them), evidence and significance.
+void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& source,
+               bool with_velocity, const ImuSeries& series, const DiagnoseOptions& options,
+               std::vector<Candidate>& candidates, std::vector<Eigen::MatrixXd>& bases) {
+  const estimation::ProbeJacobian& p = *source.fit.probes;
+  const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
+  const double dispersion = with_velocity ? VelocityDispersion(p) : 1.0;
+  const int term = source.calibration.model.FindTerm(c.name);
+  std::vector<Eigen::Index> cols;
+  for (std::size_t j = 0; j < p.probe_term.size(); ++j) {
+    if (p.probe_term[j] == term) cols.push_back(static_cast<Eigen::Index>(j));
+  }
+  Eigen::MatrixXd Z(p.Z.rows(), static_cast<Eigen::Index>(cols.size()));
+  std::vector<std::string> names;
+  std::vector<double> typical;
+  const auto& info = source.calibration.model.terms()[static_cast<std::size_t>(term)].effect->info();
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    Z.col(static_cast<Eigen::Index>(k)) = p.Z.col(cols[k]);
+    names.push_back(p.probe_names[static_cast<std::size_t>(cols[k])]);
+    typical.push_back(info.parameters[k].typical * OutputScale(info, k, series, source));
+  }
+  const ScoreTestResult s = ScoreTest(p.r, p.J, Z, p.unknown_names, names, typical, options.score);
+  Candidate cand;
+  cand.effect = c.name;
+  cand.option = c.option;
+  cand.lm = s.lm / dispersion;
+  cand.dispersion = dispersion;
+  cand.dof = s.dof;
+  cand.num_parameters = s.num_parameters;
+  cand.identifiable = s.identifiable;
+  cand.not_identifiable = s.not_identifiable;
+  cand.evidence = cand.lm - s.dof * log_n;
+  cand.threshold = s.dof > 0 ? signal::ChiSquareQuantile(1.0 - options.significance, s.dof) : 0.0;
+  cand.significant = s.identifiable && s.dof > 0 && cand.lm > cand.threshold;
+  cand.with_velocity = with_velocity;
+  candidates.push_back(std::move(cand));
+  bases.push_back(s.basis);
+}
+
+/// Candidates whose explained directions lie within another's: the smallest cosine of the
+/// principal angles between the spans (`bases`, per candidate) is at least 0.999.
+void MarkIndistinguishable(const std::vector<Eigen::MatrixXd>& bases,
+                           std::vector<Candidate>& candidates) {
+  for (std::size_t a = 0; a < candidates.size(); ++a) {
+    for (std::size_t b = 0; b < candidates.size(); ++b) {
+      if (a == b || bases[a].cols() == 0 || bases[b].cols() == 0) continue;
+      if (bases[a].rows() != bases[b].rows()) continue;  // from the two probe fits
+      const Eigen::MatrixXd cosines = bases[a].transpose() * bases[b];
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(cosines);
+      const auto& sv = svd.singularValues();
+      const bool within = sv.size() == bases[a].cols() && sv(sv.size() - 1) >= 0.999;
+      if (within) candidates[a].indistinguishable_from.push_back(candidates[b].effect);
+    }
+  }
+}
+
+/// Best evidence first; the ones not identifiable last.
+void Rank(std::vector<Candidate>& candidates) {
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) {
+                     if (a.identifiable != b.identifiable) return a.identifiable;
+                     return a.evidence > b.evidence;
+                   });
+}
+
+/// Refits the model plus each of the best `options.confirm` significant candidates: the
+/// actual fall of chi^2 from its probe fit (`fit` or, with velocity residuals, `fit_motion`).
+void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                 const model::Model& model, const geo::Site& site, const DiagnoseOptions& options,
+                 const estimation::CalibrationResult& fit,
+                 const std::optional<estimation::CalibrationResult>& fit_motion,
+                 std::vector<Candidate>& candidates) {
+  int confirmed = 0;
+  for (auto& cand : candidates) {
+    if (confirmed >= options.confirm) break;
+    if (!cand.significant) continue;
+    model::Model with = model;
+    with.Add(cand.effect, cand.option);
+    estimation::CalibrationOptions refit_options = options.calibration;
+    refit_options.accel_in_motion = cand.with_velocity;
+    estimation::CalibrationResult refit =
+        estimation::Calibrate(series, segments, with, site, refit_options);
+    const double before = cand.with_velocity ? fit_motion->fit.chi2 : fit.fit.chi2;
+    cand.refit_drop = before - refit.fit.chi2;
+    cand.refit = std::move(refit);
+    ++confirmed;
+  }
+}
+
 }  // namespace
 
 std::string SpecWith(const model::Model& model, const std::string& effect,
@@ -84,147 +255,44 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   Diagnosis d;
   d.significance = options.significance;
 
-  // The candidates, as probes of one fit.
-  std::vector<CandidateSpec> wanted;
-  if (options.candidates.empty()) {
-    for (const auto& name : model::Registry::Global().CatalogueNames()) wanted.push_back({name, ""});
-  } else {
-    for (const auto& text : options.candidates) wanted.push_back(ParseCandidate(text));
-  }
-  // Two probe fits: the candidates seen by the model's own residuals, and those that need the
-  // accelerometer during motion (velocity residuals), tested in a fit that has them.
-  model::Model probed = model, probed_motion = model;
-  std::vector<CandidateSpec> tested;
-  std::vector<bool> needs_motion;
-  for (const auto& c : wanted) {
-    const auto effect = model::Registry::Global().Make(c.name, c.option);
-    if (model.has_effect(c.name)) continue;
-    const std::string why = Unsupported(effect->info(), series, site, model);
-    if (!why.empty()) {
-      d.skipped.push_back({c.name, why});
-      continue;
-    }
-    const bool motion = effect->info().excitation.angular_acceleration;
-    (motion ? probed_motion : probed).AddProbe(c.name, c.option);
-    tested.push_back(c);
-    needs_motion.push_back(motion);
-  }
+  // 1. Probe fits: the model with the candidates as probes (held at zero), once with its own
+  // residuals and, for the candidates that need them, once with velocity residuals.
+  const std::vector<CandidateSpec> wanted = WantedCandidates(options);
+  const ProbePlan plan = PlanProbes(wanted, series, site, model, d.skipped);
   estimation::CalibrationOptions own = options.calibration;
   if (!own.accel_in_motion) own.accel_in_motion = false;
-  const estimation::CalibrationResult fit = estimation::Calibrate(series, segments, probed, site, own);
+  const estimation::CalibrationResult fit =
+      estimation::Calibrate(series, segments, plan.probed, site, own);
   d.fit = StripProbes(fit, model);
   std::optional<estimation::CalibrationResult> fit_motion;
-  if (probed_motion.has_probes() && d.fit.fit.motion_segments > 0) {
+  if (plan.probed_motion.has_probes() && d.fit.fit.motion_segments > 0) {
     estimation::CalibrationOptions with = options.calibration;
     with.accel_in_motion = true;
-    fit_motion = estimation::Calibrate(series, segments, probed_motion, site, with);
+    fit_motion = estimation::Calibrate(series, segments, plan.probed_motion, site, with);
     d.fit_with_velocity = StripProbes(*fit_motion, model);
   }
   if (!fit.fit.probes && !fit_motion) return d;
   d.num_residuals = fit.fit.probes ? static_cast<int>(fit.fit.probes->r.size()) : 0;
 
+  // 2. Score each candidate in its probe fit.
   std::vector<Eigen::MatrixXd> bases;
-  for (std::size_t ci = 0; ci < tested.size(); ++ci) {
-    const CandidateSpec& c = tested[ci];
-    const estimation::CalibrationResult* source = needs_motion[ci] ? (fit_motion ? &*fit_motion : nullptr) : &fit;
+  for (std::size_t ci = 0; ci < plan.tested.size(); ++ci) {
+    const bool motion = plan.needs_motion[ci];
+    const estimation::CalibrationResult* source =
+        motion ? (fit_motion ? &*fit_motion : nullptr) : &fit;
     if (source == nullptr || !source->fit.probes) {
-      // No motion between the poses: nothing excites it.
-      Candidate cand;
-      cand.effect = c.name;
-      cand.option = c.option;
-      cand.identifiable = false;
-      const auto effect = model::Registry::Global().Make(c.name, c.option);
-      cand.num_parameters = effect->info().size();
-      for (int i = 0; i < effect->info().size(); ++i) {
-        Confounding n;
-        n.parameter = effect->info().ParameterName(i);
-        n.excited = false;
-        n.typical = effect->info().parameters[static_cast<std::size_t>(i)].typical;
-        cand.not_identifiable.push_back(n);
-      }
-      d.candidates.push_back(std::move(cand));
-      bases.emplace_back();
-      continue;
-    }
-    const estimation::ProbeJacobian& p = *source->fit.probes;
-    const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
-    double dispersion = 1.0;
-    if (needs_motion[ci]) {
-      double ss = 0.0;
-      int rows = 0;
-      for (std::size_t row = 0; row < p.row_kind.size(); ++row) {
-        if (p.row_kind[row] != estimation::ProbeJacobian::RowKind::kVelocity) continue;
-        ss += p.r(static_cast<Eigen::Index>(row)) * p.r(static_cast<Eigen::Index>(row));
-        ++rows;
-      }
-      if (rows > 0) dispersion = std::max(1.0, ss / rows);
-    }
-    const int term = source->calibration.model.FindTerm(c.name);
-    std::vector<Eigen::Index> cols;
-    for (std::size_t j = 0; j < p.probe_term.size(); ++j) {
-      if (p.probe_term[j] == term) cols.push_back(static_cast<Eigen::Index>(j));
-    }
-    Eigen::MatrixXd Z(p.Z.rows(), static_cast<Eigen::Index>(cols.size()));
-    std::vector<std::string> names;
-    std::vector<double> typical;
-    const auto& info = source->calibration.model.terms()[static_cast<std::size_t>(term)].effect->info();
-    for (std::size_t k = 0; k < cols.size(); ++k) {
-      Z.col(static_cast<Eigen::Index>(k)) = p.Z.col(cols[k]);
-      names.push_back(p.probe_names[static_cast<std::size_t>(cols[k])]);
-      typical.push_back(info.parameters[k].typical * OutputScale(info, k, series, *source));
-    }
-    const ScoreTestResult s = ScoreTest(p.r, p.J, Z, p.unknown_names, names, typical, options.score);
-    Candidate cand;
-    cand.effect = c.name;
-    cand.option = c.option;
-    cand.lm = s.lm / dispersion;
-    cand.dispersion = dispersion;
-    cand.dof = s.dof;
-    cand.num_parameters = s.num_parameters;
-    cand.identifiable = s.identifiable;
-    cand.not_identifiable = s.not_identifiable;
-    cand.evidence = cand.lm - s.dof * log_n;
-    cand.threshold = s.dof > 0 ? signal::ChiSquareQuantile(1.0 - options.significance, s.dof) : 0.0;
-    cand.significant = s.identifiable && s.dof > 0 && cand.lm > cand.threshold;
-    cand.with_velocity = needs_motion[ci];
-    d.candidates.push_back(std::move(cand));
-    bases.push_back(s.basis);
-  }
-  // Candidates whose explained directions lie within another's: the smallest cosine of the
-  // principal angles between the spans.
-  for (std::size_t a = 0; a < d.candidates.size(); ++a) {
-    for (std::size_t b = 0; b < d.candidates.size(); ++b) {
-      if (a == b || bases[a].cols() == 0 || bases[b].cols() == 0) continue;
-      if (bases[a].rows() != bases[b].rows()) continue;  // from the two probe fits
-      const Eigen::MatrixXd cosines = bases[a].transpose() * bases[b];
-      Eigen::JacobiSVD<Eigen::MatrixXd> svd(cosines);
-      const auto& sv = svd.singularValues();
-      const bool within = sv.size() == bases[a].cols() && sv(sv.size() - 1) >= 0.999;
-      if (within) d.candidates[a].indistinguishable_from.push_back(d.candidates[b].effect);
+      AddUnexcited(plan.tested[ci], d.candidates, bases);
+    } else {
+      AddScored(plan.tested[ci], *source, motion, series, options, d.candidates, bases);
     }
   }
-  std::stable_sort(d.candidates.begin(), d.candidates.end(),
-                   [](const Candidate& a, const Candidate& b) {
-                     if (a.identifiable != b.identifiable) return a.identifiable;
-                     return a.evidence > b.evidence;
-                   });
 
-  // Confirm the best significant candidates by refitting.
-  int confirmed = 0;
-  for (auto& cand : d.candidates) {
-    if (confirmed >= options.confirm) break;
-    if (!cand.significant) continue;
-    model::Model with = model;
-    with.Add(cand.effect, cand.option);
-    estimation::CalibrationOptions refit_options = options.calibration;
-    refit_options.accel_in_motion = cand.with_velocity;
-    estimation::CalibrationResult refit =
-        estimation::Calibrate(series, segments, with, site, refit_options);
-    const double before = cand.with_velocity ? fit_motion->fit.chi2 : d.fit.fit.chi2;
-    cand.refit_drop = before - refit.fit.chi2;
-    cand.refit = std::move(refit);
-    ++confirmed;
-  }
+  // 3. Rank: which candidates this data cannot tell apart, then by evidence.
+  MarkIndistinguishable(bases, d.candidates);
+  Rank(d.candidates);
+
+  // 4. Confirm the best significant candidates by refitting.
+  ConfirmBest(series, segments, model, site, options, d.fit, fit_motion, d.candidates);
   return d;
 }
 

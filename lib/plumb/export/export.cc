@@ -4,15 +4,12 @@
 #include <cstdio>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 
 namespace plumb::exporter {
 namespace {
 
 using nlohmann::json;
-
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kRadPerSToDegPerH = 180.0 / kPi * 3600.0;  // deg/h per rad/s
 
 json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 json Vec(const Vec3& v) { return json::array({Num(v.x()), Num(v.y()), Num(v.z())}); }
@@ -161,10 +158,12 @@ ExportOutput Export(const std::string& format, const estimation::Calibration& c,
 
 json ToJson(const ExportReport& rep) {
   json out = {{"target", rep.target},
-              {"accel_still", ErrorsJson(rep.accel_still, 1e3 / kStandardGravity, "m/s^2", "mg")},
+              {"accel_still",
+               ErrorsJson(rep.accel_still, 1e3 / units::kStandardGravity, "m/s^2", "mg")},
               {"accel_per_input", Mat(rep.accel_per_input)}};
   if (rep.has_gyro) {
-    out["gyro_still"] = ErrorsJson(rep.gyro_still, kRadPerSToDegPerH, "rad/s", "deg_h");
+    out["gyro_still"] =
+        ErrorsJson(rep.gyro_still, units::kDegPerHourPerRadPerS, "rad/s", "deg_h");
     out["gyro_per_input"] = Mat(rep.gyro_per_input);
   }
   json dropped = json::array();

@@ -5,15 +5,12 @@
 #include <cstdio>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/model/model.h"
 #include "plumb/signal/segment_stats.h"
 
 namespace plumb::exporter {
 namespace {
-
-constexpr double kStandardGravity = 9.80665;          // m/s^2 per g, for mg
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kRadPerSToDegPerH = 180.0 / kPi * 3600.0;  // deg/h per rad/s
 
 /// Binomial coefficient C(k, j) for k <= 3.
 double Binomial(int k, int j) {
@@ -203,13 +200,15 @@ std::vector<std::string> ExportReport::Lines() const {
   std::vector<std::string> lines;
   lines.push_back(target + ": firmware correction minus plumb's, over " +
                   std::to_string(accel_still.segments) + " still segments (RMS / max per axis)");
-  lines.push_back("  accel RMS " + Triple(accel_still.rms, 1e3 / kStandardGravity, 3) +
-                  " mg   max " + Triple(accel_still.max_abs, 1e3 / kStandardGravity, 3) + " mg");
+  constexpr double kMgPerMS2 = 1e3 / units::kStandardGravity;
+  lines.push_back("  accel RMS " + Triple(accel_still.rms, kMgPerMS2, 3) + " mg   max " +
+                  Triple(accel_still.max_abs, kMgPerMS2, 3) + " mg");
   lines.push_back("        RMS " + Triple(accel_still.rms, 1.0, 5) + " m/s^2   max " +
                   Triple(accel_still.max_abs, 1.0, 5) + " m/s^2");
   if (has_gyro) {
-    lines.push_back("  gyro  RMS " + Triple(gyro_still.rms, kRadPerSToDegPerH, 2) +
-                    " deg/h   max " + Triple(gyro_still.max_abs, kRadPerSToDegPerH, 2) + " deg/h");
+    constexpr double kDegPerHour = units::kDegPerHourPerRadPerS;
+    lines.push_back("  gyro  RMS " + Triple(gyro_still.rms, kDegPerHour, 2) + " deg/h   max " +
+                    Triple(gyro_still.max_abs, kDegPerHour, 2) + " deg/h");
     lines.push_back("        RMS " + Triple(gyro_still.rms, 1.0, 7) + " rad/s   max " +
                     Triple(gyro_still.max_abs, 1.0, 7) + " rad/s");
   }

@@ -10,6 +10,7 @@
 
 #include "plumb/core/session.h"
 #include "plumb/core/types.h"
+#include "plumb/core/units.h"
 
 namespace plumb::geo {
 
@@ -23,7 +24,8 @@ struct Site {
   double height_m = 0.0;      ///< height above the WGS84 ellipsoid, m
   std::string source = "none";  ///< "flags", "gps", "file", "fixed" or "none"
   bool known = false;         ///< false: no site; Earth rate is left out and gravity is fixed
-  Vec3 g_n = Vec3(0.0, 0.0, 9.80665);  ///< gravity vector in NED, m/s^2 (down positive)
+  /// Gravity vector in NED, m/s^2 (down positive).
+  Vec3 g_n = Vec3(0.0, 0.0, units::kStandardGravity);
   Vec3 omega_ie_n = Vec3::Zero();      ///< Earth rate in NED, rad/s
   Mat3 C_ned_ecef = Mat3::Identity();  ///< maps ECEF vectors into NED (the paper's C_ecef^ned)
 
@@ -36,7 +38,7 @@ struct Site {
     return At(input.lat_deg, input.lon_deg, input.height_m, input.source);
   }
   /// No site: gravity `g` (default standard gravity 9.80665 m/s^2) straight down, no Earth rate.
-  static Site Unknown(double g = 9.80665);
+  static Site Unknown(double g = units::kStandardGravity);
 };
 
 }  // namespace plumb::geo

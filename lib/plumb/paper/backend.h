@@ -31,6 +31,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/core/segment.h"
+#include "plumb/core/units.h"
 #include "plumb/estimation/options.h"
 #include "plumb/estimation/result.h"
 #include "plumb/geo/site.h"
@@ -49,10 +50,9 @@ struct PaperBenchmarkBackend {
 /// CalibratePaperBenchmark on the same series) and fits it. `max_tilt_rad` as in
 /// PaperBenchmarkOptions: the still periods used are those within it of an axis. Throws what
 /// estimation::Calibrate throws.
-PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(const ImuSeries& series,
-                                                       const PaperBenchmarkResult& closed,
-                                                       const geo::Site& site,
-                                                       double max_tilt_rad = 0.3490658503988659);
+PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(
+    const ImuSeries& series, const PaperBenchmarkResult& closed, const geo::Site& site,
+    double max_tilt_rad = 20.0 * units::kRadPerDeg);
 
 /// The static configuration: the paper's model with its constants held, and the same freed.
 struct PaperStaticBackend {

@@ -6,11 +6,12 @@
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 
 namespace plumb::paper {
 namespace {
 
-constexpr double kHalfPi = 1.57079632679489661923;
+constexpr double kHalfPi = units::kPi / 2.0;
 
 std::string PoseName(int axis, bool parallel) {
   return std::string(kAxisName[axis]) + (parallel ? " parallel" : " antiparallel");

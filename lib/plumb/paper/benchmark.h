@@ -39,6 +39,7 @@
 #include "plumb/core/imu_series.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/types.h"
+#include "plumb/core/units.h"
 #include "plumb/signal/segment_stats.h"
 
 namespace plumb::paper {
@@ -86,11 +87,11 @@ struct TurnPeriod {
 /// Options of the benchmark procedure.
 struct PaperBenchmarkOptions {
   /// Local gravity, m/s^2, > 0: used only for the forward matrix F = -(U+ - U-) / (2 g).
-  double gravity_m_s2 = 9.80665;
+  double gravity_m_s2 = units::kStandardGravity;
   /// Largest angle between a still pose's mean output and its nearest axis for the pose to
   /// count as "axis parallel / antiparallel to gravity"; also the largest elevation of z for
   /// "z perpendicular". rad, in (0, pi/4].
-  double max_tilt_rad = 0.3490658503988659;  // 20 deg
+  double max_tilt_rad = 20.0 * units::kRadPerDeg;
 };
 
 /// What the benchmark procedure found, in the paper's convention and in plumb's forward one.

@@ -8,13 +8,12 @@
 #include <limits>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 
 namespace plumb::paper {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kDegToRad = 0.017453292519943295;
-constexpr double kMilliG = 9.80665e-3;  // m/s^2 per mg
 
 template <typename T>
 Compared<T> Compare(const T& benchmark, const T& proposed) {
@@ -79,11 +78,11 @@ const std::vector<PartLimits>& KnownParts() {
                  double gyro_cross_pct, double accel_xy_mg, double accel_z_mg,
                  double accel_scale_pct, double accel_cross_pct, const char* source) {
     return PartLimits{name,
-                      gyro_zro_deg_s * kDegToRad,
+                      gyro_zro_deg_s * units::kRadPerDeg,
                       gyro_scale_pct / 100.0,
                       gyro_cross_pct / 100.0,
-                      accel_xy_mg * kMilliG,
-                      accel_z_mg * kMilliG,
+                      accel_xy_mg * units::kMilliG,
+                      accel_z_mg * units::kMilliG,
                       accel_scale_pct / 100.0,
                       accel_cross_pct / 100.0,
                       source};

@@ -37,6 +37,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/core/types.h"
+#include "plumb/core/units.h"
 #include "plumb/geo/site.h"
 
 namespace plumb::paper {
@@ -45,7 +46,7 @@ struct PaperStaticOptions {
   double cutoff_hz = 0.5;        ///< high-pass cut-off, Hz, in (0, rate/2); the paper: 0.5
   double accel_diagonal = -1.0;  ///< the constant of F_xx and F_yy (paper convention), finite
   double gyro_diagonal = 1.0;    ///< the constant of E_xx and E_yy, finite
-  double earth_rate = 7.292115e-5;  ///< Omega, rad/s, > 0 (the paper's value)
+  double earth_rate = units::kEarthRate;  ///< Omega, rad/s, > 0 (the paper's 7.292115e-5)
 };
 
 /// The accelerometer part of the static procedure (paper convention; units of the output).

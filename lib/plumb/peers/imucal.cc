@@ -5,15 +5,13 @@
 #include <nlohmann/json.hpp>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/peers/json_fields.h"
 
 namespace plumb::peers {
 namespace {
 
 using nlohmann::json;
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kStandardGravity = 9.80665;  // m/s^2, imucal's "g"
 
 Mat3 MatrixKey(const json& root, const std::string& path, const std::string& key) {
   return detail::Matrix3(detail::Field(root, key, path, key, "3 rows of 3 numbers"), path, key);
@@ -48,9 +46,9 @@ double CalibratedScale(const std::string& unit, const std::string& what) {
 
 double SiPerUnit(const std::string& unit) {
   if (unit == "m/s^2" || unit == "m/s2") return 1.0;
-  if (unit == "g") return kStandardGravity;
+  if (unit == "g") return units::kStandardGravity;
   if (unit == "rad/s") return 1.0;
-  if (unit == "deg/s" || unit == "dps") return kPi / 180.0;
+  if (unit == "deg/s" || unit == "dps") return units::kRadPerDeg;
   return 0.0;
 }
 
@@ -93,7 +91,7 @@ ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string&
   f.has_g_sensitivity = true;
   f.g_sensitivity = (out_g / cal_a) * cal.K_ga * f.R_peer_b;
   const double angle_deg =
-      std::acos(std::clamp((f.R_peer_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / kPi;
+      std::acos(std::clamp((f.R_peer_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / units::kPi;
   f.notes.push_back(
       "imucal applies acc_cal = R_a^-1 K_a^-1 (acc - b_a), gyr_cal = R_g^-1 K_g^-1 (gyr - K_ga "
       "acc_cal - b_g); forward form F = K_a R_a R, E = K_g R_g R, G = K_ga R, converted to SI");

@@ -49,7 +49,8 @@ struct ImucalFerraris {
 /// numbers (a vector not 3 finite numbers).
 ImucalFerraris ReadImucalJson(const std::string& path);
 
-/// SI value of one unit: "m/s^2" 1, "g" 9.80665, "rad/s" 1, "deg/s" pi/180; 0 when unknown.
+/// SI value of one unit: "m/s^2" 1, "g" 9.80665 (units::kStandardGravity), "rad/s" 1,
+/// "deg/s" pi/180; 0 when unknown.
 double SiPerUnit(const std::string& unit);
 
 /// imucal's answer in plumb's forward form (see the file comment); `source` names the file.

@@ -88,7 +88,7 @@ struct StillDetectorOptions {
   double rate_allowance = -1.0;
   /// Join consecutive still runs when the samples between them hold the same pose (a still
   /// vehicle vibrating in bursts): equal accelerometer means, no rotation (see
-  /// JoinSamePose in still_detector.cc for the three chi^2(3) tests).
+  /// JoinSamePose in join_same_pose.cc for the three chi^2(3) tests).
   bool join_same_pose = true;
   /// Units of the series for the report's notes, e.g. "m/s^2" and "rad/s", or "counts".
   std::string acc_unit = "m/s^2";

@@ -5,11 +5,10 @@
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 
 namespace plumb::signal {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// Acklam's approximation of the normal quantile, relative error about 1e-9.
 double AcklamQuantile(double p) {
@@ -46,7 +45,7 @@ double NormalQuantile(double p) {
   double z = AcklamQuantile(p);
   // One Halley step on F(z) - p with F(z) = erfc(-z / sqrt 2) / 2.
   const double e = 0.5 * std::erfc(-z / std::sqrt(2.0)) - p;
-  const double u = e * std::sqrt(2.0 * kPi) * std::exp(0.5 * z * z);
+  const double u = e * std::sqrt(units::kTwoPi) * std::exp(0.5 * z * z);
   z -= u / (1.0 + 0.5 * z * u);
   return z;
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 
 namespace plumb::signal {
 
@@ -14,9 +15,8 @@ Biquad ButterworthHighPass(double cutoff_hz, double rate_hz) {
     throw Error("high-pass filter: need 0 < cutoff_hz < rate_hz / 2, got cutoff_hz " +
                 std::to_string(cutoff_hz) + ", rate_hz " + std::to_string(rate_hz));
   }
-  constexpr double kPi = 3.14159265358979323846;
   const double q = 1.0 / std::sqrt(2.0);
-  const double w = 2.0 * kPi * cutoff_hz / rate_hz;
+  const double w = units::kTwoPi * cutoff_hz / rate_hz;
   const double cos_w = std::cos(w);
   const double alpha = std::sin(w) / (2.0 * q);
   const double a0 = 1.0 + alpha;

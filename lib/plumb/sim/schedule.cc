@@ -6,12 +6,13 @@
 #include <random>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 
 namespace plumb::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kTwoPi = 2.0 * kPi;
+using units::kPi;
+using units::kTwoPi;
 
 void CheckDuration(double duration_s, const char* what) {
   if (!std::isfinite(duration_s) || duration_s <= 0.0) {

@@ -13,6 +13,7 @@
 // Residual signature: a still gyroscope residual fixed in the level frame, which turns with
 // the heading and flips with the pose.
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
@@ -25,8 +26,8 @@ EffectInfo MakeInfo(const std::string& option) {
   info.prefix = info.name;
   info.sensor = Sensor::kGyro;
   info.term = "y_g += E R_b_n (omega_N, 0, omega_D), still segments (candidate without a site)";
-  info.parameters = {{"omega.north", "rad/s", 7.292115e-5, 0.0},
-                     {"omega.down", "rad/s", 7.292115e-5, 0.0}};
+  info.parameters = {{"omega.north", "rad/s", units::kEarthRate, 0.0},
+                     {"omega.down", "rad/s", units::kEarthRate, 0.0}};
   info.input_side = true;
   info.excitation.still_orientations = true;
   return info;
