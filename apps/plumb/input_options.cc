@@ -11,8 +11,8 @@
 
 #include "commands.h"
 #include "plumb/core/error.h"
-#include "plumb/io/flight_log_file.h"
-#include "plumb/io/native_csv.h"
+#include "plumb/io/input/flight_log_file.h"
+#include "plumb/io/text/native_csv.h"
 
 namespace plumb::cli {
 namespace {

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "plumb/core/session.h"
-#include "plumb/io/text_table.h"
+#include "plumb/io/text/text_table.h"
 
 namespace plumb::cli {
 

@@ -21,8 +21,8 @@
 
 #include "io/io_test_util.h"
 #include "plumb/core/error.h"
-#include "plumb/io/mavlink_session.h"
-#include "plumb/io/mavlink_tlog.h"
+#include "plumb/io/mavlink/mavlink_session.h"
+#include "plumb/io/mavlink/mavlink_tlog.h"
 
 namespace plumb::io {
 namespace {

@@ -17,8 +17,8 @@
 
 #include "io_test_util.h"
 #include "plumb/core/error.h"
-#include "plumb/io/px4_session.h"
-#include "plumb/io/ulog.h"
+#include "plumb/io/px4/px4_session.h"
+#include "plumb/io/px4/ulog.h"
 
 namespace plumb::io {
 namespace {
