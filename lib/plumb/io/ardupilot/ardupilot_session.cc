@@ -12,6 +12,7 @@
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/ardupilot_correction.h"
+#include "plumb/io/ardupilot/dataflash_format.h"
 
 namespace plumb::io {
 namespace {
@@ -106,7 +107,8 @@ bool LooksLikeDataflash(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   unsigned char head[2] = {0, 0};
   in.read(reinterpret_cast<char*>(head), 2);
-  return in.gcount() == 2 && head[0] == 0xA3 && head[1] == 0x95;
+  return in.gcount() == 2 && head[0] == detail::kDataflashHead1 &&
+         head[1] == detail::kDataflashHead2;
 }
 
 }  // namespace plumb::io

@@ -9,32 +9,18 @@
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
-#include "plumb/io/ardupilot/dataflash_internal.h"
+#include "plumb/io/ardupilot/dataflash_format.h"
 
 namespace plumb::io {
 namespace {
 
-constexpr std::uint8_t kHead1 = 0xA3;
-constexpr std::uint8_t kHead2 = 0x95;
+using detail::DataflashFormat;
+using detail::DataflashStorage;
+constexpr std::uint8_t kHead1 = detail::kDataflashHead1;
+constexpr std::uint8_t kHead2 = detail::kDataflashHead2;
 constexpr std::uint8_t kFmtType = detail::kDataflashFmtType;
 constexpr std::size_t kHeaderSize = detail::kDataflashHeaderSize;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-}  // namespace
-
-std::size_t detail::DataflashFormatSize(char c) {
-  switch (c) {
-    case 'b': case 'B': case 'M': return 1;
-    case 'h': case 'H': case 'c': case 'C': return 2;
-    case 'i': case 'I': case 'f': case 'e': case 'E': case 'L': case 'n': return 4;
-    case 'd': case 'q': case 'Q': return 8;
-    case 'N': return 16;
-    case 'Z': case 'a': return 64;
-    default: return 0;
-  }
-}
-
-namespace {
 
 template <typename T>
 T Load(const std::uint8_t* p) {
@@ -48,64 +34,6 @@ std::string FixedText(const std::uint8_t* p, std::size_t n) {
   const auto* c = reinterpret_cast<const char*>(p);
   return std::string(c, strnlen(c, n));
 }
-
-std::vector<std::string> SplitColumns(const std::string& text) {
-  std::vector<std::string> out;
-  if (text.empty()) return out;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    out.push_back(text.substr(start, comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
-}  // namespace
-
-DataflashType detail::MakeDataflashType(std::uint8_t id, std::size_t length,
-                                        const std::string& name, const std::string& format,
-                                        const std::string& columns, DataflashWarnings* w) {
-  DataflashType t;
-  t.id = id;
-  t.name = name;
-  t.length = length;
-  t.format = format;
-  t.body_size = length - kHeaderSize;
-  const std::vector<std::string> names = SplitColumns(columns);
-  std::size_t offset = 0;
-  bool known = true;
-  for (std::size_t k = 0; k < format.size(); ++k) {
-    const std::size_t size = DataflashFormatSize(format[k]);
-    if (size == 0) {
-      known = false;
-      break;
-    }
-    if (offset + size <= t.body_size) {
-      DataflashColumn col;
-      col.name = k < names.size() ? names[k] : "col" + std::to_string(k);
-      col.format = format[k];
-      col.offset = offset;
-      col.size = size;
-      t.columns.push_back(std::move(col));
-    }
-    offset += size;
-  }
-  if (!known) {
-    ++w->fmt_unknown_chars;
-  } else if (offset != t.body_size) {
-    ++w->fmt_length_mismatches;
-  }
-  return t;
-}
-
-DataflashType detail::DataflashFmtType(DataflashWarnings* w) {
-  return MakeDataflashType(kFmtType, detail::kDataflashFmtLength, "FMT", "BBnNZ",
-                           "Type,Length,Name,Format,Columns", w);
-}
-
-namespace {
 
 /// The one-pass decoder state.
 class Parser {
@@ -167,24 +95,18 @@ class Parser {
 
   // FMT body: Type (B), Length (B), Name (n), Format (N), Columns (Z) = 86 bytes.
   void HandleFmt(const std::uint8_t* body, std::size_t body_size) {
-    if (body_size < 86) return;  // cannot happen with the built-in FMT
-    const std::uint8_t id = body[0];
-    const std::size_t length = body[1];
-    const std::string name = FixedText(body + 2, 4);
-    const std::string format = FixedText(body + 6, 16);
-    const std::string columns = FixedText(body + 22, 64);
-    DataflashWarnings& w = log_->warnings;
-    if (length < kHeaderSize) {
-      ++w.fmt_invalid;
-      return;
-    }
+    if (body_size < detail::kFmtBodySize) return;  // cannot happen with the built-in FMT
+    const std::uint8_t id = body[detail::kFmtTypeOffset];
+    const std::size_t length = body[detail::kFmtLengthOffset];
+    const std::string name = FixedText(body + detail::kFmtNameOffset, detail::kFmtNameSize);
+    const std::string format = FixedText(body + detail::kFmtFormatOffset, detail::kFmtFormatSize);
+    const std::string columns =
+        FixedText(body + detail::kFmtColumnsOffset, detail::kFmtColumnsSize);
     const int existing = index_[id];
-    if (existing >= 0) {
-      const DataflashType& t = log_->types[static_cast<std::size_t>(existing)];
-      if (t.length != length || t.name != name || t.format != format) ++w.fmt_conflicts;
-      return;
-    }
-    AddType(detail::MakeDataflashType(id, length, name, format, columns, &w));
+    const DataflashType* known =
+        existing >= 0 ? &log_->types[static_cast<std::size_t>(existing)] : nullptr;
+    if (!detail::AcceptFmt(known, length, name, format, &log_->warnings)) return;
+    AddType(detail::MakeDataflashType(id, length, name, format, columns, &log_->warnings));
   }
 
   const std::uint8_t* data_;
@@ -194,77 +116,6 @@ class Parser {
   std::array<int, 256> index_;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
-
-/// Fills column units and multipliers from FMTU (FmtType, UnitIds, MultIds), UNIT (Id, Label)
-/// and MULT (Id, Mult), when the log has them.
-void ApplyUnits(DataflashLog* log) {
-  const DataflashType* fmtu = log->Find("FMTU");
-  if (fmtu == nullptr) return;
-  std::map<char, std::string> units;
-  std::map<char, double> mults;
-  if (const DataflashType* u = log->Find("UNIT")) {
-    const int id = u->ColumnIndex("Id");
-    const int label = u->ColumnIndex("Label");
-    if (id >= 0 && label >= 0) {
-      for (std::size_t r = 0; r < u->rows; ++r) {
-        const double key = u->Value(r, id);
-        if (key >= -128 && key < 256) {
-          units[static_cast<char>(static_cast<int>(key))] = u->Text(r, label);
-        }
-      }
-    }
-  }
-  if (const DataflashType* m = log->Find("MULT")) {
-    const int id = m->ColumnIndex("Id");
-    const int mult = m->ColumnIndex("Mult");
-    if (id >= 0 && mult >= 0) {
-      for (std::size_t r = 0; r < m->rows; ++r) {
-        const double key = m->Value(r, id);
-        if (key >= -128 && key < 256) {
-          mults[static_cast<char>(static_cast<int>(key))] = m->Value(r, mult);
-        }
-      }
-    }
-  }
-  const int type_col = fmtu->ColumnIndex("FmtType");
-  const int unit_col = fmtu->ColumnIndex("UnitIds");
-  const int mult_col = fmtu->ColumnIndex("MultIds");
-  if (type_col < 0) return;
-  for (std::size_t r = 0; r < fmtu->rows; ++r) {
-    const double type_id = fmtu->Value(r, type_col);
-    auto it = std::find_if(log->types.begin(), log->types.end(),
-                           [&](const DataflashType& t) { return t.id == type_id; });
-    if (it == log->types.end()) continue;
-    const std::string unit_ids = unit_col >= 0 ? fmtu->Text(r, unit_col) : "";
-    const std::string mult_ids = mult_col >= 0 ? fmtu->Text(r, mult_col) : "";
-    for (std::size_t c = 0; c < it->columns.size(); ++c) {
-      if (c < unit_ids.size() && units.count(unit_ids[c])) it->columns[c].unit = units[unit_ids[c]];
-      if (c < mult_ids.size() && mults.count(mult_ids[c])) {
-        it->columns[c].multiplier = mults[mult_ids[c]];
-      }
-    }
-  }
-}
-
-void CollectParams(DataflashLog* log) {
-  const DataflashType* parm = log->Find("PARM");
-  if (parm == nullptr) return;
-  const int name = parm->ColumnIndex("Name");
-  const int value = parm->ColumnIndex("Value");
-  if (name < 0 || value < 0) return;
-  for (std::size_t r = 0; r < parm->rows; ++r) {
-    log->params[parm->Text(r, name)] = parm->Value(r, value);
-  }
-}
-
-}  // namespace
-
-void detail::FinishDataflashLog(DataflashLog* log) {
-  ApplyUnits(log);
-  CollectParams(log);
-}
-
-namespace {
 
 /// Rows of `type` that belong to IMU `instance` (all rows when `instance_col` < 0).
 std::vector<std::size_t> InstanceRows(const DataflashType& type, int instance_col,
@@ -279,17 +130,7 @@ std::vector<std::size_t> InstanceRows(const DataflashType& type, int instance_co
 
 /// The message holding IMU `instance` and the column of its instance field (-1 if none).
 const DataflashType* ImuType(const DataflashLog& log, int instance, int* instance_col) {
-  *instance_col = -1;
-  const DataflashType* imu = log.Find("IMU");
-  if (imu != nullptr) {
-    const int col = imu->ColumnIndex("I");
-    if (col >= 0) {
-      *instance_col = col;
-      return imu;
-    }
-  }
-  if (instance == 0) return imu;
-  return log.Find("IMU" + std::to_string(instance + 1));
+  return detail::DataflashInstanceMessage(log, "IMU", instance, false, instance_col);
 }
 
 /// Time of record `row` in seconds from TimeUS or TimeMS (`scale` 1e-6 or 1e-3).
@@ -321,36 +162,35 @@ int DataflashType::ColumnIndex(std::string_view column) const {
 double DataflashType::Value(std::size_t row, std::size_t col) const {
   const DataflashColumn& c = columns[col];
   const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
-  switch (c.format) {
-    case 'b': return Load<std::int8_t>(p);
-    case 'B': case 'M': return Load<std::uint8_t>(p);
-    case 'h': return Load<std::int16_t>(p);
-    case 'H': return Load<std::uint16_t>(p);
-    case 'i': return Load<std::int32_t>(p);
-    case 'I': return Load<std::uint32_t>(p);
-    case 'f': return Load<float>(p);
-    case 'd': return Load<double>(p);
-    case 'q': return static_cast<double>(Load<std::int64_t>(p));
-    case 'Q': return static_cast<double>(Load<std::uint64_t>(p));
-    case 'c': return Load<std::int16_t>(p) * 0.01;
-    case 'C': return Load<std::uint16_t>(p) * 0.01;
-    case 'e': return Load<std::int32_t>(p) * 0.01;
-    case 'E': return Load<std::uint32_t>(p) * 0.01;
-    case 'L': return Load<std::int32_t>(p) * 1e-7;
-    default: return kNaN;
+  const detail::DataflashFormatChar& f = DataflashFormat(c.format);
+  double v = 0.0;
+  switch (f.storage) {
+    case DataflashStorage::kInt8: v = Load<std::int8_t>(p); break;
+    case DataflashStorage::kUInt8: v = Load<std::uint8_t>(p); break;
+    case DataflashStorage::kInt16: v = Load<std::int16_t>(p); break;
+    case DataflashStorage::kUInt16: v = Load<std::uint16_t>(p); break;
+    case DataflashStorage::kInt32: v = Load<std::int32_t>(p); break;
+    case DataflashStorage::kUInt32: v = Load<std::uint32_t>(p); break;
+    case DataflashStorage::kInt64: v = static_cast<double>(Load<std::int64_t>(p)); break;
+    case DataflashStorage::kUInt64: v = static_cast<double>(Load<std::uint64_t>(p)); break;
+    case DataflashStorage::kFloat: v = Load<float>(p); break;
+    case DataflashStorage::kDouble: v = Load<double>(p); break;
+    case DataflashStorage::kText: case DataflashStorage::kArray: case DataflashStorage::kUnknown:
+      return kNaN;
   }
+  return f.scale == 1.0 ? v : v * f.scale;
 }
 
 std::string DataflashType::Text(std::size_t row, std::size_t col) const {
   const DataflashColumn& c = columns[col];
-  if (c.format != 'n' && c.format != 'N' && c.format != 'Z') return {};
+  if (DataflashFormat(c.format).storage != DataflashStorage::kText) return {};
   return FixedText(bodies.data() + row * body_size + c.offset, c.size);
 }
 
 std::array<std::int16_t, 32> DataflashType::Array(std::size_t row, std::size_t col) const {
   std::array<std::int16_t, 32> out{};
   const DataflashColumn& c = columns[col];
-  if (c.format == 'a') {
+  if (DataflashFormat(c.format).storage == DataflashStorage::kArray) {
     std::memcpy(out.data(), bodies.data() + row * body_size + c.offset, sizeof(out));
   }
   return out;

@@ -10,9 +10,12 @@
 #include "plumb/core/error.h"
 #include "plumb/io/ardupilot/ardupilot_correction.h"
 #include "plumb/io/ardupilot/dataflash.h"
+#include "plumb/io/ardupilot/dataflash_format.h"
 
 namespace plumb::io {
 namespace {
+
+using detail::DataflashInstanceMessage;
 
 constexpr std::size_t kIsbdSamplesPerRecord = 32;  // ISBD x/y/z are int16[32] ('a')
 constexpr int kIsbAccel = 0;                        // ISBH type: IMU_SENSOR_TYPE_ACCEL
@@ -63,25 +66,12 @@ std::vector<int> InstancesOf(const DataflashType& t, int instance_col) {
   return out;
 }
 
-/// The message of a per-instance kind: `base` with an I column ("ACC"), else `base` + (k+1)
-/// ("ACC1", "ACC2", ...), else for k == 0 `base` itself ("IMU"), then "IMU2", "IMU3".
-const DataflashType* MessageFor(const DataflashLog& log, const std::string& base, int instance,
-                                bool numbered_from_one, int* instance_col) {
-  *instance_col = -1;
-  if (const DataflashType* t = log.Find(base); t != nullptr && Col(*t, "I") >= 0) {
-    *instance_col = Col(*t, "I");
-    return t;
-  }
-  if (numbered_from_one) return log.Find(base + std::to_string(instance + 1));
-  if (instance == 0) return log.Find(base);
-  return log.Find(base + std::to_string(instance + 1));
-}
-
-/// Instances present for a per-instance kind (see MessageFor); `with_rows` skips empty ones.
+/// Instances present for a per-instance kind (see DataflashInstanceMessage); `with_rows`
+/// skips empty ones.
 std::vector<int> InstancesFor(const DataflashLog& log, const std::string& base,
                               bool numbered_from_one, bool with_rows) {
   int col = -1;
-  const DataflashType* t = MessageFor(log, base, 0, numbered_from_one, &col);
+  const DataflashType* t = DataflashInstanceMessage(log, base, 0, numbered_from_one, &col);
   if (t != nullptr && col >= 0) {
     std::vector<int> found = InstancesOf(*t, col);
     if (found.empty() && !with_rows) found.push_back(0);
@@ -89,7 +79,7 @@ std::vector<int> InstancesFor(const DataflashLog& log, const std::string& base,
   }
   std::vector<int> out;
   for (int k = 0; k < kMaxInstances; ++k) {
-    const DataflashType* m = MessageFor(log, base, k, numbered_from_one, &col);
+    const DataflashType* m = DataflashInstanceMessage(log, base, k, numbered_from_one, &col);
     if (m != nullptr && (!with_rows || m->rows > 0)) out.push_back(k);
   }
   return out;
@@ -115,7 +105,7 @@ ImuSeries ReadRawMessage(const DataflashLog& log, const std::string& base, int i
                          const std::string& vector_prefix) {
   ImuSeries s;
   int instance_col = -1;
-  const DataflashType* t = MessageFor(log, base, instance, true, &instance_col);
+  const DataflashType* t = DataflashInstanceMessage(log, base, instance, true, &instance_col);
   if (t == nullptr) return s;
   int time = Col(*t, "SampleUS");
   if (time < 0) time = Col(*t, "TimeUS");
@@ -274,7 +264,7 @@ std::vector<StreamRef> StreamRefs(const DataflashLog& log) {
   };
   for (int k : InstancesFor(log, "IMU", false, false)) {
     int col = -1;
-    const DataflashType* t = MessageFor(log, "IMU", k, false, &col);
+    const DataflashType* t = DataflashInstanceMessage(log, "IMU", k, false, &col);
     add(Kind::kImu, k, t != nullptr ? t->name : "IMU");
   }
   const std::vector<int> acc = InstancesFor(log, "ACC", true, true);

@@ -12,7 +12,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/io/ardupilot/dataflash.h"
-#include "plumb/io/ardupilot/dataflash_internal.h"
+#include "plumb/io/ardupilot/dataflash_format.h"
 #include "plumb/io/common/text_scan.h"
 
 namespace plumb::io {
@@ -22,7 +22,9 @@ constexpr std::uint8_t kModeNameValue = 255;      // stored for an 'M' field hol
 constexpr std::size_t kSniffBytes = 8192;         // LooksLikeDataflashText reads this much
 constexpr std::size_t kSniffMaxHeaderLines = 16;  // non-blank lines allowed before the FMT
 
-bool IsTextFormat(char c) { return c == 'n' || c == 'N' || c == 'Z'; }
+using detail::DataflashStorage;
+
+bool IsTextFormat(char c) { return detail::DataflashFormat(c).storage == DataflashStorage::kText; }
 
 /// One line split at its commas: trimmed fields and where each starts in the line.
 struct SplitLine {
@@ -101,33 +103,42 @@ bool EncodeScaled(std::string_view text, double inverse_scale, std::uint8_t* p) 
   return true;
 }
 
-/// Encodes one text field into the binary field at `p` (`size` bytes). False when it does not
-/// parse or fit; sets *mode_name for an 'M' field holding a name.
+/// A scaled integer field (c/C/e/E/L) of `storage`: see EncodeScaled.
+bool EncodeScaledField(DataflashStorage storage, std::string_view text, double inverse_scale,
+                       std::uint8_t* p) {
+  switch (storage) {
+    case DataflashStorage::kInt16: return EncodeScaled<std::int16_t>(text, inverse_scale, p);
+    case DataflashStorage::kUInt16: return EncodeScaled<std::uint16_t>(text, inverse_scale, p);
+    case DataflashStorage::kInt32: return EncodeScaled<std::int32_t>(text, inverse_scale, p);
+    case DataflashStorage::kUInt32: return EncodeScaled<std::uint32_t>(text, inverse_scale, p);
+    default: return false;
+  }
+}
+
+/// Encodes one text field into the binary field at `p` (`size` bytes) as the format table
+/// says. False when it does not parse or fit; sets *mode_name for an 'M' field holding a name.
 bool EncodeField(char format, std::string_view text, std::uint8_t* p, std::size_t size,
                  bool* mode_name) {
-  switch (format) {
-    case 'b': return EncodeInteger<std::int8_t>(text, p);
-    case 'B': return EncodeInteger<std::uint8_t>(text, p);
-    case 'h': return EncodeInteger<std::int16_t>(text, p);
-    case 'H': return EncodeInteger<std::uint16_t>(text, p);
-    case 'i': return EncodeInteger<std::int32_t>(text, p);
-    case 'I': return EncodeInteger<std::uint32_t>(text, p);
-    case 'q': return EncodeInteger64<std::int64_t>(text, p);
-    case 'Q': return EncodeInteger64<std::uint64_t>(text, p);
-    case 'M': {
-      double number;
-      if (detail::ParseNumber(text, number)) return EncodeInteger<std::uint8_t>(text, p);
-      if (text.empty()) return false;
-      Store<std::uint8_t>(p, kModeNameValue);  // a mode name ("Stabilize")
-      *mode_name = true;
-      return true;
-    }
-    case 'c': return EncodeScaled<std::int16_t>(text, 100.0, p);
-    case 'C': return EncodeScaled<std::uint16_t>(text, 100.0, p);
-    case 'e': return EncodeScaled<std::int32_t>(text, 100.0, p);
-    case 'E': return EncodeScaled<std::uint32_t>(text, 100.0, p);
-    case 'L': return EncodeScaled<std::int32_t>(text, 1e7, p);
-    case 'f': {
+  const detail::DataflashFormatChar& f = detail::DataflashFormat(format);
+  if (f.flight_mode) {
+    double number;
+    if (detail::ParseNumber(text, number)) return EncodeInteger<std::uint8_t>(text, p);
+    if (text.empty()) return false;
+    Store<std::uint8_t>(p, kModeNameValue);  // a mode name ("Stabilize")
+    *mode_name = true;
+    return true;
+  }
+  if (f.inverse_scale != 0.0) return EncodeScaledField(f.storage, text, f.inverse_scale, p);
+  switch (f.storage) {
+    case DataflashStorage::kInt8: return EncodeInteger<std::int8_t>(text, p);
+    case DataflashStorage::kUInt8: return EncodeInteger<std::uint8_t>(text, p);
+    case DataflashStorage::kInt16: return EncodeInteger<std::int16_t>(text, p);
+    case DataflashStorage::kUInt16: return EncodeInteger<std::uint16_t>(text, p);
+    case DataflashStorage::kInt32: return EncodeInteger<std::int32_t>(text, p);
+    case DataflashStorage::kUInt32: return EncodeInteger<std::uint32_t>(text, p);
+    case DataflashStorage::kInt64: return EncodeInteger64<std::int64_t>(text, p);
+    case DataflashStorage::kUInt64: return EncodeInteger64<std::uint64_t>(text, p);
+    case DataflashStorage::kFloat: {
       double v;
       if (!detail::ParseNumber(text, v)) return false;
       // Out of float range: not a value ArduPilot could have logged.
@@ -135,20 +146,21 @@ bool EncodeField(char format, std::string_view text, std::uint8_t* p, std::size_
       Store<float>(p, static_cast<float>(v));
       return true;
     }
-    case 'd': {
+    case DataflashStorage::kDouble: {
       double v;
       if (!detail::ParseNumber(text, v)) return false;
       Store<double>(p, v);
       return true;
     }
-    case 'n': case 'N': case 'Z':
+    case DataflashStorage::kText:
       std::memcpy(p, text.data(), std::min(text.size(), size));
       return true;
-    case 'a':
+    case DataflashStorage::kArray:
       return true;  // arrays are not written in text logs in a known form: zeros
-    default:
+    case DataflashStorage::kUnknown:
       return false;
   }
+  return false;
 }
 
 class TextParser {
@@ -246,7 +258,8 @@ class TextParser {
 
   /// An FMT line whose name or format does not fit its binary field is malformed.
   bool CheckFmt(const std::vector<std::string_view>& f) {
-    if (f[3].empty() || f[3].size() > 4 || f[4].size() > 16) {
+    if (f[3].empty() || f[3].size() > detail::kFmtNameSize ||
+        f[4].size() > detail::kFmtFormatSize) {
       Bad("FMT name " + detail::Quote(f[3]) + " (1..4 characters) or format " +
           detail::Quote(f[4]) + " (up to 16) does not fit");
       return false;
@@ -270,16 +283,10 @@ class TextParser {
       columns += (k > 5 ? "," : "") + std::string(f[k]);
     }
     DataflashWarnings& w = log_->warnings;
-    if (length < detail::kDataflashHeaderSize) {
-      ++w.fmt_invalid;
-      return;
-    }
     const int existing = index_[id];
-    if (existing >= 0) {
-      const DataflashType& t = log_->types[static_cast<std::size_t>(existing)];
-      if (t.length != length || t.name != name || t.format != format) ++w.fmt_conflicts;
-      return;
-    }
+    const DataflashType* known =
+        existing >= 0 ? &log_->types[static_cast<std::size_t>(existing)] : nullptr;
+    if (!detail::AcceptFmt(known, length, name, format, &w)) return;
     if (by_name_.count(name)) {
       ++w.fmt_conflicts;  // a second type id under a known name: lines could not tell them apart
       return;
@@ -339,8 +346,8 @@ bool LooksLikeDataflashText(const std::string& path) {
   std::string head(kSniffBytes, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
-  if (head.size() >= 2 && static_cast<unsigned char>(head[0]) == 0xA3 &&
-      static_cast<unsigned char>(head[1]) == 0x95) {
+  if (head.size() >= 2 && static_cast<unsigned char>(head[0]) == detail::kDataflashHead1 &&
+      static_cast<unsigned char>(head[1]) == detail::kDataflashHead2) {
     return false;
   }
   std::size_t header_lines = 0;
