@@ -1,13 +1,15 @@
-// plumb/io/common/log_common.h — pieces every flight-log reader shares: reading the whole file, and
-// the site from a log's GPS fixes.
+// plumb/io/common/log_common.h — pieces every flight-log reader shares: reading the whole file,
+// counting skipped bytes, saturating float conversion, and the site from a log's GPS fixes.
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "plumb/core/session.h"
+#include "plumb/core/types.h"
 
 namespace plumb::io {
 
@@ -41,6 +43,20 @@ void CountSkipped(Warnings& w, std::size_t from, std::size_t to, std::size_t& sk
   if (w.bytes_skipped == 0 || from != skip_end) ++w.skip_runs;
   w.bytes_skipped += to - from;
   skip_end = to;
+}
+
+/// double -> float with values beyond the float range as +-infinity (a plain cast is undefined
+/// there); NaN stays NaN.
+inline float SaturatedFloat(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::infinity();
+  if (v < -kMax) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(v);
+}
+
+/// The same per component.
+inline Vec3f SaturatedFloat(const Vec3& v) {
+  return Vec3f(SaturatedFloat(v.x()), SaturatedFloat(v.y()), SaturatedFloat(v.z()));
 }
 
 /// The site from a log's GPS fixes with a 3D fix: the median latitude (deg, [-90, 90]),

@@ -5,20 +5,16 @@
 #include <array>
 #include <cmath>
 #include <fstream>
-#include <limits>
-#include <sstream>
-
-#include <Eigen/Geometry>
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
+#include "plumb/io/px4/px4_correction.h"
+#include "plumb/io/px4/ulog_format.h"
 
 namespace plumb::io {
 namespace {
 
 constexpr double kUsToS = 1e-6;
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
-constexpr int kMaxCalSlots = 4;  // CAL_ACC0..CAL_ACC3
 
 enum class StreamKind { kCombined, kVehicleImu, kSensorAccel };
 
@@ -64,16 +60,6 @@ int TimeColumn(const ULogTopic& t) {
   return sample >= 0 ? sample : t.timestamp_col;
 }
 
-/// double -> float with out-of-range values as +-infinity (a plain cast is undefined there).
-float ToFloat(double v) {
-  constexpr double kMax = std::numeric_limits<float>::max();
-  if (v > kMax) return std::numeric_limits<float>::infinity();
-  if (v < -kMax) return -std::numeric_limits<float>::infinity();
-  return static_cast<float>(v);
-}
-
-Vec3f ToFloat(const Vec3& v) { return Vec3f(ToFloat(v.x()), ToFloat(v.y()), ToFloat(v.z())); }
-
 Vec3 Row3d(const ULogTopic& t, std::size_t row, const Triad& c) {
   return Vec3(t.Value(row, static_cast<std::size_t>(c[0])),
               t.Value(row, static_cast<std::size_t>(c[1])),
@@ -81,7 +67,7 @@ Vec3 Row3d(const ULogTopic& t, std::size_t row, const Triad& c) {
 }
 
 Vec3f Row3(const ULogTopic& t, std::size_t row, const Triad& c) {
-  return ToFloat(Row3d(t, row, c));
+  return SaturatedFloat(Row3d(t, row, c));
 }
 
 double TimeS(const ULogTopic& t, std::size_t row, int col) {
@@ -125,8 +111,8 @@ ImuSeries FromVehicleImu(const ULogTopic& t) {
     const double v_dt_s = t.Value(r, static_cast<std::size_t>(dv_dt)) * kUsToS;
     const double a_dt_s = t.Value(r, static_cast<std::size_t>(da_dt)) * kUsToS;
     if (!(v_dt_s > 0.0) || !(a_dt_s > 0.0)) continue;
-    const Vec3f acc = ToFloat(Row3d(t, r, *dv) / v_dt_s);
-    const Vec3f g = ToFloat(Row3d(t, r, *da) / a_dt_s);
+    const Vec3f acc = SaturatedFloat(Row3d(t, r, *dv) / v_dt_s);
+    const Vec3f g = SaturatedFloat(Row3d(t, r, *da) / a_dt_s);
     Push(&s, TimeS(t, r, time), acc, &g, nullptr);
   }
   return s;
@@ -188,7 +174,7 @@ ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topi
   for (std::size_t r = 0; r < acc_topic.rows; ++r) {
     if (paired && match[r] < 0) continue;
     const float tc =
-        temp >= 0 ? ToFloat(acc_topic.Value(r, static_cast<std::size_t>(temp))) : 0.0f;
+        temp >= 0 ? SaturatedFloat(acc_topic.Value(r, static_cast<std::size_t>(temp))) : 0.0f;
     Vec3f g;
     if (paired) g = Row3(*gyro_topic, static_cast<std::size_t>(match[r]), *gyr);
     // Temperature and gyro columns must stay aligned with t_s: Push keeps or drops all.
@@ -231,85 +217,6 @@ std::optional<double> Param(const ULog& log, const std::string& name) {
   return it->second;
 }
 
-/// A parameter or id value as integer text (any double, NaN and huge values included).
-std::string Integer(double v) {
-  std::ostringstream out;
-  out.precision(0);
-  out << std::fixed << v;
-  return out.str();
-}
-
-/// PX4's rotation enum as (roll, pitch, yaw) degrees, for the integers 0..25; nullopt
-/// otherwise (other values, fractions, NaN).
-std::optional<Vec3> RotationEuler(double value) {
-  if (!(value >= 0.0 && value <= 25.0) || value != std::floor(value)) return std::nullopt;
-  const int k = static_cast<int>(value);
-  static const double kTable[26][3] = {
-      {0, 0, 0},     {0, 0, 45},    {0, 0, 90},    {0, 0, 135},   {0, 0, 180},
-      {0, 0, 225},   {0, 0, 270},   {0, 0, 315},   {180, 0, 0},   {180, 0, 45},
-      {180, 0, 90},  {180, 0, 135}, {0, 180, 0},   {180, 0, 225}, {180, 0, 270},
-      {180, 0, 315}, {90, 0, 0},    {90, 0, 45},   {90, 0, 90},   {90, 0, 135},
-      {270, 0, 0},   {270, 0, 45},  {270, 0, 90},  {270, 0, 135}, {0, 90, 0},
-      {0, 270, 0}};
-  return Vec3(kTable[k][0], kTable[k][1], kTable[k][2]);
-}
-
-/// R = Rz(yaw) Ry(pitch) Rx(roll), angles in degrees.
-Mat3 EulerDeg(const Vec3& rpy_deg) {
-  const Vec3 r = rpy_deg * kDegToRad;
-  return (Eigen::AngleAxisd(r.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(r.y(), Vec3::UnitY()) *
-          Eigen::AngleAxisd(r.x(), Vec3::UnitX()))
-      .toRotationMatrix();
-}
-
-std::string Format(const Vec3& v) {
-  std::ostringstream out;
-  out.precision(9);
-  out << v.x() << ", " << v.y() << ", " << v.z();
-  return out.str();
-}
-
-/// What PX4 applied to one sensor (accel or gyro) of a calibrated stream.
-struct Correction {
-  std::string prefix;   ///< e.g. "CAL_ACC0"
-  Vec3 offset = Vec3::Zero();
-  Vec3 scale = Vec3::Ones();
-  Mat3 rotation = Mat3::Identity();
-  std::string rotation_text;  ///< how R was obtained
-  double device_id = 0.0;     ///< the sensor's device id (0 when unknown)
-  std::string id_source;      ///< where the device id came from
-};
-
-/// PX4's thermal offset of one sensor (TemperatureCompensation): with T clamped to
-/// [t_min_c, t_max_c] and dT = T - t_ref_c, offset_i = x[0]_i + x[1]_i dT + x[2]_i dT^2 +
-/// x[3]_i dT^3 (sensor units: m/s^2 or rad/s).
-struct Thermal {
-  std::string prefix;        ///< e.g. "TC_A1"
-  double t_ref_c = 0.0;      ///< TC_An_TREF, degC
-  double t_min_c = 0.0;      ///< TC_An_TMIN, degC
-  double t_max_c = 0.0;      ///< TC_An_TMAX, degC
-  std::array<Vec3, 4> x;     ///< TC_An_X0_* .. TC_An_X3_*, per axis
-
-  Vec3 Offset(double temp_c) const {
-    const double dt = std::clamp(temp_c, t_min_c, std::max(t_min_c, t_max_c)) - t_ref_c;
-    return x[0] + dt * (x[1] + dt * (x[2] + dt * x[3]));
-  }
-};
-
-/// A sensor temperature over time, degC at t_s (s), sorted by time.
-struct TemperatureTrack {
-  std::vector<double> t_s;
-  std::vector<double> temp_c;
-  std::string source;  ///< topic(s) it came from
-
-  /// The latest temperature at or before t_s (the first one before the track starts).
-  double At(double t) const {
-    const auto it = std::upper_bound(t_s.begin(), t_s.end(), t);
-    const std::size_t i = it == t_s.begin() ? 0 : static_cast<std::size_t>(it - t_s.begin()) - 1;
-    return temp_c[i];
-  }
-};
-
 /// The device id of the accel ("ACC") or gyro ("GYRO") behind a calibrated stream; nullopt
 /// when the log does not say. `how` explains the choice.
 std::optional<double> DeviceId(const ULog& log, const StreamSource& src, const std::string& kind,
@@ -332,112 +239,10 @@ std::optional<double> DeviceId(const ULog& log, const StreamSource& src, const s
   return imu->Value(0, static_cast<std::size_t>(c));
 }
 
-/// The correction PX4 applied for `kind` ("ACC" or "GYRO"), or nullopt with `why` set.
-std::optional<Correction> FindCorrection(const ULog& log, const StreamSource& src,
-                                         const std::string& kind, std::string* why) {
-  std::string how;
-  const std::optional<double> id = DeviceId(log, src, kind, &how);
-  int slot = -1;
-  if (id) {
-    for (int n = 0; n < kMaxCalSlots; ++n) {
-      const auto cal_id = Param(log, "CAL_" + kind + std::to_string(n) + "_ID");
-      if (cal_id && *cal_id == *id) {
-        slot = n;
-        break;
-      }
-    }
-  }
-  if (slot < 0) {
-    *why = id ? "no CAL_" + kind + "n_ID equals the device id " +
-                    Integer(*id) + " (from " + how + ")"
-              : "the log does not say which sensor it is (no device id)";
-    return std::nullopt;
-  }
-  Correction c;
-  c.prefix = "CAL_" + kind + std::to_string(slot);
-  c.device_id = *id;
-  c.id_source = how;
-  const char* axes[3] = {"X", "Y", "Z"};
-  for (int i = 0; i < 3; ++i) {
-    const auto off = Param(log, c.prefix + "_" + axes[i] + "OFF");
-    if (!off) {
-      *why = c.prefix + "_" + axes[i] + "OFF is not in the log";
-      return std::nullopt;
-    }
-    c.offset[i] = *off;
-    c.scale[i] = Param(log, c.prefix + "_" + axes[i] + "SCALE").value_or(1.0);
-  }
-  if ((c.scale.array() == 0.0).any() || !c.scale.allFinite() || !c.offset.allFinite()) {
-    *why = c.prefix + " has a zero or non-finite scale or offset";
-    return std::nullopt;
-  }
-  const auto cal_rot = Param(log, c.prefix + "_ROT");
-  if (cal_rot && *cal_rot >= 0) {
-    const auto euler = RotationEuler(*cal_rot);
-    if (!euler) {
-      *why = c.prefix + "_ROT = " + Integer(*cal_rot) + " is not a rotation plumb knows";
-      return std::nullopt;
-    }
-    c.rotation = EulerDeg(*euler);
-    c.rotation_text = c.prefix + "_ROT = " + Integer(*cal_rot);
-  } else {
-    const double board = Param(log, "SENS_BOARD_ROT").value_or(0.0);
-    const auto euler = RotationEuler(board);
-    if (!euler) {
-      *why = "SENS_BOARD_ROT = " + Integer(board) + " is not a rotation plumb knows";
-      return std::nullopt;
-    }
-    const Vec3 trim(Param(log, "SENS_BOARD_X_OFF").value_or(0.0),
-                    Param(log, "SENS_BOARD_Y_OFF").value_or(0.0),
-                    Param(log, "SENS_BOARD_Z_OFF").value_or(0.0));
-    c.rotation = EulerDeg(trim) * EulerDeg(*euler);
-    c.rotation_text = "SENS_BOARD_ROT = " + Integer(board) + ", SENS_BOARD_X/Y/Z_OFF = " +
-                      Format(trim) + " deg";
-  }
-  return c;
-}
-
-/// The TC_An / TC_Gn coefficients whose TC_*n_ID equals `device_id` (kind "A" or "G").
-std::optional<Thermal> FindThermal(const ULog& log, const std::string& kind, double device_id,
-                                   std::string* why) {
-  for (int n = 0; n < kMaxCalSlots; ++n) {
-    const std::string prefix = "TC_" + kind + std::to_string(n);
-    const auto id = Param(log, prefix + "_ID");
-    if (!id || *id != device_id) continue;
-    Thermal t;
-    t.prefix = prefix;
-    const auto ref = Param(log, prefix + "_TREF");
-    const auto tmin = Param(log, prefix + "_TMIN");
-    const auto tmax = Param(log, prefix + "_TMAX");
-    if (!ref || !tmin || !tmax) {
-      *why = prefix + "_TREF/TMIN/TMAX missing";
-      return std::nullopt;
-    }
-    t.t_ref_c = *ref;
-    t.t_min_c = *tmin;
-    t.t_max_c = *tmax;
-    for (int k = 0; k < 4; ++k) {
-      for (int i = 0; i < 3; ++i) {
-        const std::string name = prefix + "_X" + std::to_string(k) + "_" + std::to_string(i);
-        const auto v = Param(log, name);
-        if (!v) {
-          *why = name + " missing";
-          return std::nullopt;
-        }
-        t.x[static_cast<std::size_t>(k)][i] = *v;
-      }
-    }
-    return t;
-  }
-  *why = "no TC_" + kind + "n_ID equals the device id " +
-         Integer(device_id);
-  return std::nullopt;
-}
-
 /// The temperature of the sensor with `device_id` from sensor_accel/sensor_gyro (device_id,
 /// temperature) and vehicle_imu_status (accel_device_id/gyro_device_id,
 /// temperature_accel/temperature_gyro) messages; nullopt when none is logged.
-std::optional<TemperatureTrack> SensorTemperature(const ULog& log, bool accel, double device_id) {
+std::optional<Px4TemperatureTrack> SensorTemperature(const ULog& log, bool accel, double device_id) {
   std::vector<std::pair<double, double>> points;
   std::string source;
   for (const ULogTopic& t : log.topics) {
@@ -464,7 +269,7 @@ std::optional<TemperatureTrack> SensorTemperature(const ULog& log, bool accel, d
   }
   if (points.empty()) return std::nullopt;
   std::sort(points.begin(), points.end());
-  TemperatureTrack track;
+  Px4TemperatureTrack track;
   track.source = source;
   for (const auto& [when, temp] : points) {
     track.t_s.push_back(when);
@@ -473,84 +278,20 @@ std::optional<TemperatureTrack> SensorTemperature(const ULog& log, bool accel, d
   return track;
 }
 
-/// m = R^T logged ./ scale + offset (+ thermal offset at the sample's temperature), in place.
-void Undo(const Correction& c, const std::optional<Thermal>& thermal,
-          const std::optional<TemperatureTrack>& temp, const std::vector<double>& t_s,
-          std::vector<Vec3f>* v) {
-  const Mat3 rt = c.rotation.transpose();
-  for (std::size_t k = 0; k < v->size(); ++k) {
-    Vec3 m = (rt * (*v)[k].cast<double>()).cwiseQuotient(c.scale) + c.offset;
-    if (thermal && temp) m += thermal->Offset(temp->At(t_s[k]));
-    (*v)[k] = ToFloat(m);
-  }
-}
-
-std::string CalibrationNames(const ULog& log, const StreamSource& src) {
-  std::string acc_why, gyr_why;
-  const auto acc = FindCorrection(log, src, "ACC", &acc_why);
-  const auto gyr = FindCorrection(log, src, "GYRO", &gyr_why);
-  std::string out = acc ? acc->prefix + "_*" : "CAL_ACCn_*";
-  out += ", ";
-  out += gyr ? gyr->prefix + "_*" : "CAL_GYROn_*";
-  out += ", board rotation";
-  if (Param(log, "TC_A_ENABLE").value_or(0.0) == 1.0) out += ", TC_A* thermal";
-  if (Param(log, "TC_G_ENABLE").value_or(0.0) == 1.0) out += ", TC_G* thermal";
-  return out;
+/// The sensors behind a calibrated stream (sensor_combined, vehicle_imu): their device ids and
+/// logged temperatures.
+Px4Sensors SensorsOf(const ULog& log, const StreamSource& src) {
+  Px4Sensors sensors;
+  sensors.acc_id = DeviceId(log, src, "ACC", &sensors.acc_id_source);
+  sensors.gyr_id = DeviceId(log, src, "GYRO", &sensors.gyr_id_source);
+  sensors.temperature = [&log](bool accel, double device_id) {
+    return SensorTemperature(log, accel, device_id);
+  };
+  return sensors;
 }
 
 std::string Who(const StreamSource& src) {
   return std::string(KindName(src.kind)) + " instance " + std::to_string(src.instance) + ": ";
-}
-
-void UndoCorrection(const ULog& log, const StreamSource& src, Session* s) {
-  const std::string who = Who(src);
-  for (const char* kind : {"ACC", "GYRO"}) {
-    const bool acc = std::string(kind) == "ACC";
-    const std::string what = acc ? "accelerometer" : "gyroscope";
-    if (!acc && !s->series.has_gyro()) continue;
-    std::string why;
-    const auto c = FindCorrection(log, src, kind, &why);
-    if (!c) {
-      s->warnings.push_back(who + what + " taken as logged (calibrated by PX4; not undone: " +
-                            why + ")");
-      s->firmware_left.push_back(who + "PX4 " + what + " calibration (" + why + ")");
-      continue;
-    }
-    // Thermal compensation (TC_A_ENABLE / TC_G_ENABLE = 1) at the sensor's logged temperature.
-    const std::string tc = acc ? "TC_A_ENABLE" : "TC_G_ENABLE";
-    std::optional<Thermal> thermal;
-    std::optional<TemperatureTrack> temp;
-    std::string thermal_text;
-    if (Param(log, tc).value_or(0.0) == 1.0) {
-      std::string tc_why;
-      thermal = FindThermal(log, acc ? "A" : "G", c->device_id, &tc_why);
-      temp = thermal ? SensorTemperature(log, acc, c->device_id) : std::nullopt;
-      if (!thermal || !temp) {
-        if (thermal) tc_why = "no temperature of device " +
-                              Integer(c->device_id) + " in the log";
-        s->warnings.push_back(who + tc + " = 1: PX4's thermal " + what +
-                              " correction is in the samples and NOT undone (" + tc_why + ")");
-        s->firmware_left.push_back(who + "PX4 thermal " + what + " correction (" + tc_why + ")");
-        thermal.reset();
-      } else {
-        thermal_text = " + thermal offset " + thermal->prefix + "_X0..X3 (X0 " +
-                       Format(thermal->x[0]) + ", X1 " + Format(thermal->x[1]) + ", X2 " +
-                       Format(thermal->x[2]) + ", X3 " + Format(thermal->x[3]) + ", TREF " +
-                       std::to_string(thermal->t_ref_c) + " degC, clamped to [" +
-                       std::to_string(thermal->t_min_c) + ", " +
-                       std::to_string(thermal->t_max_c) + "]) at the temperature of " +
-                       temp->source;
-      }
-    }
-    Undo(*c, thermal, temp, s->series.t_s, acc ? &s->series.acc : &s->series.gyr);
-    const std::string unit = acc ? " m/s^2" : " rad/s";
-    s->warnings.push_back(who + what + " reconstructed as R^T logged ./ " + c->prefix +
-                          "_*SCALE (" + Format(c->scale) + ") + " + c->prefix + "_*OFF (" +
-                          Format(c->offset) + ")" + unit + thermal_text + ", R from " +
-                          c->rotation_text + "; " + c->prefix + " chosen by device id " +
-                          Integer(c->device_id) + " from " +
-                          c->id_source);
-  }
 }
 
 void WarnParamChanges(const ULog& log, Session* s) {
@@ -604,10 +345,9 @@ ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries
   info.has_gyro = s.has_gyro();
   info.has_temperature = s.has_temperature();
   if (src.kind != StreamKind::kSensorAccel) {
-    info.applied = CalibrationNames(log, src);
-    std::string a, g;
-    info.undoable = FindCorrection(log, src, "ACC", &a).has_value() &&
-                    (!s.has_gyro() || FindCorrection(log, src, "GYRO", &g).has_value());
+    const Px4Sensors sensors = SensorsOf(log, src);
+    info.applied = Px4AppliedText(log.params, sensors);
+    info.undoable = Px4Undoable(log.params, sensors, s.has_gyro());
   }
   return info;
 }
@@ -719,7 +459,8 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
                          infos[chosen].applied + ")");
     s.firmware_left.push_back(who + "PX4 " + infos[chosen].applied);
   } else {
-    UndoCorrection(log, *src, &s);
+    UndoPx4Correction(log.params, SensorsOf(log, *src), who, &s.series, &s.warnings,
+                      &s.firmware_left);
     WarnParamChanges(log, &s);
   }
   s.site = SiteFromULog(log);
@@ -751,10 +492,10 @@ FlightLogSummary ULogSummary(const ULog& log) {
 
 bool LooksLikeULog(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  unsigned char head[7] = {0, 0, 0, 0, 0, 0, 0};
-  in.read(reinterpret_cast<char*>(head), 7);
-  static const unsigned char kMagic[7] = {'U', 'L', 'o', 'g', 0x01, 0x12, 0x35};
-  return in.gcount() == 7 && std::equal(head, head + 7, kMagic);
+  unsigned char head[sizeof(detail::kULogMagic)] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof(head));
+  return in.gcount() == static_cast<std::streamsize>(sizeof(head)) &&
+         std::equal(head, head + sizeof(head), detail::kULogMagic);
 }
 
 }  // namespace plumb::io

@@ -18,24 +18,14 @@
 //    accel interval; unpaired accel samples are dropped. When fewer than half pair up, the
 //    stream is accelerometer-only. sensor_gyro alone is not a stream (a Session needs accel).
 //
-// PX4's correction (sensor_calibration, PX4 v1.12+; the 2016 sensors module did the same
-// with the offset/scale in the driver and the board rotation after it):
-//   logged = R ((m - thermal - CAL_ACCn_{X,Y,Z}OFF) .* CAL_ACCn_{X,Y,Z}SCALE)
-// (gyro: CAL_GYROn_*, scale 1 when the log has no CAL_GYROn_*SCALE), with R the board rotation
-// R_board = Euler(SENS_BOARD_X_OFF, SENS_BOARD_Y_OFF, SENS_BOARD_Z_OFF degrees, roll-pitch-yaw,
-// R = Rz Ry Rx) * Rot(SENS_BOARD_ROT) for an internal sensor, or Rot(CAL_ACCn_ROT) when that
-// parameter is >= 0 (external sensor). Rot(k) is PX4's rotation enum (0 none, 1..7 yaw k*45
-// deg, 8..15 roll 180 with yaw, 12 pitch 180, 16..23 roll 90/270 with yaw, 24/25 pitch
-// 90/270). n is the CAL_ACCn whose CAL_ACCn_ID equals the sensor's device id: vehicle_imu's
-// accel_device_id/gyro_device_id; for sensor_combined CAL_ACC_PRIME/CAL_GYRO_PRIME (2016
-// logs) or vehicle_imu instance 0's ids. The thermal term (TemperatureCompensation, applied
-// when TC_A_ENABLE / TC_G_ENABLE = 1) comes from the TC_An / TC_Gn set whose TC_*n_ID equals
-// the device id: with T the sensor temperature clamped to [TC_An_TMIN, TC_An_TMAX] and
-// dT = T - TC_An_TREF, thermal_i = X0_i + X1_i dT + X2_i dT^2 + X3_i dT^3 (TC_An_Xk_i).
-// T is the latest logged temperature of that device at or before the sample (sensor_accel /
-// sensor_gyro "temperature", vehicle_imu_status "temperature_accel"/"temperature_gyro").
-// Undone:  m = R^T logged ./ SCALE + OFF + thermal(T). When a parameter or the temperature is
-// missing, that part is left in the samples and the session's warnings say so.
+// PX4's correction of sensor_combined and vehicle_imu (px4_correction.h has the equations:
+// CAL_*n offsets and scales, the board rotation, the TC_*n thermal offsets) is undone with the
+// parameters of the sensor's device id: vehicle_imu's accel_device_id/gyro_device_id; for
+// sensor_combined CAL_ACC_PRIME/CAL_GYRO_PRIME (2016 logs) or vehicle_imu instance 0's ids.
+// The temperature of the thermal term is the latest logged temperature of that device at or
+// before the sample (sensor_accel / sensor_gyro "temperature", vehicle_imu_status
+// "temperature_accel"/"temperature_gyro"). When a parameter or the temperature is missing,
+// that part is left in the samples and the session's warnings say so.
 #pragma once
 
 #include <map>

@@ -8,17 +8,18 @@
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
+#include "plumb/io/px4/ulog_format.h"
 
 namespace plumb::io {
 namespace {
 
-constexpr std::uint8_t kMagic[7] = {'U', 'L', 'o', 'g', 0x01, 0x12, 0x35};
+using detail::kULogMagic;
+using detail::ULogBasicType;
+
 constexpr std::uint8_t kSyncMagic[8] = {0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, 0xBB, 0x12};
 constexpr std::size_t kFileHeaderSize = 16;
 constexpr std::size_t kMsgHeaderSize = 3;
 constexpr std::size_t kFlagBitsSize = 40;        // 8 + 8 + 3 * 8
-constexpr std::size_t kMaxDataBody = 65535 - 2;  // largest D body after the msg_id
-constexpr int kMaxNesting = 32;
 constexpr int kResyncChain = 4;  // consecutive valid headers that end a resync without D or S
 constexpr std::size_t kMinColumnBudget = 65536;  // columns allowed beyond one per input byte
 constexpr std::size_t kPreScanMinSize = std::size_t{1} << 16;  // inputs worth a counting pass
@@ -30,174 +31,12 @@ T Load(const std::uint8_t* p) {
   return v;
 }
 
-/// Size in bytes of a basic type, or nullopt for a nested type name.
-std::optional<std::pair<ULogType, std::size_t>> BasicType(std::string_view name) {
-  static const std::pair<std::string_view, std::pair<ULogType, std::size_t>> kTable[] = {
-      {"int8_t", {ULogType::kInt8, 1}},     {"uint8_t", {ULogType::kUInt8, 1}},
-      {"int16_t", {ULogType::kInt16, 2}},   {"uint16_t", {ULogType::kUInt16, 2}},
-      {"int32_t", {ULogType::kInt32, 4}},   {"uint32_t", {ULogType::kUInt32, 4}},
-      {"int64_t", {ULogType::kInt64, 8}},   {"uint64_t", {ULogType::kUInt64, 8}},
-      {"float", {ULogType::kFloat, 4}},     {"double", {ULogType::kDouble, 8}},
-      {"bool", {ULogType::kBool, 1}},       {"char", {ULogType::kChar, 1}}};
-  for (const auto& [n, t] : kTable) {
-    if (n == name) return t;
-  }
-  return std::nullopt;
-}
-
-bool IsPadding(std::string_view field) { return field.substr(0, 8) == "_padding"; }
-
 bool IsLetter(std::uint8_t c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
 
 /// The message types of ULog version 1.
 bool IsKnownType(std::uint8_t c) {
   return std::memchr("BFIMPQARDLCSO", c, 13) != nullptr && c != 0;
 }
-
-/// Parses "type name" or "type[n] name"; nullopt when malformed.
-std::optional<ULogFormatField> ParseField(std::string_view item) {
-  const std::size_t space = item.find(' ');
-  if (space == std::string_view::npos || space == 0 || space + 1 >= item.size()) {
-    return std::nullopt;
-  }
-  ULogFormatField f;
-  std::string_view type = item.substr(0, space);
-  f.name = std::string(item.substr(space + 1));
-  const std::size_t bracket = type.find('[');
-  if (bracket != std::string_view::npos) {
-    if (type.back() != ']' || bracket == 0) return std::nullopt;
-    const std::string_view digits = type.substr(bracket + 1, type.size() - bracket - 2);
-    if (digits.empty() || digits.size() > 5) return std::nullopt;
-    std::size_t n = 0;
-    for (char c : digits) {
-      if (c < '0' || c > '9') return std::nullopt;
-      n = n * 10 + static_cast<std::size_t>(c - '0');
-    }
-    if (n == 0 || n > 65535) return std::nullopt;
-    f.count = n;
-    f.is_array = true;
-    type = type.substr(0, bracket);
-  }
-  f.type = std::string(type);
-  return f;
-}
-
-/// Parses an F body "name:field;field;..."; false when malformed.
-bool ParseFormat(std::string_view text, std::string* name,
-                 std::vector<ULogFormatField>* fields) {
-  const std::size_t colon = text.find(':');
-  if (colon == std::string_view::npos || colon == 0) return false;
-  *name = std::string(text.substr(0, colon));
-  std::string_view rest = text.substr(colon + 1);
-  while (!rest.empty()) {
-    const std::size_t semi = rest.find(';');
-    const std::string_view item = rest.substr(0, semi);
-    if (!item.empty()) {
-      auto f = ParseField(item);
-      if (!f) return false;
-      fields->push_back(std::move(*f));
-    }
-    if (semi == std::string_view::npos) break;
-    rest = rest.substr(semi + 1);
-  }
-  return !fields->empty();
-}
-
-/// Resolves a subscribed format into flattened columns (see the contract in ulog.h). Sizes and
-/// column counts of resolved types are cached (a redefined format clears the cache), and the
-/// columns created over the whole log are limited to a budget proportional to the input, so
-/// that no input makes resolution slow or large.
-class FormatResolver {
- public:
-  FormatResolver(const std::map<std::string, std::vector<ULogFormatField>>& formats,
-                 std::size_t column_budget)
-      : formats_(formats), column_budget_(column_budget) {}
-
-  /// Forgets cached layouts (call when a format is redefined).
-  void Invalidate() { cache_.clear(); }
-
-  /// Fills columns, body_size, full_size and timestamp_col of `topic`; false if unresolvable
-  /// or over the column budget.
-  bool Resolve(ULogTopic* topic) {
-    const auto it = formats_.find(topic->name);
-    if (it == formats_.end()) return false;
-    const std::optional<Layout> full = LayoutOf(topic->name, 0);
-    if (!full || full->size == 0 || full->size > kMaxDataBody) return false;
-    if (full->columns > column_budget_) return false;
-    column_budget_ -= full->columns;
-    topic->full_size = full->size;
-    std::size_t trailing = 0;
-    for (auto f = it->second.rbegin(); f != it->second.rend() && IsPadding(f->name); ++f) {
-      trailing += LayoutOf(f->type, 1)->size * f->count;
-    }
-    topic->body_size = full->size - trailing;
-    topic->columns.reserve(full->columns);
-    std::size_t offset = 0;
-    Flatten(it->second, "", &offset, &topic->columns);
-    for (std::size_t c = 0; c < topic->columns.size(); ++c) {
-      const ULogColumn& col = topic->columns[c];
-      const bool time_type = col.type == ULogType::kUInt64 || col.type == ULogType::kUInt32 ||
-                             col.type == ULogType::kUInt16 || col.type == ULogType::kUInt8;
-      if (col.name == "timestamp" && time_type) {
-        topic->timestamp_col = static_cast<int>(c);
-        break;
-      }
-    }
-    return true;
-  }
-
- private:
-  struct Layout {
-    std::size_t size = 0;     ///< bytes
-    std::size_t columns = 0;  ///< non-padding basic fields after flattening
-  };
-
-  /// Layout of a type; nullopt when unknown, circular or nested deeper than kMaxNesting,
-  /// empty, or larger than a D message. Only successes are cached: they do not depend on the
-  /// depth they were computed at.
-  std::optional<Layout> LayoutOf(const std::string& type, int depth) {
-    if (const auto basic = BasicType(type)) return Layout{basic->second, 1};
-    if (depth > kMaxNesting) return std::nullopt;
-    if (const auto hit = cache_.find(type); hit != cache_.end()) return hit->second;
-    const auto it = formats_.find(type);
-    if (it == formats_.end()) return std::nullopt;
-    Layout total;
-    for (const ULogFormatField& f : it->second) {
-      const std::optional<Layout> l = LayoutOf(f.type, depth + 1);
-      if (!l || l->size == 0 || l->size > kMaxDataBody / f.count) return std::nullopt;
-      total.size += l->size * f.count;
-      if (!BasicType(f.type)) {
-        total.columns += l->columns * f.count;  // Flatten() keeps nested columns
-      } else if (!IsPadding(f.name)) {
-        total.columns += f.count;
-      }
-      if (total.size > kMaxDataBody) return std::nullopt;
-    }
-    cache_[type] = total;
-    return total;
-  }
-
-  void Flatten(const std::vector<ULogFormatField>& fields, const std::string& prefix,
-               std::size_t* offset, std::vector<ULogColumn>* out) {
-    for (const ULogFormatField& f : fields) {
-      const auto basic = BasicType(f.type);
-      for (std::size_t i = 0; i < f.count; ++i) {
-        std::string label = prefix + f.name;
-        if (f.is_array) label += "[" + std::to_string(i) + "]";
-        if (basic) {
-          if (!IsPadding(f.name)) out->push_back({std::move(label), basic->first, *offset});
-          *offset += basic->second;
-        } else {
-          Flatten(formats_.at(f.type), label + ".", offset, out);
-        }
-      }
-    }
-  }
-
-  const std::map<std::string, std::vector<ULogFormatField>>& formats_;
-  std::size_t column_budget_;
-  std::map<std::string, Layout> cache_;
-};
 
 /// Key and value of an I/P/Q/M body after its leading bytes: uint8 key_len, key, value.
 struct KeyValue {
@@ -235,7 +74,7 @@ std::string InfoText(const KeyValue& kv) {
   if (kv.type.rfind("char[", 0) == 0) {
     return std::string(reinterpret_cast<const char*>(kv.value), kv.value_size);
   }
-  if (const auto basic = BasicType(kv.type); basic && basic->second == kv.value_size) {
+  if (const auto basic = ULogBasicType(kv.type); basic && basic->second == kv.value_size) {
     const std::uint8_t* p = kv.value;
     switch (basic->first) {
       case ULogType::kInt8: return std::to_string(Load<std::int8_t>(p));
@@ -485,7 +324,7 @@ class Parser {
   void Format(const std::uint8_t* body, std::size_t size) {
     std::string name;
     std::vector<ULogFormatField> fields;
-    if (!ParseFormat(std::string_view(reinterpret_cast<const char*>(body), size), &name,
+    if (!detail::ParseULogFormat(std::string_view(reinterpret_cast<const char*>(body), size), &name,
                      &fields)) {
       return Malformed();
     }
@@ -574,7 +413,7 @@ class Parser {
   std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
   std::vector<std::uint32_t> expected_rows_;  // PreScan() counts per msg_id, or empty
   std::vector<std::size_t> expected_bytes_;   // PreScan() D body bytes per msg_id, or empty
-  FormatResolver resolver_;
+  detail::ULogFormatResolver resolver_;
   bool in_definitions_ = true;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
@@ -693,7 +532,7 @@ ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& so
                      "expected a 16-byte ULog header, the input has " + std::to_string(size) +
                          " bytes");
   }
-  if (std::memcmp(data, kMagic, sizeof(kMagic)) != 0) {
+  if (std::memcmp(data, kULogMagic, sizeof(kULogMagic)) != 0) {
     throw InputError(source, "byte 0",
                      "expected the ULog magic 'ULog' 01 12 35: not a PX4 ULog file");
   }
