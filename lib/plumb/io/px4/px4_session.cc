@@ -242,7 +242,8 @@ std::optional<double> DeviceId(const ULog& log, const StreamSource& src, const s
 /// The temperature of the sensor with `device_id` from sensor_accel/sensor_gyro (device_id,
 /// temperature) and vehicle_imu_status (accel_device_id/gyro_device_id,
 /// temperature_accel/temperature_gyro) messages; nullopt when none is logged.
-std::optional<Px4TemperatureTrack> SensorTemperature(const ULog& log, bool accel, double device_id) {
+std::optional<Px4TemperatureTrack> SensorTemperature(const ULog& log, bool accel,
+                                                     double device_id) {
   std::vector<std::pair<double, double>> points;
   std::string source;
   for (const ULogTopic& t : log.topics) {
