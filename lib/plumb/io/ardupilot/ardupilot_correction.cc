@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/units.h"
+
 namespace plumb::io {
 namespace {
 
@@ -72,8 +74,6 @@ constexpr int kCustomLast = 102;   // ROTATION_CUSTOM_2
 constexpr double kTcalReference_degc = 35.0;  // TEMP_REFERENCE
 constexpr double kTcalScale = 1e-6;           // INV_SCALE_FACTOR
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// cos and sin of a whole-degree multiple of 90 exactly, else of the angle.
 void CosSin(double deg, double* c, double* s) {
   const double quarter = deg / 90.0;
@@ -85,8 +85,8 @@ void CosSin(double deg, double* c, double* s) {
     *s = kSin[q];
     return;
   }
-  *c = std::cos(deg * kPi / 180.0);
-  *s = std::sin(deg * kPi / 180.0);
+  *c = std::cos(deg * units::kRadPerDeg);
+  *s = std::sin(deg * units::kRadPerDeg);
 }
 
 std::optional<double> Param(const std::map<std::string, double>& params, const std::string& name) {

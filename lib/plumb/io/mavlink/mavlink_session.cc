@@ -7,13 +7,13 @@
 #include <fstream>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/ardupilot_correction.h"
 
 namespace plumb::io {
 namespace {
 
-constexpr double kMilliG_m_s2 = 9.80665e-3;    // m/s^2 per mG (standard gravity / 1000)
 constexpr double kMilliRad = 1e-3;             // rad/s per mrad/s
 constexpr double kCentiDegC = 0.01;            // degC per cdegC
 constexpr double kMicro = 1e-6;                // s per µs
@@ -88,7 +88,7 @@ Units StreamUnits(Kind k, bool ardupilot) {
     u.gyr_unit = "counts";
     u.text = "raw sensor counts as sent (RAW_IMU from a non-ArduPilot autopilot)";
   } else {
-    u.acc = kMilliG_m_s2;
+    u.acc = units::kMilliG;
     u.gyr = kMilliRad;
     u.text = "mG * 9.80665e-3 -> m/s^2 and mrad/s * 1e-3 -> rad/s (steps of 1 mG and 1 mrad/s)";
   }

@@ -9,8 +9,8 @@
 //     o.acc.axes = {0, 1, 2}; o.gyr.axes = {3, 4, 5}; o.rate_hz = 100;
 //   MPU-6050 raw int16 (+-2 g, +-250 deg/s) after 4 preamble lines and a header `ax,...,gz`:
 //     o.skip_lines = 4; o.header_row = true; o.rate_hz = 100;
-//     o.acc.axes = {"ax", "ay", "az"}; o.acc.SetScale(9.80665 / 16384);
-//     o.gyr.axes = {"gx", "gy", "gz"}; o.gyr.SetScale(M_PI / 180 / 131);
+//     o.acc.axes = {"ax", "ay", "az"}; o.acc.SetScale(units::kStandardGravity / 16384);
+//     o.gyr.axes = {"gx", "gy", "gz"}; o.gyr.SetScale(units::kRadPerDeg / 131);
 //   `# time tx ty tz wx wy wz ...` comment header, unix seconds:
 //     o.time = "time"; o.acc.axes = {"tx", "ty", "tz"}; o.gyr.axes = {"wx", "wy", "wz"};
 //
