@@ -14,7 +14,7 @@
 #include "paper_methods.h"
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
-#include "plumb/io/segments_file.h"
+#include "plumb/io/text/segments_file.h"
 #include "plumb/model/model.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"

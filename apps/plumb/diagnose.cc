@@ -16,7 +16,7 @@
 #include "plumb/core/error.h"
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/diagnostics/residual_analysis.h"
-#include "plumb/io/atomic_file.h"
+#include "plumb/io/common/atomic_file.h"
 #include "plumb/report/diagnosis_json.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"

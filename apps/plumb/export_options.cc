@@ -5,7 +5,7 @@
 #include "commands.h"
 #include "plumb/core/error.h"
 #include "plumb/export/export.h"
-#include "plumb/io/atomic_file.h"
+#include "plumb/io/common/atomic_file.h"
 
 namespace plumb::cli {
 

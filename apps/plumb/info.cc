@@ -11,7 +11,7 @@
 
 #include "commands.h"
 #include "plumb/core/error.h"
-#include "plumb/io/flight_log_file.h"
+#include "plumb/io/input/flight_log_file.h"
 #include "plumb/report/json_report.h"
 #include "plumb/segmentation/still_detector.h"
 #include "segment_options.h"

@@ -3,25 +3,14 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
-#include <optional>
+#include <cstdlib>
 #include <sstream>
 
 #include "commands.h"
-#include "plumb/core/error.h"
-#include "plumb/io/flight_log_file.h"
-#include "plumb/io/native_csv.h"
+#include "plumb/io/input/open_inputs.h"
 
 namespace plumb::cli {
 namespace {
-
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
-constexpr double kDegToRad = M_PI / 180.0;
-/// Time gap put between joined inputs whose clocks overlap, s: longer than the calibrator's
-/// longest integrated motion (120 s), so no motion is assumed across files.
-constexpr double kJoinGap_s = 1000.0;
 
 const char* const kTableHint =
     "describe the table, e.g. --columns t,ax,ay,az,gx,gy,gz (by position; '-' skips a column, "
@@ -57,42 +46,6 @@ char Delimiter(const std::string& name) {
   throw UsageError("--delimiter must be one of , ; tab space (got '" + name + "')");
 }
 
-/// The first line that is neither blank nor a comment, or "" when there is none.
-std::string FirstContentLine(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
-  std::string line;
-  for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const auto first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;
-    return line;
-  }
-  return "";
-}
-
-bool IsNativeHeader(const std::string& line) {
-  int found = 0;
-  for (const auto& name : SplitList(line, ',')) {
-    found += name == "time_s" || name == "acc_x" || name == "acc_y" || name == "acc_z";
-  }
-  return found == 4;
-}
-
-/// Reads one file in the native format, or fails telling how to describe another layout.
-Session ReadNative(const std::string& path, bool insist) {
-  const std::string first = FirstContentLine(path);
-  // An empty file (or a missing one) gets the reader's own message.
-  if (first.empty()) return io::ReadNativeCsv(path);
-  if (!insist && !IsNativeHeader(first)) {
-    throw InputError(path, "",
-                     "not plumb's native CSV (header time_s,acc_x,acc_y,acc_z[,gyr_x,gyr_y,gyr_z]"
-                     "[,temp_c] expected, found '" +
-                         first.substr(0, 60) + "'); " + kTableHint);
-  }
-  return io::ReadNativeCsv(path);
-}
-
 std::array<int, 3> AxisMap(const std::string& text) {
   const auto items = SplitList(text, ',');
   std::array<int, 3> map{};
@@ -107,73 +60,98 @@ std::array<int, 3> AxisMap(const std::string& text) {
   return map;
 }
 
-/// Applies the --columns spec. Tokens: t, ax ay az, gx gy gz, temp, '-' (or empty) to skip;
-/// in two-file form t, x, y, z.
-void AssignColumns(const std::string& spec, bool split, io::TextTableOptions& o) {
+/// Applies the --columns spec of a one-file table. Tokens: t, ax ay az, gx gy gz, temp, '-'
+/// (or empty) to skip.
+io::TableColumns TableColumns(const std::string& spec, double rate_hz) {
+  io::TableColumns c;
   const auto tokens = SplitList(spec, ',');
   for (std::size_t i = 0; i < tokens.size(); ++i) {
     const std::string& tok = tokens[i];
-    const int index = static_cast<int>(i);
-    const auto set_once = [&](io::Column& column) {
-      if (column.given()) throw UsageError("--columns names '" + tok + "' twice in '" + spec + "'");
-      column = index;
+    const auto set_once = [&](int& column) {
+      if (column >= 0) throw UsageError("--columns names '" + tok + "' twice in '" + spec + "'");
+      column = static_cast<int>(i);
     };
     if (tok == "-" || tok.empty()) continue;
     if (tok == "t" || tok == "time") {
-      set_once(o.time);
-    } else if (!split && (tok == "temp" || tok == "temp_c")) {
-      set_once(o.temp.column);
-    } else if (split && tok.size() == 1 && tok[0] >= 'x' && tok[0] <= 'z') {
-      set_once(o.acc.axes[static_cast<std::size_t>(tok[0] - 'x')]);
-      o.gyr.axes[static_cast<std::size_t>(tok[0] - 'x')] = index;
-    } else if (!split && tok.size() == 2 && (tok[0] == 'a' || tok[0] == 'g') && tok[1] >= 'x' &&
+      set_once(c.time);
+    } else if (tok == "temp" || tok == "temp_c") {
+      set_once(c.temp);
+    } else if (tok.size() == 2 && (tok[0] == 'a' || tok[0] == 'g') && tok[1] >= 'x' &&
                tok[1] <= 'z') {
-      auto& triad = tok[0] == 'a' ? o.acc : o.gyr;
-      set_once(triad.axes[static_cast<std::size_t>(tok[1] - 'x')]);
+      auto& triad = tok[0] == 'a' ? c.acc : c.gyr;
+      set_once(triad[static_cast<std::size_t>(tok[1] - 'x')]);
     } else {
-      throw UsageError("--columns: unknown column '" + tok + "' in '" + spec + "'; use " +
-                       (split ? "t, x, y, z" : "t, ax, ay, az, gx, gy, gz, temp") +
-                       " or - to skip a column");
+      throw UsageError("--columns: unknown column '" + tok + "' in '" + spec +
+                       "'; use t, ax, ay, az, gx, gy, gz, temp or - to skip a column");
     }
   }
-  const auto complete = [](const io::TriadColumns& t) {
-    return t.axes[0].given() && t.axes[1].given() && t.axes[2].given();
+  const auto given = [](const std::array<int, 3>& t, bool all) {
+    return all ? t[0] >= 0 && t[1] >= 0 && t[2] >= 0 : t[0] >= 0 || t[1] >= 0 || t[2] >= 0;
   };
-  if (!complete(o.acc)) {
+  if (!given(c.acc, true)) {
     throw UsageError("--columns '" + spec + "' must name all three accelerometer columns (" +
-                     (split ? "x,y,z" : "ax,ay,az") + ")");
+                     "ax,ay,az)");
   }
-  if (o.gyr.given() && !complete(o.gyr)) {
+  if (given(c.gyr, false) && !given(c.gyr, true)) {
     throw UsageError("--columns '" + spec + "' names only part of the gyroscope (gx,gy,gz)");
   }
-  if (!o.time.given() && !(o.rate_hz > 0)) {
+  if (c.time < 0 && !(rate_hz > 0)) {
     throw UsageError("--columns '" + spec + "' has no time column (t): give --rate HZ");
   }
+  return c;
 }
 
-/// Joins `next` after `joined`, keeping the clock when it increases.
-void Append(Session& joined, Session next) {
-  ImuSeries& a = joined.series;
-  ImuSeries& b = next.series;
-  if (a.has_gyro() != b.has_gyro() || a.has_temperature() != b.has_temperature()) {
-    throw Error("cannot join " + next.source + " to " + joined.source +
-                ": one has a gyroscope or temperature column that the other lacks");
+/// Applies the --columns spec of the two-file form: t, x, y, z, '-' (or empty) to skip.
+io::TwoTableColumns TwoTableColumns(const std::string& spec, double rate_hz) {
+  io::TwoTableColumns c;
+  c.time = -1;
+  c.xyz = {-1, -1, -1};
+  const auto tokens = SplitList(spec, ',');
+  for (std::size_t i = 0; i < tokens.size(); ++i) {
+    const std::string& tok = tokens[i];
+    const auto set_once = [&](int& column) {
+      if (column >= 0) throw UsageError("--columns names '" + tok + "' twice in '" + spec + "'");
+      column = static_cast<int>(i);
+    };
+    if (tok == "-" || tok.empty()) continue;
+    if (tok == "t" || tok == "time") {
+      set_once(c.time);
+    } else if (tok.size() == 1 && tok[0] >= 'x' && tok[0] <= 'z') {
+      set_once(c.xyz[static_cast<std::size_t>(tok[0] - 'x')]);
+    } else {
+      throw UsageError("--columns: unknown column '" + tok + "' in '" + spec +
+                       "'; use t, x, y, z or - to skip a column");
+    }
   }
-  double shift = 0.0;
-  if (!a.empty() && !b.empty() && b.t_s.front() <= a.t_s.back()) {
-    shift = a.t_s.back() + kJoinGap_s - b.t_s.front();
-    joined.warnings.push_back(next.source +
-                              ": its times overlap the previous input's; shifted by " +
-                              std::to_string(shift) + " s (no motion assumed between files)");
+  if (c.xyz[0] < 0 || c.xyz[1] < 0 || c.xyz[2] < 0) {
+    throw UsageError("--columns '" + spec + "' must name all three accelerometer columns (" +
+                     "x,y,z)");
   }
-  for (double t : b.t_s) a.t_s.push_back(t + shift);
-  a.acc.insert(a.acc.end(), b.acc.begin(), b.acc.end());
-  a.gyr.insert(a.gyr.end(), b.gyr.begin(), b.gyr.end());
-  a.temp_c.insert(a.temp_c.end(), b.temp_c.begin(), b.temp_c.end());
-  joined.source += " " + next.source;
-  for (auto& w : next.warnings) joined.warnings.push_back(next.source + ": " + w);
-  for (auto& l : next.firmware_left) joined.firmware_left.push_back(next.source + ": " + l);
-  if (!joined.site) joined.site = next.site;
+  if (c.time < 0 && !(rate_hz > 0)) {
+    throw UsageError("--columns '" + spec + "' has no time column (t): give --rate HZ");
+  }
+  return c;
+}
+
+/// Turns the flags that describe a table (one-file, or each file of the two-file form when
+/// `two_files`) into `o`: --delimiter, --columns, --acc-scale, --gyr-scale, --axis-map, in that
+/// order. Returns the message of the first malformed one, "" when all are well formed. A
+/// malformed table flag is refused only when a table is read (see ReadInputs).
+std::string TableFlags(const InputArgs& a, bool two_files, io::InputOptions* o) {
+  try {
+    o->delimiter = Delimiter(a.delimiter);
+    if (two_files) {
+      o->two_table_columns = TwoTableColumns(a.columns.empty() ? "t,x,y,z" : a.columns, a.rate_hz);
+    } else {
+      o->columns = TableColumns(a.columns, a.rate_hz);
+    }
+    o->acc.scale = ParseScale(a.acc_scale, "--acc-scale");
+    o->gyr.scale = ParseScale(a.gyr_scale, "--gyr-scale");
+    o->axis_map = AxisMap(a.axis_map);
+  } catch (const UsageError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 bool TableOptionsGiven(const InputArgs& args) {
@@ -181,6 +159,72 @@ bool TableOptionsGiven(const InputArgs& args) {
     if (o->count() > 0) return true;
   }
   return false;
+}
+
+/// The library's options from the flags, with `before_read` refusing, input by input, what the
+/// command line does not accept for that kind of input: a malformed INPUT, the two-file form
+/// with --format native, --format table without --columns, malformed table flags when a table
+/// is read, table flags given in vain to a native CSV. `inputs` are the INPUT texts as given
+/// (`acc,gyr` pairs included); the options refer to them and must not outlive them.
+io::InputOptions MakeInputOptions(const InputArgs& a, const std::vector<std::string>& inputs) {
+  io::InputOptions o;
+  const bool table_asked = a.format == "table" || !a.columns.empty();
+  o.format = table_asked             ? io::InputFormat::kTable
+             : a.format == "native" ? io::InputFormat::kNative
+                                     : io::InputFormat::kAuto;
+  const std::string two_table_error = TableFlags(a, true, &o);
+  const std::string table_error = TableFlags(a, false, &o);
+  o.skip_lines = a.skip_lines;
+  o.header_row = a.header;
+  o.comment_prefix = a.comment;
+  o.time_unit_s = a.time_unit_s;
+  o.rate_hz = a.rate_hz;
+  o.drop_nan_rows = a.drop_nan;
+  o.acc.unit = a.acc_unit == "g"        ? io::AccUnit::kStandardGravity
+               : a.acc_unit == "counts" ? io::AccUnit::kCounts
+                                        : io::AccUnit::kMetersPerSecond2;
+  o.gyr.unit = a.gyr_unit == "deg/s"    ? io::GyrUnit::kDegreesPerSecond
+               : a.gyr_unit == "counts" ? io::GyrUnit::kCounts
+                                        : io::GyrUnit::kRadiansPerSecond;
+  o.acc.offset = a.acc_offset;
+  o.gyr.offset = a.gyr_offset;
+  o.flight_log.imu = a.imu;
+  o.flight_log.stream = a.stream;
+  if (a.from != nullptr && a.from->count() > 0) o.flight_log.from_s = a.from_s;
+  if (a.to != nullptr && a.to->count() > 0) o.flight_log.to_s = a.to_s;
+  o.flight_log.undo_correction = !a.as_logged;
+  o.not_native_hint = kTableHint;
+  o.before_read = [&a, &inputs, table_error, two_table_error](std::size_t i, io::InputKind kind) {
+    const std::string& input = inputs[i];
+    const std::size_t parts = SplitList(input, ',').size();
+    if (parts != 1 && parts != 2) {
+      throw UsageError("input '" + input + "': give one file, or two as acc.txt,gyr.txt");
+    }
+    switch (kind) {
+      case io::InputKind::kTwoTables:
+        if (a.format == "native") {
+          throw UsageError("the two-file form '" + input + "' is a table, not native CSV");
+        }
+        if (!two_table_error.empty()) throw UsageError(two_table_error);
+        break;
+      case io::InputKind::kTextTable:
+        if (a.columns.empty()) {
+          throw UsageError("--format table needs --columns; " + std::string(kTableHint));
+        }
+        if (!table_error.empty()) throw UsageError(table_error);
+        break;
+      case io::InputKind::kNativeCsv:
+        if (TableOptionsGiven(a)) {
+          throw UsageError(
+              "table options (--rate, --skip-lines, ...) describe a text table: give "
+              "--columns too");
+        }
+        break;
+      case io::InputKind::kFlightLog:
+        break;
+    }
+  };
+  return o;
 }
 
 }  // namespace
@@ -283,26 +327,6 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
   };
 }
 
-io::TextTableOptions MakeTableOptions(const InputArgs& a, bool split) {
-  io::TextTableOptions o;
-  o.delimiter = Delimiter(a.delimiter);
-  o.skip_lines = a.skip_lines;
-  o.header_row = a.header;
-  o.comment_prefix = a.comment;
-  o.time_unit_s = a.time_unit_s;
-  o.rate_hz = a.rate_hz;
-  o.allow_nan_rows = a.drop_nan;
-  AssignColumns(a.columns.empty() && split ? "t,x,y,z" : a.columns, split, o);
-  const double acc_unit = a.acc_unit == "g" ? kStandardGravity : 1.0;
-  const double gyr_unit = a.gyr_unit == "deg/s" ? kDegToRad : 1.0;
-  o.acc.SetScale(ParseScale(a.acc_scale, "--acc-scale") * acc_unit);
-  o.gyr.SetScale(ParseScale(a.gyr_scale, "--gyr-scale") * gyr_unit);
-  o.acc.SetOffset(a.acc_offset);
-  o.gyr.SetOffset(a.gyr_offset);
-  o.acc.axis_map = o.gyr.axis_map = AxisMap(a.axis_map);
-  return o;
-}
-
 Session ReadInputs(const InputArgs& a) {
   std::vector<std::string> inputs = a.inputs;
   if (!a.acc_file.empty() || !a.gyr_file.empty()) {
@@ -312,51 +336,15 @@ Session ReadInputs(const InputArgs& a) {
     inputs.push_back(a.acc_file + "," + a.gyr_file);
   }
   if (inputs.empty()) throw UsageError("no input: give INPUT files (or --acc FILE --gyr FILE)");
-  const bool table_asked = a.format == "table" || !a.columns.empty();
   if (a.format == "native" && TableOptionsGiven(a)) {
     throw UsageError("--format native takes no table options (--columns, --rate, ...)");
   }
-  std::optional<Session> joined;
-  for (const auto& input : inputs) {
+  std::vector<io::InputFile> files;
+  for (const std::string& input : inputs) {
     const auto parts = SplitList(input, ',');
-    Session s;
-    if (parts.size() == 2) {
-      if (a.format == "native")
-        throw UsageError("the two-file form '" + input + "' is a table, not native CSV");
-      s = io::ReadSplitTables(parts[0], parts[1], MakeTableOptions(a, true));
-    } else if (parts.size() != 1) {
-      throw UsageError("input '" + input + "': give one file, or two as acc.txt,gyr.txt");
-    } else if (!table_asked && a.format != "native" &&
-               io::SniffFlightLog(input) != io::FlightLogFormat::kNone) {
-      io::FlightLogSelection o;
-      o.imu = a.imu;
-      o.stream = a.stream;
-      if (a.from != nullptr && a.from->count() > 0) o.from_s = a.from_s;
-      if (a.to != nullptr && a.to->count() > 0) o.to_s = a.to_s;
-      o.undo_correction = !a.as_logged;
-      s = io::FlightLog::Open(input).Select(o);
-    } else if (table_asked) {
-      if (a.columns.empty())
-        throw UsageError("--format table needs --columns; " + std::string(kTableHint));
-      s = io::ReadTextTable(input, MakeTableOptions(a, false));
-    } else {
-      if (TableOptionsGiven(a)) {
-        throw UsageError(
-            "table options (--rate, --skip-lines, ...) describe a text table: give "
-            "--columns too");
-      }
-      s = ReadNative(input, a.format == "native");
-    }
-    if (a.acc_unit == "counts") s.series.acc_unit = "counts";
-    if (a.gyr_unit == "counts") s.series.gyr_unit = "counts";
-    if (!joined) {
-      joined = std::move(s);
-    } else {
-      Append(*joined, std::move(s));
-    }
+    files.push_back(parts.size() == 2 ? io::InputFile(parts[0], parts[1]) : io::InputFile(input));
   }
-  if (joined->series.empty()) throw Error(joined->source + ": no samples");
-  return std::move(*joined);
+  return io::OpenInputs(files, MakeInputOptions(a, inputs));
 }
 
 }  // namespace plumb::cli

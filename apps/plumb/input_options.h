@@ -1,4 +1,6 @@
-// apps/plumb/input_options.h — how `plumb calibrate` reads its INPUT files.
+// apps/plumb/input_options.h — how `plumb calibrate` (and diagnose, report, paper) reads its
+// INPUT files: the flags, turned into the options of plumb::io::OpenInputs
+// (lib/plumb/io/input/open_inputs.h), which reads and joins the inputs.
 //
 // Three forms, chosen by the command line:
 //   native CSV    the default: the header time_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z[,temp_c]
@@ -13,6 +15,8 @@
 // --gyr-unit rad/s|deg/s); --axis-map then turns sensor axes into body FRD axes.
 // Several INPUTs are joined one after the other into one session (times kept when they
 // increase, otherwise shifted, with a warning, so that no motion is assumed between files).
+// Flag mistakes are UsageErrors (exit 2); a table flag is checked only when a table is read
+// (a flight log or native CSV ignores it), input by input, as before.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -21,7 +25,6 @@
 #include <vector>
 
 #include "plumb/core/session.h"
-#include "plumb/io/text_table.h"
 
 namespace plumb::cli {
 
@@ -59,13 +62,9 @@ struct InputArgs {
 /// Registers INPUT... and every input option on `app`.
 void AddInputOptions(CLI::App* app, InputArgs& args);
 
-/// The text-table options described by the arguments; `split` selects the two-file meaning
-/// of --columns (t, x, y, z). Throws UsageError for malformed values.
-io::TextTableOptions MakeTableOptions(const InputArgs& args, bool split);
-
-/// Reads every input and joins them into one session (see the file comment). Throws
-/// UsageError for contradictory options, plumb::InputError naming the file for bad input,
-/// plumb::Error when the session has no samples.
+/// Reads every input and joins them into one session (plumb::io::OpenInputs). Throws
+/// UsageError for contradictory or malformed options, plumb::InputError naming the file for bad
+/// input, plumb::Error when the session has no samples.
 Session ReadInputs(const InputArgs& args);
 
 /// Parses a positive scale "x" or "a/b" (e.g. "9.80665/16384"); throws UsageError naming

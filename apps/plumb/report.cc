@@ -22,7 +22,7 @@
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/diagnostics/residual_analysis.h"
 #include "plumb/estimation/calibrator.h"
-#include "plumb/io/atomic_file.h"
+#include "plumb/io/common/atomic_file.h"
 #include "plumb/model/model.h"
 #include "plumb/report/diagnosis_json.h"
 #include "plumb/report/figures.h"

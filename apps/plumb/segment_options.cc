@@ -1,7 +1,7 @@
 // apps/plumb/segment_options.cc — see segment_options.h.
 #include "segment_options.h"
 
-#include "plumb/io/segments_file.h"
+#include "plumb/io/text/segments_file.h"
 #include "plumb/segmentation/given_segments.h"
 
 namespace plumb::cli {

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "commands.h"
-#include "plumb/io/atomic_file.h"
-#include "plumb/io/native_csv.h"
+#include "plumb/io/common/atomic_file.h"
+#include "plumb/io/text/native_csv.h"
 #include "plumb/model/model.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/version.h"

@@ -12,8 +12,8 @@
 #include <random>
 #include <string>
 
-#include "plumb/io/native_csv.h"
-#include "plumb/io/text_table.h"
+#include "plumb/io/text/native_csv.h"
+#include "plumb/io/text/text_table.h"
 
 namespace {
 

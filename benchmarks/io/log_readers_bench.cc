@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "plumb/io/dataflash.h"
-#include "plumb/io/mavlink_tlog.h"
-#include "plumb/io/ulog.h"
+#include "plumb/io/ardupilot/dataflash.h"
+#include "plumb/io/mavlink/mavlink_tlog.h"
+#include "plumb/io/px4/ulog.h"
 
 namespace {
 

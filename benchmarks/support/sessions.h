@@ -6,7 +6,7 @@
 #include <string>
 
 #include "plumb/core/session.h"
-#include "plumb/io/text_table.h"
+#include "plumb/io/text/text_table.h"
 
 namespace plumb::bench {
 

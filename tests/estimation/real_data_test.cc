@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "plumb/estimation/calibrator.h"
-#include "plumb/io/text_table.h"
+#include "plumb/io/text/text_table.h"
 #include "plumb/segmentation/still_detector.h"
 #include "plumb/report/calibration_text.h"
 

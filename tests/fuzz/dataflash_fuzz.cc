@@ -6,9 +6,9 @@
 #include <cstdint>
 
 #include "plumb/core/error.h"
-#include "plumb/io/ardupilot_session.h"
-#include "plumb/io/dataflash.h"
-#include "plumb/io/flight_log.h"
+#include "plumb/io/ardupilot/ardupilot_session.h"
+#include "plumb/io/ardupilot/dataflash.h"
+#include "plumb/io/common/flight_log.h"
 
 #include "select_every_stream.h"
 

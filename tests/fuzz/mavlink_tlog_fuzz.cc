@@ -4,15 +4,16 @@
 //
 // Built by tests/fuzz/CMakeLists.txt (scripts/fuzz); by hand:
 //   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I lib -I /usr/include/eigen3 \
-//     tests/fuzz/mavlink_tlog_fuzz.cc lib/plumb/io/mavlink_tlog.cc \
-//     lib/plumb/io/mavlink_session.cc lib/plumb/io/ardupilot_params.cc lib/plumb/core/imu_series.cc
+//     tests/fuzz/mavlink_tlog_fuzz.cc lib/plumb/io/mavlink/mavlink_tlog.cc \
+//     lib/plumb/io/mavlink/mavlink_session.cc lib/plumb/io/ardupilot/ardupilot_correction.cc \
+//     lib/plumb/io/common/log_common.cc lib/plumb/core/imu_series.cc
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "plumb/core/error.h"
-#include "plumb/io/mavlink_session.h"
-#include "plumb/io/mavlink_tlog.h"
+#include "plumb/io/mavlink/mavlink_session.h"
+#include "plumb/io/mavlink/mavlink_tlog.h"
 
 #include "select_every_stream.h"
 

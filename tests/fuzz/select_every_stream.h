@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "plumb/core/error.h"
-#include "plumb/io/flight_log.h"
+#include "plumb/io/common/flight_log.h"
 
 namespace plumb::fuzz {
 

@@ -2,14 +2,14 @@
 // plumb::Error, never a crash, a hang or a huge allocation; the streams and sessions built
 // from whatever was decoded must behave the same way.
 //   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I lib -I <eigen> \
-//     tests/fuzz/ulog_fuzz.cc lib/plumb/io/ulog.cc lib/plumb/io/px4_session.cc \
-//     lib/plumb/core/imu_series.cc
+//     tests/fuzz/ulog_fuzz.cc lib/plumb/io/px4/ulog.cc lib/plumb/io/px4/px4_session.cc \
+//     lib/plumb/io/common/log_common.cc lib/plumb/core/imu_series.cc
 #include <cstddef>
 #include <cstdint>
 
 #include "plumb/core/error.h"
-#include "plumb/io/px4_session.h"
-#include "plumb/io/ulog.h"
+#include "plumb/io/px4/px4_session.h"
+#include "plumb/io/px4/ulog.h"
 
 #include "select_every_stream.h"
 

@@ -1,8 +1,8 @@
-// An ArduPilot log as a session (io/ardupilot_session.h): the INS_* correction undone, the
-// time window, the site from the GPS, on a real still log; ArduPilot's rotation table and
-// temperature polynomial (io/ardupilot_correction.h); the undo of AHRS_ORIENTATION and INS_TCAL
-// on synthetic logs made with ArduPilot's forward correction, and on a real rotated log.
-#include "plumb/io/ardupilot_session.h"
+// An ArduPilot log as a session (io/ardupilot/ardupilot_session.h): the INS_* correction undone,
+// the time window, the site from the GPS, on a real still log; ArduPilot's rotation table and
+// temperature polynomial (io/ardupilot/ardupilot_correction.h); the undo of AHRS_ORIENTATION and
+// INS_TCAL on synthetic logs made with ArduPilot's forward correction, and on a real rotated log.
+#include "plumb/io/ardupilot/ardupilot_session.h"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "plumb/core/error.h"
-#include "plumb/io/ardupilot_correction.h"
+#include "plumb/io/ardupilot/ardupilot_correction.h"
 
 namespace plumb::io {
 namespace {

@@ -1,4 +1,4 @@
-#include "plumb/io/atomic_file.h"
+#include "plumb/io/common/atomic_file.h"
 
 #include <gtest/gtest.h>
 

@@ -19,7 +19,7 @@
 #include "dataflash_builder.h"
 #include "io_test_util.h"
 #include "plumb/core/error.h"
-#include "plumb/io/dataflash.h"
+#include "plumb/io/ardupilot/dataflash.h"
 
 namespace plumb::io {
 namespace {

@@ -13,8 +13,8 @@
 
 #include "io_test_util.h"
 #include "plumb/core/error.h"
-#include "plumb/io/ardupilot_session.h"
-#include "plumb/io/dataflash.h"
+#include "plumb/io/ardupilot/ardupilot_session.h"
+#include "plumb/io/ardupilot/dataflash.h"
 
 namespace plumb::io {
 namespace {

@@ -1,7 +1,7 @@
 // FlightLog: every file in ../shared/data/{ardupilot,mavlink,px4} is recognised by content,
 // summarised, and each of its selectable IMU streams becomes a session — or the log is
 // rejected with an InputError that names the file and says why (issue 5's acceptance point).
-#include "plumb/io/flight_log_file.h"
+#include "plumb/io/input/flight_log_file.h"
 
 #include <gtest/gtest.h>
 

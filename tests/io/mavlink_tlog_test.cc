@@ -1,8 +1,8 @@
-// MAVLink tlog reader (io/mavlink_tlog.h) and its session (io/mavlink_session.h): the real
-// ../shared/data/mavlink log against golden data from an independent Python decoder
+// MAVLink tlog reader (io/mavlink/mavlink_tlog.h) and its session (io/mavlink/mavlink_session.h):
+// the real ../shared/data/mavlink log against golden data from an independent Python decoder
 // (tests/data/mavlink/decode_golden.py, see README.md there), the CRC against known values,
-// hand-built v1/v2 frames (truncated payloads, signatures, unknown ids, several systems),
-// damaged copies of the real log, and the session with ArduPilot's correction undone.
+// hand-built v1/v2 frames (truncated payloads, signatures, unknown ids, several systems), damaged
+// copies of the real log, and the session with ArduPilot's correction undone.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -21,8 +21,8 @@
 
 #include "io/io_test_util.h"
 #include "plumb/core/error.h"
-#include "plumb/io/mavlink_session.h"
-#include "plumb/io/mavlink_tlog.h"
+#include "plumb/io/mavlink/mavlink_session.h"
+#include "plumb/io/mavlink/mavlink_tlog.h"
 
 namespace plumb::io {
 namespace {

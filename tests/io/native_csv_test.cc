@@ -1,4 +1,4 @@
-#include "plumb/io/native_csv.h"
+#include "plumb/io/text/native_csv.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "plumb/io/segments_file.h"
+#include "plumb/io/text/segments_file.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "plumb/io/text_table.h"
+#include "plumb/io/text/text_table.h"
 
 namespace plumb::io {
 namespace {

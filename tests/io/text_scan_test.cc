@@ -1,5 +1,5 @@
 // The number parser's fast path must agree bit for bit with std::from_chars.
-#include "plumb/io/text_scan.h"
+#include "plumb/io/common/text_scan.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "plumb/io/text_table.h"
+#include "plumb/io/text/text_table.h"
 
 #include <gtest/gtest.h>
 

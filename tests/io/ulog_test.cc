@@ -1,4 +1,4 @@
-// PX4 ULog reader (io/ulog.h) and sessions (io/px4_session.h): every .ulg under
+// PX4 ULog reader (io/px4/ulog.h) and sessions (io/px4/px4_session.h): every .ulg under
 // ../shared/data/px4 against golden data from an independent Python decoder
 // (tests/data/px4/decode_golden.py, see README.md there), damaged copies of real logs, small
 // hand-built logs for each message type and rule, and a session on a real still period.
@@ -17,8 +17,8 @@
 
 #include "io_test_util.h"
 #include "plumb/core/error.h"
-#include "plumb/io/px4_session.h"
-#include "plumb/io/ulog.h"
+#include "plumb/io/px4/px4_session.h"
+#include "plumb/io/px4/ulog.h"
 
 namespace plumb::io {
 namespace {

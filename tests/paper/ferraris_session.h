@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "plumb/io/segments_file.h"
-#include "plumb/io/text_table.h"
+#include "plumb/io/text/segments_file.h"
+#include "plumb/io/text/text_table.h"
 #include "plumb/paper/benchmark.h"
 
 namespace plumb::paper::testing {

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "plumb/core/error.h"
-#include "plumb/io/atomic_file.h"
+#include "plumb/io/common/atomic_file.h"
 
 extern char** environ;
 

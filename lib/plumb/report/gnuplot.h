@@ -6,7 +6,7 @@
 // is set with posix_spawn_file_actions_addchdir_np, glibc 2.29 or later), its working folder
 // is the output folder, its stdin is /dev/null and its stdout and stderr go to LOG in that
 // folder (the library never prints). Data and script files are written atomically
-// (plumb/io/atomic_file.h); the PNGs are gnuplot's own.
+// (plumb/io/common/atomic_file.h); the PNGs are gnuplot's own.
 //
 // A missing gnuplot is not an error: the outcome says so (`ran` false, `message` naming the
 // program and how to install it), the data and the script stay in the folder so that the

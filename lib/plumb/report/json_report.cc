@@ -4,7 +4,7 @@
 #include <cmath>
 #include <map>
 
-#include "plumb/io/atomic_file.h"
+#include "plumb/io/common/atomic_file.h"
 #include "plumb/report/version.h"
 
 namespace plumb::report {

@@ -1,0 +1,41 @@
+// plumb/io/common/atomic_file.h — output files written atomically (SPEC section 8).
+//
+// The content goes to a temporary file in the destination's folder (`.<name>.tmp.XXXXXX`),
+// is flushed to disk (fsync) and then renamed over the destination, so a reader never sees a
+// half-written file and a failed write leaves the old file untouched. New files get mode 0644.
+// Failures throw plumb::Error naming the destination path and the system's reason.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace plumb::io {
+
+/// Writes `content` to `path` atomically (temporary file in the same folder, then rename).
+void WriteFileAtomic(const std::string& path, std::string_view content);
+
+/// Streams a large file atomically: Write() any number of times, then Commit(). Without a
+/// successful Commit() (an exception, an early return) the destructor removes the temporary
+/// file and the destination is left as it was. Not copyable.
+class AtomicFileWriter {
+ public:
+  /// Creates the temporary file next to `path`; throws plumb::Error if the folder is not
+  /// writable or does not exist.
+  explicit AtomicFileWriter(std::string path);
+  ~AtomicFileWriter();
+  AtomicFileWriter(const AtomicFileWriter&) = delete;
+  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+
+  /// Appends bytes to the temporary file.
+  void Write(std::string_view bytes);
+  /// Flushes, closes and renames the temporary file over the destination.
+  void Commit();
+
+ private:
+  [[noreturn]] void Fail(const std::string& action);
+  std::string path_;
+  std::string temp_path_;
+  int fd_ = -1;
+};
+
+}  // namespace plumb::io

@@ -1,0 +1,66 @@
+// plumb/io/common/flight_log.h — what every flight-log reader offers, whatever the format.
+//
+// A flight log (ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg) holds one
+// or more IMU streams: a message or topic carrying accelerometer and/or gyroscope samples of
+// one sensor instance (ArduPilot IMU/IMU2/ACC/GYR/ISBD, MAVLink RAW_IMU/SCALED_IMU2/HIGHRES_IMU,
+// PX4 sensor_combined/sensor_accel/vehicle_imu). Each format's reader lists its streams as
+// ImuStreamInfo and turns one of them into a Session from a FlightLogSelection, undoing what the
+// firmware applied before logging when the log says what that was.
+//
+// ReadFlightLog()/FlightLogSession() dispatch on the file's content (not its name).
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "plumb/core/session.h"
+
+namespace plumb::io {
+
+/// One IMU stream of a log.
+struct ImuStreamInfo {
+  std::string name;          ///< message or topic name, e.g. "IMU2", "SCALED_IMU2", "sensor_combined"
+  int instance = 0;          ///< sensor instance, 0-based, >= 0
+  std::size_t samples = 0;   ///< samples in the log
+  double rate_hz = 0.0;      ///< (samples - 1) / (t_end_s - t_start_s), Hz; 0 when undefined
+  double t_start_s = 0.0;    ///< first sample's log time, s
+  double t_end_s = 0.0;      ///< last sample's log time, s
+  bool has_accel = true;     ///< the stream carries accelerometer samples
+  bool has_gyro = true;      ///< the stream carries gyroscope samples
+  bool has_temperature = false;  ///< the stream carries a sensor temperature
+  /// What the firmware applied before logging, as the log states it: empty for the sensor's
+  /// own output ("raw"), else e.g. "INS_ACCOFFS/INS_ACCSCAL, INS_GYROFFS" or "CAL_ACC0_*".
+  std::string applied;
+  /// True when the reader can undo `applied` from the log's own parameters.
+  bool undoable = false;
+};
+
+/// Which samples of a log become the session.
+struct FlightLogSelection {
+  int imu = 0;                   ///< sensor instance, 0-based, >= 0
+  /// Stream (message or topic) name; empty means the reader's default stream for `imu` (the
+  /// one carrying both accelerometer and gyroscope at the highest rate).
+  std::string stream;
+  std::optional<double> from_s;  ///< keep samples at or after this log time, s
+  std::optional<double> to_s;    ///< keep samples at or before this log time, s
+  bool undo_correction = true;   ///< recover the sensor's own output from the log's parameters
+};
+
+/// A flight log's contents as `plumb info` shows them.
+struct FlightLogSummary {
+  std::string source;                  ///< file name
+  std::string format;                  ///< "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog"
+  std::string format_detail;           ///< e.g. "MAVLink v1+v2, 41230 frames", "ULog version 1"
+  std::size_t size_bytes = 0;          ///< file size, bytes
+  std::vector<ImuStreamInfo> imus;     ///< every IMU stream
+  std::optional<SiteInput> site;       ///< from the log's GPS, when it has a fix
+  std::map<std::string, double> params;  ///< the calibration parameters in force (firmware names)
+  std::vector<std::pair<std::string, std::size_t>> messages;  ///< (message, count), log order
+  std::vector<std::string> warnings;   ///< what the reader skipped or repaired, with counts
+};
+
+}  // namespace plumb::io

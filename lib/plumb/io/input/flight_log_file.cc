@@ -1,0 +1,121 @@
+// plumb/io/input/flight_log_file.cc — see flight_log_file.h.
+#include "plumb/io/input/flight_log_file.h"
+
+#include <algorithm>
+
+#include "plumb/core/error.h"
+#include "plumb/io/ardupilot/ardupilot_session.h"
+#include "plumb/io/mavlink/mavlink_session.h"
+#include "plumb/io/px4/px4_session.h"
+
+namespace plumb::io {
+namespace {
+
+/// ArduPilot's parameters that shape the logged IMU samples.
+bool IsArdupilotCalibrationParameter(const std::string& name) {
+  for (const char* prefix : {"INS_ACC", "INS_GYR", "INS_TCAL", "AHRS_ORIENTATION"}) {
+    if (name.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+
+FlightLogSummary DataflashSummary(const DataflashLog& log, FlightLogFormat format) {
+  FlightLogSummary out;
+  out.source = log.source;
+  out.format = FlightLogFormatName(format);
+  out.format_detail = format == FlightLogFormat::kDataflashText
+                          ? "ArduPilot text log"
+                          : "ArduPilot DataFlash binary log";
+  out.size_bytes = log.size_bytes;
+  out.imus = DataflashImuStreams(log);
+  out.site = SiteFromDataflash(log);
+  for (const auto& [name, value] : log.params) {
+    if (IsArdupilotCalibrationParameter(name)) out.params[name] = value;
+  }
+  out.messages = log.MessageCounts();
+  out.warnings = log.warnings.Describe();
+  return out;
+}
+
+}  // namespace
+
+FlightLogFormat SniffFlightLog(const std::string& path) {
+  if (LooksLikeDataflash(path)) return FlightLogFormat::kDataflashBinary;
+  if (LooksLikeULog(path)) return FlightLogFormat::kPx4ULog;
+  if (LooksLikeTlog(path)) return FlightLogFormat::kMavlinkTlog;
+  if (LooksLikeDataflashText(path)) return FlightLogFormat::kDataflashText;
+  return FlightLogFormat::kNone;
+}
+
+const char* FlightLogFormatName(FlightLogFormat format) {
+  switch (format) {
+    case FlightLogFormat::kDataflashBinary:
+      return "ardupilot-dataflash";
+    case FlightLogFormat::kDataflashText:
+      return "ardupilot-text";
+    case FlightLogFormat::kMavlinkTlog:
+      return "mavlink-tlog";
+    case FlightLogFormat::kPx4ULog:
+      return "px4-ulog";
+    case FlightLogFormat::kNone:
+      break;
+  }
+  return "none";
+}
+
+FlightLog FlightLog::Open(const std::string& path) {
+  FlightLog out;
+  out.source_ = path;
+  out.format_ = SniffFlightLog(path);
+  switch (out.format_) {
+    case FlightLogFormat::kDataflashBinary:
+      out.log_ = ReadDataflash(path);
+      break;
+    case FlightLogFormat::kDataflashText:
+      out.log_ = ReadDataflashText(path);
+      break;
+    case FlightLogFormat::kMavlinkTlog:
+      out.log_ = ReadTlog(path);
+      break;
+    case FlightLogFormat::kPx4ULog:
+      out.log_ = ReadULog(path);
+      break;
+    case FlightLogFormat::kNone:
+      throw InputError(path, "byte 0",
+                       "not a flight log plumb reads (ArduPilot DataFlash .bin or text .log, "
+                       "MAVLink .tlog, PX4 ULog .ulg)");
+  }
+  return out;
+}
+
+FlightLogSummary FlightLog::Summary() const {
+  switch (format_) {
+    case FlightLogFormat::kDataflashBinary:
+    case FlightLogFormat::kDataflashText:
+      return DataflashSummary(std::get<DataflashLog>(log_), format_);
+    case FlightLogFormat::kMavlinkTlog:
+      return TlogSummary(std::get<MavlinkLog>(log_));
+    case FlightLogFormat::kPx4ULog:
+      return ULogSummary(std::get<ULog>(log_));
+    case FlightLogFormat::kNone:
+      break;
+  }
+  throw Error("FlightLog::Summary: no log");
+}
+
+Session FlightLog::Select(const FlightLogSelection& selection) const {
+  switch (format_) {
+    case FlightLogFormat::kDataflashBinary:
+    case FlightLogFormat::kDataflashText:
+      return ArdupilotSession(std::get<DataflashLog>(log_), selection);
+    case FlightLogFormat::kMavlinkTlog:
+      return TlogSession(std::get<MavlinkLog>(log_), selection);
+    case FlightLogFormat::kPx4ULog:
+      return ULogSession(std::get<ULog>(log_), selection);
+    case FlightLogFormat::kNone:
+      break;
+  }
+  throw Error("FlightLog::Select: no log");
+}
+
+}  // namespace plumb::io

@@ -1,0 +1,65 @@
+// plumb/io/input/flight_log_file.h — any flight log plumb reads, opened by content: the format is
+// recognised from the file's first bytes (not its name), the log decoded once, and then its
+// summary (`plumb info`) and any number of sessions (calibrate, diagnose, report) come from it.
+//
+//   const FlightLog log = FlightLog::Open("00000042.BIN");
+//   for (const ImuStreamInfo& s : log.Summary().imus) ...;
+//   FlightLogSelection pick;  pick.imu = 1;  pick.to_s = 60.0;
+//   const Session session = log.Select(pick);   // INS_* correction undone, site from GPS
+#pragma once
+
+#include <string>
+#include <variant>
+
+#include "plumb/core/session.h"
+#include "plumb/io/ardupilot/dataflash.h"
+#include "plumb/io/common/flight_log.h"
+#include "plumb/io/mavlink/mavlink_tlog.h"
+#include "plumb/io/px4/ulog.h"
+
+namespace plumb::io {
+
+/// The flight-log formats plumb reads.
+enum class FlightLogFormat {
+  kNone,             ///< not a flight log plumb knows (a text table, say)
+  kDataflashBinary,  ///< ArduPilot DataFlash .bin (0xA3 0x95 records)
+  kDataflashText,    ///< ArduPilot text log .log ("FMT, ..." lines)
+  kMavlinkTlog,      ///< MAVLink telemetry log .tlog (time-stamped v1/v2 frames)
+  kPx4ULog,          ///< PX4 ULog .ulg ("ULog" magic)
+};
+
+/// The format of the file at `path`, from its first bytes; kNone when it is none of them or
+/// cannot be read.
+FlightLogFormat SniffFlightLog(const std::string& path);
+
+/// "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog" ("none" for kNone).
+const char* FlightLogFormatName(FlightLogFormat format);
+
+/// A decoded flight log of any supported format.
+class FlightLog {
+ public:
+  /// Reads and decodes the log at `path`. Throws plumb::InputError naming the file when it is
+  /// not a flight log plumb reads, and as the format's reader does.
+  static FlightLog Open(const std::string& path);
+
+  FlightLogFormat format() const { return format_; }
+  const std::string& source() const { return source_; }
+
+  /// Every IMU stream, the site, the calibration parameters in force, the message counts and
+  /// the reader's warnings.
+  FlightLogSummary Summary() const;
+
+  /// The session of the selected stream, with the firmware's correction undone when
+  /// selection.undo_correction and the log says what it was (the session's warnings say which
+  /// inputs were raw and which reconstructed), the site from the log's GPS. Throws
+  /// plumb::InputError naming the log when the stream is absent or holds too few samples.
+  Session Select(const FlightLogSelection& selection) const;
+
+ private:
+  FlightLog() = default;
+  FlightLogFormat format_ = FlightLogFormat::kNone;
+  std::string source_;
+  std::variant<DataflashLog, MavlinkLog, ULog> log_;
+};
+
+}  // namespace plumb::io

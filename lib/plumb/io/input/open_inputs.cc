@@ -1,0 +1,178 @@
+// plumb/io/input/open_inputs.cc — see open_inputs.h.
+#include "plumb/io/input/open_inputs.h"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <string_view>
+
+#include "plumb/core/error.h"
+#include "plumb/core/units.h"
+#include "plumb/io/common/text_scan.h"
+#include "plumb/io/input/flight_log_file.h"
+#include "plumb/io/text/native_csv.h"
+#include "plumb/io/text/text_table.h"
+
+namespace plumb::io {
+namespace {
+
+/// Time gap put between joined inputs whose clocks overlap, s: longer than the calibrator's
+/// longest integrated motion (120 s), so no motion is assumed across files.
+constexpr double kJoinGap_s = 1000.0;
+
+/// The first line that is neither blank nor a comment, or "" when there is none.
+std::string FirstContentLine(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
+  std::string line;
+  for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    return line;
+  }
+  return "";
+}
+
+/// True when the comma-separated `line` names time_s, acc_x, acc_y and acc_z.
+bool IsNativeHeader(std::string_view line) {
+  int found = 0;
+  detail::FieldCursor fields(line, ',');
+  std::string_view name;
+  while (fields.Next(name)) {
+    found += name == "time_s" || name == "acc_x" || name == "acc_y" || name == "acc_z";
+  }
+  return found == 4;
+}
+
+/// Reads one file in the native format; unless `insist`, first checks its header and fails
+/// with `hint` when it is not native CSV.
+Session ReadNative(const std::string& path, bool insist, const std::string& hint) {
+  const std::string first = FirstContentLine(path);
+  // An empty file (or a missing one) gets the reader's own message.
+  if (first.empty()) return ReadNativeCsv(path);
+  if (!insist && !IsNativeHeader(first)) {
+    throw InputError(path, "",
+                     "not plumb's native CSV (header time_s,acc_x,acc_y,acc_z[,gyr_x,gyr_y,gyr_z]"
+                     "[,temp_c] expected, found '" +
+                         first.substr(0, 60) + "'); " + hint);
+  }
+  return ReadNativeCsv(path);
+}
+
+double UnitFactor(AccUnit unit) {
+  return unit == AccUnit::kStandardGravity ? units::kStandardGravity : 1.0;
+}
+
+double UnitFactor(GyrUnit unit) {
+  return unit == GyrUnit::kDegreesPerSecond ? units::kRadPerDeg : 1.0;
+}
+
+/// The text-table options of a one-file table, or of each file of the two-file form.
+TextTableOptions TableOptions(const InputOptions& o, bool two_files) {
+  TextTableOptions t;
+  t.delimiter = o.delimiter;
+  t.skip_lines = o.skip_lines;
+  t.header_row = o.header_row;
+  t.comment_prefix = o.comment_prefix;
+  t.time_unit_s = o.time_unit_s;
+  t.rate_hz = o.rate_hz;
+  t.allow_nan_rows = o.drop_nan_rows;
+  if (two_files) {
+    const TwoTableColumns& c = o.two_table_columns;
+    if (c.time >= 0) t.time = c.time;
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (c.xyz[i] >= 0) t.acc.axes[i] = t.gyr.axes[i] = c.xyz[i];
+    }
+  } else {
+    const TableColumns& c = o.columns;
+    if (c.time >= 0) t.time = c.time;
+    if (c.temp >= 0) t.temp.column = c.temp;
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (c.acc[i] >= 0) t.acc.axes[i] = c.acc[i];
+      if (c.gyr[i] >= 0) t.gyr.axes[i] = c.gyr[i];
+    }
+  }
+  t.acc.SetScale(o.acc.scale * UnitFactor(o.acc.unit));
+  t.gyr.SetScale(o.gyr.scale * UnitFactor(o.gyr.unit));
+  t.acc.SetOffset(o.acc.offset);
+  t.gyr.SetOffset(o.gyr.offset);
+  t.acc.axis_map = t.gyr.axis_map = o.axis_map;
+  return t;
+}
+
+InputKind KindOf(const InputFile& input, const InputOptions& o) {
+  if (input.two_files) return InputKind::kTwoTables;
+  if (o.format == InputFormat::kTable) return InputKind::kTextTable;
+  if (o.format == InputFormat::kAuto && SniffFlightLog(input.path) != FlightLogFormat::kNone) {
+    return InputKind::kFlightLog;
+  }
+  return InputKind::kNativeCsv;
+}
+
+Session Read(const InputFile& input, InputKind kind, const InputOptions& o) {
+  switch (kind) {
+    case InputKind::kTwoTables:
+      if (o.format == InputFormat::kNative) {
+        throw Error(input.path + "," + input.gyr_path +
+                    ": the two-file form is a table, not native CSV");
+      }
+      return ReadSplitTables(input.path, input.gyr_path, TableOptions(o, true));
+    case InputKind::kFlightLog:
+      return FlightLog::Open(input.path).Select(o.flight_log);
+    case InputKind::kTextTable:
+      return ReadTextTable(input.path, TableOptions(o, false));
+    case InputKind::kNativeCsv:
+      break;
+  }
+  return ReadNative(input.path, o.format == InputFormat::kNative, o.not_native_hint);
+}
+
+/// Joins `next` after `joined`, keeping the clock when it increases.
+void Append(Session& joined, Session next) {
+  ImuSeries& a = joined.series;
+  ImuSeries& b = next.series;
+  if (a.has_gyro() != b.has_gyro() || a.has_temperature() != b.has_temperature()) {
+    throw Error("cannot join " + next.source + " to " + joined.source +
+                ": one has a gyroscope or temperature column that the other lacks");
+  }
+  double shift = 0.0;
+  if (!a.empty() && !b.empty() && b.t_s.front() <= a.t_s.back()) {
+    shift = a.t_s.back() + kJoinGap_s - b.t_s.front();
+    joined.warnings.push_back(next.source +
+                              ": its times overlap the previous input's; shifted by " +
+                              std::to_string(shift) + " s (no motion assumed between files)");
+  }
+  for (double t : b.t_s) a.t_s.push_back(t + shift);
+  a.acc.insert(a.acc.end(), b.acc.begin(), b.acc.end());
+  a.gyr.insert(a.gyr.end(), b.gyr.begin(), b.gyr.end());
+  a.temp_c.insert(a.temp_c.end(), b.temp_c.begin(), b.temp_c.end());
+  joined.source += " " + next.source;
+  for (auto& w : next.warnings) joined.warnings.push_back(next.source + ": " + w);
+  for (auto& l : next.firmware_left) joined.firmware_left.push_back(next.source + ": " + l);
+  if (!joined.site) joined.site = next.site;
+}
+
+}  // namespace
+
+Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& options) {
+  if (inputs.empty()) throw Error("OpenInputs: no input");
+  std::optional<Session> joined;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const InputKind kind = KindOf(inputs[i], options);
+    if (options.before_read) options.before_read(i, kind);
+    Session s = Read(inputs[i], kind, options);
+    if (options.acc.unit == AccUnit::kCounts) s.series.acc_unit = "counts";
+    if (options.gyr.unit == GyrUnit::kCounts) s.series.gyr_unit = "counts";
+    if (!joined) {
+      joined = std::move(s);
+    } else {
+      Append(*joined, std::move(s));
+    }
+  }
+  if (joined->series.empty()) throw Error(joined->source + ": no samples");
+  return std::move(*joined);
+}
+
+}  // namespace plumb::io

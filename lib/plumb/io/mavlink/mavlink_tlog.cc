@@ -1,0 +1,514 @@
+// plumb/io/mavlink/mavlink_tlog.cc — see mavlink_tlog.h for the format and the decoding contract.
+#include "plumb/io/mavlink/mavlink_tlog.h"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+
+#include "plumb/core/error.h"
+#include "plumb/io/common/log_common.h"
+
+namespace plumb::io {
+namespace {
+
+constexpr std::uint8_t kStxV1 = 0xFE;
+constexpr std::uint8_t kStxV2 = 0xFD;
+constexpr std::size_t kTimeBytes = 8;        // big-endian uint64 µs before every frame
+constexpr std::size_t kHeaderV1 = 6;         // STX len seq sys comp msgid
+constexpr std::size_t kHeaderV2 = 10;        // STX len incompat compat seq sys comp msgid[3]
+constexpr std::size_t kCrcBytes = 2;
+constexpr std::size_t kSignatureBytes = 13;
+constexpr std::uint8_t kIncompatSigned = 0x01;
+// Plausible tlog times: 2000-01-01 and 2100-01-01 in µs since the unix epoch.
+constexpr std::uint64_t kMinTimeUs = 946684800ull * 1000000ull;
+constexpr std::uint64_t kMaxTimeUs = 4102444800ull * 1000000ull;
+constexpr std::size_t kMaxPayload = 255;
+
+/// One message the reader knows: its CRC_EXTRA (common.xml; checked against the real logs
+/// under ../shared/data/mavlink, every frame of which passes) and, for decoded messages, the
+/// full payload length including extensions.
+struct KnownMessage {
+  std::uint32_t id;
+  const char* name;
+  int crc_extra;         // -1: name known (dialect-specific id), CRC not checked
+  std::size_t full_len;  // 0: not decoded
+};
+
+constexpr KnownMessage kKnown[] = {
+    {0, "HEARTBEAT", 50, 9},
+    {1, "SYS_STATUS", 124, 0},
+    {2, "SYSTEM_TIME", 137, 0},
+    {21, "PARAM_REQUEST_LIST", 159, 0},
+    {22, "PARAM_VALUE", 220, 25},
+    {24, "GPS_RAW_INT", 24, 52},
+    {26, "SCALED_IMU", 170, 24},
+    {27, "RAW_IMU", 144, 29},
+    {29, "SCALED_PRESSURE", 115, 0},
+    {30, "ATTITUDE", 39, 0},
+    {33, "GLOBAL_POSITION_INT", 104, 0},
+    {35, "RC_CHANNELS_RAW", 244, 0},
+    {36, "SERVO_OUTPUT_RAW", 222, 0},
+    {42, "MISSION_CURRENT", 28, 0},
+    {62, "NAV_CONTROLLER_OUTPUT", 183, 0},
+    {65, "RC_CHANNELS", 118, 0},
+    {66, "REQUEST_DATA_STREAM", 148, 0},
+    {74, "VFR_HUD", 20, 0},
+    {87, "POSITION_TARGET_GLOBAL_INT", 150, 0},
+    {105, "HIGHRES_IMU", 93, 63},
+    {116, "SCALED_IMU2", 76, 24},
+    {125, "POWER_STATUS", 203, 0},
+    {129, "SCALED_IMU3", 46, 24},
+    {137, "SCALED_PRESSURE2", 195, 0},
+    // ardupilotmega.xml ids: named, not checked (other dialects reuse the range).
+    {150, "SENSOR_OFFSETS", -1, 0},
+    {152, "MEMINFO", -1, 0},
+    {163, "AHRS", -1, 0},
+    {165, "HWSTATUS", -1, 0},
+    {168, "WIND", -1, 0},
+    {178, "AHRS2", -1, 0},
+    {182, "AHRS3", -1, 0},
+    {193, "EKF_STATUS_REPORT", -1, 0},
+    {241, "VIBRATION", 90, 0},
+    {253, "STATUSTEXT", 83, 0},
+};
+
+/// CRC-16/MCRF4XX tables (reflected polynomial 0x8408) for slicing by 8, built once.
+/// t[0] is the classic byte table: crc' = (crc >> 8) ^ t[0][(crc ^ byte) & 0xFF]. t[k][v] is
+/// the contribution of byte value v followed by k zero bytes, t[k][v] = (t[k-1][v] >> 8) ^
+/// t[0][t[k-1][v] & 0xFF], so that 8 bytes b0..b7 advance the 16-bit state c as
+///   c' = t[7][(c ^ b0) & 0xFF] ^ t[6][((c >> 8) ^ b1) & 0xFF] ^ t[5][b2] ^ ... ^ t[0][b7]
+/// (the CRC is linear over GF(2); the state holds only two bytes).
+struct CrcTable {
+  std::array<std::array<std::uint16_t, 256>, 8> t{};
+  CrcTable() {
+    for (unsigned b = 0; b < 256; ++b) {
+      std::uint16_t crc = static_cast<std::uint16_t>(b);
+      for (int k = 0; k < 8; ++k) {
+        crc = static_cast<std::uint16_t>((crc & 1u) ? (crc >> 1) ^ 0x8408u : crc >> 1);
+      }
+      t[0][b] = crc;
+    }
+    for (std::size_t k = 1; k < 8; ++k) {
+      for (unsigned b = 0; b < 256; ++b) {
+        const std::uint16_t prev = t[k - 1][b];
+        t[k][b] = static_cast<std::uint16_t>((prev >> 8) ^ t[0][prev & 0xFFu]);
+      }
+    }
+  }
+};
+const CrcTable kCrcTable;
+
+/// One byte into the CRC state.
+inline std::uint16_t CrcByte(std::uint16_t crc, std::uint8_t byte) {
+  return static_cast<std::uint16_t>((crc >> 8) ^ kCrcTable.t[0][(crc ^ byte) & 0xFFu]);
+}
+
+/// X.25 CRC of `size` bytes from state `crc`, sliced by 8 (see CrcTable).
+inline std::uint16_t Crc(const std::uint8_t* data, std::size_t size, std::uint16_t crc) {
+  const auto& t = kCrcTable.t;
+  std::size_t k = 0;
+  for (; k + 8 <= size; k += 8) {
+    const std::uint8_t* b = data + k;
+    crc = static_cast<std::uint16_t>(
+        t[7][(crc ^ b[0]) & 0xFFu] ^ t[6][((crc >> 8) ^ b[1]) & 0xFFu] ^ t[5][b[2]] ^
+        t[4][b[3]] ^ t[3][b[4]] ^ t[2][b[5]] ^ t[1][b[6]] ^ t[0][b[7]]);
+  }
+  for (; k < size; ++k) crc = CrcByte(crc, data[k]);
+  return crc;
+}
+
+/// Per low id (< 256): CRC_EXTRA (-1 unknown) and full decoded length (0 not decoded).
+struct IdTable {
+  std::array<std::int16_t, 256> crc_extra{};
+  std::array<std::uint8_t, 256> full_len{};
+  IdTable() {
+    crc_extra.fill(-1);
+    for (const KnownMessage& m : kKnown) {
+      crc_extra[m.id] = static_cast<std::int16_t>(m.crc_extra);
+      full_len[m.id] = static_cast<std::uint8_t>(m.full_len);
+    }
+  }
+};
+const IdTable kIds;
+
+template <typename T>
+T Load(const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));  // little endian on every supported host
+  return v;
+}
+
+std::uint64_t LoadBigEndian64(const std::uint8_t* p) {
+  return __builtin_bswap64(Load<std::uint64_t>(p));  // little-endian host
+}
+
+std::array<std::int16_t, 3> Int16Triad(const std::uint8_t* p) {
+  return {Load<std::int16_t>(p), Load<std::int16_t>(p + 2), Load<std::int16_t>(p + 4)};
+}
+
+std::array<float, 3> FloatTriad(const std::uint8_t* p) {
+  return {Load<float>(p), Load<float>(p + 4), Load<float>(p + 8)};
+}
+
+/// A frame located in the input.
+struct Frame {
+  std::size_t record_bytes = 0;  // 8-byte time + the whole frame (signature included)
+  std::uint64_t time_us = 0;
+  std::uint32_t msgid = 0;
+  const std::uint8_t* payload = nullptr;
+  std::size_t len = 0;
+  std::uint8_t system_id = 0;
+  std::uint8_t component_id = 0;
+  bool v2 = false;
+  bool is_signed = false;
+};
+
+enum class Verdict { kNotStart, kIncomplete, kCrcFailed, kChecked, kUnchecked };
+
+bool PlausibleTime(std::uint64_t t_us) { return t_us >= kMinTimeUs && t_us < kMaxTimeUs; }
+
+/// Whether a record can start at `pos` (pure: no side effects).
+Verdict Examine(const std::uint8_t* data, std::size_t size, std::size_t pos, Frame* f) {
+  const std::size_t left = size - pos;
+  if (left < kTimeBytes + 1) return Verdict::kIncomplete;
+  const std::uint8_t* p = data + pos;
+  f->time_us = LoadBigEndian64(p);
+  if (!PlausibleTime(f->time_us)) return Verdict::kNotStart;
+  const std::uint8_t* frame = p + kTimeBytes;
+  const std::size_t frame_left = left - kTimeBytes;
+  std::size_t header = 0;
+  std::size_t extra = 0;
+  if (frame[0] == kStxV1) {
+    header = kHeaderV1;
+    if (frame_left < header) return Verdict::kIncomplete;
+    f->v2 = false;
+    f->is_signed = false;
+    f->len = frame[1];
+    f->system_id = frame[3];
+    f->component_id = frame[4];
+    f->msgid = frame[5];
+  } else if (frame[0] == kStxV2) {
+    header = kHeaderV2;
+    if (frame_left < 3) return Verdict::kIncomplete;
+    const std::uint8_t incompat = frame[2];
+    if ((incompat & ~kIncompatSigned) != 0) return Verdict::kNotStart;
+    if (frame_left < header) return Verdict::kIncomplete;
+    f->v2 = true;
+    f->is_signed = (incompat & kIncompatSigned) != 0;
+    extra = f->is_signed ? kSignatureBytes : 0;
+    f->len = frame[1];
+    f->system_id = frame[5];
+    f->component_id = frame[6];
+    f->msgid = static_cast<std::uint32_t>(frame[7]) | (static_cast<std::uint32_t>(frame[8]) << 8) |
+               (static_cast<std::uint32_t>(frame[9]) << 16);
+  } else {
+    return Verdict::kNotStart;
+  }
+  const std::size_t frame_bytes = header + f->len + kCrcBytes + extra;
+  if (frame_left < frame_bytes) return Verdict::kIncomplete;
+  f->record_bytes = kTimeBytes + frame_bytes;
+  f->payload = frame + header;
+  const int crc_extra = f->msgid < 256 ? kIds.crc_extra[f->msgid] : -1;
+  if (crc_extra < 0) return Verdict::kUnchecked;
+  const std::uint16_t crc = CrcByte(Crc(frame + 1, header - 1 + f->len, 0xFFFF),
+                                    static_cast<std::uint8_t>(crc_extra));
+  const std::uint16_t sent = Load<std::uint16_t>(f->payload + f->len);
+  return crc == sent ? Verdict::kChecked : Verdict::kCrcFailed;
+}
+
+/// A record of any id could start at `pos`: the end of the data, a tail too short for a
+/// record header, or a plausible time followed by a start byte.
+bool NextLooksLikeRecord(const std::uint8_t* data, std::size_t size, std::size_t pos) {
+  return size - pos < kTimeBytes + 1 || LooksLikeTlogRecord(data + pos, size - pos);
+}
+
+/// The one-pass decoder.
+class Parser {
+ public:
+  Parser(const std::uint8_t* data, std::size_t size, MavlinkLog* log)
+      : data_(data), size_(size), log_(log) {
+    low_counts_.fill(0);
+  }
+
+  void Run() {
+    std::size_t pos = 0;
+    std::size_t last_end = 0;  // end of the last accepted record
+    Frame f;
+    while (pos < size_) {
+      const Verdict v = Examine(data_, size_, pos, &f);
+      if (v == Verdict::kChecked ||
+          (v == Verdict::kUnchecked && NextLooksLikeRecord(data_, size_, pos + f.record_bytes))) {
+        Accept(f, v == Verdict::kChecked);
+        pos += f.record_bytes;
+        last_end = pos;
+        continue;
+      }
+      if (v == Verdict::kCrcFailed) {
+        MavlinkWarnings& w = log_->warnings;
+        if (w.crc_failures == 0) w.first_crc_failure_offset = pos;
+        ++w.crc_failures;
+      }
+      if (v == Verdict::kIncomplete) {
+        if (size_ - pos < kTimeBytes + 1 && pos != last_end) {
+          SkipTo(pos, size_);
+          break;
+        }
+        const std::size_t next = FindRecord(pos + 1);
+        if (next == size_) {
+          log_->warnings.truncated_records = 1;
+          log_->warnings.truncated_bytes = size_ - pos;
+          break;
+        }
+        SkipTo(pos, next);
+        pos = next;
+        continue;
+      }
+      SkipTo(pos, pos + 1);
+      ++pos;
+    }
+    for (std::uint32_t id = 0; id < 256; ++id) {
+      if (low_counts_[id] > 0) log_->message_counts[id] += low_counts_[id];
+    }
+  }
+
+ private:
+  /// First position >= from where a record is accepted, or size_.
+  std::size_t FindRecord(std::size_t from) const {
+    Frame f;
+    for (std::size_t p = from; p < size_; ++p) {
+      const Verdict v = Examine(data_, size_, p, &f);
+      if (v == Verdict::kChecked ||
+          (v == Verdict::kUnchecked && NextLooksLikeRecord(data_, size_, p + f.record_bytes))) {
+        return p;
+      }
+    }
+    return size_;
+  }
+
+  /// Counts bytes [from, to) as skipped.
+  void SkipTo(std::size_t from, std::size_t to) {
+    CountSkipped(log_->warnings, from, to, skip_end_);
+  }
+
+  void Accept(const Frame& f, bool checked) {
+    if (f.v2) {
+      ++log_->frames_v2;
+      if (f.is_signed) ++log_->frames_signed;
+    } else {
+      ++log_->frames_v1;
+    }
+    log_->record_bytes += f.record_bytes;
+    if (!checked) ++log_->warnings.unchecked_frames;
+    if (f.msgid >= 256) {
+      ++log_->message_counts[f.msgid];
+      return;
+    }
+    ++low_counts_[f.msgid];
+    const std::size_t full = kIds.full_len[f.msgid];
+    if (full == 0 || !checked) return;
+    // Zero-extend a truncated payload (MAVLink 2) to the full length.
+    const std::uint8_t* p = f.payload;
+    if (f.len < full) {
+      std::memset(buffer_.data(), 0, full);
+      std::memcpy(buffer_.data(), f.payload, f.len);
+      p = buffer_.data();
+    }
+    Decode(f, p);
+  }
+
+  void Decode(const Frame& f, const std::uint8_t* p) {
+    const double log_time_s = static_cast<double>(f.time_us) * 1e-6;
+    switch (f.msgid) {
+      case kMavHeartbeat: {
+        MavlinkHeartbeat& h = log_->heartbeat.emplace_back();
+        h.log_time_s = log_time_s;
+        h.system_id = f.system_id;
+        h.component_id = f.component_id;
+        h.custom_mode = Load<std::uint32_t>(p);
+        h.type = p[4];
+        h.autopilot = p[5];
+        h.base_mode = p[6];
+        h.system_status = p[7];
+        h.mavlink_version = p[8];
+        break;
+      }
+      case kMavParamValue: {
+        MavlinkParamValue& v = log_->param_value.emplace_back();
+        v.log_time_s = log_time_s;
+        v.system_id = f.system_id;
+        v.component_id = f.component_id;
+        v.value = Load<float>(p);
+        v.count = Load<std::uint16_t>(p + 4);
+        v.index = Load<std::uint16_t>(p + 6);
+        std::memcpy(v.id.data(), p + 8, 16);
+        v.type = p[24];
+        break;
+      }
+      case kMavGpsRawInt: {
+        MavlinkGpsRawInt& g = log_->gps_raw_int.emplace_back();
+        g.log_time_s = log_time_s;
+        g.system_id = f.system_id;
+        g.component_id = f.component_id;
+        g.time_us = Load<std::uint64_t>(p);
+        g.lat_e7 = Load<std::int32_t>(p + 8);
+        g.lon_e7 = Load<std::int32_t>(p + 12);
+        g.alt_mm = Load<std::int32_t>(p + 16);
+        g.eph = Load<std::uint16_t>(p + 20);
+        g.epv = Load<std::uint16_t>(p + 22);
+        g.vel_cm_s = Load<std::uint16_t>(p + 24);
+        g.cog_cdeg = Load<std::uint16_t>(p + 26);
+        g.fix_type = p[28];
+        g.satellites_visible = p[29];
+        g.alt_ellipsoid_mm = Load<std::int32_t>(p + 30);
+        g.h_acc_mm = Load<std::uint32_t>(p + 34);
+        g.v_acc_mm = Load<std::uint32_t>(p + 38);
+        g.vel_acc_mm_s = Load<std::uint32_t>(p + 42);
+        g.hdg_acc_degE5 = Load<std::uint32_t>(p + 46);
+        g.yaw_cdeg = Load<std::uint16_t>(p + 50);
+        break;
+      }
+      case kMavRawImu: {
+        // time_usec u64, 9 x int16, extensions id u8 (26), temperature int16 (27).
+        MavlinkInt16Imu& s = log_->raw_imu.emplace_back();
+        FillInt16Imu(f, log_time_s, Load<std::uint64_t>(p), p + 8, &s);
+        s.id = p[26];
+        s.temperature_cdegc = Load<std::int16_t>(p + 27);
+        break;
+      }
+      case kMavScaledImu:
+      case kMavScaledImu2:
+      case kMavScaledImu3: {
+        // time_boot_ms u32, 9 x int16, extension temperature int16 (22).
+        std::vector<MavlinkInt16Imu>& out = f.msgid == kMavScaledImu    ? log_->scaled_imu
+                                            : f.msgid == kMavScaledImu2 ? log_->scaled_imu2
+                                                                        : log_->scaled_imu3;
+        MavlinkInt16Imu& s = out.emplace_back();
+        FillInt16Imu(f, log_time_s, std::uint64_t{Load<std::uint32_t>(p)} * 1000u, p + 4, &s);
+        s.temperature_cdegc = Load<std::int16_t>(p + 22);
+        break;
+      }
+      case kMavHighresImu: {
+        // time_usec u64, 13 floats, fields_updated u16 (60), extension id u8 (62).
+        MavlinkHighresImu& h = log_->highres_imu.emplace_back();
+        h.log_time_s = log_time_s;
+        h.system_id = f.system_id;
+        h.component_id = f.component_id;
+        h.time_us = Load<std::uint64_t>(p);
+        h.acc = FloatTriad(p + 8);
+        h.gyr = FloatTriad(p + 20);
+        h.mag = FloatTriad(p + 32);
+        h.abs_pressure_hpa = Load<float>(p + 44);
+        h.diff_pressure_hpa = Load<float>(p + 48);
+        h.pressure_alt = Load<float>(p + 52);
+        h.temperature_degc = Load<float>(p + 56);
+        h.fields_updated = Load<std::uint16_t>(p + 60);
+        h.id = p[62];
+        break;
+      }
+      default:
+        break;
+    }
+  }
+
+  static void FillInt16Imu(const Frame& f, double log_time_s, std::uint64_t time_us,
+                           const std::uint8_t* triads, MavlinkInt16Imu* s) {
+    s->log_time_s = log_time_s;
+    s->time_us = time_us;
+    s->system_id = f.system_id;
+    s->component_id = f.component_id;
+    s->acc = Int16Triad(triads);
+    s->gyr = Int16Triad(triads + 6);
+    s->mag = Int16Triad(triads + 12);
+  }
+
+  const std::uint8_t* data_;
+  std::size_t size_;
+  MavlinkLog* log_;
+  std::array<std::size_t, 256> low_counts_;
+  std::array<std::uint8_t, kMaxPayload + 1> buffer_{};
+  std::size_t skip_end_ = 0;
+};
+
+}  // namespace
+
+std::uint16_t MavlinkCrc(const std::uint8_t* data, std::size_t size, std::uint16_t crc) {
+  return Crc(data, size, crc);
+}
+
+bool LooksLikeTlogRecord(const std::uint8_t* data, std::size_t size) {
+  if (size < kTimeBytes + 1) return false;
+  const std::uint8_t stx = data[kTimeBytes];
+  return PlausibleTime(LoadBigEndian64(data)) && (stx == kStxV1 || stx == kStxV2);
+}
+
+std::string MavlinkMessageName(std::uint32_t msgid) {
+  for (const KnownMessage& m : kKnown) {
+    if (m.id == msgid) return m.name;
+  }
+  return "MSG" + std::to_string(msgid);
+}
+
+int MavlinkCrcExtra(std::uint32_t msgid) { return msgid < 256 ? kIds.crc_extra[msgid] : -1; }
+
+std::string MavlinkParamValue::Name() const {
+  return std::string(id.data(), strnlen(id.data(), id.size()));
+}
+
+std::vector<std::string> MavlinkWarnings::Describe(
+    const std::map<std::uint32_t, std::size_t>& counts) const {
+  std::vector<std::string> out;
+  if (bytes_skipped) {
+    out.push_back("skipped " + std::to_string(bytes_skipped) + " bytes in " +
+                  std::to_string(skip_runs) +
+                  " run(s) not forming a valid tlog record (first at byte " +
+                  std::to_string(first_skip_offset) + ")");
+  }
+  if (crc_failures) {
+    out.push_back(std::to_string(crc_failures) + " frame(s) failed their CRC and were dropped " +
+                  "(first at byte " + std::to_string(first_crc_failure_offset) + ")");
+  }
+  if (truncated_records) {
+    out.push_back("dropped the truncated last record (" + std::to_string(truncated_bytes) +
+                  " bytes)");
+  }
+  if (unchecked_frames) {
+    std::string ids;
+    for (const auto& [id, n] : counts) {
+      if (MavlinkCrcExtra(id) >= 0) continue;
+      ids += (ids.empty() ? "" : ", ") + MavlinkMessageName(id) + " (id " + std::to_string(id) +
+             ") x" + std::to_string(n);
+    }
+    out.push_back(std::to_string(unchecked_frames) +
+                  " frame(s) of messages without a known CRC_EXTRA kept unchecked and not "
+                  "decoded: " + ids);
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, std::size_t>> MavlinkLog::MessageCounts() const {
+  std::vector<std::pair<std::string, std::size_t>> out;
+  for (const auto& [id, n] : message_counts) out.emplace_back(MavlinkMessageName(id), n);
+  return out;
+}
+
+MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source) {
+  MavlinkLog log;
+  log.source = source;
+  log.size_bytes = size;
+  Parser parser(data, size, &log);
+  parser.Run();
+  if (log.frames_v1 + log.frames_v2 == 0) {
+    throw InputError(source, "byte 0",
+                     "no MAVLink frame ([8-byte big-endian unix time in µs][0xFE or 0xFD "
+                     "frame] with a valid CRC) in " + std::to_string(size) +
+                         " bytes: not a MAVLink .tlog");
+  }
+  return log;
+}
+
+MavlinkLog ReadTlog(const std::string& path) {
+  const LogFile file(path, "MAVLink tlog");
+  return ParseTlog(file.data(), file.size(), path);
+}
+
+}  // namespace plumb::io

@@ -1,0 +1,502 @@
+// plumb/io/px4/px4_session.cc — see px4_session.h.
+#include "plumb/io/px4/px4_session.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+
+#include "plumb/core/error.h"
+#include "plumb/io/common/log_common.h"
+#include "plumb/io/px4/px4_correction.h"
+#include "plumb/io/px4/ulog_format.h"
+
+namespace plumb::io {
+namespace {
+
+constexpr double kUsToS = 1e-6;
+
+enum class StreamKind { kCombined, kVehicleImu, kSensorAccel };
+
+/// Where a stream's samples come from.
+struct StreamSource {
+  StreamKind kind = StreamKind::kCombined;
+  int instance = 0;
+  const ULogTopic* topic = nullptr;  ///< sensor_combined, vehicle_imu or sensor_accel
+  const ULogTopic* gyro = nullptr;   ///< sensor_gyro paired with sensor_accel, or nullptr
+};
+
+const char* KindName(StreamKind kind) {
+  switch (kind) {
+    case StreamKind::kCombined: return "sensor_combined";
+    case StreamKind::kVehicleImu: return "vehicle_imu";
+    case StreamKind::kSensorAccel: return "sensor_accel";
+  }
+  return "";
+}
+
+using Triad = std::array<int, 3>;
+
+/// Columns base[0], base[1], base[2] of `t`, or nullopt when any is missing.
+std::optional<Triad> ArrayColumns(const ULogTopic& t, const std::string& base) {
+  Triad c;
+  for (int i = 0; i < 3; ++i) {
+    c[static_cast<std::size_t>(i)] = t.ColumnIndex(base + "[" + std::to_string(i) + "]");
+    if (c[static_cast<std::size_t>(i)] < 0) return std::nullopt;
+  }
+  return c;
+}
+
+/// Columns x, y, z of `t`, or nullopt.
+std::optional<Triad> XyzColumns(const ULogTopic& t) {
+  const Triad c = {t.ColumnIndex("x"), t.ColumnIndex("y"), t.ColumnIndex("z")};
+  if (c[0] < 0 || c[1] < 0 || c[2] < 0) return std::nullopt;
+  return c;
+}
+
+/// The sample-time column: timestamp_sample when present, else timestamp; -1 if neither.
+int TimeColumn(const ULogTopic& t) {
+  const int sample = t.ColumnIndex("timestamp_sample");
+  return sample >= 0 ? sample : t.timestamp_col;
+}
+
+Vec3 Row3d(const ULogTopic& t, std::size_t row, const Triad& c) {
+  return Vec3(t.Value(row, static_cast<std::size_t>(c[0])),
+              t.Value(row, static_cast<std::size_t>(c[1])),
+              t.Value(row, static_cast<std::size_t>(c[2])));
+}
+
+Vec3f Row3(const ULogTopic& t, std::size_t row, const Triad& c) {
+  return SaturatedFloat(Row3d(t, row, c));
+}
+
+double TimeS(const ULogTopic& t, std::size_t row, int col) {
+  return t.Value(row, static_cast<std::size_t>(col)) * kUsToS;
+}
+
+/// Appends a sample when its time increases; returns whether it was kept.
+bool Push(ImuSeries* s, double t_s, const Vec3f& acc, const Vec3f* gyr, const float* temp) {
+  if (!std::isfinite(t_s) || (!s->t_s.empty() && !(t_s > s->t_s.back()))) return false;
+  s->t_s.push_back(t_s);
+  s->acc.push_back(acc);
+  if (gyr != nullptr) s->gyr.push_back(*gyr);
+  if (temp != nullptr) s->temp_c.push_back(*temp);
+  return true;
+}
+
+ImuSeries FromCombined(const ULogTopic& t) {
+  ImuSeries s;
+  const auto acc = ArrayColumns(t, "accelerometer_m_s2");
+  auto gyr = ArrayColumns(t, "gyro_rad");
+  if (!gyr) gyr = ArrayColumns(t, "gyro_rad_s");
+  if (!acc || !gyr || t.timestamp_col < 0) return s;
+  s.reserve(t.rows);
+  for (std::size_t r = 0; r < t.rows; ++r) {
+    const Vec3f g = Row3(t, r, *gyr);
+    Push(&s, TimeS(t, r, t.timestamp_col), Row3(t, r, *acc), &g, nullptr);
+  }
+  return s;
+}
+
+ImuSeries FromVehicleImu(const ULogTopic& t) {
+  ImuSeries s;
+  const auto dv = ArrayColumns(t, "delta_velocity");
+  const auto da = ArrayColumns(t, "delta_angle");
+  const int dv_dt = t.ColumnIndex("delta_velocity_dt");
+  const int da_dt = t.ColumnIndex("delta_angle_dt");
+  const int time = TimeColumn(t);
+  if (!dv || !da || dv_dt < 0 || da_dt < 0 || time < 0) return s;
+  s.reserve(t.rows);
+  for (std::size_t r = 0; r < t.rows; ++r) {
+    const double v_dt_s = t.Value(r, static_cast<std::size_t>(dv_dt)) * kUsToS;
+    const double a_dt_s = t.Value(r, static_cast<std::size_t>(da_dt)) * kUsToS;
+    if (!(v_dt_s > 0.0) || !(a_dt_s > 0.0)) continue;
+    const Vec3f acc = SaturatedFloat(Row3d(t, r, *dv) / v_dt_s);
+    const Vec3f g = SaturatedFloat(Row3d(t, r, *da) / a_dt_s);
+    Push(&s, TimeS(t, r, time), acc, &g, nullptr);
+  }
+  return s;
+}
+
+/// Median of the positive differences of `t`, 0 when there are none.
+double MedianStep(const std::vector<double>& t) {
+  std::vector<double> d;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (t[i] > t[i - 1]) d.push_back(t[i] - t[i - 1]);
+  }
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topic,
+                          std::vector<std::string>* notes) {
+  ImuSeries s;
+  const auto acc = XyzColumns(acc_topic);
+  const int time = TimeColumn(acc_topic);
+  const int temp = acc_topic.ColumnIndex("temperature");
+  if (!acc || time < 0) return s;
+  std::vector<double> t_acc(acc_topic.rows);
+  for (std::size_t r = 0; r < acc_topic.rows; ++r) t_acc[r] = TimeS(acc_topic, r, time);
+
+  // Pairing with sensor_gyro: nearest gyro time within half the median accel interval.
+  std::vector<long> match(acc_topic.rows, -1);
+  std::size_t matched = 0;
+  std::optional<Triad> gyr;
+  if (gyro_topic != nullptr) {
+    gyr = XyzColumns(*gyro_topic);
+    const int gtime = TimeColumn(*gyro_topic);
+    const double tolerance_s = 0.5 * MedianStep(t_acc);
+    if (gyr && gtime >= 0 && tolerance_s > 0.0) {
+      std::size_t g = 0;
+      for (std::size_t r = 0; r < acc_topic.rows; ++r) {
+        while (g + 1 < gyro_topic->rows &&
+               std::abs(TimeS(*gyro_topic, g + 1, gtime) - t_acc[r]) <=
+                   std::abs(TimeS(*gyro_topic, g, gtime) - t_acc[r])) {
+          ++g;
+        }
+        if (g < gyro_topic->rows && std::abs(TimeS(*gyro_topic, g, gtime) - t_acc[r]) <= tolerance_s) {
+          match[r] = static_cast<long>(g);
+          ++matched;
+        }
+      }
+    }
+  }
+  const bool paired = gyr && matched * 2 >= acc_topic.rows && matched > 0;
+  if (gyro_topic != nullptr && !paired && notes != nullptr) {
+    notes->push_back("sensor_gyro instance " + std::to_string(gyro_topic->multi_id) +
+                     ": only " + std::to_string(matched) + " of " +
+                     std::to_string(acc_topic.rows) +
+                     " accel samples have a gyro sample within half an interval: "
+                     "accelerometer only");
+  }
+  s.reserve(acc_topic.rows);
+  for (std::size_t r = 0; r < acc_topic.rows; ++r) {
+    if (paired && match[r] < 0) continue;
+    const float tc =
+        temp >= 0 ? SaturatedFloat(acc_topic.Value(r, static_cast<std::size_t>(temp))) : 0.0f;
+    Vec3f g;
+    if (paired) g = Row3(*gyro_topic, static_cast<std::size_t>(match[r]), *gyr);
+    // Temperature and gyro columns must stay aligned with t_s: Push keeps or drops all.
+    Push(&s, t_acc[r], Row3(acc_topic, r, *acc), paired ? &g : nullptr, temp >= 0 ? &tc : nullptr);
+  }
+  return s;
+}
+
+ImuSeries Extract(const StreamSource& src, std::vector<std::string>* notes) {
+  switch (src.kind) {
+    case StreamKind::kCombined: return FromCombined(*src.topic);
+    case StreamKind::kVehicleImu: return FromVehicleImu(*src.topic);
+    case StreamKind::kSensorAccel: return FromSensorAccel(*src.topic, src.gyro, notes);
+  }
+  return {};
+}
+
+std::vector<StreamSource> Sources(const ULog& log) {
+  std::vector<StreamSource> out;
+  if (const ULogTopic* t = log.Find("sensor_combined", 0); t != nullptr && t->rows > 0) {
+    out.push_back({StreamKind::kCombined, 0, t, nullptr});
+  }
+  for (int k = 0; k < 256; ++k) {
+    if (const ULogTopic* t = log.Find("vehicle_imu", k); t != nullptr && t->rows > 0) {
+      out.push_back({StreamKind::kVehicleImu, k, t, nullptr});
+    }
+  }
+  for (int k = 0; k < 256; ++k) {
+    if (const ULogTopic* t = log.Find("sensor_accel", k); t != nullptr && t->rows > 0) {
+      const ULogTopic* g = log.Find("sensor_gyro", k);
+      out.push_back({StreamKind::kSensorAccel, k, t, g != nullptr && g->rows > 0 ? g : nullptr});
+    }
+  }
+  return out;
+}
+
+std::optional<double> Param(const ULog& log, const std::string& name) {
+  const auto it = log.params.find(name);
+  if (it == log.params.end()) return std::nullopt;
+  return it->second;
+}
+
+/// The device id of the accel ("ACC") or gyro ("GYRO") behind a calibrated stream; nullopt
+/// when the log does not say. `how` explains the choice.
+std::optional<double> DeviceId(const ULog& log, const StreamSource& src, const std::string& kind,
+                               std::string* how) {
+  const std::string field = kind == "ACC" ? "accel_device_id" : "gyro_device_id";
+  const ULogTopic* imu = src.kind == StreamKind::kVehicleImu ? src.topic : nullptr;
+  if (src.kind == StreamKind::kCombined) {
+    if (const auto prime = Param(log, "CAL_" + kind + "_PRIME"); prime && *prime != 0.0) {
+      *how = "CAL_" + kind + "_PRIME";
+      return prime;
+    }
+    imu = log.Find("vehicle_imu", 0);
+    *how = "vehicle_imu instance 0 " + field + " (assumed primary)";
+  } else {
+    *how = "vehicle_imu " + field;
+  }
+  if (imu == nullptr || imu->rows == 0) return std::nullopt;
+  const int c = imu->ColumnIndex(field);
+  if (c < 0) return std::nullopt;
+  return imu->Value(0, static_cast<std::size_t>(c));
+}
+
+/// The temperature of the sensor with `device_id` from sensor_accel/sensor_gyro (device_id,
+/// temperature) and vehicle_imu_status (accel_device_id/gyro_device_id,
+/// temperature_accel/temperature_gyro) messages; nullopt when none is logged.
+std::optional<Px4TemperatureTrack> SensorTemperature(const ULog& log, bool accel,
+                                                     double device_id) {
+  std::vector<std::pair<double, double>> points;
+  std::string source;
+  for (const ULogTopic& t : log.topics) {
+    int id_col = -1, temp_col = -1;
+    if (t.name == (accel ? "sensor_accel" : "sensor_gyro")) {
+      id_col = t.ColumnIndex("device_id");
+      temp_col = t.ColumnIndex("temperature");
+    } else if (t.name == "vehicle_imu_status") {
+      id_col = t.ColumnIndex(accel ? "accel_device_id" : "gyro_device_id");
+      temp_col = t.ColumnIndex(accel ? "temperature_accel" : "temperature_gyro");
+    }
+    const int time = TimeColumn(t);
+    if (id_col < 0 || temp_col < 0 || time < 0) continue;
+    const std::size_t before = points.size();
+    for (std::size_t r = 0; r < t.rows; ++r) {
+      if (t.Value(r, static_cast<std::size_t>(id_col)) != device_id) continue;
+      const double temp = t.Value(r, static_cast<std::size_t>(temp_col));
+      const double when = TimeS(t, r, time);
+      if (std::isfinite(temp) && std::isfinite(when)) points.emplace_back(when, temp);
+    }
+    if (points.size() > before) {
+      source += (source.empty() ? "" : ", ") + t.name + " instance " + std::to_string(t.multi_id);
+    }
+  }
+  if (points.empty()) return std::nullopt;
+  std::sort(points.begin(), points.end());
+  Px4TemperatureTrack track;
+  track.source = source;
+  for (const auto& [when, temp] : points) {
+    track.t_s.push_back(when);
+    track.temp_c.push_back(temp);
+  }
+  return track;
+}
+
+/// The sensors behind a calibrated stream (sensor_combined, vehicle_imu): their device ids and
+/// logged temperatures.
+Px4Sensors SensorsOf(const ULog& log, const StreamSource& src) {
+  Px4Sensors sensors;
+  sensors.acc_id = DeviceId(log, src, "ACC", &sensors.acc_id_source);
+  sensors.gyr_id = DeviceId(log, src, "GYRO", &sensors.gyr_id_source);
+  sensors.temperature = [&log](bool accel, double device_id) {
+    return SensorTemperature(log, accel, device_id);
+  };
+  return sensors;
+}
+
+std::string Who(const StreamSource& src) {
+  return std::string(KindName(src.kind)) + " instance " + std::to_string(src.instance) + ": ";
+}
+
+void WarnParamChanges(const ULog& log, Session* s) {
+  std::size_t changes = 0;
+  std::string first;
+  for (const ULogParamChange& c : log.param_changes) {
+    if (c.name.rfind("CAL_", 0) == 0 || c.name.rfind("TC_", 0) == 0 ||
+        c.name.rfind("SENS_BOARD_", 0) == 0) {
+      if (changes++ == 0) first = c.name;
+    }
+  }
+  if (changes > 0) {
+    s->warnings.push_back(std::to_string(changes) + " calibration parameter change(s) during " +
+                          "the log (first: " + first + "); the initial values were used");
+  }
+}
+
+const StreamSource* Select(const std::vector<StreamSource>& sources,
+                           const std::vector<ImuStreamInfo>& infos,
+                           const FlightLogSelection& sel) {
+  const StreamSource* best = nullptr;
+  double best_rate = -1.0;
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    if (infos[i].instance != sel.imu) continue;
+    if (!sel.stream.empty()) {
+      if (infos[i].name == sel.stream) return &sources[i];
+      continue;
+    }
+    const bool both = infos[i].has_accel && infos[i].has_gyro;
+    const double score = (both ? 1e9 : 0.0) + infos[i].rate_hz;
+    if (score > best_rate) {
+      best_rate = score;
+      best = &sources[i];
+    }
+  }
+  return best;
+}
+
+ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries& s) {
+  ImuStreamInfo info;
+  info.name = KindName(src.kind);
+  info.instance = src.instance;
+  info.samples = s.size();
+  if (!s.empty()) {
+    info.t_start_s = s.t_s.front();
+    info.t_end_s = s.t_s.back();
+  }
+  const double span = info.t_end_s - info.t_start_s;
+  if (s.size() >= 2 && span > 0.0) info.rate_hz = static_cast<double>(s.size() - 1) / span;
+  info.has_accel = true;
+  info.has_gyro = s.has_gyro();
+  info.has_temperature = s.has_temperature();
+  if (src.kind != StreamKind::kSensorAccel) {
+    const Px4Sensors sensors = SensorsOf(log, src);
+    info.applied = Px4AppliedText(log.params, sensors);
+    info.undoable = Px4Undoable(log.params, sensors, s.has_gyro());
+  }
+  return info;
+}
+
+}  // namespace
+
+std::vector<ImuStreamInfo> ULogImuStreams(const ULog& log) {
+  std::vector<ImuStreamInfo> out;
+  for (const StreamSource& src : Sources(log)) {
+    out.push_back(Describe(log, src, Extract(src, nullptr)));
+  }
+  return out;
+}
+
+std::optional<SiteInput> SiteFromULog(const ULog& log) {
+  std::vector<double> lats, lons, alts;
+  for (const ULogTopic& t : log.topics) {
+    if (t.name != "vehicle_gps_position" && t.name != "sensor_gps") continue;
+    const int fix = t.ColumnIndex("fix_type");
+    int lat = t.ColumnIndex("latitude_deg");
+    int lon = t.ColumnIndex("longitude_deg");
+    int alt = t.ColumnIndex("altitude_msl_m");
+    double lat_scale = 1.0, alt_scale = 1.0;
+    if (lat < 0 || lon < 0) {  // old layout: int32 1e-7 deg, alt int32 mm
+      lat = t.ColumnIndex("lat");
+      lon = t.ColumnIndex("lon");
+      alt = t.ColumnIndex("alt");
+      lat_scale = 1e-7;
+      alt_scale = 1e-3;
+    }
+    if (fix < 0 || lat < 0 || lon < 0) continue;
+    for (std::size_t r = 0; r < t.rows; ++r) {
+      if (t.Value(r, static_cast<std::size_t>(fix)) < 3) continue;
+      const double la = t.Value(r, static_cast<std::size_t>(lat)) * lat_scale;
+      const double lo = t.Value(r, static_cast<std::size_t>(lon)) * lat_scale;
+      if (!std::isfinite(la) || !std::isfinite(lo) || (la == 0.0 && lo == 0.0)) continue;
+      if (std::abs(la) > 90.0 || std::abs(lo) > 180.0) continue;
+      const double h = alt >= 0 ? t.Value(r, static_cast<std::size_t>(alt)) * alt_scale : 0.0;
+      lats.push_back(la);
+      lons.push_back(lo);
+      alts.push_back(std::isfinite(h) ? h : 0.0);
+    }
+  }
+  return MedianSite(std::move(lats), std::move(lons), std::move(alts));
+}
+
+std::map<std::string, double> ULogParams(const ULog& log) {
+  std::map<std::string, double> out;
+  for (const auto& [name, value] : log.params) {
+    for (const char* prefix : {"CAL_ACC", "CAL_GYRO", "TC_A", "TC_G", "SENS_BOARD_"}) {
+      if (name.rfind(prefix, 0) == 0) {
+        out[name] = value;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
+  const std::vector<StreamSource> sources = Sources(log);
+  std::vector<ImuStreamInfo> infos;
+  std::vector<ImuSeries> all;
+  std::vector<std::vector<std::string>> notes(sources.size());
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    all.push_back(Extract(sources[i], &notes[i]));
+    infos.push_back(Describe(log, sources[i], all.back()));
+  }
+  const StreamSource* src = Select(sources, infos, selection);
+  const std::string wanted = (selection.stream.empty() ? std::string("IMU") : selection.stream) +
+                             " instance " + std::to_string(selection.imu);
+  if (src == nullptr) {
+    throw InputError(log.source, "", "no " + wanted +
+                                         " stream (sensor_combined, vehicle_imu or sensor_accel)");
+  }
+  const auto chosen = static_cast<std::size_t>(src - sources.data());
+  Session s;
+  s.source = log.source + " (" + KindName(src->kind) + " instance " +
+             std::to_string(src->instance) + ")";
+  for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
+  if (log.dropouts > 0) {
+    s.warnings.push_back(log.source + ": " + std::to_string(log.dropouts) +
+                         " logging dropout(s), " + std::to_string(log.dropout_total_ms) +
+                         " ms in total");
+  }
+  for (auto& n : notes[chosen]) s.warnings.push_back(std::move(n));
+  const ImuSeries& whole = all[chosen];
+
+  ImuSeries& out = s.series;
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    const double t = whole.t_s[i];
+    if (selection.from_s && t < *selection.from_s) continue;
+    if (selection.to_s && t > *selection.to_s) continue;
+    out.t_s.push_back(t);
+    out.acc.push_back(whole.acc[i]);
+    if (whole.has_gyro()) out.gyr.push_back(whole.gyr[i]);
+    if (whole.has_temperature()) out.temp_c.push_back(whole.temp_c[i]);
+  }
+  if (out.size() < 2) {
+    throw InputError(log.source, std::string(KindName(src->kind)) + " instance " +
+                                     std::to_string(src->instance),
+                     "fewer than 2 samples in the time window");
+  }
+  const std::string who = Who(*src);
+  if (src->kind == StreamKind::kSensorAccel) {
+    s.warnings.push_back(who + "raw driver output (not calibrated by PX4), taken as logged");
+  } else if (!selection.undo_correction) {
+    s.warnings.push_back(who + "samples taken as logged (calibrated by PX4 with " +
+                         infos[chosen].applied + ")");
+    s.firmware_left.push_back(who + "PX4 " + infos[chosen].applied);
+  } else {
+    UndoPx4Correction(log.params, SensorsOf(log, *src), who, &s.series, &s.warnings,
+                      &s.firmware_left);
+    WarnParamChanges(log, &s);
+  }
+  s.site = SiteFromULog(log);
+  return s;
+}
+
+FlightLogSummary ULogSummary(const ULog& log) {
+  FlightLogSummary out;
+  out.source = log.source;
+  out.format = "px4-ulog";
+  out.format_detail = "ULog version " + std::to_string(log.version) + ", " +
+                      std::to_string(log.topics.size()) + " subscriptions";
+  if (log.data_appended) {
+    out.format_detail += ", data appended at " + std::to_string(log.appended_offsets.size()) +
+                         " offset(s)";
+  }
+  out.size_bytes = log.size_bytes;
+  out.imus = ULogImuStreams(log);
+  out.site = SiteFromULog(log);
+  out.params = ULogParams(log);
+  out.messages = log.MessageCounts();
+  out.warnings = log.warnings.Describe();
+  if (log.dropouts > 0) {
+    out.warnings.push_back(std::to_string(log.dropouts) + " logging dropout(s), " +
+                           std::to_string(log.dropout_total_ms) + " ms in total");
+  }
+  return out;
+}
+
+bool LooksLikeULog(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[sizeof(detail::kULogMagic)] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof(head));
+  return in.gcount() == static_cast<std::streamsize>(sizeof(head)) &&
+         std::equal(head, head + sizeof(head), detail::kULogMagic);
+}
+
+}  // namespace plumb::io

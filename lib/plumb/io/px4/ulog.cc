@@ -1,0 +1,552 @@
+// plumb/io/px4/ulog.cc — see ulog.h for the format and the decoding contract.
+#include "plumb/io/px4/ulog.h"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <optional>
+
+#include "plumb/core/error.h"
+#include "plumb/io/common/log_common.h"
+#include "plumb/io/px4/ulog_format.h"
+
+namespace plumb::io {
+namespace {
+
+using detail::kULogMagic;
+using detail::ULogBasicType;
+
+constexpr std::uint8_t kSyncMagic[8] = {0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, 0xBB, 0x12};
+constexpr std::size_t kFileHeaderSize = 16;
+constexpr std::size_t kMsgHeaderSize = 3;
+constexpr std::size_t kFlagBitsSize = 40;        // 8 + 8 + 3 * 8
+constexpr int kResyncChain = 4;  // consecutive valid headers that end a resync without D or S
+constexpr std::size_t kMinColumnBudget = 65536;  // columns allowed beyond one per input byte
+constexpr std::size_t kPreScanMinSize = std::size_t{1} << 16;  // inputs worth a counting pass
+
+template <typename T>
+T Load(const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));  // little endian on every supported host
+  return v;
+}
+
+bool IsLetter(std::uint8_t c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
+
+/// The message types of ULog version 1.
+bool IsKnownType(std::uint8_t c) {
+  return std::memchr("BFIMPQARDLCSO", c, 13) != nullptr && c != 0;
+}
+
+/// Key and value of an I/P/Q/M body after its leading bytes: uint8 key_len, key, value.
+struct KeyValue {
+  std::string type;   ///< e.g. "int32_t", "char[5]"
+  std::string name;
+  const std::uint8_t* value = nullptr;
+  std::size_t value_size = 0;
+};
+
+std::optional<KeyValue> ParseKeyValue(const std::uint8_t* p, std::size_t n) {
+  if (n < 1) return std::nullopt;
+  const std::size_t key_len = p[0];
+  if (key_len == 0 || 1 + key_len > n) return std::nullopt;
+  const std::string key(reinterpret_cast<const char*>(p + 1), key_len);
+  const std::size_t space = key.find(' ');
+  if (space == std::string::npos || space == 0 || space + 1 >= key.size()) return std::nullopt;
+  KeyValue kv;
+  kv.type = key.substr(0, space);
+  kv.name = key.substr(space + 1);
+  kv.value = p + 1 + key_len;
+  kv.value_size = n - 1 - key_len;
+  return kv;
+}
+
+/// A parameter value (int32_t or float, 4 bytes); nullopt otherwise.
+std::optional<double> ParamValue(const KeyValue& kv) {
+  if (kv.value_size != 4) return std::nullopt;
+  if (kv.type == "int32_t") return Load<std::int32_t>(kv.value);
+  if (kv.type == "float") return Load<float>(kv.value);
+  return std::nullopt;
+}
+
+/// An info value as text: strings as they are, numbers in decimal, anything else in hex.
+std::string InfoText(const KeyValue& kv) {
+  if (kv.type.rfind("char[", 0) == 0) {
+    return std::string(reinterpret_cast<const char*>(kv.value), kv.value_size);
+  }
+  if (const auto basic = ULogBasicType(kv.type); basic && basic->second == kv.value_size) {
+    const std::uint8_t* p = kv.value;
+    switch (basic->first) {
+      case ULogType::kInt8: return std::to_string(Load<std::int8_t>(p));
+      case ULogType::kUInt8: case ULogType::kBool: case ULogType::kChar:
+        return std::to_string(Load<std::uint8_t>(p));
+      case ULogType::kInt16: return std::to_string(Load<std::int16_t>(p));
+      case ULogType::kUInt16: return std::to_string(Load<std::uint16_t>(p));
+      case ULogType::kInt32: return std::to_string(Load<std::int32_t>(p));
+      case ULogType::kUInt32: return std::to_string(Load<std::uint32_t>(p));
+      case ULogType::kInt64: return std::to_string(Load<std::int64_t>(p));
+      case ULogType::kUInt64: return std::to_string(Load<std::uint64_t>(p));
+      case ULogType::kFloat: return std::to_string(Load<float>(p));
+      case ULogType::kDouble: return std::to_string(Load<double>(p));
+    }
+  }
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (std::size_t k = 0; k < kv.value_size; ++k) {
+    out += kHex[kv.value[k] >> 4];
+    out += kHex[kv.value[k] & 15];
+  }
+  return out;
+}
+
+/// The one-pass decoder state.
+class Parser {
+ public:
+  Parser(const std::uint8_t* data, std::size_t size, ULog* log)
+      : data_(data), size_(size), log_(log),
+        resolver_(log->formats, size + kMinColumnBudget) {}
+
+  void Run() {
+    if (size_ >= kPreScanMinSize) PreScan();
+    std::size_t pos = kFileHeaderSize;
+    std::size_t end = size_;
+    std::size_t next_segment = 0;  // index into log_->appended_offsets
+    bool resync = false;
+    while (true) {
+      if (pos >= end) {
+        if (next_segment < log_->appended_offsets.size()) {
+          pos = static_cast<std::size_t>(log_->appended_offsets[next_segment]);
+          ++next_segment;
+          end = next_segment < log_->appended_offsets.size()
+                    ? static_cast<std::size_t>(log_->appended_offsets[next_segment])
+                    : size_;
+          resync = false;
+          continue;
+        }
+        return;
+      }
+      if (resync) {
+        if (!ResyncPoint(pos, end)) {
+          Skip(pos);
+          ++pos;
+          continue;
+        }
+        resync = false;
+      }
+      if (end - pos < kMsgHeaderSize) {
+        Truncated(end - pos);
+        pos = end;
+        continue;
+      }
+      const std::size_t size = Load<std::uint16_t>(data_ + pos);
+      const std::uint8_t type = data_[pos + 2];
+      if (Corrupt(pos, end, size, type)) {
+        resync = true;
+        continue;
+      }
+      if (size > end - pos - kMsgHeaderSize) {
+        Truncated(end - pos);
+        pos = end;
+        continue;
+      }
+      const std::uint8_t* body = data_ + pos + kMsgHeaderSize;
+      const std::size_t at = pos;
+      pos += kMsgHeaderSize + size;
+      if (type == 'D') {
+        Data(body, size);
+      } else {
+        Other(at, type, body, size, &end);
+      }
+    }
+  }
+
+ private:
+  bool Corrupt(std::size_t pos, std::size_t end, std::size_t size, std::uint8_t type) const {
+    if (size == 0 || !IsLetter(type)) return true;
+    const bool body_fits = size <= end - pos - kMsgHeaderSize;
+    switch (type) {
+      case 'D': {
+        if (size < 2) return true;
+        if (end - pos < kMsgHeaderSize + 2) return false;  // truncated: the caller decides
+        const int idx = Index(Load<std::uint16_t>(data_ + pos + kMsgHeaderSize));
+        if (idx < 0) return false;
+        const ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
+        return size - 2 < t.body_size || size - 2 > t.full_size;
+      }
+      case 'S':
+        return size != sizeof(kSyncMagic) ||
+               (body_fits &&
+                std::memcmp(data_ + pos + kMsgHeaderSize, kSyncMagic, sizeof(kSyncMagic)) != 0);
+      case 'O': case 'R': return size != 2;
+      case 'A': return size < 4;
+      case 'L': return size < 9;
+      case 'C': return size < 11;
+      default: return false;
+    }
+  }
+
+  /// True when reading may resume at `pos`: a complete D message of a subscribed msg_id with a
+  /// fitting size, a complete S message with its magic, or a chain of kResyncChain complete,
+  /// non-corrupt messages of known types (fewer when the segment ends right after them).
+  bool ResyncPoint(std::size_t pos, std::size_t end) const {
+    if (end - pos < kMsgHeaderSize) return false;
+    const std::size_t size = Load<std::uint16_t>(data_ + pos);
+    const std::uint8_t type = data_[pos + 2];
+    if (size > end - pos - kMsgHeaderSize) return false;
+    const std::uint8_t* body = data_ + pos + kMsgHeaderSize;
+    if (type == 'D' && size >= 2 && Index(Load<std::uint16_t>(body)) >= 0) {
+      const ULogTopic& t = log_->topics[static_cast<std::size_t>(Index(Load<std::uint16_t>(body)))];
+      return size - 2 >= t.body_size && size - 2 <= t.full_size;
+    }
+    if (type == 'S') {
+      return size == sizeof(kSyncMagic) && std::memcmp(body, kSyncMagic, size) == 0;
+    }
+    std::size_t at = pos;
+    for (int k = 0; k < kResyncChain; ++k) {
+      if (at == end) return true;
+      if (end - at < kMsgHeaderSize) return false;
+      const std::size_t n = Load<std::uint16_t>(data_ + at);
+      const std::uint8_t ty = data_[at + 2];
+      if (!IsKnownType(ty) || Corrupt(at, end, n, ty) || n > end - at - kMsgHeaderSize) {
+        return false;
+      }
+      at += kMsgHeaderSize + n;
+    }
+    return true;
+  }
+
+  void Data(const std::uint8_t* body, std::size_t size) {
+    const std::uint16_t msg_id = Load<std::uint16_t>(body);
+    const int idx = Index(msg_id);
+    if (idx < 0) {
+      ++log_->warnings.unknown_msg_id_messages;
+      return;
+    }
+    ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
+    (void)size;  // checked by Corrupt(): body_size <= size - 2 <= full_size
+    t.bodies.insert(t.bodies.end(), body + 2, body + 2 + t.body_size);
+    ++t.rows;
+  }
+
+  /// The newest timestamp among the last message of every topic, us (for parameter changes).
+  std::uint64_t NewestTimestampUs() const {
+    std::uint64_t newest = 0;
+    for (const ULogTopic& t : log_->topics) {
+      if (t.rows > 0) newest = std::max(newest, t.TimestampUs(t.rows - 1));
+    }
+    return newest;
+  }
+
+  void Other(std::size_t at, std::uint8_t type, const std::uint8_t* body, std::size_t size,
+             std::size_t* end) {
+    switch (type) {
+      case 'B': FlagBits(at, body, size, end); break;
+      case 'F': Format(body, size); break;
+      case 'I': Info(body, size); break;
+      case 'M': InfoMultiple(body, size); break;
+      case 'P': Param(body, size); break;
+      case 'Q': DefaultParam(body, size); break;
+      case 'A': AddLogged(body, size); break;
+      case 'R': break;
+      case 'L': Text(body, size, false); break;
+      case 'C': Text(body, size, true); break;
+      case 'S': ++log_->sync_messages; break;
+      case 'O':
+        ++log_->dropouts;
+        log_->dropout_total_ms += Load<std::uint16_t>(body);
+        break;
+      default: ++log_->warnings.unknown_type_messages; break;
+    }
+  }
+
+  void Malformed() { ++log_->warnings.malformed_messages; }
+
+  /// Counts D messages per msg_id by hopping from header to header, so that each topic's
+  /// storage is reserved once (no reallocation copies). Stops at the first implausible header;
+  /// the counts are only a hint.
+  void PreScan() {
+    expected_rows_.assign(std::size_t{65536}, 0);
+    expected_bytes_.assign(std::size_t{65536}, 0);
+    std::size_t pos = kFileHeaderSize;
+    while (size_ - pos >= kMsgHeaderSize + 2) {
+      const std::size_t size = Load<std::uint16_t>(data_ + pos);
+      if (size == 0 || size > size_ - pos - kMsgHeaderSize) break;
+      if (data_[pos + 2] == 'D' && size >= 2) {
+        const std::uint16_t id = Load<std::uint16_t>(data_ + pos + 3);
+        ++expected_rows_[id];
+        expected_bytes_[id] += size - 2;
+      }
+      pos += kMsgHeaderSize + size;
+    }
+  }
+
+  void Reserve(ULogTopic* t) {
+    if (expected_rows_.empty()) return;
+    // Never more than the D bytes seen for this id: the reservations add up to at most the
+    // input size.
+    t->bodies.reserve(std::min(std::size_t{expected_rows_[t->msg_id]} * t->body_size,
+                               expected_bytes_[t->msg_id]));
+  }
+
+  /// Index into log_->topics of a msg_id, -1 when it is not subscribed.
+  int Index(std::uint16_t msg_id) const {
+    return msg_id < index_.size() ? index_[msg_id] : -1;
+  }
+
+  void FlagBits(std::size_t at, const std::uint8_t* body, std::size_t size, std::size_t* end) {
+    if (at != kFileHeaderSize || size < kFlagBitsSize) return Malformed();
+    std::memcpy(log_->compat_flags.data(), body, 8);
+    std::memcpy(log_->incompat_flags.data(), body + 8, 8);
+    bool unknown = (log_->incompat_flags[0] & ~1u) != 0;
+    for (int k = 1; k < 8; ++k) unknown = unknown || log_->incompat_flags[k] != 0;
+    if (unknown) {
+      throw InputError(log_->source, "byte " + std::to_string(at + kMsgHeaderSize + 8),
+                       "unknown incompatible ULog flag bits set: this log needs a newer reader");
+    }
+    if ((log_->incompat_flags[0] & 1u) == 0) return;
+    std::size_t last = at + kMsgHeaderSize + size;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t off = Load<std::uint64_t>(body + 16 + 8 * k);
+      if (off == 0) continue;
+      if (off < last || off > size_) {
+        ++log_->warnings.bad_appended_offsets;
+        continue;
+      }
+      log_->appended_offsets.push_back(off);
+      last = static_cast<std::size_t>(off);
+    }
+    if (!log_->appended_offsets.empty()) {
+      log_->data_appended = true;
+      *end = static_cast<std::size_t>(log_->appended_offsets.front());
+    }
+  }
+
+  void Format(const std::uint8_t* body, std::size_t size) {
+    std::string name;
+    std::vector<ULogFormatField> fields;
+    if (!detail::ParseULogFormat(std::string_view(reinterpret_cast<const char*>(body), size), &name,
+                     &fields)) {
+      return Malformed();
+    }
+    if (log_->formats.count(name) != 0) resolver_.Invalidate();
+    log_->formats[name] = std::move(fields);
+  }
+
+  void Info(const std::uint8_t* body, std::size_t size) {
+    const auto kv = ParseKeyValue(body, size);
+    if (!kv) return Malformed();
+    log_->info[kv->name] = InfoText(*kv);
+  }
+
+  void InfoMultiple(const std::uint8_t* body, std::size_t size) {
+    const auto kv = size >= 1 ? ParseKeyValue(body + 1, size - 1) : std::nullopt;
+    if (!kv) return Malformed();
+    auto& list = log_->info_multiple[kv->name];
+    const std::string text = InfoText(*kv);
+    if (body[0] != 0 && !list.empty()) {
+      list.back() += text;
+    } else {
+      list.push_back(text);
+    }
+  }
+
+  void Param(const std::uint8_t* body, std::size_t size) {
+    const auto kv = ParseKeyValue(body, size);
+    const auto value = kv ? ParamValue(*kv) : std::nullopt;
+    if (!value) return Malformed();
+    if (in_definitions_) {
+      log_->params[kv->name] = *value;
+    } else {
+      log_->param_changes.push_back({NewestTimestampUs(), kv->name, *value});
+    }
+  }
+
+  void DefaultParam(const std::uint8_t* body, std::size_t size) {
+    const auto kv = size >= 1 ? ParseKeyValue(body + 1, size - 1) : std::nullopt;
+    const auto value = kv ? ParamValue(*kv) : std::nullopt;
+    if (!value) return Malformed();
+    log_->default_params.push_back({kv->name, *value, body[0]});
+  }
+
+  void AddLogged(const std::uint8_t* body, std::size_t size) {
+    in_definitions_ = false;
+    ULogTopic t;
+    t.multi_id = body[0];
+    t.msg_id = Load<std::uint16_t>(body + 1);
+    t.name.assign(reinterpret_cast<const char*>(body + 3), size - 3);
+    if (Index(t.msg_id) >= 0) return Malformed();  // an id must not be reused
+    if (!resolver_.Resolve(&t)) {
+      ++log_->warnings.unresolved_subscriptions;
+      return;
+    }
+    Reserve(&t);
+    if (index_.size() <= t.msg_id) index_.resize(std::size_t{t.msg_id} + 1, -1);
+    index_[t.msg_id] = static_cast<int>(log_->topics.size());
+    log_->topics.push_back(std::move(t));
+  }
+
+  void Text(const std::uint8_t* body, std::size_t size, bool tagged) {
+    in_definitions_ = false;
+    ULogText t;
+    t.level = body[0];
+    std::size_t off = 1;
+    if (tagged) {
+      t.tag = Load<std::uint16_t>(body + 1);
+      off = 3;
+    }
+    t.timestamp_us = Load<std::uint64_t>(body + off);
+    off += 8;
+    t.text.assign(reinterpret_cast<const char*>(body + off), size - off);
+    log_->texts.push_back(std::move(t));
+  }
+
+  void Skip(std::size_t pos) { CountSkipped(log_->warnings, pos, pos + 1, skip_end_); }
+
+  void Truncated(std::size_t bytes) {
+    ++log_->warnings.truncated_records;
+    log_->warnings.truncated_bytes += bytes;
+  }
+
+  const std::uint8_t* data_;
+  std::size_t size_;
+  ULog* log_;
+  std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
+  std::vector<std::uint32_t> expected_rows_;  // PreScan() counts per msg_id, or empty
+  std::vector<std::size_t> expected_bytes_;   // PreScan() D body bytes per msg_id, or empty
+  detail::ULogFormatResolver resolver_;
+  bool in_definitions_ = true;
+  std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
+};
+
+}  // namespace
+
+int ULogTopic::ColumnIndex(std::string_view column) const {
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    if (columns[c].name == column) return static_cast<int>(c);
+  }
+  return -1;
+}
+
+double ULogTopic::Value(std::size_t row, std::size_t col) const {
+  const ULogColumn& c = columns[col];
+  const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
+  switch (c.type) {
+    case ULogType::kInt8: return Load<std::int8_t>(p);
+    case ULogType::kUInt8: case ULogType::kChar: return Load<std::uint8_t>(p);
+    case ULogType::kBool: return Load<std::uint8_t>(p) != 0 ? 1.0 : 0.0;
+    case ULogType::kInt16: return Load<std::int16_t>(p);
+    case ULogType::kUInt16: return Load<std::uint16_t>(p);
+    case ULogType::kInt32: return Load<std::int32_t>(p);
+    case ULogType::kUInt32: return Load<std::uint32_t>(p);
+    case ULogType::kInt64: return static_cast<double>(Load<std::int64_t>(p));
+    case ULogType::kUInt64: return static_cast<double>(Load<std::uint64_t>(p));
+    case ULogType::kFloat: return Load<float>(p);
+    case ULogType::kDouble: return Load<double>(p);
+  }
+  return 0.0;
+}
+
+std::uint64_t ULogTopic::TimestampUs(std::size_t row) const {
+  if (timestamp_col < 0) return 0;
+  const ULogColumn& c = columns[static_cast<std::size_t>(timestamp_col)];
+  const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
+  switch (c.type) {
+    case ULogType::kUInt64: return Load<std::uint64_t>(p);
+    case ULogType::kUInt32: return Load<std::uint32_t>(p);
+    case ULogType::kUInt16: return Load<std::uint16_t>(p);
+    case ULogType::kUInt8: return std::uint64_t{Load<std::uint8_t>(p)} * 1000u;
+    default: return 0;
+  }
+}
+
+std::vector<double> ULogTopic::Column(std::string_view column) const {
+  const int c = ColumnIndex(column);
+  if (c < 0) throw Error("ULog topic " + name + " has no field " + std::string(column));
+  std::vector<double> out(rows);
+  for (std::size_t r = 0; r < rows; ++r) out[r] = Value(r, static_cast<std::size_t>(c));
+  return out;
+}
+
+bool ULogWarnings::any() const {
+  return bytes_skipped || truncated_records || unknown_msg_id_messages ||
+         unknown_type_messages || malformed_messages || unresolved_subscriptions ||
+         bad_appended_offsets || unknown_version;
+}
+
+std::vector<std::string> ULogWarnings::Describe() const {
+  std::vector<std::string> out;
+  const auto n = [](std::size_t v) { return std::to_string(v); };
+  if (bytes_skipped) {
+    out.push_back("skipped " + n(bytes_skipped) + " bytes in " + n(skip_runs) +
+                  " run(s) after corrupt message headers (first at byte " +
+                  n(first_skip_offset) + ")");
+  }
+  if (truncated_records) {
+    out.push_back("dropped " + n(truncated_records) + " truncated message(s) (" +
+                  n(truncated_bytes) + " bytes)");
+  }
+  if (unknown_msg_id_messages) {
+    out.push_back(n(unknown_msg_id_messages) + " data message(s) of an unsubscribed msg_id");
+  }
+  if (unknown_type_messages) {
+    out.push_back(n(unknown_type_messages) + " message(s) of an unknown type, skipped");
+  }
+  if (malformed_messages) {
+    out.push_back(n(malformed_messages) + " malformed definition/info message(s), skipped");
+  }
+  if (unresolved_subscriptions) {
+    out.push_back(n(unresolved_subscriptions) +
+                  " subscription(s) whose format cannot be resolved (their data is skipped)");
+  }
+  if (bad_appended_offsets) {
+    out.push_back(n(bad_appended_offsets) + " invalid appended-data offset(s), ignored");
+  }
+  if (unknown_version) out.push_back("ULog version byte above 1: read as version 1");
+  return out;
+}
+
+const ULogTopic* ULog::Find(std::string_view name, int multi_id) const {
+  const ULogTopic* best = nullptr;
+  for (const ULogTopic& t : topics) {
+    if (t.name == name && t.multi_id == multi_id && (best == nullptr || t.rows > best->rows)) {
+      best = &t;
+    }
+  }
+  return best;
+}
+
+std::vector<std::pair<std::string, std::size_t>> ULog::MessageCounts() const {
+  std::vector<std::pair<std::string, std::size_t>> out;
+  for (const ULogTopic& t : topics) {
+    if (t.rows > 0) out.emplace_back(t.name + "/" + std::to_string(t.multi_id), t.rows);
+  }
+  return out;
+}
+
+ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source) {
+  ULog log;
+  log.source = source;
+  log.size_bytes = size;
+  if (size < kFileHeaderSize) {
+    throw InputError(source, "byte 0",
+                     "expected a 16-byte ULog header, the input has " + std::to_string(size) +
+                         " bytes");
+  }
+  if (std::memcmp(data, kULogMagic, sizeof(kULogMagic)) != 0) {
+    throw InputError(source, "byte 0",
+                     "expected the ULog magic 'ULog' 01 12 35: not a PX4 ULog file");
+  }
+  log.version = data[7];
+  log.warnings.unknown_version = log.version > 1;
+  log.start_timestamp_us = Load<std::uint64_t>(data + 8);
+  Parser parser(data, size, &log);
+  parser.Run();
+  return log;
+}
+
+ULog ReadULog(const std::string& path) {
+  const LogFile file(path, "ULog file");
+  return ParseULog(file.data(), file.size(), path);
+}
+
+}  // namespace plumb::io

@@ -1,0 +1,145 @@
+// Every input form behind one call (io/input/open_inputs.h): native CSV by its header, text
+// tables with units, scales, offsets and the axis map, the two-file form, flight logs by
+// content, joining with the clock shifted, the "counts" units, and the before_read hook.
+#include "plumb/io/input/open_inputs.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "io_test_util.h"
+#include "plumb/core/error.h"
+#include "plumb/core/units.h"
+
+namespace plumb::io {
+namespace {
+
+using testing::ExpectInputError;
+using testing::TempDir;
+
+const char kNative[] =
+    "time_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n"
+    "0.0,0.1,0.2,-9.8,0.01,0.02,0.03\n"
+    "0.1,0.1,0.2,-9.8,0.01,0.02,0.03\n"
+    "0.2,0.1,0.2,-9.8,0.01,0.02,0.03\n";
+
+TEST(OpenInputs, NativeCsvByItsHeader) {
+  TempDir dir;
+  const std::string path = dir.Write("a.csv", kNative);
+  const Session s = OpenInputs({path});
+  EXPECT_EQ(s.source, path);
+  ASSERT_EQ(s.series.size(), 3u);
+  EXPECT_FLOAT_EQ(s.series.acc[0].z(), -9.8f);
+  EXPECT_EQ(s.series.acc_unit, "m/s^2");
+}
+
+TEST(OpenInputs, NotNativeEndsWithTheHint) {
+  TempDir dir;
+  const std::string path = dir.Write("t.txt", "1 2 3\n4 5 6\n");
+  InputOptions o;
+  o.not_native_hint = "say which column is which";
+  ExpectInputError([&] { OpenInputs({path}, o); }, path, "",
+                   {"not plumb's native CSV", "found '1 2 3'", "; say which column is which"});
+}
+
+TEST(OpenInputs, TableWithUnitsScalesOffsetsAndAxisMap) {
+  TempDir dir;
+  // Counts at +-2 g (16384 per g) and +-250 deg/s (131 per deg/s), offset 10, no time, 50 Hz.
+  const std::string path = dir.Write("m.txt",
+                                     "16394,10,-16374,141,10,-121\n"
+                                     "16394,10,-16374,141,10,-121\n");
+  InputOptions o;
+  o.format = InputFormat::kTable;
+  o.rate_hz = 50;
+  o.columns.acc = {0, 1, 2};
+  o.columns.gyr = {3, 4, 5};
+  o.acc = {AccUnit::kStandardGravity, 1.0 / 16384, 10.0};
+  o.gyr = {GyrUnit::kDegreesPerSecond, 1.0 / 131, 10.0};
+  o.axis_map = {1, -2, -3};
+  const Session s = OpenInputs({path}, o);
+  ASSERT_EQ(s.series.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.series.t_s[1], 0.02);
+  EXPECT_NEAR(s.series.acc[0].x(), units::kStandardGravity, 1e-5);
+  EXPECT_NEAR(s.series.acc[0].z(), units::kStandardGravity, 1e-5);  // -1 g, z flipped
+  EXPECT_NEAR(s.series.gyr[0].x(), units::kRadPerDeg, 1e-6);
+  EXPECT_NEAR(s.series.gyr[0].z(), units::kRadPerDeg, 1e-6);  // -1 deg/s, z flipped
+  EXPECT_EQ(s.series.acc_unit, "m/s^2");
+}
+
+TEST(OpenInputs, TwoFileFormAndCountsUnits) {
+  TempDir dir;
+  const std::string acc = dir.Write("acc.txt", "0 1 2 3\n1 1 2 3\n2 1 2 3\n");
+  const std::string gyr = dir.Write("gyr.txt", "0 4 5 6\n1 4 5 6\n2 4 5 6\n");
+  InputOptions o;
+  o.acc.unit = AccUnit::kCounts;
+  o.gyr.unit = GyrUnit::kCounts;
+  const Session s = OpenInputs({{acc, gyr}}, o);
+  ASSERT_EQ(s.series.size(), 3u);
+  EXPECT_FLOAT_EQ(s.series.acc[2].y(), 2.0f);
+  EXPECT_FLOAT_EQ(s.series.gyr[2].z(), 6.0f);
+  EXPECT_EQ(s.series.acc_unit, "counts");
+  EXPECT_EQ(s.series.gyr_unit, "counts");
+  o.format = InputFormat::kNative;
+  EXPECT_THROW(OpenInputs({{acc, gyr}}, o), Error);
+}
+
+TEST(OpenInputs, JoinsShiftingAnOverlappingClock) {
+  TempDir dir;
+  const std::string a = dir.Write("a.csv", kNative);
+  const std::string b = dir.Write("b.csv", kNative);
+  const Session s = OpenInputs({a, b});
+  ASSERT_EQ(s.series.size(), 6u);
+  EXPECT_DOUBLE_EQ(s.series.t_s[3], 0.2 + 1000.0);
+  EXPECT_EQ(s.source, a + " " + b);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("shifted by 1000.200000 s"), std::string::npos) << s.warnings[0];
+}
+
+TEST(OpenInputs, RefusesToJoinDifferentSensors) {
+  TempDir dir;
+  const std::string a = dir.Write("a.csv", kNative);
+  const std::string b = dir.Write("b.csv", "time_s,acc_x,acc_y,acc_z\n5,0,0,-9.8\n6,0,0,-9.8\n");
+  EXPECT_THROW(OpenInputs({a, b}), Error);
+}
+
+TEST(OpenInputs, BeforeReadSeesEveryKindInOrderAndMayRefuse) {
+  TempDir dir;
+  const std::string a = dir.Write("a.csv", kNative);
+  const std::string acc = dir.Write("acc.txt", "0 1 2 3\n1 1 2 3\n");
+  const std::string gyr = dir.Write("gyr.txt", "0 4 5 6\n1 4 5 6\n");
+  std::vector<std::pair<std::size_t, InputKind>> seen;
+  InputOptions o;
+  o.before_read = [&](std::size_t i, InputKind kind) { seen.emplace_back(i, kind); };
+  OpenInputs({a, {acc, gyr}}, o);
+  const std::vector<std::pair<std::size_t, InputKind>> expected = {
+      {0, InputKind::kNativeCsv}, {1, InputKind::kTwoTables}};
+  EXPECT_EQ(seen, expected);
+  o.before_read = [](std::size_t, InputKind kind) {
+    if (kind == InputKind::kTwoTables) throw std::runtime_error("no pairs here");
+  };
+  EXPECT_THROW(OpenInputs({a, {acc, gyr}}, o), std::runtime_error);
+}
+
+TEST(OpenInputs, FlightLogByContent) {
+  const std::string path = testing::SharedLogPath("ardupilot", "plane408_centre_point.BIN");
+  PLUMB_SKIP_IF_ABSENT(path);
+  InputOptions o;
+  InputKind kind = InputKind::kNativeCsv;
+  o.before_read = [&](std::size_t, InputKind k) { kind = k; };
+  o.flight_log.imu = 1;
+  o.flight_log.to_s = 20.0;
+  const Session s = OpenInputs({path}, o);
+  EXPECT_EQ(kind, InputKind::kFlightLog);
+  EXPECT_NE(s.source.find("IMU2"), std::string::npos) << s.source;
+  EXPECT_LE(s.series.t_s.back(), 20.0);
+  EXPECT_TRUE(s.site.has_value());
+}
+
+TEST(OpenInputs, NoInputIsAnError) { EXPECT_THROW(OpenInputs({}), Error); }
+
+}  // namespace
+}  // namespace plumb::io
