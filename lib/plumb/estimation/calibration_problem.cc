@@ -36,9 +36,14 @@ CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model mod
       site_(site),
       options_(options),
       still_(std::move(still)),
-      theta_(std::move(theta)),
       noise_(noise),
       start_(start) {
+  for (const auto& block : theta) {
+    block_offset_.push_back(values_.size());
+    values_.insert(values_.end(), block.begin(), block.end());
+  }
+  q_offset_ = values_.size();
+  for (const auto& s : still_.poses) values_.insert(values_.end(), s.q.begin(), s.q.end());
   has_gyro_ = model_.has_gyro();
   still_gyro_ = has_gyro_ && options_.use_still_gyro;
   bool needs_velocity = false;
@@ -130,8 +135,28 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
 }
 
 void CalibrationProblem::SetMotionWeightsFromSolution() {
-  const auto linear = model_.Predict(theta_, model::SensorInput<double>());
+  const std::vector<const double*> blocks = BlockPointers();
+  const auto linear = model_.Predict(blocks.data(), model::SensorInput<double>());
   SetMotionWeights(linear.E, linear.F);
+}
+
+std::vector<const double*> CalibrationProblem::BlockPointers() const {
+  std::vector<const double*> out;
+  for (int t = 0; t < model_.num_terms(); ++t) out.push_back(block(t));
+  return out;
+}
+
+std::vector<const double*> CalibrationProblem::ModelBlocks() const { return BlockPointers(); }
+
+model::ParameterBlocks CalibrationProblem::theta() const {
+  model::ParameterBlocks out;
+  for (int t = 0; t < model_.num_terms(); ++t) out.emplace_back(block(t), block(t) + block_size(t));
+  return out;
+}
+
+Quat CalibrationProblem::R_n_b(std::size_t k) const {
+  const double* v = q(k);
+  return Quat(v[3], v[0], v[1], v[2]);
 }
 
 void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
@@ -139,9 +164,10 @@ void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
                                             bool free_probes) {
   ceres::Problem* problem = built.problem.get();
   for (int t = 0; t < model_.num_terms(); ++t) {
-    auto& block = theta_[static_cast<std::size_t>(t)];
+    double* values = block(t);
+    const int size = block_size(t);
     const auto& term = model_.terms()[static_cast<std::size_t>(t)];
-    problem->AddParameterBlock(block.data(), static_cast<int>(block.size()));
+    problem->AddParameterBlock(values, size);
     if (free_probes && term.probe) continue;
     std::vector<int> held;
     for (std::size_t i = 0; i < term.fixed.size(); ++i) {
@@ -149,23 +175,23 @@ void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
                                    std::make_pair(t, static_cast<int>(i))) != held_extra.end();
       if (term.fixed[i] || extra) held.push_back(static_cast<int>(i));
     }
-    if (held.size() == block.size()) {
-      problem->SetParameterBlockConstant(block.data());
+    if (static_cast<int>(held.size()) == size) {
+      problem->SetParameterBlockConstant(values);
     } else if (!held.empty()) {
-      built.manifolds.push_back(
-          std::make_unique<ceres::SubsetManifold>(static_cast<int>(block.size()), held));
-      problem->SetManifold(block.data(), built.manifolds.back().get());
+      built.manifolds.push_back(std::make_unique<ceres::SubsetManifold>(size, held));
+      problem->SetManifold(values, built.manifolds.back().get());
     }
   }
-  for (auto& s : still_.poses) {
-    problem->AddParameterBlock(s.q.data(), 4);
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
+    const StillPose& s = still_.poses[k];
+    problem->AddParameterBlock(q(k), 4);
     if (s.known) {
-      problem->SetParameterBlockConstant(s.q.data());
+      problem->SetParameterBlockConstant(q(k));
     } else {
       built.manifolds.push_back(s.heading_only ? residuals::HeadingManifold()
                                 : s.chain_head ? residuals::TiltManifold()
                                                : residuals::AttitudeManifold());
-      problem->SetManifold(s.q.data(), built.manifolds.back().get());
+      problem->SetManifold(q(k), built.manifolds.back().get());
     }
   }
 }
@@ -175,38 +201,40 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
   ceres::Problem* problem = built.problem.get();
   const auto acc_terms = StillResidual::TermsOf(model_, model::Sensor::kAccel);
   const auto gyr_terms = StillResidual::TermsOf(model_, model::Sensor::kGyro);
-  auto blocks_of = [&](const std::vector<int>& terms, double* q) {
-    std::vector<double*> blocks = {q};
-    for (int t : terms) blocks.push_back(theta_[static_cast<std::size_t>(t)].data());
+  auto blocks_of = [&](const std::vector<int>& terms, double* q_k) {
+    std::vector<double*> blocks = {q_k};
+    for (int t : terms) blocks.push_back(block(t));
     return blocks;
   };
-  for (auto& s : still_.poses) {
+  std::vector<double*> all_terms;
+  for (int t = 0; t < model_.num_terms(); ++t) all_terms.push_back(block(t));
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
+    const StillPose& s = still_.poses[k];
     built.acc.push_back(
         s.spinning ? nullptr
                    : problem->AddResidualBlock(
                          StillResidual::Create(model_, model::Sensor::kAccel, s.acc_measurement,
                                                site_.g_n, site_.omega_ie_n),
-                         nullptr, blocks_of(acc_terms, s.q.data())));
+                         nullptr, blocks_of(acc_terms, q(k))));
     built.gyr.push_back(
         still_gyro_ ? problem->AddResidualBlock(
                           StillResidual::Create(model_, model::Sensor::kGyro, s.gyr_measurement,
                                                 site_.g_n, site_.omega_ie_n,
                                                 s.segment.known_omega_eb_b.value_or(Vec3::Zero())),
-                          nullptr, blocks_of(gyr_terms, s.q.data()))
+                          nullptr, blocks_of(gyr_terms, q(k)))
                     : nullptr);
   }
   const auto& motions = still_.motions;
   for (std::size_t k = 0; k < motions.size(); ++k) {
     const auto& mo = motions[k];
-    std::vector<double*> blocks = {still_.poses[mo.from].q.data(),
-                                   still_.poses[mo.from + 1].q.data()};
-    for (auto& b : theta_) blocks.push_back(b.data());
+    std::vector<double*> blocks = {q(mo.from), q(mo.from + 1)};
+    blocks.insert(blocks.end(), all_terms.begin(), all_terms.end());
     built.motion.push_back(problem->AddResidualBlock(
         residuals::MotionResidual::Create(model_, motion_samples_[k], site_.omega_ie_n), nullptr,
         blocks));
     if (velocity_on_) {
-      std::vector<double*> vblocks = {still_.poses[mo.from].q.data()};
-      for (auto& b : theta_) vblocks.push_back(b.data());
+      std::vector<double*> vblocks = {q(mo.from)};
+      vblocks.insert(vblocks.end(), all_terms.begin(), all_terms.end());
       built.velocity.push_back(problem->AddResidualBlock(
           residuals::VelocityResidual::Create(model_, motion_samples_[k], site_.g_n,
                                               site_.omega_ie_n, velocity_info_[k]),
@@ -229,25 +257,24 @@ BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
 UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem) {
   UnknownColumns out;
   for (int t = 0; t < model_.num_terms(); ++t) {
-    auto& block = theta_[static_cast<std::size_t>(t)];
-    if (problem.IsParameterBlockConstant(block.data())) continue;
-    out.blocks.push_back(block.data());
+    double* values = block(t);
+    if (problem.IsParameterBlockConstant(values)) continue;
+    out.blocks.push_back(values);
     const auto& term = model_.terms()[static_cast<std::size_t>(t)];
     const auto& info = term.effect->info();
     for (int i = 0; i < info.size(); ++i) {
       if (term.fixed[static_cast<std::size_t>(i)]) continue;
       out.names.push_back(info.ParameterName(i));
-      out.values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal +
-                           block[static_cast<std::size_t>(i)]);
+      out.values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal + values[i]);
       out.is_model.push_back(true);
       out.model_index.emplace_back(t, i);
     }
   }
   const char* kTangentName[3] = {"north", "east", "down"};
   for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    auto& s = still_.poses[k];
+    const StillPose& s = still_.poses[k];
     if (s.known) continue;
-    out.blocks.push_back(s.q.data());
+    out.blocks.push_back(q(k));
     const int first = s.heading_only ? 2 : 0;
     const int dims = s.heading_only ? 1 : s.chain_head ? 2 : 3;
     for (int i = first; i < first + dims; ++i) {
@@ -279,7 +306,7 @@ ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
   for (int t = 0; t < model_.num_terms(); ++t) {
     const auto& term = model_.terms()[static_cast<std::size_t>(t)];
     if (!term.probe) continue;
-    blocks.push_back(theta_[static_cast<std::size_t>(t)].data());
+    blocks.push_back(block(t));
     for (int i = 0; i < term.effect->info().size(); ++i) {
       out.probe_names.push_back(term.effect->info().ParameterName(i));
       out.probe_term.push_back(t);
@@ -328,7 +355,7 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     f.count = s.stats.count;
     f.acc_mean = s.stats.acc_mean;
     if (has_gyro_) f.gyr_mean = s.stats.gyr_mean;
-    f.R_n_b = s.R_n_b();
+    f.R_n_b = R_n_b(k);
     f.attitude_known = s.known;
     // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
     double w[3];
@@ -377,15 +404,10 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
   }
 }
 
-void CalibrationProblem::SaveValues() {
-  saved_theta_ = theta_;
-  saved_q_.clear();
-  for (const auto& s : still_.poses) saved_q_.push_back(s.q);
-}
+void CalibrationProblem::SaveValues() { saved_values_ = values_; }
 
 void CalibrationProblem::RestoreValues() {
-  theta_ = saved_theta_;
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) still_.poses[k].q = saved_q_[k];
+  std::copy(saved_values_.begin(), saved_values_.end(), values_.begin());
 }
 
 }  // namespace plumb::estimation

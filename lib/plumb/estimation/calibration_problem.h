@@ -9,10 +9,13 @@
 //   motion                Log((R_k dR)^T R_k+1), dR the corrected rate integrated on SO(3)
 //   velocity (optional)   the accelerometer integrated while the IMU turns (lever arms, time
 //                         offset: effects whose excitation includes angular acceleration)
-// The problem owns the values (theta, the poses) that Ceres works on, so a ceres::Problem can
-// be built from them again (with other parameters held) and its residuals and Jacobians handed
-// out: the observability analysis, the covariance, diagnose's probe columns and the per-segment
-// residuals all read them here.
+// The problem owns the values (theta, the poses' attitudes) that Ceres works on, so a
+// ceres::Problem can be built from them again (with other parameters held) and its residuals
+// and Jacobians handed out: the observability analysis, the covariance, diagnose's probe
+// columns and the per-segment residuals all read them here. The values lie in one buffer, model
+// blocks in term order then the attitudes in pose order, so that every ordering by address
+// (ceres::Covariance sorts parameter blocks by address) is the same on every run: results do
+// not depend on how the heap happened to be laid out.
 #pragma once
 
 #include <ceres/ceres.h>
@@ -95,7 +98,12 @@ class CalibrationProblem {
 
   const model::Model& model() const { return model_; }
   const StillSet& still() const { return still_; }
-  const model::ParameterBlocks& theta() const { return theta_; }
+  /// The current model parameter blocks (a copy), one per term.
+  model::ParameterBlocks theta() const;
+  /// Where Ceres keeps each term's block (for ceres::Covariance on a built problem).
+  std::vector<const double*> ModelBlocks() const;
+  /// The current attitude R_n_b of pose k.
+  Quat R_n_b(std::size_t k) const;
   /// Saves the current values (theta and the attitudes), and puts them back (the solve's
   /// restart from the starting values, solve.h).
   void SaveValues();
@@ -109,13 +117,26 @@ class CalibrationProblem {
   void AddParameterBlocks(BuiltProblem& built, const std::vector<ParameterIndex>& held,
                           bool free_probes);
   void AddResiduals(BuiltProblem& built);
+  double* block(int term) { return values_.data() + block_offset_[static_cast<std::size_t>(term)]; }
+  const double* block(int term) const {
+    return values_.data() + block_offset_[static_cast<std::size_t>(term)];
+  }
+  int block_size(int term) const {
+    return model_.terms()[static_cast<std::size_t>(term)].effect->info().size();
+  }
+  double* q(std::size_t k) { return values_.data() + q_offset_ + 4 * k; }
+  const double* q(std::size_t k) const { return values_.data() + q_offset_ + 4 * k; }
+  /// Pointers to every term's block, for model::Model::Predict.
+  std::vector<const double*> BlockPointers() const;
 
   const ImuSeries& series_;
   model::Model model_;
   geo::Site site_;
   CalibrationOptions options_;
   StillSet still_;
-  model::ParameterBlocks theta_;
+  std::vector<double> values_;              // model blocks in term order, then q_k per pose
+  std::vector<std::size_t> block_offset_;   // per term: offset of its block in values_
+  std::size_t q_offset_ = 0;                // offset of the first attitude in values_
   NoiseModel noise_;
   StartingValues start_;
   bool has_gyro_ = false;
@@ -124,8 +145,7 @@ class CalibrationProblem {
   std::vector<residuals::MotionSamples> motion_samples_;
   std::vector<std::vector<Vec3>> output_rate_;  // per motion, per sample: d y_g / dt, units/s
   std::vector<Vec3> velocity_info_;             // per motion: 1 / sigma of the velocity residual
-  model::ParameterBlocks saved_theta_;
-  std::vector<std::array<double, 4>> saved_q_;
+  std::vector<double> saved_values_;
 };
 
 }  // namespace plumb::estimation

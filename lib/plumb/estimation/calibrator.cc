@@ -94,9 +94,9 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
 
   // 6. Parameters and their covariance.
   std::vector<Eigen::Index> column_of;
-  cal.parameters =
-      ReportParameters(cal.model, problem.theta(), series, columns, analysis, column_of);
-  ComputeCovariance(solution.fitted(), problem.theta(), analysis, column_of, options, cal,
+  cal.theta = problem.theta();
+  cal.parameters = ReportParameters(cal.model, cal.theta, series, columns, analysis, column_of);
+  ComputeCovariance(solution.fitted(), problem.ModelBlocks(), analysis, column_of, options, cal,
                     fit.warnings);
 
   // 7. The fit: chi^2, degrees of freedom and the residuals.
@@ -112,7 +112,6 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   if (cal.model.has_probes()) {
     fit.probes = problem.ProbeColumns(problem.Build({}, true), columns);
   }
-  cal.theta = problem.theta();
   return result;
 }
 

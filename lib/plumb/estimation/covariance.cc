@@ -39,11 +39,11 @@ std::vector<Eigen::Index> TermOffsets(const model::Model& model) {
 /// ceres::Covariance over the free model blocks of `fitted` into `cov` (zero elsewhere);
 /// false when Ceres finds the problem singular or there is nothing to compute.
 bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
-                     const model::ParameterBlocks& theta, Eigen::MatrixXd& cov) {
+                     const std::vector<const double*>& fitted_blocks, Eigen::MatrixXd& cov) {
   std::vector<const double*> blocks;
   std::vector<int> block_term;
   for (int t = 0; t < model.num_terms(); ++t) {
-    const double* b = theta[static_cast<std::size_t>(t)].data();
+    const double* b = fitted_blocks[static_cast<std::size_t>(t)];
     if (fitted.IsParameterBlockConstant(b)) continue;
     blocks.push_back(b);
     block_term.push_back(t);
@@ -107,7 +107,7 @@ std::vector<ParameterEstimate> ReportParameters(const model::Model& model,
   return out;
 }
 
-void ComputeCovariance(ceres::Problem& fitted, const model::ParameterBlocks& fitted_theta,
+void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>& fitted_blocks,
                        const ObservabilityAnalysis& analysis,
                        const std::vector<Eigen::Index>& column_of,
                        const CalibrationOptions& options, Calibration& calibration,
@@ -116,7 +116,7 @@ void ComputeCovariance(ceres::Problem& fitted, const model::ParameterBlocks& fit
   calibration.covariance = Eigen::MatrixXd::Zero(n, n);
   const bool from_ceres =
       options.use_ceres_covariance &&
-      CeresCovariance(fitted, calibration.model, fitted_theta, calibration.covariance);
+      CeresCovariance(fitted, calibration.model, fitted_blocks, calibration.covariance);
   if (!from_ceres) {
     if (options.use_ceres_covariance && calibration.model.num_free_parameters() > 0) {
       warnings.push_back("ceres::Covariance found the problem singular; sigmas are from "

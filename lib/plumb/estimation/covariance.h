@@ -34,9 +34,10 @@ std::vector<ParameterEstimate> ReportParameters(const model::Model& model,
 
 /// Stage 6 (file comment): fills `calibration.covariance`, `sigma_source` and every
 /// parameter's sigma (NaN for fixed and unobservable ones). `fitted` is the problem the fit
-/// was made on and `fitted_theta` the blocks it was built on (CalibrationProblem::theta());
+/// was made on and `fitted_blocks` where it keeps each term's block
+/// (CalibrationProblem::ModelBlocks());
 /// warnings go to `warnings`.
-void ComputeCovariance(ceres::Problem& fitted, const model::ParameterBlocks& fitted_theta,
+void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>& fitted_blocks,
                        const ObservabilityAnalysis& analysis,
                        const std::vector<Eigen::Index>& column_of,
                        const CalibrationOptions& options, Calibration& calibration,
