@@ -33,6 +33,9 @@ struct Combination {
   std::string text;  ///< e.g. "accel.bias.z - 9.78 accel.matrix.zz"
   double value = 0;
   double sigma = 0;
+  /// The combination as numbers: sum_i coefficients[i] * value of parameter names[i].
+  std::vector<std::string> names;
+  std::vector<double> coefficients;
 };
 
 struct Observability {

@@ -200,6 +200,8 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
       comb.text = FormatCombination(c, names, false);
       comb.value = c.dot(values);
       comb.sigma = std::sqrt(std::max(0.0, c_full.dot(out.covariance * c_full)));
+      comb.names = names;
+      comb.coefficients.assign(c.data(), c.data() + c.size());
       out.summary.determined.push_back(comb);
     }
   }
