@@ -46,6 +46,8 @@ struct Observability {
   std::vector<std::string> unobservable;
   /// Combinations of unobservable parameters that the data does determine.
   std::vector<Combination> determined;
+  /// Their covariance, c_i^T C c_j, in `determined` order (its diagonal: their sigma squared).
+  Eigen::MatrixXd determined_covariance;
   /// Smallest kept and largest dropped relative singular values (diagnostics).
   double smallest_kept = 0, largest_dropped = 0;
 };

@@ -1,7 +1,7 @@
 #include "plumb/estimation/uncertainty.h"
 
+#include <algorithm>
 #include <cmath>
-#include <map>
 
 namespace plumb::estimation {
 
@@ -31,30 +31,18 @@ NamedCovariance ParameterCovariance(const Calibration& calibration) {
       if (rows[a] < C.rows() && rows[b] < C.cols()) out.matrix(a, b) = C(rows[a], rows[b]);
     }
   }
+  out.matrix = 0.5 * (out.matrix + out.matrix.transpose()).eval();  // exactly symmetric
   return out;
 }
 
 NamedCovariance DeterminedCovariance(const Calibration& calibration) {
-  std::map<std::string, Eigen::Index> index;
-  for (std::size_t i = 0; i < calibration.parameters.size(); ++i) {
-    index[calibration.parameters[i].name] = static_cast<Eigen::Index>(i);
-  }
-  const Eigen::MatrixXd& C = calibration.covariance;
-  const auto n = static_cast<Eigen::Index>(calibration.parameters.size());
-  const auto& determined = calibration.observability.determined;
-  const auto k = static_cast<Eigen::Index>(determined.size());
-  Eigen::MatrixXd combos = Eigen::MatrixXd::Zero(n, k);  // one column per combination
+  const Observability& o = calibration.observability;
   NamedCovariance out;
-  for (Eigen::Index j = 0; j < k; ++j) {
-    const Combination& c = determined[static_cast<std::size_t>(j)];
-    out.names.push_back(c.text);
-    for (std::size_t i = 0; i < c.names.size() && i < c.coefficients.size(); ++i) {
-      const auto at = index.find(c.names[i]);
-      if (at != index.end()) combos(at->second, j) = c.coefficients[i];
-    }
-  }
-  out.matrix = (C.rows() == n && C.cols() == n) ? Eigen::MatrixXd(combos.transpose() * C * combos)
-                                                : Eigen::MatrixXd::Zero(k, k);
+  for (const auto& c : o.determined) out.names.push_back(c.text);
+  const auto k = static_cast<Eigen::Index>(o.determined.size());
+  const bool sized = o.determined_covariance.rows() == k && o.determined_covariance.cols() == k;
+  out.matrix = sized ? o.determined_covariance : Eigen::MatrixXd::Zero(k, k);
+  out.matrix = 0.5 * (out.matrix + out.matrix.transpose()).eval();
   return out;
 }
 

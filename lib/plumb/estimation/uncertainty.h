@@ -39,7 +39,8 @@ struct NamedCovariance {
 NamedCovariance ParameterCovariance(const Calibration& calibration);
 
 /// The covariance of the determined combinations (calibration.observability.determined),
-/// c_i^T C c_j: estimable functions, so it does not depend on the gauge the fit held.
+/// c_i^T C c_j with C the observability analysis's covariance, the one their sigmas come from
+/// (Observability::determined_covariance), so that its diagonal is their sigma squared.
 NamedCovariance DeterminedCovariance(const Calibration& calibration);
 
 }  // namespace plumb::estimation
