@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -44,26 +45,34 @@ double Median(std::vector<double> v) {
   return *mid;
 }
 
-/// Per sample: inside one of the still segments.
-std::vector<char> InStill(std::size_t n, const std::vector<StillSegment>& still) {
-  std::vector<char> in(n, 0);
-  for (const auto& s : still) {
-    for (std::size_t i = s.begin; i < std::min(s.end, n); ++i) in[i] = 1;
+/// The still segments as sorted, merged sample ranges, asked about samples in increasing order.
+class StillRanges {
+ public:
+  explicit StillRanges(const std::vector<StillSegment>& still) {
+    for (const auto& s : still) {
+      if (s.end > s.begin) ranges_.emplace_back(s.begin, s.end);
+    }
+    std::sort(ranges_.begin(), ranges_.end());
   }
-  return in;
-}
+  /// Sample i lies in a still segment; i must not decrease between calls (until Rewind).
+  bool Contains(std::size_t i) {
+    while (k_ < ranges_.size() && ranges_[k_].second <= i) ++k_;
+    for (std::size_t j = k_; j < ranges_.size() && ranges_[j].first <= i; ++j) {
+      if (i < ranges_[j].second) return true;
+    }
+    return false;
+  }
+  void Rewind() { k_ = 0; }
+
+ private:
+  std::vector<std::pair<std::size_t, std::size_t>> ranges_;
+  std::size_t k_ = 0;
+};
 
 /// The per-axis limit of out_of_range for one sensor of `series`.
 double RangeLimit(const ImuSeries& series, bool gyro) {
   if (gyro) return SiGyro(series) ? kMaxGyroDegS * units::kRadPerDeg : kMaxCounts;
   return SiAccel(series) ? kMaxAccelG * units::kStandardGravity : kMaxCounts;
-}
-
-bool InRange(const Vec3f& v, double limit) {
-  for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(v[a]) || std::abs(static_cast<double>(v[a])) > limit) return false;
-  }
-  return true;
 }
 
 std::string LimitText(const ImuSeries& series, bool gyro) {
@@ -74,62 +83,117 @@ std::string LimitText(const ImuSeries& series, bool gyro) {
   return Num(limit) + " " + unit;
 }
 
-std::optional<Gate> OutOfRange(const ImuSeries& series, const std::vector<char>& in_still) {
-  const double acc_limit = RangeLimit(series, false);
-  const double gyr_limit = RangeLimit(series, true);
-  std::size_t count = 0, inside = 0, first = 0;
-  for (std::size_t i = 0; i < series.size(); ++i) {
-    const bool ok = InRange(series.acc[i], acc_limit) &&
-                    (!series.has_gyro() || InRange(series.gyr[i], gyr_limit));
-    if (ok) continue;
-    if (count == 0) first = i;
-    ++count;
-    inside += in_still[i] ? 1 : 0;
+/// Axis k of sample i: accelerometer x, y, z for k = 0..2, gyroscope x, y, z for k = 3..5.
+float Component(const ImuSeries& series, std::size_t i, int k) {
+  return k < 3 ? series.acc[i][k] : series.gyr[i][k - 3];
+}
+
+/// One pass over the samples: those out of range, and each axis's extremes over the rest.
+struct SampleScan {
+  std::size_t bad = 0, bad_in_still = 0, first_bad = 0;
+  std::array<float, 6> lo{}, hi{};
+  std::array<bool, 6> any{};
+};
+
+/// Extremes of one sensor's axes over the components within `limit`; returns the number of
+/// components beyond it or not finite. The samples are read as a flat array of floats, 12 (4
+/// samples) at a time into 12 accumulators, which the compiler vectorises: one fast pass.
+std::size_t Extremes(const std::vector<Vec3f>& v, float limit, float* lo, float* hi) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f is three packed floats");
+  const float* p = v.empty() ? nullptr : v.data()->data();
+  const std::size_t n = 3 * v.size();
+  float l[12], h[12];
+  unsigned bad[12] = {0};
+  for (int k = 0; k < 12; ++k) l[k] = kInf, h[k] = -kInf;
+  std::size_t i = 0;
+  for (; i + 12 <= n; i += 12) {
+    for (int k = 0; k < 12; ++k) {
+      const float x = p[i + static_cast<std::size_t>(k)];
+      const bool ok = std::abs(x) <= limit;  // false for NaN too
+      const float xl = ok ? x : kInf, xh = ok ? x : -kInf;
+      l[k] = xl < l[k] ? xl : l[k];
+      h[k] = xh > h[k] ? xh : h[k];
+      bad[k] += ok ? 0u : 1u;
+    }
   }
-  if (count == 0) return std::nullopt;
+  std::size_t total = 0;
+  for (; i < n; ++i) {
+    const float x = p[i];
+    const std::size_t a = i % 3;
+    if (std::abs(x) <= limit) {
+      l[a] = std::min(l[a], x);
+      h[a] = std::max(h[a], x);
+    } else {
+      ++total;
+    }
+  }
+  for (int a = 0; a < 3; ++a) lo[a] = kInf, hi[a] = -kInf;
+  for (int k = 0; k < 12; ++k) {
+    lo[k % 3] = std::min(lo[k % 3], l[k]);
+    hi[k % 3] = std::max(hi[k % 3], h[k]);
+    total += bad[k];
+  }
+  return total;
+}
+
+SampleScan Scan(const ImuSeries& series, StillRanges& still) {
+  SampleScan out;
+  const float limit[2] = {static_cast<float>(RangeLimit(series, false)),
+                          static_cast<float>(RangeLimit(series, true))};
+  std::size_t bad = Extremes(series.acc, limit[0], out.lo.data(), out.hi.data());
+  if (series.has_gyro()) bad += Extremes(series.gyr, limit[1], out.lo.data() + 3, out.hi.data() + 3);
+  for (std::size_t k = 0; k < 6; ++k) out.any[k] = out.hi[k] >= out.lo[k];
+  if (bad == 0) return out;
+  // Some samples are out of range: count them, and find the first.
+  const int axes = series.has_gyro() ? 6 : 3;
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    bool ok = true;
+    for (int k = 0; k < axes; ++k) ok = ok && std::abs(Component(series, i, k)) <= limit[k / 3];
+    if (ok) continue;
+    if (out.bad == 0) out.first_bad = i;
+    ++out.bad;
+    out.bad_in_still += still.Contains(i) ? 1 : 0;
+  }
+  return out;
+}
+
+std::optional<Gate> OutOfRange(const ImuSeries& series, const SampleScan& scan) {
+  if (scan.bad == 0) return std::nullopt;
+  const std::size_t first = scan.first_bad;
   std::string sample = "accel " + Triple(series.acc[first].cast<double>()) + " " + series.acc_unit;
   if (series.has_gyro()) {
     sample += ", gyro " + Triple(series.gyr[first].cast<double>()) + " " + series.gyr_unit;
   }
   return Gate{"out_of_range",
-              Count(count, "sample") + " outside any IMU's range (an axis beyond " + LimitText(series, false) +
+              Count(scan.bad, "sample") + " outside any IMU's range (an axis beyond " +
+                  LimitText(series, false) +
                   (series.has_gyro() ? " or " + LimitText(series, true) : std::string()) +
-                  ", or not finite), " + std::to_string(inside) +
+                  ", or not finite), " + std::to_string(scan.bad_in_still) +
                   " of them inside the still segments; the first at t = " + Num(series.t_s[first]) +
                   " s (sample " + std::to_string(first) + "): " + sample +
                   ". A corrupt log (flipped bytes, a bad record) or a wrong unit: cut them out "
                   "(--from/--to, --segments) or fix the input before trusting this fit"};
 }
 
-/// Longest run of samples equal to `extreme` on axis `a` outside the still segments.
+/// Runs of samples at one axis's extreme value outside the still segments.
 struct Run {
-  std::size_t longest = 0, start = 0, runs = 0, samples = 0;
-};
+  bool active = false;  ///< the extreme is beyond the saturation floor
+  float value = 0;
+  std::size_t current = 0, longest = 0, start = 0, runs = 0, samples = 0;
 
-Run RunsAt(const std::vector<Vec3f>& v, int a, float extreme, const std::vector<char>& in_still) {
-  Run out;
-  std::size_t cur = 0;
-  auto close = [&](std::size_t end) {
-    if (cur >= static_cast<std::size_t>(kSaturationRun)) {
-      ++out.runs;
-      out.samples += cur;
-      if (cur > out.longest) {
-        out.longest = cur;
-        out.start = end - cur;
+  void Close(std::size_t end) {
+    if (current >= static_cast<std::size_t>(kSaturationRun)) {
+      ++runs;
+      samples += current;
+      if (current > longest) {
+        longest = current;
+        start = end - current;
       }
     }
-    cur = 0;
-  };
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!in_still[i] && v[i][a] == extreme) {
-      ++cur;
-    } else {
-      close(i);
-    }
+    current = 0;
   }
-  close(v.size());
-  return out;
-}
+};
 
 /// Median norm of the accelerometer mean over the still segments, sensor units (0 if none).
 double StillAccelNorm(const ImuSeries& series, const std::vector<StillSegment>& still) {
@@ -144,40 +208,57 @@ double StillAccelNorm(const ImuSeries& series, const std::vector<StillSegment>& 
   return std::isfinite(m) ? m : 0.0;
 }
 
-std::optional<Gate> Saturated(const ImuSeries& series, const std::vector<StillSegment>& still,
-                              const std::vector<char>& in_still) {
+/// Per axis (k = 0..5) and extreme (high, low): the runs at it, when beyond the floor.
+std::array<Run, 12> SaturationRuns(const ImuSeries& series, const std::vector<StillSegment>& still,
+                                   const SampleScan& scan, StillRanges& ranges) {
+  std::array<Run, 12> runs{};
+  const int axes = series.has_gyro() ? 6 : 3;
+  const double floor[2] = {
+      SiAccel(series) ? kSaturationMinAccelG * units::kStandardGravity
+                      : kSaturationMinAccelG * StillAccelNorm(series, still),
+      SiGyro(series) ? kSaturationMinGyroDegS * units::kRadPerDeg : 0.0};
+  bool any = false;
+  for (int k = 0; k < axes; ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    for (int e = 0; e < 2; ++e) {
+      Run& r = runs[2 * kk + static_cast<std::size_t>(e)];
+      r.value = e == 0 ? scan.hi[kk] : scan.lo[kk];
+      r.active = scan.any[kk] && std::abs(static_cast<double>(r.value)) >= floor[k / 3];
+      any = any || r.active;
+    }
+  }
+  if (!any) return runs;
+  // Per active extreme, one pass over its axis: equal samples are rare, so the loop is a
+  // compare with a branch almost never taken; runs are counted on the matches alone.
+  for (std::size_t t = 0; t < runs.size(); ++t) {
+    Run& r = runs[t];
+    if (!r.active) continue;
+    const int k = static_cast<int>(t / 2);
+    const float* p = (k < 3 ? series.acc : series.gyr).data()->data() + k % 3;
+    std::size_t last = 0;  // one past the last sample of the current run
+    ranges.Rewind();
+    for (std::size_t i = 0; i < series.size(); ++i) {
+      if (p[3 * i] != r.value || ranges.Contains(i)) continue;
+      if (r.current > 0 && i != last) r.Close(last);
+      ++r.current;
+      last = i + 1;
+    }
+    r.Close(last);
+  }
+  return runs;
+}
+
+std::optional<Gate> Saturated(const ImuSeries& series, const std::array<Run, 12>& runs) {
   std::string axes;
-  for (int sensor = 0; sensor < (series.has_gyro() ? 2 : 1); ++sensor) {
-    const bool gyro = sensor == 1;
-    const std::vector<Vec3f>& v = gyro ? series.gyr : series.acc;
-    const double limit = RangeLimit(series, gyro);
-    double floor = 0.0;
-    if (gyro && SiGyro(series)) floor = kSaturationMinGyroDegS * units::kRadPerDeg;
-    if (!gyro) {
-      floor = SiAccel(series) ? kSaturationMinAccelG * units::kStandardGravity
-                              : kSaturationMinAccelG * StillAccelNorm(series, still);
-    }
-    const std::string unit = gyro ? series.gyr_unit : series.acc_unit;
-    for (int a = 0; a < 3; ++a) {
-      float lo = 0, hi = 0;
-      bool any = false;
-      for (const auto& s : v) {
-        const float x = s[a];
-        if (!std::isfinite(x) || std::abs(static_cast<double>(x)) > limit) continue;
-        lo = any ? std::min(lo, x) : x;
-        hi = any ? std::max(hi, x) : x;
-        any = true;
-      }
-      for (const float extreme : {hi, lo}) {
-        if (!any || std::abs(static_cast<double>(extreme)) < floor) continue;
-        const Run run = RunsAt(v, a, extreme, in_still);
-        if (run.runs == 0) continue;
-        axes += std::string(axes.empty() ? "" : "; ") + (gyro ? "gyro " : "accel ") + kAxis[a] +
-                " sits at " + Exact(extreme) + " " + unit + " for " + std::to_string(run.longest) +
-                " samples in a row from t = " + Num(series.t_s[run.start]) + " s (" +
-                Count(run.runs, "such run") + ", " + Count(run.samples, "sample") + ")";
-      }
-    }
+  for (std::size_t t = 0; t < runs.size(); ++t) {
+    const Run& run = runs[t];
+    if (!run.active || run.runs == 0) continue;
+    const bool gyro = t >= 6;
+    axes += std::string(axes.empty() ? "" : "; ") + (gyro ? "gyro " : "accel ") + kAxis[(t / 2) % 3] +
+            " sits at " + Exact(run.value) + " " + (gyro ? series.gyr_unit : series.acc_unit) +
+            " for " + std::to_string(run.longest) + " samples in a row from t = " +
+            Num(series.t_s[run.start]) + " s (" + Count(run.runs, "such run") + ", " +
+            Count(run.samples, "sample") + ")";
   }
   if (axes.empty()) return std::nullopt;
   return Gate{"saturated",
@@ -419,9 +500,10 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
 
 std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillSegment>& still) {
   std::vector<Gate> gates;
-  const std::vector<char> in_still = InStill(series.size(), still);
-  if (auto g = OutOfRange(series, in_still)) gates.push_back(*g);
-  if (auto g = Saturated(series, still, in_still)) gates.push_back(*g);
+  StillRanges ranges(still);
+  const SampleScan scan = Scan(series, ranges);
+  if (auto g = OutOfRange(series, scan)) gates.push_back(*g);
+  if (auto g = Saturated(series, SaturationRuns(series, still, scan, ranges))) gates.push_back(*g);
   return gates;
 }
 
