@@ -261,6 +261,14 @@ TEST(GatesCli, AWrongRateIsNamedAndStrictExportWritesNothing) {
                              " failed a gate (unit_or_rate) under --strict (see 'gate failed' "
                              "above); nothing written\n");
   EXPECT_FALSE(std::filesystem::exists(param));
+  // plumb report too: exit 3 before writing the page.
+  const std::string page = dir.File("page");
+  const ToolRun report = Plumb({"report", Mikoff(), "--columns", "ax,ay,az,gx,gy,gz", "--rate",
+                                "10", "--strict", "--no-figures", "--no-diagnose", "--out", page},
+                               dir);
+  EXPECT_EQ(report.exit_code, 3) << report.err;
+  EXPECT_TRUE(Contains(report.out, "gate failed: unit_or_rate: " + Mikoff())) << report.out;
+  EXPECT_FALSE(std::filesystem::exists(page + "/index.html"));
   // The right rate passes every gate.
   const ToolRun right = Plumb({"calibrate", Mikoff(), "--columns", "ax,ay,az,gx,gy,gz", "--rate",
                                "100", "--strict", "--export", "ardupilot=" + param},
