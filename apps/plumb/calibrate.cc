@@ -104,9 +104,8 @@ class CalibrateCommand : public Command {
     PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose) << "\n";
 
-    const estimation::CalibrationResult result =
-        estimation::Calibrate(series, segments, model, site, options);
-    std::cout << report::CalibrationSummary(result);
+    const estimation::CalibrationResult result = CalibrateSession(session, fit);
+    std::cout << report::CalibrationSummary(result, session.source);
     std::optional<estimation::CalibrationResult> baseline;
     if (!a.baseline.empty()) {
       model::Model before = model::Model::Parse(a.baseline);
@@ -118,6 +117,8 @@ class CalibrateCommand : public Command {
       std::cout << "\n" << report::BeforeAfterSummary(*baseline, result);
     }
 
+    if (const int code = StrictGateExit(result.fit, session.source, a.fit.strict)) return code;
+    CheckGatesForExport(exports, a.exports, result.fit, session.source);
     nlohmann::json exported;
     if (!exports.empty()) {
       exported = RunExports(exports, a.exports, a.input.imu, result, series, std::cout);
@@ -158,7 +159,7 @@ class CalibrateCommand : public Command {
         begin = given.front().begin;
         end = given.front().end;
       }
-      return RunPaperStatic(session, begin, end, site, a.json_path);
+      return RunPaperStatic(session, begin, end, site, a.json_path, a.fit.strict);
     }
     std::vector<StillSegment> still;
     std::vector<paper::MotionRange> motion;
@@ -171,7 +172,7 @@ class CalibrateCommand : public Command {
       std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose) << "\n";
       still = seg.segments;
     }
-    return RunPaperBenchmark(session, still, motion, site, a.json_path);
+    return RunPaperBenchmark(session, still, motion, site, a.json_path, a.fit.strict);
   }
 
   CalibrateArgs args_;

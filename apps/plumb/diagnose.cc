@@ -104,7 +104,7 @@ class DiagnoseCommand : public Command {
     ra_options.significance = a.significance;
     const diagnostics::ResidualAnalysis ra = diagnostics::AnalyseResiduals(series, d.fit, ra_options);
     std::cout << "plumb diagnose: " << report::FitVerdict(d.fit.fit) << "\n"
-              << report::ResidualAnalysisText(ra) << report::DiagnosisText(d);
+              << report::GateLines(d.fit.fit, session.source) << report::ResidualAnalysisText(ra) << report::DiagnosisText(d);
     const auto best = std::find_if(d.candidates.begin(), d.candidates.end(),
                                    [](const diagnostics::Candidate& c) { return c.refit.has_value(); });
     if (best != d.candidates.end()) {

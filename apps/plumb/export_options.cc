@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "commands.h"
+#include "fit_options.h"
 #include "plumb/core/error.h"
 #include "plumb/export/export.h"
 #include "plumb/io/common/atomic_file.h"
@@ -26,6 +27,11 @@ void AddExportOptions(CLI::App* app, ExportArgs& a) {
                 "Write ArduPilot/PX4 parameters even when the session leaves the plumb "
                 "parameters they come from undetermined (one still pose, say): those values are "
                 "the ones plumb held, not measured, and replace the vehicle's");
+  app->add_flag("--export-anyway", a.anyway,
+                "Write the --export files even when the fit failed a gate (not converged, "
+                "segments of one pose, samples out of range, a unit or rate the data "
+                "contradict, a saturated axis); without it such an export is refused (exit 1) "
+                "and nothing is written");
   app->add_option("--kalibr-topic", a.rostopic, "rostopic written in Kalibr's imu.yaml")
       ->capture_default_str();
 }
@@ -55,6 +61,15 @@ void CheckExportable(const ImuSeries& series) {
                 "densities act on SI output, so they cannot be exported from this session "
                 "(give --acc-scale/--acc-unit and --gyr-scale/--gyr-unit to calibrate in SI)");
   }
+}
+
+void CheckGatesForExport(const std::vector<ExportRequest>& requests, const ExportArgs& a,
+                         const estimation::FitReport& fit, const std::string& source) {
+  if (requests.empty() || fit.gates.empty() || a.anyway) return;
+  throw Error("--export refused: " + GateFailure(fit, source) +
+              " (see 'gate failed' above), so its parameters would replace the vehicle's with "
+              "numbers not to be trusted; nothing written. Fix the input, or give "
+              "--export-anyway to write them regardless");
 }
 
 nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const ExportArgs& a,

@@ -20,6 +20,7 @@ struct ExportArgs {
   CLI::Option* imu_option = nullptr; ///< to tell whether --export-imu was given
   std::string rostopic = "/imu0";    ///< --kalibr-topic: Kalibr's rostopic
   bool undetermined = false;         ///< --export-undetermined: write undetermined values too
+  bool anyway = false;               ///< --export-anyway: write even when the fit failed a gate
 };
 
 /// One requested export.
@@ -28,7 +29,7 @@ struct ExportRequest {
   std::string path;    ///< file to write (atomically)
 };
 
-/// Registers --export, --export-imu, --export-undetermined and --kalibr-topic.
+/// Registers --export, --export-imu, --export-undetermined, --export-anyway and --kalibr-topic.
 void AddExportOptions(CLI::App* app, ExportArgs& args);
 
 /// The requests of --export; throws UsageError for a missing '=', an empty file or an
@@ -38,6 +39,11 @@ std::vector<ExportRequest> ParseExports(const ExportArgs& args);
 /// Throws plumb::Error when the session's samples are not in SI (raw counts): firmware
 /// parameters and noise densities would be meaningless. Call before calibrating.
 void CheckExportable(const ImuSeries& series);
+
+/// Throws plumb::Error, naming `source` and the gates, when there are `requests` and the fit
+/// failed a gate (estimation/gates.h) without --export-anyway. Call before writing anything.
+void CheckGatesForExport(const std::vector<ExportRequest>& requests, const ExportArgs& args,
+                         const estimation::FitReport& fit, const std::string& source);
 
 /// Writes every request (atomically), prints each report to `out`, and returns the JSON
 /// object {"<format>": {...}} for calibrate's document. `imu` is the instance used when

@@ -4,6 +4,10 @@
 #include <iostream>
 #include <optional>
 
+#include "plumb/core/error.h"
+#include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/gates.h"
+
 namespace plumb::cli {
 
 void AddModelOption(CLI::App* app, FitArgs& a) {
@@ -16,7 +20,9 @@ void AddModelOption(CLI::App* app, FitArgs& a) {
 void AddFitOptions(CLI::App* app, FitArgs& a) {
   app->add_flag("--strict", a.strict,
                 "Fail (exit 1) when the data cannot determine every parameter of the model, "
-                "instead of reporting the unobservable directions");
+                "instead of reporting the unobservable directions, and (exit 3, nothing "
+                "written) when the fit fails a gate: not converged, segments of one pose, "
+                "samples out of range, a unit or rate the data contradict, a saturated axis");
   a.heading = app->add_option("--heading", a.heading_deg,
                               "Heading of the first still pose's x axis from north, degrees "
                               "(0 = x north); otherwise the heading is an arbitrary gauge");
@@ -26,6 +32,11 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
   level->excludes(a.heading);
   app->add_option("--temp-ref", a.temp_ref_c,
                   "Reference temperature of the temperature terms, degC")
+      ->capture_default_str();
+  app->add_option("--max-iterations", a.max_iterations,
+                  "Iteration limit of each solve; a fit that reaches it has not converged "
+                  "(the gate not_converged)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
 }
 
@@ -49,6 +60,7 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
     out.options.first_heading_deg = fit.heading_deg;
   }
   if (fit.strict) out.options.on_insufficient = estimation::InsufficientData::kError;
+  out.options.max_iterations = fit.max_iterations;
   return out;
 }
 
@@ -58,6 +70,34 @@ void PrintSession(const Session& session) {
             << " s" << (series.has_gyro() ? "" : ", no gyroscope")
             << (series.has_temperature() ? ", with temperature" : "") << "\n";
   for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+}
+
+estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit) {
+  try {
+    return estimation::Calibrate(session.series, fit.segments, fit.model, fit.site, fit.options);
+  } catch (const Error& e) {
+    const std::vector<estimation::Gate> gates =
+        estimation::CheckSamples(session.series, fit.segments);
+    if (gates.empty()) throw;
+    std::string text = e.what();
+    for (const auto& g : gates) text += "\ngate failed: " + g.name + ": " + session.source + ": " + g.message;
+    throw Error(text);
+  }
+}
+
+std::string GateFailure(const estimation::FitReport& fit, const std::string& source) {
+  std::string names;
+  for (const auto& g : fit.gates) names += (names.empty() ? "" : ", ") + g.name;
+  const std::size_t n = fit.gates.size();
+  return "the fit of " + source + " failed " +
+         (n == 1 ? std::string("a gate") : std::to_string(n) + " gates") + " (" + names + ")";
+}
+
+int StrictGateExit(const estimation::FitReport& fit, const std::string& source, bool strict) {
+  if (!strict || fit.gates.empty()) return 0;
+  std::cerr << "plumb: error: " << GateFailure(fit, source)
+            << " under --strict (see 'gate failed' above); nothing written\n";
+  return kExitGateFailed;
 }
 
 }  // namespace plumb::cli

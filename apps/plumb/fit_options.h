@@ -1,6 +1,7 @@
 // The options of a generalized fit that `calibrate` and `report` share (--model, --strict,
-// --heading, --level-north, --temp-ref), and the steps both take from a session to the
-// calibration's inputs: segments, site, model and options.
+// --heading, --level-north, --temp-ref, --max-iterations), the steps both take from a session
+// to the calibration's inputs (segments, site, model and options) and to the calibration, and
+// what a failed gate (estimation/gates.h) does under --strict.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,7 @@
 #include "plumb/core/segment.h"
 #include "plumb/core/session.h"
 #include "plumb/estimation/options.h"
+#include "plumb/estimation/result.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
 #include "plumb/segmentation/still_detector.h"
@@ -20,16 +22,21 @@ namespace plumb::cli {
 struct FitArgs {
   std::string model = "base";      ///< --model SPEC
   bool strict = false;             ///< --strict: fail when the data cannot determine the model
+                                   ///< (exit 1) or the fit fails a gate (exit 3)
   double heading_deg = 0.0;        ///< --heading: first still pose's x axis from north, degrees
   CLI::Option* heading = nullptr;  ///< set when --heading was given
   bool level_north = false;        ///< --level-north: first still pose level, x north (known)
   double temp_ref_c = 25.0;        ///< --temp-ref: reference of the temperature terms, degC
+  int max_iterations = 200;        ///< --max-iterations: the solver's limit per solve, >= 1
 };
+
+/// The exit code of a failed gate under --strict (SPEC section 8).
+inline constexpr int kExitGateFailed = 3;
 
 /// Registers --model on `app`.
 void AddModelOption(CLI::App* app, FitArgs& args);
 
-/// Registers --strict, --heading, --level-north and --temp-ref on `app`.
+/// Registers --strict, --heading, --level-north, --temp-ref and --max-iterations on `app`.
 void AddFitOptions(CLI::App* app, FitArgs& args);
 
 /// Everything Calibrate() takes besides the samples.
@@ -48,5 +55,17 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
 
 /// "<source>: N samples, T s[, no gyroscope][, with temperature]" and the session's warnings.
 void PrintSession(const Session& session);
+
+/// estimation::Calibrate on the session with `fit`. When it throws, the error also lists the
+/// samples' gates (estimation::CheckSamples: samples out of range, a saturated axis), often
+/// the reason, naming the input.
+estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit);
+
+/// "the fit of SOURCE failed N gates (names)": for errors and refusals.
+std::string GateFailure(const estimation::FitReport& fit, const std::string& source);
+
+/// With --strict and a failed gate: prints "plumb: error: ..." on stderr and returns
+/// kExitGateFailed (the caller returns it before writing anything); otherwise 0.
+int StrictGateExit(const estimation::FitReport& fit, const std::string& source, bool strict);
 
 }  // namespace plumb::cli

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "fit_options.h"
 #include "plumb/core/units.h"
 #include "plumb/paper/backend.h"
 #include "plumb/paper/static_procedure.h"
@@ -46,11 +47,21 @@ void Finish(const nlohmann::json& doc, const std::vector<std::string>& notes,
   }
 }
 
+/// The keys every calibrate document has (SPEC section 6): the schema version, and the
+/// covariance and gates of the method's configuration of the backend (the closed forms have
+/// none), the same as under "backend".
+void AddSchema(nlohmann::json& doc, const estimation::CalibrationResult& backend) {
+  doc["schema_version"] = report::kSchemaVersion;
+  doc["covariance"] = report::CovarianceJson(backend);
+  doc["covariance"]["source"] = "backend";
+  doc["gates"] = report::GatesJson(backend.fit);
+}
+
 }  // namespace
 
 int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& still,
                       const std::vector<paper::MotionRange>& motion, const geo::Site& site,
-                      const std::string& json_path) {
+                      const std::string& json_path, bool strict) {
   paper::PaperBenchmarkOptions options;
   options.gravity_m_s2 = site.gravity();
   const paper::PaperBenchmarkResult r =
@@ -102,14 +113,16 @@ int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& s
             << "accel_linear:full+gyro_linear+gyro_bias_drift):\n";
   const paper::PaperBenchmarkBackend backend =
       paper::CalibratePaperBenchmarkOnBackend(session.series, r, site);
-  std::cout << report::CalibrationSummary(backend.result);
+  std::cout << report::CalibrationSummary(backend.result, session.source);
   doc["backend"] = report::ToJson(backend.result);
+  AddSchema(doc, backend.result);
+  if (const int code = StrictGateExit(backend.result.fit, session.source, strict)) return code;
   Finish(doc, r.notes, json_path);
   return 0;
 }
 
 int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
-                   const geo::Site& site, const std::string& json_path) {
+                   const geo::Site& site, const std::string& json_path, bool strict) {
   const paper::PaperStaticResult r =
       paper::CalibratePaperStatic(session.series, begin, end, site, paper::PaperStaticOptions{});
   const std::string au = session.series.acc_unit;
@@ -158,7 +171,7 @@ int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
                "the paper's constants held):\n";
   const paper::PaperStaticBackend backend =
       paper::CalibratePaperStaticOnBackend(session.series, begin, end, site);
-  std::cout << report::CalibrationSummary(backend.fixed);
+  std::cout << report::CalibrationSummary(backend.fixed, session.source);
   auto join = [](const std::vector<std::string>& names) {
     std::string out;
     for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
@@ -171,6 +184,8 @@ int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
   doc["backend_freed"] = {{"unobservable", backend.fixed_unobservable},
                           {"observable", backend.fixed_observable},
                           {"result", report::ToJson(backend.freed)}};
+  AddSchema(doc, backend.fixed);
+  if (const int code = StrictGateExit(backend.fixed.fit, session.source, strict)) return code;
   Finish(doc, r.notes, json_path);
   return 0;
 }

@@ -15,14 +15,15 @@ namespace plumb::cli {
 
 /// Runs paper-benchmark on the series with the given still periods and turn sections (empty:
 /// the gaps between still periods of the same pose); prints both conventions; writes
-/// `json_path` when not empty. Returns the exit code.
+/// `json_path` when not empty. Returns the exit code: kExitGateFailed, before writing, when
+/// `strict` and the backend's fit failed a gate (estimation/gates.h).
 int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& still,
                       const std::vector<paper::MotionRange>& motion, const geo::Site& site,
-                      const std::string& json_path);
+                      const std::string& json_path, bool strict);
 
 /// Runs paper-static on samples [begin, end) at `site` (must be known); prints both
-/// conventions; writes `json_path` when not empty. Returns the exit code.
+/// conventions; writes `json_path` when not empty. Returns the exit code, as above.
 int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
-                   const geo::Site& site, const std::string& json_path);
+                   const geo::Site& site, const std::string& json_path, bool strict);
 
 }  // namespace plumb::cli

@@ -141,9 +141,9 @@ class ReportCommand : public Command {
     PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose);
 
-    const estimation::CalibrationResult result =
-        estimation::Calibrate(series, segments, model, site, options);
-    std::cout << report::FitVerdict(result.fit) << "\n";
+    const estimation::CalibrationResult result = CalibrateSession(session, fit);
+    std::cout << report::FitVerdict(result.fit) << "\n" << report::GateLines(result.fit, session.source);
+    if (const int code = StrictGateExit(result.fit, session.source, a.fit.strict)) return code;
     std::optional<diagnostics::Diagnosis> diagnosis;
     if (a.diagnose) diagnosis = RunDiagnosis(series, segments, model, site, options);
 

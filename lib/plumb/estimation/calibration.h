@@ -33,6 +33,9 @@ struct Combination {
   std::string text;  ///< e.g. "accel.bias.z - 9.78 accel.matrix.zz"
   double value = 0;
   double sigma = 0;
+  /// The combination as numbers: sum_i coefficients[i] * value of parameter names[i].
+  std::vector<std::string> names;
+  std::vector<double> coefficients;
 };
 
 struct Observability {
@@ -43,6 +46,8 @@ struct Observability {
   std::vector<std::string> unobservable;
   /// Combinations of unobservable parameters that the data does determine.
   std::vector<Combination> determined;
+  /// Their covariance, c_i^T C c_j, in `determined` order (its diagonal: their sigma squared).
+  Eigen::MatrixXd determined_covariance;
   /// Smallest kept and largest dropped relative singular values (diagnostics).
   double smallest_kept = 0, largest_dropped = 0;
 };

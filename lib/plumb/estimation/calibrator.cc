@@ -9,6 +9,7 @@
 #include "plumb/estimation/advice.h"
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/covariance.h"
+#include "plumb/estimation/gates.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/solve.h"
@@ -112,6 +113,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   if (cal.model.has_probes()) {
     fit.probes = problem.ProbeColumns(problem.Build({}, true), columns);
   }
+  fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
   return result;
 }
 

@@ -58,6 +58,14 @@ struct ProbeJacobian {
   std::vector<int> row_axis;      ///< per row: 0, 1, 2
 };
 
+/// A check the fit failed (estimation/gates.h, SPEC section 3 "Gates"): a fit that did not
+/// converge, a rank from segments of one pose, samples outside the sensor's range, a rate or
+/// unit the data contradict, a saturated axis. `name` is one of kGateNames (gates.h).
+struct Gate {
+  std::string name;     ///< e.g. "not_converged"
+  std::string message;  ///< what failed, in numbers, and what to do
+};
+
 struct FitReport {
   double chi2 = 0;   ///< sum of squared whitened residuals
   int num_residuals = 0;
@@ -77,6 +85,12 @@ struct FitReport {
   std::vector<StillSegmentFit> still;  ///< per still segment used, in time order
   std::vector<MotionFit> motion;       ///< per motion interval integrated
   std::vector<std::string> warnings;   ///< what the user must know, in words
+  /// Checks the fit failed (empty: all passed); a failed gate means the numbers above are
+  /// not to be trusted as they stand (estimation/gates.h).
+  std::vector<Gate> gates;
+  /// Distinct poses among the still segments at rest: consecutive segments with the same
+  /// gravity direction and no turn between them count once (estimation/gates.h).
+  int distinct_poses = 0;
   /// Present when the model has probe terms.
   std::optional<ProbeJacobian> probes;
 };

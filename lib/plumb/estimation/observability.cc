@@ -164,6 +164,7 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
     }
     rows_of_group[static_cast<std::size_t>(g)].push_back(static_cast<int>(r));
   }
+  std::vector<Eigen::VectorXd> determined_vectors;  // over all n unknowns
   for (std::size_t g = 0; g < rows_of_group.size(); ++g) {
     if (rows_of_group[g].empty()) continue;
     std::vector<int> support;
@@ -200,9 +201,17 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
       comb.text = FormatCombination(c, names, false);
       comb.value = c.dot(values);
       comb.sigma = std::sqrt(std::max(0.0, c_full.dot(out.covariance * c_full)));
+      comb.names = names;
+      comb.coefficients.assign(c.data(), c.data() + c.size());
       out.summary.determined.push_back(comb);
+      determined_vectors.push_back(c_full);
     }
   }
+  Eigen::MatrixXd combos(n, static_cast<Eigen::Index>(determined_vectors.size()));
+  for (std::size_t j = 0; j < determined_vectors.size(); ++j) {
+    combos.col(static_cast<Eigen::Index>(j)) = determined_vectors[j];
+  }
+  out.summary.determined_covariance = combos.transpose() * out.covariance * combos;
   return out;
 }
 

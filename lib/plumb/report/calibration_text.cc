@@ -1,7 +1,10 @@
 #include "plumb/report/calibration_text.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
+
+#include "plumb/estimation/uncertainty.h"
 
 namespace plumb::report {
 namespace {
@@ -14,6 +17,25 @@ std::string Format(const char* fmt, double a) {
 
 std::string Vec(const Vec3& v, const char* fmt = "%.4g") {
   return "(" + Format(fmt, v.x()) + ", " + Format(fmt, v.y()) + ", " + Format(fmt, v.z()) + ")";
+}
+
+/// `text` right-aligned in 12 columns.
+std::string Pad(const std::string& text) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%12s", text.c_str());
+  return buf;
+}
+
+/// Beside the sigma table when chi^2/dof is above its band (estimation/uncertainty.h).
+std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
+  const double upper = 1.0 + estimation::kChi2BandSigmas * std::sqrt(2.0 / fit.dof);
+  return "chi2/dof " + Format("%.4g", fit.chi2_dof()) + " is above its band (up to " +
+         Format("%.3g", upper) +
+         "): the residuals exceed the noise the fit was whitened with, so the formal sigma "
+         "(from that noise) is too small; 'scaled' is sigma * sqrt(chi2/dof) = sigma * " +
+         Format("%.4g", scale) +
+         ". The JSON's sigma and covariance are the scaled ones (sigma_formal beside); the "
+         "exported files carry values only\n";
 }
 
 }  // namespace
@@ -52,13 +74,19 @@ std::string FullReport(const estimation::CalibrationResult& result) {
        << ")";
   }
   os << "\n\n";
-  char line[160];
-  std::snprintf(line, sizeof line, "%-34s %15s %12s  %s\n", "parameter", "value", "sigma", "unit");
+  const double scale = estimation::SigmaScale(fit);
+  const bool scaled = scale > 1.0;
+  if (scaled) os << OverDispersionNote(fit, scale);
+  char line[192];
+  std::snprintf(line, sizeof line, "%-34s %15s %12s%s  %s\n", "parameter", "value", "sigma",
+                scaled ? "       scaled" : "", "unit");
   os << line;
   for (const auto& p : c.parameters) {
+    const bool none = p.fixed || !p.observable;
     std::string sigma = p.fixed ? "fixed" : !p.observable ? "unobservable" : Format("%.3g", p.sigma);
-    std::snprintf(line, sizeof line, "%-34s %15.8g %12s  %s\n", p.name.c_str(), p.value,
-                  sigma.c_str(), p.unit.c_str());
+    const std::string extra = !scaled ? "" : " " + Pad(none ? "" : Format("%.3g", scale * p.sigma));
+    std::snprintf(line, sizeof line, "%-34s %15.8g %12s%s  %s\n", p.name.c_str(), p.value,
+                  sigma.c_str(), extra.c_str(), p.unit.c_str());
     os << line;
   }
   if (!c.observability.unobservable.empty()) {
@@ -69,7 +97,9 @@ std::string FullReport(const estimation::CalibrationResult& result) {
     os << "determined combinations:\n";
     for (const auto& d : c.observability.determined) {
       os << "  " << d.text << " = " << Format("%.8g", d.value) << " +- "
-         << Format("%.3g", d.sigma) << "\n";
+         << Format("%.3g", d.sigma);
+      if (scaled) os << " (scaled " << Format("%.3g", scale * d.sigma) << ")";
+      os << "\n";
     }
   }
   for (const auto& w : fit.warnings) os << "warning: " << w << "\n";

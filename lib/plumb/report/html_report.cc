@@ -85,10 +85,15 @@ std::string SummarySection(const estimation::CalibrationResult& r,
                            const diagnostics::Diagnosis* d) {
   const auto band = Chi2DofBand(r.fit.dof);
   const double ratio = r.fit.chi2_dof();
-  const bool good = r.fit.dof > 0 && ratio >= band.first && ratio <= band.second;
+  const bool good = r.fit.dof > 0 && ratio >= band.first && ratio <= band.second &&
+                    r.fit.gates.empty();
   std::string out = "<h2 id=\"summary\">Summary</h2>\n<p class=\"" +
                     std::string(good ? "ok" : "bad") + "\">" + HtmlEscape(FitVerdict(r.fit)) +
                     "</p>\n<ul>\n";
+  for (const auto& g : r.fit.gates) {
+    out += "<li class=\"warn\">gate failed: " + Code(g.name) + ": " + HtmlEscape(g.message) +
+           "</li>\n";
+  }
   int free = 0;
   for (const auto& p : r.calibration.parameters) free += p.fixed ? 0 : 1;
   out += "<li>" + std::to_string(free) + " parameters fitted (model " + Code(r.calibration.model.spec()) +

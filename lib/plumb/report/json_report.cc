@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "plumb/estimation/uncertainty.h"
 #include "plumb/io/common/atomic_file.h"
 #include "plumb/report/version.h"
 
@@ -43,10 +44,13 @@ json Sensor(const Mat3& forward, const Vec3& bias, const json& correction) {
   return json{{"matrix", Matrix(forward)}, {"bias", Vector(bias)}, {"correction", correction}};
 }
 
-json ParameterJson(const estimation::ParameterEstimate& p) {
+/// `sigma_scale` (estimation::SigmaScale) multiplies "sigma"; "sigma_formal" is the fit's own.
+json ParameterJson(const estimation::ParameterEstimate& p, double sigma_scale) {
+  const bool none = p.fixed || !p.observable;
   return json{{"name", p.name},
               {"value", Number(p.value)},
-              {"sigma", (p.fixed || !p.observable) ? json(nullptr) : Number(p.sigma)},
+              {"sigma", none ? json(nullptr) : Number(sigma_scale * p.sigma)},
+              {"sigma_formal", none ? json(nullptr) : Number(p.sigma)},
               {"observable", p.observable},
               {"fixed", p.fixed},
               {"unit", p.unit}};
@@ -54,8 +58,10 @@ json ParameterJson(const estimation::ParameterEstimate& p) {
 
 /// One entry of "effects": the effect's parameters in block order with sigma and units.
 json EffectJson(const model::EffectInfo& info,
-                const std::map<std::string, const estimation::ParameterEstimate*>& by_name) {
+                const std::map<std::string, const estimation::ParameterEstimate*>& by_name,
+                double sigma_scale) {
   json names = json::array(), values = json::array(), sigmas = json::array(), units = json::array();
+  json formal = json::array();
   bool uniform = true;
   for (int i = 0; i < info.size(); ++i) {
     const std::string full = info.ParameterName(i);
@@ -67,17 +73,21 @@ json EffectJson(const model::EffectInfo& info,
     if (it == by_name.end()) {
       values.push_back(nullptr);
       sigmas.push_back(nullptr);
+      formal.push_back(nullptr);
       continue;
     }
     const auto& p = *it->second;
+    const bool none = p.fixed || !p.observable;
     values.push_back(Number(p.value));
-    sigmas.push_back((p.fixed || !p.observable) ? json(nullptr) : Number(p.sigma));
+    sigmas.push_back(none ? json(nullptr) : Number(sigma_scale * p.sigma));
+    formal.push_back(none ? json(nullptr) : Number(p.sigma));
   }
   json e{{"term", info.term},
          {"option", info.option},
          {"names", names},
          {"parameters", values},
-         {"sigma", sigmas}};
+         {"sigma", sigmas},
+         {"sigma_formal", formal}};
   e["unit"] = (uniform && info.size() > 0) ? json(info.parameters.front().unit) : units;
   return e;
 }
@@ -88,7 +98,9 @@ json EffectsJson(const estimation::CalibrationResult& r) {
   json effects = json::object();
   for (const auto& term : r.calibration.model.terms()) {
     const auto& info = term.effect->info();
-    if (!info.linear_stage) effects[info.name] = EffectJson(info, by_name);
+    if (!info.linear_stage) {
+      effects[info.name] = EffectJson(info, by_name, estimation::SigmaScale(r.fit));
+    }
   }
   return effects;
 }
@@ -106,14 +118,18 @@ json FitJson(const estimation::CalibrationResult& r) {
               {"segments", {{"still", f.still_segments}, {"motion", f.motion_segments}}},
               {"converged", f.converged},
               {"iterations", f.iterations},
-              {"solver", f.solver_report}};
+              {"solver", f.solver_report},
+              {"chi2_above_band", estimation::Chi2AboveBand(f)},
+              {"distinct_poses", f.distinct_poses}};
 }
 
-json ObservabilityJson(const estimation::Observability& o) {
+json ObservabilityJson(const estimation::Observability& o, double sigma_scale) {
   json determined = json::array();
   for (const auto& d : o.determined) {
-    determined.push_back(
-        {{"combination", d.text}, {"value", Number(d.value)}, {"sigma", Number(d.sigma)}});
+    determined.push_back({{"combination", d.text},
+                          {"value", Number(d.value)},
+                          {"sigma", Number(sigma_scale * d.sigma)},
+                          {"sigma_formal", Number(d.sigma)}});
   }
   return json{{"rank", o.rank},
               {"unknowns", o.num_unknowns},
@@ -214,8 +230,48 @@ json Matrix(const Mat3& m) {
   return rows;
 }
 
+namespace {
+
+json Rows(const Eigen::MatrixXd& m) {
+  json rows = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    json row = json::array();
+    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(Number(m(r, c)));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+json CovarianceJson(const estimation::CalibrationResult& r) {
+  const double scale = estimation::SigmaScale(r.fit);
+  const estimation::NamedCovariance params = estimation::ParameterCovariance(r.calibration);
+  const estimation::NamedCovariance combos = estimation::DeterminedCovariance(r.calibration);
+  json units = json::array();
+  for (const auto& name : params.names) {
+    for (const auto& p : r.calibration.parameters) {
+      if (p.name == name) units.push_back(p.unit);
+    }
+  }
+  return json{{"parameters", params.names},
+              {"units", units},
+              {"matrix", Rows(scale * scale * params.matrix)},
+              {"sigma_scaled_by_chi2", scale > 1.0},
+              {"sigma_scale", scale},
+              {"determined",
+               {{"combinations", combos.names}, {"matrix", Rows(scale * scale * combos.matrix)}}}};
+}
+
+json GatesJson(const estimation::FitReport& fit) {
+  json gates = json::array();
+  for (const auto& g : fit.gates) gates.push_back({{"name", g.name}, {"message", g.message}});
+  return gates;
+}
+
 json ToJson(const estimation::CalibrationResult& r) {
   json doc;
+  doc["schema_version"] = kSchemaVersion;
   doc["plumb_version"] = Version();
   doc["method"] = r.calibration.method;
   doc["model"] = r.calibration.model.spec();
@@ -239,9 +295,14 @@ json ToJson(const estimation::CalibrationResult& r) {
                  : json(nullptr);
   doc["effects"] = EffectsJson(r);
   doc["parameters"] = json::array();
-  for (const auto& p : r.calibration.parameters) doc["parameters"].push_back(ParameterJson(p));
+  const double sigma_scale = estimation::SigmaScale(r.fit);
+  for (const auto& p : r.calibration.parameters) {
+    doc["parameters"].push_back(ParameterJson(p, sigma_scale));
+  }
+  doc["covariance"] = CovarianceJson(r);
   doc["fit"] = FitJson(r);
-  doc["observability"] = ObservabilityJson(r.calibration.observability);
+  doc["gates"] = GatesJson(r.fit);
+  doc["observability"] = ObservabilityJson(r.calibration.observability, sigma_scale);
   doc["site"] = SiteJson(r.calibration.site);
   doc["noise"] = NoiseJson(r);
   doc["segments"] = json::array();

@@ -6,15 +6,27 @@
 // freedom) is written as null, never as NaN: the output is always valid JSON.
 //
 // Top-level keys of CalibrationJson():
-//   plumb_version, method, model, model_reference {t_ref_s, temp_ref_c},
+//   schema_version (kSchemaVersion), plumb_version, method, model,
+//   model_reference {t_ref_s, temp_ref_c},
 //   convention {accel, gyro}                      the forward model, in words
 //   accel {matrix, bias, correction {formula, matrix, offset}}   forward model F, b_a, SI;
 //   gyro  {... the same with E, b_g}              the correction is f_b = F^-1 (y_a - b_a)
-//   effects {name: {term, option, names, parameters, sigma, unit}}   non-base effects only
-//   parameters [{name, value, sigma, observable, fixed, unit}]
+//   effects {name: {term, option, names, parameters, sigma, sigma_formal, unit}}   non-base
+//                                                 effects only
+//   parameters [{name, value, sigma, sigma_formal, observable, fixed, unit}]
+//   covariance {parameters [names], units [], matrix [[...]], sigma_scaled_by_chi2,
+//               sigma_scale, determined {combinations [texts], matrix [[...]]}}
+//                                                 see CovarianceJson
 //   fit {chi2, dof, chi2_dof, num_residuals, residual_rms {accel, gyro, motion},
-//        segments {still, motion}, converged, iterations, solver}
-//   observability {rank, unknowns, unobservable [], determined [{combination, value, sigma}]}
+//        segments {still, motion}, converged, iterations, solver, chi2_above_band,
+//        distinct_poses}
+//   gates [{name, message}]                       the gates the fit failed (estimation/gates.h)
+//   observability {rank, unknowns, unobservable [],
+//                  determined [{combination, value, sigma, sigma_formal}]}
+//
+// "sigma" (parameters, effects, determined combinations) is the formal sigma times
+// estimation::SigmaScale: sqrt(chi2/dof) when chi^2/dof is above its band (fit.chi2_above_band),
+// 1 otherwise; "sigma_formal" is the formal one.
 //   site {lat_deg, lon_deg, height_m, gravity, source}   null coordinates, source "none"
 //                                                         without a site
 //   noise {accel, gyro, tau_accel, tau_gyro}       per-sample sigma (sensor units), tau in samples
@@ -41,6 +53,21 @@ nlohmann::json Number(double value);
 nlohmann::json Vector(const Vec3& v);
 /// [[row x], [row y], [row z]], non-finite entries null.
 nlohmann::json Matrix(const Mat3& m);
+
+/// Version of the calibrate document's layout, "schema_version": 1 adds covariance, gates,
+/// sigma_formal, fit.chi2_above_band and fit.distinct_poses to the earlier unversioned layout.
+inline constexpr int kSchemaVersion = 1;
+
+/// The covariance of the free, observable parameters in the order of "parameters" (their
+/// names and units), times chi2/dof when chi^2/dof is above its band
+/// ("sigma_scaled_by_chi2": true; "sigma_scale" is the factor on the sigmas), so that the
+/// square roots of its diagonal are the parameters' "sigma"; and the covariance of the
+/// determined combinations (c_i^T C c_j, scaled alike) with their texts, for what a singular
+/// problem does determine (empty when every parameter is observable).
+nlohmann::json CovarianceJson(const estimation::CalibrationResult& result);
+
+/// [{name, message}] of the failed gates.
+nlohmann::json GatesJson(const estimation::FitReport& fit);
 
 /// The calibration result alone: every key listed above except segmentation and inputs.
 nlohmann::json ToJson(const estimation::CalibrationResult& result);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "plumb/estimation/uncertainty.h"
 #include "plumb/report/version.h"
 
 namespace plumb::report {
@@ -69,6 +70,16 @@ std::string SegmentationSummary(const segmentation::SegmentationResult& s,
 }
 
 std::string FitVerdict(const estimation::FitReport& fit) {
+  if (!fit.gates.empty()) {
+    // Whatever chi^2/dof says, a failed gate means the fit is not to be trusted as it stands.
+    std::string names;
+    for (const auto& g : fit.gates) names += (names.empty() ? "" : ", ") + g.name;
+    const std::string value =
+        fit.dof > 0 ? "chi2/dof " + Format("%.3g", fit.chi2_dof()) : std::string("no dof left");
+    const std::size_t n = fit.gates.size();
+    return value + ", but the fit failed " + (n == 1 ? std::string("a gate") : std::to_string(n) + " gates") +
+           " (" + names + "): not to be trusted as it stands";
+  }
   if (fit.dof <= 0) {
     return "no degrees of freedom left: the fit cannot be judged (record more still poses)";
   }
@@ -76,7 +87,7 @@ std::string FitVerdict(const estimation::FitReport& fit) {
   const double spread = std::sqrt(2.0 / fit.dof);
   const std::string value =
       "chi2/dof " + Format("%.3g", ratio) + " (expected 1 +- " + Format("%.2g", spread) + ")";
-  if (ratio > 1.0 + 3.0 * spread) {
+  if (estimation::Chi2AboveBand(fit)) {
     return value + ": residuals exceed the noise; the model or the segments miss something";
   }
   if (ratio < 1.0 - 3.0 * spread) {
@@ -85,14 +96,22 @@ std::string FitVerdict(const estimation::FitReport& fit) {
   return value + ": consistent with the noise";
 }
 
-std::string CalibrationSummary(const estimation::CalibrationResult& r) {
+std::string GateLines(const estimation::FitReport& fit, const std::string& source) {
+  std::string out;
+  for (const auto& g : fit.gates) {
+    out += "gate failed: " + g.name + ": " + (source.empty() ? "" : source + ": ") + g.message + "\n";
+  }
+  return out;
+}
+
+std::string CalibrationSummary(const estimation::CalibrationResult& r, const std::string& source) {
   std::ostringstream os;
   os << "plumb " << Version() << " calibrate: method " << r.calibration.method << ", model " << r.calibration.model.spec()
      << "\n";
   os << FitVerdict(r.fit);
   const std::size_t lost = r.calibration.observability.unobservable.size();
   if (lost > 0) os << "; " << lost << " unobservable direction" << (lost > 1 ? "s" : "");
-  os << "\n\n" << FullReport(r);
+  os << "\n" << GateLines(r.fit, source) << "\n" << FullReport(r);
   return os.str();
 }
 

@@ -20,11 +20,18 @@ std::string SegmentationSummary(const segmentation::SegmentationResult& segmenta
                                 const std::string& source = "", bool with_notes = false);
 
 /// One line judging chi^2/dof: consistent with the noise when within 3 standard deviations of
-/// 1 (the standard deviation of chi^2/dof is sqrt(2 / dof)), otherwise what it suggests.
+/// 1 (the standard deviation of chi^2/dof is sqrt(2 / dof)), otherwise what it suggests. When
+/// the fit failed a gate (FitReport::gates) it says so instead, naming them: never "consistent
+/// with the noise" then.
 std::string FitVerdict(const estimation::FitReport& fit);
 
-/// Header plus the full report of the result.
-std::string CalibrationSummary(const estimation::CalibrationResult& result);
+/// One line per failed gate: "gate failed: NAME: [SOURCE: ]MESSAGE" (empty when all passed).
+std::string GateLines(const estimation::FitReport& fit, const std::string& source = "");
+
+/// Header (with the verdict and the failed gates, naming `source`, the input, when given)
+/// plus the full report of the result.
+std::string CalibrationSummary(const estimation::CalibrationResult& result,
+                               const std::string& source = "");
 
 /// Two fits of the same data side by side, `before` (e.g. base) and `after` (e.g.
 /// base+gyro_g_sensitivity): chi^2, dof, chi^2/dof, per-axis RMS of the still accelerometer,

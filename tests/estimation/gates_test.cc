@@ -1,0 +1,248 @@
+// The gates (estimation/gates.h) on made series and simulated sessions, and the covariance as
+// reported (estimation/uncertainty.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/gates.h"
+#include "plumb/estimation/uncertainty.h"
+#include "plumb/report/calibration_text.h"
+#include "plumb/report/summary.h"
+#include "plumb/sim/schedule.h"
+#include "plumb/sim/simulate.h"
+#include "plumb/sim/truth.h"
+
+namespace plumb::estimation {
+namespace {
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// The gate called `name`, or nullptr.
+const Gate* Find(const std::vector<Gate>& gates, const std::string& name) {
+  for (const auto& g : gates) {
+    if (g.name == name) return &g;
+  }
+  return nullptr;
+}
+
+std::string Names(const std::vector<Gate>& gates) {
+  std::string out;
+  for (const auto& g : gates) out += g.name + " ";
+  return out;
+}
+
+/// `n` samples at 100 Hz of a still, level IMU with white noise.
+ImuSeries Level(std::size_t n) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.01f);
+  ImuSeries s;
+  for (std::size_t i = 0; i < n; ++i) {
+    s.t_s.push_back(0.01 * static_cast<double>(i));
+    s.acc.emplace_back(noise(rng), noise(rng), -9.81f + noise(rng));
+    s.gyr.emplace_back(0.001f * noise(rng), 0.001f * noise(rng), 0.001f * noise(rng));
+  }
+  return s;
+}
+
+TEST(Gates, OutOfRangeNamesTheFirstSampleAndTheCount) {
+  ImuSeries s = Level(1000);
+  s.acc[300].z() = 4.7e21f;                                    // flipped bytes
+  s.gyr[500].x() = std::numeric_limits<float>::quiet_NaN();    // a bad record
+  const std::vector<StillSegment> still = {{400, 600, "still #1"}};
+  const std::vector<Gate> gates = CheckSamples(s, still);
+  const Gate* g = Find(gates, "out_of_range");
+  ASSERT_NE(g, nullptr) << Names(gates);
+  EXPECT_TRUE(Contains(g->message, "2 samples outside any IMU's range (an axis beyond 313.8 m/s^2 "
+                                   "(32 g) or 69.81 rad/s (4000 deg/s), or not finite), 1 of them "
+                                   "inside the still segments; the first at t = 3 s (sample 300)"))
+      << g->message;
+}
+
+TEST(Gates, CountsHaveTheirOwnRange) {
+  ImuSeries s = Level(200);
+  for (auto& a : s.acc) a *= -16384.0f / 9.81f;  // a 2 g MPU-6050 in counts
+  s.acc_unit = "counts";
+  EXPECT_EQ(Find(CheckSamples(s, {}), "out_of_range"), nullptr);
+  s.acc[10].x() = 3e6f;
+  EXPECT_NE(Find(CheckSamples(s, {}), "out_of_range"), nullptr);
+}
+
+TEST(Gates, ARunAtTheExtremeOutsideTheStillSegmentsIsSaturation) {
+  ImuSeries s = Level(1000);
+  // A turn about z from sample 400 to 600 whose peak the gyroscope clips at 250 deg/s.
+  const float clip = static_cast<float>(250.0 * units::kRadPerDeg);
+  for (std::size_t i = 400; i < 600; ++i) {
+    const double x = static_cast<double>(i - 400) / 200.0;
+    s.gyr[i].z() = std::min(clip, static_cast<float>(6.0 * std::sin(units::kPi * x)));
+  }
+  const std::vector<StillSegment> still = {{0, 400, "before"}, {600, 1000, "after"}};
+  const std::vector<Gate> gates = CheckSamples(s, still);
+  const Gate* g = Find(gates, "saturated");
+  ASSERT_NE(g, nullptr);
+  EXPECT_TRUE(Contains(g->message, "gyro z sits at 4.363323 rad/s for ")) << g->message;
+  // The same flat top inside a still segment is a pose, not a clipped turn.
+  const std::vector<StillSegment> covering = {{0, 1000, "all"}};
+  EXPECT_EQ(Find(CheckSamples(s, covering), "saturated"), nullptr);
+  // A reading that sits still at a constant value (coarse quantisation) is no saturation.
+  ImuSeries flat = Level(500);
+  for (auto& a : flat.acc) a = Vec3f(0, 0, -9.81f);
+  EXPECT_EQ(Find(CheckSamples(flat, {}), "saturated"), nullptr);
+}
+
+/// A multi-pose session as calibrate_sim_test.cc makes it.
+sim::Simulation MultiPose(std::uint64_t seed, int poses = 12, double still_s = 6.0) {
+  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  opt.rate_hz = 100.0;
+  opt.accel_bias_walk_density = 0.0;
+  opt.gyro_bias_walk_density = 0.0;
+  opt.model = model::Model::Parse("base");
+  opt.truth = sim::RandomParameters(opt.model, 1.0, seed);
+  opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
+  opt.seed = seed;
+  return sim::Simulate(sim::MultiPose(poses, still_s, 2.0, seed), opt);
+}
+
+std::vector<StillSegment> FreeAttitudes(std::vector<StillSegment> segments) {
+  for (auto& s : segments) s.known_R_n_b.reset();
+  return segments;
+}
+
+TEST(Gates, AGoodSessionPassesEveryGate) {
+  const sim::Simulation s = MultiPose(31);
+  const CalibrationResult r =
+      Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site);
+  EXPECT_TRUE(r.fit.gates.empty()) << Names(r.fit.gates) << report::FullReport(r);
+  EXPECT_EQ(r.fit.distinct_poses, 12);
+  EXPECT_TRUE(Contains(report::FitVerdict(r.fit), "consistent with the noise"))
+      << report::FitVerdict(r.fit);
+}
+
+TEST(Gates, PiecesOfOnePoseAreOnePose) {
+  const sim::Simulation s = MultiPose(32);
+  const StillSegment first = FreeAttitudes(s.truth_segments).front();
+  std::vector<StillSegment> pieces;
+  const std::size_t step = first.count() / 12;
+  for (std::size_t k = 0; k < 12; ++k) {
+    pieces.push_back({first.begin + k * step + 2, first.begin + (k + 1) * step, "piece"});
+  }
+  const CalibrationResult r = Calibrate(s.session.series, pieces, s.model, s.site);
+  EXPECT_EQ(r.fit.distinct_poses, 1);
+  const Gate* g = Find(r.fit.gates, "one_pose");
+  ASSERT_NE(g, nullptr) << Names(r.fit.gates);
+  EXPECT_TRUE(Contains(g->message, "the 12 still segments lie in 1 distinct pose (segments 1-12 "
+                                   "have the same gravity direction within the noise and no turn "
+                                   "between them): the rank ("))
+      << g->message;
+  EXPECT_FALSE(Contains(report::FitVerdict(r.fit), "consistent with the noise"));
+}
+
+TEST(Gates, TheIterationLimitFailsNotConverged) {
+  const sim::Simulation s = MultiPose(33);
+  CalibrationOptions options;
+  options.max_iterations = 1;
+  const CalibrationResult r =
+      Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site, options);
+  EXPECT_FALSE(r.fit.converged);
+  const Gate* g = Find(r.fit.gates, "not_converged");
+  ASSERT_NE(g, nullptr) << Names(r.fit.gates);
+  EXPECT_TRUE(Contains(g->message, "the solver did not converge: it stopped after ")) << g->message;
+  EXPECT_TRUE(Contains(g->message, "Termination: NO_CONVERGENCE")) << g->message;
+  const std::string verdict = report::FitVerdict(r.fit);
+  EXPECT_FALSE(Contains(verdict, "consistent with the noise")) << verdict;
+  EXPECT_TRUE(Contains(verdict, "the fit failed a gate (not_converged)")) << verdict;
+}
+
+TEST(Gates, TimeStampsTenTimesTooFarApartShowAsAGyroScaleOfTen) {
+  sim::Simulation s = MultiPose(34);
+  for (auto& t : s.session.series.t_s) t *= 10.0;  // --rate 10 on 100 Hz data
+  const CalibrationResult r =
+      Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site);
+  const Gate* g = Find(r.fit.gates, "unit_or_rate");
+  ASSERT_NE(g, nullptr) << Names(r.fit.gates);
+  EXPECT_TRUE(Contains(g->message, "the samples are 0.1 s apart (10 Hz), the turns say about 10"))
+      << g->message;
+  EXPECT_NEAR(r.calibration.GyroMatrix().diagonal().mean(), 10.0, 0.5);
+}
+
+TEST(Gates, AccelerometerInGUnitsIsNamed) {
+  sim::Simulation s = MultiPose(35);
+  for (auto& a : s.session.series.acc) a /= static_cast<float>(units::kStandardGravity);
+  const CalibrationResult r =
+      Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site);
+  const Gate* g = Find(r.fit.gates, "unit_or_rate");
+  ASSERT_NE(g, nullptr) << Names(r.fit.gates);
+  EXPECT_TRUE(Contains(g->message, "the samples look like g, not m/s^2: give --acc-unit g"))
+      << g->message;
+}
+
+TEST(Gates, GyroscopeInDegreesIsNamed) {
+  sim::Simulation s = MultiPose(36);
+  for (auto& w : s.session.series.gyr) w *= static_cast<float>(units::kDegPerRad);
+  const CalibrationResult r =
+      Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site);
+  const Gate* g = Find(r.fit.gates, "unit_or_rate");
+  ASSERT_NE(g, nullptr) << Names(r.fit.gates);
+  EXPECT_TRUE(Contains(g->message, "--gyr-unit deg/s")) << g->message;
+}
+
+TEST(Uncertainty, ParameterCovarianceHoldsTheSigmasInOrder) {
+  const sim::Simulation s = MultiPose(37);
+  const CalibrationResult r =
+      Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site);
+  const NamedCovariance c = ParameterCovariance(r.calibration);
+  ASSERT_EQ(c.names.size(), 21u);
+  ASSERT_EQ(c.matrix.rows(), 21);
+  EXPECT_LT((c.matrix - c.matrix.transpose()).norm(), 1e-12 * c.matrix.norm());
+  for (std::size_t i = 0; i < c.names.size(); ++i) {
+    EXPECT_EQ(c.names[i], r.calibration.parameters[i].name);
+    EXPECT_NEAR(std::sqrt(c.matrix(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i))),
+                r.calibration.parameters[i].sigma, 1e-9 * r.calibration.parameters[i].sigma);
+  }
+}
+
+TEST(Uncertainty, DeterminedCovarianceHoldsTheCombinationSigmas) {
+  // The paper's one level pose: singular, with determined combinations.
+  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  opt.rate_hz = 100.0;
+  opt.truth = sim::RandomParameters(opt.model, 1.0, 5);
+  opt.site = geo::Site::At(6.67, -1.57, 250.0, "flags");
+  opt.seed = 5;
+  const sim::Simulation s = sim::Simulate(sim::PaperStatic(60.0), opt);
+  for (const bool ceres : {true, false}) {
+    CalibrationOptions options;
+    options.use_ceres_covariance = ceres;
+    const CalibrationResult r = Calibrate(s.session.series, s.truth_segments, s.model, s.site, options);
+    const auto& determined = r.calibration.observability.determined;
+    ASSERT_GE(determined.size(), 3u);
+    const NamedCovariance c = DeterminedCovariance(r.calibration);
+    ASSERT_EQ(c.matrix.rows(), static_cast<Eigen::Index>(determined.size()));
+    for (std::size_t i = 0; i < determined.size(); ++i) {
+      EXPECT_EQ(c.names[i], determined[i].text);
+      const auto ii = static_cast<Eigen::Index>(i);
+      EXPECT_NEAR(std::sqrt(c.matrix(ii, ii)), determined[i].sigma, 1e-6 * determined[i].sigma)
+          << determined[i].text << (ceres ? " (ceres)" : " (pseudo-inverse)");
+    }
+    EXPECT_LT((c.matrix - c.matrix.transpose()).norm(), 1e-9 * c.matrix.norm());
+  }
+}
+
+TEST(Uncertainty, SigmasAreScaledOnlyAboveTheBand) {
+  FitReport fit;
+  fit.dof = 200;  // band: 1 + 3 sqrt(2 / 200) = 1.3
+  fit.chi2 = 1.25 * fit.dof;
+  EXPECT_FALSE(Chi2AboveBand(fit));
+  EXPECT_EQ(SigmaScale(fit), 1.0);
+  fit.chi2 = 4.0 * fit.dof;
+  EXPECT_TRUE(Chi2AboveBand(fit));
+  EXPECT_DOUBLE_EQ(SigmaScale(fit), 2.0);
+  fit.dof = 0;
+  EXPECT_FALSE(Chi2AboveBand(fit));
+}
+
+}  // namespace
+}  // namespace plumb::estimation
