@@ -27,6 +27,15 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
   app->add_option("--temp-ref", a.temp_ref_c,
                   "Reference temperature of the temperature terms, degC")
       ->capture_default_str();
+  app->add_option("--accel-rw", a.accel_walk_density,
+                  "Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor units/s/sqrt(Hz) for "
+                  "unscaled samples): the bias walks over the session and every still pose "
+                  "gets bias-walk states tied by random-walk factors; 0 = constant bias")
+      ->check(CLI::NonNegativeNumber);
+  app->add_option("--gyro-rw", a.gyro_walk_density,
+                  "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor "
+                  "units/s/sqrt(Hz) for unscaled samples); 0 = constant bias")
+      ->check(CLI::NonNegativeNumber);
 }
 
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
@@ -49,6 +58,8 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
     out.options.first_heading_deg = fit.heading_deg;
   }
   if (fit.strict) out.options.on_insufficient = estimation::InsufficientData::kError;
+  out.options.accel_walk_density = fit.accel_walk_density;
+  out.options.gyro_walk_density = fit.gyro_walk_density;
   return out;
 }
 

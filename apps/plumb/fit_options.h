@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,12 +25,15 @@ struct FitArgs {
   CLI::Option* heading = nullptr;  ///< set when --heading was given
   bool level_north = false;        ///< --level-north: first still pose level, x north (known)
   double temp_ref_c = 25.0;        ///< --temp-ref: reference of the temperature terms, degC
+  /// --accel-rw / --gyro-rw: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0.
+  std::optional<double> accel_walk_density;
+  std::optional<double> gyro_walk_density;
 };
 
 /// Registers --model on `app`.
 void AddModelOption(CLI::App* app, FitArgs& args);
 
-/// Registers --strict, --heading, --level-north and --temp-ref on `app`.
+/// Registers --strict, --heading, --level-north, --temp-ref, --accel-rw and --gyro-rw on `app`.
 void AddFitOptions(CLI::App* app, FitArgs& args);
 
 /// Everything Calibrate() takes besides the samples.
