@@ -36,6 +36,10 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
                   "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor "
                   "units/s/sqrt(Hz) for unscaled samples); 0 = constant bias")
       ->check(CLI::NonNegativeNumber);
+  app->add_flag("--estimate-rw", a.estimate_walk,
+                "Estimate the bias random walks not given by --accel-rw/--gyro-rw from the "
+                "session itself (variance components over the walk factors; needs 6 or more "
+                "still poses)");
 }
 
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
@@ -60,6 +64,7 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
   if (fit.strict) out.options.on_insufficient = estimation::InsufficientData::kError;
   out.options.accel_walk_density = fit.accel_walk_density;
   out.options.gyro_walk_density = fit.gyro_walk_density;
+  out.options.estimate_walk = fit.estimate_walk;
   return out;
 }
 

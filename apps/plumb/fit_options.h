@@ -28,6 +28,7 @@ struct FitArgs {
   /// --accel-rw / --gyro-rw: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0.
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
+  bool estimate_walk = false;  ///< --estimate-rw: estimate the walks not given from the data
 };
 
 /// Registers --model on `app`.

@@ -23,7 +23,7 @@ struct Outcome {
 /// the true still segments given (attitudes unknown).
 Outcome CalibrateMultiPose(std::uint64_t seed, const std::string& spec = "base",
                            int poses = 16, double still_s = 5.0, bool walk = false,
-                           bool model_walk = false) {
+                           bool model_walk = false, bool estimate_walk = false) {
   sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
   opt.rate_hz = 100.0;
   if (!walk) {
@@ -43,6 +43,7 @@ Outcome CalibrateMultiPose(std::uint64_t seed, const std::string& spec = "base",
     options.accel_walk_density = opt.accel_bias_walk_density;
     options.gyro_walk_density = opt.gyro_bias_walk_density;
   }
+  options.estimate_walk = estimate_walk;
   o.result = Calibrate(o.sim.session.series, segments, o.sim.model, o.sim.site, options);
   return o;
 }

@@ -81,6 +81,7 @@ struct FitReport {
   std::vector<StillSegmentFit> still;  ///< per still segment used, in time order
   std::vector<MotionFit> motion;       ///< per motion interval integrated
   std::vector<std::string> warnings;   ///< what the user must know, in words
+  std::vector<std::string> notes;      ///< how the fit was made, in words (e.g. the noise)
   /// Present when the model has probe terms.
   std::optional<ProbeJacobian> probes;
 };

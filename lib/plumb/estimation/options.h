@@ -45,6 +45,11 @@ struct CalibrationOptions {
   /// then the bias at the model's reference time. Unset or 0: the bias is constant.
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
+  /// Estimate the walk densities that are not given from the session itself, by
+  /// variance-component estimation over the walk factors (estimation/walk_estimate.h).
+  bool estimate_walk = false;
+  /// Fewest still segments for that estimate (>= 2); with fewer the bias stays constant.
+  int walk_min_poses = 6;
   /// Lower bound on the noise standard deviation per sample, in sensor units, guarding
   /// against quantised data whose scatter reads zero (> 0).
   double min_sigma_acc = 1e-6;

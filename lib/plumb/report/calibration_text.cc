@@ -51,7 +51,18 @@ std::string FullReport(const estimation::CalibrationResult& result) {
     os << ", gyro " << Vec(c.noise.gyr) << " " << c.gyr_unit << " (tau " << Format("%.2f", c.noise.tau_gyr)
        << ")";
   }
-  os << "\n\n";
+  os << "\n";
+  const bool acc_walk = c.noise.walk_acc.minCoeff() > 0, gyr_walk = c.noise.walk_gyr.minCoeff() > 0;
+  if (acc_walk || gyr_walk) {
+    os << "bias random walk in the fit (per segment, tied by random-walk factors):";
+    if (acc_walk) os << " accel " << Vec(c.noise.walk_acc) << " " << c.acc_unit << "/s/sqrt(Hz)";
+    if (gyr_walk) {
+      os << (acc_walk ? "," : "") << " gyro " << Vec(c.noise.walk_gyr) << " " << c.gyr_unit
+         << "/s/sqrt(Hz)";
+    }
+    os << "; biases are at the session start\n";
+  }
+  os << "\n";
   char line[160];
   std::snprintf(line, sizeof line, "%-34s %15s %12s  %s\n", "parameter", "value", "sigma", "unit");
   os << line;
@@ -72,6 +83,7 @@ std::string FullReport(const estimation::CalibrationResult& result) {
          << Format("%.3g", d.sigma) << "\n";
     }
   }
+  for (const auto& n : fit.notes) os << "note: " << n << "\n";
   for (const auto& w : fit.warnings) os << "warning: " << w << "\n";
   return os.str();
 }
