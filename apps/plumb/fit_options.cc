@@ -38,6 +38,19 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
                   "(the gate not_converged)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app->add_option("--accel-rw", a.accel_walk_density,
+                  "Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor units/s/sqrt(Hz) for "
+                  "unscaled samples): the bias walks over the session and every still pose "
+                  "gets bias-walk states tied by random-walk factors; 0 = constant bias")
+      ->check(CLI::NonNegativeNumber);
+  app->add_option("--gyro-rw", a.gyro_walk_density,
+                  "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor "
+                  "units/s/sqrt(Hz) for unscaled samples); 0 = constant bias")
+      ->check(CLI::NonNegativeNumber);
+  app->add_flag("--estimate-rw", a.estimate_walk,
+                "Estimate the bias random walks not given by --accel-rw/--gyro-rw from the "
+                "session itself (variance components over the walk factors; needs 6 or more "
+                "still poses)");
 }
 
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
@@ -61,6 +74,9 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
   }
   if (fit.strict) out.options.on_insufficient = estimation::InsufficientData::kError;
   out.options.max_iterations = fit.max_iterations;
+  out.options.accel_walk_density = fit.accel_walk_density;
+  out.options.gyro_walk_density = fit.gyro_walk_density;
+  out.options.estimate_walk = fit.estimate_walk;
   return out;
 }
 

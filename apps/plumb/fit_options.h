@@ -5,6 +5,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,10 @@ struct FitArgs {
   bool level_north = false;        ///< --level-north: first still pose level, x north (known)
   double temp_ref_c = 25.0;        ///< --temp-ref: reference of the temperature terms, degC
   int max_iterations = 200;        ///< --max-iterations: the solver's limit per solve, >= 1
+  /// --accel-rw / --gyro-rw: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0.
+  std::optional<double> accel_walk_density;
+  std::optional<double> gyro_walk_density;
+  bool estimate_walk = false;  ///< --estimate-rw: estimate the walks not given from the data
 };
 
 /// The exit code of a failed gate under --strict (SPEC section 8).
@@ -36,7 +41,8 @@ inline constexpr int kExitGateFailed = 3;
 /// Registers --model on `app`.
 void AddModelOption(CLI::App* app, FitArgs& args);
 
-/// Registers --strict, --heading, --level-north, --temp-ref and --max-iterations on `app`.
+/// Registers --strict, --heading, --level-north, --temp-ref, --max-iterations, --accel-rw,
+/// --gyro-rw and --estimate-rw on `app`.
 void AddFitOptions(CLI::App* app, FitArgs& args);
 
 /// Everything Calibrate() takes besides the samples.

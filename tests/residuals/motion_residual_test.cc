@@ -45,7 +45,7 @@ TEST(MotionResidual, IntegratesAKnownTurn) {
 
 /// Jacobian error of the motion residual for `spec` with small non-zero parameters, the
 /// attitudes off the turn by 0.01 rad and Earth rate present.
-double MotionJacobianError(const std::string& spec) {
+double MotionJacobianError(const std::string& spec, bool walk = false) {
   Quat dR_true;
   const MotionSamples s = Turn(&dR_true);
   const model::Model m = model::Model::Parse(spec);
@@ -58,13 +58,16 @@ double MotionJacobianError(const std::string& spec) {
   for (std::size_t t = 2; t < theta.size(); ++t) {
     for (std::size_t i = 0; i < theta[t].size(); ++i) theta[t][i] = 1e-4 * (1.0 + static_cast<double>(i));
   }
-  std::unique_ptr<ceres::CostFunction> cost(MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5)));
+  std::unique_ptr<ceres::CostFunction> cost(
+      MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5), walk));
   const Quat qa = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 0, 1).normalized()));
   const Quat qb = qa * dR_true * Quat(Eigen::AngleAxisd(0.01, Vec3::UnitX()));
   const double a[4] = {qa.x(), qa.y(), qa.z(), qa.w()};
   const double b[4] = {qb.x(), qb.y(), qb.z(), qb.w()};
   std::vector<const double*> params = {a, b};
   for (const auto& block : theta) params.push_back(block.data());
+  const double b_from[3] = {2e-3, -1e-3, 4e-4}, b_to[3] = {-5e-4, 3e-3, 1e-3};  // bias walk
+  if (walk) params.insert(params.end(), {b_from, b_to});
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifolds[1] = manifold.get();
@@ -83,6 +86,31 @@ TEST(MotionResidual, JacobianMatchesNumericWithGyroEffects) {
 
 TEST(MotionResidual, JacobianMatchesNumericWithAccelEffect) {
   EXPECT_LT(MotionJacobianError("base+accel_bias_drift"), 1e-7);
+}
+
+TEST(MotionResidual, JacobianMatchesNumericWithABiasWalk) {
+  EXPECT_LT(MotionJacobianError("base", true), 1e-7);
+  EXPECT_LT(MotionJacobianError("base+gyro_g_sensitivity+gyro_scale_nonlinearity", true), 1e-7);
+}
+
+TEST(MotionResidual, AWalkAtZeroChangesNothing) {
+  // The walk's blocks at zero give the residual without a walk, to the last bit.
+  Quat dR_true;
+  const MotionSamples s = Turn(&dR_true);
+  const model::Model m = model::Model::Parse("base");
+  const auto theta = m.ZeroParameters();
+  const Quat qa = Quat::Identity(), qb = dR_true;
+  const double a[4] = {qa.x(), qa.y(), qa.z(), qa.w()}, b[4] = {qb.x(), qb.y(), qb.z(), qb.w()};
+  const double zero[3] = {0, 0, 0};
+  std::vector<const double*> p = {a, b, theta[0].data(), theta[1].data()};
+  std::unique_ptr<ceres::CostFunction> plain(MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5)));
+  double r0[3], r1[3];
+  plain->Evaluate(p.data(), r0, nullptr);
+  p.insert(p.end(), {zero, zero});
+  std::unique_ptr<ceres::CostFunction> walked(
+      MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5), true));
+  walked->Evaluate(p.data(), r1, nullptr);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(r0[i], r1[i]);
 }
 
 }  // namespace

@@ -30,7 +30,7 @@ model::ParameterBlocks SmallParameters(const model::Model& m, std::uint64_t seed
 }
 
 /// Runs the gradient checker on a still residual of `sensor` and returns its max error.
-double StillJacobianError(const std::string& spec, model::Sensor sensor) {
+double StillJacobianError(const std::string& spec, model::Sensor sensor, bool walk = false) {
   model::Model m = model::Model::Parse(spec);
   const auto theta = SmallParameters(m, 7);
   StillMeasurement meas;
@@ -39,11 +39,13 @@ double StillJacobianError(const std::string& spec, model::Sensor sensor) {
   meas.dt_s = 40.0;
   meas.dtemp_c = 3.0;
   std::unique_ptr<ceres::CostFunction> cost(StillResidual::Create(
-      m, sensor, meas, Vec3(0, 0, 9.81), Vec3(4.5e-5, 0, -5.7e-5)));
+      m, sensor, meas, Vec3(0, 0, 9.81), Vec3(4.5e-5, 0, -5.7e-5), Vec3::Zero(), walk));
   const Quat q = Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())).normalized();
   const double q_block[4] = {q.x(), q.y(), q.z(), q.w()};
   std::vector<const double*> params = {q_block};
   for (int t : StillResidual::TermsOf(m, sensor)) params.push_back(theta[static_cast<std::size_t>(t)].data());
+  const double s_k[3] = {0.01, -0.02, 0.005}, e_k[3] = {0.015, -0.01, 0.0};  // bias walk
+  if (walk) params.insert(params.end(), {s_k, e_k});
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifold.get();
@@ -52,6 +54,11 @@ double StillJacobianError(const std::string& spec, model::Sensor sensor) {
 
 TEST(StillResidual, AccelJacobianMatchesNumericBase) {
   EXPECT_LT(StillJacobianError("base", model::Sensor::kAccel), 1e-8);
+}
+
+TEST(StillResidual, JacobianMatchesNumericWithABiasWalk) {
+  EXPECT_LT(StillJacobianError("base", model::Sensor::kAccel, true), 1e-8);
+  EXPECT_LT(StillJacobianError("base+gyro_g_sensitivity", model::Sensor::kGyro, true), 1e-8);
 }
 
 TEST(StillResidual, GyroJacobianMatchesNumericBase) {

@@ -58,6 +58,10 @@ struct NoiseLevels {
   Vec3 gyr = Vec3::Zero();  ///< gyroscope noise per sample, sensor units
   /// Integrated autocorrelation times used (the largest over the axes), samples (>= 1).
   double tau_acc = 1, tau_gyr = 1;
+  /// Bias random-walk densities the fit assumed per axis, sensor units / s / sqrt(Hz);
+  /// zero: the bias was held constant over the session.
+  Vec3 walk_acc = Vec3::Zero();
+  Vec3 walk_gyr = Vec3::Zero();
 };
 
 struct Calibration {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plumb/residuals/bias_walk_residual.h"
 #include "plumb/residuals/manifolds.h"
 #include "plumb/residuals/motion_residual.h"
 #include "plumb/residuals/still_residuals.h"
@@ -11,6 +12,10 @@
 
 namespace plumb::estimation {
 namespace {
+
+/// Shortest time a bias-walk factor spans, s: keeps its weight finite where two instants
+/// coincide.
+constexpr double kMinWalkSpan_s = 1e-3;
 
 /// Dense copy of a Ceres CRS matrix.
 Eigen::MatrixXd Dense(const ceres::CRSMatrix& crs) {
@@ -38,13 +43,16 @@ CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model mod
       still_(std::move(still)),
       noise_(noise),
       start_(start) {
+  has_gyro_ = model_.has_gyro();
   for (const auto& block : theta) {
     block_offset_.push_back(values_.size());
     values_.insert(values_.end(), block.begin(), block.end());
   }
   q_offset_ = values_.size();
   for (const auto& s : still_.poses) values_.insert(values_.end(), s.q.begin(), s.q.end());
-  has_gyro_ = model_.has_gyro();
+  walk_offset_ = values_.size();
+  walk_per_pose_ = (noise_.accel_walks() ? 6 : 0) + (has_gyro_ && noise_.gyro_walks() ? 6 : 0);
+  values_.resize(values_.size() + walk_per_pose_ * still_.poses.size(), 0.0);
   still_gyro_ = has_gyro_ && options_.use_still_gyro;
   bool needs_velocity = false;
   for (const auto& term : model_.terms()) {
@@ -67,10 +75,20 @@ void CalibrationProblem::SetMeasurements(const NoiseModel& noise) {
     m.dtemp_c = std::isfinite(s.stats.temp_mean_c) ? s.stats.temp_mean_c - model_.temp_ref_c : 0.0;
     m.mean = s.stats.acc_mean;
     for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_acc[i]) / noise.sigma_acc[i];
+    // With a walk, the state is its value at both ends; the Brownian bridge between them
+    // adds K^2 T / 12 to the variance of the segment's mean.
+    const double T = s.stats.t_end_s - s.stats.t_begin_s;
+    auto add_bridge = [&](Vec3& sqrt_info, const Vec3& K) {
+      for (int i = 0; i < 3; ++i) {
+        sqrt_info[i] = 1.0 / std::sqrt(1.0 / (sqrt_info[i] * sqrt_info[i]) + K[i] * K[i] * T / 12.0);
+      }
+    };
+    if (noise.accel_walks()) add_bridge(m.sqrt_info, noise.walk_acc);
     s.acc_measurement = m;
     if (still_gyro_) {
       m.mean = s.stats.gyr_mean;
       for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_gyr[i]) / noise.sigma_gyr[i];
+      if (noise.gyro_walks()) add_bridge(m.sqrt_info, noise.walk_gyr);
       s.gyr_measurement = m;
     }
   }
@@ -121,6 +139,17 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
       const double sigma_rate = std::sqrt(cov_rate(i, i));  // rad/s per sample
       motion_samples_[k].sqrt_info[i] =
           1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * noise_.tau_gyr[i]));
+    }
+    if (noise_.gyro_walks()) {
+      // The walk about the line from e_k to s_k+1 (a Brownian bridge over the interval T)
+      // integrates to an angle of variance K^2 T^3 / 12 per sensor axis, through E^-1.
+      const double T = series_.t_s[mo.last] - series_.t_s[mo.first];
+      const Mat3 cov_bridge = E_inv * (noise_.walk_gyr.cwiseAbs2() * (T * T * T / 12.0)).asDiagonal() *
+                              E_inv.transpose();
+      for (int i = 0; i < 3; ++i) {
+        const double var = 1.0 / (motion_samples_[k].sqrt_info[i] * motion_samples_[k].sqrt_info[i]);
+        motion_samples_[k].sqrt_info[i] = 1.0 / std::sqrt(var + cov_bridge(i, i));
+      }
     }
     const double n = std::max(1.0, steps);
     const double var_w = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();
@@ -194,6 +223,11 @@ void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
       problem->SetManifold(q(k), built.manifolds.back().get());
     }
   }
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
+    for (std::size_t v = 0; v < walk_per_pose_; v += 3) {
+      problem->AddParameterBlock(values_.data() + walk_offset_ + walk_per_pose_ * k + v, 3);
+    }
+  }
 }
 
 void CalibrationProblem::AddResiduals(BuiltProblem& built) {
@@ -208,20 +242,34 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
   };
   std::vector<double*> all_terms;
   for (int t = 0; t < model_.num_terms(); ++t) all_terms.push_back(block(t));
+  const bool acc_walk = noise_.accel_walks();
+  const bool gyr_walk = has_gyro_ && noise_.gyro_walks();
   for (std::size_t k = 0; k < still_.poses.size(); ++k) {
     const StillPose& s = still_.poses[k];
+    std::vector<double*> acc_blocks = blocks_of(acc_terms, q(k));
+    std::vector<double*> gyr_blocks = blocks_of(gyr_terms, q(k));
+    if (acc_walk) {
+      acc_blocks.insert(acc_blocks.end(), {walk(k, model::Sensor::kAccel, false),
+                                           walk(k, model::Sensor::kAccel, true)});
+    }
+    if (gyr_walk) {
+      gyr_blocks.insert(gyr_blocks.end(), {walk(k, model::Sensor::kGyro, false),
+                                           walk(k, model::Sensor::kGyro, true)});
+    }
     built.acc.push_back(
         s.spinning ? nullptr
                    : problem->AddResidualBlock(
                          StillResidual::Create(model_, model::Sensor::kAccel, s.acc_measurement,
-                                               site_.g_n, site_.omega_ie_n),
-                         nullptr, blocks_of(acc_terms, q(k))));
+                                               site_.g_n, site_.omega_ie_n, Vec3::Zero(),
+                                               acc_walk),
+                         nullptr, acc_blocks));
     built.gyr.push_back(
         still_gyro_ ? problem->AddResidualBlock(
                           StillResidual::Create(model_, model::Sensor::kGyro, s.gyr_measurement,
                                                 site_.g_n, site_.omega_ie_n,
-                                                s.segment.known_omega_eb_b.value_or(Vec3::Zero())),
-                          nullptr, blocks_of(gyr_terms, q(k)))
+                                                s.segment.known_omega_eb_b.value_or(Vec3::Zero()),
+                                                gyr_walk),
+                          nullptr, gyr_blocks)
                     : nullptr);
   }
   const auto& motions = still_.motions;
@@ -229,9 +277,13 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
     const auto& mo = motions[k];
     std::vector<double*> blocks = {q(mo.from), q(mo.from + 1)};
     blocks.insert(blocks.end(), all_terms.begin(), all_terms.end());
+    if (gyr_walk) {
+      blocks.insert(blocks.end(), {walk(mo.from, model::Sensor::kGyro, true),
+                                   walk(mo.from + 1, model::Sensor::kGyro, false)});
+    }
     built.motion.push_back(problem->AddResidualBlock(
-        residuals::MotionResidual::Create(model_, motion_samples_[k], site_.omega_ie_n), nullptr,
-        blocks));
+        residuals::MotionResidual::Create(model_, motion_samples_[k], site_.omega_ie_n, gyr_walk),
+        nullptr, blocks));
     if (velocity_on_) {
       std::vector<double*> vblocks = {q(mo.from)};
       vblocks.insert(vblocks.end(), all_terms.begin(), all_terms.end());
@@ -243,6 +295,30 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
   }
 }
 
+void CalibrationProblem::AddWalkFactors(BuiltProblem& built, model::Sensor sensor,
+                                        const Vec3& K) {
+  auto add = [&](double* from, double* to, double span_s) {
+    const Vec3 inv_sigma = (K * std::sqrt(std::max(span_s, kMinWalkSpan_s))).cwiseInverse();
+    built.walk.push_back(
+        from == nullptr
+            ? built.problem->AddResidualBlock(
+                  residuals::BiasWalkResidual::CreateAnchor(inv_sigma), nullptr, to)
+            : built.problem->AddResidualBlock(residuals::BiasWalkResidual::Create(inv_sigma),
+                                              nullptr, from, to));
+  };
+  const auto& poses = still_.poses;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const auto& stats = poses[k].stats;
+    if (k == 0) {
+      add(nullptr, walk(0, sensor, false), stats.t_begin_s - model_.t_ref_s);
+    } else {
+      add(walk(k - 1, sensor, true), walk(k, sensor, false),
+          stats.t_begin_s - poses[k - 1].stats.t_end_s);
+    }
+    add(walk(k, sensor, false), walk(k, sensor, true), stats.t_end_s - stats.t_begin_s);
+  }
+}
+
 BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
                                        bool free_probes) {
   BuiltProblem built;
@@ -251,6 +327,8 @@ BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
   built.problem = std::make_unique<ceres::Problem>(problem_options);
   AddParameterBlocks(built, held, free_probes);
   AddResiduals(built);
+  if (noise_.accel_walks()) AddWalkFactors(built, model::Sensor::kAccel, noise_.walk_acc);
+  if (has_gyro_ && noise_.gyro_walks()) AddWalkFactors(built, model::Sensor::kGyro, noise_.walk_gyr);
   return built;
 }
 
@@ -282,6 +360,20 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem) {
       out.values.push_back(std::nan(""));
       out.is_model.push_back(false);
       out.model_index.emplace_back(-1, static_cast<int>(k));
+    }
+  }
+  const char* kEnd[2] = {"start", "end"};
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
+    for (std::size_t v = 0; v < walk_per_pose_; v += 3) {
+      out.blocks.push_back(values_.data() + walk_offset_ + walk_per_pose_ * k + v);
+      const bool gyro = v >= 6 || !noise_.accel_walks();
+      for (int i = 0; i < 3; ++i) {
+        out.names.push_back("walk[" + std::to_string(k) + "]." + (gyro ? "gyro." : "accel.") +
+                            kEnd[(v / 3) % 2] + "." + kAxisName[i]);
+        out.values.push_back(std::nan(""));
+        out.is_model.push_back(false);
+        out.model_index.emplace_back(-1, static_cast<int>(k));
+      }
     }
   }
   return out;
@@ -333,6 +425,9 @@ ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
   for (std::size_t k = 0; k < probe.velocity.size(); ++k) {
     add_rows(probe.velocity[k], ProbeJacobian::RowKind::kVelocity, static_cast<int>(k));
   }
+  for (std::size_t k = 0; k < probe.walk.size(); ++k) {
+    add_rows(probe.walk[k], ProbeJacobian::RowKind::kBiasWalk, static_cast<int>(k));
+  }
   std::vector<double> r;
   ceres::CRSMatrix crs;
   probe.problem->Evaluate(eval, nullptr, &r, nullptr, &crs);
@@ -357,6 +452,12 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     if (has_gyro_) f.gyr_mean = s.stats.gyr_mean;
     f.R_n_b = R_n_b(k);
     f.attitude_known = s.known;
+    auto walk_mean = [&](model::Sensor sensor) {
+      return Vec3(0.5 * (Eigen::Map<const Vec3>(walk(k, sensor, false)) +
+                         Eigen::Map<const Vec3>(walk(k, sensor, true))));
+    };
+    if (noise_.accel_walks()) f.acc_walk = walk_mean(model::Sensor::kAccel);
+    if (has_gyro_ && noise_.gyro_walks()) f.gyr_walk = walk_mean(model::Sensor::kGyro);
     // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
     double w[3];
     if (built.acc[k]) {

@@ -9,6 +9,11 @@
 //   motion                Log((R_k dR)^T R_k+1), dR the corrected rate integrated on SO(3)
 //   velocity (optional)   the accelerometer integrated while the IMU turns (lever arms, time
 //                         offset: effects whose excitation includes angular acceleration)
+//   bias walk (optional)  with a bias random walk in the noise model, every pose has the walk
+//                         at its first and last sample (s_k, e_k, per walking sensor) as
+//                         unknowns, in the still residual as (s_k + e_k) / 2, in the motion
+//                         residual linear between e_k and s_k+1, and tied by the factors
+//                         t_ref -> s_0 -> e_0 -> s_1 -> ... (residuals/bias_walk_residual.h)
 // The problem owns the values (theta, the poses' attitudes) that Ceres works on, so a
 // ceres::Problem can be built from them again (with other parameters held) and its residuals
 // and Jacobians handed out: the observability analysis, the covariance, diagnose's probe
@@ -46,10 +51,12 @@ struct BuiltProblem {
   std::vector<ceres::ResidualBlockId> acc, gyr;  ///< per still pose
   std::vector<ceres::ResidualBlockId> motion;    ///< per motion interval
   std::vector<ceres::ResidualBlockId> velocity;  ///< per motion interval, when used
+  std::vector<ceres::ResidualBlockId> walk;      ///< bias-walk factors, when the bias walks
 };
 
 /// The free unknowns of a built problem as Jacobian columns, in order: model parameters
-/// (term by term), then attitude tangents (pose by pose: north, east, down as free).
+/// (term by term), then attitude tangents (pose by pose: north, east, down as free), then the
+/// bias-walk states (pose by pose: accelerometer start, end, gyroscope start, end).
 struct UnknownColumns {
   std::vector<double*> blocks;          ///< parameter blocks in column order
   std::vector<std::string> names;       ///< per column, e.g. "accel.bias.x", "attitude[3].down"
@@ -124,6 +131,17 @@ class CalibrationProblem {
   int block_size(int term) const {
     return model_.terms()[static_cast<std::size_t>(term)].effect->info().size();
   }
+  /// The bias-walk state of pose k: `sensor`, at the segment's first (`end` false) or last
+  /// sample (3 values, sensor units). Only for a walking sensor.
+  double* walk(std::size_t k, model::Sensor sensor, bool end) {
+    const std::size_t sensor_offset = sensor == model::Sensor::kGyro && noise_.accel_walks() ? 6 : 0;
+    return values_.data() + walk_offset_ + walk_per_pose_ * k + sensor_offset + (end ? 3 : 0);
+  }
+  const double* walk(std::size_t k, model::Sensor sensor, bool end) const {
+    return const_cast<CalibrationProblem*>(this)->walk(k, sensor, end);
+  }
+  /// Adds the bias-walk factors of `sensor` (walk densities `K`) to `built`.
+  void AddWalkFactors(BuiltProblem& built, model::Sensor sensor, const Vec3& K);
   double* q(std::size_t k) { return values_.data() + q_offset_ + 4 * k; }
   const double* q(std::size_t k) const { return values_.data() + q_offset_ + 4 * k; }
   /// Pointers to every term's block, for model::Model::Predict.
@@ -137,6 +155,8 @@ class CalibrationProblem {
   std::vector<double> values_;              // model blocks in term order, then q_k per pose
   std::vector<std::size_t> block_offset_;   // per term: offset of its block in values_
   std::size_t q_offset_ = 0;                // offset of the first attitude in values_
+  std::size_t walk_offset_ = 0;             // offset of the first bias-walk state
+  std::size_t walk_per_pose_ = 0;           // bias-walk values per pose (0, 6 or 12)
   NoiseModel noise_;
   StartingValues start_;
   bool has_gyro_ = false;

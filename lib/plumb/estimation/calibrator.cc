@@ -14,6 +14,7 @@
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/solve.h"
 #include "plumb/estimation/still_set.h"
+#include "plumb/estimation/walk_estimate.h"
 
 namespace plumb::estimation {
 namespace {
@@ -75,12 +76,18 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   const bool earth_rate_seen = site.known && cal.has_gyro && options.use_still_gyro;
   const bool motion_on = options.use_motion && cal.has_gyro;
   StillSet still = MakeStillSet(series, segments, earth_rate_seen, motion_on, options);
-  const NoiseModel noise = EstimateNoise(series, still, cal.has_gyro, options);
-  cal.noise = noise.Levels();
+  NoiseModel noise = EstimateNoise(series, still, cal.has_gyro, options);
   model::ParameterBlocks theta = cal.model.ZeroParameters();
   const StartingValues start = Initialize(series, cal.model, site.gravity(), cal.has_gyro,
                                           options.first_heading_deg, still, theta);
   AssignHeadingGauge(still, cal.has_gyro);
+  if (options.estimate_walk) {
+    const WalkEstimate walk =
+        EstimateWalk(series, cal.model, site, still, theta, noise, start, options);
+    noise = walk.noise;
+    (walk.estimated ? fit.notes : fit.warnings).push_back(walk.note);
+  }
+  cal.noise = noise.Levels();
 
   // 4. The problem; 5. the solve; then the analysis of the solution with every unknown free.
   CalibrationProblem problem(series, cal.model, site, std::move(still), std::move(theta), noise,

@@ -27,6 +27,10 @@ struct StillSegmentFit {
   Vec3 gyr_whitened = Vec3::Zero();
   Quat R_n_b = Quat::Identity();     ///< estimated (or known) attitude
   bool attitude_known = false;
+  /// With a bias random walk: the walk's mean over the segment, (s_k + e_k) / 2, sensor
+  /// units (the bias over the segment is the model's plus this); zero without.
+  Vec3 acc_walk = Vec3::Zero();
+  Vec3 gyr_walk = Vec3::Zero();
 };
 
 /// Residual of one motion interval, rad (unwhitened) and whitened.
@@ -52,7 +56,7 @@ struct ProbeJacobian {
   std::vector<bool> unknown_is_model;      ///< J's columns: model parameter (else attitude)
   std::vector<std::string> probe_names;    ///< Z's columns, e.g. "gyro_g_sensitivity.G.xy"
   std::vector<int> probe_term;             ///< Z's columns: index of the term in the model
-  enum class RowKind { kStillAccel, kStillGyro, kMotion, kVelocity };
+  enum class RowKind { kStillAccel, kStillGyro, kMotion, kVelocity, kBiasWalk };
   std::vector<RowKind> row_kind;  ///< per row
   std::vector<int> row_index;     ///< per row: still segment or motion interval index
   std::vector<int> row_axis;      ///< per row: 0, 1, 2
@@ -85,6 +89,7 @@ struct FitReport {
   std::vector<StillSegmentFit> still;  ///< per still segment used, in time order
   std::vector<MotionFit> motion;       ///< per motion interval integrated
   std::vector<std::string> warnings;   ///< what the user must know, in words
+  std::vector<std::string> notes;      ///< how the fit was made, in words (e.g. the noise)
   /// Checks the fit failed (empty: all passed); a failed gate means the numbers above are
   /// not to be trusted as they stand (estimation/gates.h).
   std::vector<Gate> gates;

@@ -14,6 +14,8 @@ NoiseLevels NoiseModel::Levels() const {
   out.gyr = sigma_gyr;
   out.tau_acc = tau_acc.maxCoeff();
   out.tau_gyr = tau_gyr.maxCoeff();
+  out.walk_acc = walk_acc;
+  out.walk_gyr = walk_gyr;
   return out;
 }
 
@@ -32,6 +34,10 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
       noise.sigma_gyr[i] = std::max(std::sqrt(gyr[axis].variance), options.min_sigma_gyr);
       noise.tau_gyr[i] = std::max(1.0, gyr[axis].tau_int);
     }
+  }
+  if (options.accel_walk_density) noise.walk_acc = Vec3::Constant(*options.accel_walk_density);
+  if (options.gyro_walk_density && has_gyro) {
+    noise.walk_gyr = Vec3::Constant(*options.gyro_walk_density);
   }
   return noise;
 }

@@ -5,7 +5,8 @@
 // floored at options.min_sigma_*) and the integrated autocorrelation time tau (Sokal's
 // windowed estimate, signal/correlation_time.h; at least 1 sample). The variance of a segment
 // mean of N samples is then sigma^2 tau / N. Segments turning at a stated rate are left out:
-// their scatter is signal.
+// their scatter is signal. The bias random-walk densities come from the options
+// (CalibrationOptions::accel_walk_density, gyro_walk_density).
 #pragma once
 
 #include "plumb/core/imu_series.h"
@@ -21,6 +22,12 @@ struct NoiseModel {
   Vec3 sigma_gyr = Vec3::Zero();  ///< gyroscope noise per sample, sensor units (0: no gyro)
   Vec3 tau_acc = Vec3::Ones();    ///< integrated autocorrelation time per axis, samples (>= 1)
   Vec3 tau_gyr = Vec3::Ones();
+  /// Bias random-walk densities per axis, sensor units / s / sqrt(Hz) (0: no walk).
+  Vec3 walk_acc = Vec3::Zero();
+  Vec3 walk_gyr = Vec3::Zero();
+
+  bool accel_walks() const { return walk_acc.minCoeff() > 0; }
+  bool gyro_walks() const { return walk_gyr.minCoeff() > 0; }
 
   /// As the calibration reports it: sigma per axis and the largest tau of each sensor.
   NoiseLevels Levels() const;

@@ -37,6 +37,19 @@ struct CalibrationOptions {
   double rank_tolerance = 1e-9;
   /// Minimum samples for a still segment to be used.
   int min_segment_samples = 10;
+  /// Bias random-walk densities K (IEEE Std 952 rate / acceleration random walk) of the
+  /// accelerometer and the gyroscope, sensor units / s / sqrt(Hz) (m/s^3/sqrt(Hz) and
+  /// rad/s^2/sqrt(Hz) for SI samples), >= 0 and finite. Set and > 0: the bias is not one
+  /// constant over the session but walks, and the backend gives every still segment bias-walk
+  /// states tied by random-walk factors (residuals/bias_walk_residual.h); the model's bias is
+  /// then the bias at the model's reference time. Unset or 0: the bias is constant.
+  std::optional<double> accel_walk_density;
+  std::optional<double> gyro_walk_density;
+  /// Estimate the walk densities that are not given from the session itself, by
+  /// variance-component estimation over the walk factors (estimation/walk_estimate.h).
+  bool estimate_walk = false;
+  /// Fewest still segments for that estimate (>= 2); with fewer the bias stays constant.
+  int walk_min_poses = 6;
   /// Lower bound on the noise standard deviation per sample, in sensor units, guarding
   /// against quantised data whose scatter reads zero (> 0).
   double min_sigma_acc = 1e-6;

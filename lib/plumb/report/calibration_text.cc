@@ -73,7 +73,18 @@ std::string FullReport(const estimation::CalibrationResult& result) {
     os << ", gyro " << Vec(c.noise.gyr) << " " << c.gyr_unit << " (tau " << Format("%.2f", c.noise.tau_gyr)
        << ")";
   }
-  os << "\n\n";
+  os << "\n";
+  const bool acc_walk = c.noise.walk_acc.minCoeff() > 0, gyr_walk = c.noise.walk_gyr.minCoeff() > 0;
+  if (acc_walk || gyr_walk) {
+    os << "bias random walk in the fit (per segment, tied by random-walk factors):";
+    if (acc_walk) os << " accel " << Vec(c.noise.walk_acc) << " " << c.acc_unit << "/s/sqrt(Hz)";
+    if (gyr_walk) {
+      os << (acc_walk ? "," : "") << " gyro " << Vec(c.noise.walk_gyr) << " " << c.gyr_unit
+         << "/s/sqrt(Hz)";
+    }
+    os << "; biases are at the session start\n";
+  }
+  os << "\n";
   const double scale = estimation::SigmaScale(fit);
   const bool scaled = scale > 1.0;
   if (scaled) os << OverDispersionNote(fit, scale);
@@ -102,6 +113,7 @@ std::string FullReport(const estimation::CalibrationResult& result) {
       os << "\n";
     }
   }
+  for (const auto& n : fit.notes) os << "note: " << n << "\n";
   for (const auto& w : fit.warnings) os << "warning: " << w << "\n";
   return os.str();
 }

@@ -148,16 +148,26 @@ json SiteJson(const geo::Site& site) {
 }
 
 json NoiseJson(const estimation::CalibrationResult& r) {
-  return json{{"accel", Vector(r.calibration.noise.acc)},
-              {"gyro", r.calibration.has_gyro ? Vector(r.calibration.noise.gyr) : json(nullptr)},
-              {"tau_accel", Number(r.calibration.noise.tau_acc)},
-              {"tau_gyro", r.calibration.has_gyro ? Number(r.calibration.noise.tau_gyr) : json(nullptr)},
-              {"units", "sensor units per sample; tau in samples"}};
+  const auto& n = r.calibration.noise;
+  json out{{"accel", Vector(n.acc)},
+           {"gyro", r.calibration.has_gyro ? Vector(n.gyr) : json(nullptr)},
+           {"tau_accel", Number(n.tau_acc)},
+           {"tau_gyro", r.calibration.has_gyro ? Number(n.tau_gyr) : json(nullptr)},
+           {"units", "sensor units per sample; tau in samples"}};
+  // The bias random walk the fit assumed (present only when the bias walked in the fit).
+  const bool acc_walk = n.walk_acc.minCoeff() > 0;
+  const bool gyr_walk = n.walk_gyr.minCoeff() > 0;
+  if (acc_walk || gyr_walk) {
+    out["walk_accel"] = acc_walk ? Vector(n.walk_acc) : json(nullptr);
+    out["walk_gyro"] = gyr_walk ? Vector(n.walk_gyr) : json(nullptr);
+    out["walk_units"] = "sensor units / s / sqrt(Hz) (bias random walk density)";
+  }
+  return out;
 }
 
 json StillJson(const estimation::StillSegmentFit& s, bool has_gyro) {
   const Quat& q = s.R_n_b;
-  return json{
+  json out{
       {"label", s.segment.label},
       {"begin", s.segment.begin},
       {"end", s.segment.end},
@@ -171,6 +181,10 @@ json StillJson(const estimation::StillSegmentFit& s, bool has_gyro) {
       {"gyr_whitened", has_gyro ? Vector(s.gyr_whitened) : json(nullptr)},
       {"attitude_quaternion_wxyz", {Number(q.w()), Number(q.x()), Number(q.y()), Number(q.z())}},
       {"attitude_known", s.attitude_known}};
+  // With a bias random walk in the fit: the walk's mean over the segment, sensor units.
+  if (!s.acc_walk.isZero()) out["acc_walk"] = Vector(s.acc_walk);
+  if (!s.gyr_walk.isZero()) out["gyr_walk"] = Vector(s.gyr_walk);
+  return out;
 }
 
 json MotionJson(const estimation::MotionFit& m) {
@@ -310,6 +324,7 @@ json ToJson(const estimation::CalibrationResult& r) {
   doc["motion"] = json::array();
   for (const auto& m : r.fit.motion) doc["motion"].push_back(MotionJson(m));
   doc["warnings"] = r.fit.warnings;
+  if (!r.fit.notes.empty()) doc["notes"] = r.fit.notes;
   return doc;
 }
 

@@ -25,16 +25,22 @@ Eigen::Matrix<double, 4, 3> LeftPlusJacobian(const Quat& q) {
 }
 
 MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
-                               const Vec3& omega_ie_n)
-    : model_(&model), s_(std::move(samples)), omega_ie_n_(omega_ie_n) {
+                               const Vec3& omega_ie_n, bool walk)
+    : model_(&model), s_(std::move(samples)), omega_ie_n_(omega_ie_n), walk_(walk) {
   for (const auto& t : model.terms()) {
     block_offset_.push_back(num_model_parameters_);
     num_model_parameters_ += t.effect->info().size();
   }
+  const int g = model.BaseTerm(model::Sensor::kGyro);
+  if (g >= 0) bias_offset_ = block_offset_[static_cast<std::size_t>(g)] + model::gyro_linear::kBias;
   set_num_residuals(3);
   mutable_parameter_block_sizes()->push_back(4);
   mutable_parameter_block_sizes()->push_back(4);
   for (const auto& t : model.terms()) mutable_parameter_block_sizes()->push_back(t.effect->info().size());
+  if (walk_) {
+    mutable_parameter_block_sizes()->push_back(3);
+    mutable_parameter_block_sizes()->push_back(3);
+  }
 }
 
 bool MotionResidual::LinearAt(double const* const* theta, double** jacobians) const {
@@ -49,8 +55,8 @@ bool MotionResidual::LinearAt(double const* const* theta, double** jacobians) co
   return true;
 }
 
-void MotionResidual::CorrectedRates(double const* const* theta, bool linear,
-                                    std::vector<Vec3>* w,
+void MotionResidual::CorrectedRates(double const* const* theta, const std::vector<Vec3>& gyr,
+                                    bool linear, std::vector<Vec3>* w,
                                     std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const {
   const std::size_t n = s_.size();
   const int P = num_model_parameters_;
@@ -66,7 +72,7 @@ void MotionResidual::CorrectedRates(double const* const* theta, bool linear,
     const int g = model_->BaseTerm(model::Sensor::kGyro);
     const int off = g >= 0 ? block_offset_[static_cast<std::size_t>(g)] : 0;
     for (std::size_t i = 0; i < n; ++i) {
-      (*w)[i] = E_inv * (s_.gyr[i] - b_g);
+      (*w)[i] = E_inv * (gyr[i] - b_g);
       if (!W || g < 0) continue;
       model::gyro_linear::SubtractRateJacobian(
           E_inv, (*w)[i], (*W)[i].middleCols(off, model::gyro_linear::kSize));
@@ -81,7 +87,7 @@ void MotionResidual::CorrectedRates(double const* const* theta, bool linear,
     in.alpha_b = s_.alpha_b[i].cast<T>();
     in.dt_s = T(s_.dt_s[i]);
     in.dtemp_c = T(s_.dtemp_c[i]);
-    return model_->Correct<T>(th, s_.acc[i].cast<T>(), s_.gyr[i].cast<T>(), in, Finv, Einv, 3)
+    return model_->Correct<T>(th, s_.acc[i].cast<T>(), gyr[i].cast<T>(), in, Finv, Einv, 3)
         .second;
   };
   for (std::size_t i = 0; i < n; ++i) (*w)[i] = correct(theta, F_inv, E_inv, i);
@@ -121,7 +127,26 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   double const* const* theta = parameters + 2;
   const bool want_jacobians = jacobians != nullptr;
   const int P = num_model_parameters_;
-  const int U = P + 3;  // unknowns: model parameters, then the left perturbation of R_k
+  // Unknowns: model parameters, the left perturbation of R_k, then (walk) b_from and b_to.
+  const int U = P + 3 + (walk_ ? 6 : 0);
+  const int att = P;      // column of R_k's perturbation
+  const int from = P + 3;  // columns of b_from, then b_to
+
+  // The outputs with the bias walk taken off (the samples themselves without a walk).
+  std::vector<Vec3> walked;
+  std::vector<double> a;  // per sample: the weight of b_to
+  if (walk_) {
+    const Eigen::Map<const Vec3> b_from(parameters[2 + model_->num_terms()]);
+    const Eigen::Map<const Vec3> b_to(parameters[3 + model_->num_terms()]);
+    const double span = s_.dt_s.back() - s_.dt_s.front();
+    walked.resize(s_.size());
+    a.resize(s_.size());
+    for (std::size_t i = 0; i < s_.size(); ++i) {
+      a[i] = span > 0 ? (s_.dt_s[i] - s_.dt_s.front()) / span : 0.0;
+      walked[i] = s_.gyr[i] - ((1.0 - a[i]) * b_from + a[i] * b_to);
+    }
+  }
+  const std::vector<Vec3>& gyr = walk_ ? walked : s_.gyr;
 
   std::vector<Vec3> w;
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> W;
@@ -129,7 +154,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   // w = E^-1 (y - b_g), dw/dE_rc = -E^-1 e_r w_c, dw/db_g = -E^-1. It also holds when every
   // other effect is at zero and its Jacobian is not asked for (e.g. diagnose's probes).
   const bool closed_form = LinearAt(theta, jacobians);
-  CorrectedRates(theta, closed_form, &w, want_jacobians && !closed_form ? &W : nullptr);
+  CorrectedRates(theta, gyr, closed_form, &w, want_jacobians && !closed_form ? &W : nullptr);
   Mat3 E_inv = Mat3::Identity();
   int gyro_offset = -1;
   if (closed_form && want_jacobians) {
@@ -139,16 +164,27 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
       E_inv = model_->Predict(theta, model::SensorInput<double>()).E.inverse();
     }
   }
-  // Adds K dw_i/dtheta to the first P columns of `out`.
+  // Adds K dw_i/dtheta to the first P columns of `out` and, with a walk, K dw_i/d b_from and
+  // K dw_i/d b_to (d w_i / d b_g weighted by 1 - a_i and a_i) to the walk's columns.
   auto add_rate_jacobian = [&](const Mat3& K, std::size_t i,
                                Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
     if (!closed_form) {
       out.leftCols(P).noalias() += K * W[i];
+      if (walk_) {
+        const Mat3 K_dw_db = K * W[i].middleCols<3>(bias_offset_);
+        out.middleCols<3>(from).noalias() += (1.0 - a[i]) * K_dw_db;
+        out.middleCols<3>(from + 3).noalias() += a[i] * K_dw_db;
+      }
       return;
     }
     if (gyro_offset < 0) return;
+    const Mat3 KE_inv = K * E_inv;
     model::gyro_linear::SubtractRateJacobian(
-        K * E_inv, w[i], out.middleCols(gyro_offset, model::gyro_linear::kSize));
+        KE_inv, w[i], out.middleCols(gyro_offset, model::gyro_linear::kSize));
+    if (walk_) {
+      out.middleCols<3>(from).noalias() -= (1.0 - a[i]) * KE_inv;
+      out.middleCols<3>(from + 3).noalias() -= a[i] * KE_inv;
+    }
   };
 
   const Vec3 omega_k = R_k.transpose() * omega_ie_n_;  // Earth rate in b_k
@@ -178,7 +214,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
       A_next.noalias() = G * A;
       add_rate_jacobian(K0, i, A_next);
       add_rate_jacobian(K1, i + 1, A_next);
-      A_next.rightCols<3>().noalias() -= K * (dR.transpose() * d_omega_k);
+      A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
       A.swap(A_next);
     }
     dR = dR * Ex;
@@ -192,7 +228,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   const Eigen::DiagonalMatrix<double, 3> Wsi(s_.sqrt_info);
   // Tangent Jacobians (left perturbations in NED for the attitudes), then ambient ones
   // J_amb = J_tan 4 P^T, which satisfy J_amb P = J_tan since P^T P = I / 4.
-  const Mat3 J_k = Wsi * (-Jli * (M + A.rightCols<3>()));
+  const Mat3 J_k = Wsi * (-Jli * (M + A.middleCols<3>(att)));
   const Mat3 J_k1 = Wsi * (Jli * M);
   auto ambient = [](const Mat3& J_tan, const Quat& q, double* out) {
     const Eigen::Matrix<double, 3, 4> J = J_tan * 4.0 * LeftPlusJacobian(q).transpose();
@@ -209,6 +245,14 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J_out(out, 3, size);
     J_out = J_theta.middleCols(block_offset_[static_cast<std::size_t>(t)], size);
   }
+  if (walk_) {
+    for (int b = 0; b < 2; ++b) {
+      double* out = jacobians[2 + model_->num_terms() + b];
+      if (!out) continue;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> J_out(out);
+      J_out = Wsi * (-Jli * A.middleCols<3>(from + 3 * b));
+    }
+  }
   return true;
 }
 
@@ -216,6 +260,8 @@ Quat MotionResidual::Integrate(const double* q_k, const model::ParameterBlocks& 
   // Residual with R_k+1 = R_k: r = Log(dR^T), so dR = Exp(-r).
   std::vector<const double*> p = {q_k, q_k};
   for (const auto& b : theta) p.push_back(b.data());
+  const double zero[3] = {0.0, 0.0, 0.0};
+  if (walk_) p.insert(p.end(), {zero, zero});
   double r[3];
   Evaluate(p.data(), r, nullptr);
   const Vec3 rv = Vec3(r[0], r[1], r[2]).cwiseQuotient(s_.sqrt_info);

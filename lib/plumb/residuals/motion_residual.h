@@ -19,9 +19,16 @@
 // d(w_i)/d(theta) is closed-form for the base model and from Jets (one pass per 8 parameters)
 // when the model has other effects. The cost is one pass over the samples per evaluation.
 //
+// With a gyroscope bias random walk (residuals/bias_walk_residual.h), the output carries the
+// walk too: it is b_from at the first sample (the walk at the last sample of segment k) and
+// b_to at the last (the walk at the first sample of k+1), linear in time between them (the
+// Brownian bridge about that line is in sqrt_info), and is taken off the output before the
+// model is inverted: y_g,i - ((1 - a_i) b_from + a_i b_to), a_i = (t_i - t_0) / (t_n - t_0).
+// It enters like the gyroscope bias, so d w_i / d b_from = (1 - a_i) d w_i / d b_g.
+//
 // Parameter blocks, in order: q_k (4), q_k+1 (4) (Eigen order x y z w, R_n_b, manifolds of
 // plumb/residuals/manifolds.h: left perturbation in NED), then every block of the model in
-// model order.
+// model order, then, with `walk`, b_from (3) and b_to (3) in sensor units.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -35,26 +42,30 @@ class MotionResidual final : public ceres::CostFunction {
  public:
   /// `omega_ie_n`: Earth rate in NED, rad/s (zero without a site). The model must outlive
   /// the cost function.
-  MotionResidual(const model::Model& model, MotionSamples samples, const Vec3& omega_ie_n);
+  MotionResidual(const model::Model& model, MotionSamples samples, const Vec3& omega_ie_n,
+                 bool walk = false);
 
   static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
-                                     const Vec3& omega_ie_n) {
-    return new MotionResidual(model, std::move(samples), omega_ie_n);
+                                     const Vec3& omega_ie_n, bool walk = false) {
+    return new MotionResidual(model, std::move(samples), omega_ie_n, walk);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
-  /// The integrated rotation dR = R_k^T R(t_end) (body frame) at given values.
+  /// The integrated rotation dR = R_k^T R(t_end) (body frame) at given values (with a walk:
+  /// the walk at zero).
   Quat Integrate(const double* q_k, const model::ParameterBlocks& theta) const;
 
  private:
   /// True when the model acts as its linear stage at `theta`: every other effect is at zero
   /// and its Jacobian is not requested (`jacobians` may be null).
   bool LinearAt(double const* const* theta, double** jacobians) const;
-  /// Corrected rates w_i and, if `W` is non-null, their Jacobians d w_i / d theta (3 x P,
-  /// P = all model parameters in block order); `linear` selects the closed form of LinearAt.
-  void CorrectedRates(double const* const* theta, bool linear, std::vector<Vec3>* w,
+  /// Corrected rates w_i of the outputs `gyr` and, if `W` is non-null, their Jacobians
+  /// d w_i / d theta (3 x P, P = all model parameters in block order); `linear` selects the
+  /// closed form of LinearAt.
+  void CorrectedRates(double const* const* theta, const std::vector<Vec3>& gyr, bool linear,
+                      std::vector<Vec3>* w,
                       std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const;
 
   const model::Model* model_;
@@ -62,6 +73,8 @@ class MotionResidual final : public ceres::CostFunction {
   Vec3 omega_ie_n_;
   int num_model_parameters_ = 0;
   std::vector<int> block_offset_;  // offset of each model block in the P parameters
+  bool walk_ = false;              // the gyroscope bias walk's two blocks follow the model's
+  int bias_offset_ = -1;           // offset of b_g among the P parameters (-1: no gyroscope)
 };
 
 /// d(Exp(delta) (x) q)/d(delta) at delta = 0 for q in Eigen order (x y z w): 4 x 3.

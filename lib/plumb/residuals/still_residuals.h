@@ -13,8 +13,15 @@
 // mean (sqrt(N_k) / sigma_k, corrected for sample correlation), so the cost does not grow with
 // the number of samples.
 //
+// With a bias random walk (residuals/bias_walk_residual.h) the segment's mean output also
+// carries the mean of the walk over the segment, (s_k + e_k) / 2 given the walk at its first
+// and last sample (the rest, a Brownian bridge of variance K^2 T / 12, is in sqrt_info):
+//
+//   r = W (mean(y)_k - h(theta, ...) - (s_k + e_k) / 2)
+//
 // Parameter blocks, in order: q_k (4, Eigen order x y z w, unit quaternion of R_n_b), then
-// the blocks of the model terms listed in `terms` (their sizes in info().size()).
+// the blocks of the model terms listed in `terms` (their sizes in info().size()), then, with
+// `walk`, s_k (3) and e_k (3) in sensor units.
 // Units: g_n in m/s^2 (NED, down positive), omega in rad/s, outputs in sensor units.
 #pragma once
 
@@ -36,7 +43,7 @@ class StillResidual {
   /// rad/s (zero without a site); `omega_eb_b` a known rate relative to the Earth, rad/s.
   StillResidual(const model::Model& model, model::Sensor sensor, std::vector<int> terms,
                 StillMeasurement measurement, const Vec3& g_n, const Vec3& omega_ie_n,
-                const Vec3& omega_eb_b = Vec3::Zero());
+                const Vec3& omega_eb_b = Vec3::Zero(), bool walk = false);
 
   template <typename T>
   bool operator()(T const* const* parameters, T* residuals) const;
@@ -45,7 +52,7 @@ class StillResidual {
   static ceres::CostFunction* Create(const model::Model& model, model::Sensor sensor,
                                      StillMeasurement measurement, const Vec3& g_n,
                                      const Vec3& omega_ie_n,
-                                     const Vec3& omega_eb_b = Vec3::Zero());
+                                     const Vec3& omega_eb_b = Vec3::Zero(), bool walk = false);
 
   /// Indices of the model terms that act on `sensor`.
   static std::vector<int> TermsOf(const model::Model& model, model::Sensor sensor);
@@ -62,6 +69,7 @@ class StillResidual {
   std::vector<int> terms_;
   StillMeasurement m_;
   Vec3 g_n_, omega_ie_n_, omega_eb_b_;
+  bool walk_ = false;
 };
 
 }  // namespace plumb::residuals

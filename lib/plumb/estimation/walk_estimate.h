@@ -1,0 +1,51 @@
+// plumb/estimation/walk_estimate.h — the bias random-walk densities from the session itself,
+// by variance-component estimation (stage 2b of the backend, when asked for).
+//
+// A multi-pose session shows how far the biases wander between its holds, but only through the
+// fit: the still means differ by the walk *and* by the poses. Helmert's variance-component
+// estimate (Förstner 1979; Koch, Parameter Estimation and Hypothesis Testing, 3.6) separates
+// them. With the walk factors of one sensor as a group g of whitened residuals r_g, their
+// redundancy is
+//
+//   red_g = sum_{i in g} (1 - h_ii),     h_ii = J_i C J_i^T,
+//
+// J the whitened Jacobian over every free unknown (model, attitudes, walk states) and C its
+// (pseudo-)inverse normal matrix: the part of the group's residuals that the fit cannot absorb.
+// At the right density, E[r_g^T r_g] = red_g, so each iteration scales K^2 by
+// r_g^T r_g / red_g and fits again, until K changes by less than `tolerance`. The start is
+// the typical consumer MEMS walk (1e-4 m/s^3/sqrt(Hz), 2e-6 rad/s^2/sqrt(Hz), scaled to the
+// sensor's units by the starting scale); the result is floored at 1e-3 of it (a walk too
+// small to see leaves the factors stiff but finite).
+//
+// The estimate needs holds to compare: at least `min_poses` still segments, else the
+// densities are left as given (zero: a constant bias) and the reason is returned.
+#pragma once
+
+#include <string>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/estimation/initialization.h"
+#include "plumb/estimation/noise_model.h"
+#include "plumb/estimation/options.h"
+#include "plumb/estimation/still_set.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+
+namespace plumb::estimation {
+
+struct WalkEstimate {
+  NoiseModel noise;        ///< the noise model with the estimated walk densities
+  int iterations = 0;      ///< fits made
+  double redundancy_acc = 0, redundancy_gyr = 0;  ///< red_g of each sensor's walk factors
+  bool estimated = false;  ///< false: not estimated, `note` says why
+  std::string note;        ///< what was done, in words
+};
+
+/// Iterates fits of the problem (stages 4-5) from `theta` and the poses of `still`, scaling
+/// each walking sensor's density (file comment). `noise` gives the white noise.
+WalkEstimate EstimateWalk(const ImuSeries& series, const model::Model& model,
+                          const geo::Site& site, const StillSet& still,
+                          const model::ParameterBlocks& theta, const NoiseModel& noise,
+                          const StartingValues& start, const CalibrationOptions& options);
+
+}  // namespace plumb::estimation
