@@ -66,6 +66,7 @@ WalkEstimate EstimateWalk(const ImuSeries& series, const model::Model& model,
   const double gyr0 = kTypicalGyroWalk / start.gyro_rad_per_unit;
   if (!noise.accel_walks()) out.noise.walk_acc = Vec3::Constant(acc0);
   if (has_gyro && !noise.gyro_walks()) out.noise.walk_gyr = Vec3::Constant(gyr0);
+  bool learnt_acc = false, learnt_gyr = false;
   for (int it = 0; it < kMaxIterations; ++it) {
     CalibrationProblem problem(series, model, site, still, theta, out.noise, start, options);
     FitReport scratch;
@@ -76,25 +77,34 @@ WalkEstimate EstimateWalk(const ImuSeries& series, const model::Model& model,
     out.redundancy_acc = g.red_acc;
     out.redundancy_gyr = g.red_gyr;
     double change = 0;
-    auto scale = [&](Vec3& K, double chi2, double red, double k0) {
+    auto scale = [&](Vec3& K, double chi2, double red, double k0, bool& learnt) {
       if (red <= 1.0) return;  // the factors are absorbed: nothing to learn from them
+      learnt = true;
       const double next = std::max(K[0] * std::sqrt(chi2 / red), kFloor * k0);
       change = std::max(change, std::abs(next / K[0] - 1.0));
       K.setConstant(next);
     };
-    scale(out.noise.walk_acc, g.chi2_acc, g.red_acc, acc0);
-    if (has_gyro) scale(out.noise.walk_gyr, g.chi2_gyr, g.red_gyr, gyr0);
+    scale(out.noise.walk_acc, g.chi2_acc, g.red_acc, acc0, learnt_acc);
+    if (has_gyro) scale(out.noise.walk_gyr, g.chi2_gyr, g.red_gyr, gyr0, learnt_gyr);
     if (change < kTolerance) break;
   }
   out.estimated = true;
-  char text[256];
-  std::snprintf(text, sizeof text,
-                "bias random walk estimated from the session (variance components, %d fits): "
-                "accel %.3g, gyro %.3g sensor units/s/sqrt(Hz), from %.1f and %.1f redundant "
-                "walk factors",
-                out.iterations, out.noise.walk_acc[0], has_gyro ? out.noise.walk_gyr[0] : 0.0,
-                out.redundancy_acc, out.redundancy_gyr);
-  out.note = text;
+  // Per sensor: estimated, or (its walk factors fully absorbed by the other unknowns, e.g.
+  // holds not joined by turns) the typical MEMS walk kept.
+  auto describe = [](const char* sensor, double K, double red, bool learnt) {
+    char text[160];
+    std::snprintf(text, sizeof text, learnt ? "%s %.3g (from %.1f redundant walk factors)"
+                                            : "%s %.3g (the typical MEMS walk: its walk factors "
+                                              "are absorbed by the fit, %.1f redundant)",
+                  sensor, K, red);
+    return std::string(text);
+  };
+  out.note = "bias random walk from the session (variance components, " +
+             std::to_string(out.iterations) + " fits), sensor units/s/sqrt(Hz): " +
+             describe("accel", out.noise.walk_acc[0], out.redundancy_acc, learnt_acc);
+  if (has_gyro) {
+    out.note += ", " + describe("gyro", out.noise.walk_gyr[0], out.redundancy_gyr, learnt_gyr);
+  }
   return out;
 }
 
