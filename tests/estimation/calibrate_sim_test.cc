@@ -136,6 +136,35 @@ TEST(CalibrateSimulated, CovarianceIsHonestWithABiasRandomWalk) {
   }
 }
 
+TEST(CalibrateSimulated, WalkEstimateFindsTheSimulatedWalk) {
+  // --estimate-rw on sessions of 24 poses of 10 s with the simulator's accelerometer walk
+  // (1e-4 m/s^3/sqrt(Hz)): the variance-component estimate, averaged in log over 4 sessions,
+  // lies within a factor 2 of the truth.
+  double log_sum = 0;
+  for (int run = 0; run < 4; ++run) {
+    const Outcome o = CalibrateMultiPose(7000 + static_cast<std::uint64_t>(run), "base", 24,
+                                         10.0, /*walk=*/true, /*model_walk=*/false,
+                                         /*estimate_walk=*/true);
+    ASSERT_FALSE(o.result.fit.notes.empty());
+    log_sum += std::log(o.result.calibration.noise.walk_acc[0] / 1e-4);
+  }
+  const double ratio = std::exp(log_sum / 4);
+  EXPECT_GT(ratio, 0.5);
+  EXPECT_LT(ratio, 2.0);
+  std::cout << "estimated / true accelerometer walk: " << ratio << "\n";
+}
+
+TEST(CalibrateSimulated, WalkEstimateNeedsSixHolds) {
+  const Outcome o = CalibrateMultiPose(7100, "base", 4, 10.0, true, false, true);
+  EXPECT_TRUE(o.result.calibration.noise.walk_acc.isZero());
+  bool said = false;
+  for (const auto& w : o.result.fit.warnings) {
+    said = said || w.find("bias random walk not estimated: 4 still segments, at least 6") !=
+                       std::string::npos;
+  }
+  EXPECT_TRUE(said);
+}
+
 TEST(CalibrateSimulated, AConstantBiasUnderstatesSigmaWhenTheBiasWalks) {
   // The same sessions fitted with the bias held constant: the sigmas are too small (what the
   // walk states above repair). 30 s holds: NEES/dof about 38 instead of 1.
