@@ -1,5 +1,6 @@
 #include "plumb/export/export.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -118,11 +119,14 @@ ExportOutput Kalibr(const estimation::Calibration& c, const ImuSeries& series,
   auto detail = [&](const char* name, const SensorNoise& n) {
     const auto count = [](const std::array<bool, 3>& a) { return a[0] + a[1] + a[2]; };
     if (count(n.white_from_ieee) > 0) {
+      double largest = 0.0;  // over the axes the fit resolves (NaN elsewhere)
+      for (int i = 0; i < 3; ++i) {
+        if (n.white_from_ieee[i]) largest = std::max(largest, n.white_ieee[i]);
+      }
       std::snprintf(buf, sizeof buf,
                     "        %s: N of the IEEE fit to the still data's Allan deviation on %d of 3 "
                     "axes (largest %.3g), K on %d of 3",
-                    name, count(n.white_from_ieee), n.white_ieee.maxCoeff(),
-                    count(n.walk_from_ieee));
+                    name, count(n.white_from_ieee), largest, count(n.walk_from_ieee));
       out.lines.push_back(buf);
     }
     if (count(n.white_from_ieee) == 3) return;
