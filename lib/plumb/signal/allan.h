@@ -34,10 +34,13 @@
 // records: each record's estimate is a chi-square variable scaled by its share w_k =
 // terms_k / terms of the second differences, so the pool's EDF is Satterthwaite's
 // 1 / sum_k (w_k^2 / edf_k) (one record: its own EDF; K equal records: K times it).
-// Greenhall and Riley's exact EDF (2003) is not used: the table's approximations are within a
-// few per cent of it for these noise types, which is below what the intervals are used for.
-// The default interval is one sigma (c = 0.6827) for the white-FM EDF; callers that know the
-// dominant noise per tau (the noise-term fit, noise_terms.h) set it with SetAllanIntervals.
+// (The flicker-FM entry at m = 1 has (N-2)^2, as in Stein's table; a transcription without the
+// square, found in some libraries, gives an EDF below 1.) Greenhall and Riley's EDF algorithm
+// (2003), which Stable32 uses, is not implemented. The intervals' coverage is checked by
+// simulation (tests/signal/allan_test.cc: white noise and random walk, one-sigma intervals
+// hold the truth 68 % of the time within the binomial spread). The default interval is one
+// sigma (c = 0.6827) for the white-FM EDF; callers that know the dominant noise per tau (the
+// noise-term fit, noise_terms.h) set it with SetAllanIntervals.
 #pragma once
 
 #include <cstddef>
