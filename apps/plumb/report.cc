@@ -1,6 +1,7 @@
 // plumb report INPUT... --out DIR — one page that says what was calibrated and how well
 // (SPEC section 6): DIR/index.html, beside it result.json (calibrate's JSON), diagnose.json,
-// residuals.csv and the figures (PNG, drawn by gnuplot from figures.gp and its CSV files).
+// allan.json (plumb allan's JSON on the fit's still segments), residuals.csv and the figures
+// (PNG, drawn by gnuplot from figures.gp and its CSV files).
 //
 // Reads the inputs, finds the still segments and resolves the site exactly as calibrate does
 // (the same options), fits, runs diagnose's ranking of the missing-effect catalogue unless
@@ -29,8 +30,10 @@
 #include "plumb/report/gnuplot.h"
 #include "plumb/report/html_report.h"
 #include "plumb/report/json_report.h"
+#include "plumb/report/noise_text.h"
 #include "plumb/report/summary.h"
 #include "plumb/report/diagnosis_text.h"
+#include "plumb/signal/noise_terms.h"
 #include "segment_options.h"
 #include "site_options.h"
 
@@ -102,7 +105,8 @@ class ReportCommand : public Command {
     AddInputOptions(app_, a.input);
     app_->add_option("--out", a.out_dir,
                      "Folder of the page (created when missing): index.html, result.json, "
-                     "diagnose.json, residuals.csv, figures.gp, its CSV data and the PNGs")
+                     "diagnose.json, allan.json, residuals.csv, figures.gp, its CSV data and "
+                     "the PNGs")
         ->type_name("DIR")
         ->required();
     AddModelOption(app_, a.fit);
@@ -169,6 +173,16 @@ class ReportCommand : public Command {
     extras.title = "plumb report: " + session.source;
     extras.command = CommandText();
     extras.segments_source = a.segments.segments_path;
+    // The sensor's noise as `plumb allan` measures it on the same still segments.
+    try {
+      extras.still_noise = signal::AnalyseStillNoise(series, segments);
+      report::WriteJson((dir / "allan.json").string(),
+                        report::StillNoiseJson(*extras.still_noise, series));
+      files.push_back("allan.json");
+    } catch (const InsufficientDataError& e) {
+      extras.still_noise_note = e.what();
+      std::cout << "warning: no noise terms: " << e.what() << "\n";
+    }
     if (a.no_figures) {
       extras.figure_notes.push_back("not drawn (--no-figures)");
     } else {
@@ -215,7 +229,8 @@ class ReportCommand : public Command {
     ra_options.allan_length_fraction = 1.0;
     const diagnostics::ResidualAnalysis longest =
         diagnostics::AnalyseResiduals(series, result, ra_options);
-    const report::FigurePlan plan = report::PlanFigures(series, segments, result, longest);
+    report::FigurePlan plan = report::PlanFigures(series, segments, result, longest);
+    if (extras.still_noise) report::AddStillNoiseFigure(*extras.still_noise, {}, plan);
     const report::GnuplotOutcome outcome = report::RunGnuplot(args_.out_dir, plan.job, args_.gnuplot);
     for (const auto& figure : plan.figures) {
       if (std::find(outcome.written.begin(), outcome.written.end(), figure.file) !=

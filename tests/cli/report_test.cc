@@ -69,13 +69,19 @@ ToolRun* ReportOnDemoSession::run_ = nullptr;
 TEST_F(ReportOnDemoSession, WritesThePageAndTheFilesBesideIt) {
   ASSERT_EQ(run_->exit_code, 0) << run_->out << run_->err;
   EXPECT_TRUE(Contains(run_->out, "index.html")) << run_->out;
-  for (const char* name : {"index.html", "result.json", "diagnose.json", "residuals.csv"}) {
+  for (const char* name :
+       {"index.html", "result.json", "diagnose.json", "allan.json", "residuals.csv"}) {
     EXPECT_GT(SizeOf(Out(name)), 0u) << name;
   }
   const auto result = ReadJson(Out("result.json"));
   EXPECT_EQ(result["model"], "base");
   const auto diagnosis = ReadJson(Out("diagnose.json"));
   EXPECT_FALSE(diagnosis["candidates"].empty());
+  // plumb allan's document on the fit's still segments.
+  const auto noise = ReadJson(Out("allan.json"));
+  EXPECT_EQ(noise["still"]["segments"].size(),
+            result["fit"]["segments"]["still"].get<std::size_t>());
+  EXPECT_TRUE(noise["accel"]["axes"]["x"]["terms"]["N"]["resolved"].get<bool>());
 }
 
 TEST_F(ReportOnDemoSession, PageHoldsTheParametersTheFitAndTheCommand) {
@@ -90,6 +96,8 @@ TEST_F(ReportOnDemoSession, PageHoldsTheParametersTheFitAndTheCommand) {
   EXPECT_TRUE(Contains(page, chi2)) << chi2;
   EXPECT_TRUE(Contains(page, "99 % band"));
   EXPECT_TRUE(Contains(page, "id=\"diagnosis\""));
+  EXPECT_TRUE(Contains(page, "id=\"noise\""));
+  EXPECT_TRUE(Contains(page, "velocity random walk"));
   EXPECT_TRUE(Contains(page, "--columns ax,ay,az,gx,gy,gz --rate 100 --out"));
   EXPECT_TRUE(Contains(page, "</html>"));
 }
@@ -99,7 +107,7 @@ TEST_F(ReportOnDemoSession, DrawsTheFiguresWithGnuplot) {
   if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on the PATH: no PNGs to check";
   const std::string page = ReadAll(Out("index.html"));
   // imu0.log has no temperature column, so no temperature.png.
-  for (const char* png : {"series.png", "residuals.png", "allan.png"}) {
+  for (const char* png : {"series.png", "residuals.png", "allan.png", "noise.png"}) {
     EXPECT_GT(SizeOf(Out(png)), 0u) << png << "\n" << ReadAll(Out("figures.log"));
     EXPECT_TRUE(Contains(page, std::string("<img src=\"") + png + "\"")) << png;
   }

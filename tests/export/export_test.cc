@@ -17,6 +17,8 @@
 namespace plumb::exporter {
 namespace {
 
+using nlohmann::json;
+
 constexpr double kG = 9.80665;
 
 // ---- helpers --------------------------------------------------------------------------------
@@ -317,7 +319,12 @@ TEST(Kalibr, WhiteNoiseDensityMatchesTheAllanDeviationAtOneSecond) {
     // White noise: ADEV(1 s) = sigma sqrt(dt), within the estimator's scatter.
     EXPECT_NEAR(imu.accel.white_low[i] / (sigma_a * std::sqrt(dt)), 1.0, 0.1) << i;
     EXPECT_NEAR(imu.gyro.white_low[i] / (sigma_g * std::sqrt(dt)), 1.0, 0.1) << i;
-    EXPECT_EQ(imu.gyro.white[i], std::max(imu.gyro.white_sample[i], imu.gyro.white_low[i]));
+    // N is the IEEE fit's, resolved on every axis, and agrees with both fallbacks.
+    EXPECT_TRUE(imu.gyro.white_from_ieee[i]) << i;
+    EXPECT_EQ(imu.gyro.white[i], imu.gyro.white_ieee[i]);
+    EXPECT_NEAR(imu.gyro.white[i] / (sigma_g * std::sqrt(dt)), 1.0, 0.03) << i;
+    EXPECT_NEAR(imu.accel.white[i] / (sigma_a * std::sqrt(dt)), 1.0, 0.03) << i;
+    EXPECT_FALSE(imu.accel.walk_from_ieee[i]) << i;
   }
   // White noise has no random walk: the bound is small but the +1/2 slope is not there.
   EXPECT_FALSE(imu.accel.walk_resolved);
@@ -334,32 +341,102 @@ TEST(Kalibr, WhiteNoiseDensityMatchesTheAllanDeviationAtOneSecond) {
   EXPECT_NE(KalibrYaml(imu).find("upper bound"), std::string::npos);
 }
 
-TEST(Kalibr, ShortSegmentsFallBackToTheAutocorrelationTime) {
-  // 2 s of still data: too short for ADEV at 1 s; the low-frequency level is then
-  // sigma sqrt(tau dt), which the correlated output (tau = 4 samples) makes the larger.
-  const double dt = 0.005, sigma = 0.01, tau = 4.0;
+/// An accelerometer-only session of `samples` white samples (sigma) every dt, cut into still
+/// segments of `segment` samples, whose calibration states the noise sigma and the
+/// correlation time tau (samples).
+Session AccelOnly(std::size_t samples, std::size_t segment, double dt, double sigma, double tau) {
   std::mt19937_64 rng(11);
   std::normal_distribution<double> n(0.0, sigma);
   Session s;
   s.r.calibration.model = model::Model::Parse("base");
   s.r.calibration.model.DropGyro();
   s.r.calibration.theta = s.r.calibration.model.ZeroParameters();
-  for (int i = 0; i < 400; ++i) {
-    s.series.t_s.push_back(i * dt);
+  for (std::size_t i = 0; i < samples; ++i) {
+    s.series.t_s.push_back(static_cast<double>(i) * dt);
     s.series.acc.push_back(Vec3f(n(rng), n(rng), -kG + n(rng)));
   }
-  estimation::StillSegmentFit fit;
-  fit.segment.end = s.series.size();
-  s.r.fit.still.push_back(fit);
+  for (std::size_t begin = 0; begin + segment <= samples; begin += segment) {
+    estimation::StillSegmentFit fit;
+    fit.segment.begin = begin;
+    fit.segment.end = begin + segment;
+    s.r.fit.still.push_back(fit);
+  }
   s.r.calibration.noise.acc = Vec3::Constant(sigma);
   s.r.calibration.noise.tau_acc = tau;
+  return s;
+}
+
+TEST(Kalibr, ShortSegmentsFallBackToTheAutocorrelationTime) {
+  // Still segments of 6 samples (30 ms): too short for ADEV at 1 s and for the IEEE terms; the
+  // low-frequency level is then sigma sqrt(tau dt), which the stated correlation time
+  // (tau = 4 samples) makes the larger.
+  const double dt = 0.005, sigma = 0.01, tau = 4.0;
+  const Session s = AccelOnly(400, 6, dt, sigma, tau);
   const KalibrImu imu = KalibrNoise(s.r.calibration, s.series, s.r.fit.still, "/imu");
   EXPECT_FALSE(imu.accel.low_from_allan);
+  EXPECT_FALSE(imu.accel.white_from_ieee[0]);
   EXPECT_NEAR(imu.accelerometer_noise_density(), sigma * std::sqrt(tau * dt), 1e-15);
   EXPECT_FALSE(imu.has_gyro);
   const std::string yaml = KalibrYaml(imu);
   EXPECT_EQ(yaml.find("gyroscope"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("rostopic: /imu\n"), std::string::npos) << yaml;
+  EXPECT_EQ(yaml.find("N of the IEEE noise fit"), std::string::npos) << yaml;
+  const json j = ToJson(imu);
+  EXPECT_EQ(j["accel"]["noise_density_source"][0], "fallback");
+  bool said = false;
+  for (const auto& note : imu.notes) said = said || note.find("no IEEE noise terms") == 0;
+  EXPECT_TRUE(said);
+}
+
+TEST(Kalibr, NoiseDensityOfTheIeeeFitWhereItIsResolved) {
+  // 2 s of white still data: too short for ADEV at 1 s, long enough for the white noise's
+  // -1/2 slope: N is the IEEE fit's, sigma sqrt(dt), not the stated correlation's larger level.
+  const double dt = 0.005, sigma = 0.01, tau = 4.0;
+  const Session s = AccelOnly(400, 400, dt, sigma, tau);
+  const KalibrImu imu = KalibrNoise(s.r.calibration, s.series, s.r.fit.still, "/imu");
+  EXPECT_FALSE(imu.accel.low_from_allan);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_TRUE(imu.accel.white_from_ieee[i]) << i;
+    EXPECT_NEAR(imu.accel.white[i] / (sigma * std::sqrt(dt)), 1.0, 0.1) << i;
+  }
+  EXPECT_NE(KalibrYaml(imu).find("N of the IEEE noise fit"), std::string::npos);
+  const json j = ToJson(imu);
+  EXPECT_EQ(j["accel"]["noise_density_source"], json({"ieee_fit", "ieee_fit", "ieee_fit"}));
+}
+
+TEST(Kalibr, RandomWalkOfTheIeeeFitWhereItIsResolved) {
+  // Ten minutes of still data at 100 Hz with a bias random walk K on white noise N: the +1/2
+  // slope shows from sqrt(3) N / K = 6 s on, and K comes from the fit.
+  const double dt = 0.01, n_a = 1e-3, k_a = 3e-4;
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> e(0.0, 1.0);
+  Session s;
+  s.r.calibration.model = model::Model::Parse("base");
+  s.r.calibration.model.DropGyro();
+  s.r.calibration.theta = s.r.calibration.model.ZeroParameters();
+  Vec3 bias = Vec3::Zero();
+  for (int i = 0; i < 60000; ++i) {
+    for (int a = 0; a < 3; ++a) bias[a] += k_a * std::sqrt(dt) * e(rng);
+    const Vec3 white(e(rng), e(rng), e(rng));
+    s.series.t_s.push_back(i * dt);
+    s.series.acc.push_back((bias + n_a / std::sqrt(dt) * white + Vec3(0, 0, -kG)).cast<float>());
+  }
+  estimation::StillSegmentFit fit;
+  fit.segment.end = s.series.size();
+  s.r.fit.still.push_back(fit);
+  s.r.calibration.noise.acc = Vec3::Constant(n_a / std::sqrt(dt));
+  const KalibrImu imu = KalibrNoise(s.r.calibration, s.series, s.r.fit.still, "/imu0");
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(imu.accel.walk_from_ieee[i]) << i;
+    EXPECT_EQ(imu.accel.walk[i], imu.accel.walk_ieee[i]) << i;
+    // One realisation of ten minutes: K to about 10 % (one sigma), 0.61 on y here (its long
+    // clusters happen to sit low); the statistics are tested in tests/signal.
+    EXPECT_NEAR(imu.accel.walk[i] / k_a, 1.0, 0.5) << i;
+    EXPECT_NEAR(imu.accel.white[i] / n_a, 1.0, 0.03) << i;
+  }
+  EXPECT_TRUE(imu.accel.walk_resolved);
+  EXPECT_EQ(KalibrYaml(imu).find("upper bound"), std::string::npos);
+  EXPECT_EQ(ToJson(imu)["accel"]["random_walk_source"][2], "ieee_fit");
 }
 
 }  // namespace

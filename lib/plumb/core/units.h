@@ -19,8 +19,9 @@ inline constexpr double kDegPerRad = 180.0 / kPi;
 /// Standard gravity g0 (CGPM 1901, ISO 80000-3), m/s^2: the "g" of datasheets and of
 /// firmware units (mg, mG); not local gravity, which plumb takes from the site (geo::Site).
 inline constexpr double kStandardGravity = 9.80665;
-/// m/s^2 per milli-g.
+/// m/s^2 per milli-g and per micro-g.
 inline constexpr double kMilliG = kStandardGravity * 1e-3;
+inline constexpr double kMicroG = kStandardGravity * 1e-6;
 
 /// Earth's rotation rate relative to inertial space (WGS84 / GRS80 value), rad/s.
 inline constexpr double kEarthRate = 7.292115e-5;
@@ -28,5 +29,8 @@ inline constexpr double kEarthRate = 7.292115e-5;
 /// Seconds per hour, and deg/h per rad/s (the unit gyroscope biases are quoted in).
 inline constexpr double kSecondsPerHour = 3600.0;
 inline constexpr double kDegPerHourPerRadPerS = kDegPerRad * kSecondsPerHour;
+/// sqrt(s) per sqrt(h): a noise density per sqrt(s) times this is per sqrt(h) (deg/sqrt(h) of
+/// an angle random walk from deg/sqrt(s)).
+inline constexpr double kSqrtSecondsPerSqrtHour = 60.0;
 
 }  // namespace plumb::units

@@ -1,5 +1,6 @@
 #include "plumb/export/export.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -116,9 +117,22 @@ ExportOutput Kalibr(const estimation::Calibration& c, const ImuSeries& series,
     out.lines.push_back(buf);
   }
   auto detail = [&](const char* name, const SensorNoise& n) {
+    const auto count = [](const std::array<bool, 3>& a) { return a[0] + a[1] + a[2]; };
+    if (count(n.white_from_ieee) > 0) {
+      double largest = 0.0;  // over the axes the fit resolves (NaN elsewhere)
+      for (int i = 0; i < 3; ++i) {
+        if (n.white_from_ieee[i]) largest = std::max(largest, n.white_ieee[i]);
+      }
+      std::snprintf(buf, sizeof buf,
+                    "        %s: N of the IEEE fit to the still data's Allan deviation on %d of 3 "
+                    "axes (largest %.3g), K on %d of 3",
+                    name, count(n.white_from_ieee), largest, count(n.walk_from_ieee));
+      out.lines.push_back(buf);
+    }
+    if (count(n.white_from_ieee) == 3) return;
     std::snprintf(buf, sizeof buf,
                   "        %s: per-sample sigma sqrt(dt) %.3g, %s %.3g (largest axis; the "
-                  "larger is written)",
+                  "larger is written where the IEEE fit does not resolve N)",
                   name, n.white_sample.maxCoeff(),
                   n.low_from_allan ? "ADEV(1 s)" : "sigma sqrt(tau dt)", n.white_low.maxCoeff());
     out.lines.push_back(buf);
@@ -181,12 +195,21 @@ json ToJson(const ExportReport& rep) {
 }
 
 json ToJson(const KalibrImu& imu) {
-  auto sensor = [](const SensorNoise& n) {
+  auto source = [](const std::array<bool, 3>& ieee) {
+    json out = json::array();
+    for (bool b : ieee) out.push_back(b ? "ieee_fit" : "fallback");
+    return out;
+  };
+  auto sensor = [&](const SensorNoise& n) {
     return json{{"noise_density", Vec(n.white)},
+                {"noise_density_source", source(n.white_from_ieee)},
+                {"noise_density_ieee", Vec(n.white_ieee)},
                 {"noise_density_sample", Vec(n.white_sample)},
                 {"noise_density_low", Vec(n.white_low)},
                 {"low_from_allan", n.low_from_allan},
                 {"random_walk", Vec(n.walk)},
+                {"random_walk_source", source(n.walk_from_ieee)},
+                {"random_walk_ieee", Vec(n.walk_ieee)},
                 {"random_walk_resolved", n.walk_resolved}};
   };
   json out = {{"rostopic", imu.rostopic},

@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "plumb/core/error.h"
 #include "plumb/signal/allan.h"
 #include "plumb/signal/axis_view.h"
+#include "plumb/signal/noise_terms.h"
 
 namespace plumb::exporter {
 namespace {
@@ -27,7 +29,9 @@ const StillSegment* LongestStill(const std::vector<estimation::StillSegmentFit>&
 
 /// N from the whitening noise, ADEV(1 s) and the random-walk bound of one sensor.
 SensorNoise Measure(const ImuSeries& series, signal::Sensor sensor, const Vec3& sigma,
-                    double tau_samples, double dt_s, const StillSegment* seg) {
+                    double tau_samples, double dt_s, const StillSegment* seg,
+                    std::array<bool, 3>& slope_seen) {
+  slope_seen = {false, false, false};
   SensorNoise noise;
   noise.white_sample = sigma * std::sqrt(dt_s);
   noise.white_low = sigma * std::sqrt(std::max(1.0, tau_samples) * dt_s);
@@ -61,6 +65,7 @@ SensorNoise Measure(const ImuSeries& series, signal::Sensor sensor, const Vec3& 
       resolved = slope >= kRandomWalkSlope;
     }
     all_resolved = all_resolved && resolved;
+    slope_seen[axis] = resolved;
     const double seg_s = static_cast<double>(n) * dt_s;
     if (seg_s >= kMinSegmentForCheck_s) {
       const std::size_t m1 = static_cast<std::size_t>(std::lround(kAllanCheckTau_s / dt_s));
@@ -86,6 +91,44 @@ std::string Num(double value) {
   return buf;
 }
 
+/// Where the IEEE fit of the still data resolves N or K on an axis, it replaces the fallback.
+/// `slope_seen`: the fallback's own +1/2 test per axis.
+void UseIeeeTerms(const signal::StillNoise* noise, signal::Sensor sensor,
+                  const std::array<bool, 3>& slope_seen, SensorNoise& n) {
+  bool resolved = true;
+  for (int axis = 0; axis < 3; ++axis) {
+    const signal::AxisNoise* a = noise != nullptr ? noise->Find(sensor, axis) : nullptr;
+    if (a != nullptr && a->fit.term(signal::NoiseTermKind::kWhite).resolved) {
+      n.white_ieee[axis] = a->fit.term(signal::NoiseTermKind::kWhite).fitted;
+      n.white[axis] = n.white_ieee[axis];
+      n.white_from_ieee[axis] = true;
+    }
+    if (a != nullptr && a->fit.term(signal::NoiseTermKind::kRandomWalk).resolved) {
+      n.walk_ieee[axis] = a->fit.term(signal::NoiseTermKind::kRandomWalk).fitted;
+      n.walk[axis] = n.walk_ieee[axis];
+      n.walk_from_ieee[axis] = true;
+    }
+    resolved = resolved && (n.walk_from_ieee[axis] || slope_seen[axis]);
+  }
+  n.walk_resolved = resolved;
+}
+
+/// "x, y, z", "x", ... the axes where `which` is `value`; "none" when there is none.
+std::string Axes(const std::array<bool, 3>& which, bool value) {
+  std::string out;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (which[axis] == value) out += std::string(out.empty() ? "" : ", ") + "xyz"[axis];
+  }
+  return out.empty() ? "none" : out;
+}
+
+/// The note that says which axes' N and K came from the IEEE fit.
+std::string SourceNote(const char* sensor, const SensorNoise& n) {
+  return std::string(sensor) + ": N from the IEEE fit on " + Axes(n.white_from_ieee, true) +
+         " (fallback on " + Axes(n.white_from_ieee, false) + "), K from the IEEE fit on " +
+         Axes(n.walk_from_ieee, true) + " (fallback on " + Axes(n.walk_from_ieee, false) + ")";
+}
+
 }  // namespace
 
 KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
@@ -104,21 +147,44 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   imu.has_gyro = c.has_gyro && series.has_gyro();
   const StillSegment* seg = LongestStill(still, series.size());
   imu.longest_still_s = seg ? static_cast<double>(seg->count()) * dt_s : 0.0;
-  imu.accel = Measure(series, signal::Sensor::kAccel, c.noise.acc, c.noise.tau_acc, dt_s, seg);
+  std::array<bool, 3> accel_slope{}, gyro_slope{};
+  imu.accel = Measure(series, signal::Sensor::kAccel, c.noise.acc, c.noise.tau_acc, dt_s, seg,
+                      accel_slope);
   if (imu.has_gyro) {
-    imu.gyro = Measure(series, signal::Sensor::kGyro, c.noise.gyr, c.noise.tau_gyr, dt_s, seg);
+    imu.gyro = Measure(series, signal::Sensor::kGyro, c.noise.gyr, c.noise.tau_gyr, dt_s, seg,
+                       gyro_slope);
   }
   imu.notes.push_back("Kalibr's imu.yaml holds the noise model only: plumb's scale, "
                       "misalignment, biases and effects are not in it (Kalibr estimates its own "
                       "IMU intrinsics)");
+  // The IEEE terms of the still data (every still segment that does not turn, pooled).
+  std::vector<StillSegment> segments;
+  for (const auto& s : still) segments.push_back(s.segment);
+  std::optional<signal::StillNoise> ieee;
+  try {
+    if (seg) ieee = signal::AnalyseStillNoise(series, segments);
+  } catch (const InsufficientDataError& e) {
+    imu.notes.push_back(std::string("no IEEE noise terms: ") + e.what());
+  }
+  UseIeeeTerms(ieee ? &*ieee : nullptr, signal::Sensor::kAccel, accel_slope, imu.accel);
+  if (imu.has_gyro) {
+    UseIeeeTerms(ieee ? &*ieee : nullptr, signal::Sensor::kGyro, gyro_slope, imu.gyro);
+  }
+  if (ieee) {
+    imu.notes.push_back("IEEE noise terms fitted to the Allan deviation of " +
+                        Num(ieee->still_s) + " s of still data in " +
+                        std::to_string(ieee->segments.size()) + " segment(s) (plumb allan)");
+    imu.notes.push_back(SourceNote("accel", imu.accel));
+    if (imu.has_gyro) imu.notes.push_back(SourceNote("gyro", imu.gyro));
+  }
   const bool resolved = imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved);
   if (!seg) {
     imu.notes.push_back("no still segment: random walks unknown, written as 0");
     imu.accel.walk = imu.gyro.walk = Vec3::Zero();
   } else if (!resolved) {
-    imu.notes.push_back("random walks are upper bounds (min over t of ADEV(t) sqrt(3/t)): the "
-                        "longest still segment (" + Num(imu.longest_still_s) +
-                        " s) is too short to show the +1/2 slope");
+    imu.notes.push_back("random walks not resolved by the IEEE fit are upper bounds (min over t "
+                        "of ADEV(t) sqrt(3/t)): the longest still segment (" +
+                        Num(imu.longest_still_s) + " s) is too short to show the +1/2 slope");
   }
   return imu;
 }
@@ -131,13 +197,19 @@ std::string KalibrYaml(const KalibrImu& imu) {
   const std::string walk_comment = bound ? "  # upper bound from a short session" : "";
   text += "rostopic: " + imu.rostopic + "\n";
   text += "update_rate: " + Num(imu.update_rate_hz) + "  # Hz\n";
+  // Where the written (largest) value came from.
+  const auto origin = [](const Vec3& v, const std::array<bool, 3>& ieee) {
+    Eigen::Index axis = 0;
+    v.maxCoeff(&axis);
+    return std::string(ieee[axis] ? ", N of the IEEE noise fit" : "");
+  };
   text += "accelerometer_noise_density: " + Num(imu.accelerometer_noise_density()) +
-          "  # m/s^2/sqrt(Hz)\n";
+          "  # m/s^2/sqrt(Hz)" + origin(imu.accel.white, imu.accel.white_from_ieee) + "\n";
   text += "accelerometer_random_walk: " + Num(imu.accelerometer_random_walk()) +
           "  # m/s^3/sqrt(Hz)" + walk_comment + "\n";
   if (imu.has_gyro) {
     text += "gyroscope_noise_density: " + Num(imu.gyroscope_noise_density()) +
-            "  # rad/s/sqrt(Hz)\n";
+            "  # rad/s/sqrt(Hz)" + origin(imu.gyro.white, imu.gyro.white_from_ieee) + "\n";
     text += "gyroscope_random_walk: " + Num(imu.gyroscope_random_walk()) +
             "  # rad/s^2/sqrt(Hz)" + walk_comment + "\n";
   }

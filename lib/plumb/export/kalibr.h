@@ -9,9 +9,15 @@
 // It has no place for scale, misalignment, biases or any plumb effect: Kalibr estimates its
 // own IMU intrinsics (its scale-misalignment models) in the camera-IMU calibration.
 //
-// From the session:
-// - N, from two measurements, the larger written (an understated noise misleads a filter
-//   more than an overstated one):
+// From the session, per axis:
+// - N and K are the IEEE terms fitted to the overlapping Allan deviation of the still data
+//   (signal/noise_terms.h: every still segment that does not turn, pooled) where the fit
+//   resolves them. That needs a still record that shows each term's slope: N (-1/2) nearly
+//   always, K (+1/2) only in long still data (several minutes). Axes where a term is not
+//   resolved keep the fallback below, and the notes, the report lines and the JSON say which
+//   axis came from where.
+// - Fallback N, from two measurements, the larger written (an understated noise misleads a
+//   filter more than an overstated one):
 //   * the per-sample noise sigma (the still-segment scatter plumb whitened with):
 //     N_sample = sigma sqrt(dt), Kalibr's own conversion between its continuous density and
 //     the discrete per-sample sigma (sigma_d = N / sqrt(dt));
@@ -19,7 +25,7 @@
 //     (white noise: ADEV(t) = N / sqrt(t)) when that segment lasts at least 3 s, otherwise
 //     sigma sqrt(tau dt) with tau plumb's integrated autocorrelation time (samples): the
 //     density near zero frequency of a (possibly low-pass filtered) output.
-// - K: a random walk adds K^2 t / 3 to the Allan variance, so every cluster time t bounds
+// - Fallback K: a random walk adds K^2 t / 3 to the Allan variance, so every cluster time t bounds
 //   K <= ADEV(t) sqrt(3 / t); the smallest bound over t (up to a third of the longest still
 //   segment) is written. It is an estimate only when the Allan deviation rises with slope
 //   close to +1/2 at the longest times; otherwise (short still segments, the usual case) it is
@@ -27,6 +33,7 @@
 // Kalibr takes one value per sensor: the largest over the three axes.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -38,13 +45,22 @@
 namespace plumb::exporter {
 
 struct SensorNoise {
-  Vec3 white = Vec3::Zero();         ///< N per axis (the larger of the two below), unit/sqrt(Hz)
+  /// N per axis, unit/sqrt(Hz): white_ieee where white_from_ieee, else the larger of
+  /// white_sample and white_low.
+  Vec3 white = Vec3::Zero();
+  Vec3 white_ieee = Vec3::Constant(kNaN);  ///< N of the IEEE fit, NaN where not resolved
+  std::array<bool, 3> white_from_ieee{};   ///< the axis's N is the IEEE fit's
   Vec3 white_sample = Vec3::Zero();  ///< sigma sqrt(dt) per axis, unit/sqrt(Hz)
   /// Low-frequency level per axis: ADEV(1 s), or sigma sqrt(tau dt) when not measurable.
   Vec3 white_low = Vec3::Zero();
   bool low_from_allan = false;       ///< white_low is ADEV(1 s) (on every axis)
-  Vec3 walk = Vec3::Zero();         ///< K per axis (estimate or upper bound), unit/s/sqrt(Hz)
-  bool walk_resolved = false;       ///< true: the +1/2 slope was seen on every axis
+  /// K per axis, unit/s/sqrt(Hz): walk_ieee where walk_from_ieee, else the fallback (estimate
+  /// or upper bound).
+  Vec3 walk = Vec3::Zero();
+  Vec3 walk_ieee = Vec3::Constant(kNaN);  ///< K of the IEEE fit, NaN where not resolved
+  std::array<bool, 3> walk_from_ieee{};   ///< the axis's K is the IEEE fit's
+  /// true: every axis's K is resolved (the IEEE fit's, or the fallback's +1/2 slope seen)
+  bool walk_resolved = false;
 };
 
 struct KalibrImu {
@@ -61,10 +77,10 @@ struct KalibrImu {
   double gyroscope_random_walk() const { return gyro.walk.maxCoeff(); }
 };
 
-/// The noise of the session (file comment): the calibration's noise levels, checked with the
-/// Allan deviation of the longest of the session's still segments `still` that is not
-/// turning. Throws plumb::Error when the outputs are not in SI or the series has fewer than
-/// two samples.
+/// The noise of the session (file comment): the IEEE terms of the still segments `still`
+/// where resolved, otherwise the calibration's noise levels checked with the Allan deviation
+/// of the longest still segment that is not turning. Throws plumb::Error when the outputs are
+/// not in SI or the series has fewer than two samples.
 KalibrImu KalibrNoise(const estimation::Calibration& calibration, const ImuSeries& series,
                       const std::vector<estimation::StillSegmentFit>& still,
                       const std::string& rostopic);

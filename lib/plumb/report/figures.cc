@@ -273,7 +273,69 @@ void AllanFigure(const ImuSeries& series, const estimation::CalibrationResult& f
            ratios + "."});
 }
 
+/// One gnuplot data block per axis of `noise`, in its order: tau, adev, lower, upper, model
+/// (the model only over the fitted taus).
+std::string StillNoiseData(const signal::StillNoise& noise) {
+  std::ostringstream csv;
+  for (const signal::AxisNoise& a : noise.axes) {
+    csv << "# " << signal::SensorName(a.sensor) << " " << kAxisName[a.axis]
+        << ": tau_s,adev,lower,upper,model\n";
+    const signal::AllanDeviation& d = a.adev;
+    for (std::size_t j = 0; j < d.tau_s.size(); ++j) {
+      const bool fitted = j >= a.fit.first && j <= a.fit.last && !a.fit.misfit;
+      csv << Cell(d.tau_s[j]) << "," << Cell(d.adev[j]) << "," << Cell(d.adev_lower[j]) << ","
+          << Cell(d.adev_upper[j]) << ","
+          << (fitted ? Cell(std::sqrt(a.fit.Avar(d.tau_s[j]))) : std::string()) << "\n";
+    }
+    csv << "\n\n";
+  }
+  return csv.str();
+}
+
 }  // namespace
+
+void AddStillNoiseFigure(const signal::StillNoise& noise, const FigureOptions& o,
+                         FigurePlan& plan) {
+  if (o.width_px <= 0 || o.panel_height_px <= 0) throw Error("figures: the sizes must be > 0");
+  if (noise.axes.empty()) return;
+  plan.job.data.push_back({"noise.csv", StillNoiseData(noise)});
+  std::ostringstream gp;
+  int panels = 0;
+  for (signal::Sensor sensor : {signal::Sensor::kAccel, signal::Sensor::kGyro}) {
+    std::string clauses;
+    for (std::size_t i = 0; i < noise.axes.size(); ++i) {
+      const signal::AxisNoise& a = noise.axes[i];
+      if (a.sensor != sensor) continue;
+      const std::string colour = kAxisColour[a.axis];
+      const std::string index = " index " + std::to_string(i);
+      clauses += std::string(clauses.empty() ? "'noise.csv'" : ", ''") + index +
+                 " using 1:2:3:4 with yerrorbars pt 7 ps 0.5 lc rgb '" + colour + "' title '" +
+                 kAxisName[a.axis] + "', ''" + index + " using 1:5 with lines lw 2 lc rgb '" +
+                 colour + "' title '" + kAxisName[a.axis] + " model'";
+    }
+    if (clauses.empty()) continue;
+    ++panels;
+    const bool accel = sensor == signal::Sensor::kAccel;
+    gp << "set ylabel "
+       << GnuplotQuote(std::string(accel ? "accel" : "gyro") + " ADEV (" +
+                       (accel ? noise.acc_unit : noise.gyr_unit) + ")")
+       << "\nplot " << clauses << "\n";
+  }
+  plan.job.script += Begin(o, "noise.png", panels) +
+                     "set logscale xy\nset format y '%g'\nset xlabel 'cluster time tau (s)'\n" +
+                     gp.str() + End() + "unset logscale\nset format y\n";
+  plan.job.outputs.push_back("noise.png");
+  const double confidence = noise.axes.front().adev.confidence;
+  plan.figures.push_back(
+      {"noise.png", "Allan deviation of the still data and the IEEE noise model",
+       "Overlapping Allan deviation of the raw samples over " + Fixed(noise.still_s, "%.4g") +
+           " s of still data in " + std::to_string(noise.segments.size()) +
+           " segment(s), per axis (points, with " + Fixed(100.0 * confidence, "%.3g") +
+           " % chi-square intervals for the noise type the fit finds at each tau), and the "
+           "fitted model 3Q^2/tau^2 + N^2/tau + 0.44 B^2 + K^2 tau/3 (line, over the fitted "
+           "taus). Slopes -1, -1/2, 0, +1/2: quantisation, white noise, bias instability, "
+           "random walk. The terms are in the 'Sensor noise' table."});
+}
 
 FigurePlan PlanFigures(const ImuSeries& series, const std::vector<StillSegment>& segments,
                        const estimation::CalibrationResult& fit,

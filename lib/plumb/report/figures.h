@@ -12,6 +12,10 @@
 //   allan.png        (only when the analysis has an Allan deviation) the residual's Allan
 //                    deviation per axis against the white-noise line sigma_white / sqrt(m),
 //                    log-log, series' units against cluster time in s
+//   noise.png        (AddStillNoiseFigure) the Allan deviation of the still data per axis with
+//                    its confidence intervals as error bars, and the fitted IEEE noise model
+//                    (signal/noise_terms.h) as a line over the fitted taus; one panel per
+//                    sensor, log-log
 // Times in every figure are seconds since the first sample of the series (log times may be
 // Unix times). Data files are CSV with a '#' header line; non-finite values are left empty
 // (gnuplot skips them).
@@ -26,6 +30,7 @@
 #include "plumb/diagnostics/residual_analysis.h"
 #include "plumb/estimation/result.h"
 #include "plumb/report/gnuplot.h"
+#include "plumb/signal/noise_terms.h"
 
 namespace plumb::report {
 
@@ -56,5 +61,11 @@ FigurePlan PlanFigures(const ImuSeries& series, const std::vector<StillSegment>&
                        const estimation::CalibrationResult& fit,
                        const diagnostics::ResidualAnalysis& analysis,
                        const FigureOptions& options = {});
+
+/// Adds noise.png and its data noise.csv (one gnuplot data block per axis: tau_s, adev,
+/// lower, upper, model) to `plan`: the still data's noise as `plumb allan` measures it. Throws
+/// plumb::Error for options out of range.
+void AddStillNoiseFigure(const signal::StillNoise& noise, const FigureOptions& options,
+                         FigurePlan& plan);
 
 }  // namespace plumb::report

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "plumb/report/noise_text.h"
 #include "plumb/report/summary.h"
 #include "plumb/report/version.h"
 #include "plumb/signal/chi_square.h"
@@ -217,6 +218,69 @@ std::string FitSection(const estimation::CalibrationResult& r) {
            VecCells(r.calibration.noise.gyr) + "</tr>\n";
   }
   return out + "</table>\n";
+}
+
+/// One cell of the noise table: value (with "<" for a bound), datasheet value, tau range.
+std::string NoiseCell(const signal::NoiseTerm& t, const NoiseTermLabel& label) {
+  const std::string mark = t.resolved ? "" : "&lt; ";
+  std::string cell = mark + G3(t.value());
+  if (!label.datasheet_unit.empty()) {
+    cell += "<br><span class=\"muted\">" + mark + G3(t.value() * label.datasheet_scale) + " " +
+            HtmlEscape(label.datasheet_unit) + "</span>";
+  }
+  const std::string tau = t.resolved && t.tau_min_s != t.tau_max_s
+                              ? G3(t.tau_min_s) + "&ndash;" + G3(t.tau_max_s)
+                              : G3(t.tau_min_s);
+  return TdNum(cell + "<br><span class=\"muted\">tau " + tau + " s</span>");
+}
+
+std::string NoiseSection(const PageExtras& extras) {
+  std::string out = "<h2 id=\"noise\">Sensor noise</h2>\n";
+  if (!extras.still_noise) {
+    return out + "<p class=\"muted\">Not measured" +
+           (extras.still_noise_note.empty() ? std::string(".")
+                                            : ": " + HtmlEscape(extras.still_noise_note)) +
+           "</p>\n";
+  }
+  const signal::StillNoise& n = *extras.still_noise;
+  out += "<p>IEEE Std 952 noise terms fitted to the overlapping Allan deviation of " +
+         G3(n.still_s) + " s of still data (" + std::to_string(n.segments.size()) +
+         " still segment(s) pooled, the longest " + G3(n.longest_s) +
+         " s), as <code>plumb allan</code> measures them: weighted least squares with "
+         "non-negative coefficients. &lt; marks an upper bound (at " +
+         G2(100.0 * n.options.terms.term_confidence) +
+         " %): the data does not resolve that term. Each cell: the value in the unit of the "
+         "row, the datasheet unit, and the cluster times it was read from. The points, their "
+         "intervals and the fit are in <code>allan.json</code>.</p>\n";
+  for (signal::Sensor sensor : {signal::Sensor::kAccel, signal::Sensor::kGyro}) {
+    if (n.Find(sensor, 0) == nullptr) continue;
+    const std::string unit = sensor == signal::Sensor::kAccel ? n.acc_unit : n.gyr_unit;
+    out += "<h3>" + HtmlEscape(signal::SensorName(sensor)) + "</h3>\n<table>\n" +
+           HeaderRow({"term", "unit", "x", "y", "z"});
+    for (int k = 0; k < signal::kNoiseTermCount; ++k) {
+      const auto kind = static_cast<signal::NoiseTermKind>(k);
+      const NoiseTermLabel label = LabelNoiseTerm(sensor, kind, unit);
+      out += "<tr>" + Td(HtmlEscape(std::string(signal::NoiseTermSymbol(kind)) + " " +
+                                    label.name)) +
+             Td(HtmlEscape(label.unit));
+      for (int axis = 0; axis < 3; ++axis) {
+        const signal::AxisNoise* a = n.Find(sensor, axis);
+        out += a != nullptr ? NoiseCell(a->fit.term(kind), label) : TdNum("&ndash;");
+      }
+      out += "</tr>\n";
+    }
+    out += "</table>\n";
+  }
+  for (const signal::AxisNoise& a : n.axes) {
+    if (!a.fit.misfit) continue;
+    out += "<p class=\"warn\">" + HtmlEscape(std::string(signal::SensorName(a.sensor)) + " " +
+                                              "xyz"[a.axis] + ": " + MisfitWords(a, n)) +
+           "</p>\n";
+  }
+  for (const std::string& note : n.notes) {
+    out += "<p class=\"muted\">" + HtmlEscape(note) + "</p>\n";
+  }
+  return out;
 }
 
 std::string FigureSection(const PageExtras& extras) {
@@ -489,6 +553,7 @@ std::string HtmlReport(const InputSummary& input,
   page += InputSection(input, segmentation, result, extras);
   page += ModelSection(result);
   page += FitSection(result);
+  page += NoiseSection(extras);
   page += FigureSection(extras);
   page += ParameterSection(result);
   page += MatrixSection(result);

@@ -5,7 +5,8 @@
 // Sections, in order: summary (the verdict on chi^2/dof, unobservable directions, the best
 // candidate), input (source, samples, rate, duration, site and where it came from, still
 // segments, reader warnings), model (spec, terms), fit quality (chi^2, dof, chi^2/dof with
-// the 99 % band of a complete model, per-axis RMS, noise), figures, parameters (value +- sigma
+// the 99 % band of a complete model, per-axis RMS, noise), sensor noise (the IEEE terms of the
+// still data per axis, noise_text.h, when PageExtras has them), figures, parameters (value +- sigma
 // with units, or "unobservable"/"fixed"), forward model and correction matrices,
 // observability (unobservable directions in words, determined combinations), missing effects
 // (diagnose's ranking), worst residual ranges and residual signatures, warnings, files, and
@@ -20,6 +21,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -29,6 +31,7 @@
 #include "plumb/estimation/result.h"
 #include "plumb/report/figures.h"
 #include "plumb/segmentation/still_detector.h"
+#include "plumb/signal/noise_terms.h"
 
 namespace plumb::report {
 
@@ -54,6 +57,9 @@ struct PageExtras {
   std::string command;                      ///< the command line that reproduces the page
   std::vector<std::string> files;           ///< other files written beside the page
   std::string segments_source;              ///< --segments FILE, or "" when detected
+  /// The still data's noise (plumb allan's analysis of the fit's still segments), if measured.
+  std::optional<signal::StillNoise> still_noise;
+  std::string still_noise_note;  ///< why it is missing, when it is
 };
 
 /// Escapes & < > " ' for HTML text and attribute values; invalid UTF-8 passes unchanged.

@@ -1,6 +1,7 @@
 #include "plumb/signal/chi_square.h"
 
 #include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <string>
 
@@ -59,6 +60,17 @@ double ChiSquareQuantile(double p, double dof) {
   const double h = 2.0 / (9.0 * dof);
   const double cube_root = std::max(0.0, 1.0 - h + z * std::sqrt(h));
   return dof * cube_root * cube_root * cube_root;
+}
+
+double ChiSquareQuantileExact(double p, double dof) {
+  if (!(dof > 0.0) || !std::isfinite(dof)) {
+    throw Error("chi-square quantile: degrees of freedom " + std::to_string(dof) +
+                " must be positive and finite");
+  }
+  if (!(p > 0.0 && p < 1.0)) {
+    throw Error("chi-square quantile: probability " + std::to_string(p) + " is not in (0, 1)");
+  }
+  return boost::math::quantile(boost::math::chi_squared_distribution<double>(dof), p);
 }
 
 }  // namespace plumb::signal

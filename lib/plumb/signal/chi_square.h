@@ -1,4 +1,9 @@
-// plumb/signal/chi_square.h — quantiles for detection thresholds.
+// plumb/signal/chi_square.h — quantiles for detection thresholds and confidence intervals.
+//
+// Two chi-square quantiles: ChiSquareQuantile, the Wilson-Hilferty approximation the still
+// detector's thresholds and the report's chi^2/dof band were made with (kept so that their
+// numbers stay as they are), and ChiSquareQuantileExact (Boost.Math), for confidence intervals
+// that must hold at small degrees of freedom (the Allan deviation's, signal/allan.h).
 #pragma once
 
 namespace plumb::signal {
@@ -15,5 +20,11 @@ double NormalQuantile(double p);
 /// under 0.2% for dof >= 100. Throws plumb::Error when p
 /// is not in (0, 1) or dof <= 0.
 double ChiSquareQuantile(double p, double dof);
+
+/// The exact quantile of the chi-square distribution with `dof` degrees of freedom (dof > 0,
+/// need not be an integer): x with P(X <= x) = p, from Boost.Math's chi_squared distribution
+/// (the inverse of the regularised incomplete gamma function, to double precision). Throws
+/// plumb::Error when p is not in (0, 1) or dof is not positive and finite.
+double ChiSquareQuantileExact(double p, double dof);
 
 }  // namespace plumb::signal
