@@ -164,18 +164,16 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
 }
 
 void CalibrationProblem::SetMotionWeightsFromSolution() {
-  const std::vector<const double*> blocks = BlockPointers();
+  const std::vector<const double*> blocks = ModelBlocks();
   const auto linear = model_.Predict(blocks.data(), model::SensorInput<double>());
   SetMotionWeights(linear.E, linear.F);
 }
 
-std::vector<const double*> CalibrationProblem::BlockPointers() const {
+std::vector<const double*> CalibrationProblem::ModelBlocks() const {
   std::vector<const double*> out;
   for (int t = 0; t < model_.num_terms(); ++t) out.push_back(block(t));
   return out;
 }
-
-std::vector<const double*> CalibrationProblem::ModelBlocks() const { return BlockPointers(); }
 
 model::ParameterBlocks CalibrationProblem::theta() const {
   model::ParameterBlocks out;

@@ -107,7 +107,8 @@ class CalibrationProblem {
   const StillSet& still() const { return still_; }
   /// The current model parameter blocks (a copy), one per term.
   model::ParameterBlocks theta() const;
-  /// Where Ceres keeps each term's block (for ceres::Covariance on a built problem).
+  /// Where Ceres keeps each term's block, in term order (for model::Model::Predict and
+  /// ceres::Covariance on a built problem).
   std::vector<const double*> ModelBlocks() const;
   /// The current attitude R_n_b of pose k.
   Quat R_n_b(std::size_t k) const;
@@ -144,8 +145,6 @@ class CalibrationProblem {
   void AddWalkFactors(BuiltProblem& built, model::Sensor sensor, const Vec3& K);
   double* q(std::size_t k) { return values_.data() + q_offset_ + 4 * k; }
   const double* q(std::size_t k) const { return values_.data() + q_offset_ + 4 * k; }
-  /// Pointers to every term's block, for model::Model::Predict.
-  std::vector<const double*> BlockPointers() const;
 
   const ImuSeries& series_;
   model::Model model_;

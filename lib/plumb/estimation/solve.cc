@@ -24,7 +24,8 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 
 ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
                                 const CalibrationOptions& options, UnknownColumns& columns,
-                                double* cost, std::vector<double>* residuals) {
+                                double* cost, std::vector<double>* residuals,
+                                Eigen::MatrixXd* jacobian) {
   columns = calibration.Columns(problem);
   ObservabilityInput in;
   in.J = calibration.Jacobian(problem, columns, cost, residuals);
@@ -32,7 +33,9 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   in.values = columns.values;
   in.is_model = columns.is_model;
   in.rank_tolerance = options.rank_tolerance;
-  return AnalyseObservability(in);
+  ObservabilityAnalysis out = AnalyseObservability(in);
+  if (jacobian != nullptr) *jacobian = std::move(in.J);
+  return out;
 }
 
 Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOptions& options,

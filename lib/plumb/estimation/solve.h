@@ -37,10 +37,11 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 
 /// The observability analysis (observability.h) of `problem` at the current values: its free
 /// unknowns go to `columns`, the cost and whitened residuals (optional) to `cost` and
-/// `residuals`.
+/// `residuals`, and the whitened Jacobian it analysed to `jacobian` (optional).
 ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
                                 const CalibrationOptions& options, UnknownColumns& columns,
-                                double* cost, std::vector<double>* residuals);
+                                double* cost, std::vector<double>* residuals,
+                                Eigen::MatrixXd* jacobian = nullptr);
 
 /// The solved problem.
 struct Solution {

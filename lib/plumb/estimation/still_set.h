@@ -24,7 +24,8 @@ namespace plumb::estimation {
 struct StillPose {
   StillSegment segment;
   signal::SegmentStats stats;
-  /// The attitude unknown R_n_b, stored as Ceres and Eigen's coefficients() do: x, y, z, w.
+  /// The starting attitude R_n_b (Initialize), stored as Ceres and Eigen's coefficients() do:
+  /// x, y, z, w. CalibrationProblem keeps the current value (CalibrationProblem::R_n_b).
   std::array<double, 4> q{0, 0, 0, 1};
   bool known = false;         ///< attitude held constant
   bool heading_only = false;  ///< tilt known, heading estimated (residuals::HeadingManifold)

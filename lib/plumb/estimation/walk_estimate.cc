@@ -28,11 +28,11 @@ GroupStats WalkGroups(CalibrationProblem& problem, BuiltProblem& built,
   UnknownColumns columns;
   std::vector<double> r;
   double cost = 0;
+  Eigen::MatrixXd J;
   const ObservabilityAnalysis analysis =
-      AnalyseAt(problem, *built.problem, options, columns, &cost, &r);
+      AnalyseAt(problem, *built.problem, options, columns, &cost, &r, &J);
   // Rows of the walk factors: the last 3 * built.walk.size() rows (added last), the
   // accelerometer's first.
-  const Eigen::MatrixXd J = problem.Jacobian(*built.problem, columns, nullptr, nullptr);
   const auto rows = static_cast<Eigen::Index>(r.size());
   const auto walk_rows = static_cast<Eigen::Index>(3 * built.walk.size());
   GroupStats g;

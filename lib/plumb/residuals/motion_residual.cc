@@ -40,6 +40,10 @@ MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
   if (walk_) {
     mutable_parameter_block_sizes()->push_back(3);
     mutable_parameter_block_sizes()->push_back(3);
+    const double span = s_.dt_s.back() - s_.dt_s.front();
+    for (std::size_t i = 0; i < s_.size(); ++i) {
+      walk_weight_.push_back(span > 0 ? (s_.dt_s[i] - s_.dt_s.front()) / span : 0.0);
+    }
   }
 }
 
@@ -134,15 +138,12 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
 
   // The outputs with the bias walk taken off (the samples themselves without a walk).
   std::vector<Vec3> walked;
-  std::vector<double> a;  // per sample: the weight of b_to
+  const std::vector<double>& a = walk_weight_;
   if (walk_) {
     const Eigen::Map<const Vec3> b_from(parameters[2 + model_->num_terms()]);
     const Eigen::Map<const Vec3> b_to(parameters[3 + model_->num_terms()]);
-    const double span = s_.dt_s.back() - s_.dt_s.front();
     walked.resize(s_.size());
-    a.resize(s_.size());
     for (std::size_t i = 0; i < s_.size(); ++i) {
-      a[i] = span > 0 ? (s_.dt_s[i] - s_.dt_s.front()) / span : 0.0;
       walked[i] = s_.gyr[i] - ((1.0 - a[i]) * b_from + a[i] * b_to);
     }
   }

@@ -75,6 +75,7 @@ class MotionResidual final : public ceres::CostFunction {
   std::vector<int> block_offset_;  // offset of each model block in the P parameters
   bool walk_ = false;              // the gyroscope bias walk's two blocks follow the model's
   int bias_offset_ = -1;           // offset of b_g among the P parameters (-1: no gyroscope)
+  std::vector<double> walk_weight_;  // per sample, with a walk: a_i, the weight of b_to
 };
 
 /// d(Exp(delta) (x) q)/d(delta) at delta = 0 for q in Eigen order (x y z w): 4 x 3.
