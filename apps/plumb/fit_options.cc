@@ -1,6 +1,7 @@
 // See fit_options.h.
 #include "fit_options.h"
 
+#include <cmath>
 #include <iostream>
 #include <optional>
 
@@ -16,6 +17,21 @@ void AddModelOption(CLI::App* app, FitArgs& a) {
                   "(see 'plumb effects')")
       ->capture_default_str();
 }
+
+namespace {
+
+/// A finite number >= 0 (CLI::NonNegativeNumber lets NaN through).
+const CLI::Validator kFiniteNonNegative(
+    [](std::string& text) -> std::string {
+      double v = 0;
+      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0) {
+        return "must be a finite number >= 0 (got '" + text + "')";
+      }
+      return {};
+    },
+    "FINITE >= 0");
+
+}  // namespace
 
 void AddFitOptions(CLI::App* app, FitArgs& a) {
   app->add_flag("--strict", a.strict,
@@ -42,11 +58,11 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
                   "Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor units/s/sqrt(Hz) for "
                   "unscaled samples): the bias walks over the session and every still pose "
                   "gets bias-walk states tied by random-walk factors; 0 = constant bias")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kFiniteNonNegative);
   app->add_option("--gyro-rw", a.gyro_walk_density,
                   "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor "
                   "units/s/sqrt(Hz) for unscaled samples); 0 = constant bias")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kFiniteNonNegative);
   app->add_flag("--estimate-rw", a.estimate_walk,
                 "Estimate the bias random walks not given by --accel-rw/--gyro-rw from the "
                 "session itself (variance components over the walk factors; needs 6 or more "

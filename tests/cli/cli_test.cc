@@ -158,6 +158,20 @@ TEST(Cli, CalibrateJsonIsBitForBitWhateverTheHeapLayout) {
   EXPECT_EQ(testing::ReadAll(dir.File("a.json")), testing::ReadAll(dir.File("b.json")));
 }
 
+TEST(Cli, BiasWalkDensityMustBeFiniteAndNonNegative) {
+  TempDir dir;
+  const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
+  for (const char* value : {"nan", "inf", "-1"}) {
+    const ToolRun run = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate",
+                               "100", "--accel-rw", value}, dir);
+    EXPECT_EQ(run.exit_code, 2) << value;
+    EXPECT_NE(run.err.find(std::string("--accel-rw: must be a finite number >= 0 (got '") +
+                           value + "')"),
+              std::string::npos)
+        << run.err;
+  }
+}
+
 TEST(Cli, HelpListsTheSubcommands) {
   TempDir dir;
   const ToolRun run = Plumb({"--help"}, dir);

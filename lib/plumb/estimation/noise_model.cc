@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "plumb/core/error.h"
 #include "plumb/signal/correlation_time.h"
 
 namespace plumb::estimation {
@@ -33,6 +34,12 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
     if (has_gyro) {
       noise.sigma_gyr[i] = std::max(std::sqrt(gyr[axis].variance), options.min_sigma_gyr);
       noise.tau_gyr[i] = std::max(1.0, gyr[axis].tau_int);
+    }
+  }
+  for (const auto& density : {options.accel_walk_density, options.gyro_walk_density}) {
+    if (density && !(std::isfinite(*density) && *density >= 0)) {
+      throw Error("a bias random-walk density must be finite and >= 0 (got " +
+                  std::to_string(*density) + ")");
     }
   }
   if (options.accel_walk_density) noise.walk_acc = Vec3::Constant(*options.accel_walk_density);
