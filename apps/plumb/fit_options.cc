@@ -54,19 +54,34 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
                   "(the gate not_converged)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  // The bias wander (estimation/noise_model.h): with any of these options the bias wanders
+  // in the fit, and the levels not given are estimated (the walk) or typical.
+  const char* kWander = " Any wander option makes the bias wander in the fit; the levels not "
+                        "given are then estimated (walk) or typical MEMS (instability)";
   app->add_option("--accel-rw", a.accel_walk_density,
-                  "Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor units/s/sqrt(Hz) for "
-                  "unscaled samples): the bias walks over the session and every still pose "
-                  "gets bias-walk states tied by random-walk factors; 0 = constant bias")
+                  std::string("Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor "
+                              "units/s/sqrt(Hz) for unscaled samples); 0 = none.") + kWander)
       ->check(kFiniteNonNegative);
   app->add_option("--gyro-rw", a.gyro_walk_density,
                   "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor "
-                  "units/s/sqrt(Hz) for unscaled samples); 0 = constant bias")
+                  "units/s/sqrt(Hz) for unscaled samples); 0 = none")
       ->check(kFiniteNonNegative);
   app->add_flag("--estimate-rw", a.estimate_walk,
-                "Estimate the bias random walks not given by --accel-rw/--gyro-rw from the "
-                "session itself (variance components over the walk factors; needs 6 or more "
-                "still poses)");
+                "Estimate the bias random walks not given from the session itself (variance "
+                "components over the walk factors; 6 or more still poses, else the typical MEMS "
+                "walk)");
+  app->add_option("--accel-bi", a.accel_instability,
+                  "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 "
+                  "(sensor units for unscaled samples); 0 = none; typical MEMS 4e-4")
+      ->check(kFiniteNonNegative);
+  app->add_option("--gyro-bi", a.gyro_instability,
+                  "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s "
+                  "(sensor units for unscaled samples); 0 = none; typical MEMS 2e-5")
+      ->check(kFiniteNonNegative);
+  app->add_option("--bi-time", a.instability_time_s,
+                  "Correlation time of the bias instability, s")
+      ->check(CLI::Range(1e-3, 1e9))
+      ->capture_default_str();
 }
 
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
@@ -93,6 +108,9 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
   out.options.accel_walk_density = fit.accel_walk_density;
   out.options.gyro_walk_density = fit.gyro_walk_density;
   out.options.estimate_walk = fit.estimate_walk;
+  out.options.accel_instability = fit.accel_instability;
+  out.options.gyro_instability = fit.gyro_instability;
+  out.options.instability_time_s = fit.instability_time_s;
   return out;
 }
 

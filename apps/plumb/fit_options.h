@@ -32,7 +32,12 @@ struct FitArgs {
   /// --accel-rw / --gyro-rw: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0.
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
-  bool estimate_walk = false;  ///< --estimate-rw: estimate the walks not given from the data
+  bool estimate_walk = false;  ///< --estimate-rw
+  /// --accel-bi / --gyro-bi: bias instability (Gauss-Markov sigma), sensor units, >= 0;
+  /// --bi-time: its correlation time, s.
+  std::optional<double> accel_instability;
+  std::optional<double> gyro_instability;
+  double instability_time_s = typical_mems::kInstabilityTime_s;
 };
 
 /// The exit code of a failed gate under --strict (SPEC section 8).
@@ -41,8 +46,8 @@ inline constexpr int kExitGateFailed = 3;
 /// Registers --model on `app`.
 void AddModelOption(CLI::App* app, FitArgs& args);
 
-/// Registers --strict, --heading, --level-north, --temp-ref, --max-iterations, --accel-rw,
-/// --gyro-rw and --estimate-rw on `app`.
+/// Registers --strict, --heading, --level-north, --temp-ref, --max-iterations, the bias
+/// wander (--accel-rw, --gyro-rw, --estimate-rw, --accel-bi, --gyro-bi, --bi-time) on `app`.
 void AddFitOptions(CLI::App* app, FitArgs& args);
 
 /// Everything Calibrate() takes besides the samples.

@@ -36,7 +36,7 @@ struct SimulateArgs {
   std::vector<std::string> truth;  ///< PARAM=VALUE settings of the true parameters
   double random_truth = 0.0;       ///< scale of random true parameters (x typical), >= 0
   sim::SimulationOptions noise = sim::SimulationOptions::TypicalMems();
-  std::string temperature = "const:25";  ///< temperature profile
+  std::string temperature = "ramp:25:35";  ///< temperature profile (the board warming up)
   bool no_temperature = false;           ///< leave the temp_c column out
   double temp_ref_c = 25.0;              ///< reference temperature of the true model, degC
   double t0_s = 0.0;                     ///< time of the first sample, s
@@ -115,7 +115,10 @@ nlohmann::json TruthJson(const sim::Simulation& s, const SimulateArgs& a) {
         {"accel_noise_density", a.noise.accel_noise_density},
         {"gyro_noise_density", a.noise.gyro_noise_density},
         {"accel_rw_density", a.noise.accel_bias_walk_density},
-        {"gyro_rw_density", a.noise.gyro_bias_walk_density}}},
+        {"gyro_rw_density", a.noise.gyro_bias_walk_density},
+        {"accel_bias_instability", a.noise.accel_bias_instability},
+        {"gyro_bias_instability", a.noise.gyro_bias_instability},
+        {"bias_instability_time_s", a.noise.bias_instability_time_s}}},
       {"schedule", a.schedule},
       {"rate_hz", s.rate_hz},
       {"t0_s", s.t0_s},
@@ -195,6 +198,21 @@ class SimulateCommand : public Command {
         ->add_option("--gyro-rw", a.noise.gyro_bias_walk_density,
                      "Gyroscope bias random-walk density, rad/s^2/sqrt(Hz)")
         ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--accel-bi", a.noise.accel_bias_instability,
+                     "Accelerometer bias instability: Gauss-Markov sigma, m/s^2")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--gyro-bi", a.noise.gyro_bias_instability,
+                     "Gyroscope bias instability: Gauss-Markov sigma, rad/s")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    noise
+        ->add_option("--bi-time", a.noise.bias_instability_time_s,
+                     "Correlation time of the bias instability, s")
+        ->check(CLI::PositiveNumber)
         ->capture_default_str();
     noise
         ->add_option("--quantisation-acc", a.noise.accel_quantum,

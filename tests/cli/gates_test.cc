@@ -37,7 +37,8 @@ std::string Simulate(const TempDir& dir, const std::vector<std::string>& extra =
   const std::string csv = dir.File("session.csv");
   std::vector<std::string> args = {"simulate", "--out", csv, "--poses", "12", "--still", "4",
                                    "--turn", "1.5", "--rate", "100", "--accel-rw", "0",
-                                   "--gyro-rw", "0", "--no-temperature", "--seed", "1"};
+                                   "--gyro-rw", "0", "--accel-bi", "0", "--gyro-bi", "0",
+                                   "--no-temperature", "--seed", "1"};
   args.insert(args.end(), kSite.begin(), kSite.end());
   args.insert(args.end(), extra.begin(), extra.end());
   const ToolRun run = Plumb(args, dir);

@@ -99,10 +99,8 @@ Session Simulate(const SessionSpec& spec) {
   const sim::Schedule schedule = sim::MultiPose(spec.poses, spec.still_s, spec.turn_s, spec.seed);
   std::string model_spec = "base";
   for (const auto& h : spec.hidden) model_spec += "+" + h.effect;
-  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  sim::SimulationOptions opt = sim::SimulationOptions::WhiteMems();
   opt.rate_hz = kRateHz;
-  opt.accel_bias_walk_density = 0.0;  // not modelled by the backend yet
-  opt.gyro_bias_walk_density = 0.0;
   opt.model = model::Model::Parse(model_spec);
   // The base at typical random values, the hidden effects at their stated sizes.
   opt.truth = sim::RandomParameters(opt.model, 1.0, spec.seed);

@@ -37,10 +37,8 @@ struct Truth {
 };
 
 Scenario SimulateAndFit(const Truth& setup, const sim::Schedule& schedule) {
-  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  sim::SimulationOptions opt = sim::SimulationOptions::WhiteMems();
   opt.rate_hz = setup.rate_hz;
-  opt.accel_bias_walk_density = 0.0;
-  opt.gyro_bias_walk_density = 0.0;
   opt.model = model::Model::Parse(setup.effect.empty() ? "base" : "base+" + setup.effect);
   opt.truth = sim::RandomParameters(opt.model, 1.0, setup.seed);
   for (int t = 0; t < opt.model.num_terms(); ++t) {

@@ -96,10 +96,8 @@ TEST(Gates, ARunAtTheExtremeOutsideTheStillSegmentsIsSaturation) {
 
 /// A multi-pose session as calibrate_sim_test.cc makes it.
 sim::Simulation MultiPose(std::uint64_t seed, int poses = 12, double still_s = 6.0) {
-  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  sim::SimulationOptions opt = sim::SimulationOptions::WhiteMems();
   opt.rate_hz = 100.0;
-  opt.accel_bias_walk_density = 0.0;
-  opt.gyro_bias_walk_density = 0.0;
   opt.model = model::Model::Parse("base");
   opt.truth = sim::RandomParameters(opt.model, 1.0, seed);
   opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");

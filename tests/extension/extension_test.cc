@@ -130,10 +130,8 @@ estimation::CalibrationResult Fit(const sim::Simulation& s, const std::string& s
 const Demonstration& WarmingSession() {
   static const Demonstration demo = [] {
     constexpr std::uint64_t kSeed = 4242;
-    sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+    sim::SimulationOptions opt = sim::SimulationOptions::WhiteMems();
     opt.rate_hz = 100.0;
-    opt.accel_bias_walk_density = 0.0;
-    opt.gyro_bias_walk_density = 0.0;
     opt.model = model::Model::Parse(kSpec);
     opt.truth = sim::RandomParameters(opt.model, 1.0, kSeed);
     for (int i = 0; i < 3; ++i) {

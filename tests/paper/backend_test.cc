@@ -32,9 +32,7 @@ const estimation::ParameterEstimate& Find(const estimation::CalibrationResult& r
 // no bias random walk: the backend's whitening does not model the walk yet (a known
 // limitation, docs/tutorial.md), and this test is about the configuration.
 sim::Simulation SimulateBenchmark(model::ParameterBlocks& truth, model::Model& model) {
-  sim::SimulationOptions o = sim::SimulationOptions::TypicalMems();
-  o.accel_bias_walk_density = 0.0;
-  o.gyro_bias_walk_density = 0.0;
+  sim::SimulationOptions o = sim::SimulationOptions::WhiteMems();
   o.rate_hz = 200.0;
   o.seed = 7;
   o.site = geo::Site::At(6.67, -1.57, 250.0, "test");  // near the paper's site

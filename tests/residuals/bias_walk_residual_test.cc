@@ -33,6 +33,19 @@ TEST(BiasWalkResidual, JacobianMatchesNumeric) {
   EXPECT_LT(testing::JacobianError(*cost, {from, to}, {nullptr, nullptr}), 1e-8);
 }
 
+TEST(BiasWalkResidual, GaussMarkovFactorCarriesPhi) {
+  // r = (to - phi from) inv_sigma, and its Jacobian.
+  std::unique_ptr<ceres::CostFunction> cost(BiasWalkResidual::Create(Vec3(2.0, 4.0, 8.0), 0.5));
+  const double from[3] = {1.0, 2.0, 3.0}, to[3] = {1.5, 1.0, 3.25};
+  const double* p[2] = {from, to};
+  double r[3];
+  ASSERT_TRUE(cost->Evaluate(p, r, nullptr));
+  EXPECT_DOUBLE_EQ(r[0], 2.0);
+  EXPECT_DOUBLE_EQ(r[1], 0.0);
+  EXPECT_DOUBLE_EQ(r[2], 14.0);
+  EXPECT_LT(testing::JacobianError(*cost, {from, to}, {nullptr, nullptr}), 1e-8);
+}
+
 TEST(BiasWalkResidual, WhitensASimulatedWalk) {
   // A walk of density K sampled every dt: the factor over each step is N(0, 1) per axis, so
   // the mean square over many steps is 1 within its spread (sqrt(2 / n)).

@@ -45,7 +45,7 @@ TEST(MotionResidual, IntegratesAKnownTurn) {
 
 /// Jacobian error of the motion residual for `spec` with small non-zero parameters, the
 /// attitudes off the turn by 0.01 rad and Earth rate present.
-double MotionJacobianError(const std::string& spec, bool walk = false) {
+double MotionJacobianError(const std::string& spec, int processes = 0) {
   Quat dR_true;
   const MotionSamples s = Turn(&dR_true);
   const model::Model m = model::Model::Parse(spec);
@@ -59,15 +59,17 @@ double MotionJacobianError(const std::string& spec, bool walk = false) {
     for (std::size_t i = 0; i < theta[t].size(); ++i) theta[t][i] = 1e-4 * (1.0 + static_cast<double>(i));
   }
   std::unique_ptr<ceres::CostFunction> cost(
-      MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5), walk));
+      MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5), processes));
   const Quat qa = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 0, 1).normalized()));
   const Quat qb = qa * dR_true * Quat(Eigen::AngleAxisd(0.01, Vec3::UnitX()));
   const double a[4] = {qa.x(), qa.y(), qa.z(), qa.w()};
   const double b[4] = {qb.x(), qb.y(), qb.z(), qb.w()};
   std::vector<const double*> params = {a, b};
   for (const auto& block : theta) params.push_back(block.data());
-  const double b_from[3] = {2e-3, -1e-3, 4e-4}, b_to[3] = {-5e-4, 3e-3, 1e-3};  // bias walk
-  if (walk) params.insert(params.end(), {b_from, b_to});
+  // Wander states: from and to of each process.
+  const double states[2][2][3] = {{{2e-3, -1e-3, 4e-4}, {-5e-4, 3e-3, 1e-3}},
+                                  {{-4e-4, 6e-4, 1e-4}, {3e-4, -2e-4, 5e-4}}};
+  for (int p = 0; p < processes; ++p) params.insert(params.end(), {states[p][0], states[p][1]});
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifolds[1] = manifold.get();
@@ -89,8 +91,13 @@ TEST(MotionResidual, JacobianMatchesNumericWithAccelEffect) {
 }
 
 TEST(MotionResidual, JacobianMatchesNumericWithABiasWalk) {
-  EXPECT_LT(MotionJacobianError("base", true), 1e-7);
-  EXPECT_LT(MotionJacobianError("base+gyro_g_sensitivity+gyro_scale_nonlinearity", true), 1e-7);
+  EXPECT_LT(MotionJacobianError("base", 1), 1e-7);
+  EXPECT_LT(MotionJacobianError("base+gyro_g_sensitivity+gyro_scale_nonlinearity", 1), 1e-7);
+}
+
+TEST(MotionResidual, JacobianMatchesNumericWithAWalkAndAnInstability) {
+  EXPECT_LT(MotionJacobianError("base", 2), 1e-7);
+  EXPECT_LT(MotionJacobianError("base+gyro_g_sensitivity+gyro_scale_nonlinearity", 2), 1e-7);
 }
 
 TEST(MotionResidual, AWalkAtZeroChangesNothing) {
@@ -108,7 +115,7 @@ TEST(MotionResidual, AWalkAtZeroChangesNothing) {
   plain->Evaluate(p.data(), r0, nullptr);
   p.insert(p.end(), {zero, zero});
   std::unique_ptr<ceres::CostFunction> walked(
-      MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5), true));
+      MotionResidual::Create(m, s, Vec3(4e-5, 0, -5e-5), 1));
   walked->Evaluate(p.data(), r1, nullptr);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(r0[i], r1[i]);
 }

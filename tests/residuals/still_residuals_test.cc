@@ -30,7 +30,9 @@ model::ParameterBlocks SmallParameters(const model::Model& m, std::uint64_t seed
 }
 
 /// Runs the gradient checker on a still residual of `sensor` and returns its max error.
-double StillJacobianError(const std::string& spec, model::Sensor sensor, bool walk = false) {
+/// `weights`: the wander processes' bridge-mean weights (none: a constant bias).
+double StillJacobianError(const std::string& spec, model::Sensor sensor,
+                          std::vector<double> weights = {}) {
   model::Model m = model::Model::Parse(spec);
   const auto theta = SmallParameters(m, 7);
   StillMeasurement meas;
@@ -39,13 +41,17 @@ double StillJacobianError(const std::string& spec, model::Sensor sensor, bool wa
   meas.dt_s = 40.0;
   meas.dtemp_c = 3.0;
   std::unique_ptr<ceres::CostFunction> cost(StillResidual::Create(
-      m, sensor, meas, Vec3(0, 0, 9.81), Vec3(4.5e-5, 0, -5.7e-5), Vec3::Zero(), walk));
+      m, sensor, meas, Vec3(0, 0, 9.81), Vec3(4.5e-5, 0, -5.7e-5), Vec3::Zero(), weights));
   const Quat q = Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())).normalized();
   const double q_block[4] = {q.x(), q.y(), q.z(), q.w()};
   std::vector<const double*> params = {q_block};
   for (int t : StillResidual::TermsOf(m, sensor)) params.push_back(theta[static_cast<std::size_t>(t)].data());
-  const double s_k[3] = {0.01, -0.02, 0.005}, e_k[3] = {0.015, -0.01, 0.0};  // bias walk
-  if (walk) params.insert(params.end(), {s_k, e_k});
+  // Wander states: start and end of each process.
+  const double states[2][2][3] = {{{0.01, -0.02, 0.005}, {0.015, -0.01, 0.0}},
+                                  {{-0.003, 0.004, 0.002}, {0.001, 0.006, -0.002}}};
+  for (std::size_t p = 0; p < weights.size(); ++p) {
+    params.insert(params.end(), {states[p][0], states[p][1]});
+  }
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifold.get();
@@ -57,8 +63,39 @@ TEST(StillResidual, AccelJacobianMatchesNumericBase) {
 }
 
 TEST(StillResidual, JacobianMatchesNumericWithABiasWalk) {
-  EXPECT_LT(StillJacobianError("base", model::Sensor::kAccel, true), 1e-8);
-  EXPECT_LT(StillJacobianError("base+gyro_g_sensitivity", model::Sensor::kGyro, true), 1e-8);
+  EXPECT_LT(StillJacobianError("base", model::Sensor::kAccel, {0.5}), 1e-8);
+  EXPECT_LT(StillJacobianError("base+gyro_g_sensitivity", model::Sensor::kGyro, {0.5}), 1e-8);
+}
+
+TEST(StillResidual, JacobianMatchesNumericWithAWalkAndAnInstability) {
+  EXPECT_LT(StillJacobianError("base", model::Sensor::kAccel, {0.5, 0.31}), 1e-8);
+  EXPECT_LT(StillJacobianError("base+gyro_g_sensitivity", model::Sensor::kGyro, {0.5, 0.42}),
+            1e-8);
+}
+
+TEST(StillResidual, TheWanderEntersAsItsWeightedEnds) {
+  // r(weights) - r(none) = -W sum_p w_p (s_p + e_p), exactly.
+  model::Model m = model::Model::Parse("base");
+  const auto theta = m.ZeroParameters();
+  StillMeasurement meas;
+  meas.mean = Vec3(0.3, -0.2, -9.7);
+  meas.sqrt_info = Vec3(100, 120, 90);
+  const double q[4] = {0, 0, 0, 1};
+  const double s0[3] = {0.01, -0.02, 0.005}, e0[3] = {0.015, -0.01, 0.0};
+  const double s1[3] = {-0.003, 0.004, 0.002}, e1[3] = {0.001, 0.006, -0.002};
+  std::vector<const double*> p = {q, theta[0].data()};
+  std::unique_ptr<ceres::CostFunction> plain(StillResidual::Create(
+      m, model::Sensor::kAccel, meas, Vec3(0, 0, 9.81), Vec3::Zero()));
+  double r0[3], r1[3];
+  plain->Evaluate(p.data(), r0, nullptr);
+  p.insert(p.end(), {s0, e0, s1, e1});
+  std::unique_ptr<ceres::CostFunction> wandered(StillResidual::Create(
+      m, model::Sensor::kAccel, meas, Vec3(0, 0, 9.81), Vec3::Zero(), Vec3::Zero(), {0.5, 0.3}));
+  wandered->Evaluate(p.data(), r1, nullptr);
+  for (int i = 0; i < 3; ++i) {
+    const double shift = 0.5 * (s0[i] + e0[i]) + 0.3 * (s1[i] + e1[i]);
+    EXPECT_NEAR(r1[i], r0[i] - meas.sqrt_info[i] * shift, 1e-12);
+  }
 }
 
 TEST(StillResidual, GyroJacobianMatchesNumericBase) {

@@ -62,6 +62,11 @@ struct NoiseLevels {
   /// zero: the bias was held constant over the session.
   Vec3 walk_acc = Vec3::Zero();
   Vec3 walk_gyr = Vec3::Zero();
+  /// Bias instability the fit assumed (Gauss-Markov sigma per axis, sensor units; zero:
+  /// none) and its correlation time, s.
+  Vec3 instability_acc = Vec3::Zero();
+  Vec3 instability_gyr = Vec3::Zero();
+  double instability_time_s = 0;
 };
 
 struct Calibration {

@@ -51,8 +51,8 @@ CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model mod
   q_offset_ = values_.size();
   for (const auto& s : still_.poses) values_.insert(values_.end(), s.q.begin(), s.q.end());
   walk_offset_ = values_.size();
-  walk_per_pose_ = (noise_.accel_walks() ? 6 : 0) + (has_gyro_ && noise_.gyro_walks() ? 6 : 0);
-  values_.resize(values_.size() + walk_per_pose_ * still_.poses.size(), 0.0);
+  wander_ = noise_.Wander(has_gyro_);
+  values_.resize(values_.size() + 6 * wander_.size() * still_.poses.size(), 0.0);
   still_gyro_ = has_gyro_ && options_.use_still_gyro;
   bool needs_velocity = false;
   for (const auto& term : model_.terms()) {
@@ -140,12 +140,17 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
       motion_samples_[k].sqrt_info[i] =
           1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * noise_.tau_gyr[i]));
     }
-    if (noise_.gyro_walks()) {
-      // The walk about the line from e_k to s_k+1 (a Brownian bridge over the interval T)
-      // integrates to an angle of variance K^2 T^3 / 12 per sensor axis, through E^-1.
-      const double T = series_.t_s[mo.last] - series_.t_s[mo.first];
-      const Mat3 cov_bridge = E_inv * (noise_.walk_gyr.cwiseAbs2() * (T * T * T / 12.0)).asDiagonal() *
-                              E_inv.transpose();
+    // Each gyroscope wander process about the line from e_k to s_k+1 integrates to an angle:
+    // a Brownian bridge over the interval T to K^2 T^3 / 12 per sensor axis, through E^-1.
+    // The instability is taken as the walk of equal short-time spread, K^2 = 2 s^2 / tau
+    // (exact for T << tau; turns last seconds, correlation times tens of seconds and more).
+    const double T = series_.t_s[mo.last] - series_.t_s[mo.first];
+    for (std::size_t p : WanderOf(model::Sensor::kGyro)) {
+      const WanderProcess& w = wander_[p];
+      const Vec3 K2 = w.kind == WanderProcess::Kind::kWalk
+                          ? Vec3(w.level.cwiseAbs2())
+                          : Vec3(w.level.cwiseAbs2() * (2.0 / w.tau_s));
+      const Mat3 cov_bridge = E_inv * (K2 * (T * T * T / 12.0)).asDiagonal() * E_inv.transpose();
       for (int i = 0; i < 3; ++i) {
         const double var = 1.0 / (motion_samples_[k].sqrt_info[i] * motion_samples_[k].sqrt_info[i]);
         motion_samples_[k].sqrt_info[i] = 1.0 / std::sqrt(var + cov_bridge(i, i));
@@ -222,8 +227,8 @@ void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
     }
   }
   for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    for (std::size_t v = 0; v < walk_per_pose_; v += 3) {
-      problem->AddParameterBlock(values_.data() + walk_offset_ + walk_per_pose_ * k + v, 3);
+    for (std::size_t p = 0; p < wander_.size(); ++p) {
+      for (bool end : {false, true}) problem->AddParameterBlock(wander(k, p, end), 3);
     }
   }
 }
@@ -240,33 +245,35 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
   };
   std::vector<double*> all_terms;
   for (int t = 0; t < model_.num_terms(); ++t) all_terms.push_back(block(t));
-  const bool acc_walk = noise_.accel_walks();
-  const bool gyr_walk = has_gyro_ && noise_.gyro_walks();
+  const std::vector<std::size_t> acc_wander = WanderOf(model::Sensor::kAccel);
+  const std::vector<std::size_t> gyr_wander = WanderOf(model::Sensor::kGyro);
   for (std::size_t k = 0; k < still_.poses.size(); ++k) {
     const StillPose& s = still_.poses[k];
     std::vector<double*> acc_blocks = blocks_of(acc_terms, q(k));
     std::vector<double*> gyr_blocks = blocks_of(gyr_terms, q(k));
-    if (acc_walk) {
-      acc_blocks.insert(acc_blocks.end(), {walk(k, model::Sensor::kAccel, false),
-                                           walk(k, model::Sensor::kAccel, true)});
+    const double T = s.stats.t_end_s - s.stats.t_begin_s;
+    std::vector<double> acc_weights, gyr_weights;
+    for (std::size_t p : acc_wander) {
+      acc_blocks.insert(acc_blocks.end(), {wander(k, p, false), wander(k, p, true)});
+      acc_weights.push_back(wander_[p].BridgeMeanWeight(T));
     }
-    if (gyr_walk) {
-      gyr_blocks.insert(gyr_blocks.end(), {walk(k, model::Sensor::kGyro, false),
-                                           walk(k, model::Sensor::kGyro, true)});
+    for (std::size_t p : gyr_wander) {
+      gyr_blocks.insert(gyr_blocks.end(), {wander(k, p, false), wander(k, p, true)});
+      gyr_weights.push_back(wander_[p].BridgeMeanWeight(T));
     }
     built.acc.push_back(
         s.spinning ? nullptr
                    : problem->AddResidualBlock(
                          StillResidual::Create(model_, model::Sensor::kAccel, s.acc_measurement,
                                                site_.g_n, site_.omega_ie_n, Vec3::Zero(),
-                                               acc_walk),
+                                               acc_weights),
                          nullptr, acc_blocks));
     built.gyr.push_back(
         still_gyro_ ? problem->AddResidualBlock(
                           StillResidual::Create(model_, model::Sensor::kGyro, s.gyr_measurement,
                                                 site_.g_n, site_.omega_ie_n,
                                                 s.segment.known_omega_eb_b.value_or(Vec3::Zero()),
-                                                gyr_walk),
+                                                gyr_weights),
                           nullptr, gyr_blocks)
                     : nullptr);
   }
@@ -275,12 +282,12 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
     const auto& mo = motions[k];
     std::vector<double*> blocks = {q(mo.from), q(mo.from + 1)};
     blocks.insert(blocks.end(), all_terms.begin(), all_terms.end());
-    if (gyr_walk) {
-      blocks.insert(blocks.end(), {walk(mo.from, model::Sensor::kGyro, true),
-                                   walk(mo.from + 1, model::Sensor::kGyro, false)});
+    for (std::size_t p : gyr_wander) {
+      blocks.insert(blocks.end(), {wander(mo.from, p, true), wander(mo.from + 1, p, false)});
     }
     built.motion.push_back(problem->AddResidualBlock(
-        residuals::MotionResidual::Create(model_, motion_samples_[k], site_.omega_ie_n, gyr_walk),
+        residuals::MotionResidual::Create(model_, motion_samples_[k], site_.omega_ie_n,
+                                          static_cast<int>(gyr_wander.size())),
         nullptr, blocks));
     if (velocity_on_) {
       std::vector<double*> vblocks = {q(mo.from)};
@@ -293,27 +300,37 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
   }
 }
 
-void CalibrationProblem::AddWalkFactors(BuiltProblem& built, model::Sensor sensor,
-                                        const Vec3& K) {
+std::vector<std::size_t> CalibrationProblem::WanderOf(model::Sensor sensor) const {
+  std::vector<std::size_t> out;
+  for (std::size_t p = 0; p < wander_.size(); ++p) {
+    if (wander_[p].sensor == sensor) out.push_back(p);
+  }
+  return out;
+}
+
+void CalibrationProblem::AddWanderFactors(BuiltProblem& built, std::size_t p) {
+  const WanderProcess& w = wander_[p];
   auto add = [&](double* from, double* to, double span_s) {
-    const Vec3 inv_sigma = (K * std::sqrt(std::max(span_s, kMinWalkSpan_s))).cwiseInverse();
+    const double dt = std::max(span_s, kMinWalkSpan_s);
+    const Vec3 inv_sigma = w.StepSigma(dt).cwiseInverse();
     built.walk.push_back(
         from == nullptr
             ? built.problem->AddResidualBlock(
                   residuals::BiasWalkResidual::CreateAnchor(inv_sigma), nullptr, to)
-            : built.problem->AddResidualBlock(residuals::BiasWalkResidual::Create(inv_sigma),
-                                              nullptr, from, to));
+            : built.problem->AddResidualBlock(
+                  residuals::BiasWalkResidual::Create(inv_sigma, w.Phi(dt)), nullptr, from, to));
+    built.walk_process.push_back(p);
   };
   const auto& poses = still_.poses;
   for (std::size_t k = 0; k < poses.size(); ++k) {
     const auto& stats = poses[k].stats;
     if (k == 0) {
-      add(nullptr, walk(0, sensor, false), stats.t_begin_s - model_.t_ref_s);
+      add(nullptr, wander(0, p, false), stats.t_begin_s - model_.t_ref_s);
     } else {
-      add(walk(k - 1, sensor, true), walk(k, sensor, false),
+      add(wander(k - 1, p, true), wander(k, p, false),
           stats.t_begin_s - poses[k - 1].stats.t_end_s);
     }
-    add(walk(k, sensor, false), walk(k, sensor, true), stats.t_end_s - stats.t_begin_s);
+    add(wander(k, p, false), wander(k, p, true), stats.t_end_s - stats.t_begin_s);
   }
 }
 
@@ -325,8 +342,7 @@ BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
   built.problem = std::make_unique<ceres::Problem>(problem_options);
   AddParameterBlocks(built, held, free_probes);
   AddResiduals(built);
-  if (noise_.accel_walks()) AddWalkFactors(built, model::Sensor::kAccel, noise_.walk_acc);
-  if (has_gyro_ && noise_.gyro_walks()) AddWalkFactors(built, model::Sensor::kGyro, noise_.walk_gyr);
+  for (std::size_t p = 0; p < wander_.size(); ++p) AddWanderFactors(built, p);
   return built;
 }
 
@@ -360,17 +376,22 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem) {
       out.model_index.emplace_back(-1, static_cast<int>(k));
     }
   }
-  const char* kEnd[2] = {"start", "end"};
+  out.first_wander = out.names.size();
   for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    for (std::size_t v = 0; v < walk_per_pose_; v += 3) {
-      out.blocks.push_back(values_.data() + walk_offset_ + walk_per_pose_ * k + v);
-      const bool gyro = v >= 6 || !noise_.accel_walks();
-      for (int i = 0; i < 3; ++i) {
-        out.names.push_back("walk[" + std::to_string(k) + "]." + (gyro ? "gyro." : "accel.") +
-                            kEnd[(v / 3) % 2] + "." + kAxisName[i]);
-        out.values.push_back(std::nan(""));
-        out.is_model.push_back(false);
-        out.model_index.emplace_back(-1, static_cast<int>(k));
+    for (std::size_t p = 0; p < wander_.size(); ++p) {
+      const WanderProcess& w = wander_[p];
+      for (bool end : {false, true}) {
+        out.blocks.push_back(wander(k, p, end));
+        for (int i = 0; i < 3; ++i) {
+          out.names.push_back(
+              std::string(w.kind == WanderProcess::Kind::kWalk ? "walk[" : "instability[") +
+              std::to_string(k) + "]." +
+              (w.sensor == model::Sensor::kGyro ? "gyro." : "accel.") +
+              (end ? "end." : "start.") + kAxisName[i]);
+          out.values.push_back(std::nan(""));
+          out.is_model.push_back(false);
+          out.model_index.emplace_back(-1, static_cast<int>(k));
+        }
       }
     }
   }
@@ -385,6 +406,27 @@ Eigen::MatrixXd CalibrationProblem::Jacobian(ceres::Problem& problem,
   ceres::CRSMatrix crs;
   problem.Evaluate(eval, cost, residuals, nullptr, &crs);
   return Dense(crs);
+}
+
+Eigen::SparseMatrix<double> CalibrationProblem::SparseJacobian(
+    ceres::Problem& problem, const UnknownColumns& columns, double* cost,
+    std::vector<double>* residuals) const {
+  ceres::Problem::EvaluateOptions eval;
+  eval.parameter_blocks = columns.blocks;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(eval, cost, residuals, nullptr, &crs);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(crs.values.size());
+  for (int row = 0; row < crs.num_rows; ++row) {
+    for (int idx = crs.rows[static_cast<std::size_t>(row)];
+         idx < crs.rows[static_cast<std::size_t>(row) + 1]; ++idx) {
+      entries.emplace_back(row, crs.cols[static_cast<std::size_t>(idx)],
+                           crs.values[static_cast<std::size_t>(idx)]);
+    }
+  }
+  Eigen::SparseMatrix<double> J(crs.num_rows, crs.num_cols);
+  J.setFromTriplets(entries.begin(), entries.end());
+  return J;
 }
 
 ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
@@ -450,12 +492,13 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     if (has_gyro_) f.gyr_mean = s.stats.gyr_mean;
     f.R_n_b = R_n_b(k);
     f.attitude_known = s.known;
-    auto walk_mean = [&](model::Sensor sensor) {
-      return Vec3(0.5 * (Eigen::Map<const Vec3>(walk(k, sensor, false)) +
-                         Eigen::Map<const Vec3>(walk(k, sensor, true))));
-    };
-    if (noise_.accel_walks()) f.acc_walk = walk_mean(model::Sensor::kAccel);
-    if (has_gyro_ && noise_.gyro_walks()) f.gyr_walk = walk_mean(model::Sensor::kGyro);
+    const double T = s.stats.t_end_s - s.stats.t_begin_s;
+    for (std::size_t p = 0; p < wander_.size(); ++p) {
+      const Vec3 mean = wander_[p].BridgeMeanWeight(T) *
+                        (Eigen::Map<const Vec3>(wander(k, p, false)) +
+                         Eigen::Map<const Vec3>(wander(k, p, true)));
+      (wander_[p].sensor == model::Sensor::kAccel ? f.acc_walk : f.gyr_walk) += mean;
+    }
     // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
     double w[3];
     if (built.acc[k]) {

@@ -9,10 +9,11 @@
 //   motion                Log((R_k dR)^T R_k+1), dR the corrected rate integrated on SO(3)
 //   velocity (optional)   the accelerometer integrated while the IMU turns (lever arms, time
 //                         offset: effects whose excitation includes angular acceleration)
-//   bias walk (optional)  with a bias random walk in the noise model, every pose has the walk
-//                         at its first and last sample (s_k, e_k, per walking sensor) as
-//                         unknowns, in the still residual as (s_k + e_k) / 2, in the motion
-//                         residual linear between e_k and s_k+1, and tied by the factors
+//   bias wander (optional) with a bias random walk or instability in the noise model, every
+//                         pose has each wander process (noise_model.h) at its first and last
+//                         sample (s_k, e_k) as unknowns, in the still residual as
+//                         w (s_k + e_k) (the process's bridge mean), in the motion residual
+//                         linear between e_k and s_k+1, and tied by the Markov factors
 //                         t_ref -> s_0 -> e_0 -> s_1 -> ... (residuals/bias_walk_residual.h)
 // The problem owns the values (theta, the poses' attitudes) that Ceres works on, so a
 // ceres::Problem can be built from them again (with other parameters held) and its residuals
@@ -26,6 +27,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <memory>
 #include <string>
 #include <utility>
@@ -51,18 +53,21 @@ struct BuiltProblem {
   std::vector<ceres::ResidualBlockId> acc, gyr;  ///< per still pose
   std::vector<ceres::ResidualBlockId> motion;    ///< per motion interval
   std::vector<ceres::ResidualBlockId> velocity;  ///< per motion interval, when used
-  std::vector<ceres::ResidualBlockId> walk;      ///< bias-walk factors, when the bias walks
+  std::vector<ceres::ResidualBlockId> walk;      ///< bias-wander factors, when the bias wanders
+  std::vector<std::size_t> walk_process;         ///< per wander factor: its process (Wander order)
 };
 
 /// The free unknowns of a built problem as Jacobian columns, in order: model parameters
 /// (term by term), then attitude tangents (pose by pose: north, east, down as free), then the
-/// bias-walk states (pose by pose: accelerometer start, end, gyroscope start, end).
+/// bias-wander states (pose by pose; per process of NoiseModel::Wander, start then end).
 struct UnknownColumns {
   std::vector<double*> blocks;          ///< parameter blocks in column order
   std::vector<std::string> names;       ///< per column, e.g. "accel.bias.x", "attitude[3].down"
   std::vector<double> values;           ///< per column: reported value (NaN for attitudes)
   std::vector<bool> is_model;           ///< per column: model parameter (else attitude)
   std::vector<std::pair<int, int>> model_index;  ///< per column: (term, index) or (-1, pose)
+  /// Columns [first_wander, size) are the bias-wander states (none: first_wander == size).
+  std::size_t first_wander = 0;
 };
 
 /// A (term, index) pair naming one scalar model parameter.
@@ -96,6 +101,10 @@ class CalibrationProblem {
   /// Whitened residuals (optional) and Jacobian over `columns`, with the cost 0.5 r^T r.
   Eigen::MatrixXd Jacobian(ceres::Problem& problem, const UnknownColumns& columns,
                            double* cost, std::vector<double>* residuals) const;
+  /// The same Jacobian, sparse (column-major), for problems with many unknowns.
+  Eigen::SparseMatrix<double> SparseJacobian(ceres::Problem& problem,
+                                             const UnknownColumns& columns, double* cost,
+                                             std::vector<double>* residuals) const;
   /// The whitened residuals and Jacobian of `probe` (Build(..., true)) at the current values:
   /// columns `columns` then every probe term's block.
   ProbeJacobian ProbeColumns(const BuiltProblem& probe, const UnknownColumns& columns);
@@ -116,6 +125,9 @@ class CalibrationProblem {
   /// restart from the starting values, solve.h).
   void SaveValues();
   void RestoreValues();
+  /// The processes the biases wander by (NoiseModel::Wander): BuiltProblem::walk_process
+  /// indexes them.
+  const std::vector<WanderProcess>& WanderProcesses() const { return wander_; }
   /// The gyroscope is integrated between poses (there are motion intervals).
   bool has_motion() const { return has_gyro_ && !still_.motions.empty(); }
 
@@ -132,17 +144,18 @@ class CalibrationProblem {
   int block_size(int term) const {
     return model_.terms()[static_cast<std::size_t>(term)].effect->info().size();
   }
-  /// The bias-walk state of pose k: `sensor`, at the segment's first (`end` false) or last
-  /// sample (3 values, sensor units). Only for a walking sensor.
-  double* walk(std::size_t k, model::Sensor sensor, bool end) {
-    const std::size_t sensor_offset = sensor == model::Sensor::kGyro && noise_.accel_walks() ? 6 : 0;
-    return values_.data() + walk_offset_ + walk_per_pose_ * k + sensor_offset + (end ? 3 : 0);
+  /// The state of wander process p (wander_ order) in pose k, at the segment's first (`end`
+  /// false) or last sample (3 values, sensor units).
+  double* wander(std::size_t k, std::size_t p, bool end) {
+    return values_.data() + walk_offset_ + 6 * (wander_.size() * k + p) + (end ? 3 : 0);
   }
-  const double* walk(std::size_t k, model::Sensor sensor, bool end) const {
-    return const_cast<CalibrationProblem*>(this)->walk(k, sensor, end);
+  const double* wander(std::size_t k, std::size_t p, bool end) const {
+    return const_cast<CalibrationProblem*>(this)->wander(k, p, end);
   }
-  /// Adds the bias-walk factors of `sensor` (walk densities `K`) to `built`.
-  void AddWalkFactors(BuiltProblem& built, model::Sensor sensor, const Vec3& K);
+  /// The wander processes of `sensor` (indices into wander_).
+  std::vector<std::size_t> WanderOf(model::Sensor sensor) const;
+  /// Adds the Markov factors of wander process p to `built`.
+  void AddWanderFactors(BuiltProblem& built, std::size_t p);
   double* q(std::size_t k) { return values_.data() + q_offset_ + 4 * k; }
   const double* q(std::size_t k) const { return values_.data() + q_offset_ + 4 * k; }
 
@@ -154,9 +167,9 @@ class CalibrationProblem {
   std::vector<double> values_;              // model blocks in term order, then q_k per pose
   std::vector<std::size_t> block_offset_;   // per term: offset of its block in values_
   std::size_t q_offset_ = 0;                // offset of the first attitude in values_
-  std::size_t walk_offset_ = 0;             // offset of the first bias-walk state
-  std::size_t walk_per_pose_ = 0;           // bias-walk values per pose (0, 6 or 12)
+  std::size_t walk_offset_ = 0;             // offset of the first bias-wander state
   NoiseModel noise_;
+  std::vector<WanderProcess> wander_;       // noise_.Wander(has_gyro_): 6 values per pose each
   StartingValues start_;
   bool has_gyro_ = false;
   bool still_gyro_ = false;   // still gyroscope residuals are used

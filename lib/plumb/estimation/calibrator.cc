@@ -81,11 +81,12 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   const StartingValues start = Initialize(series, cal.model, site.gravity(), cal.has_gyro,
                                           options.first_heading_deg, still, theta);
   AssignHeadingGauge(still, cal.has_gyro);
-  if (options.estimate_walk) {
-    const WalkEstimate walk =
-        EstimateWalk(series, cal.model, site, still, theta, noise, start, options);
-    noise = walk.noise;
-    (walk.estimated ? fit.notes : fit.warnings).push_back(walk.note);
+  if (options.ModelsWander()) {
+    WalkEstimate wander =
+        ResolveWander(series, cal.model, site, still, theta, noise, start, options);
+    noise = wander.noise;
+    fit.notes.insert(fit.notes.end(), wander.notes.begin(), wander.notes.end());
+    fit.warnings.insert(fit.warnings.end(), wander.warnings.begin(), wander.warnings.end());
   }
   cal.noise = noise.Levels();
 

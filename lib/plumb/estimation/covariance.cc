@@ -1,5 +1,7 @@
 #include "plumb/estimation/covariance.h"
 
+#include "plumb/estimation/solve.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -53,7 +55,10 @@ bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
     for (std::size_t j = i; j < blocks.size(); ++j) pairs.emplace_back(blocks[i], blocks[j]);
   }
   ceres::Covariance::Options cov_options;
-  cov_options.algorithm_type = ceres::DENSE_SVD;
+  // Many unknowns (bias-wander states): the sparse QR, which needs full rank (the
+  // pseudo-inverse of the analysis covers the rest).
+  cov_options.algorithm_type =
+      fitted.NumParameters() > kDenseUnknowns ? ceres::SPARSE_QR : ceres::DENSE_SVD;
   cov_options.num_threads = 1;
   ceres::Covariance covariance(cov_options);
   if (pairs.empty() || !covariance.Compute(pairs, &fitted)) return false;
@@ -137,7 +142,10 @@ void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>&
                   ? std::sqrt(std::max(0.0, calibration.covariance(ii, ii)))
                   : std::numeric_limits<double>::quiet_NaN();
   }
-  calibration.sigma_source = from_ceres ? "ceres::Covariance (DENSE_SVD)" : "pseudo-inverse";
+  calibration.sigma_source =
+      !from_ceres ? "pseudo-inverse"
+      : fitted.NumParameters() > kDenseUnknowns ? "ceres::Covariance (SPARSE_QR)"
+                                                : "ceres::Covariance (DENSE_SVD)";
 }
 
 }  // namespace plumb::estimation

@@ -9,6 +9,59 @@
 
 namespace plumb::estimation {
 
+namespace {
+
+/// Below this T / tau the Gauss-Markov bridge uses its series (the closed form cancels).
+constexpr double kSeriesBelow = 1e-4;
+
+}  // namespace
+
+double WanderProcess::Phi(double dt_s) const {
+  return kind == Kind::kWalk ? 1.0 : std::exp(-dt_s / tau_s);
+}
+
+Vec3 WanderProcess::StepSigma(double dt_s) const {
+  if (kind == Kind::kWalk) return level * std::sqrt(dt_s);
+  // 1 - phi^2 = -expm1(-2 dt / tau), exact also for small dt.
+  return level * std::sqrt(-std::expm1(-2.0 * dt_s / tau_s));
+}
+
+// A Brownian bridge over T: E[mean] = (b_0 + b_T) / 2, variance K^2 T / 12. An
+// Ornstein-Uhlenbeck bridge (stationary variance s^2, x = T / tau, u = 1 / x, phi = e^-x):
+//   E[mean] = u (1 - phi) / (1 + phi) (b_0 + b_T) = u tanh(x / 2) (b_0 + b_T)
+//   var     = s^2 [2 u^2 (x - 1 + phi) - 2 u^2 (1 - phi)^2 / (1 + phi)]
+// (the mean's variance minus what the two ends explain); for small x: 1/2 and s^2 x / 6, the
+// walk's values with K^2 = 2 s^2 / tau.
+double WanderProcess::BridgeMeanWeight(double T_s) const {
+  const double x = T_s / tau_s;
+  if (kind == Kind::kWalk || x < kSeriesBelow) return 0.5;
+  return std::tanh(0.5 * x) / x;
+}
+
+Vec3 WanderProcess::BridgeMeanVariance(double T_s) const {
+  if (kind == Kind::kWalk) return level.cwiseAbs2() * (T_s / 12.0);
+  const double x = T_s / tau_s;
+  double unit = x / 6.0;
+  if (x >= kSeriesBelow) {
+    const double phi = std::exp(-x), u = 1.0 / x;
+    unit = 2.0 * u * u * (x - 1.0 + phi) - 2.0 * u * u * (1.0 - phi) * (1.0 - phi) / (1.0 + phi);
+  }
+  return level.cwiseAbs2() * std::max(unit, 0.0);
+}
+
+std::vector<WanderProcess> NoiseModel::Wander(bool has_gyro) const {
+  std::vector<WanderProcess> out;
+  using Kind = WanderProcess::Kind;
+  auto add = [&](model::Sensor sensor, Kind kind, const Vec3& level, bool on) {
+    if (on) out.push_back(WanderProcess{sensor, kind, level, instability_time_s});
+  };
+  add(model::Sensor::kAccel, Kind::kWalk, walk_acc, accel_walks());
+  add(model::Sensor::kAccel, Kind::kInstability, instability_acc, accel_unstable());
+  add(model::Sensor::kGyro, Kind::kWalk, walk_gyr, has_gyro && gyro_walks());
+  add(model::Sensor::kGyro, Kind::kInstability, instability_gyr, has_gyro && gyro_unstable());
+  return out;
+}
+
 NoiseLevels NoiseModel::Levels() const {
   NoiseLevels out;
   out.acc = sigma_acc;
@@ -17,6 +70,9 @@ NoiseLevels NoiseModel::Levels() const {
   out.tau_gyr = tau_gyr.maxCoeff();
   out.walk_acc = walk_acc;
   out.walk_gyr = walk_gyr;
+  out.instability_acc = instability_acc;
+  out.instability_gyr = instability_gyr;
+  out.instability_time_s = instability_time_s;
   return out;
 }
 
@@ -41,6 +97,21 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
       throw Error("a bias random-walk density must be finite and >= 0 (got " +
                   std::to_string(*density) + ")");
     }
+  }
+  for (const auto& level : {options.accel_instability, options.gyro_instability}) {
+    if (level && !(std::isfinite(*level) && *level >= 0)) {
+      throw Error("a bias instability must be finite and >= 0 (got " + std::to_string(*level) +
+                  ")");
+    }
+  }
+  if (!(std::isfinite(options.instability_time_s) && options.instability_time_s > 0)) {
+    throw Error("the bias instability's correlation time must be finite and > 0 s (got " +
+                std::to_string(options.instability_time_s) + ")");
+  }
+  noise.instability_time_s = options.instability_time_s;
+  if (options.accel_instability) noise.instability_acc = Vec3::Constant(*options.accel_instability);
+  if (options.gyro_instability && has_gyro) {
+    noise.instability_gyr = Vec3::Constant(*options.gyro_instability);
   }
   if (options.accel_walk_density) noise.walk_acc = Vec3::Constant(*options.accel_walk_density);
   if (options.gyro_walk_density && has_gyro) {

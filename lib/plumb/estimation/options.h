@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/typical_mems.h"
+
 namespace plumb::estimation {
 
 /// What to do when the data cannot determine every parameter of the requested model.
@@ -42,12 +44,33 @@ struct CalibrationOptions {
   /// rad/s^2/sqrt(Hz) for SI samples), >= 0 and finite. Set and > 0: the bias is not one
   /// constant over the session but walks, and the backend gives every still segment bias-walk
   /// states tied by random-walk factors (residuals/bias_walk_residual.h); the model's bias is
-  /// then the bias at the model's reference time. Unset or 0: the bias is constant.
+  /// then the bias at the model's reference time. 0: no walk. Unset: see estimate_walk.
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
+  /// Bias instability as a first-order Gauss-Markov process per axis: steady-state sigma
+  /// (accelerometer m/s^2, gyroscope rad/s, sensor units for unscaled samples; finite >= 0;
+  /// 0: none; unset: see estimate_walk)
+  /// and correlation time (s, finite > 0). Every still segment then also has instability
+  /// states at both ends, tied by Gauss-Markov factors (residuals/bias_walk_residual.h).
+  std::optional<double> accel_instability;
+  std::optional<double> gyro_instability;
+  double instability_time_s = typical_mems::kInstabilityTime_s;
   /// Estimate the walk densities that are not given from the session itself, by
-  /// variance-component estimation over the walk factors (estimation/walk_estimate.h).
+  /// variance-component estimation over the walk factors (estimation/walk_estimate.h), when
+  /// it has walk_min_poses still poses (else the typical MEMS walk, said in the warnings).
+  ///
+  /// The bias wanders in the fit when any of estimate_walk, the walk densities or the
+  /// instabilities is set; the levels left unset are then estimated (the walk) or typical
+  /// (core/typical_mems.h), said in the notes. With none set the bias is one constant over
+  /// the session, honest only for white noise (the report says so). The constant bias stays
+  /// the default until the analysis eliminates the wander states (a Schur complement), as
+  /// their dense SVD costs O(poses^3).
   bool estimate_walk = false;
+  /// Whether the options ask for a wandering bias (the paragraph above).
+  bool ModelsWander() const {
+    return estimate_walk || accel_walk_density || gyro_walk_density || accel_instability ||
+           gyro_instability;
+  }
   /// Fewest still segments for that estimate (>= 2); with fewer the bias stays constant.
   int walk_min_poses = 6;
   /// Lower bound on the noise standard deviation per sample, in sensor units, guarding

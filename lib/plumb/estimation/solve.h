@@ -21,6 +21,10 @@
 
 namespace plumb::estimation {
 
+/// Above this many parameters (ambient, all blocks) the solve uses a sparse Cholesky
+/// factorisation instead of dense QR.
+inline constexpr int kDenseUnknowns = 400;
+
 /// Tolerances of a first, rough solve that another solve refines (options.function_tolerance
 /// and parameter_tolerance apply to the final one).
 inline constexpr double kRoughFunctionTolerance = 1e-6;
@@ -37,7 +41,10 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 
 /// The observability analysis (observability.h) of `problem` at the current values: its free
 /// unknowns go to `columns`, the cost and whitened residuals (optional) to `cost` and
-/// `residuals`, and the whitened Jacobian it analysed to `jacobian` (optional).
+/// `residuals`, and the whitened Jacobian it analysed to `jacobian` (optional). Without
+/// `jacobian`, bias-wander states are eliminated first (a sparse QR): the analysis and its
+/// covariance are then over the columns before columns.first_wander, the wander marginalised;
+/// with it, over every column (dense, O(unknowns^3)).
 ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
                                 const CalibrationOptions& options, UnknownColumns& columns,
                                 double* cost, std::vector<double>* residuals,

@@ -3,15 +3,16 @@
 #include <cmath>
 #include <cstdio>
 
+#include "plumb/core/typical_mems.h"
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/solve.h"
 
 namespace plumb::estimation {
 namespace {
 
-/// Typical consumer MEMS bias walks (the simulator's TypicalMems), SI.
-constexpr double kTypicalAccelWalk = 1e-4;   // m/s^3/sqrt(Hz)
-constexpr double kTypicalGyroWalk = 2e-6;    // rad/s^2/sqrt(Hz)
+/// Typical consumer MEMS bias walks, SI.
+constexpr double kTypicalAccelWalk = typical_mems::kAccelWalk;  // m/s^3/sqrt(Hz)
+constexpr double kTypicalGyroWalk = typical_mems::kGyroWalk;    // rad/s^2/sqrt(Hz)
 /// Smallest density kept, as a fraction of the start.
 constexpr double kFloor = 1e-3;
 /// Relative change of K below which the iteration stops, and the most fits made.
@@ -24,21 +25,25 @@ struct GroupStats {
 };
 
 GroupStats WalkGroups(CalibrationProblem& problem, BuiltProblem& built,
-                      const CalibrationOptions& options, std::size_t acc_factors) {
+                      const CalibrationOptions& options) {
   UnknownColumns columns;
   std::vector<double> r;
   double cost = 0;
   Eigen::MatrixXd J;
   const ObservabilityAnalysis analysis =
       AnalyseAt(problem, *built.problem, options, columns, &cost, &r, &J);
-  // Rows of the walk factors: the last 3 * built.walk.size() rows (added last), the
-  // accelerometer's first.
+  // Rows of the wander factors: the last 3 * built.walk.size() rows (added last, in the
+  // order of built.walk_process). Only the walks' factors form the groups.
   const auto rows = static_cast<Eigen::Index>(r.size());
   const auto walk_rows = static_cast<Eigen::Index>(3 * built.walk.size());
+  const auto& processes = problem.WanderProcesses();
   GroupStats g;
   for (Eigen::Index i = rows - walk_rows; i < rows; ++i) {
+    const WanderProcess& w =
+        processes[built.walk_process[static_cast<std::size_t>((i - (rows - walk_rows)) / 3)]];
+    if (w.kind != WanderProcess::Kind::kWalk) continue;
     const double h = J.row(i).dot(analysis.covariance * J.row(i).transpose());
-    const bool acc = (i - (rows - walk_rows)) < static_cast<Eigen::Index>(3 * acc_factors);
+    const bool acc = w.sensor == model::Sensor::kAccel;
     const double r2 = r[static_cast<std::size_t>(i)] * r[static_cast<std::size_t>(i)];
     (acc ? g.chi2_acc : g.chi2_gyr) += r2;
     (acc ? g.red_acc : g.red_gyr) += 1.0 - h;
@@ -48,31 +53,69 @@ GroupStats WalkGroups(CalibrationProblem& problem, BuiltProblem& built,
 
 }  // namespace
 
-WalkEstimate EstimateWalk(const ImuSeries& series, const model::Model& model,
-                          const geo::Site& site, const StillSet& still,
-                          const model::ParameterBlocks& theta, const NoiseModel& noise,
-                          const StartingValues& start, const CalibrationOptions& options) {
+namespace {
+
+/// The typical MEMS instability for the sensors whose instability is not given, in the
+/// sensor's units; said in `notes`.
+void AssumeTypicalInstability(const StartingValues& start, const CalibrationOptions& options,
+                              bool has_gyro, NoiseModel& noise, std::vector<std::string>& notes) {
+  const bool acc = !options.accel_instability.has_value();
+  const bool gyr = has_gyro && !options.gyro_instability.has_value();
+  if (acc) noise.instability_acc.setConstant(typical_mems::kAccelInstability * start.accel.scale);
+  if (gyr) noise.instability_gyr.setConstant(typical_mems::kGyroInstability / start.gyro_rad_per_unit);
+  if (!acc && !gyr) return;
+  char acc_text[64] = "", gyr_text[64] = "";
+  if (acc) std::snprintf(acc_text, sizeof acc_text, " accel %.3g m/s^2", typical_mems::kAccelInstability);
+  if (gyr) std::snprintf(gyr_text, sizeof gyr_text, " gyro %.3g rad/s", typical_mems::kGyroInstability);
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "bias instability not measured by this session: the typical MEMS value assumed "
+                "(Gauss-Markov sigma%s%s%s, correlation time %.3g s; give --accel-bi/--gyro-bi, "
+                "e.g. from 'plumb allan' on a long still recording)",
+                acc_text, acc && gyr ? "," : "", gyr_text, noise.instability_time_s);
+  notes.emplace_back(text);
+}
+
+}  // namespace
+
+WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
+                           const geo::Site& site, const StillSet& still,
+                           const model::ParameterBlocks& theta, const NoiseModel& noise,
+                           const StartingValues& start, const CalibrationOptions& options) {
   WalkEstimate out;
   out.noise = noise;
   const bool has_gyro = model.has_gyro();
-  if (static_cast<int>(still.poses.size()) < options.walk_min_poses) {
-    out.note = "bias random walk not estimated: " + std::to_string(still.poses.size()) +
-               " still segments, at least " + std::to_string(options.walk_min_poses) +
-               " are needed to see it (give --accel-rw/--gyro-rw)";
-    return out;
-  }
-  // Start from the typical walk in the sensor's units.
+  AssumeTypicalInstability(start, options, has_gyro, out.noise, out.notes);
+  // The walks not given: from the typical MEMS walk in the sensor's units, estimated when
+  // the session can show it.
   const double acc0 = kTypicalAccelWalk * start.accel.scale;
   const double gyr0 = kTypicalGyroWalk / start.gyro_rad_per_unit;
-  if (!noise.accel_walks()) out.noise.walk_acc = Vec3::Constant(acc0);
-  if (has_gyro && !noise.gyro_walks()) out.noise.walk_gyr = Vec3::Constant(gyr0);
+  const bool free_acc = !options.accel_walk_density.has_value();
+  const bool free_gyr = has_gyro && !options.gyro_walk_density.has_value();
+  if (free_acc) out.noise.walk_acc = Vec3::Constant(acc0);
+  if (free_gyr) out.noise.walk_gyr = Vec3::Constant(gyr0);
+  if (!free_acc && !free_gyr) return out;
+  if (!options.estimate_walk || static_cast<int>(still.poses.size()) < options.walk_min_poses) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "bias random walk not estimated (%s): the typical MEMS walk assumed "
+                  "(accel %.3g m/s^3/sqrt(Hz), gyro %.3g rad/s^2/sqrt(Hz)); give "
+                  "--accel-rw/--gyro-rw for another sensor",
+                  options.estimate_walk
+                      ? (std::to_string(still.poses.size()) + " still segments, at least " +
+                         std::to_string(options.walk_min_poses) + " are needed to see it")
+                            .c_str()
+                      : "--no-estimate-rw",
+                  kTypicalAccelWalk, kTypicalGyroWalk);
+    out.warnings.emplace_back(text);
+    return out;
+  }
   bool learnt_acc = false, learnt_gyr = false;
   for (int it = 0; it < kMaxIterations; ++it) {
     CalibrationProblem problem(series, model, site, still, theta, out.noise, start, options);
     FitReport scratch;
     Solution solution = SolveWithGauge(problem, options, scratch);
-    const std::size_t acc_factors = 2 * still.poses.size();
-    const GroupStats g = WalkGroups(problem, solution.all_free, options, acc_factors);
+    const GroupStats g = WalkGroups(problem, solution.all_free, options);
     ++out.iterations;
     out.redundancy_acc = g.red_acc;
     out.redundancy_gyr = g.red_gyr;
@@ -84,8 +127,8 @@ WalkEstimate EstimateWalk(const ImuSeries& series, const model::Model& model,
       change = std::max(change, std::abs(next / K[0] - 1.0));
       K.setConstant(next);
     };
-    scale(out.noise.walk_acc, g.chi2_acc, g.red_acc, acc0, learnt_acc);
-    if (has_gyro) scale(out.noise.walk_gyr, g.chi2_gyr, g.red_gyr, gyr0, learnt_gyr);
+    if (free_acc) scale(out.noise.walk_acc, g.chi2_acc, g.red_acc, acc0, learnt_acc);
+    if (free_gyr) scale(out.noise.walk_gyr, g.chi2_gyr, g.red_gyr, gyr0, learnt_gyr);
     if (change < kTolerance) break;
   }
   out.estimated = true;
@@ -99,12 +142,14 @@ WalkEstimate EstimateWalk(const ImuSeries& series, const model::Model& model,
                   sensor, K, red);
     return std::string(text);
   };
-  out.note = "bias random walk from the session (variance components, " +
-             std::to_string(out.iterations) + " fits), sensor units/s/sqrt(Hz): " +
-             describe("accel", out.noise.walk_acc[0], out.redundancy_acc, learnt_acc);
-  if (has_gyro) {
-    out.note += ", " + describe("gyro", out.noise.walk_gyr[0], out.redundancy_gyr, learnt_gyr);
+  std::string note = "bias random walk from the session (variance components, " +
+                     std::to_string(out.iterations) + " fits), sensor units/s/sqrt(Hz):";
+  if (free_acc) note += " " + describe("accel", out.noise.walk_acc[0], out.redundancy_acc, learnt_acc);
+  if (free_gyr) {
+    note += std::string(free_acc ? "," : "") + " " +
+            describe("gyro", out.noise.walk_gyr[0], out.redundancy_gyr, learnt_gyr);
   }
+  out.notes.push_back(note);
   return out;
 }
 

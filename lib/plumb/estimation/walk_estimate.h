@@ -1,5 +1,7 @@
-// plumb/estimation/walk_estimate.h — the bias random-walk densities from the session itself,
-// by variance-component estimation (stage 2b of the backend, when asked for).
+// plumb/estimation/walk_estimate.h — the bias wander's levels not given by the user (stage
+// 2b of the backend): the random-walk densities from the session itself, by
+// variance-component estimation; the instability, which a multi-pose session cannot separate
+// from the walk, from the typical MEMS sensor (core/typical_mems.h), said in the notes.
 //
 // A multi-pose session shows how far the biases wander between its holds, but only through the
 // fit: the still means differ by the walk *and* by the poses. Helmert's variance-component
@@ -17,11 +19,13 @@
 // sensor's units by the starting scale); the result is floored at 1e-3 of it (a walk too
 // small to see leaves the factors stiff but finite).
 //
-// The estimate needs holds to compare: at least `min_poses` still segments, else the
-// densities are left as given (zero: a constant bias) and the reason is returned.
+// The estimate needs holds to compare: at least `walk_min_poses` still segments, else the
+// typical MEMS walk is assumed and a warning says so. Densities given in the options (0
+// included: no walk) are kept.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "plumb/core/imu_series.h"
 #include "plumb/estimation/initialization.h"
@@ -34,16 +38,18 @@
 namespace plumb::estimation {
 
 struct WalkEstimate {
-  NoiseModel noise;        ///< the noise model with the estimated walk densities
+  NoiseModel noise;        ///< the noise model with every wander level resolved
   int iterations = 0;      ///< fits made
   double redundancy_acc = 0, redundancy_gyr = 0;  ///< red_g of each sensor's walk factors
-  bool estimated = false;  ///< false: not estimated, `note` says why
-  std::string note;        ///< what was done, in words
+  bool estimated = false;  ///< the walk was estimated from the session
+  std::vector<std::string> notes;     ///< what was done, in words
+  std::vector<std::string> warnings;  ///< what was assumed for lack of data
 };
 
-/// Iterates fits of the problem (stages 4-5) from `theta` and the poses of `still`, scaling
-/// each walking sensor's density (file comment). `noise` gives the white noise.
-WalkEstimate EstimateWalk(const ImuSeries& series, const model::Model& model,
+/// Resolves the levels the options leave unset: iterates fits of the problem (stages 4-5)
+/// from `theta` and the poses of `still`, scaling each free walk density (file comment).
+/// `noise` gives the white noise and the levels given.
+WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
                           const geo::Site& site, const StillSet& still,
                           const model::ParameterBlocks& theta, const NoiseModel& noise,
                           const StartingValues& start, const CalibrationOptions& options);

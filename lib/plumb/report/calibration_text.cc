@@ -82,7 +82,22 @@ std::string FullReport(const estimation::CalibrationResult& result) {
       os << (acc_walk ? "," : "") << " gyro " << Vec(c.noise.walk_gyr) << " " << c.gyr_unit
          << "/s/sqrt(Hz)";
     }
-    os << "; biases are at the session start\n";
+    os << "\n";
+  }
+  const bool acc_bi = c.noise.instability_acc.minCoeff() > 0;
+  const bool gyr_bi = c.noise.instability_gyr.minCoeff() > 0;
+  if (acc_bi || gyr_bi) {
+    os << "bias instability in the fit (Gauss-Markov, tau " << Format("%.3g", c.noise.instability_time_s)
+       << " s):";
+    if (acc_bi) os << " accel " << Vec(c.noise.instability_acc) << " " << c.acc_unit;
+    if (gyr_bi) os << (acc_bi ? "," : "") << " gyro " << Vec(c.noise.instability_gyr) << " " << c.gyr_unit;
+    os << "\n";
+  }
+  if (acc_walk || gyr_walk || acc_bi || gyr_bi) {
+    os << "the bias wanders over the session; the biases below are at its start\n";
+  } else {
+    os << "bias held constant over the session: the sigma is honest only if the noise is white "
+          "(--estimate-rw lets it wander: a random walk and an instability)\n";
   }
   os << "\n";
   const double scale = estimation::SigmaScale(fit);

@@ -162,6 +162,15 @@ json NoiseJson(const estimation::CalibrationResult& r) {
     out["walk_gyro"] = gyr_walk ? Vector(n.walk_gyr) : json(nullptr);
     out["walk_units"] = "sensor units / s / sqrt(Hz) (bias random walk density)";
   }
+  // The bias instability the fit assumed (a Gauss-Markov process), when it did.
+  const bool acc_bi = n.instability_acc.minCoeff() > 0;
+  const bool gyr_bi = n.instability_gyr.minCoeff() > 0;
+  if (acc_bi || gyr_bi) {
+    out["instability_accel"] = acc_bi ? Vector(n.instability_acc) : json(nullptr);
+    out["instability_gyro"] = gyr_bi ? Vector(n.instability_gyr) : json(nullptr);
+    out["instability_time_s"] = Number(n.instability_time_s);
+    out["instability_units"] = "sensor units (Gauss-Markov sigma); correlation time in s";
+  }
   return out;
 }
 

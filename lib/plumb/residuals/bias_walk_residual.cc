@@ -4,9 +4,9 @@
 
 namespace plumb::residuals {
 
-ceres::CostFunction* BiasWalkResidual::Create(const Vec3& inv_sigma) {
+ceres::CostFunction* BiasWalkResidual::Create(const Vec3& inv_sigma, double phi) {
   return new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
-      new BiasWalkResidual(inv_sigma));
+      new BiasWalkResidual(inv_sigma, phi));
 }
 
 ceres::CostFunction* BiasWalkResidual::CreateAnchor(const Vec3& inv_sigma) {

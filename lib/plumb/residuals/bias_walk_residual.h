@@ -13,6 +13,14 @@
 // across a gap) are independent and exact. The anchor at t_ref, where the walk is zero by
 // definition, is the same factor with b_from = 0 (one parameter block).
 //
+// The bias instability (a first-order Gauss-Markov process of steady-state sigma s and
+// correlation time tau per axis) is Markov too; its factor between two instants is
+//
+//   r = (b_to - phi b_from) ./ (s sqrt(1 - phi^2)),     phi = exp(-(t_to - t_from) / tau),
+//
+// and its anchor (the process is zero at t_ref, like the walk) is the same with b_from = 0.
+// Both are this functor: phi = 1 for the walk.
+//
 // Parameter blocks: b_from (3) then b_to (3); or b_to (3) only for the anchor.
 #pragma once
 
@@ -24,12 +32,15 @@ namespace plumb::residuals {
 
 class BiasWalkResidual {
  public:
-  /// `inv_sigma`: 1 / (K sqrt(dt)) per axis, 1 / sensor units (> 0, finite).
-  explicit BiasWalkResidual(const Vec3& inv_sigma) : inv_sigma_(inv_sigma) {}
+  /// `inv_sigma`: 1 / the sigma of the step per axis (walk: K sqrt(dt); instability:
+  /// s sqrt(1 - phi^2)), 1 / sensor units (> 0, finite); `phi`: the factor carried over
+  /// (1 for the walk, exp(-dt / tau) for the instability).
+  explicit BiasWalkResidual(const Vec3& inv_sigma, double phi = 1.0)
+      : inv_sigma_(inv_sigma), phi_(phi) {}
 
   template <typename T>
   bool operator()(const T* from, const T* to, T* residuals) const {
-    for (int i = 0; i < 3; ++i) residuals[i] = (to[i] - from[i]) * inv_sigma_[i];
+    for (int i = 0; i < 3; ++i) residuals[i] = (to[i] - phi_ * from[i]) * inv_sigma_[i];
     return true;
   }
   template <typename T>
@@ -39,12 +50,13 @@ class BiasWalkResidual {
   }
 
   /// The factor between two states (blocks b_from, b_to).
-  static ceres::CostFunction* Create(const Vec3& inv_sigma);
+  static ceres::CostFunction* Create(const Vec3& inv_sigma, double phi = 1.0);
   /// The anchor: the walk starts at zero at t_ref (block b_to).
   static ceres::CostFunction* CreateAnchor(const Vec3& inv_sigma);
 
  private:
   Vec3 inv_sigma_;
+  double phi_ = 1.0;
 };
 
 }  // namespace plumb::residuals

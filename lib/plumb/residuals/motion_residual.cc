@@ -25,8 +25,8 @@ Eigen::Matrix<double, 4, 3> LeftPlusJacobian(const Quat& q) {
 }
 
 MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
-                               const Vec3& omega_ie_n, bool walk)
-    : model_(&model), s_(std::move(samples)), omega_ie_n_(omega_ie_n), walk_(walk) {
+                               const Vec3& omega_ie_n, int wander_processes)
+    : model_(&model), s_(std::move(samples)), omega_ie_n_(omega_ie_n), wander_(wander_processes) {
   for (const auto& t : model.terms()) {
     block_offset_.push_back(num_model_parameters_);
     num_model_parameters_ += t.effect->info().size();
@@ -37,9 +37,8 @@ MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
   mutable_parameter_block_sizes()->push_back(4);
   mutable_parameter_block_sizes()->push_back(4);
   for (const auto& t : model.terms()) mutable_parameter_block_sizes()->push_back(t.effect->info().size());
-  if (walk_) {
-    mutable_parameter_block_sizes()->push_back(3);
-    mutable_parameter_block_sizes()->push_back(3);
+  if (wander_ > 0) {
+    for (int b = 0; b < 2 * wander_; ++b) mutable_parameter_block_sizes()->push_back(3);
     const double span = s_.dt_s.back() - s_.dt_s.front();
     for (std::size_t i = 0; i < s_.size(); ++i) {
       walk_weight_.push_back(span > 0 ? (s_.dt_s[i] - s_.dt_s.front()) / span : 0.0);
@@ -131,23 +130,27 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   double const* const* theta = parameters + 2;
   const bool want_jacobians = jacobians != nullptr;
   const int P = num_model_parameters_;
-  // Unknowns: model parameters, the left perturbation of R_k, then (walk) b_from and b_to.
-  const int U = P + 3 + (walk_ ? 6 : 0);
+  // Unknowns: model parameters, the left perturbation of R_k, then (wander) b_from and b_to.
+  const bool walk = wander_ > 0;
+  const int U = P + 3 + (walk ? 6 : 0);
   const int att = P;      // column of R_k's perturbation
   const int from = P + 3;  // columns of b_from, then b_to
 
   // The outputs with the bias walk taken off (the samples themselves without a walk).
   std::vector<Vec3> walked;
   const std::vector<double>& a = walk_weight_;
-  if (walk_) {
-    const Eigen::Map<const Vec3> b_from(parameters[2 + model_->num_terms()]);
-    const Eigen::Map<const Vec3> b_to(parameters[3 + model_->num_terms()]);
+  if (walk) {
+    Vec3 b_from = Vec3::Zero(), b_to = Vec3::Zero();
+    for (int p = 0; p < wander_; ++p) {
+      b_from += Eigen::Map<const Vec3>(parameters[2 + model_->num_terms() + 2 * p]);
+      b_to += Eigen::Map<const Vec3>(parameters[3 + model_->num_terms() + 2 * p]);
+    }
     walked.resize(s_.size());
     for (std::size_t i = 0; i < s_.size(); ++i) {
       walked[i] = s_.gyr[i] - ((1.0 - a[i]) * b_from + a[i] * b_to);
     }
   }
-  const std::vector<Vec3>& gyr = walk_ ? walked : s_.gyr;
+  const std::vector<Vec3>& gyr = walk ? walked : s_.gyr;
 
   std::vector<Vec3> w;
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> W;
@@ -171,7 +174,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
                                Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
     if (!closed_form) {
       out.leftCols(P).noalias() += K * W[i];
-      if (walk_) {
+      if (walk) {
         const Mat3 K_dw_db = K * W[i].middleCols<3>(bias_offset_);
         out.middleCols<3>(from).noalias() += (1.0 - a[i]) * K_dw_db;
         out.middleCols<3>(from + 3).noalias() += a[i] * K_dw_db;
@@ -182,7 +185,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     const Mat3 KE_inv = K * E_inv;
     model::gyro_linear::SubtractRateJacobian(
         KE_inv, w[i], out.middleCols(gyro_offset, model::gyro_linear::kSize));
-    if (walk_) {
+    if (walk) {
       out.middleCols<3>(from).noalias() -= (1.0 - a[i]) * KE_inv;
       out.middleCols<3>(from + 3).noalias() -= a[i] * KE_inv;
     }
@@ -246,13 +249,11 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J_out(out, 3, size);
     J_out = J_theta.middleCols(block_offset_[static_cast<std::size_t>(t)], size);
   }
-  if (walk_) {
-    for (int b = 0; b < 2; ++b) {
-      double* out = jacobians[2 + model_->num_terms() + b];
-      if (!out) continue;
-      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> J_out(out);
-      J_out = Wsi * (-Jli * A.middleCols<3>(from + 3 * b));
-    }
+  for (int b = 0; b < 2 * wander_; ++b) {
+    double* out = jacobians[2 + model_->num_terms() + b];
+    if (!out) continue;
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> J_out(out);
+    J_out = Wsi * (-Jli * A.middleCols<3>(from + 3 * (b % 2)));
   }
   return true;
 }
@@ -262,7 +263,7 @@ Quat MotionResidual::Integrate(const double* q_k, const model::ParameterBlocks& 
   std::vector<const double*> p = {q_k, q_k};
   for (const auto& b : theta) p.push_back(b.data());
   const double zero[3] = {0.0, 0.0, 0.0};
-  if (walk_) p.insert(p.end(), {zero, zero});
+  for (int b = 0; b < 2 * wander_; ++b) p.push_back(zero);
   double r[3];
   Evaluate(p.data(), r, nullptr);
   const Vec3 rv = Vec3(r[0], r[1], r[2]).cwiseQuotient(s_.sqrt_info);

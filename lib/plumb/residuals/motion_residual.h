@@ -24,11 +24,14 @@
 // b_to at the last (the walk at the first sample of k+1), linear in time between them (the
 // Brownian bridge about that line is in sqrt_info), and is taken off the output before the
 // model is inverted: y_g,i - ((1 - a_i) b_from + a_i b_to), a_i = (t_i - t_0) / (t_n - t_0).
-// It enters like the gyroscope bias, so d w_i / d b_from = (1 - a_i) d w_i / d b_g.
+// It enters like the gyroscope bias, so d w_i / d b_from = (1 - a_i) d w_i / d b_g. When the
+// bias wanders as a sum of processes (walk, instability), b_from and b_to are the sums of
+// their states, which all have the same Jacobian.
 //
 // Parameter blocks, in order: q_k (4), q_k+1 (4) (Eigen order x y z w, R_n_b, manifolds of
 // plumb/residuals/manifolds.h: left perturbation in NED), then every block of the model in
-// model order, then, with `walk`, b_from (3) and b_to (3) in sensor units.
+// model order, then, per wander process (`wander_processes` of them), its b_from (3) and b_to
+// (3) in sensor units.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -43,11 +46,11 @@ class MotionResidual final : public ceres::CostFunction {
   /// `omega_ie_n`: Earth rate in NED, rad/s (zero without a site). The model must outlive
   /// the cost function.
   MotionResidual(const model::Model& model, MotionSamples samples, const Vec3& omega_ie_n,
-                 bool walk = false);
+                 int wander_processes = 0);
 
   static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
-                                     const Vec3& omega_ie_n, bool walk = false) {
-    return new MotionResidual(model, std::move(samples), omega_ie_n, walk);
+                                     const Vec3& omega_ie_n, int wander_processes = 0) {
+    return new MotionResidual(model, std::move(samples), omega_ie_n, wander_processes);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
@@ -73,7 +76,7 @@ class MotionResidual final : public ceres::CostFunction {
   Vec3 omega_ie_n_;
   int num_model_parameters_ = 0;
   std::vector<int> block_offset_;  // offset of each model block in the P parameters
-  bool walk_ = false;              // the gyroscope bias walk's two blocks follow the model's
+  int wander_ = 0;                 // wander processes; their block pairs follow the model's
   int bias_offset_ = -1;           // offset of b_g among the P parameters (-1: no gyroscope)
   std::vector<double> walk_weight_;  // per sample, with a walk: a_i, the weight of b_to
 };

@@ -7,9 +7,9 @@ namespace plumb::residuals {
 StillResidual::StillResidual(const model::Model& model, model::Sensor sensor,
                              std::vector<int> terms, StillMeasurement measurement,
                              const Vec3& g_n, const Vec3& omega_ie_n, const Vec3& omega_eb_b,
-                             bool walk)
+                             std::vector<double> wander_weights)
     : model_(&model), sensor_(sensor), terms_(std::move(terms)), m_(measurement), g_n_(g_n),
-      omega_ie_n_(omega_ie_n), omega_eb_b_(omega_eb_b), walk_(walk) {}
+      omega_ie_n_(omega_ie_n), omega_eb_b_(omega_eb_b), wander_weights_(std::move(wander_weights)) {}
 
 std::vector<int> StillResidual::TermsOf(const model::Model& model, model::Sensor sensor) {
   std::vector<int> terms;
@@ -41,10 +41,10 @@ Vec3T<T> StillResidual::PredictT(T const* const* parameters) const {
 template <typename T>
 bool StillResidual::operator()(T const* const* parameters, T* residuals) const {
   Vec3T<T> predicted = PredictT(parameters);
-  if (walk_) {
-    const std::size_t w = terms_.size() + 1;
+  for (std::size_t p = 0; p < wander_weights_.size(); ++p) {
+    const std::size_t w = terms_.size() + 1 + 2 * p;
     const Eigen::Map<const Vec3T<T>> s_k(parameters[w]), e_k(parameters[w + 1]);
-    predicted += T(0.5) * (s_k + e_k);
+    predicted += T(wander_weights_[p]) * (s_k + e_k);
   }
   Eigen::Map<Vec3T<T>> r(residuals);
   r = (m_.mean.cast<T>() - predicted).cwiseProduct(m_.sqrt_info.cast<T>());
@@ -60,17 +60,15 @@ Vec3 StillResidual::Predict(const double* q_k, const model::ParameterBlocks& the
 ceres::CostFunction* StillResidual::Create(const model::Model& model, model::Sensor sensor,
                                            StillMeasurement measurement, const Vec3& g_n,
                                            const Vec3& omega_ie_n, const Vec3& omega_eb_b,
-                                           bool walk) {
+                                           std::vector<double> wander_weights) {
   auto terms = TermsOf(model, sensor);
-  auto* functor =
-      new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n, omega_eb_b, walk);
+  const std::size_t processes = wander_weights.size();
+  auto* functor = new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n,
+                                    omega_eb_b, std::move(wander_weights));
   auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, model::kJetStride>(functor);
   cost->AddParameterBlock(4);
   for (int t : terms) cost->AddParameterBlock(model.terms()[static_cast<std::size_t>(t)].effect->info().size());
-  if (walk) {
-    cost->AddParameterBlock(3);
-    cost->AddParameterBlock(3);
-  }
+  for (std::size_t p = 0; p < 2 * processes; ++p) cost->AddParameterBlock(3);
   cost->SetNumResiduals(3);
   return cost;
 }

@@ -19,9 +19,14 @@
 //
 //   r = W (mean(y)_k - h(theta, ...) - (s_k + e_k) / 2)
 //
+// More generally the bias wanders as a sum of independent Markov processes (the walk, the
+// instability's Gauss-Markov process), each with its states at both ends; the segment mean
+// carries sum_p w_p (s_p + e_p), w_p the weight of process p (1/2 for the walk; for a
+// Gauss-Markov process the mean of its bridge, estimation/calibration_problem.cc).
+//
 // Parameter blocks, in order: q_k (4, Eigen order x y z w, unit quaternion of R_n_b), then
-// the blocks of the model terms listed in `terms` (their sizes in info().size()), then, with
-// `walk`, s_k (3) and e_k (3) in sensor units.
+// the blocks of the model terms listed in `terms` (their sizes in info().size()), then, per
+// entry of `wander_weights`, s_p (3) and e_p (3) in sensor units.
 // Units: g_n in m/s^2 (NED, down positive), omega in rad/s, outputs in sensor units.
 #pragma once
 
@@ -43,7 +48,7 @@ class StillResidual {
   /// rad/s (zero without a site); `omega_eb_b` a known rate relative to the Earth, rad/s.
   StillResidual(const model::Model& model, model::Sensor sensor, std::vector<int> terms,
                 StillMeasurement measurement, const Vec3& g_n, const Vec3& omega_ie_n,
-                const Vec3& omega_eb_b = Vec3::Zero(), bool walk = false);
+                const Vec3& omega_eb_b = Vec3::Zero(), std::vector<double> wander_weights = {});
 
   template <typename T>
   bool operator()(T const* const* parameters, T* residuals) const;
@@ -52,7 +57,7 @@ class StillResidual {
   static ceres::CostFunction* Create(const model::Model& model, model::Sensor sensor,
                                      StillMeasurement measurement, const Vec3& g_n,
                                      const Vec3& omega_ie_n,
-                                     const Vec3& omega_eb_b = Vec3::Zero(), bool walk = false);
+                                     const Vec3& omega_eb_b = Vec3::Zero(), std::vector<double> wander_weights = {});
 
   /// Indices of the model terms that act on `sensor`.
   static std::vector<int> TermsOf(const model::Model& model, model::Sensor sensor);
@@ -69,7 +74,7 @@ class StillResidual {
   std::vector<int> terms_;
   StillMeasurement m_;
   Vec3 g_n_, omega_ie_n_, omega_eb_b_;
-  bool walk_ = false;
+  std::vector<double> wander_weights_;  // per wander process: w_p
 };
 
 }  // namespace plumb::residuals

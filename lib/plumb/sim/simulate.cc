@@ -6,6 +6,7 @@
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/core/typical_mems.h"
 
 namespace plumb::sim {
 namespace {
@@ -31,6 +32,12 @@ void ValidateOptions(const SimulationOptions& o) {
   CheckNonNegative(o.gyro_noise_density, "gyro_noise_density (rad/s/sqrt(Hz))");
   CheckNonNegative(o.accel_bias_walk_density, "accel_bias_walk_density (m/s^3/sqrt(Hz))");
   CheckNonNegative(o.gyro_bias_walk_density, "gyro_bias_walk_density (rad/s^2/sqrt(Hz))");
+  CheckNonNegative(o.accel_bias_instability, "accel_bias_instability (m/s^2)");
+  CheckNonNegative(o.gyro_bias_instability, "gyro_bias_instability (rad/s)");
+  if (!(std::isfinite(o.bias_instability_time_s) && o.bias_instability_time_s > 0.0)) {
+    throw Error("simulation option bias_instability_time_s = " +
+                std::to_string(o.bias_instability_time_s) + " must be finite and > 0 (s)");
+  }
   CheckNonNegative(o.accel_quantum, "accel_quantum (m/s^2)");
   CheckNonNegative(o.gyro_quantum, "gyro_quantum (rad/s)");
   if (!std::isfinite(o.t0_s)) throw Error("simulation option t0_s must be finite");
@@ -98,6 +105,21 @@ struct NoiseSource {
   }
 };
 
+/// The bias instability of one sensor: per axis a first-order Gauss-Markov process,
+/// propagated exactly over one sample, starting at zero.
+class Instability {
+ public:
+  Instability(double sigma, double tau_s, double rate_hz)
+      : phi_(std::exp(-1.0 / (rate_hz * tau_s))), step_(sigma * std::sqrt(1.0 - phi_ * phi_)) {}
+  bool on() const { return step_ > 0.0; }
+  const Vec3& value() const { return state_; }
+  void Step(NoiseSource& noise) { state_ = phi_ * state_ + step_ * noise.Draw(); }
+
+ private:
+  double phi_ = 0.0, step_ = 0.0;
+  Vec3 state_ = Vec3::Zero();
+};
+
 }  // namespace
 
 TemperatureProfile TemperatureProfile::Constant(double temp_c) {
@@ -151,11 +173,20 @@ void TemperatureProfile::Validate() const {
 }
 
 SimulationOptions SimulationOptions::TypicalMems() {
+  SimulationOptions o = WhiteMems();
+  o.accel_bias_walk_density = typical_mems::kAccelWalk;
+  o.gyro_bias_walk_density = typical_mems::kGyroWalk;
+  o.accel_bias_instability = typical_mems::kAccelInstability;
+  o.gyro_bias_instability = typical_mems::kGyroInstability;
+  o.bias_instability_time_s = typical_mems::kInstabilityTime_s;
+  o.temperature = TemperatureProfile::Ramp(25.0, 35.0);
+  return o;
+}
+
+SimulationOptions SimulationOptions::WhiteMems() {
   SimulationOptions o;
-  o.accel_noise_density = 1e-3;
-  o.gyro_noise_density = 7e-5;
-  o.accel_bias_walk_density = 1e-4;
-  o.gyro_bias_walk_density = 2e-6;
+  o.accel_noise_density = typical_mems::kAccelNoiseDensity;
+  o.gyro_noise_density = typical_mems::kGyroNoiseDensity;
   return o;
 }
 
@@ -204,6 +235,10 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
   NoiseSource noise{std::mt19937_64(options.seed)};
   Vec3 accel_walk = Vec3::Zero();
   Vec3 gyro_walk = Vec3::Zero();
+  Instability accel_instability(options.accel_bias_instability, options.bias_instability_time_s,
+                                rate_hz);
+  Instability gyro_instability(options.gyro_bias_instability, options.bias_instability_time_s,
+                               rate_hz);
   std::vector<const double*> theta;
   for (const auto& block : sim.truth) theta.push_back(block.data());
 
@@ -222,8 +257,10 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
       const model::SensorOutput<double> out = sim.model.Predict<double>(theta.data(), in);
       const Vec3 accel_white = noise.Draw();
       const Vec3 gyro_white = noise.Draw();
-      const Vec3 acc = out.acc + accel_walk + sim.accel_sigma * accel_white;
-      const Vec3 gyr = out.gyr + gyro_walk + sim.gyro_sigma * gyro_white;
+      const Vec3 accel_wander = accel_walk + accel_instability.value();
+      const Vec3 gyro_wander = gyro_walk + gyro_instability.value();
+      const Vec3 acc = out.acc + accel_wander + sim.accel_sigma * accel_white;
+      const Vec3 gyr = out.gyr + gyro_wander + sim.gyro_sigma * gyro_white;
       series.t_s.push_back(t_s);
       series.acc.push_back(Quantise(acc, options.accel_quantum).cast<float>());
       if (gyro) series.gyr.push_back(Quantise(gyr, options.gyro_quantum).cast<float>());
@@ -233,11 +270,15 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
         still.f_b = in.f_b;
         still.omega_b = in.omega_b;
       }
-      still.accel_bias_walk += accel_walk;
-      still.gyro_bias_walk += gyro_walk;
+      still.accel_bias_walk += accel_wander;
+      still.gyro_bias_walk += gyro_wander;
       still.mean_temp_c += temp_c;
       accel_walk += accel_walk_step * noise.Draw();
       gyro_walk += gyro_walk_step * noise.Draw();
+      // Drawn after the walk, and only when on: sessions without instability keep the noise
+      // sequence they had before it existed.
+      if (accel_instability.on()) accel_instability.Step(noise);
+      if (gyro_instability.on()) gyro_instability.Step(noise);
     }
     if (!schedule.is_still(i) || end == begin) continue;
     const double count = static_cast<double>(end - begin);

@@ -20,6 +20,7 @@
 // density is zero, so the same options give the same session bit for bit.
 #pragma once
 
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -76,6 +77,14 @@ struct SimulationOptions {
   /// >= 0. The bias moves by a step of sigma density / sqrt(rate_hz) per sample.
   double accel_bias_walk_density = 0.0;
   double gyro_bias_walk_density = 0.0;
+  /// Bias instability, the usual inertial-navigation model of it: per axis a first-order
+  /// Gauss-Markov process of steady-state sigma accel m/s^2, gyro rad/s (>= 0) and
+  /// correlation time bias_instability_time_s (> 0). Its Allan deviation peaks at
+  /// 0.618 sigma near 1.89 tau, so IEEE Std 952's B (peak / 0.664) is 0.93 sigma. The
+  /// process starts at zero at t0_s, like the walk: the truth's bias is the bias at the start.
+  double accel_bias_instability = 0.0;
+  double gyro_bias_instability = 0.0;
+  double bias_instability_time_s = 30.0;
   /// Quantisation steps of the outputs: accelerometer m/s^2, gyroscope rad/s; >= 0, 0 = none.
   double accel_quantum = 0.0;
   double gyro_quantum = 0.0;
@@ -89,10 +98,15 @@ struct SimulationOptions {
   std::uint64_t seed = 1;
 
   /// Noise of a typical consumer MEMS IMU on a small UAV (ICM-20602/42688 class):
-  /// accelerometer 1e-3 m/s^2/sqrt(Hz) (100 ug/sqrt(Hz)), gyroscope 7e-5 rad/s/sqrt(Hz)
-  /// (0.004 deg/s/sqrt(Hz)), bias walks 1e-4 m/s^3/sqrt(Hz) and 2e-6 rad/s^2/sqrt(Hz), no
-  /// quantisation. Other fields keep their defaults.
+  /// accelerometer white 1e-3 m/s^2/sqrt(Hz) (100 ug/sqrt(Hz)), gyroscope 7e-5 rad/s/sqrt(Hz)
+  /// (0.004 deg/s/sqrt(Hz)); bias instability (Gauss-Markov sigma) 4e-4 m/s^2 (40 ug) and
+  /// 2e-5 rad/s (4 deg/h), correlation time 30 s;
+  /// bias walks 1e-4 m/s^3/sqrt(Hz) and 2e-6 rad/s^2/sqrt(Hz); the board warming from 25 to
+  /// 35 degC over the session (a ramp; it moves the outputs only through the true model's
+  /// temperature effects); no quantisation. Other fields keep their defaults.
   static SimulationOptions TypicalMems();
+  /// The same without bias instability, walk or temperature change: white noise only.
+  static SimulationOptions WhiteMems();
 };
 
 /// Truth of one still step.
@@ -101,8 +115,10 @@ struct StillTruth {
   Quat R_n_b = Quat::Identity();      ///< true attitude, body to NED
   Vec3 f_b = Vec3::Zero();            ///< true specific force, body frame, m/s^2
   Vec3 omega_b = Vec3::Zero();        ///< true angular rate (Earth rate), body frame, rad/s
-  Vec3 accel_bias_walk = Vec3::Zero();  ///< mean random-walk bias over the segment, m/s^2
-  Vec3 gyro_bias_walk = Vec3::Zero();   ///< mean random-walk bias over the segment, rad/s
+  /// Mean over the segment of the bias's wander from its value at t0 (random walk plus
+  /// instability), m/s^2 and rad/s.
+  Vec3 accel_bias_walk = Vec3::Zero();
+  Vec3 gyro_bias_walk = Vec3::Zero();
   double mean_temp_c = 0.0;           ///< mean temperature over the segment, degC
 };
 
