@@ -2,8 +2,8 @@
 
 #include "plumb/core/error.h"
 
-#include <Eigen/SparseQR>
-#include <Eigen/OrderingMethods>
+#include <Eigen/SVD>
+#include <Eigen/SparseCholesky>
 #include <string>
 
 namespace plumb::estimation {
@@ -31,24 +31,51 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 
 namespace {
 
-/// The whitened Jacobian of the columns before `columns.first_wander` with the wander states
-/// eliminated: J = [J_a J_w], J_w = Q [R; 0] (sparse QR; J_w has full column rank, every
-/// state being tied to zero at t_ref by its Markov factors), and the rows of Q^T J_a below
-/// R are the part of J_a the wander states cannot absorb. Its SVD gives the rank, null space
-/// and covariance of the other unknowns with the wander marginalised, as the full dense
-/// analysis would, at the cost of a sparse QR instead of an SVD over every state.
-Eigen::MatrixXd WanderEliminated(const Eigen::SparseMatrix<double>& J, Eigen::Index first_wander) {
-  const Eigen::Index n_w = J.cols() - first_wander;
-  const Eigen::SparseMatrix<double> J_w = J.rightCols(n_w);
-  Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> qr(J_w);
-  if (qr.info() != Eigen::Success || qr.rank() != n_w) {
-    throw Error("the bias-wander states are not determined by their factors (rank " +
-                std::to_string(qr.rank()) + " of " + std::to_string(n_w) + ")");
+/// The whitened Jacobian J = [J_a J_w] split at `first_wander`, and the projection P_w onto
+/// the range of the wander states' columns J_w, through the sparse Cholesky factor of
+/// J_w^T J_w (J_w has full column rank and a banded normal matrix: every state is tied to
+/// zero at t_ref by its Markov factors). (I - P_w) J_a is the part of J_a the wander states
+/// cannot absorb: its SVD gives the rank, null space and covariance of the other unknowns
+/// with the wander marginalised, as the full dense analysis would, at the cost of a banded
+/// factorisation instead of an SVD over every state. One step of iterative refinement (the
+/// corrected semi-normal equations) keeps it as accurate as a QR of J_w.
+class WanderElimination {
+ public:
+  WanderElimination(const Eigen::SparseMatrix<double>& J, Eigen::Index first_wander)
+      : J_(J), first_(first_wander), J_w_(J.rightCols(J.cols() - first_wander)) {
+    chol_.compute(Eigen::SparseMatrix<double>(J_w_.transpose() * J_w_));
+    if (chol_.info() != Eigen::Success) {
+      throw Error("the bias-wander states are not determined by their factors (their normal "
+                  "matrix is not positive definite)");
+    }
   }
-  const Eigen::MatrixXd J_a = Eigen::MatrixXd(J.leftCols(first_wander));
-  const Eigen::MatrixXd QtJ_a = qr.matrixQ().transpose() * J_a;
-  return QtJ_a.bottomRows(J.rows() - n_w);
-}
+  /// (I - P_w) A for a dense A with J's rows.
+  Eigen::MatrixXd Project(const Eigen::MatrixXd& A) const {
+    Eigen::MatrixXd X = chol_.solve(J_w_.transpose() * A);
+    Eigen::MatrixXd R = A - J_w_ * X;
+    X = chol_.solve(J_w_.transpose() * R);  // refinement
+    return R - J_w_ * X;
+  }
+  /// (I - P_w) J_a: rows x first_wander.
+  Eigen::MatrixXd Reduced() const { return Project(Eigen::MatrixXd(J_.leftCols(first_))); }
+  /// The diagonal of P_w at `rows`.
+  Eigen::VectorXd WanderLeverage(const std::vector<Eigen::Index>& rows) const {
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(J_.rows(), static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t i = 0; i < rows.size(); ++i) E(rows[i], static_cast<Eigen::Index>(i)) = 1.0;
+    const Eigen::MatrixXd P = E - Project(E);  // P_w E
+    Eigen::VectorXd out(static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      out[static_cast<Eigen::Index>(i)] = P(rows[i], static_cast<Eigen::Index>(i));
+    }
+    return out;
+  }
+
+ private:
+  const Eigen::SparseMatrix<double>& J_;
+  Eigen::Index first_;
+  Eigen::SparseMatrix<double> J_w_;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> chol_;
+};
 
 }  // namespace
 
@@ -69,8 +96,8 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
     if (jacobian != nullptr) *jacobian = std::move(in.J);
     return out;
   }
-  const auto first = static_cast<Eigen::Index>(columns.first_wander);
-  in.J = WanderEliminated(calibration.SparseJacobian(problem, columns, cost, residuals), first);
+  const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, cost, residuals);
+  in.J = WanderElimination(J, static_cast<Eigen::Index>(columns.first_wander)).Reduced();
   in.names.resize(columns.first_wander);
   in.values.resize(columns.first_wander);
   in.is_model.resize(columns.first_wander);
@@ -80,6 +107,39 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   out.summary.rank += n_w;
   out.summary.num_unknowns += n_w;
   return out;
+}
+
+Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& problem,
+                          const CalibrationOptions& options, const std::vector<Eigen::Index>& rows,
+                          std::vector<double>* residuals) {
+  const UnknownColumns columns = calibration.Columns(problem);
+  double cost = 0;
+  const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, &cost, residuals);
+  // The projector onto range(J) is P_w (the wander columns' range) plus the projector U_r U_r^T
+  // onto the range of the reduced Jacobian M = (I - P_w) J_a, M's rank as the analysis
+  // decides it on unit-norm columns: h_ii = (P_w)_ii + |U_r^T e_i|^2.
+  const auto first = static_cast<Eigen::Index>(columns.first_wander);
+  Eigen::MatrixXd M;
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
+  if (first < J.cols()) {
+    const WanderElimination elimination(J, first);
+    M = elimination.Reduced();
+    h = elimination.WanderLeverage(rows);
+  } else {
+    M = Eigen::MatrixXd(J);
+  }
+  for (Eigen::Index c = 0; c < M.cols(); ++c) {
+    const double norm = M.col(c).norm();
+    if (norm > 0) M.col(c) /= norm;
+  }
+  const Eigen::BDCSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  Eigen::Index r = 0;
+  while (r < sv.size() && sv[r] > options.rank_tolerance * sv[0]) ++r;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    h[static_cast<Eigen::Index>(i)] += svd.matrixU().row(rows[i]).head(r).squaredNorm();
+  }
+  return h;
 }
 
 Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOptions& options,

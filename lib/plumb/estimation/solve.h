@@ -50,6 +50,13 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
                                 double* cost, std::vector<double>* residuals,
                                 Eigen::MatrixXd* jacobian = nullptr);
 
+/// The leverages h_ii = J_i (J^T J)^+ J_i^T of the whitened residual rows `rows` of `problem`
+/// (every free unknown, the wander states eliminated by a sparse QR first), and its whitened
+/// residuals (optional): the part of each residual the fit absorbs, for variance components.
+Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& problem,
+                          const CalibrationOptions& options, const std::vector<Eigen::Index>& rows,
+                          std::vector<double>* residuals);
+
 /// The solved problem.
 struct Solution {
   BuiltProblem all_free;  ///< every free unknown: for the analysis and the residuals
