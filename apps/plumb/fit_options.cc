@@ -54,34 +54,42 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
                   "(the gate not_converged)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  // The bias wander (estimation/noise_model.h): with any of these options the bias wanders
-  // in the fit, and the levels not given are estimated (the walk) or typical.
-  const char* kWander = " Any wander option makes the bias wander in the fit; the levels not "
-                        "given are then estimated (walk) or typical MEMS (instability)";
-  app->add_option("--accel-rw", a.accel_walk_density,
-                  std::string("Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor "
-                              "units/s/sqrt(Hz) for unscaled samples); 0 = none.") + kWander)
-      ->check(kFiniteNonNegative);
-  app->add_option("--gyro-rw", a.gyro_walk_density,
-                  "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor "
-                  "units/s/sqrt(Hz) for unscaled samples); 0 = none")
-      ->check(kFiniteNonNegative);
-  app->add_flag("--estimate-rw", a.estimate_walk,
-                "Estimate the bias random walks not given from the session itself (variance "
-                "components over the walk factors; 6 or more still poses, else the typical MEMS "
-                "walk)");
-  app->add_option("--accel-bi", a.accel_instability,
-                  "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 "
-                  "(sensor units for unscaled samples); 0 = none; typical MEMS 4e-4")
-      ->check(kFiniteNonNegative);
-  app->add_option("--gyro-bi", a.gyro_instability,
-                  "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s "
-                  "(sensor units for unscaled samples); 0 = none; typical MEMS 2e-5")
-      ->check(kFiniteNonNegative);
-  app->add_option("--bi-time", a.instability_time_s,
-                  "Correlation time of the bias instability, s")
-      ->check(CLI::Range(1e-3, 1e9))
-      ->capture_default_str();
+  // The bias wander (estimation/noise_model.h): by default the bias wanders (a random walk
+  // and a Gauss-Markov instability); levels not given are estimated (the walk) or typical.
+  auto* rw_acc = app->add_option(
+      "--accel-rw", a.accel_walk_density,
+      "Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor units/s/sqrt(Hz) for unscaled "
+      "samples); 0 = none. Default: estimated from the session (6 or more still poses), else "
+      "the typical MEMS walk 1e-4");
+  rw_acc->check(kFiniteNonNegative);
+  auto* rw_gyr = app->add_option(
+      "--gyro-rw", a.gyro_walk_density,
+      "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor units/s/sqrt(Hz) "
+      "for unscaled samples); 0 = none. Default as --accel-rw (typical 2e-6)");
+  rw_gyr->check(kFiniteNonNegative);
+  auto* estimate = app->add_flag(
+      "--estimate-rw,!--no-estimate-rw", a.estimate_walk,
+      "Estimate the bias random walks not given from the session (variance components over "
+      "the walk factors; 6 or more still poses): the default. --no-estimate-rw takes the "
+      "typical MEMS walk instead");
+  auto* bi_acc = app->add_option(
+      "--accel-bi", a.accel_instability,
+      "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 (sensor units "
+      "for unscaled samples); 0 = none. Default: the typical MEMS 4e-4");
+  bi_acc->check(kFiniteNonNegative);
+  auto* bi_gyr = app->add_option(
+      "--gyro-bi", a.gyro_instability,
+      "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s (sensor units for "
+      "unscaled samples); 0 = none. Default: the typical MEMS 2e-5");
+  bi_gyr->check(kFiniteNonNegative);
+  auto* bi_time = app->add_option("--bi-time", a.instability_time_s,
+                                  "Correlation time of the bias instability, s");
+  bi_time->check(CLI::Range(1e-3, 1e9))->capture_default_str();
+  auto* constant = app->add_flag(
+      "--constant-bias", a.constant_bias,
+      "One constant bias over the session: no random walk, no instability (the sigma is then "
+      "honest only for white noise; for comparisons with peers that assume it)");
+  for (auto* o : {rw_acc, rw_gyr, estimate, bi_acc, bi_gyr, bi_time}) constant->excludes(o);
 }
 
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
@@ -111,6 +119,7 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
   out.options.accel_instability = fit.accel_instability;
   out.options.gyro_instability = fit.gyro_instability;
   out.options.instability_time_s = fit.instability_time_s;
+  out.options.constant_bias = fit.constant_bias;
   return out;
 }
 

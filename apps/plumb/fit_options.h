@@ -32,7 +32,8 @@ struct FitArgs {
   /// --accel-rw / --gyro-rw: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0.
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
-  bool estimate_walk = false;  ///< --estimate-rw
+  bool estimate_walk = true;  ///< --estimate-rw / --no-estimate-rw
+  bool constant_bias = false;  ///< --constant-bias
   /// --accel-bi / --gyro-bi: bias instability (Gauss-Markov sigma), sensor units, >= 0;
   /// --bi-time: its correlation time, s.
   std::optional<double> accel_instability;
@@ -47,7 +48,8 @@ inline constexpr int kExitGateFailed = 3;
 void AddModelOption(CLI::App* app, FitArgs& args);
 
 /// Registers --strict, --heading, --level-north, --temp-ref, --max-iterations, the bias
-/// wander (--accel-rw, --gyro-rw, --estimate-rw, --accel-bi, --gyro-bi, --bi-time) on `app`.
+/// wander (--accel-rw, --gyro-rw, --estimate-rw, --accel-bi, --gyro-bi, --bi-time,
+/// --constant-bias) on `app`.
 void AddFitOptions(CLI::App* app, FitArgs& args);
 
 /// Everything Calibrate() takes besides the samples.

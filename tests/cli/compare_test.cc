@@ -157,7 +157,7 @@ TEST(CliCompare, ImuTksOwnDataAgreesWithImuTk) {
   const std::string result = dir.File("imu_tk_plumb.json");
   const ToolRun cal = Plumb({"calibrate", "--acc", kImuTk + "/xsens_acc.mat", "--gyr",
                              kImuTk + "/xsens_gyro.mat", "--init-still", "50", "--gravity",
-                             "9.81744", "--json", result},
+                             "9.81744", "--constant-bias", "--json", result},
                             dir);
   ASSERT_EQ(cal.exit_code, 0) << cal.err;
   const std::string out = dir.File("comparison.json");

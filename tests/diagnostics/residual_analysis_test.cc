@@ -60,7 +60,9 @@ Scenario SimulateAndFit(const Truth& setup, const sim::Schedule& schedule) {
   model::Model base = model::Model::Parse("base");
   base.t_ref_s = s.sim.model.t_ref_s;
   base.temp_ref_c = s.sim.model.temp_ref_c;
-  s.fit = estimation::Calibrate(s.sim.session.series, segments, base, s.sim.site);
+  estimation::CalibrationOptions white;  // white noise: one constant bias matches
+  white.constant_bias = true;
+  s.fit = estimation::Calibrate(s.sim.session.series, segments, base, s.sim.site, white);
   return s;
 }
 

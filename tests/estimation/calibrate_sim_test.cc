@@ -32,13 +32,13 @@ enum class Noise {
 /// How the fit treats the bias.
 enum class Fit {
   kWander,    ///< the bias wanders, at the simulator's levels (--accel-rw ... --gyro-bi)
-  kEstimate,  ///< the bias wanders: walk estimated (--estimate-rw), typical instability
-  kConstant,  ///< one constant bias (CalibrationOptions as they come)
+  kEstimate,  ///< the default: walk estimated from the session, typical instability
+  kConstant,  ///< one constant bias (--constant-bias)
 };
 
 CalibrationOptions OptionsFor(Fit fit) {
   CalibrationOptions options;
-  options.estimate_walk = fit == Fit::kEstimate;
+  options.constant_bias = fit == Fit::kConstant;
   if (fit == Fit::kWander) {
     const sim::SimulationOptions truth = sim::SimulationOptions::TypicalMems();
     options.accel_walk_density = truth.accel_bias_walk_density;
@@ -221,7 +221,7 @@ TEST(CalibrateSimulated, CovarianceIsHonestOnThePaperBenchmarkWithRealisticNoise
 }
 
 TEST(CalibrateSimulated, AConstantBiasUnderstatesSigmaWhenTheBiasWanders) {
-  // The same sessions fitted with one constant bias (the default): the sigmas are too
+  // The same sessions fitted with one constant bias (--constant-bias): the sigmas are too
   // small, what the wander states above repair. 30 s holds: NEES/dof far above 1.
   double lo = 0, hi = 0;
   const double nees = MeanNeesPerDof(40, 30.0, Fit::kConstant, &lo, &hi);

@@ -121,7 +121,10 @@ struct Demonstration {
 estimation::CalibrationResult Fit(const sim::Simulation& s, const std::string& spec) {
   std::vector<StillSegment> segments = s.truth_segments;
   for (auto& segment : segments) segment.known_R_n_b.reset();  // attitudes are unknowns
-  return estimation::Calibrate(s.session.series, segments, model::Model::Parse(spec), s.site);
+  estimation::CalibrationOptions white;  // white noise: one constant bias matches
+  white.constant_bias = true;
+  return estimation::Calibrate(s.session.series, segments, model::Model::Parse(spec), s.site,
+                               white);
 }
 
 /// 24 still poses of 5 s joined by 2 s turns at 100 Hz (about 170 s), typical MEMS noise,
@@ -235,6 +238,7 @@ TEST(ScaleTemperatureSession, DiagnoseRanksTheUserEffectFirst) {
   for (auto& segment : segments) segment.known_R_n_b.reset();
   diagnostics::DiagnoseOptions options;
   options.confirm = 1;
+  options.calibration.constant_bias = true;  // white noise: one constant bias matches
   const diagnostics::Diagnosis dx = diagnostics::Diagnose(
       d.sim.session.series, segments, model::Model::Parse("base"), d.sim.site, options);
   if (std::getenv("PLUMB_PRINT")) std::cout << report::DiagnosisText(dx);

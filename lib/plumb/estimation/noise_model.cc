@@ -109,6 +109,7 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
                 std::to_string(options.instability_time_s) + ")");
   }
   noise.instability_time_s = options.instability_time_s;
+  if (options.constant_bias) return noise;  // no walk, no instability
   if (options.accel_instability) noise.instability_acc = Vec3::Constant(*options.accel_instability);
   if (options.gyro_instability && has_gyro) {
     noise.instability_gyr = Vec3::Constant(*options.gyro_instability);

@@ -45,6 +45,8 @@ struct CalibrationOptions {
   /// constant over the session but walks, and the backend gives every still segment bias-walk
   /// states tied by random-walk factors (residuals/bias_walk_residual.h); the model's bias is
   /// then the bias at the model's reference time. 0: no walk. Unset: see estimate_walk.
+  /// A wandering bias (walk and instability states per segment) is the default; it costs
+  /// about 6 unknowns per segment and sensor, eliminated before the analysis (solve.h).
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
   /// Bias instability as a first-order Gauss-Markov process per axis: steady-state sigma
@@ -57,21 +59,16 @@ struct CalibrationOptions {
   double instability_time_s = typical_mems::kInstabilityTime_s;
   /// Estimate the walk densities that are not given from the session itself, by
   /// variance-component estimation over the walk factors (estimation/walk_estimate.h), when
-  /// it has walk_min_poses still poses (else the typical MEMS walk, said in the warnings).
-  ///
-  /// The bias wanders in the fit when any of estimate_walk, the walk densities or the
-  /// instabilities is set; the levels left unset are then estimated (the walk) or typical
-  /// (core/typical_mems.h), said in the notes. With none set the bias is one constant over
-  /// the session, honest only for white noise (the report says so). The constant bias stays
-  /// the default until the analysis eliminates the wander states (a Schur complement), as
-  /// their dense SVD costs O(poses^3).
-  bool estimate_walk = false;
-  /// Whether the options ask for a wandering bias (the paragraph above).
-  bool ModelsWander() const {
-    return estimate_walk || accel_walk_density || gyro_walk_density || accel_instability ||
-           gyro_instability;
-  }
-  /// Fewest still segments for that estimate (>= 2); with fewer the bias stays constant.
+  /// it has walk_min_poses still poses (else, or when false, the typical MEMS walk, said in
+  /// the warnings).
+  bool estimate_walk = true;
+  /// One constant bias over the session: no walk, no instability, whatever the fields above
+  /// say. Honest only for white noise (the report says so); for comparisons and peers' methods.
+  bool constant_bias = false;
+  /// Whether the bias wanders in the fit: always, unless constant_bias. Levels not given are
+  /// then estimated (the walk) or typical (core/typical_mems.h), said in the notes.
+  bool ModelsWander() const { return !constant_bias; }
+  /// Fewest still segments for the walk estimate (>= 2); with fewer the typical walk is used.
   int walk_min_poses = 6;
   /// Lower bound on the noise standard deviation per sample, in sensor units, guarding
   /// against quantised data whose scatter reads zero (> 0).

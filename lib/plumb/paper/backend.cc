@@ -60,6 +60,7 @@ PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(const ImuSeries& series,
   estimation::CalibrationOptions options;
   options.method = "paper-benchmark (backend)";
   options.use_motion = false;
+  options.constant_bias = true;  // the paper's method: one bias per session
   out.result = estimation::Calibrate(series, out.segments, model, site, options);
   return out;
 }
@@ -88,6 +89,7 @@ PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::s
   estimation::CalibrationOptions options;
   options.method = "paper-static (backend)";
   options.use_motion = false;
+  options.constant_bias = true;  // the paper's method: one bias per session
 
   model::Model freed = model::Model::Parse("paper");
   freed.t_ref_s = series.t_s.front();

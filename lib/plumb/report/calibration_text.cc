@@ -96,8 +96,8 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   if (acc_walk || gyr_walk || acc_bi || gyr_bi) {
     os << "the bias wanders over the session; the biases below are at its start\n";
   } else {
-    os << "bias held constant over the session: the sigma is honest only if the noise is white "
-          "(--estimate-rw lets it wander: a random walk and an instability)\n";
+    os << "bias held constant over the session (--constant-bias): the sigma is honest only if "
+          "the noise is white\n";
   }
   os << "\n";
   const double scale = estimation::SigmaScale(fit);
