@@ -27,6 +27,9 @@ std::string Pad(const std::string& text) {
 }
 
 /// Beside the sigma table when chi^2/dof is above its band (estimation/uncertainty.h).
+/// chi2/dof this many times above its band's upper edge: the misfit is not noise.
+constexpr double kMisfitFactor = 3.0;
+
 std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
   const double upper = 1.0 + estimation::kChi2BandSigmas * std::sqrt(2.0 / fit.dof);
   return "chi2/dof " + Format("%.4g", fit.chi2_dof()) + " is above its band (up to " +
@@ -35,7 +38,14 @@ std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
          "(from that noise) is too small; 'scaled' is sigma * sqrt(chi2/dof) = sigma * " +
          Format("%.4g", scale) +
          ". The JSON's sigma and covariance are the scaled ones (sigma_formal beside); the "
-         "exported files carry values only\n";
+         "exported files carry values only\n" +
+         (fit.chi2_dof() > kMisfitFactor * upper
+              ? "chi2/dof is more than " + Format("%.0f", kMisfitFactor) +
+                    " times its band: the misfit is a missing effect or bad segments, not "
+                    "noise, and even the scaled sigma assumes it is random: do not trust these "
+                    "parameters to their sigma (another session of the same sensor can differ "
+                    "by more) until 'plumb diagnose' explains the misfit\n"
+              : std::string());
 }
 
 }  // namespace

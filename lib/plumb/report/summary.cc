@@ -138,6 +138,20 @@ std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
     }
   }
   os << "  chi2 fell by " << Format("%.1f", before.fit.chi2 - after.fit.chi2) << "\n";
+  // Still above the band after the best effect: say how much of the misfit is left.
+  const double upper = 1.0 + estimation::kChi2BandSigmas * std::sqrt(2.0 / std::max(after.fit.dof, 1));
+  if (after.fit.dof > 0 && after.fit.chi2_dof() > upper) {
+    const double excess_before = std::max(before.fit.chi2 - before.fit.dof, 0.0);
+    const double excess_after = std::max(after.fit.chi2 - after.fit.dof, 0.0);
+    os << "  still above its band after the refit: chi2/dof " << Format("%.3g", after.fit.chi2_dof())
+       << " (band up to " << Format("%.3g", upper) << "); the misfit beyond the noise (chi2 - dof) went "
+       << Format("%.1f", excess_before) << " -> " << Format("%.1f", excess_after) << ", "
+       << Format("%.0f", excess_before > 0 ? 100.0 * excess_after / excess_before : 100.0)
+       << "% of it not explained by this effect: add the next candidate and diagnose again; what "
+          "no catalogue effect explains is outside plumb's model (segments that are not still, "
+          "an effect not in the catalogue), and the sigmas are not to be trusted until it is "
+          "explained\n";
+  }
   bool header = false;
   for (const auto& p : after.calibration.parameters) {
     const bool known = std::any_of(before.calibration.parameters.begin(), before.calibration.parameters.end(),
