@@ -55,23 +55,22 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   // The bias wander (estimation/noise_model.h): by default the bias wanders (a random walk
-  // and a Gauss-Markov instability); levels not given are estimated (the walk) or typical.
+  // and a Gauss-Markov instability) at the levels given or the typical MEMS ones.
   auto* rw_acc = app->add_option(
       "--accel-rw", a.accel_walk_density,
       "Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor units/s/sqrt(Hz) for unscaled "
-      "samples); 0 = none. Default: estimated from the session (6 or more still poses), else "
-      "the typical MEMS walk 1e-4");
+      "samples); 0 = none. Default: the typical MEMS walk 1e-4 (or --estimate-rw)");
   rw_acc->check(kFiniteNonNegative);
   auto* rw_gyr = app->add_option(
       "--gyro-rw", a.gyro_walk_density,
       "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor units/s/sqrt(Hz) "
-      "for unscaled samples); 0 = none. Default as --accel-rw (typical 2e-6)");
+      "for unscaled samples); 0 = none. Default: the typical MEMS walk 2e-6 (or --estimate-rw)");
   rw_gyr->check(kFiniteNonNegative);
   auto* estimate = app->add_flag(
-      "--estimate-rw,!--no-estimate-rw", a.estimate_walk,
+      "--estimate-rw", a.estimate_walk,
       "Estimate the bias random walks not given from the session (variance components over "
-      "the walk factors; 6 or more still poses): the default. --no-estimate-rw takes the "
-      "typical MEMS walk instead");
+      "the walk factors; 6 or more still poses). The differences between poses it reads as a "
+      "walk also carry any effect the model misses: check with 'plumb diagnose' first");
   auto* bi_acc = app->add_option(
       "--accel-bi", a.accel_instability,
       "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 (sensor units "

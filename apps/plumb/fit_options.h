@@ -32,7 +32,7 @@ struct FitArgs {
   /// --accel-rw / --gyro-rw: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0.
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
-  bool estimate_walk = true;  ///< --estimate-rw / --no-estimate-rw
+  bool estimate_walk = false;  ///< --estimate-rw
   bool constant_bias = false;  ///< --constant-bias
   /// --accel-bi / --gyro-bi: bias instability (Gauss-Markov sigma), sensor units, >= 0;
   /// --bi-time: its correlation time, s.

@@ -247,7 +247,7 @@ TEST(GatesCli, AWrongRateIsNamedAndStrictExportWritesNothing) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(LineStarting(run.out, "gate failed: "),
             "gate failed: unit_or_rate: " + Mikoff() +
-                ": the gyroscope's scale came out 10.03 (gyro.matrix diagonal 9.989, 10.04, "
+                ": the gyroscope's scale came out 10.03 (gyro.matrix diagonal 9.988, 10.04, "
                 "10.07), not about 1: the turns integrate to 10.03 times the angles the "
                 "accelerometer sees between the poses, so the sample times are likely wrong by "
                 "that factor: the samples are 0.1 s apart (10 Hz), the turns say about 100.3 Hz "
@@ -295,6 +295,35 @@ TEST(GatesCli, AnAccelerometerInGIsNamed) {
   EXPECT_TRUE(Contains(line, " m/s^2 (median norm over 12 still segments) where gravity is "
                              "9.812 m/s^2: the samples look like g, not m/s^2: give --acc-unit g"))
       << line;
+}
+
+TEST(GatesCli, AnImplausibleWalkEstimateIsAGate) {
+  // White noise and a hidden g-sensitivity: --estimate-rw reads the poses' misfit as a walk
+  // hundreds of times the typical one, which would make chi2/dof read "consistent".
+  TempDir dir;
+  const std::string csv = Simulate(dir, {"--model", "base+gyro_g_sensitivity", "--truth",
+                                         "gyro_g_sensitivity.G.xz=3e-4"});
+  const ToolRun run = Plumb({"calibrate", csv, "--lat", "51.64", "--lon", "-1.2", "--height",
+                             "100", "--estimate-rw", "--strict"},
+                            dir);
+  EXPECT_EQ(run.exit_code, 3) << run.out << run.err;
+  const std::string line = LineStarting(run.out, "gate failed: implausible_walk: ");
+  // Which sensor's walk absorbs the misfit depends on the poses (here the accelerometer's).
+  EXPECT_EQ(line.rfind("gate failed: implausible_walk: " + csv + ": the estimated accelerometer walk is ", 0), 0u)
+      << run.out;
+  EXPECT_TRUE(Contains(line, " times the typical MEMS walk: the differences between poses it "
+                             "was read from are more likely an effect the model misses than a "
+                             "walk, and a walk that large hides it from chi2; run 'plumb "
+                             "diagnose' (without --estimate-rw) or give the walk "
+                             "(--accel-rw/--gyro-rw)"))
+      << line;
+  EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
+  // Without the estimate (the default, the typical walk) the misfit shows in chi2.
+  const ToolRun plain = Plumb({"calibrate", csv, "--lat", "51.64", "--lon", "-1.2", "--height",
+                               "100"},
+                              dir);
+  EXPECT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_TRUE(Contains(plain.out, "residuals exceed the noise")) << plain.out;
 }
 
 TEST(GatesCli, ASaturatedAxisIsNamed) {

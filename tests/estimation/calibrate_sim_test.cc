@@ -31,14 +31,15 @@ enum class Noise {
 
 /// How the fit treats the bias.
 enum class Fit {
-  kWander,    ///< the bias wanders, at the simulator's levels (--accel-rw ... --gyro-bi)
-  kEstimate,  ///< the default: walk estimated from the session, typical instability
+  kWander,    ///< the default: the bias wanders at the typical MEMS levels (the simulator's)
+  kEstimate,  ///< the walk estimated from the session (--estimate-rw), typical instability
   kConstant,  ///< one constant bias (--constant-bias)
 };
 
 CalibrationOptions OptionsFor(Fit fit) {
   CalibrationOptions options;
   options.constant_bias = fit == Fit::kConstant;
+  options.estimate_walk = fit == Fit::kEstimate;
   if (fit == Fit::kWander) {
     const sim::SimulationOptions truth = sim::SimulationOptions::TypicalMems();
     options.accel_walk_density = truth.accel_bias_walk_density;

@@ -81,12 +81,14 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   const StartingValues start = Initialize(series, cal.model, site.gravity(), cal.has_gyro,
                                           options.first_heading_deg, still, theta);
   AssignHeadingGauge(still, cal.has_gyro);
+  std::string implausible_walk;
   if (options.ModelsWander()) {
     WalkEstimate wander =
         ResolveWander(series, cal.model, site, still, theta, noise, start, options);
     noise = wander.noise;
     fit.notes.insert(fit.notes.end(), wander.notes.begin(), wander.notes.end());
     fit.warnings.insert(fit.warnings.end(), wander.warnings.begin(), wander.warnings.end());
+    implausible_walk = wander.implausible;
   }
   cal.noise = noise.Levels();
 
@@ -122,6 +124,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     fit.probes = problem.ProbeColumns(problem.Build({}, true), columns);
   }
   fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
+  if (!implausible_walk.empty()) fit.gates.push_back(Gate{"implausible_walk", implausible_walk});
   return result;
 }
 

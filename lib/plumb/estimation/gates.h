@@ -21,6 +21,9 @@
 //                  are noise and the gates above say so)
 //   saturated      an axis sits at its extreme value for kSaturationRun samples or more in a
 //                  row outside the still segments (a clipped turn or shock)
+//   implausible_walk  a bias random walk estimated from the session (--estimate-rw) more than
+//                  10 times the typical MEMS walk: more likely a missing effect seen between
+//                  the poses, which a walk that large hides from chi2 (walk_estimate.h)
 //
 // CheckSamples looks at the samples (before the fit: the fit itself may be garbage when they
 // are), CheckFit at the fitted calibration; Calibrate (calibrator.cc) runs both and puts the
@@ -40,7 +43,7 @@ namespace plumb::estimation {
 
 /// The gates' names, in the order they are checked.
 inline constexpr const char* kGateNames[] = {"out_of_range", "saturated", "not_converged",
-                                             "one_pose", "unit_or_rate"};
+                                             "one_pose", "unit_or_rate", "implausible_walk"};
 
 /// out_of_range: per-axis limits. 32 g is twice the largest common MEMS full scale (16 g;
 /// 24 g parts stay inside), 4000 deg/s twice the common 2000 deg/s; 2^20 counts holds any

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "plumb/core/typical_mems.h"
 #include "plumb/estimation/calibration_problem.h"
@@ -13,6 +14,8 @@ namespace {
 /// Typical consumer MEMS bias walks, SI.
 constexpr double kTypicalAccelWalk = typical_mems::kAccelWalk;  // m/s^3/sqrt(Hz)
 constexpr double kTypicalGyroWalk = typical_mems::kGyroWalk;    // rad/s^2/sqrt(Hz)
+/// An estimated walk this many times the typical one draws a warning.
+constexpr double kImplausibleWalk = 10.0;
 /// Smallest density kept, as a fraction of the start.
 constexpr double kFloor = 1e-3;
 /// Relative change of K below which the iteration stops (the estimate's own spread,
@@ -96,18 +99,22 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
   if (free_acc) out.noise.walk_acc = Vec3::Constant(acc0);
   if (free_gyr) out.noise.walk_gyr = Vec3::Constant(gyr0);
   if (!free_acc && !free_gyr) return out;
-  if (!options.estimate_walk || static_cast<int>(still.poses.size()) < options.walk_min_poses) {
+  if (!options.estimate_walk) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "bias random walk: the typical MEMS walk assumed (accel %.3g m/s^3/sqrt(Hz), "
+                  "gyro %.3g rad/s^2/sqrt(Hz)); give --accel-rw/--gyro-rw, or --estimate-rw",
+                  kTypicalAccelWalk, kTypicalGyroWalk);
+    out.notes.emplace_back(text);
+    return out;
+  }
+  if (static_cast<int>(still.poses.size()) < options.walk_min_poses) {
     char text[320];
     std::snprintf(text, sizeof text,
-                  "bias random walk not estimated (%s): the typical MEMS walk assumed "
-                  "(accel %.3g m/s^3/sqrt(Hz), gyro %.3g rad/s^2/sqrt(Hz)); give "
-                  "--accel-rw/--gyro-rw for another sensor",
-                  options.estimate_walk
-                      ? (std::to_string(still.poses.size()) + " still segments, at least " +
-                         std::to_string(options.walk_min_poses) + " are needed to see it")
-                            .c_str()
-                      : "--no-estimate-rw",
-                  kTypicalAccelWalk, kTypicalGyroWalk);
+                  "bias random walk not estimated (%zu still segments, at least %d are needed to "
+                  "see it): the typical MEMS walk assumed (accel %.3g m/s^3/sqrt(Hz), gyro %.3g "
+                  "rad/s^2/sqrt(Hz)); give --accel-rw/--gyro-rw for another sensor",
+                  still.poses.size(), options.walk_min_poses, kTypicalAccelWalk, kTypicalGyroWalk);
     out.warnings.emplace_back(text);
     return out;
   }
@@ -151,6 +158,19 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
             describe("gyro", out.noise.walk_gyr[0], out.redundancy_gyr, learnt_gyr);
   }
   out.notes.push_back(note);
+  // A walk far above any MEMS sensor's is more likely a missing effect seen between the poses.
+  for (const auto& [name, K, K0, free] : {std::tuple{"accelerometer", out.noise.walk_acc[0], acc0, free_acc},
+                                           std::tuple{"gyroscope", out.noise.walk_gyr[0], gyr0, free_gyr}}) {
+    if (!free || K <= kImplausibleWalk * K0) continue;
+    char text[360];
+    std::snprintf(text, sizeof text,
+                  "%sthe estimated %s walk is %.0f times the typical MEMS walk: the differences "
+                  "between poses it was read from are more likely an effect the model misses "
+                  "than a walk, and a walk that large hides it from chi2; run 'plumb diagnose' "
+                  "(without --estimate-rw) or give the walk (--accel-rw/--gyro-rw)",
+                  out.implausible.empty() ? "" : "; ", name, K / K0);
+    out.implausible += text;
+  }
   return out;
 }
 

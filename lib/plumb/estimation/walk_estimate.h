@@ -44,6 +44,8 @@ struct WalkEstimate {
   bool estimated = false;  ///< the walk was estimated from the session
   std::vector<std::string> notes;     ///< what was done, in words
   std::vector<std::string> warnings;  ///< what was assumed for lack of data
+  /// Non-empty when an estimated walk is implausibly large (the gate implausible_walk).
+  std::string implausible;
 };
 
 /// Resolves the levels the options leave unset: iterates fits of the problem (stages 4-5)
