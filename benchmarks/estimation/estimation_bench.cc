@@ -22,8 +22,12 @@ using bench::ImuTkPresent;
 using bench::ReadImuTk;
 using bench::ReadMikoff;
 
+/// Calibrates `s` with the default options (the bias wanders: walk and instability states per
+/// segment) or, with `constant_bias`, one constant bias as imu_tk assumes.
 void CalibrateSession(benchmark::State& state, const Session& s, const geo::Site& site,
-                      double init_still_s) {
+                      double init_still_s, bool constant_bias = false) {
+  estimation::CalibrationOptions options;
+  options.constant_bias = constant_bias;
   segmentation::StillDetectorOptions d;
   d.init_still_s = init_still_s;
   const auto seg = segmentation::DetectStillSegments(s.series, d);
@@ -31,10 +35,11 @@ void CalibrateSession(benchmark::State& state, const Session& s, const geo::Site
   m.t_ref_s = s.series.t_s.front();
   estimation::CalibrationResult r;
   for (auto _ : state) {
-    r = estimation::Calibrate(s.series, seg.segments, m, site);
+    r = estimation::Calibrate(s.series, seg.segments, m, site, options);
     benchmark::DoNotOptimize(r);
   }
   state.counters["segments"] = static_cast<double>(r.fit.still_segments);
+  state.counters["unknowns"] = static_cast<double>(r.calibration.observability.num_unknowns);
   state.counters["chi2_dof"] = r.fit.chi2_dof();
   state.counters["samples"] = static_cast<double>(s.series.size());
 }
@@ -47,6 +52,15 @@ void BM_CalibrateImuTk(benchmark::State& state) {
   CalibrateSession(state, ReadImuTk(), geo::Site::Unknown(9.81744), 50.0);
 }
 BENCHMARK(BM_CalibrateImuTk)->Unit(benchmark::kMillisecond);
+
+void BM_CalibrateImuTkConstantBias(benchmark::State& state) {
+  if (!ImuTkPresent()) {
+    state.SkipWithError("shared data absent");
+    return;
+  }
+  CalibrateSession(state, ReadImuTk(), geo::Site::Unknown(9.81744), 50.0, true);
+}
+BENCHMARK(BM_CalibrateImuTkConstantBias)->Unit(benchmark::kMillisecond);
 
 void BM_CalibrateMikoff(benchmark::State& state) {
   CalibrateSession(state, ReadMikoff(), geo::Site::Unknown(), 0.0);

@@ -155,7 +155,11 @@ void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& sour
                bool with_velocity, const ImuSeries& series, const DiagnoseOptions& options,
                std::vector<Candidate>& candidates, std::vector<Eigen::MatrixXd>& bases) {
   const estimation::ProbeJacobian& p = *source.fit.probes;
-  const double log_n = std::log(std::max(1.0, static_cast<double>(p.r.size())));
+  // N counts the observations: the bias-wander factors are priors, not measurements.
+  const auto observations = std::count_if(p.row_kind.begin(), p.row_kind.end(), [](auto kind) {
+    return kind != estimation::ProbeJacobian::RowKind::kBiasWalk;
+  });
+  const double log_n = std::log(std::max(1.0, static_cast<double>(observations)));
   const double dispersion = with_velocity ? VelocityDispersion(p) : 1.0;
   const int term = source.calibration.model.FindTerm(c.name);
   std::vector<Eigen::Index> cols;
@@ -272,7 +276,13 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     d.fit_with_velocity = StripProbes(*fit_motion, model);
   }
   if (!fit.fit.probes && !fit_motion) return d;
-  d.num_residuals = fit.fit.probes ? static_cast<int>(fit.fit.probes->r.size()) : 0;
+  d.num_residuals = fit.fit.probes
+                        ? static_cast<int>(std::count_if(
+                              fit.fit.probes->row_kind.begin(), fit.fit.probes->row_kind.end(),
+                              [](auto kind) {
+                                return kind != estimation::ProbeJacobian::RowKind::kBiasWalk;
+                              }))
+                        : 0;
 
   // 2. Score each candidate in its probe fit.
   std::vector<Eigen::MatrixXd> bases;
