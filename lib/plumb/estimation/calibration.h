@@ -41,6 +41,9 @@ struct Combination {
 struct Observability {
   int rank = 0;            ///< numerical rank of the column-scaled whitened Jacobian
   int num_unknowns = 0;    ///< free tangent-space unknowns (model parameters and attitudes)
+  /// Bias-wander states besides them (always determined: each has its Markov factor), which
+  /// the degrees of freedom also subtract.
+  int wander_states = 0;
   /// Null-space directions, each "a p1 + b p2 ...": moving the parameters along it changes
   /// no prediction.
   std::vector<std::string> unobservable;

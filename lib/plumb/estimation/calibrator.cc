@@ -113,7 +113,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   // 7. The fit: chi^2, degrees of freedom and the residuals.
   fit.chi2 = 2.0 * cost;
   fit.num_residuals = static_cast<int>(residual_values.size());
-  fit.dof = fit.num_residuals - analysis.summary.rank;
+  fit.dof = fit.num_residuals - analysis.summary.rank - analysis.summary.wander_states;
   fit.still_segments = static_cast<int>(problem.still().poses.size());
   fit.motion_segments = static_cast<int>(problem.still().motions.size());
   problem.ReportResiduals(solution.all_free, fit);

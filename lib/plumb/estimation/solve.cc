@@ -102,10 +102,8 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   in.values.resize(columns.first_wander);
   in.is_model.resize(columns.first_wander);
   ObservabilityAnalysis out = AnalyseObservability(in);
-  // The wander states are always determined (their factors tie them down): they add to the
-  // rank and the unknowns alike.
-  out.summary.rank += n_w;
-  out.summary.num_unknowns += n_w;
+  // The wander states are always determined (their factors tie them down): counted apart.
+  out.summary.wander_states = n_w;
   return out;
 }
 

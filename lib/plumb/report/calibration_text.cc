@@ -58,7 +58,11 @@ std::string BriefReport(const estimation::CalibrationResult& result) {
      << " still segments, " << fit.motion_segments << " motion intervals\n";
   os << "chi2 " << Format("%.6g", fit.chi2) << " on " << fit.dof << " dof, chi2/dof "
      << Format("%.4g", fit.chi2_dof()) << "; rank " << c.observability.rank << " of "
-     << c.observability.num_unknowns << " unknowns; "
+     << c.observability.num_unknowns << " unknowns"
+     << (c.observability.wander_states > 0
+             ? " (and " + std::to_string(c.observability.wander_states) + " bias-wander states)"
+             : std::string())
+     << "; "
      << (fit.converged ? "converged" : "NOT converged") << " in " << fit.iterations
      << " iterations\n";
   return os.str();

@@ -133,6 +133,7 @@ json ObservabilityJson(const estimation::Observability& o, double sigma_scale) {
   }
   return json{{"rank", o.rank},
               {"unknowns", o.num_unknowns},
+              {"wander_states", o.wander_states},
               {"unobservable", o.unobservable},
               {"determined", determined}};
 }
