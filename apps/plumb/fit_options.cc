@@ -31,6 +31,40 @@ const CLI::Validator kFiniteNonNegative(
     },
     "FINITE >= 0");
 
+/// The bias wander (estimation/noise_model.h): by default the bias wanders (a random walk and
+/// a Gauss-Markov instability) at the levels given or the typical MEMS ones.
+void AddWanderOptions(CLI::App* app, FitArgs& a) {
+  const auto level = [&](const char* name, std::optional<double>& target, const std::string& text) {
+    return app->add_option(name, target, text)->check(kFiniteNonNegative);
+  };
+  const std::string units = " (sensor units for unscaled samples); 0 = none. Default: the typical MEMS ";
+  CLI::Option* wander[] = {
+      level("--accel-rw", a.accel_walk_density,
+            "Accelerometer bias random walk, m/s^3/sqrt(Hz)" + units + "1e-4 (or --estimate-rw)"),
+      level("--gyro-rw", a.gyro_walk_density,
+            "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz)" + units +
+                "2e-6 (or --estimate-rw)"),
+      app->add_flag("--estimate-rw", a.estimate_walk,
+                    "Estimate the bias random walks not given from the session (variance "
+                    "components over the walk factors; 6 or more still poses). The differences "
+                    "between poses it reads as a walk also carry any effect the model misses: "
+                    "check with 'plumb diagnose' first"),
+      level("--accel-bi", a.accel_instability,
+            "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2" + units +
+                "4e-4"),
+      level("--gyro-bi", a.gyro_instability,
+            "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s" + units +
+                "2e-5"),
+      app->add_option("--bi-time", a.instability_time_s, "Correlation time of the bias instability, s")
+          ->check(CLI::Range(1e-3, 1e9))
+          ->capture_default_str()};
+  auto* constant = app->add_flag(
+      "--constant-bias", a.constant_bias,
+      "One constant bias over the session: no random walk, no instability (the sigma is then "
+      "honest only for white noise; for comparisons with peers that assume it)");
+  for (auto* o : wander) constant->excludes(o);
+}
+
 }  // namespace
 
 void AddFitOptions(CLI::App* app, FitArgs& a) {
@@ -54,41 +88,7 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
                   "(the gate not_converged)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  // The bias wander (estimation/noise_model.h): by default the bias wanders (a random walk
-  // and a Gauss-Markov instability) at the levels given or the typical MEMS ones.
-  auto* rw_acc = app->add_option(
-      "--accel-rw", a.accel_walk_density,
-      "Accelerometer bias random walk, m/s^3/sqrt(Hz) (sensor units/s/sqrt(Hz) for unscaled "
-      "samples); 0 = none. Default: the typical MEMS walk 1e-4 (or --estimate-rw)");
-  rw_acc->check(kFiniteNonNegative);
-  auto* rw_gyr = app->add_option(
-      "--gyro-rw", a.gyro_walk_density,
-      "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) (sensor units/s/sqrt(Hz) "
-      "for unscaled samples); 0 = none. Default: the typical MEMS walk 2e-6 (or --estimate-rw)");
-  rw_gyr->check(kFiniteNonNegative);
-  auto* estimate = app->add_flag(
-      "--estimate-rw", a.estimate_walk,
-      "Estimate the bias random walks not given from the session (variance components over "
-      "the walk factors; 6 or more still poses). The differences between poses it reads as a "
-      "walk also carry any effect the model misses: check with 'plumb diagnose' first");
-  auto* bi_acc = app->add_option(
-      "--accel-bi", a.accel_instability,
-      "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 (sensor units "
-      "for unscaled samples); 0 = none. Default: the typical MEMS 4e-4");
-  bi_acc->check(kFiniteNonNegative);
-  auto* bi_gyr = app->add_option(
-      "--gyro-bi", a.gyro_instability,
-      "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s (sensor units for "
-      "unscaled samples); 0 = none. Default: the typical MEMS 2e-5");
-  bi_gyr->check(kFiniteNonNegative);
-  auto* bi_time = app->add_option("--bi-time", a.instability_time_s,
-                                  "Correlation time of the bias instability, s");
-  bi_time->check(CLI::Range(1e-3, 1e9))->capture_default_str();
-  auto* constant = app->add_flag(
-      "--constant-bias", a.constant_bias,
-      "One constant bias over the session: no random walk, no instability (the sigma is then "
-      "honest only for white noise; for comparisons with peers that assume it)");
-  for (auto* o : {rw_acc, rw_gyr, estimate, bi_acc, bi_gyr, bi_time}) constant->excludes(o);
+  AddWanderOptions(app, a);
 }
 
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,

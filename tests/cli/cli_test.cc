@@ -158,18 +158,46 @@ TEST(Cli, CalibrateJsonIsBitForBitWhateverTheHeapLayout) {
   EXPECT_EQ(testing::ReadAll(dir.File("a.json")), testing::ReadAll(dir.File("b.json")));
 }
 
-TEST(Cli, BiasWalkDensityMustBeFiniteAndNonNegative) {
+TEST(Cli, BiasWanderLevelsMustBeFiniteAndNonNegative) {
   TempDir dir;
   const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
-  for (const char* value : {"nan", "inf", "-1"}) {
-    const ToolRun run = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate",
-                               "100", "--accel-rw", value}, dir);
-    EXPECT_EQ(run.exit_code, 2) << value;
-    EXPECT_NE(run.err.find(std::string("--accel-rw: must be a finite number >= 0 (got '") +
-                           value + "')"),
-              std::string::npos)
-        << run.err;
+  for (const char* flag : {"--accel-rw", "--gyro-rw", "--accel-bi", "--gyro-bi"}) {
+    for (const char* value : {"nan", "inf", "-1"}) {
+      const ToolRun run = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate",
+                                 "100", flag, value}, dir);
+      EXPECT_EQ(run.exit_code, 2) << flag << " " << value;
+      EXPECT_NE(run.err.find(std::string(flag) + ": must be a finite number >= 0 (got '" +
+                             value + "')"),
+                std::string::npos)
+          << run.err;
+    }
   }
+}
+
+TEST(Cli, ConstantBiasExcludesTheWanderLevels) {
+  TempDir dir;
+  const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
+  const ToolRun run = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate", "100",
+                             "--constant-bias", "--accel-bi", "1e-3"}, dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--accel-bi excludes --constant-bias"), std::string::npos) << run.err;
+  // Alone it fits one constant bias and says what that means for the sigma.
+  const ToolRun constant = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate",
+                                  "100", "--constant-bias"}, dir);
+  EXPECT_EQ(constant.exit_code, 0) << constant.err;
+  EXPECT_NE(constant.out.find("bias held constant over the session (--constant-bias): the sigma "
+                              "is honest only if the noise is white"),
+            std::string::npos)
+      << constant.out;
+  // By default the bias wanders, at the typical levels, and the output says so.
+  const ToolRun wander = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate",
+                                "100"}, dir);
+  EXPECT_NE(wander.out.find("the bias wanders over the session; the biases below are at its start"),
+            std::string::npos)
+      << wander.out;
+  EXPECT_NE(wander.out.find("note: bias random walk: the typical MEMS walk assumed"),
+            std::string::npos)
+      << wander.out;
 }
 
 TEST(Cli, HelpListsTheSubcommands) {
