@@ -106,7 +106,7 @@ TEST(GatesCli, NotConvergedIsShownStrictExitsThreeAndExportIsRefused) {
                 "iterations (--max-iterations)")
       << run.out;
   EXPECT_EQ(Verdict(run.out),
-            "chi2/dof 0.823, but the fit failed a gate (not_converged): not to be trusted as it "
+            "chi2/dof 0.83, but the fit failed a gate (not_converged): not to be trusted as it "
             "stands");
   EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
   const json doc = ReadJson(out);

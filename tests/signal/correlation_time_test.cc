@@ -36,6 +36,28 @@ TEST(CorrelationTime, WhiteNoiseIsOne) {
   EXPECT_NEAR(std::sqrt(ct.variance), 0.02, 0.0003);
 }
 
+TEST(CorrelationTime, DetrendIgnoresADriftInsideEachChunk) {
+  // White noise of sigma 0.02 plus a ramp of 0.2 over each chunk (a board warming during the
+  // hold): about the chunk's mean the ramp adds 0.2 / sqrt(12) = 0.058 to the scatter, about
+  // its line nothing; white noise alone gives the same either way.
+  PooledAr1 noise(0.0, 0.02);
+  for (auto& d : noise.data) {
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      d[i] += static_cast<float>(0.2 * static_cast<double>(i) / static_cast<double>(d.size()));
+    }
+  }
+  CorrelationTimeOptions line;
+  line.detrend = true;
+  const CorrelationTime about_mean = EstimateCorrelationTime(noise.views);
+  const CorrelationTime about_line = EstimateCorrelationTime(noise.views, line);
+  EXPECT_GT(std::sqrt(about_mean.variance), 0.05);
+  EXPECT_NEAR(std::sqrt(about_line.variance), 0.02, 0.0003);
+  EXPECT_NEAR(about_line.tau_int, 1.0, 0.05);
+  const PooledAr1 white(0.0, 0.02);
+  EXPECT_NEAR(EstimateCorrelationTime(white.views, line).variance,
+              EstimateCorrelationTime(white.views).variance, 1e-3 * 0.02 * 0.02);
+}
+
 TEST(CorrelationTime, Ar1MatchesTheory) {
   for (double phi : {0.5, 0.8, 0.9}) {
     const PooledAr1 noise(phi, 0.01);

@@ -79,9 +79,15 @@ NoiseLevels NoiseModel::Levels() const {
 NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_gyro,
                          const CalibrationOptions& options) {
   const std::vector<StillSegment> used = set.AtRestSegments();
-  const auto acc = signal::EstimateCorrelationTime(series, used, signal::Sensor::kAccel);
+  // Each segment about its own line: a drift inside a hold (the board warming, the bias's
+  // wander) is not white noise; the wander processes carry it (file comment).
+  signal::CorrelationTimeOptions correlation;
+  correlation.detrend = true;
+  const auto acc = signal::EstimateCorrelationTime(series, used, signal::Sensor::kAccel, correlation);
   std::array<signal::CorrelationTime, 3> gyr{};
-  if (has_gyro) gyr = signal::EstimateCorrelationTime(series, used, signal::Sensor::kGyro);
+  if (has_gyro) {
+    gyr = signal::EstimateCorrelationTime(series, used, signal::Sensor::kGyro, correlation);
+  }
   NoiseModel noise;
   for (int i = 0; i < 3; ++i) {
     const auto axis = static_cast<std::size_t>(i);

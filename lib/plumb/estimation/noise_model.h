@@ -1,8 +1,10 @@
 // plumb/estimation/noise_model.h — stage 2 of the backend: the noise the residuals are
 // whitened with, measured on the session's own still segments.
 //
-// Per axis: the pooled within-segment scatter of the samples (sigma per sample, sensor units,
-// floored at options.min_sigma_*) and the integrated autocorrelation time tau (Sokal's
+// Per axis: the pooled within-segment scatter of the samples about each segment's own
+// least-squares line in time (sigma per sample, sensor units, floored at options.min_sigma_*;
+// a temperature change or a wander inside a hold is not white noise, so it must not inflate
+// sigma) and the integrated autocorrelation time tau (Sokal's
 // windowed estimate, signal/correlation_time.h; at least 1 sample). The variance of a segment
 // mean of N samples is then sigma^2 tau / N. Segments turning at a stated rate are left out:
 // their scatter is signal.

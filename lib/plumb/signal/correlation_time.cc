@@ -20,15 +20,28 @@ struct CentredChunks {
   std::size_t length(std::size_t c) const { return offsets[c + 1] - offsets[c]; }
 };
 
-CentredChunks Centre(const std::vector<AxisView>& chunks) {
+CentredChunks Centre(const std::vector<AxisView>& chunks, bool detrend) {
   CentredChunks out;
   out.offsets.push_back(0);
   for (const AxisView& chunk : chunks) {
     const auto n = static_cast<std::size_t>(chunk.size());
-    if (n < 2) continue;
+    if (n < (detrend ? 3u : 2u)) continue;
     const double mean = chunk.cast<double>().mean();
+    // The least-squares slope against the sample index about its middle (0 without detrend).
+    const double mid = 0.5 * static_cast<double>(n - 1);
+    double slope = 0.0;
+    if (detrend) {
+      double sxy = 0.0, sxx = 0.0;
+      for (Eigen::Index i = 0; i < chunk.size(); ++i) {
+        const double x = static_cast<double>(i) - mid;
+        sxy += x * (static_cast<double>(chunk[i]) - mean);
+        sxx += x * x;
+      }
+      slope = sxy / sxx;
+    }
     for (Eigen::Index i = 0; i < chunk.size(); ++i) {
-      out.values.push_back(static_cast<double>(chunk[i]) - mean);
+      out.values.push_back(static_cast<double>(chunk[i]) - mean -
+                           slope * (static_cast<double>(i) - mid));
     }
     out.offsets.push_back(out.values.size());
     out.longest = std::max(out.longest, n);
@@ -67,9 +80,10 @@ void CheckOptions(const CorrelationTimeOptions& options) {
 CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
                                         const CorrelationTimeOptions& options) {
   CheckOptions(options);
-  const CentredChunks data = Centre(chunks);
+  const CentredChunks data = Centre(chunks, options.detrend);
   if (data.count() == 0) {
-    throw Error("correlation time: no chunk has at least 2 samples (" +
+    throw Error(std::string("correlation time: no chunk has at least ") +
+                (options.detrend ? "3" : "2") + " samples (" +
                 std::to_string(chunks.size()) + " chunks given)");
   }
   CorrelationTime out;
@@ -77,7 +91,8 @@ CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
   out.samples = data.values.size();
   double sum_sq = 0.0;
   for (double y : data.values) sum_sq += y * y;
-  out.variance = sum_sq / static_cast<double>(out.samples - out.chunks);
+  const std::size_t fitted = (options.detrend ? 2 : 1) * out.chunks;  // means (and slopes)
+  out.variance = sum_sq / static_cast<double>(out.samples - fitted);
   const double c0 = sum_sq / static_cast<double>(out.samples);
   if (!(c0 > 0.0) || !std::isfinite(c0)) {
     throw Error("correlation time: the samples have zero or non-finite variance (" +

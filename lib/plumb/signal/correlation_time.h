@@ -9,7 +9,7 @@
 // so it has about N / tau_sq degrees of freedom (used by the still detector's threshold).
 //
 // Estimator: the autocovariance is pooled over several still chunks, each centred on its own
-// mean (C_k = sum over chunks of sum_i y_i y_{i+k}, divided by the number of such pairs), and
+// mean (or its own line, with `detrend`) (C_k = sum over chunks of sum_i y_i y_{i+k}, divided by the number of such pairs), and
 // the sum over lags stops at Sokal's automatic window: the first M with M >= c tau_int(M)
 // (A. Sokal, "Monte Carlo methods in statistical mechanics", 1997; c = 5 by default). The cost
 // is O(N M) for N samples; M is about c tau_int, small for IMU noise. Centring on each chunk's
@@ -33,6 +33,10 @@ struct CorrelationTimeOptions {
   /// Largest lag summed, samples, >= 1. Reaching it (or half the longest chunk) leaves the
   /// estimate marked not converged.
   std::size_t max_lag = 5000;
+  /// Centre each chunk on its least-squares line instead of its mean: a slow drift inside a
+  /// chunk (a warming board, the bias's wander) then does not count as noise. The variance's
+  /// divisor loses one more degree of freedom per chunk (samples - 2 chunks).
+  bool detrend = false;
 };
 
 /// Result for one axis.
@@ -54,7 +58,7 @@ struct CorrelationTime {
 };
 
 /// tau_int, tau_sq and the pooled variance of one axis from several still chunks. Chunks with
-/// fewer than 2 samples are skipped. Throws plumb::Error if no chunk has 2 samples, the pooled
+/// fewer than 2 samples (3 with detrend) are skipped. Throws plumb::Error if none is left, the pooled
 /// variance is zero or not finite, or the options are out of range.
 CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
                                         const CorrelationTimeOptions& options = {});
