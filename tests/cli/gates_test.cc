@@ -318,12 +318,19 @@ TEST(GatesCli, AnImplausibleWalkEstimateIsAGate) {
                              "(--accel-rw/--gyro-rw)"))
       << line;
   EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
-  // Without the estimate (the default, the typical walk) the misfit shows in chi2.
+  // Without the estimate (the default, the typical walk) the misfit shows in chi2, and the
+  // output says not to trust the sigmas: beside the table and in the JSON.
+  const std::string json_path = dir.File("plain.json");
   const ToolRun plain = Plumb({"calibrate", csv, "--lat", "51.64", "--lon", "-1.2", "--height",
-                               "100"},
+                               "100", "--json", json_path},
                               dir);
   EXPECT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_TRUE(Contains(plain.out, "residuals exceed the noise")) << plain.out;
+  EXPECT_TRUE(Contains(plain.out, "the misfit is a missing effect or bad segments, not noise, and "
+                                  "even the scaled sigma assumes it is random: do not trust these "
+                                  "parameters to their sigma"))
+      << plain.out;
+  EXPECT_TRUE(ReadJson(json_path)["fit"]["misfit_beyond_noise"].get<bool>());
 }
 
 TEST(GatesCli, ASaturatedAxisIsNamed) {

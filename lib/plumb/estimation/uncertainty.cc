@@ -10,6 +10,11 @@ bool Chi2AboveBand(const FitReport& fit) {
   return fit.chi2_dof() > 1.0 + kChi2BandSigmas * std::sqrt(2.0 / fit.dof);
 }
 
+bool MisfitBeyondNoise(const FitReport& fit) {
+  if (fit.dof <= 0) return false;
+  return fit.chi2_dof() > kMisfitFactor * (1.0 + kChi2BandSigmas * std::sqrt(2.0 / fit.dof));
+}
+
 double SigmaScale(const FitReport& fit) {
   return Chi2AboveBand(fit) ? std::sqrt(fit.chi2_dof()) : 1.0;
 }

@@ -26,6 +26,12 @@ inline constexpr double kChi2BandSigmas = 3.0;
 /// chi^2/dof is above 1 + kChi2BandSigmas sqrt(2 / dof) (false without degrees of freedom).
 bool Chi2AboveBand(const FitReport& fit);
 
+/// chi^2/dof more than kMisfitFactor times the band's upper edge: the misfit is a missing
+/// effect or bad segments, not noise, and even the scaled sigma (which assumes the misfit is
+/// random) is not to be trusted; another session of the same sensor can differ by more.
+inline constexpr double kMisfitFactor = 3.0;
+bool MisfitBeyondNoise(const FitReport& fit);
+
 /// sqrt(chi^2/dof) when Chi2AboveBand(fit), else 1: the factor on every reported sigma.
 double SigmaScale(const FitReport& fit);
 

@@ -27,9 +27,6 @@ std::string Pad(const std::string& text) {
 }
 
 /// Beside the sigma table when chi^2/dof is above its band (estimation/uncertainty.h).
-/// chi2/dof this many times above its band's upper edge: the misfit is not noise.
-constexpr double kMisfitFactor = 3.0;
-
 std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
   const double upper = 1.0 + estimation::kChi2BandSigmas * std::sqrt(2.0 / fit.dof);
   return "chi2/dof " + Format("%.4g", fit.chi2_dof()) + " is above its band (up to " +
@@ -39,8 +36,8 @@ std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
          Format("%.4g", scale) +
          ". The JSON's sigma and covariance are the scaled ones (sigma_formal beside); the "
          "exported files carry values only\n" +
-         (fit.chi2_dof() > kMisfitFactor * upper
-              ? "chi2/dof is more than " + Format("%.0f", kMisfitFactor) +
+         (estimation::MisfitBeyondNoise(fit)
+              ? "chi2/dof is more than " + Format("%.0f", estimation::kMisfitFactor) +
                     " times its band: the misfit is a missing effect or bad segments, not "
                     "noise, and even the scaled sigma assumes it is random: do not trust these "
                     "parameters to their sigma (another session of the same sensor can differ "

@@ -120,6 +120,7 @@ json FitJson(const estimation::CalibrationResult& r) {
               {"iterations", f.iterations},
               {"solver", f.solver_report},
               {"chi2_above_band", estimation::Chi2AboveBand(f)},
+              {"misfit_beyond_noise", estimation::MisfitBeyondNoise(f)},
               {"distinct_poses", f.distinct_poses}};
 }
 
