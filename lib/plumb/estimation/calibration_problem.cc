@@ -415,18 +415,11 @@ Eigen::SparseMatrix<double> CalibrationProblem::SparseJacobian(
   eval.parameter_blocks = columns.blocks;
   ceres::CRSMatrix crs;
   problem.Evaluate(eval, cost, residuals, nullptr, &crs);
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(crs.values.size());
-  for (int row = 0; row < crs.num_rows; ++row) {
-    for (int idx = crs.rows[static_cast<std::size_t>(row)];
-         idx < crs.rows[static_cast<std::size_t>(row) + 1]; ++idx) {
-      entries.emplace_back(row, crs.cols[static_cast<std::size_t>(idx)],
-                           crs.values[static_cast<std::size_t>(idx)]);
-    }
-  }
-  Eigen::SparseMatrix<double> J(crs.num_rows, crs.num_cols);
-  J.setFromTriplets(entries.begin(), entries.end());
-  return J;
+  // Ceres' CRS is Eigen's compressed row-major layout.
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> rows(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
+      crs.cols.data(), crs.values.data());
+  return Eigen::SparseMatrix<double>(rows);
 }
 
 ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,

@@ -22,6 +22,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/core/types.h"
+#include "plumb/core/typical_mems.h"
 #include "plumb/model/effect.h"
 #include "plumb/estimation/calibration.h"
 #include "plumb/estimation/options.h"
@@ -60,7 +61,7 @@ struct NoiseModel {
   /// correlation time, s.
   Vec3 instability_acc = Vec3::Zero();
   Vec3 instability_gyr = Vec3::Zero();
-  double instability_time_s = 30.0;
+  double instability_time_s = typical_mems::kInstabilityTime_s;
 
   bool accel_walks() const { return walk_acc.minCoeff() > 0; }
   bool gyro_walks() const { return walk_gyr.minCoeff() > 0; }

@@ -5,14 +5,14 @@
 
 namespace plumb::estimation {
 
+double Chi2BandUpper(int dof) { return 1.0 + kChi2BandSigmas * std::sqrt(2.0 / std::max(dof, 1)); }
+
 bool Chi2AboveBand(const FitReport& fit) {
-  if (fit.dof <= 0) return false;
-  return fit.chi2_dof() > 1.0 + kChi2BandSigmas * std::sqrt(2.0 / fit.dof);
+  return fit.dof > 0 && fit.chi2_dof() > Chi2BandUpper(fit.dof);
 }
 
 bool MisfitBeyondNoise(const FitReport& fit) {
-  if (fit.dof <= 0) return false;
-  return fit.chi2_dof() > kMisfitFactor * (1.0 + kChi2BandSigmas * std::sqrt(2.0 / fit.dof));
+  return fit.dof > 0 && fit.chi2_dof() > kMisfitFactor * Chi2BandUpper(fit.dof);
 }
 
 double SigmaScale(const FitReport& fit) {

@@ -23,7 +23,10 @@ namespace plumb::estimation {
 /// Width of chi^2/dof's band, in its standard deviations sqrt(2 / dof).
 inline constexpr double kChi2BandSigmas = 3.0;
 
-/// chi^2/dof is above 1 + kChi2BandSigmas sqrt(2 / dof) (false without degrees of freedom).
+/// The upper edge of chi^2/dof's band, 1 + kChi2BandSigmas sqrt(2 / dof) (dof >= 1).
+double Chi2BandUpper(int dof);
+
+/// chi^2/dof is above Chi2BandUpper (false without degrees of freedom).
 bool Chi2AboveBand(const FitReport& fit);
 
 /// chi^2/dof more than kMisfitFactor times the band's upper edge: the misfit is a missing

@@ -11,9 +11,6 @@
 namespace plumb::estimation {
 namespace {
 
-/// Typical consumer MEMS bias walks, SI.
-constexpr double kTypicalAccelWalk = typical_mems::kAccelWalk;  // m/s^3/sqrt(Hz)
-constexpr double kTypicalGyroWalk = typical_mems::kGyroWalk;    // rad/s^2/sqrt(Hz)
 /// An estimated walk this many times the typical one draws a warning.
 constexpr double kImplausibleWalk = 10.0;
 /// Smallest density kept, as a fraction of the start.
@@ -92,8 +89,8 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
   AssumeTypicalInstability(start, options, has_gyro, out.noise, out.notes);
   // The walks not given: from the typical MEMS walk in the sensor's units, estimated when
   // the session can show it.
-  const double acc0 = kTypicalAccelWalk * start.accel.scale;
-  const double gyr0 = kTypicalGyroWalk / start.gyro_rad_per_unit;
+  const double acc0 = typical_mems::kAccelWalk * start.accel.scale;
+  const double gyr0 = typical_mems::kGyroWalk / start.gyro_rad_per_unit;
   const bool free_acc = !options.accel_walk_density.has_value();
   const bool free_gyr = has_gyro && !options.gyro_walk_density.has_value();
   if (free_acc) out.noise.walk_acc = Vec3::Constant(acc0);
@@ -104,7 +101,7 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
     std::snprintf(text, sizeof text,
                   "bias random walk: the typical MEMS walk assumed (accel %.3g m/s^3/sqrt(Hz), "
                   "gyro %.3g rad/s^2/sqrt(Hz)); give --accel-rw/--gyro-rw, or --estimate-rw",
-                  kTypicalAccelWalk, kTypicalGyroWalk);
+                  typical_mems::kAccelWalk, typical_mems::kGyroWalk);
     out.notes.emplace_back(text);
     return out;
   }
@@ -114,7 +111,7 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
                   "bias random walk not estimated (%zu still segments, at least %d are needed to "
                   "see it): the typical MEMS walk assumed (accel %.3g m/s^3/sqrt(Hz), gyro %.3g "
                   "rad/s^2/sqrt(Hz)); give --accel-rw/--gyro-rw for another sensor",
-                  still.poses.size(), options.walk_min_poses, kTypicalAccelWalk, kTypicalGyroWalk);
+                  still.poses.size(), options.walk_min_poses, typical_mems::kAccelWalk, typical_mems::kGyroWalk);
     out.warnings.emplace_back(text);
     return out;
   }
@@ -139,7 +136,6 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
     if (free_gyr) scale(out.noise.walk_gyr, g.chi2_gyr, g.red_gyr, gyr0, learnt_gyr);
     if (change < kTolerance) break;
   }
-  out.estimated = true;
   // Per sensor: estimated, or (its walk factors fully absorbed by the other unknowns, e.g.
   // holds not joined by turns) the typical MEMS walk kept.
   auto describe = [](const char* sensor, double K, double red, bool learnt) {

@@ -41,7 +41,6 @@ struct WalkEstimate {
   NoiseModel noise;        ///< the noise model with every wander level resolved
   int iterations = 0;      ///< fits made
   double redundancy_acc = 0, redundancy_gyr = 0;  ///< red_g of each sensor's walk factors
-  bool estimated = false;  ///< the walk was estimated from the session
   std::vector<std::string> notes;     ///< what was done, in words
   std::vector<std::string> warnings;  ///< what was assumed for lack of data
   /// Non-empty when an estimated walk is implausibly large (the gate implausible_walk).

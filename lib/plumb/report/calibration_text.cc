@@ -28,7 +28,7 @@ std::string Pad(const std::string& text) {
 
 /// Beside the sigma table when chi^2/dof is above its band (estimation/uncertainty.h).
 std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
-  const double upper = 1.0 + estimation::kChi2BandSigmas * std::sqrt(2.0 / fit.dof);
+  const double upper = estimation::Chi2BandUpper(fit.dof);
   return "chi2/dof " + Format("%.4g", fit.chi2_dof()) + " is above its band (up to " +
          Format("%.3g", upper) +
          "): the residuals exceed the noise the fit was whitened with, so the formal sigma "

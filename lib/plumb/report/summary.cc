@@ -139,7 +139,7 @@ std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
   }
   os << "  chi2 fell by " << Format("%.1f", before.fit.chi2 - after.fit.chi2) << "\n";
   // Still above the band after the best effect: say how much of the misfit is left.
-  const double upper = 1.0 + estimation::kChi2BandSigmas * std::sqrt(2.0 / std::max(after.fit.dof, 1));
+  const double upper = estimation::Chi2BandUpper(after.fit.dof);
   if (after.fit.dof > 0 && after.fit.chi2_dof() > upper) {
     const double excess_before = std::max(before.fit.chi2 - before.fit.dof, 0.0);
     const double excess_after = std::max(after.fit.chi2 - after.fit.dof, 0.0);

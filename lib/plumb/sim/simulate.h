@@ -28,6 +28,7 @@
 #include "plumb/core/segment.h"
 #include "plumb/core/session.h"
 #include "plumb/core/types.h"
+#include "plumb/core/typical_mems.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
 #include "plumb/sim/schedule.h"
@@ -84,7 +85,7 @@ struct SimulationOptions {
   /// process starts at zero at t0_s, like the walk: the truth's bias is the bias at the start.
   double accel_bias_instability = 0.0;
   double gyro_bias_instability = 0.0;
-  double bias_instability_time_s = 30.0;
+  double bias_instability_time_s = typical_mems::kInstabilityTime_s;
   /// Quantisation steps of the outputs: accelerometer m/s^2, gyroscope rad/s; >= 0, 0 = none.
   double accel_quantum = 0.0;
   double gyro_quantum = 0.0;
