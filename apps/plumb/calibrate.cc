@@ -95,7 +95,7 @@ class CalibrateCommand : public Command {
     }
 
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
-    FitSetup fit = PrepareFit(session, seg, a.site, a.fit);
+    FitSetup fit = PrepareFit(session, seg, a.site, a.fit, a.input);
     const std::vector<StillSegment>& segments = fit.segments;
     const geo::Site& site = fit.site;
     const model::Model& model = fit.model;

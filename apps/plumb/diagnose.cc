@@ -85,7 +85,7 @@ class DiagnoseCommand : public Command {
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
-    const FitSetup fit = PrepareFit(session, seg, a.site, a.fit);
+    const FitSetup fit = PrepareFit(session, seg, a.site, a.fit, a.input);
     const geo::Site& site = fit.site;
     const model::Model& model = fit.model;
     diagnostics::DiagnoseOptions options;

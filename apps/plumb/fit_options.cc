@@ -1,13 +1,18 @@
 // See fit_options.h.
 #include "fit_options.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <optional>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/gates.h"
+#include "plumb/signal/noise_terms.h"
+#include "segment_options.h"
 
 namespace plumb::cli {
 
@@ -20,44 +25,95 @@ void AddModelOption(CLI::App* app, FitArgs& a) {
 
 namespace {
 
-/// A finite number >= 0 (CLI::NonNegativeNumber lets NaN through).
-const CLI::Validator kFiniteNonNegative(
-    [](std::string& text) -> std::string {
-      double v = 0;
-      if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < 0) {
-        return "must be a finite number >= 0 (got '" + text + "')";
-      }
-      return {};
-    },
-    "FINITE >= 0");
+/// A wander level as a datasheet states it: a finite number >= 0 with an optional unit from
+/// `units` (name, SI per unit), e.g. "4 deg/h" or "40ug"; rewritten to the SI number. Without
+/// a unit: SI (sensor units for unscaled samples).
+CLI::Validator DatasheetLevel(std::vector<std::pair<std::string, double>> units) {
+  std::string names;
+  for (const auto& u : units) names += (names.empty() ? "" : ", ") + u.first;
+  return CLI::Validator(
+      [units, names](std::string& text) -> std::string {
+        std::size_t end = 0;
+        double v = 0;
+        try {
+          v = std::stod(text, &end);
+        } catch (const std::exception&) {
+          return "must be a number >= 0 with an optional unit (" + names + "), got '" + text + "'";
+        }
+        std::string unit = text.substr(end);
+        unit.erase(std::remove(unit.begin(), unit.end(), ' '), unit.end());
+        double scale = 1.0;
+        if (!unit.empty()) {
+          const auto it = std::find_if(units.begin(), units.end(),
+                                       [&](const auto& u) { return u.first == unit; });
+          if (it == units.end()) {
+            return "unit '" + unit + "' not known here; use one of " + names + " (got '" + text + "')";
+          }
+          scale = it->second;
+        }
+        if (!std::isfinite(v) || v < 0) return "must be a finite number >= 0 (got '" + text + "')";
+        char number[40];
+        std::snprintf(number, sizeof number, "%.17g", v * scale);
+        text = number;
+        return {};
+      },
+      "LEVEL[UNIT]");
+}
+
+/// The units of datasheets and of 'plumb allan''s datasheet column, SI per unit.
+const double kDegPerHour = 1.0 / units::kDegPerHourPerRadPerS;
+const std::vector<std::pair<std::string, double>> kAccelInstabilityUnits{
+    {"m/s^2", 1.0}, {"ug", units::kMicroG}, {"mg", units::kMilliG}};
+const std::vector<std::pair<std::string, double>> kGyroInstabilityUnits{
+    {"rad/s", 1.0}, {"deg/s", units::kRadPerDeg}, {"deg/h", kDegPerHour}};
+const std::vector<std::pair<std::string, double>> kAccelWalkUnits{
+    {"m/s^3/sqrt(Hz)", 1.0}, {"m/s^2/sqrt(s)", 1.0}, {"ug/sqrt(s)", units::kMicroG},
+    {"ug/sqrt(h)", units::kMicroG / units::kSqrtSecondsPerSqrtHour}};
+const std::vector<std::pair<std::string, double>> kGyroWalkUnits{
+    {"rad/s^2/sqrt(Hz)", 1.0}, {"rad/s/sqrt(s)", 1.0}, {"deg/s/sqrt(s)", units::kRadPerDeg},
+    {"deg/h/sqrt(h)", kDegPerHour / units::kSqrtSecondsPerSqrtHour}};
 
 /// The bias wander (estimation/noise_model.h): by default the bias wanders (a random walk and
-/// a Gauss-Markov instability) at the levels given or the typical MEMS ones.
+/// a Gauss-Markov instability) at the levels given, else from the still data or typical
+/// (estimation/wander_levels.h).
 void AddWanderOptions(CLI::App* app, FitArgs& a) {
-  const auto level = [&](const char* name, std::optional<double>& target, const std::string& text) {
-    return app->add_option(name, target, text)->check(kFiniteNonNegative);
+  const auto level = [&](const char* name, std::optional<double>& target, const std::string& text,
+                         const std::vector<std::pair<std::string, double>>& units) {
+    return app->add_option(name, target, text)->transform(DatasheetLevel(units));
   };
-  const std::string units = " (sensor units for unscaled samples); 0 = none. Default: the typical MEMS ";
+  const std::string units =
+      " (sensor units for unscaled samples), or with a datasheet's unit; 0 = none. Default: "
+      "from the still data's Allan deviation, else the typical MEMS ";
   CLI::Option* wander[] = {
       level("--accel-rw", a.accel_walk_density,
-            "Accelerometer bias random walk, m/s^3/sqrt(Hz)" + units + "1e-4 (or --estimate-rw)"),
+            "Accelerometer bias random walk, m/s^3/sqrt(Hz) or ug/sqrt(s), ug/sqrt(h)" + units +
+                "1e-4 (or --estimate-rw)",
+            kAccelWalkUnits),
       level("--gyro-rw", a.gyro_walk_density,
-            "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz)" + units +
-                "2e-6 (or --estimate-rw)"),
+            "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) or deg/h/sqrt(h), "
+            "deg/s/sqrt(s)" + units + "2e-6 (or --estimate-rw)",
+            kGyroWalkUnits),
       app->add_flag("--estimate-rw", a.estimate_walk,
                     "Estimate the bias random walks not given from the session (variance "
                     "components over the walk factors; 6 or more still poses). The differences "
                     "between poses it reads as a walk also carry any effect the model misses: "
                     "check with 'plumb diagnose' first"),
       level("--accel-bi", a.accel_instability,
-            "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2" + units +
-                "4e-4"),
+            "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 or ug, "
+            "mg" + units + "4e-4",
+            kAccelInstabilityUnits),
       level("--gyro-bi", a.gyro_instability,
-            "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s" + units +
-                "2e-5"),
+            "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s or deg/h, "
+            "deg/s" + units + "2e-5",
+            kGyroInstabilityUnits),
       app->add_option("--bi-time", a.instability_time_s, "Correlation time of the bias instability, s")
           ->check(CLI::Range(1e-3, 1e9))
-          ->capture_default_str()};
+          ->capture_default_str(),
+      app->add_option("--noise-from", a.noise_from,
+                      "A still recording of the same sensor (read with the same input options), "
+                      "e.g. several minutes on the bench: its Allan deviation informs the bias "
+                      "wander levels not given, beside the session's own still data")
+          ->type_name("FILE")};
   auto* constant = app->add_flag(
       "--constant-bias", a.constant_bias,
       "One constant bias over the session: no random walk, no instability (the sigma is then "
@@ -91,8 +147,27 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
   AddWanderOptions(app, a);
 }
 
+namespace {
+
+/// The noise of the still recording `path` (--noise-from), read like the session.
+signal::StillNoise StillNoiseFrom(const std::string& path, const InputArgs& input) {
+  InputArgs other = input;
+  other.inputs = {path};
+  other.acc_file.clear();
+  other.gyr_file.clear();
+  const Session still = ReadInputs(other);
+  const segmentation::SegmentationResult seg = FindSegments(still.series, SegmentArgs{});
+  try {
+    return signal::AnalyseStillNoise(still.series, seg.segments);
+  } catch (const InsufficientDataError& e) {
+    throw InsufficientDataError("--noise-from " + path + ": " + e.what());
+  }
+}
+
+}  // namespace
+
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
-                    const SiteArgs& site_args, const FitArgs& fit) {
+                    const SiteArgs& site_args, const FitArgs& fit, const InputArgs& input) {
   FitSetup out;
   out.segments = segmentation.segments;
   if (fit.level_north && !out.segments.empty()) {
@@ -119,6 +194,9 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
   out.options.gyro_instability = fit.gyro_instability;
   out.options.instability_time_s = fit.instability_time_s;
   out.options.constant_bias = fit.constant_bias;
+  if (!fit.noise_from.empty()) {
+    out.options.other_still_noise.push_back(StillNoiseFrom(fit.noise_from, input));
+  }
   return out;
 }
 

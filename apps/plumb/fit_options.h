@@ -16,6 +16,7 @@
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
 #include "plumb/segmentation/still_detector.h"
+#include "input_options.h"
 #include "site_options.h"
 
 namespace plumb::cli {
@@ -39,6 +40,9 @@ struct FitArgs {
   std::optional<double> accel_instability;
   std::optional<double> gyro_instability;
   double instability_time_s = typical_mems::kInstabilityTime_s;
+  /// --noise-from FILE: a still recording of the same sensor whose Allan deviation informs
+  /// the wander levels not given (estimation/wander_levels.h).
+  std::string noise_from;
 };
 
 /// The exit code of a failed gate under --strict (SPEC section 8).
@@ -49,7 +53,7 @@ void AddModelOption(CLI::App* app, FitArgs& args);
 
 /// Registers --strict, --heading, --level-north, --temp-ref, --max-iterations, the bias
 /// wander (--accel-rw, --gyro-rw, --estimate-rw, --accel-bi, --gyro-bi, --bi-time,
-/// --constant-bias) on `app`.
+/// --noise-from, --constant-bias) on `app`.
 void AddFitOptions(CLI::App* app, FitArgs& args);
 
 /// Everything Calibrate() takes besides the samples.
@@ -62,9 +66,11 @@ struct FitSetup {
 };
 
 /// The fit's inputs for `session` and its segmentation; adds to session.warnings when
-/// --gravity overrides WGS84 gravity at a known site.
+/// --gravity overrides WGS84 gravity at a known site. With --noise-from, reads that still
+/// recording with `input`'s options and analyses its noise (signal::AnalyseStillNoise);
+/// throws plumb::Error naming the file when it has no still stretch long enough.
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
-                    const SiteArgs& site_args, const FitArgs& fit);
+                    const SiteArgs& site_args, const FitArgs& fit, const InputArgs& input);
 
 /// "<source>: N samples, T s[, no gyroscope][, with temperature]" and the session's warnings.
 void PrintSession(const Session& session);

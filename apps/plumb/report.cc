@@ -137,7 +137,7 @@ class ReportCommand : public Command {
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
-    const FitSetup fit = PrepareFit(session, seg, a.site, a.fit);
+    const FitSetup fit = PrepareFit(session, seg, a.site, a.fit, a.input);
     const std::vector<StillSegment>& segments = fit.segments;
     const geo::Site& site = fit.site;
     const model::Model& model = fit.model;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
+#include <tuple>
 
 #include "run_tool.h"
 
@@ -195,9 +196,64 @@ TEST(Cli, ConstantBiasExcludesTheWanderLevels) {
   EXPECT_NE(wander.out.find("the bias wanders over the session; the biases below are at its start"),
             std::string::npos)
       << wander.out;
-  EXPECT_NE(wander.out.find("note: bias random walk: the typical MEMS walk assumed"),
+  EXPECT_NE(wander.out.find("note: bias wander levels (Allan deviation of 89 s of still data): "
+                            "accel instability 0.0004 m/s^2 typical (bound 0.053..0.055), accel "
+                            "walk 0.0001 m/s^3/sqrt(Hz) typical (bound 0.013..0.014)"),
             std::string::npos)
       << wander.out;
+}
+
+TEST(Cli, WanderLevelsTakeDatasheetUnits) {
+  // --gyro-bi "4 deg/h" is 4 / 206264.8 rad/s; the JSON says the level was given.
+  TempDir dir;
+  const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
+  const std::string json_path = (dir.path() / "cal.json").string();
+  const ToolRun run = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate", "100",
+                             "--gyro-bi", "4 deg/h", "--accel-rw", "20ug/sqrt(s)", "--json",
+                             json_path}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json doc = nlohmann::json::parse(cli::testing::ReadAll((dir.path() / "cal.json").string()));
+  EXPECT_NEAR(doc["noise"]["instability_gyro"][0].get<double>(), 4.0 / 206264.806, 1e-12);
+  EXPECT_NEAR(doc["noise"]["walk_accel"][2].get<double>(), 20 * 9.80665e-6, 1e-12);
+  EXPECT_EQ(doc["noise"]["sources"]["instability_gyro"][1], "given");
+  EXPECT_EQ(doc["noise"]["sources"]["walk_gyro"][1], "typical");
+  const ToolRun bad = Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate", "100",
+                             "--gyro-bi", "4 deg/hour"}, dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("unit 'deg/hour' not known here; use one of rad/s, deg/s, deg/h"),
+            std::string::npos)
+      << bad.err;
+}
+
+TEST(Cli, NoiseFromALongStillRecordingMeasuresTheWander) {
+  // A 20-minute still recording of a sensor with 3 times the typical walk: with --noise-from
+  // the walks are measured (JSON sources "allan", levels near the truth); the session alone
+  // only bounds them.
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  for (const auto& [out, poses, still] : {std::tuple{"still.csv", "1", "1200"},
+                                          std::tuple{"session.csv", "12", "5"}}) {
+    const ToolRun sim = Plumb({"simulate", "--out", at(out), "--poses", poses, "--still", still,
+                               "--rate", "100", "--accel-rw", "3e-4", "--gyro-rw", "6e-6",
+                               "--seed", "5"}, dir);
+    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  }
+  const ToolRun run = Plumb({"calibrate", at("session.csv"), "--noise-from", at("still.csv"),
+                             "--json", at("cal.json")}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("note: bias wander levels (Allan deviation of "), std::string::npos)
+      << run.out;
+  const nlohmann::json doc = nlohmann::json::parse(cli::testing::ReadAll((dir.path() / "cal.json").string()));
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_EQ(doc["noise"]["sources"]["walk_accel"][axis], "allan");
+    const double K = doc["noise"]["walk_accel"][axis].get<double>();
+    EXPECT_GT(K, 1.5e-4);
+    EXPECT_LT(K, 6e-4);
+  }
+  const ToolRun missing = Plumb({"calibrate", at("session.csv"), "--noise-from", at("nothere.csv")},
+                                dir);
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("nothere.csv"), std::string::npos) << missing.err;
 }
 
 TEST(Cli, HelpListsTheSubcommands) {

@@ -191,6 +191,53 @@ TEST(NoiseTerms, RateRampWhenAsked) {
 
 // ---- Options, data and the session's still segments -------------------------------------------
 
+TEST(NoiseTerms, GaussMarkovShapeHasItsLimits) {
+  // Short taus: a random walk of K^2 = 2 / tau_c (AVAR 2 x / 3); the peak 0.6174^2 near
+  // x = 1.89 (0.6174 sigma); long taus: white noise 2 / x.
+  EXPECT_NEAR(GaussMarkovAvarShape(1e-4, 1.0) / (2e-4 / 3.0), 1.0, 1e-3);
+  EXPECT_NEAR(GaussMarkovAvarShape(1e-2, 1.0) / (2e-2 / 3.0), 1.0, 1e-2);
+  double peak = 0.0, at = 0.0;
+  for (double x = 0.5; x < 5.0; x += 1e-3) {
+    if (GaussMarkovAvarShape(x, 1.0) > peak) {
+      peak = GaussMarkovAvarShape(x, 1.0);
+      at = x;
+    }
+  }
+  EXPECT_NEAR(std::sqrt(peak), 0.6174, 1e-4);
+  EXPECT_NEAR(at, 1.89, 0.01);
+  EXPECT_NEAR(GaussMarkovAvarShape(1e4, 1.0) / 2e-4, 1.0, 1e-3);
+  // Continuous across the series' threshold x = 1e-3.
+  EXPECT_NEAR(GaussMarkovAvarShape(0.999e-3, 1.0) / 0.999e-3,
+              GaussMarkovAvarShape(1.001e-3, 1.0) / 1.001e-3, 1e-6);
+}
+
+TEST(NoiseTerms, AGaussMarkovInstabilityGivesItsSigma) {
+  // White noise with a Gauss-Markov bias of sigma 2e-3 and correlation time 20 s, 10 hours at
+  // 10 Hz; fitted with the instability as that process (gauss_markov_time_s, the estimator's
+  // own, estimation/wander_levels.h): its sigma resolved within 20 %. The flicker floor's B,
+  // fitted to the same curve, is not that sigma.
+  constexpr double kSigma = 2e-3, kTime = 20.0;
+  std::mt19937_64 rng(31);
+  std::normal_distribution<double> e(0.0, 1.0);
+  const double phi = std::exp(-kDt / kTime);
+  std::vector<float> x(360000);
+  double b = 0.0;
+  for (float& v : x) {
+    b = phi * b + kSigma * std::sqrt(1.0 - phi * phi) * e(rng);
+    v = static_cast<float>(b + 1e-3 / std::sqrt(kDt) * e(rng));
+  }
+  NoiseTermsOptions gm;
+  gm.gauss_markov_time_s = kTime;
+  const Analysed a = Analyse(x, gm);
+  const NoiseTerm& s = Term(a, NoiseTermKind::kBiasInstability);
+  EXPECT_TRUE(s.resolved);
+  EXPECT_NEAR(s.fitted / kSigma, 1.0, 0.2);
+  EXPECT_FALSE(Term(a, NoiseTermKind::kRandomWalk).resolved);
+  EXPECT_DOUBLE_EQ(a.fit.gauss_markov_time_s, kTime);
+  EXPECT_NEAR(a.fit.Avar(40.0) / (kSigma * kSigma * GaussMarkovAvarShape(40.0, kTime) +
+                                  1e-6 / 40.0), 1.0, 0.25);
+}
+
 TEST(NoiseTerms, RejectsBadOptionsAndTooFewPoints) {
   const std::vector<float> x = Simulate(7, 1000, Levels{0.0, 1e-3, 0.0, 0.0});
   const AllanDeviation ad = OverlappingAllanDeviation(ViewContiguous(x.data(), x.size()), kDt);

@@ -5,6 +5,18 @@
 
 namespace plumb::estimation {
 
+const char* LevelSourceName(LevelSource source) {
+  switch (source) {
+    case LevelSource::kNone: return "none";
+    case LevelSource::kGiven: return "given";
+    case LevelSource::kMeasured: return "allan";
+    case LevelSource::kBounded: return "allan_bound";
+    case LevelSource::kTypical: return "typical";
+    case LevelSource::kEstimated: return "estimated";
+  }
+  return "none";
+}
+
 Mat3 Calibration::AccelMatrix() const {
   return model.Predict(theta, model::SensorInput<double>()).F;
 }

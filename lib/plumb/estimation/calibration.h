@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -55,6 +56,24 @@ struct Observability {
   double smallest_kept = 0, largest_dropped = 0;
 };
 
+/// Where a level of the bias wander came from (estimation/wander_levels.h), per sensor,
+/// process and axis.
+enum class LevelSource {
+  kNone,       ///< no such process in the fit (a constant bias, or a level given as 0)
+  kGiven,      ///< given in the options (--accel-rw, --gyro-bi, ...)
+  kMeasured,   ///< resolved by the Allan deviation of still data
+  kBounded,    ///< not resolved; the Allan deviation's upper bound, below the typical level
+  kTypical,    ///< the typical MEMS level (core/typical_mems.h), within the data's bound
+  kEstimated,  ///< estimated over the fit by variance components (--estimate-rw)
+};
+/// "none", "given", "allan", "allan_bound", "typical", "estimated" (the JSON's words).
+const char* LevelSourceName(LevelSource source);
+
+/// The sources of the four wander processes' levels, per axis.
+struct WanderSources {
+  std::array<LevelSource, 3> walk_acc{}, walk_gyr{}, instability_acc{}, instability_gyr{};
+};
+
 /// The sensor noise the fit was whitened with, measured on the session's still segments.
 struct NoiseLevels {
   Vec3 acc = Vec3::Zero();  ///< accelerometer noise per sample, sensor units
@@ -70,6 +89,10 @@ struct NoiseLevels {
   Vec3 instability_acc = Vec3::Zero();
   Vec3 instability_gyr = Vec3::Zero();
   double instability_time_s = 0;
+  WanderSources from;  ///< where each wander level came from
+  /// Quantisation (IEEE Q) per axis the fit assumed, sensor units x s (0: none).
+  Vec3 quantisation_acc = Vec3::Zero();
+  Vec3 quantisation_gyr = Vec3::Zero();
 };
 
 struct Calibration {

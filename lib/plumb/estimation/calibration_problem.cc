@@ -75,20 +75,25 @@ void CalibrationProblem::SetMeasurements(const NoiseModel& noise) {
     m.dtemp_c = std::isfinite(s.stats.temp_mean_c) ? s.stats.temp_mean_c - model_.temp_ref_c : 0.0;
     m.mean = s.stats.acc_mean;
     for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_acc[i]) / noise.sigma_acc[i];
-    // With a walk, the state is its value at both ends; the Brownian bridge between them
-    // adds K^2 T / 12 to the variance of the segment's mean.
+    // Each wander process has a state at both ends of the segment; its bridge between them
+    // adds BridgeMeanVariance (the walk's K^2 T / 12) to the variance of the segment's mean.
     const double T = s.stats.t_end_s - s.stats.t_begin_s;
-    auto add_bridge = [&](Vec3& sqrt_info, const Vec3& K) {
-      for (int i = 0; i < 3; ++i) {
-        sqrt_info[i] = 1.0 / std::sqrt(1.0 / (sqrt_info[i] * sqrt_info[i]) + K[i] * K[i] * T / 12.0);
+    // Quantisation (IEEE Q) adds 2 Q^2 / T^2 (noise_model.h).
+    auto add_bridges = [&](Vec3& sqrt_info, model::Sensor sensor) {
+      Vec3 var = sqrt_info.cwiseAbs2().cwiseInverse();
+      for (const WanderProcess& w : wander_) {
+        if (w.sensor == sensor) var += w.BridgeMeanVariance(T);
       }
+      const Vec3& Q = sensor == model::Sensor::kAccel ? noise.quantisation_acc : noise.quantisation_gyr;
+      if (T > 0) var += Q.cwiseAbs2() * (2.0 / (T * T));
+      sqrt_info = var.cwiseSqrt().cwiseInverse();
     };
-    if (noise.accel_walks()) add_bridge(m.sqrt_info, noise.walk_acc);
+    add_bridges(m.sqrt_info, model::Sensor::kAccel);
     s.acc_measurement = m;
     if (still_gyro_) {
       m.mean = s.stats.gyr_mean;
       for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_gyr[i]) / noise.sigma_gyr[i];
-      if (noise.gyro_walks()) add_bridge(m.sqrt_info, noise.walk_gyr);
+      add_bridges(m.sqrt_info, model::Sensor::kGyro);
       s.gyr_measurement = m;
     }
   }
@@ -155,6 +160,12 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
         const double var = 1.0 / (motion_samples_[k].sqrt_info[i] * motion_samples_[k].sqrt_info[i]);
         motion_samples_[k].sqrt_info[i] = 1.0 / std::sqrt(var + cov_bridge(i, i));
       }
+    }
+    // Quantisation: the integrated angle carries 2 Q^2 (noise_model.h).
+    const Mat3 cov_q = E_inv * (2.0 * noise_.quantisation_gyr.cwiseAbs2()).asDiagonal() * E_inv.transpose();
+    for (int i = 0; i < 3; ++i) {
+      const double var = 1.0 / (motion_samples_[k].sqrt_info[i] * motion_samples_[k].sqrt_info[i]);
+      motion_samples_[k].sqrt_info[i] = 1.0 / std::sqrt(var + cov_q(i, i));
     }
     const double n = std::max(1.0, steps);
     const double var_w = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "plumb/core/error.h"
@@ -15,6 +16,7 @@
 #include "plumb/estimation/solve.h"
 #include "plumb/estimation/still_set.h"
 #include "plumb/estimation/walk_estimate.h"
+#include "plumb/estimation/wander_levels.h"
 
 namespace plumb::estimation {
 namespace {
@@ -83,6 +85,16 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   AssignHeadingGauge(still, cal.has_gyro);
   std::string implausible_walk;
   if (options.ModelsWander()) {
+    // 2a. The wander's levels: given, from the still data's Allan deviation, or typical;
+    // 2b. the walk estimated over the fit (opt-in).
+    std::vector<const signal::StillNoise*> measured;
+    const std::optional<signal::StillNoise> own = MeasureStillNoise(series, still, fit.notes);
+    if (own) measured.push_back(&*own);
+    for (const signal::StillNoise& other : options.other_still_noise) measured.push_back(&other);
+    WanderLevels levels =
+        AssignWanderLevels(noise, measured, start, cal.has_gyro, series.duration_s(), options);
+    noise = levels.noise;
+    fit.notes.insert(fit.notes.end(), levels.notes.begin(), levels.notes.end());
     WalkEstimate wander =
         ResolveWander(series, cal.model, site, still, theta, noise, start, options);
     noise = wander.noise;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "plumb/core/error.h"
 #include "plumb/signal/correlation_time.h"
@@ -73,6 +74,9 @@ NoiseLevels NoiseModel::Levels() const {
   out.instability_acc = instability_acc;
   out.instability_gyr = instability_gyr;
   out.instability_time_s = instability_time_s;
+  out.from = from;
+  out.quantisation_acc = quantisation_acc;
+  out.quantisation_gyr = quantisation_gyr;
   return out;
 }
 
@@ -116,13 +120,17 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
   }
   noise.instability_time_s = options.instability_time_s;
   if (options.constant_bias) return noise;  // no walk, no instability
-  if (options.accel_instability) noise.instability_acc = Vec3::Constant(*options.accel_instability);
-  if (options.gyro_instability && has_gyro) {
-    noise.instability_gyr = Vec3::Constant(*options.gyro_instability);
-  }
-  if (options.accel_walk_density) noise.walk_acc = Vec3::Constant(*options.accel_walk_density);
-  if (options.gyro_walk_density && has_gyro) {
-    noise.walk_gyr = Vec3::Constant(*options.gyro_walk_density);
+  // The levels given; the others are set by stage 2a (wander_levels.h).
+  auto give = [](const std::optional<double>& level, Vec3& to, std::array<LevelSource, 3>& from) {
+    if (!level) return;
+    to = Vec3::Constant(*level);
+    from.fill(*level > 0 ? LevelSource::kGiven : LevelSource::kNone);
+  };
+  give(options.accel_instability, noise.instability_acc, noise.from.instability_acc);
+  give(options.accel_walk_density, noise.walk_acc, noise.from.walk_acc);
+  if (has_gyro) {
+    give(options.gyro_instability, noise.instability_gyr, noise.from.instability_gyr);
+    give(options.gyro_walk_density, noise.walk_gyr, noise.from.walk_gyr);
   }
   return noise;
 }

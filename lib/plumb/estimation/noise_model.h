@@ -14,8 +14,8 @@
 //   walk         random walk of density K (units/sqrt(s)): var b(t) = K^2 (t - t_ref)
 //   instability  first-order Gauss-Markov of steady-state sigma s and correlation time tau:
 //                b(t2) = phi b(t1) + w, phi = exp(-(t2 - t1) / tau), var w = s^2 (1 - phi^2)
-// Their levels come from the options (CalibrationOptions::accel_walk_density, ...,
-// accel_instability, ..., instability_time_s) or the walk estimate (walk_estimate.h).
+// Their levels come from the options, the Allan deviation of still data or the typical MEMS
+// sensor (wander_levels.h), or the walk estimate (walk_estimate.h).
 #pragma once
 
 #include <vector>
@@ -62,6 +62,12 @@ struct NoiseModel {
   Vec3 instability_acc = Vec3::Zero();
   Vec3 instability_gyr = Vec3::Zero();
   double instability_time_s = typical_mems::kInstabilityTime_s;
+  WanderSources from;  ///< where each wander level came from (wander_levels.h)
+  /// Quantisation per axis (IEEE Q, resolved by the Allan deviation of still data,
+  /// wander_levels.h), sensor units x s (0: none): the mean output over T carries 2 Q^2 / T^2
+  /// more variance, an integrated angle 2 Q^2.
+  Vec3 quantisation_acc = Vec3::Zero();
+  Vec3 quantisation_gyr = Vec3::Zero();
 
   bool accel_walks() const { return walk_acc.minCoeff() > 0; }
   bool gyro_walks() const { return walk_gyr.minCoeff() > 0; }

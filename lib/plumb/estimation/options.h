@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "plumb/core/typical_mems.h"
+#include "plumb/signal/noise_terms.h"
 
 namespace plumb::estimation {
 
@@ -44,14 +45,14 @@ struct CalibrationOptions {
   /// rad/s^2/sqrt(Hz) for SI samples), >= 0 and finite. Set and > 0: the bias is not one
   /// constant over the session but walks, and the backend gives every still segment bias-walk
   /// states tied by random-walk factors (residuals/bias_walk_residual.h); the model's bias is
-  /// then the bias at the model's reference time. 0: no walk. Unset: see estimate_walk.
+  /// then the bias at the model's reference time. 0: no walk. Unset: wander_levels.h.
   /// A wandering bias (walk and instability states per segment) is the default; it costs
   /// about 6 unknowns per segment and sensor, eliminated before the analysis (solve.h).
   std::optional<double> accel_walk_density;
   std::optional<double> gyro_walk_density;
   /// Bias instability as a first-order Gauss-Markov process per axis: steady-state sigma
   /// (accelerometer m/s^2, gyroscope rad/s, sensor units for unscaled samples; finite >= 0;
-  /// 0: none; unset: see estimate_walk)
+  /// 0: none; unset: wander_levels.h)
   /// and correlation time (s, finite > 0). Every still segment then also has instability
   /// states at both ends, tied by Gauss-Markov factors (residuals/bias_walk_residual.h).
   std::optional<double> accel_instability;
@@ -59,18 +60,23 @@ struct CalibrationOptions {
   double instability_time_s = typical_mems::kInstabilityTime_s;
   /// Estimate the walk densities that are not given from the session itself, by
   /// variance-component estimation over the walk factors (estimation/walk_estimate.h), when
-  /// it has walk_min_poses still poses (else the typical MEMS walk, said in the warnings).
-  /// Off by default: the differences between holds that the estimate reads as a walk also
-  /// carry whatever effect the model misses (a session with a hidden g-sensitivity read as
-  /// "consistent with the noise" with it on), so the default is the typical walk and a
-  /// misfit stays visible.
+  /// it has walk_min_poses still poses (else the level of wander_levels.h, said in the
+  /// warnings). Off by default: the differences between holds that the estimate reads as a
+  /// walk also carry whatever effect the model misses (a session with a hidden g-sensitivity
+  /// read as "consistent with the noise" with it on), so the default is the level from still
+  /// data alone (wander_levels.h) and a misfit stays visible.
   bool estimate_walk = false;
   /// One constant bias over the session: no walk, no instability, whatever the fields above
   /// say. Honest only for white noise (the report says so); for comparisons and peers' methods.
   bool constant_bias = false;
-  /// Whether the bias wanders in the fit: always, unless constant_bias. Levels not given are
-  /// then estimated (the walk) or typical (core/typical_mems.h), said in the notes.
+  /// Whether the bias wanders in the fit: always, unless constant_bias. Levels not given come
+  /// from the still data's Allan deviation or the typical sensor (wander_levels.h), or the
+  /// walk estimate, said in the notes.
   bool ModelsWander() const { return !constant_bias; }
+  /// Other still recordings of the same sensor, analysed (signal::AnalyseStillNoise), whose
+  /// Allan deviation informs the wander levels not given, beside the session's own still
+  /// segments (wander_levels.h); e.g. a long still recording that resolves the walk.
+  std::vector<signal::StillNoise> other_still_noise;
   /// Fewest still segments for the walk estimate (>= 2); with fewer the typical walk is used.
   int walk_min_poses = 6;
   /// Lower bound on the noise standard deviation per sample, in sensor units, guarding

@@ -54,31 +54,6 @@ GroupStats WalkGroups(CalibrationProblem& problem, BuiltProblem& built,
 
 }  // namespace
 
-namespace {
-
-/// The typical MEMS instability for the sensors whose instability is not given, in the
-/// sensor's units; said in `notes`.
-void AssumeTypicalInstability(const StartingValues& start, const CalibrationOptions& options,
-                              bool has_gyro, NoiseModel& noise, std::vector<std::string>& notes) {
-  const bool acc = !options.accel_instability.has_value();
-  const bool gyr = has_gyro && !options.gyro_instability.has_value();
-  if (acc) noise.instability_acc.setConstant(typical_mems::kAccelInstability * start.accel.scale);
-  if (gyr) noise.instability_gyr.setConstant(typical_mems::kGyroInstability / start.gyro_rad_per_unit);
-  if (!acc && !gyr) return;
-  char acc_text[64] = "", gyr_text[64] = "";
-  if (acc) std::snprintf(acc_text, sizeof acc_text, " accel %.3g m/s^2", typical_mems::kAccelInstability);
-  if (gyr) std::snprintf(gyr_text, sizeof gyr_text, " gyro %.3g rad/s", typical_mems::kGyroInstability);
-  char text[320];
-  std::snprintf(text, sizeof text,
-                "bias instability not measured by this session: the typical MEMS value assumed "
-                "(Gauss-Markov sigma%s%s%s, correlation time %.3g s; give --accel-bi/--gyro-bi, "
-                "e.g. from 'plumb allan' on a long still recording)",
-                acc_text, acc && gyr ? "," : "", gyr_text, noise.instability_time_s);
-  notes.emplace_back(text);
-}
-
-}  // namespace
-
 WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
                            const geo::Site& site, const StillSet& still,
                            const model::ParameterBlocks& theta, const NoiseModel& noise,
@@ -86,32 +61,18 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
   WalkEstimate out;
   out.noise = noise;
   const bool has_gyro = model.has_gyro();
-  AssumeTypicalInstability(start, options, has_gyro, out.noise, out.notes);
-  // The walks not given: from the typical MEMS walk in the sensor's units, estimated when
-  // the session can show it.
+  // The walks not given are estimated, starting from the levels of stage 2a (wander_levels.h).
   const double acc0 = typical_mems::kAccelWalk * start.accel.scale;
   const double gyr0 = typical_mems::kGyroWalk / start.gyro_rad_per_unit;
   const bool free_acc = !options.accel_walk_density.has_value();
   const bool free_gyr = has_gyro && !options.gyro_walk_density.has_value();
-  if (free_acc) out.noise.walk_acc = Vec3::Constant(acc0);
-  if (free_gyr) out.noise.walk_gyr = Vec3::Constant(gyr0);
-  if (!free_acc && !free_gyr) return out;
-  if (!options.estimate_walk) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "bias random walk: the typical MEMS walk assumed (accel %.3g m/s^3/sqrt(Hz), "
-                  "gyro %.3g rad/s^2/sqrt(Hz)); give --accel-rw/--gyro-rw, or --estimate-rw",
-                  typical_mems::kAccelWalk, typical_mems::kGyroWalk);
-    out.notes.emplace_back(text);
-    return out;
-  }
+  if (!options.estimate_walk || (!free_acc && !free_gyr)) return out;
   if (static_cast<int>(still.poses.size()) < options.walk_min_poses) {
-    char text[320];
+    char text[240];
     std::snprintf(text, sizeof text,
                   "bias random walk not estimated (%zu still segments, at least %d are needed to "
-                  "see it): the typical MEMS walk assumed (accel %.3g m/s^3/sqrt(Hz), gyro %.3g "
-                  "rad/s^2/sqrt(Hz)); give --accel-rw/--gyro-rw for another sensor",
-                  still.poses.size(), options.walk_min_poses, typical_mems::kAccelWalk, typical_mems::kGyroWalk);
+                  "see it): the level from the still data or the typical MEMS sensor kept",
+                  still.poses.size(), options.walk_min_poses);
     out.warnings.emplace_back(text);
     return out;
   }
@@ -128,8 +89,8 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
     auto scale = [&](Vec3& K, double chi2, double red, double k0, bool& learnt) {
       if (red <= 1.0) return;  // the factors are absorbed: nothing to learn from them
       learnt = true;
-      const double next = std::max(K[0] * std::sqrt(chi2 / red), kFloor * k0);
-      change = std::max(change, std::abs(next / K[0] - 1.0));
+      const double next = std::max(K.maxCoeff() * std::sqrt(chi2 / red), kFloor * k0);
+      change = std::max(change, std::abs(next / K.maxCoeff() - 1.0));
       K.setConstant(next);
     };
     if (free_acc) scale(out.noise.walk_acc, g.chi2_acc, g.red_acc, acc0, learnt_acc);
@@ -137,12 +98,14 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
     if (change < kTolerance) break;
   }
   // Per sensor: estimated, or (its walk factors fully absorbed by the other unknowns, e.g.
-  // holds not joined by turns) the typical MEMS walk kept.
+  // holds not joined by turns) the level of stage 2a kept.
+  if (learnt_acc) out.noise.from.walk_acc.fill(LevelSource::kEstimated);
+  if (learnt_gyr) out.noise.from.walk_gyr.fill(LevelSource::kEstimated);
   auto describe = [](const char* sensor, double K, double red, bool learnt) {
     char text[160];
     std::snprintf(text, sizeof text, learnt ? "%s %.3g (from %.1f redundant walk factors)"
-                                            : "%s %.3g (the typical MEMS walk: its walk factors "
-                                              "are absorbed by the fit, %.1f redundant)",
+                                            : "%s %.3g (kept: its walk factors are absorbed by "
+                                              "the fit, %.1f redundant)",
                   sensor, K, red);
     return std::string(text);
   };

@@ -1,7 +1,5 @@
-// plumb/estimation/walk_estimate.h — the bias wander's levels not given by the user (stage
-// 2b of the backend): the random-walk densities from the session itself, by
-// variance-component estimation; the instability, which a multi-pose session cannot separate
-// from the walk, from the typical MEMS sensor (core/typical_mems.h), said in the notes.
+// plumb/estimation/walk_estimate.h — the bias random walk estimated over the fit (stage 2b
+// of the backend, opt-in: CalibrationOptions::estimate_walk), for the walks not given.
 //
 // A multi-pose session shows how far the biases wander between its holds, but only through the
 // fit: the still means differ by the walk *and* by the poses. Helmert's variance-component
@@ -15,12 +13,11 @@
 // (pseudo-)inverse normal matrix: the part of the group's residuals that the fit cannot absorb.
 // At the right density, E[r_g^T r_g] = red_g, so each iteration scales K^2 by
 // r_g^T r_g / red_g and fits again, until K changes by less than `tolerance`. The start is
-// the typical consumer MEMS walk (1e-4 m/s^3/sqrt(Hz), 2e-6 rad/s^2/sqrt(Hz), scaled to the
-// sensor's units by the starting scale); the result is floored at 1e-3 of it (a walk too
-// small to see leaves the factors stiff but finite).
+// the level of stage 2a (wander_levels.h; the largest axis's); the result is floored at 1e-3
+// of the typical MEMS walk (a walk too small to see leaves the factors stiff but finite).
 //
 // The estimate needs holds to compare: at least `walk_min_poses` still segments, else the
-// typical MEMS walk is assumed and a warning says so. Densities given in the options (0
+// level of stage 2a is kept and a warning says so. Densities given in the options (0
 // included: no walk) are kept.
 #pragma once
 

@@ -173,6 +173,29 @@ json NoiseJson(const estimation::CalibrationResult& r) {
     out["instability_time_s"] = Number(n.instability_time_s);
     out["instability_units"] = "sensor units (Gauss-Markov sigma); correlation time in s";
   }
+  // Quantisation, when the still data resolved it on some axis.
+  const bool acc_q = !n.quantisation_acc.isZero(), gyr_q = !n.quantisation_gyr.isZero();
+  if (acc_q || gyr_q) {
+    out["quantisation_accel"] = Vector(n.quantisation_acc);
+    out["quantisation_gyro"] = r.calibration.has_gyro ? Vector(n.quantisation_gyr) : json(nullptr);
+    out["quantisation_units"] = "sensor units x s (IEEE Q)";
+  }
+  // Where each wander level came from, per axis (estimation/wander_levels.h).
+  if (acc_walk || gyr_walk || acc_bi || gyr_bi) {
+    auto sources = [](const std::array<estimation::LevelSource, 3>& from) {
+      json list = json::array();
+      for (estimation::LevelSource s : from) list.push_back(estimation::LevelSourceName(s));
+      return list;
+    };
+    out["sources"] = {{"walk_accel", sources(n.from.walk_acc)},
+                      {"walk_gyro", sources(n.from.walk_gyr)},
+                      {"instability_accel", sources(n.from.instability_acc)},
+                      {"instability_gyro", sources(n.from.instability_gyr)},
+                      {"meaning", "given: an option; allan: the Allan deviation of still data; "
+                                  "allan_bound: its 95% upper bound, below the typical level; "
+                                  "typical: the typical MEMS sensor; estimated: --estimate-rw; "
+                                  "none: not in the fit"}};
+  }
   return out;
 }
 

@@ -22,7 +22,9 @@
 // More generally the bias wanders as a sum of independent Markov processes (the walk, the
 // instability's Gauss-Markov process), each with its states at both ends; the segment mean
 // carries sum_p w_p (s_p + e_p), w_p the weight of process p (1/2 for the walk; for a
-// Gauss-Markov process the mean of its bridge, estimation/calibration_problem.cc).
+// Gauss-Markov process the mean of its bridge), and sqrt_info the variance of every
+// process's bridge about it (estimation/noise_model.h, BridgeMeanVariance; set in
+// estimation/calibration_problem.cc).
 //
 // Parameter blocks, in order: q_k (4, Eigen order x y z w, unit quaternion of R_n_b), then
 // the blocks of the model terms listed in `terms` (their sizes in info().size()), then, per

@@ -25,11 +25,12 @@ void CheckOptions(const NoiseTermsOptions& o) {
   const bool ok = o.tau_min_s >= 0.0 && std::isfinite(o.tau_min_s) && o.tau_max_s >= 0.0 &&
                   std::isfinite(o.tau_max_s) && o.min_edf >= 1.0 && std::isfinite(o.min_edf) &&
                   o.min_points >= 1 && o.term_confidence > 0.5 && o.term_confidence < 1.0 &&
-                  o.max_iterations >= 1 && o.misfit_chi2_per_point > 0.0;
+                  o.max_iterations >= 1 && o.misfit_chi2_per_point > 0.0 &&
+                  o.gauss_markov_time_s >= 0.0 && std::isfinite(o.gauss_markov_time_s);
   if (!ok) {
     throw Error("noise terms: options out of range (tau_min_s, tau_max_s >= 0, min_edf >= 1, "
                 "min_points >= 1, term_confidence in (0.5, 1), max_iterations >= 1, "
-                "misfit_chi2_per_point > 0)");
+                "misfit_chi2_per_point > 0, gauss_markov_time_s >= 0)");
   }
 }
 
@@ -50,20 +51,28 @@ std::vector<std::size_t> FittedPoints(const AllanDeviation& a, const NoiseTermsO
 
 using Coefficients = std::array<double, kNoiseTermCount>;
 
+/// The shape of term k: NoiseTermShape, but a Gauss-Markov process of correlation time gm
+/// for the instability when gm > 0 (NoiseTermsOptions::gauss_markov_time_s).
+double TermShape(int k, double tau, double gm) {
+  if (gm > 0.0 && Kind(k) == NoiseTermKind::kBiasInstability) return GaussMarkovAvarShape(tau, gm);
+  return NoiseTermShape(Kind(k), tau);
+}
+
 struct WeightedProblem {
   std::vector<double> tau, target, weight;  // per fitted point
+  double gm = 0.0;                          // the instability's shape (TermShape)
 };
 
-double Model(const Coefficients& c, double tau) {
+double Model(const Coefficients& c, double tau, double gm) {
   double sum = 0.0;
-  for (int k = 0; k < kNoiseTermCount; ++k) sum += c[k] * NoiseTermShape(Kind(k), tau);
+  for (int k = 0; k < kNoiseTermCount; ++k) sum += c[k] * TermShape(k, tau, gm);
   return sum;
 }
 
 double LinearCost(const WeightedProblem& p, const Coefficients& c) {
   double cost = 0.0;
   for (std::size_t j = 0; j < p.tau.size(); ++j) {
-    const double r = p.target[j] - Model(c, p.tau[j]);
+    const double r = p.target[j] - Model(c, p.tau[j], p.gm);
     cost += p.weight[j] * r * r;
   }
   return cost;
@@ -90,7 +99,7 @@ Coefficients SolveNonNegative(const WeightedProblem& p,
       const double s = std::sqrt(p.weight[j]);
       y[j] = s * p.target[j];
       for (std::size_t i = 0; i < cols.size(); ++i) {
-        design(j, static_cast<Eigen::Index>(i)) = s * NoiseTermShape(Kind(cols[i]), p.tau[j]);
+        design(j, static_cast<Eigen::Index>(i)) = s * TermShape(cols[i], p.tau[j], p.gm);
       }
     }
     const Eigen::VectorXd norms = design.colwise().norm();
@@ -116,11 +125,11 @@ Coefficients SolveNonNegative(const WeightedProblem& p,
 }
 
 /// The term with the largest AVAR at tau (the white noise when every coefficient is 0).
-int Dominant(const Coefficients& c, double tau) {
+int Dominant(const Coefficients& c, double tau, double gm) {
   int best = static_cast<int>(NoiseTermKind::kWhite);
   double largest = 0.0;
   for (int k = 0; k < kNoiseTermCount; ++k) {
-    const double v = c[k] * NoiseTermShape(Kind(k), tau);
+    const double v = c[k] * TermShape(k, tau, gm);
     if (v > largest) {
       largest = v;
       best = k;
@@ -140,10 +149,10 @@ struct FitState {
 
 /// sum_j edf_j / 2 (ln AVAR_j - ln model_j)^2; infinite where the model is not positive.
 double LogCost(const std::vector<double>& tau, const std::vector<double>& avar,
-               const std::vector<double>& edf, const Coefficients& c) {
+               const std::vector<double>& edf, const Coefficients& c, double gm) {
   double cost = 0.0;
   for (std::size_t j = 0; j < tau.size(); ++j) {
-    const double m = Model(c, tau[j]);
+    const double m = Model(c, tau[j], gm);
     if (!(m > 0.0)) return std::numeric_limits<double>::infinity();
     const double r = std::log(avar[j] / m);
     cost += 0.5 * edf[j] * r * r;
@@ -156,11 +165,13 @@ double LogCost(const std::vector<double>& tau, const std::vector<double>& avar,
 /// model = AVAR, is the relative-error fit), halves the step while the log cost rises, and
 /// updates the noise types and EDF from the dominant terms.
 FitState FitInLogs(const AllanDeviation& a, const std::vector<std::size_t>& points,
-                   const std::array<bool, kNoiseTermCount>& enabled, int max_iterations) {
+                   const std::array<bool, kNoiseTermCount>& enabled, int max_iterations,
+                   double gm) {
   FitState s;
   s.noise.assign(points.size(), PowerLawNoise::kWhiteFrequency);
   s.edf.assign(points.size(), 0.0);
   WeightedProblem p;
+  p.gm = gm;
   std::vector<double> avar;
   for (std::size_t j : points) {
     p.tau.push_back(a.tau_s[j]);
@@ -183,14 +194,14 @@ FitState FitInLogs(const AllanDeviation& a, const std::vector<std::size_t>& poin
     Coefficients c = SolveNonNegative(p, enabled);
     if (it > 1) {  // step control: never a higher log cost than the last solution's
       const Coefficients from = s.c;
-      const double before = LogCost(p.tau, avar, s.edf, from);
+      const double before = LogCost(p.tau, avar, s.edf, from, gm);
       double step = 1.0;
       Coefficients trial = c;
-      while (LogCost(p.tau, avar, s.edf, trial) > before && step > 1.0 / 64) {
+      while (LogCost(p.tau, avar, s.edf, trial, gm) > before && step > 1.0 / 64) {
         step *= 0.5;
         for (int k = 0; k < kNoiseTermCount; ++k) trial[k] = from[k] + step * (c[k] - from[k]);
       }
-      c = LogCost(p.tau, avar, s.edf, trial) <= before ? trial : from;
+      c = LogCost(p.tau, avar, s.edf, trial, gm) <= before ? trial : from;
     }
     s.iterations = it;
     bool same = it > 1;
@@ -201,16 +212,16 @@ FitState FitInLogs(const AllanDeviation& a, const std::vector<std::size_t>& poin
     }
     s.c = c;
     for (std::size_t i = 0; i < points.size(); ++i) {
-      const double m = Model(c, p.tau[i]);
+      const double m = Model(c, p.tau[i], gm);
       model[i] = m > 0.0 ? m : avar[i];
-      const PowerLawNoise noise = NoiseTermNoise(Kind(Dominant(c, p.tau[i])));
+      const PowerLawNoise noise = NoiseTermNoise(Kind(Dominant(c, p.tau[i], gm)));
       same = same && noise == s.noise[i];
       s.noise[i] = noise;
     }
     if (same) break;
   }
   update_edf();
-  s.chi2 = LogCost(p.tau, avar, s.edf, s.c);
+  s.chi2 = LogCost(p.tau, avar, s.edf, s.c, gm);
   return s;
 }
 
@@ -237,12 +248,12 @@ NoiseTerm Judge(int k, const AllanDeviation& a, const std::vector<std::size_t>& 
     const double tau = a.tau_s[points[i]];
     const double avar = a.adev[points[i]] * a.adev[points[i]];
     const double upper = avar * s.edf[i] / ChiSquareQuantileExact(tail, s.edf[i]);
-    const double b = upper / NoiseTermShape(t.kind, tau);
+    const double b = upper / TermShape(k, tau, o.gauss_markov_time_s);
     if (b < bound) {
       bound = b;
       t.bound_tau_s = tau;
     }
-    const bool dominant = s.c[k] > 0.0 && Dominant(s.c, tau) == k;
+    const bool dominant = s.c[k] > 0.0 && Dominant(s.c, tau, o.gauss_markov_time_s) == k;
     run_length = dominant ? run_length + 1 : 0;
     if (run_length == 1) run_begin = i;
     if (run_length > best_length) {
@@ -256,7 +267,8 @@ NoiseTerm Judge(int k, const AllanDeviation& a, const std::vector<std::size_t>& 
     // as one observation.
     std::array<bool, kNoiseTermCount> without = Enabled(o);
     without[k] = false;
-    const Coefficients c = FitInLogs(a, points, without, o.max_iterations).c;
+    const Coefficients c =
+        FitInLogs(a, points, without, o.max_iterations, o.gauss_markov_time_s).c;
     std::vector<double> tau, avar;
     for (std::size_t j : points) {
       tau.push_back(a.tau_s[j]);
@@ -265,7 +277,7 @@ NoiseTerm Judge(int k, const AllanDeviation& a, const std::vector<std::size_t>& 
     const double decades = std::log10(tau.back() / tau.front());
     const double per_decade =
         decades > 0.0 ? std::max(1.0, static_cast<double>(points.size() - 1) / decades) : 1.0;
-    t.chi2_rise = (LogCost(tau, avar, s.edf, c) - s.chi2) / per_decade;
+    t.chi2_rise = (LogCost(tau, avar, s.edf, c, o.gauss_markov_time_s) - s.chi2) / per_decade;
     t.resolved = t.chi2_rise > ChiSquareQuantileExact(o.term_confidence, 1.0);
   }
   if (t.resolved) {
@@ -312,9 +324,19 @@ PowerLawNoise NoiseTermNoise(NoiseTermKind kind) {
   return PowerLawNoise::kWhiteFrequency;
 }
 
+double GaussMarkovAvarShape(double tau_s, double tau_c_s) {
+  const double x = tau_s / tau_c_s;
+  // Below x = 1e-3 the bracket cancels to rounding: its series, 2 x / 3 - x^2 / 2.
+  if (x < 1e-3) return x * (2.0 / 3.0 - 0.5 * x);
+  return (2.0 - (3.0 - 4.0 * std::exp(-x) + std::exp(-2.0 * x)) / x) / x;
+}
+
 double NoiseFit::Avar(double tau_s) const {
   double sum = 0.0;
-  for (const NoiseTerm& t : terms) sum += t.fitted * t.fitted * NoiseTermShape(t.kind, tau_s);
+  for (int k = 0; k < kNoiseTermCount; ++k) {
+    const NoiseTerm& t = terms[static_cast<std::size_t>(k)];
+    sum += t.fitted * t.fitted * TermShape(k, tau_s, gauss_markov_time_s);
+  }
   return sum;
 }
 
@@ -326,8 +348,9 @@ NoiseFit FitNoiseTerms(const AllanDeviation& a, const NoiseTermsOptions& o) {
         "noise terms: " + std::to_string(points.size()) +
         " Allan deviation point(s) in the fitted range; record a longer still period");
   }
-  const FitState s = FitInLogs(a, points, Enabled(o), o.max_iterations);
+  const FitState s = FitInLogs(a, points, Enabled(o), o.max_iterations, o.gauss_markov_time_s);
   NoiseFit fit;
+  fit.gauss_markov_time_s = o.gauss_markov_time_s;
   for (int k = 0; k < kNoiseTermCount; ++k) fit.terms[k] = Judge(k, a, points, s, o);
   fit.first = points.front();
   fit.last = points.back();

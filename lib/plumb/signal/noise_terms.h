@@ -112,6 +112,11 @@ struct NoiseTermsOptions {
   /// simulated still records (white, flicker, random walk, quantisation, their sums; 180
   /// records) stayed below 3.3 per point, of tomisuarez2's 449 s still record below 1.
   double misfit_chi2_per_point = 10.0;
+  /// > 0: the instability term is a first-order Gauss-Markov process of this correlation
+  /// time, s (GaussMarkovAvarShape; its level the process's sigma) instead of IEEE's flicker
+  /// floor B: the process the estimator's bias wander has (estimation/wander_levels.h), whose
+  /// sigma the flicker floor does not give where a random walk hides the floor.
+  double gauss_markov_time_s = 0.0;
 };
 
 struct NoiseTerm {
@@ -142,6 +147,8 @@ struct NoiseFit {
   int dof = 0;          ///< fitted points minus nonzero coefficients
   int iterations = 0;   ///< passes made
   bool misfit = false;  ///< chi2 above misfit_chi2_per_point per point: nothing resolved
+  /// The options' gauss_markov_time_s: > 0, the instability term was a Gauss-Markov process.
+  double gauss_markov_time_s = 0.0;
   std::size_t points() const { return last + 1 - first; }
   const NoiseTerm& term(NoiseTermKind kind) const { return terms[static_cast<int>(kind)]; }
   /// The fitted model's Allan variance at tau_s > 0, unit^2.
@@ -151,6 +158,13 @@ struct NoiseFit {
 /// Fits the terms to `adev` (its record_sizes set the EDF). Throws plumb::Error for options out
 /// of range, InsufficientDataError when fewer than 2 points lie in the fitted range.
 NoiseFit FitNoiseTerms(const AllanDeviation& adev, const NoiseTermsOptions& options = {});
+
+/// The Allan variance of a first-order Gauss-Markov process of unit steady-state sigma and
+/// correlation time tau_c_s > 0 at cluster time tau_s > 0 (x = tau / tau_c):
+///   AVAR = (1 / x) [2 - (1 / x) (3 - 4 e^-x + e^-2x)]
+/// (Gelb; El-Sheimy et al. 2008). About 2 x / 3 for x << 1 (a random walk with
+/// K^2 = 2 / tau_c), largest, 0.6174^2, at x = 1.89, and 2 / x for x >> 1 (white noise).
+double GaussMarkovAvarShape(double tau_s, double tau_c_s);
 
 struct StillNoiseOptions {
   /// Cluster sizes or density and the confidence of the intervals; its `noise` is replaced per
