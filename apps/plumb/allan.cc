@@ -21,6 +21,7 @@
 #include "plumb/report/summary.h"
 #include "plumb/signal/noise_terms.h"
 #include "segment_options.h"
+#include "json_output.h"
 
 namespace plumb::cli {
 namespace {
@@ -116,8 +117,8 @@ class AllanCommand : public Command {
     RefuseInputAsOutput(a.input, a.json_path);
     const Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
-    const bool to_stdout = a.json_path == "-";
-    std::ostream& out = to_stdout ? std::cerr : std::cout;  // keep stdout for the JSON
+    const TextAsideForJson text_aside(a.json_path);  // "-": the JSON alone on stdout
+    std::ostream& out = std::cout;
     std::vector<StillSegment> still;
     segmentation::SegmentationResult seg;
     if (a.whole) {
@@ -130,7 +131,7 @@ class AllanCommand : public Command {
       seg = FindSegments(series, a.segments);
       still = seg.segments;
     }
-    if (!to_stdout) PrintSession(session);
+    PrintSession(session);
     out << (a.whole ? std::string("still segments: the whole input (--whole)\n")
                     : report::SegmentationSummary(seg, a.segments.segments_path,
                                                   a.segments.verbose));
@@ -149,12 +150,7 @@ class AllanCommand : public Command {
       doc["source"] = session.source;
       doc["still"]["method"] = a.whole ? "whole" : seg.report.method;
       doc["warnings"] = session.warnings;
-      if (to_stdout) {
-        std::cout << doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-      } else {
-        report::WriteJson(a.json_path, doc);
-        std::cout << "wrote " << a.json_path << "\n";
-      }
+      WriteJsonOutput(a.json_path, doc);
     }
     return 0;
   }

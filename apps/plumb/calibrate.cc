@@ -22,6 +22,7 @@
 #include "plumb/segmentation/still_detector.h"
 #include "segment_options.h"
 #include "site_options.h"
+#include "json_output.h"
 
 namespace plumb::cli {
 namespace {
@@ -55,7 +56,7 @@ class CalibrateCommand : public Command {
     AddModelOption(app_, a.fit);
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
-    app_->add_option("--json", a.json_path, "Write the result as JSON to FILE (atomically)")
+    app_->add_option("--json", a.json_path, "Write the result as JSON to FILE (atomically; - for stdout, the text then on stderr)")
         ->type_name("FILE");
     AddFitOptions(app_, a.fit);
     app_->add_option("--baseline", a.baseline,
@@ -69,6 +70,7 @@ class CalibrateCommand : public Command {
 
   int Run() override {
     const CalibrateArgs& a = args_;
+    const TextAsideForJson text_aside(a.json_path);
     const std::vector<ExportRequest> exports = ParseExports(a.exports);
     if (!exports.empty() && a.method != "generalized") {
       throw UsageError("--export needs --method generalized (plumb's forward model)");
@@ -134,8 +136,7 @@ class CalibrateCommand : public Command {
                            {"chi2_drop", baseline->fit.chi2 - result.fit.chi2}};
       }
       if (!exports.empty()) doc["export"] = exported;
-      report::WriteJson(a.json_path, doc);
-      std::cout << "wrote " << a.json_path << "\n";
+      WriteJsonOutput(a.json_path, doc);
     }
     return 0;
   }

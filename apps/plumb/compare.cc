@@ -12,6 +12,7 @@
 #include "plumb/peers/imucal.h"
 #include "plumb/peers/plumb_result.h"
 #include "plumb/report/json_report.h"
+#include "json_output.h"
 
 namespace plumb::cli {
 namespace {
@@ -54,12 +55,13 @@ class CompareCommand : public Command {
                      "Gravity magnitude of imu_tk's cost, m/s^2 (default: the result's "
                      "site.gravity; imu_tk's demo used 9.81744)")
         ->check(CLI::PositiveNumber);
-    app_->add_option("--json", a.json_path, "Also write the comparison as JSON to FILE")
+    app_->add_option("--json", a.json_path, "Also write the comparison as JSON to FILE (- for stdout, the text then on stderr)")
         ->type_name("FILE");
   }
 
   int Run() override {
     const CompareArgs& a = args_;
+    const TextAsideForJson text_aside(a.json_path);
     const peers::ForwardCalibration peer = ReadPeer();
     const peers::PlumbResult result = peers::ReadPlumbResult(a.result_path);
     peers::CompareOptions options;
@@ -67,8 +69,7 @@ class CompareCommand : public Command {
     const peers::Comparison comparison = peers::Compare(result, peer, options);
     std::cout << peers::ComparisonText(comparison);
     if (!a.json_path.empty()) {
-      report::WriteJson(a.json_path, peers::ComparisonJson(comparison));
-      std::cout << "wrote " << a.json_path << "\n";
+      WriteJsonOutput(a.json_path, peers::ComparisonJson(comparison));
     }
     return 0;
   }

@@ -23,6 +23,7 @@
 #include "plumb/report/diagnosis_text.h"
 #include "segment_options.h"
 #include "site_options.h"
+#include "json_output.h"
 
 namespace plumb::cli {
 namespace {
@@ -52,7 +53,7 @@ class DiagnoseCommand : public Command {
         ->capture_default_str();
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
-    app_->add_option("--json", a.json_path, "Write the diagnosis as JSON to FILE (atomically)")
+    app_->add_option("--json", a.json_path, "Write the diagnosis as JSON to FILE (atomically; - for stdout, the text then on stderr)")
         ->type_name("FILE");
     app_->add_option("--residuals", a.residuals_path,
                      "Write the per-sample still residuals of the model's fit as CSV to FILE "
@@ -82,6 +83,7 @@ class DiagnoseCommand : public Command {
 
   int Run() override {
     const DiagnoseArgs& a = args_;
+    const TextAsideForJson text_aside(a.json_path);
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
@@ -116,8 +118,7 @@ class DiagnoseCommand : public Command {
     for (const auto& w : d.fit.fit.warnings) std::cout << "warning: " << w << "\n";
 
     if (!a.json_path.empty()) {
-      report::WriteJson(a.json_path, report::DiagnosisJson(d, ra));
-      std::cout << "wrote " << a.json_path << "\n";
+      WriteJsonOutput(a.json_path, report::DiagnosisJson(d, ra));
     }
     if (!a.residuals_path.empty()) {
       io::WriteFileAtomic(a.residuals_path, report::ResidualsCsv(ra.samples));

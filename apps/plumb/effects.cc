@@ -5,6 +5,7 @@
 #include "plumb/model/registry.h"
 #include "plumb/report/catalogue.h"
 #include "plumb/report/json_report.h"
+#include "json_output.h"
 
 namespace plumb::cli {
 namespace {
@@ -16,16 +17,16 @@ class EffectsCommand : public Command {
                                  "List the effects a model can be made of, with their terms, "
                                  "parameters and units");
     app_->add_option("NAME", name_, "Show only this effect");
-    app_->add_option("--json", json_path_, "Also write the catalogue as JSON to FILE")
+    app_->add_option("--json", json_path_, "Also write the catalogue as JSON to FILE (- for stdout, the text then on stderr)")
         ->type_name("FILE");
   }
 
   int Run() override {
+    const TextAsideForJson text_aside(json_path_);
     const auto& registry = model::Registry::Global();
     std::cout << report::CatalogueText(registry, name_);
     if (!json_path_.empty()) {
-      report::WriteJson(json_path_, report::CatalogueJson(registry, name_));
-      std::cout << "wrote " << json_path_ << "\n";
+      WriteJsonOutput(json_path_, report::CatalogueJson(registry, name_));
     }
     return 0;
   }

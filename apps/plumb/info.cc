@@ -15,6 +15,7 @@
 #include "plumb/report/json_report.h"
 #include "plumb/segmentation/still_detector.h"
 #include "segment_options.h"
+#include "json_output.h"
 
 namespace plumb::cli {
 namespace {
@@ -62,12 +63,13 @@ class InfoCommand : public Command {
         "info", "What is inside a flight log (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg): IMU "
                 "streams, still periods, the site from GPS, the calibration parameters in force");
     app_->add_option("LOG", args_.log_path, "The log file")->required()->type_name("LOG");
-    app_->add_option("--json", args_.json_path, "Also write it as JSON to FILE (atomically)")
+    app_->add_option("--json", args_.json_path, "Also write it as JSON to FILE (atomically; - for stdout, the text then on stderr)")
         ->type_name("FILE");
   }
 
   int Run() override {
     const InfoArgs& a = args_;
+    const TextAsideForJson text_aside(a.json_path);
     const io::FlightLog log = io::FlightLog::Open(a.log_path);
     const io::FlightLogSummary summary = log.Summary();
     nlohmann::json doc;
@@ -136,8 +138,7 @@ class InfoCommand : public Command {
     doc["warnings"] = summary.warnings;
     for (const auto& w : summary.warnings) std::cout << "warning: " << w << "\n";
     if (!a.json_path.empty()) {
-      report::WriteJson(a.json_path, doc);
-      std::cout << "wrote " << a.json_path << "\n";
+      WriteJsonOutput(a.json_path, doc);
     }
     return 0;
   }

@@ -13,6 +13,7 @@
 #include "plumb/paper/static_procedure.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"
+#include "json_output.h"
 
 namespace plumb::cli {
 namespace {
@@ -42,8 +43,7 @@ void Finish(const nlohmann::json& doc, const std::vector<std::string>& notes,
             const std::string& json_path) {
   for (const auto& n : notes) std::cout << "note: " << n << "\n";
   if (!json_path.empty()) {
-    report::WriteJson(json_path, doc);
-    std::cout << "wrote " << json_path << "\n";
+    WriteJsonOutput(json_path, doc);
   }
 }
 

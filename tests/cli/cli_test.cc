@@ -256,6 +256,21 @@ TEST(Cli, NoiseFromALongStillRecordingMeasuresTheWander) {
   EXPECT_NE(missing.err.find("nothere.csv"), std::string::npos) << missing.err;
 }
 
+TEST(Cli, JsonDashWritesTheDocumentAloneToStdout) {
+  // SPEC section 6: --json - writes to stdout (stdout parses as one JSON document); the text
+  // report then goes to stderr.
+  TempDir dir;
+  const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
+  for (const char* command : {"calibrate", "diagnose"}) {
+    const ToolRun run = Plumb({command, imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate", "100",
+                               "--json", "-"}, dir);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const json doc = json::parse(run.out);  // throws, failing the test, on anything but JSON
+    EXPECT_TRUE(doc.contains("fit")) << command;
+    EXPECT_TRUE(Contains(run.err, "chi2/dof")) << command << ": " << run.err;
+  }
+}
+
 TEST(Cli, HelpListsTheSubcommands) {
   TempDir dir;
   const ToolRun run = Plumb({"--help"}, dir);
