@@ -1,9 +1,12 @@
 // plumb compare RESULT.json --imu-tk ACC.calib GYRO.calib | --imu-tk-params FILE |
 //               --imucal CAL.json [--gravity G] [--json FILE]
+// plumb compare RESULT.json... --truth TRUTH.json [--json FILE]
 //
 // Sets plumb's calibration (what `plumb calibrate --json` wrote) beside another tool's answer,
 // both in plumb's forward form (plumb/peers), prints the side-by-side table and imu_tk's
 // accelerometer cost of both on plumb's still segments, and writes the comparison as JSON.
+// With --truth, against a simulated session's truth instead: errors in sigmas and the NEES
+// (plumb/peers/truth.h), one line per result when there are several.
 #include <iostream>
 
 #include "commands.h"
@@ -11,6 +14,7 @@
 #include "plumb/peers/imu_tk.h"
 #include "plumb/peers/imucal.h"
 #include "plumb/peers/plumb_result.h"
+#include "plumb/peers/truth.h"
 #include "plumb/report/json_report.h"
 #include "json_output.h"
 
@@ -18,12 +22,13 @@ namespace plumb::cli {
 namespace {
 
 struct CompareArgs {
-  std::string result_path;              ///< RESULT.json of plumb calibrate --json
+  std::vector<std::string> results;     ///< RESULT.json of plumb calibrate --json (several: --truth)
   std::vector<std::string> imu_tk;      ///< --imu-tk ACC.calib GYRO.calib
   std::string imu_tk_params;            ///< --imu-tk-params full_precision_params.txt
   std::string imucal;                   ///< --imucal CAL.json
   double gravity_m_s2 = 0.0;            ///< --gravity, m/s^2, > 0; 0 = the result's
   std::string json_path;                ///< --json FILE
+  std::string truth;                    ///< --truth TRUTH.json of plumb simulate --truth-json
 };
 
 class CompareCommand : public Command {
@@ -34,7 +39,8 @@ class CompareCommand : public Command {
         "Compare plumb's calibration (calibrate --json) with another tool's answer on the same "
         "data, parameter by parameter in plumb's forward form");
     CompareArgs& a = args_;
-    app_->add_option("RESULT", a.result_path, "The JSON that 'plumb calibrate --json' wrote")
+    app_->add_option("RESULT", a.results,
+                     "The JSON that 'plumb calibrate --json' wrote (several only with --truth)")
         ->required()
         ->type_name("RESULT.json");
     auto* tk = app_->add_option("--imu-tk", a.imu_tk,
@@ -49,8 +55,14 @@ class CompareCommand : public Command {
     auto* cal = app_->add_option("--imucal", a.imucal,
                                  "imucal's Ferraris (or Turntable) calibration JSON")
                     ->type_name("CAL.json");
-    tk->excludes(tk_full)->excludes(cal);
-    tk_full->excludes(cal);
+    auto* truth = app_->add_option("--truth", a.truth,
+                                   "The truth of a simulated session ('plumb simulate "
+                                   "--truth-json'): each parameter's error in sigmas and the "
+                                   "NEES over the full covariance, with its chi^2 band")
+                      ->type_name("TRUTH.json");
+    tk->excludes(tk_full)->excludes(cal)->excludes(truth);
+    tk_full->excludes(cal)->excludes(truth);
+    cal->excludes(truth);
     app_->add_option("--gravity", a.gravity_m_s2,
                      "Gravity magnitude of imu_tk's cost, m/s^2 (default: the result's "
                      "site.gravity; imu_tk's demo used 9.81744)")
@@ -62,8 +74,13 @@ class CompareCommand : public Command {
   int Run() override {
     const CompareArgs& a = args_;
     const TextAsideForJson text_aside(a.json_path);
+    if (!a.truth.empty()) return RunTruth();
+    if (a.results.size() != 1) {
+      throw UsageError("compare takes one RESULT.json against another tool (several only with "
+                       "--truth)");
+    }
     const peers::ForwardCalibration peer = ReadPeer();
-    const peers::PlumbResult result = peers::ReadPlumbResult(a.result_path);
+    const peers::PlumbResult result = peers::ReadPlumbResult(a.results.front());
     peers::CompareOptions options;
     options.gravity_m_s2 = a.gravity_m_s2;
     const peers::Comparison comparison = peers::Compare(result, peer, options);
@@ -75,6 +92,21 @@ class CompareCommand : public Command {
   }
 
  private:
+  /// --truth: each result against the simulated truth.
+  int RunTruth() const {
+    const CompareArgs& a = args_;
+    const std::vector<peers::TrueParameter> truth = peers::ReadSimulationTruth(a.truth);
+    nlohmann::json all = nlohmann::json::array();
+    for (const std::string& path : a.results) {
+      const peers::TruthComparison c =
+          peers::CompareWithTruth(peers::ReadPlumbResult(path), truth, a.truth);
+      std::cout << peers::TruthComparisonText(c, a.results.size() == 1);
+      all.push_back(peers::TruthComparisonJson(c));
+    }
+    if (!a.json_path.empty()) WriteJsonOutput(a.json_path, a.results.size() == 1 ? all[0] : all);
+    return 0;
+  }
+
   peers::ForwardCalibration ReadPeer() const {
     const CompareArgs& a = args_;
     if (!a.imu_tk.empty()) {

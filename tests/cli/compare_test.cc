@@ -184,5 +184,39 @@ TEST(CliCompare, ImuTksOwnDataAgreesWithImuTk) {
   EXPECT_NEAR(per_interval * 38, 0.120131, 0.05 * 0.120131);
 }
 
+TEST(CompareCli, AgainstTheSimulatedTruthGivesTheNees) {
+  // simulate -> calibrate -> compare --truth: the table, the NEES over the 21 base parameters
+  // with its band; two results give a line each; --truth with a peer is a usage error.
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  ASSERT_EQ(Plumb({"simulate", "--out", at("s.csv"), "--random-truth", "1", "--lat", "51", "--lon",
+                   "0", "--truth-json", at("truth.json"), "--seed", "3"}, dir).exit_code, 0);
+  for (const char* name : {"a.json", "b.json"}) {
+    std::vector<std::string> args = {"calibrate", at("s.csv"), "--lat", "51", "--lon", "0",
+                                     "--json", at(name)};
+    if (std::string(name) == "b.json") args.push_back("--constant-bias");
+    ASSERT_EQ(Plumb(args, dir).exit_code, 0);
+  }
+  const ToolRun one = Plumb({"compare", at("a.json"), "--truth", at("truth.json"), "--json",
+                             at("c.json")}, dir);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  EXPECT_TRUE(Contains(one.out, "accel.matrix.xx")) << one.out;
+  EXPECT_TRUE(Contains(one.out, "on 21 parameters (full covariance): chi^2(21) 95% band 10.3 .. 35.5"))
+      << one.out;
+  const json c = ReadJson(at("c.json"));
+  EXPECT_EQ(c["nees"]["dof"], 21);
+  EXPECT_GT(c["nees"]["value"].get<double>(), 0.0);
+  const ToolRun two = Plumb({"compare", at("a.json"), at("b.json"), "--truth", at("truth.json")}, dir);
+  ASSERT_EQ(two.exit_code, 0) << two.err;
+  EXPECT_TRUE(Contains(two.out, at("a.json") + ": NEES ")) << two.out;
+  EXPECT_TRUE(Contains(two.out, at("b.json") + ": NEES ")) << two.out;
+  const ToolRun both = Plumb({"compare", at("a.json"), "--truth", at("truth.json"), "--imucal",
+                              at("truth.json")}, dir);
+  EXPECT_EQ(both.exit_code, 2);
+  const ToolRun many = Plumb({"compare", at("a.json"), at("b.json"), "--imucal", at("x.json")}, dir);
+  EXPECT_EQ(many.exit_code, 2);
+  EXPECT_TRUE(Contains(many.err, "several only with --truth")) << many.err;
+}
+
 }  // namespace
 }  // namespace plumb::cli

@@ -70,6 +70,35 @@ PlumbStillSegment ReadSegment(const json& s, const std::string& path, std::size_
   return out;
 }
 
+
+/// "covariance": {"parameters": [names], "matrix": [[...]], "sigma_scaled_by_chi2": bool}.
+void ReadCovariance(const json& cov, const std::string& path, PlumbResult& r) {
+  const json& names = Field(cov, "parameters", path, "covariance.parameters", "a list of names");
+  const json& matrix = Field(cov, "matrix", path, "covariance.matrix", "a square matrix");
+  if (!names.is_array() || !matrix.is_array() || matrix.size() != names.size()) {
+    throw InputError(path, KeyPlace("covariance"),
+                     "expected a list of names and a matrix with a row for each");
+  }
+  const auto n = static_cast<Eigen::Index>(names.size());
+  r.covariance.resize(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const json& name = names[static_cast<std::size_t>(i)];
+    if (!name.is_string()) throw InputError(path, KeyPlace("covariance.parameters"), "expected names");
+    r.covariance_names.push_back(name.get<std::string>());
+    const json& row = matrix[static_cast<std::size_t>(i)];
+    const std::string where = "covariance.matrix[" + std::to_string(i) + "]";
+    if (!row.is_array() || row.size() != names.size()) {
+      throw InputError(path, KeyPlace(where), "expected " + std::to_string(n) + " numbers");
+    }
+    for (Eigen::Index j = 0; j < n; ++j) {
+      r.covariance(i, j) = detail::FiniteNumber(row[static_cast<std::size_t>(j)], path, where);
+    }
+  }
+  r.sigma_scaled_by_chi2 = cov.contains("sigma_scaled_by_chi2") &&
+                           cov.at("sigma_scaled_by_chi2").is_boolean() &&
+                           cov.at("sigma_scaled_by_chi2").get<bool>();
+}
+
 }  // namespace
 
 PlumbResult ReadPlumbResult(const std::string& path) {
@@ -110,6 +139,9 @@ PlumbResult ReadPlumbResult(const std::string& path) {
                            std::all_of(noise_accel.begin(), noise_accel.end(),
                                        [](const json& v) { return v.is_number(); });
   if (noise_known) r.noise_accel = detail::Vector3(noise_accel, path, "noise.accel");
+  if (root.contains("covariance") && root.at("covariance").is_object()) {
+    ReadCovariance(root.at("covariance"), path, r);
+  }
   if (root.contains("inputs") && root.at("inputs").is_array()) {
     for (const auto& input : root.at("inputs")) {
       if (input.is_string()) r.inputs.push_back(input.get<std::string>());

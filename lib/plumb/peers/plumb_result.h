@@ -5,6 +5,7 @@
 // counts when it was given counts), as in the file.
 #pragma once
 
+#include <Eigen/Core>
 #include <limits>
 #include <optional>
 #include <string>
@@ -50,11 +51,17 @@ struct PlumbResult {
   /// absent or not three numbers.
   Vec3 noise_accel = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
   std::vector<std::string> inputs;  ///< the data files plumb read
+  /// "covariance": the parameters it is over, in order, and the matrix (units of the
+  /// parameters squared); both empty when the file has none.
+  std::vector<std::string> covariance_names;
+  Eigen::MatrixXd covariance;
+  bool sigma_scaled_by_chi2 = false;  ///< covariance.sigma_scaled_by_chi2
 };
 
 /// Reads the JSON document. Throws plumb::InputError naming `path` and the key when the JSON is
 /// invalid (with its byte offset), or "accel" or "parameters" are missing or malformed; a
-/// segment without acc_mean/count is an error too, a document without "segments" is not.
+/// segment without acc_mean/count is an error too, a document without "segments" is not; a
+/// "covariance" must be a square matrix of finite numbers over its "parameters".
 PlumbResult ReadPlumbResult(const std::string& path);
 
 /// The parameter called `name`, or nullptr.
