@@ -88,5 +88,49 @@ TEST(VelocityResidual, JacobianMatchesNumeric) {
   EXPECT_LT(testing::JacobianError(*cost, params, manifolds), 1e-4);
 }
 
+TEST(VelocityResidual, TakesTheWanderAlongItsLineOffTheOutputs) {
+  // Outputs carrying an accelerometer wander from a to b and a gyroscope wander from c to d
+  // (linear over the turn), with those as the wander blocks: the velocity change of the clean
+  // turn. Without the blocks the wander shows as velocity.
+  const MotionSamples clean = TurnAboutX();
+  MotionSamples s = clean;
+  const Vec3 a(0.02, -0.01, 0.03), b(0.05, 0.0, -0.02), c(1e-3, -2e-3, 5e-4), d(-1e-3, 0.0, 2e-3);
+  const double T = s.dt_s.back();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double u = s.dt_s[i] / T;
+    s.acc[i] += a + u * (b - a);
+    s.gyr[i] += c + u * (d - c);
+  }
+  const model::Model m = model::Model::Parse("base");
+  const auto theta = m.ZeroParameters();
+  const double q[4] = {0, 0, 0, 1};
+  // Two accelerometer processes (a split in two) and one gyroscope process.
+  const Vec3 a1 = 0.25 * a, a2 = 0.75 * a, b1 = 0.5 * b, b2 = 0.5 * b;
+  std::vector<const double*> p = {q, theta[0].data(), theta[1].data(), a1.data(), b1.data(),
+                                  a2.data(), b2.data(), c.data(), d.data()};
+  const VelocityResidual with(m, s, Vec3(0, 0, kG), Vec3::Zero(), Vec3::Ones(), 2, 1);
+  EXPECT_LT((with.VelocityChange(p.data()) - Change(m, theta, clean)).norm(), 1e-9);
+  EXPECT_GT(Change(m, theta, s).norm(), 0.05);
+}
+
+TEST(VelocityResidual, JacobianMatchesNumericWithWander) {
+  const MotionSamples s = TurnAboutX();
+  const model::Model m = model::Model::Parse("base+time_offset");
+  auto theta = m.ZeroParameters();
+  theta[2][0] = 1e-3;
+  std::unique_ptr<ceres::CostFunction> cost(VelocityResidual::Create(
+      m, s, Vec3(0, 0, kG), Vec3(4e-5, 0, -5e-5), Vec3::Constant(100.0), 1, 1));
+  const Quat q(Eigen::AngleAxisd(0.02, Vec3(1, 1, 0).normalized()));
+  const double a[4] = {q.x(), q.y(), q.z(), q.w()};
+  const Vec3 w0(0.01, 0.02, -0.01), w1(0.03, 0.0, 0.01), g0(1e-4, 0, -1e-4), g1(0, 2e-4, 0);
+  std::vector<const double*> params = {a};
+  for (const auto& block : theta) params.push_back(block.data());
+  for (const Vec3* w : {&w0, &w1, &g0, &g1}) params.push_back(w->data());
+  const auto manifold = AttitudeManifold();
+  std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
+  manifolds[0] = manifold.get();
+  EXPECT_LT(testing::JacobianError(*cost, params, manifolds), 1e-4);
+}
+
 }  // namespace
 }  // namespace plumb::residuals

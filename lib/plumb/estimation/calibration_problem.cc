@@ -176,6 +176,20 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
                            across * g * g * var_w * dt * dt * dt * dt * n * n * n / 3.0;
       velocity_info_[k][i] = 1.0 / std::sqrt(var_v);
     }
+    // Each accelerometer wander process about its line (the velocity residual takes the line
+    // off): its bridge's mean over T, times T, through F^-1; the instability as the walk of
+    // equal short-time spread, as for the rotation above.
+    for (std::size_t p : WanderOf(model::Sensor::kAccel)) {
+      const WanderProcess& w = wander_[p];
+      const Vec3 K2 = w.kind == WanderProcess::Kind::kWalk
+                          ? Vec3(w.level.cwiseAbs2())
+                          : Vec3(w.level.cwiseAbs2() * (2.0 / w.tau_s));
+      const Mat3 cov = F_inv * (K2 * (T * T * T / 12.0)).asDiagonal() * F_inv.transpose();
+      for (int i = 0; i < 3; ++i) {
+        const double var = 1.0 / (velocity_info_[k][i] * velocity_info_[k][i]);
+        velocity_info_[k][i] = 1.0 / std::sqrt(var + cov(i, i));
+      }
+    }
   }
 }
 
@@ -303,9 +317,16 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
     if (velocity_on_) {
       std::vector<double*> vblocks = {q(mo.from)};
       vblocks.insert(vblocks.end(), all_terms.begin(), all_terms.end());
+      for (const auto* processes : {&acc_wander, &gyr_wander}) {
+        for (std::size_t p : *processes) {
+          vblocks.insert(vblocks.end(), {wander(mo.from, p, true), wander(mo.from + 1, p, false)});
+        }
+      }
       built.velocity.push_back(problem->AddResidualBlock(
           residuals::VelocityResidual::Create(model_, motion_samples_[k], site_.g_n,
-                                              site_.omega_ie_n, velocity_info_[k]),
+                                              site_.omega_ie_n, velocity_info_[k],
+                                              static_cast<int>(acc_wander.size()),
+                                              static_cast<int>(gyr_wander.size())),
           nullptr, vblocks));
     }
   }

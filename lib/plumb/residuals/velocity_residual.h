@@ -18,12 +18,19 @@
 //   sigma_v^2 = sigma_f^2 h^2 N tau_a + g^2 sigma_w^2 h^4 N^3 tau_g / 3.
 // Its correlation with the rotation residual of the same interval is neglected.
 //
+// The wandering bias (estimation/noise_model.h) over the motion: as in MotionResidual, each
+// process of each sensor runs along the line from its value at the end of segment k (b_from)
+// to its value at the start of k+1 (b_to), and the sum of a sensor's processes is taken off its
+// outputs before the correction: y(t) - (b_from + (b_to - b_from) (t - t_0) / T). (The bridge
+// about that line is in sqrt_info.)
+//
 // Jacobians: central differences (ceres::DynamicNumericDiffCostFunction), one pass over the
 // samples per parameter: the backend adds these residuals only when the model has an effect
 // that needs them (EffectInfo::excitation.angular_acceleration).
 //
 // Parameter blocks, in order: q_k (4, R_n_b in Eigen order x y z w), then every block of the
-// model in model order.
+// model in model order, then per accelerometer wander process (`accel_wander` of them) its
+// b_from (3) and b_to (3), then the same per gyroscope process (`gyro_wander`), sensor units.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -38,12 +45,15 @@ class VelocityResidual {
   /// `g_n` gravity in NED, m/s^2; `omega_ie_n` Earth rate in NED, rad/s; `sqrt_info` 1 / sigma_v
   /// per axis, s/m. The model must outlive the cost function.
   VelocityResidual(const model::Model& model, MotionSamples samples, const Vec3& g_n,
-                   const Vec3& omega_ie_n, const Vec3& sqrt_info);
+                   const Vec3& omega_ie_n, const Vec3& sqrt_info, int accel_wander = 0,
+                   int gyro_wander = 0);
 
-  /// The cost function (numeric differentiation over q_k and every model block).
+  /// The cost function (numeric differentiation over q_k, every model block and the wander
+  /// blocks).
   static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
                                      const Vec3& g_n, const Vec3& omega_ie_n,
-                                     const Vec3& sqrt_info);
+                                     const Vec3& sqrt_info, int accel_wander = 0,
+                                     int gyro_wander = 0);
 
   /// r (3 values, whitened) at the given blocks.
   bool operator()(double const* const* parameters, double* residuals) const;
@@ -55,6 +65,7 @@ class VelocityResidual {
   const model::Model* model_;
   MotionSamples s_;
   Vec3 g_n_, omega_ie_n_, sqrt_info_;
+  int accel_wander_ = 0, gyro_wander_ = 0;  // wander processes; their block pairs follow the model's
 };
 
 }  // namespace plumb::residuals
