@@ -271,6 +271,19 @@ TEST(CalibrateSimulated, CovarianceIsHonestOnThePaperBenchmarkWithRealisticNoise
   std::cout << "paper benchmark: NEES/dof " << nees << " (95% band " << lo << " .. " << hi << ")\n";
 }
 
+// The walk estimated from the session (--estimate-rw) on the same sessions as
+// CovarianceIsHonestWithRealisticNoise: the figures model.md quotes. Several fits per session,
+// so not in every run of the suite: --gtest_also_run_disabled_tests runs it (about 2 minutes).
+TEST(CalibrateSimulated, DISABLED_EstimatedWalkNeesOnRealisticNoise) {
+  for (double still_s : {5.0, 30.0}) {
+    double lo = 0, hi = 0;
+    const double nees = MeanNeesPerDof(kRealisticRuns, still_s, Fit::kEstimate, &lo, &hi);
+    EXPECT_LT(nees, 1.5) << still_s << " s holds";
+    std::cout << "walk estimated, holds of " << still_s << " s: NEES/dof " << nees
+              << " (95% band " << lo << " .. " << hi << ")\n";
+  }
+}
+
 TEST(CalibrateSimulated, AConstantBiasUnderstatesSigmaWhenTheBiasWanders) {
   // The same sessions fitted with one constant bias (--constant-bias): the sigmas are too
   // small, what the wander states above repair. 30 s holds: NEES/dof far above 1.
