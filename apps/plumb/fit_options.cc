@@ -11,6 +11,7 @@
 #include "plumb/core/units.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/gates.h"
+#include "plumb/estimation/wander_levels.h"
 #include "plumb/signal/noise_terms.h"
 #include "segment_options.h"
 
@@ -150,7 +151,8 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
 namespace {
 
 /// The noise of the still recording `path` (--noise-from), read like the session.
-signal::StillNoise StillNoiseFrom(const std::string& path, const InputArgs& input) {
+signal::StillNoise StillNoiseFrom(const std::string& path, const InputArgs& input,
+                                  double instability_time_s) {
   InputArgs other = input;
   other.inputs = {path};
   other.acc_file.clear();
@@ -158,7 +160,8 @@ signal::StillNoise StillNoiseFrom(const std::string& path, const InputArgs& inpu
   const Session still = ReadInputs(other);
   const segmentation::SegmentationResult seg = FindSegments(still.series, SegmentArgs{});
   try {
-    return signal::AnalyseStillNoise(still.series, seg.segments);
+    return signal::AnalyseStillNoise(still.series, seg.segments,
+                                     estimation::WanderNoiseOptions(instability_time_s));
   } catch (const InsufficientDataError& e) {
     throw InsufficientDataError("--noise-from " + path + ": " + e.what());
   }
@@ -195,7 +198,8 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
   out.options.instability_time_s = fit.instability_time_s;
   out.options.constant_bias = fit.constant_bias;
   if (!fit.noise_from.empty()) {
-    out.options.other_still_noise.push_back(StillNoiseFrom(fit.noise_from, input));
+    out.options.other_still_noise.push_back(
+        StillNoiseFrom(fit.noise_from, input, fit.instability_time_s));
   }
   return out;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/wander_levels.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
@@ -171,8 +172,8 @@ TEST(CalibrateSimulated, CovarianceIsHonestWithWanderLevelsFromALongStillRecordi
   sim::SimulationOptions bench = sensor;
   bench.seed = 9500;
   const sim::Simulation still = sim::Simulate(sim::MultiPose(1, 1800.0, 2.0, 9500), bench);
-  const signal::StillNoise measured =
-      signal::AnalyseStillNoise(still.session.series, still.truth_segments);
+  const signal::StillNoise measured = signal::AnalyseStillNoise(
+      still.session.series, still.truth_segments, WanderNoiseOptions(sensor.bias_instability_time_s));
   constexpr int kRuns = 60, kParams = 21;
   double with_recording = 0, typical = 0;
   for (int run = 0; run < kRuns; ++run) {

@@ -88,7 +88,8 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     // 2a. The wander's levels: given, from the still data's Allan deviation, or typical;
     // 2b. the walk estimated over the fit (opt-in).
     std::vector<const signal::StillNoise*> measured;
-    const std::optional<signal::StillNoise> own = MeasureStillNoise(series, still, fit.notes);
+    const std::optional<signal::StillNoise> own =
+        MeasureStillNoise(series, still, options.instability_time_s, fit.notes);
     if (own) measured.push_back(&*own);
     for (const signal::StillNoise& other : options.other_still_noise) measured.push_back(&other);
     WanderLevels levels =

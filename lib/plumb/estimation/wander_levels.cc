@@ -46,14 +46,19 @@ AxisLevel LevelOf(const Slot& slot, int axis, const std::vector<const signal::St
   for (const signal::StillNoise* m : measured) {
     const signal::AxisNoise* a = m->Find(slot.sensor, axis);
     if (a == nullptr) continue;
-    // The terms again, with the estimator's instability: a Gauss-Markov process.
-    signal::NoiseTermsOptions options = m->options.terms;
-    options.gauss_markov_time_s = instability_time_s;
+    // The terms with the estimator's instability, a Gauss-Markov process: as analysed
+    // (MeasureStillNoise), or fitted again.
     signal::NoiseFit fit;
-    try {
-      fit = signal::FitNoiseTerms(a->adev, options);
-    } catch (const InsufficientDataError&) {
-      continue;  // too few points: this record says nothing
+    if (m->options.terms.gauss_markov_time_s == instability_time_s) {
+      fit = a->fit;
+    } else {
+      signal::NoiseTermsOptions options = m->options.terms;
+      options.gauss_markov_time_s = instability_time_s;
+      try {
+        fit = signal::FitNoiseTerms(a->adev, options);
+      } catch (const InsufficientDataError&) {
+        continue;  // too few points: this record says nothing
+      }
     }
     const signal::NoiseTerm& term = fit.term(kind);
     if (std::isfinite(term.upper_bound)) bound = std::min(bound, term.upper_bound);
@@ -212,10 +217,22 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
   return out;
 }
 
+signal::StillNoiseOptions WanderNoiseOptions(double instability_time_s) {
+  signal::StillNoiseOptions options;
+  options.terms.gauss_markov_time_s = instability_time_s;
+  // Half the density of 'plumb allan': the fit's tests count points per decade, and the
+  // Allan deviation of an hour at 1 kHz costs half as much (one pass over the samples per
+  // cluster size).
+  options.allan.points_per_decade = 5;
+  return options;
+}
+
 std::optional<signal::StillNoise> MeasureStillNoise(const ImuSeries& series, const StillSet& set,
+                                                    double instability_time_s,
                                                     std::vector<std::string>& notes) {
   try {
-    return signal::AnalyseStillNoise(series, set.AtRestSegments());
+    return signal::AnalyseStillNoise(series, set.AtRestSegments(),
+                                      WanderNoiseOptions(instability_time_s));
   } catch (const InsufficientDataError& e) {
     notes.push_back(std::string("the still data are too short for an Allan deviation (") +
                     e.what() + ")");

@@ -59,9 +59,15 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
                                 const StartingValues& start, bool has_gyro, double span_s,
                                 const CalibrationOptions& options);
 
-/// The noise terms of the session's segments at rest (signal::AnalyseStillNoise), or nullopt
-/// when they are too short for an Allan deviation (the reason appended to `notes`).
+/// The options of AnalyseStillNoise that fit the instability as the estimator's Gauss-Markov
+/// process of `instability_time_s` (so that AssignWanderLevels need not fit again).
+signal::StillNoiseOptions WanderNoiseOptions(double instability_time_s);
+
+/// The noise terms of the session's segments at rest (signal::AnalyseStillNoise with
+/// WanderNoiseOptions), or nullopt when they are too short for an Allan deviation (the reason
+/// appended to `notes`).
 std::optional<signal::StillNoise> MeasureStillNoise(const ImuSeries& series, const StillSet& set,
+                                                    double instability_time_s,
                                                     std::vector<std::string>& notes);
 
 }  // namespace plumb::estimation
