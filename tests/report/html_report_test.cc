@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
+
 #include "report_test_util.h"
 
 namespace plumb::report {
@@ -63,6 +66,21 @@ TEST(HtmlReport, ListsEveryParameterWithSigmaOrStatus) {
   EXPECT_TRUE(Contains(page, "<td class=\"num\">&plusmn; 0.001</td>"));
   EXPECT_TRUE(Contains(page, "<span class=\"warn\">unobservable</span>"));
   EXPECT_TRUE(Contains(page, "<span class=\"warn\">fixed</span>"));
+}
+
+TEST(HtmlReport, AboveItsBandBothSigmasAndWhatTheyMean) {
+  // chi2 12.5 on 10 dof is within the band: one sigma column. chi2 400 on 10 dof (40, more
+  // than 3 times the band): the scaled column, sigma * sqrt(40), and the terminal's notes.
+  PageParts parts;
+  EXPECT_FALSE(Contains(parts.Page(), "scaled sigma"));
+  parts.result.fit.chi2 = 400.0;
+  const std::string page = parts.Page();
+  EXPECT_TRUE(Contains(page, "<th>scaled sigma</th>")) << page;
+  char scaled[64];
+  std::snprintf(scaled, sizeof scaled, "<td class=\"num\">&plusmn; %.2g</td>", 1e-3 * std::sqrt(40.0));
+  EXPECT_TRUE(Contains(page, scaled)) << scaled;
+  EXPECT_TRUE(Contains(page, "is above its band"));
+  EXPECT_TRUE(Contains(page, "do not trust these parameters to their sigma"));
 }
 
 TEST(HtmlReport, ShowsChi2TheRatioAndItsBand) {

@@ -26,8 +26,11 @@ std::string Pad(const std::string& text) {
   return buf;
 }
 
-/// Beside the sigma table when chi^2/dof is above its band (estimation/uncertainty.h).
-std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
+}  // namespace
+
+std::string OverDispersionNote(const estimation::FitReport& fit) {
+  if (!estimation::Chi2AboveBand(fit)) return "";
+  const double scale = estimation::SigmaScale(fit);
   const double upper = estimation::Chi2BandUpper(fit.dof);
   return "chi2/dof " + Format("%.4g", fit.chi2_dof()) + " is above its band (up to " +
          Format("%.3g", upper) +
@@ -44,8 +47,6 @@ std::string OverDispersionNote(const estimation::FitReport& fit, double scale) {
                     "by more) until 'plumb diagnose' explains the misfit\n"
               : std::string());
 }
-
-}  // namespace
 
 std::string BriefReport(const estimation::CalibrationResult& result) {
   const estimation::Calibration& c = result.calibration;
@@ -113,7 +114,7 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   os << "\n";
   const double scale = estimation::SigmaScale(fit);
   const bool scaled = scale > 1.0;
-  if (scaled) os << OverDispersionNote(fit, scale);
+  if (scaled) os << OverDispersionNote(fit);
   char line[192];
   std::snprintf(line, sizeof line, "%-34s %15s %12s%s  %s\n", "parameter", "value", "sigma",
                 scaled ? "       scaled" : "", "unit");

@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 
+#include "plumb/estimation/uncertainty.h"
+#include "plumb/report/calibration_text.h"
 #include "plumb/report/noise_text.h"
 #include "plumb/report/summary.h"
 #include "plumb/report/version.h"
@@ -297,14 +299,27 @@ std::string FigureSection(const PageExtras& extras) {
 }
 
 std::string ParameterSection(const estimation::CalibrationResult& r) {
+  // Above its band, chi^2/dof scales the sigma (estimation/uncertainty.h): both columns, and
+  // the note the terminal prints beside them.
+  const double scale = estimation::SigmaScale(r.fit);
+  const bool scaled = scale > 1.0;
   std::string out = "<h2 id=\"parameters\">Parameters</h2>\n<p>Forward-model quantities, SI "
                     "(sample units for biases and additive terms); sigma is one standard "
-                    "deviation.</p>\n<table>\n" +
-                    HeaderRow({"parameter", "value", "sigma", "unit", "status"});
+                    "deviation.</p>\n";
+  if (scaled) {
+    std::istringstream note(OverDispersionNote(r.fit));
+    for (std::string line; std::getline(note, line);) {
+      out += "<p class=\"warn\">" + HtmlEscape(line) + "</p>\n";
+    }
+  }
+  out += "<table>\n" + (scaled ? HeaderRow({"parameter", "value", "sigma", "scaled sigma", "unit", "status"})
+                               : HeaderRow({"parameter", "value", "sigma", "unit", "status"}));
   for (const auto& p : r.calibration.parameters) {
     const std::string status = p.fixed ? "fixed" : !p.observable ? "unobservable" : "";
+    const bool none = p.fixed || !p.observable;
     out += "<tr>" + Td(Code(p.name)) + TdNum(G6(p.value)) +
-           TdNum(p.fixed || !p.observable ? "&ndash;" : "&plusmn; " + G2(p.sigma)) +
+           TdNum(none ? "&ndash;" : "&plusmn; " + G2(p.sigma)) +
+           (scaled ? TdNum(none ? "&ndash;" : "&plusmn; " + G2(scale * p.sigma)) : std::string()) +
            Td(HtmlEscape(p.unit)) +
            Td(status.empty() ? std::string() : "<span class=\"warn\">" + status + "</span>") +
            "</tr>\n";
