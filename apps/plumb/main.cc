@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
   commands.push_back(plumb::cli::MakeInfoCommand(app));
   commands.push_back(plumb::cli::MakeReportCommand(app));
   commands.push_back(plumb::cli::MakeAllanCommand(app));
+  commands.push_back(plumb::cli::MakeSweepCommand(app));
 
   if (argc > 1 && argv[1][0] != '-') {
     const std::string name = argv[1];

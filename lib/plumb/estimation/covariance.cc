@@ -55,10 +55,7 @@ bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
     for (std::size_t j = i; j < blocks.size(); ++j) pairs.emplace_back(blocks[i], blocks[j]);
   }
   ceres::Covariance::Options cov_options;
-  // Many unknowns (bias-wander states): the sparse QR, which needs full rank (the
-  // pseudo-inverse of the analysis covers the rest).
-  cov_options.algorithm_type =
-      fitted.NumParameters() > kDenseUnknowns ? ceres::SPARSE_QR : ceres::DENSE_SVD;
+  cov_options.algorithm_type = ceres::DENSE_SVD;
   cov_options.num_threads = 1;
   ceres::Covariance covariance(cov_options);
   if (pairs.empty() || !covariance.Compute(pairs, &fitted)) return false;
@@ -119,11 +116,15 @@ void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>&
                        std::vector<std::string>& warnings) {
   const auto n = static_cast<Eigen::Index>(calibration.parameters.size());
   calibration.covariance = Eigen::MatrixXd::Zero(n, n);
+  // With the bias-wander states (more than kDenseUnknowns unknowns) the analysis's covariance,
+  // the wander eliminated by Eigen's sparse Cholesky (solve.h): ceres::Covariance would need
+  // SuiteSparseQR, whose BLAS kernels make the last bits depend on the heap layout.
+  const bool dense = fitted.NumParameters() <= kDenseUnknowns;
   const bool from_ceres =
-      options.use_ceres_covariance &&
+      options.use_ceres_covariance && dense &&
       CeresCovariance(fitted, calibration.model, fitted_blocks, calibration.covariance);
   if (!from_ceres) {
-    if (options.use_ceres_covariance && calibration.model.num_free_parameters() > 0) {
+    if (options.use_ceres_covariance && dense && calibration.model.num_free_parameters() > 0) {
       warnings.push_back("ceres::Covariance found the problem singular; sigmas are from "
                          "the pseudo-inverse of the column-scaled Jacobian");
     }
@@ -142,10 +143,9 @@ void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>&
                   ? std::sqrt(std::max(0.0, calibration.covariance(ii, ii)))
                   : std::numeric_limits<double>::quiet_NaN();
   }
-  calibration.sigma_source =
-      !from_ceres ? "pseudo-inverse"
-      : fitted.NumParameters() > kDenseUnknowns ? "ceres::Covariance (SPARSE_QR)"
-                                                : "ceres::Covariance (DENSE_SVD)";
+  calibration.sigma_source = from_ceres ? "ceres::Covariance (DENSE_SVD)"
+                             : dense    ? "pseudo-inverse"
+                                        : "pseudo-inverse (bias-wander states eliminated)";
 }
 
 }  // namespace plumb::estimation

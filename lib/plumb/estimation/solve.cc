@@ -15,6 +15,10 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
   // banded chain: a sparse factorisation keeps their cost linear in the poses.
   solver_options.linear_solver_type =
       problem.NumParameters() > kDenseUnknowns ? ceres::SPARSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
+  // Eigen's sparse Cholesky rather than SuiteSparse's: SuiteSparse's supernodal kernels go
+  // through the system BLAS, whose code paths depend on where the heap put the arrays, and a
+  // fit must give the same bits whatever the heap and the thread (plumb sweep's shards).
+  solver_options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = rough ? kRoughFunctionTolerance : options.function_tolerance;
   solver_options.parameter_tolerance = rough ? kRoughParameterTolerance : options.parameter_tolerance;

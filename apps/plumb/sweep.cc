@@ -1,0 +1,238 @@
+// plumb sweep STUDY.json --out DIR [--shard K/N] [--jobs N]
+// plumb sweep merge DIR... --out DIR
+//
+// Runs a sensitivity study (plumb/study): every point of its design, its Monte Carlo runs in
+// parallel (OpenMP), each point written to DIR/points/point-NNNNN.json as soon as its runs
+// are done (a rerun resumes: points already written are kept), then DIR/results.csv and
+// DIR/results.json from the point files. With --shard K/N only the points whose index is K-1
+// modulo N are run and the results are left to `sweep merge`, which joins the shards' points
+// into the same files, byte for byte, as one unsharded run.
+#include <omp.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "commands.h"
+#include "plumb/core/error.h"
+#include "plumb/io/common/atomic_file.h"
+#include "plumb/report/json_report.h"
+#include "plumb/study/run.h"
+#include "plumb/study/summary.h"
+
+namespace plumb::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct SweepArgs {
+  std::string study_path;  ///< STUDY.json
+  std::string out;         ///< --out DIR
+  std::string shard;       ///< --shard K/N
+  int jobs = 0;            ///< --jobs N (0: every core)
+  std::vector<std::string> merge_dirs;  ///< merge DIR...
+  std::string merge_out;                ///< merge --out DIR
+};
+
+json ReadJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "", "cannot be read");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
+  }
+}
+
+std::string PointPath(const std::string& dir, int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "point-%05d.json", index);
+  return (fs::path(dir) / "points" / name).string();
+}
+
+/// --shard K/N as {K, N}; {1, 1} when empty.
+std::pair<int, int> ParseShard(const std::string& text) {
+  if (text.empty()) return {1, 1};
+  int k = 0, n = 0;
+  char slash = 0;
+  std::istringstream is(text);
+  if (!(is >> k >> slash >> n) || slash != '/' || !is.eof() || n < 1 || k < 1 || k > n) {
+    throw UsageError("--shard takes K/N with 1 <= K <= N (e.g. 2/8), got '" + text + "'");
+  }
+  return {k, n};
+}
+
+/// The results of every design point from the point files of `dir` (all must be there).
+void WriteResults(const study::Study& s, const std::vector<study::Point>& points,
+                  const std::string& dir) {
+  std::vector<study::PointSummary> summaries;
+  for (const study::Point& p : points) {
+    const std::string path = PointPath(dir, p.index);
+    summaries.push_back(study::PointFromJson(s, ReadJsonFile(path), path));
+  }
+  io::WriteFileAtomic((fs::path(dir) / "results.csv").string(), study::ResultsCsv(s, summaries));
+  report::WriteJson((fs::path(dir) / "results.json").string(), study::ResultsJson(s, summaries));
+}
+
+std::string PointLine(const study::Study& s, const study::PointSummary& p) {
+  std::ostringstream os;
+  os << "point " << p.point.index << ":";
+  for (std::size_t f = 0; f < s.factors.size(); ++f) {
+    os << " " << s.factors[f].name << "=" << p.point.values[f];
+  }
+  char nees[96] = "no NEES";
+  if (p.nees_dof > 0) {
+    std::snprintf(nees, sizeof nees, "NEES/dof %.3f (band %.3f .. %.3f)%s", p.nees_per_dof,
+                  p.nees_low, p.nees_high,
+                  p.nees_per_dof > p.nees_high ? " above" : p.nees_per_dof < p.nees_low ? " below" : "");
+  }
+  os << "; " << p.runs << " runs, " << p.failed << " failed, " << p.flagged << " flagged; " << nees;
+  return os.str();
+}
+
+class SweepCommand : public Command {
+ public:
+  explicit SweepCommand(CLI::App& parent) {
+    app_ = parent.add_subcommand(
+        "sweep",
+        "Sensitivity study of the calibration procedure: simulate a design at every point of a "
+        "study's factors, fit it, and summarise the errors against the truth, the sigmas and "
+        "the NEES per point (CSV and JSON)");
+    SweepArgs& a = args_;
+    app_->add_option("STUDY", a.study_path, "The study file (JSON; see examples/studies/)")
+        ->type_name("STUDY.json");
+    app_->add_option("--out", a.out, "Folder for the results (created; a rerun resumes)")
+        ->type_name("DIR");
+    app_->add_option("--shard", a.shard,
+                     "Run only the K-th of N shares of the points (index = K-1 modulo N); join "
+                     "the shards with 'plumb sweep merge'")
+        ->type_name("K/N");
+    app_->add_option("--jobs", a.jobs, "Runs in parallel (default: every core)")
+        ->check(CLI::NonNegativeNumber);
+    merge_ = app_->add_subcommand("merge", "Join the folders of a study's shards into one result");
+    merge_->add_option("DIR", a.merge_dirs, "The shards' --out folders")->required();
+    merge_->add_option("--out", a.merge_out, "Folder for the joined result")->required();
+  }
+
+  int Run() override {
+    if (merge_->parsed()) return Merge();
+    const SweepArgs& a = args_;
+    if (a.study_path.empty() || a.out.empty()) {
+      throw UsageError("sweep needs a study file and --out DIR (or: sweep merge DIR... --out DIR)");
+    }
+    const auto [k, n] = ParseShard(a.shard);
+    const study::Study s = study::ParseStudy(ReadJsonFile(a.study_path), a.study_path);
+    const std::vector<study::Point> points = study::DesignPoints(s);
+    fs::create_directories(fs::path(a.out) / "points");
+    report::WriteJson((fs::path(a.out) / "study.json").string(), s.source);
+    // The points of this shard not written yet (a rerun resumes).
+    std::vector<study::Point> todo;
+    int kept = 0;
+    for (const study::Point& p : points) {
+      if (p.index % n != k - 1) continue;
+      const std::string path = PointPath(a.out, p.index);
+      if (fs::exists(path)) {
+        study::PointFromJson(s, ReadJsonFile(path), path);  // another study's point: an error
+        ++kept;
+        continue;
+      }
+      todo.push_back(p);
+    }
+    std::cout << "study " << (s.name.empty() ? a.study_path : s.name) << ": " << points.size()
+              << " points x " << s.runs << " runs" << (n > 1 ? ", shard " + a.shard : "")
+              << "; " << kept << " already written, " << todo.size() << " to run\n";
+    RunPoints(s, todo);
+    if (n == 1) {
+      WriteResults(s, points, a.out);
+      std::cout << "wrote " << (fs::path(a.out) / "results.csv").string() << " and results.json\n";
+    } else {
+      std::cout << "shard " << a.shard << " done; join the shards with 'plumb sweep merge DIR... "
+                   "--out DIR'\n";
+    }
+    return 0;
+  }
+
+ private:
+  /// Every run of every point in `todo`, in parallel; a point is written when its last run ends.
+  void RunPoints(const study::Study& s, const std::vector<study::Point>& todo) const {
+    const auto runs = static_cast<std::size_t>(s.runs);
+    const std::size_t tasks = todo.size() * runs;
+    std::vector<std::vector<study::RunOutcome>> outcomes(todo.size(),
+                                                         std::vector<study::RunOutcome>(runs));
+    std::vector<std::atomic<std::size_t>> done(todo.size());
+    const int jobs = args_.jobs > 0 ? args_.jobs : omp_get_num_procs();
+    const bool progress = isatty(STDERR_FILENO) != 0;
+    std::string error;
+#pragma omp parallel for schedule(dynamic) num_threads(jobs)
+    for (std::size_t t = 0; t < tasks; ++t) {
+      const std::size_t i = t / runs, r = t % runs;
+      try {
+        outcomes[i][r] = study::RunOnce(s, todo[i], static_cast<int>(r));
+      } catch (const std::exception& e) {
+#pragma omp critical(sweep_error)
+        if (error.empty()) error = e.what();
+      }
+      if (++done[i] == runs) {
+#pragma omp critical(sweep_write)
+        {
+          const study::PointSummary summary = study::Summarise(todo[i], outcomes[i]);
+          report::WriteJson(PointPath(args_.out, todo[i].index), study::PointJson(s, summary));
+          std::cout << PointLine(s, summary) << "\n" << std::flush;
+          if (progress) std::cerr << "\r" << i + 1 << " of " << todo.size() << " points" << std::flush;
+        }
+      }
+    }
+    if (progress) std::cerr << "\n";
+    if (!error.empty()) throw Error("sweep: " + error);
+  }
+
+  /// sweep merge DIR... --out DIR.
+  int Merge() const {
+    const SweepArgs& a = args_;
+    const std::string first = (fs::path(a.merge_dirs.front()) / "study.json").string();
+    const study::Study s = study::ParseStudy(ReadJsonFile(first), first);
+    for (const std::string& dir : a.merge_dirs) {
+      const std::string path = (fs::path(dir) / "study.json").string();
+      if (ReadJsonFile(path) != s.source) {
+        throw InputError(path, "", "another study than " + first + ": shards must share the study");
+      }
+    }
+    const std::vector<study::Point> points = study::DesignPoints(s);
+    fs::create_directories(fs::path(a.merge_out) / "points");
+    report::WriteJson((fs::path(a.merge_out) / "study.json").string(), s.source);
+    for (const study::Point& p : points) {
+      std::string found;
+      for (const std::string& dir : a.merge_dirs) {
+        if (fs::exists(PointPath(dir, p.index))) found = PointPath(dir, p.index);
+      }
+      if (found.empty()) {
+        throw Error("sweep merge: point " + std::to_string(p.index) + " is in none of the shards "
+                    "(run the missing shard, or rerun it to resume)");
+      }
+      const study::PointSummary summary = study::PointFromJson(s, ReadJsonFile(found), found);
+      report::WriteJson(PointPath(a.merge_out, p.index), study::PointJson(s, summary));
+    }
+    WriteResults(s, points, a.merge_out);
+    std::cout << "merged " << points.size() << " points from " << a.merge_dirs.size()
+              << " folders; wrote " << (fs::path(a.merge_out) / "results.csv").string()
+              << " and results.json\n";
+    return 0;
+  }
+
+  SweepArgs args_;
+  CLI::App* merge_ = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeSweepCommand(CLI::App& parent) {
+  return std::make_unique<SweepCommand>(parent);
+}
+
+}  // namespace plumb::cli

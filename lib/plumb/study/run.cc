@@ -1,0 +1,123 @@
+#include "plumb/study/run.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "plumb/core/error.h"
+#include "plumb/estimation/calibrator.h"
+#include "plumb/sim/schedule.h"
+#include "plumb/sim/simulate.h"
+#include "plumb/sim/truth.h"
+
+namespace plumb::study {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// The simulator's options for a point (study.h's base with the point applied).
+sim::SimulationOptions SensorOf(const Base& b, const model::Model& model, std::uint64_t seed) {
+  sim::SimulationOptions o = b.sensor == "white" ? sim::SimulationOptions::WhiteMems()
+                                                 : sim::SimulationOptions::TypicalMems();
+  auto set = [](double value, double& field) {
+    if (!std::isnan(value)) field = value;
+  };
+  set(b.accel_noise, o.accel_noise_density);
+  set(b.gyro_noise, o.gyro_noise_density);
+  set(b.accel_rw, o.accel_bias_walk_density);
+  set(b.gyro_rw, o.gyro_bias_walk_density);
+  set(b.accel_bi, o.accel_bias_instability);
+  set(b.gyro_bi, o.gyro_bias_instability);
+  o.bias_instability_time_s = b.bi_time_s;
+  o.temperature = sim::TemperatureProfile::Ramp(25.0, 25.0 + b.temperature_rise_c);
+  o.rate_hz = b.rate_hz;
+  o.site = geo::Site::At(b.lat_deg, b.lon_deg, b.height_m, "study");
+  o.model = model;
+  o.truth = sim::RandomParameters(model, b.random_truth, seed);
+  for (const auto& [name, value] : b.truth) sim::SetParameter(model, o.truth, name, value);
+  o.seed = seed;
+  return o;
+}
+
+sim::Schedule ScheduleOf(const Base& b, std::uint64_t seed) {
+  if (b.schedule == "paper_static") return sim::PaperStatic(b.still_s);
+  if (b.schedule == "paper_benchmark") return sim::PaperBenchmark(b.still_s, b.turn_s);
+  return sim::MultiPose(static_cast<int>(std::lround(b.poses)), b.still_s, b.turn_s, seed);
+}
+
+/// Errors, sigmas and the NEES of a calibration against the simulated truth.
+void Score(const estimation::CalibrationResult& result, const sim::Simulation& s,
+           const model::Model& fitted, RunOutcome& out) {
+  const std::vector<std::string> sim_names = s.model.ParameterNames();
+  const std::vector<double> sim_values = model::ReportedValues(s.model, s.truth);
+  const std::vector<double> nominal = model::ReportedValues(fitted, fitted.ZeroParameters());
+  const auto& params = result.calibration.parameters;
+  std::vector<Eigen::Index> in_nees;
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const auto& p = params[i];
+    double truth = nominal[i];
+    for (std::size_t j = 0; j < sim_names.size(); ++j) {
+      if (sim_names[j] == p.name) truth = sim_values[j];
+    }
+    out.names.push_back(p.name);
+    out.units.push_back(p.unit);
+    const bool determined = !p.fixed && p.observable && std::isfinite(p.sigma);
+    out.error.push_back(determined ? p.value - truth : kNaN);
+    out.sigma.push_back(determined ? p.sigma : kNaN);
+    if (determined) in_nees.push_back(static_cast<Eigen::Index>(i));
+  }
+  const auto n = static_cast<Eigen::Index>(in_nees.size());
+  if (n == 0) return;
+  Eigen::VectorXd e(n);
+  Eigen::MatrixXd C(n, n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    e[a] = out.error[static_cast<std::size_t>(in_nees[static_cast<std::size_t>(a)])];
+    for (Eigen::Index b = 0; b < n; ++b) {
+      C(a, b) = result.calibration.covariance(in_nees[static_cast<std::size_t>(a)],
+                                              in_nees[static_cast<std::size_t>(b)]);
+    }
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(C);
+  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0.0).all()) {
+    out.nees = e.dot(ldlt.solve(e));
+    out.nees_dof = static_cast<int>(n);
+  }
+}
+
+}  // namespace
+
+RunOutcome RunOnce(const Study& study, const Point& point, int run) {
+  const Base b = Apply(study, point);
+  const std::uint64_t seed = RunSeed(study.seed, point.index, run);
+  const model::Model sim_model =
+      model::Model::Parse(study.simulate_model.empty() ? study.fit_model : study.simulate_model);
+  const sim::Simulation s = sim::Simulate(ScheduleOf(b, seed), SensorOf(b, sim_model, seed));
+  std::vector<StillSegment> segments = s.truth_segments;
+  if (b.schedule != "paper_static") {
+    for (auto& seg : segments) seg.known_R_n_b.reset();
+  }
+  geo::Site site = geo::Site::At(b.lat_deg + b.fit_lat_error_deg, b.lon_deg, b.height_m, "study");
+  if (b.fit_gravity_m_s2 > 0.0) site.g_n = Vec3(0.0, 0.0, b.fit_gravity_m_s2);
+  model::Model fitted = model::Model::Parse(study.fit_model);
+  fitted.t_ref_s = s.model.t_ref_s;
+  fitted.temp_ref_c = s.model.temp_ref_c;
+  estimation::CalibrationOptions options;
+  options.constant_bias = study.constant_bias;
+  RunOutcome out;
+  try {
+    const estimation::CalibrationResult result =
+        estimation::Calibrate(s.session.series, segments, fitted, site, options);
+    out.chi2_dof = result.fit.chi2_dof();
+    out.flagged = !result.fit.gates.empty();
+    if (!result.fit.converged) {
+      out.failed = true;
+      out.failure = "not converged";
+    }
+    Score(result, s, fitted, out);
+  } catch (const Error& e) {
+    out.failed = true;
+    out.failure = e.what();
+  }
+  return out;
+}
+
+}  // namespace plumb::study

@@ -1,0 +1,41 @@
+// plumb/study/run.h — one Monte Carlo run of a study point: simulate the point's design with
+// its own seed (study.h, RunSeed), fit it with the generalized method, and score the estimate
+// against the truth.
+//
+// Truth of a fitted parameter: the simulated model's value of the parameter of that name, or
+// the fitted model's nominal value when the simulated model does not have it (an effect fitted
+// but not simulated is truly zero). A simulated effect the fit lacks shows only as the error it
+// leaves in the fitted parameters. Attitudes are unknown to the fit except on the paper's
+// static design (level, x north, as the paper assumes). The fit is given the simulated site,
+// off by fit_lat_error_deg in latitude, and fit_gravity_m_s2 instead of WGS84 gravity when > 0.
+//
+// NEES = e^T C^-1 e over the parameters that are free and observable (C their block of the
+// reported covariance, solved by LDLT); NaN when C is not positive definite.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "plumb/study/study.h"
+
+namespace plumb::study {
+
+struct RunOutcome {
+  bool failed = false;   ///< the fit threw or did not converge
+  std::string failure;   ///< why, when failed
+  bool flagged = false;  ///< the fit failed a gate (estimation/gates.h)
+  std::vector<std::string> names, units;  ///< the fitted model's parameters, in order
+  std::vector<double> error;  ///< estimate - truth per parameter; NaN: fixed or unobservable
+  std::vector<double> sigma;  ///< the reported sigma; NaN where none
+  double nees = std::numeric_limits<double>::quiet_NaN();
+  int nees_dof = 0;  ///< parameters in the NEES
+  double chi2_dof = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// Run `run` of `point` (file comment). Never throws for a failed fit (failed, failure say
+/// it); throws plumb::Error for a study that cannot be simulated (an unknown model spec or
+/// truth parameter).
+RunOutcome RunOnce(const Study& study, const Point& point, int run);
+
+}  // namespace plumb::study

@@ -1,0 +1,298 @@
+#include "plumb/study/study.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+
+#include "plumb/core/error.h"
+
+namespace plumb::study {
+namespace {
+
+using nlohmann::json;
+
+/// The base's field of a factor name, or nullptr.
+double* Field(Base& b, const std::string& name) {
+  struct Entry {
+    const char* name;
+    double Base::*field;
+  };
+  static const Entry kFields[] = {
+      {"poses", &Base::poses},
+      {"still_s", &Base::still_s},
+      {"turn_s", &Base::turn_s},
+      {"rate_hz", &Base::rate_hz},
+      {"accel_noise", &Base::accel_noise},
+      {"gyro_noise", &Base::gyro_noise},
+      {"accel_rw", &Base::accel_rw},
+      {"gyro_rw", &Base::gyro_rw},
+      {"accel_bi", &Base::accel_bi},
+      {"gyro_bi", &Base::gyro_bi},
+      {"bi_time_s", &Base::bi_time_s},
+      {"temperature_rise_c", &Base::temperature_rise_c},
+      {"lat_deg", &Base::lat_deg},
+      {"height_m", &Base::height_m},
+      {"fit_lat_error_deg", &Base::fit_lat_error_deg},
+      {"fit_gravity_m_s2", &Base::fit_gravity_m_s2},
+  };
+  for (const Entry& e : kFields) {
+    if (name == e.name) return &(b.*e.field);
+  }
+  return nullptr;
+}
+
+bool IsTruth(const std::string& name) { return name.rfind("truth.", 0) == 0; }
+
+double Number(const json& v, const std::string& path, const std::string& where) {
+  if (!v.is_number() || !std::isfinite(v.get<double>())) {
+    throw InputError(path, "key '" + where + "'", "expected a finite number");
+  }
+  return v.get<double>();
+}
+
+void ReadBase(const json& b, const std::string& path, Base& base) {
+  if (!b.is_object()) throw InputError(path, "key 'base'", "expected an object");
+  for (const auto& [key, value] : b.items()) {
+    const std::string where = "base." + key;
+    if (key == "schedule" || key == "sensor") {
+      if (!value.is_string()) throw InputError(path, "key '" + where + "'", "expected a name");
+      (key == "schedule" ? base.schedule : base.sensor) = value.get<std::string>();
+    } else if (key == "random_truth") {
+      base.random_truth = Number(value, path, where);
+    } else if (key == "lon_deg") {
+      base.lon_deg = Number(value, path, where);
+    } else if (key == "truth") {
+      if (!value.is_object()) throw InputError(path, "key 'base.truth'", "expected an object");
+      for (const auto& [name, v] : value.items()) {
+        base.truth.emplace_back(name, Number(v, path, "base.truth." + name));
+      }
+    } else if (double* field = Field(base, key)) {
+      *field = Number(value, path, where);
+    } else {
+      throw InputError(path, "key '" + where + "'", "not a field of the base");
+    }
+  }
+  const std::vector<std::string> schedules = {"multipose", "paper_static", "paper_benchmark"};
+  if (std::find(schedules.begin(), schedules.end(), base.schedule) == schedules.end()) {
+    throw InputError(path, "key 'base.schedule'",
+                     "expected multipose, paper_static or paper_benchmark");
+  }
+  if (base.sensor != "typical" && base.sensor != "white") {
+    throw InputError(path, "key 'base.sensor'", "expected typical or white");
+  }
+}
+
+Factor ReadFactor(const json& f, const std::string& path, std::size_t i, DesignKind design) {
+  const std::string where = "factors[" + std::to_string(i) + "]";
+  if (!f.is_object() || !f.contains("name") || !f.at("name").is_string()) {
+    throw InputError(path, "key '" + where + "'", "expected {\"name\": ..., \"levels\": [...]}");
+  }
+  Factor out;
+  out.name = f.at("name").get<std::string>();
+  Base probe;
+  if (!IsTruth(out.name) && Field(probe, out.name) == nullptr) {
+    std::string names;
+    for (const auto& n : FactorNames()) names += (names.empty() ? "" : ", ") + n;
+    throw InputError(path, "key '" + where + ".name'",
+                     "unknown factor '" + out.name + "'; known: " + names + ", truth.PARAMETER");
+  }
+  if (f.contains("levels")) {
+    const json& levels = f.at("levels");
+    if (!levels.is_array() || levels.empty()) {
+      throw InputError(path, "key '" + where + ".levels'", "expected a non-empty list of numbers");
+    }
+    for (std::size_t j = 0; j < levels.size(); ++j) {
+      out.levels.push_back(Number(levels[j], path, where + ".levels[" + std::to_string(j) + "]"));
+    }
+  } else if (f.contains("range")) {
+    const json& range = f.at("range");
+    if (design != DesignKind::kLatinHypercube) {
+      throw InputError(path, "key '" + where + ".range'",
+                       "a range needs the latin_hypercube design; give levels for a grid or one "
+                       "factor at a time");
+    }
+    if (!range.is_array() || range.size() != 2) {
+      throw InputError(path, "key '" + where + ".range'", "expected [low, high]");
+    }
+    out.low = Number(range[0], path, where + ".range[0]");
+    out.high = Number(range[1], path, where + ".range[1]");
+    if (!(out.low < out.high)) throw InputError(path, "key '" + where + ".range'", "expected low < high");
+  } else {
+    throw InputError(path, "key '" + where + "'", "expected levels or a range");
+  }
+  return out;
+}
+
+void ReadDesign(const json& d, const std::string& path, Study& s) {
+  if (d.is_string() && d.get<std::string>() == "grid") {
+    s.design = DesignKind::kGrid;
+  } else if (d.is_string() && d.get<std::string>() == "one_at_a_time") {
+    s.design = DesignKind::kOneAtATime;
+  } else if (d.is_object() && d.contains("latin_hypercube") && d.at("latin_hypercube").is_number_integer() &&
+             d.at("latin_hypercube").get<int>() >= 1) {
+    s.design = DesignKind::kLatinHypercube;
+    s.lhs_points = d.at("latin_hypercube").get<int>();
+  } else {
+    throw InputError(path, "key 'design'",
+                     "expected \"grid\", \"one_at_a_time\" or {\"latin_hypercube\": POINTS}");
+  }
+}
+
+}  // namespace
+
+const std::vector<std::string>& FactorNames() {
+  static const std::vector<std::string> kNames = {
+      "poses",   "still_s",  "turn_s",   "rate_hz",   "accel_noise", "gyro_noise",
+      "accel_rw", "gyro_rw", "accel_bi", "gyro_bi",   "bi_time_s",   "temperature_rise_c",
+      "lat_deg", "height_m", "fit_lat_error_deg", "fit_gravity_m_s2"};
+  return kNames;
+}
+
+Study ParseStudy(const json& doc, const std::string& path) {
+  if (!doc.is_object()) throw InputError(path, "", "expected a study object");
+  Study s;
+  s.source = doc;
+  for (const auto& [key, value] : doc.items()) {
+    if (key == "name") {
+      if (!value.is_string()) throw InputError(path, "key 'name'", "expected text");
+      s.name = value.get<std::string>();
+    } else if (key == "seed") {
+      if (!value.is_number_integer() || (value.is_number_integer() && !value.is_number_unsigned() &&
+                                          value.get<long long>() < 0)) {
+        throw InputError(path, "key 'seed'", "expected an integer >= 0");
+      }
+      s.seed = value.get<std::uint64_t>();
+    } else if (key == "runs") {
+      if (!value.is_number_integer() || value.get<long>() < 1 || value.get<long>() > 1000000) {
+        throw InputError(path, "key 'runs'", "expected an integer in [1, 1000000]");
+      }
+      s.runs = value.get<int>();
+    } else if (key == "design") {
+      ReadDesign(value, path, s);
+    } else if (key == "base") {
+      ReadBase(value, path, s.base);
+    } else if (key == "simulate") {
+      if (!value.is_string()) throw InputError(path, "key 'simulate'", "expected a model spec");
+      s.simulate_model = value.get<std::string>();
+    } else if (key == "fit") {
+      if (!value.is_object()) throw InputError(path, "key 'fit'", "expected an object");
+      for (const auto& [k, v] : value.items()) {
+        if (k == "model" && v.is_string()) {
+          s.fit_model = v.get<std::string>();
+        } else if (k == "constant_bias" && v.is_boolean()) {
+          s.constant_bias = v.get<bool>();
+        } else {
+          throw InputError(path, "key 'fit." + k + "'", "expected model (text) or constant_bias (true/false)");
+        }
+      }
+    } else if (key != "factors") {
+      throw InputError(path, "key '" + key + "'", "not a key of a study");
+    }
+  }
+  if (doc.contains("factors")) {
+    const json& factors = doc.at("factors");
+    if (!factors.is_array()) throw InputError(path, "key 'factors'", "expected a list");
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      s.factors.push_back(ReadFactor(factors[i], path, i, s.design));
+    }
+  }
+  return s;
+}
+
+std::vector<Point> DesignPoints(const Study& study) {
+  std::vector<Point> out;
+  const std::size_t k = study.factors.size();
+  Base base = study.base;
+  std::vector<double> at_base(k, 0.0);
+  // The base's value of each factor (one at a time holds the others there).
+  for (std::size_t f = 0; f < k; ++f) {
+    const std::string& name = study.factors[f].name;
+    if (IsTruth(name)) {
+      at_base[f] = 0.0;
+      for (const auto& [n, v] : base.truth) {
+        if ("truth." + n == name) at_base[f] = v;
+      }
+    } else {
+      at_base[f] = *Field(base, name);
+    }
+  }
+  if (study.design == DesignKind::kGrid) {
+    std::vector<std::size_t> index(k, 0);
+    while (true) {
+      Point p{static_cast<int>(out.size()), {}};
+      for (std::size_t f = 0; f < k; ++f) p.values.push_back(study.factors[f].levels[index[f]]);
+      out.push_back(p);
+      std::size_t f = k;
+      while (f > 0 && ++index[f - 1] == study.factors[f - 1].levels.size()) index[--f] = 0;
+      if (f == 0) break;
+    }
+  } else if (study.design == DesignKind::kOneAtATime) {
+    out.push_back(Point{0, at_base});
+    for (std::size_t f = 0; f < k; ++f) {
+      for (double level : study.factors[f].levels) {
+        if (level == at_base[f]) continue;
+        Point p{static_cast<int>(out.size()), at_base};
+        p.values[f] = level;
+        out.push_back(p);
+      }
+    }
+  } else {
+    // Latin hypercube: each factor's range cut into lhs_points strata, one draw in each, the
+    // strata permuted independently per factor (McKay, Beckman and Conover 1979).
+    std::mt19937_64 rng(RunSeed(study.seed, -1, -1));
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const auto n = static_cast<std::size_t>(study.lhs_points);
+    out.assign(n, Point{});
+    for (std::size_t i = 0; i < n; ++i) out[i].index = static_cast<int>(i);
+    for (std::size_t f = 0; f < k; ++f) {
+      std::vector<std::size_t> strata(n);
+      for (std::size_t i = 0; i < n; ++i) strata[i] = i;
+      std::shuffle(strata.begin(), strata.end(), rng);
+      const Factor& fac = study.factors[f];
+      for (std::size_t i = 0; i < n; ++i) {
+        const double x = (static_cast<double>(strata[i]) + u(rng)) / static_cast<double>(n);
+        if (fac.levels.empty()) {
+          out[i].values.push_back(fac.low + x * (fac.high - fac.low));
+        } else {
+          const auto j = std::min(fac.levels.size() - 1,
+                                  static_cast<std::size_t>(x * static_cast<double>(fac.levels.size())));
+          out[i].values.push_back(fac.levels[j]);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+Base Apply(const Study& study, const Point& point) {
+  Base b = study.base;
+  for (std::size_t f = 0; f < point.values.size() && f < study.factors.size(); ++f) {
+    const std::string& name = study.factors[f].name;
+    if (IsTruth(name)) {
+      const std::string param = name.substr(6);
+      auto it = std::find_if(b.truth.begin(), b.truth.end(),
+                             [&](const auto& t) { return t.first == param; });
+      if (it == b.truth.end()) {
+        b.truth.emplace_back(param, point.values[f]);
+      } else {
+        it->second = point.values[f];
+      }
+    } else if (double* field = Field(b, name)) {
+      *field = point.values[f];
+    } else {
+      throw Error("study: unknown factor '" + name + "'");
+    }
+  }
+  return b;
+}
+
+std::uint64_t RunSeed(std::uint64_t study_seed, int point, int run) {
+  std::seed_seq seq{static_cast<std::uint32_t>(study_seed), static_cast<std::uint32_t>(study_seed >> 32),
+                    static_cast<std::uint32_t>(point), static_cast<std::uint32_t>(run), 0x706c756dU};
+  std::array<std::uint32_t, 2> out{};
+  seq.generate(out.begin(), out.end());
+  return (static_cast<std::uint64_t>(out[0]) << 32) | out[1];
+}
+
+}  // namespace plumb::study

@@ -1,0 +1,103 @@
+// plumb/study/study.h — a sensitivity study of the calibration procedure (`plumb sweep`): a
+// base design simulated with known truth, factors that change it, and Monte Carlo runs of the
+// generalized fit at every point of a design over the factors.
+//
+// The study file (JSON; docs/reference/cli.md#plumb-sweep, examples/studies/):
+//
+//   { "name": "poses",                    what the study is called
+//     "seed": 1,                          the study seed (every run's seed derives from it)
+//     "runs": 20,                         Monte Carlo runs per point, >= 1
+//     "design": "grid",                   "grid" | "one_at_a_time" | {"latin_hypercube": N}
+//     "base": { "schedule": "multipose",  "multipose" | "paper_static" | "paper_benchmark"
+//               "poses": 12, "still_s": 5, "turn_s": 2, "rate_hz": 100,
+//               "sensor": "typical",      "typical" (white, instability, walk, warming) | "white"
+//               "random_truth": 1,        scale of the random true parameters (sim/truth.h)
+//               "lat_deg": 51.64, "lon_deg": -1.2, "height_m": 100 },
+//     "simulate": "base",                 the model simulated (default: the fitted one)
+//     "fit": { "model": "base", "constant_bias": false },
+//     "factors": [ {"name": "poses", "levels": [6, 9, 12]},
+//                  {"name": "still_s", "range": [2, 30]} ] }   (a range: latin hypercube only)
+//
+// Factors (FactorNames()): poses, still_s, turn_s, rate_hz, accel_noise, gyro_noise, accel_rw,
+// gyro_rw, accel_bi, gyro_bi, bi_time_s, temperature_rise_c, lat_deg, height_m (the site,
+// simulated and fitted), fit_lat_error_deg (the site the fit is given is off by this much in
+// latitude), fit_gravity_m_s2 (the fit uses this gravity instead of WGS84's at the site; 0:
+// WGS84), and truth.PARAMETER (a true parameter of the simulated model in its unit, e.g.
+// truth.gyro_g_sensitivity.G.xy). Each sets the field of the base of that name.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace plumb::study {
+
+/// A factor and its levels (grid, one at a time) or range (latin hypercube).
+struct Factor {
+  std::string name;
+  std::vector<double> levels;  ///< the values, in the factor's unit
+  double low = 0.0, high = 0.0;  ///< the range; used when levels is empty
+};
+
+/// The base of every point; each factor overrides its field.
+struct Base {
+  std::string schedule = "multipose";  ///< multipose | paper_static | paper_benchmark
+  double poses = 12, still_s = 5, turn_s = 2, rate_hz = 100;
+  std::string sensor = "typical";  ///< typical | white
+  double random_truth = 1.0;
+  double lat_deg = 51.64, lon_deg = -1.2, height_m = 100.0;
+  /// Noise levels (as `plumb simulate`'s flags); NaN: the sensor's (typical or white).
+  static constexpr double kSensor = std::numeric_limits<double>::quiet_NaN();
+  double accel_noise = kSensor, gyro_noise = kSensor, accel_rw = kSensor, gyro_rw = kSensor;
+  double accel_bi = kSensor, gyro_bi = kSensor;
+  double bi_time_s = 30.0, temperature_rise_c = 10.0;
+  double fit_lat_error_deg = 0.0, fit_gravity_m_s2 = 0.0;
+  /// truth.PARAMETER factors and the base's "truth" object: name -> value.
+  std::vector<std::pair<std::string, double>> truth;
+};
+
+enum class DesignKind { kGrid, kOneAtATime, kLatinHypercube };
+
+struct Study {
+  std::string name;
+  std::uint64_t seed = 1;
+  int runs = 10;
+  DesignKind design = DesignKind::kGrid;
+  int lhs_points = 0;  ///< latin hypercube: points
+  Base base;
+  std::string simulate_model;  ///< the simulated model spec ("" = the fitted one)
+  std::string fit_model = "base";
+  bool constant_bias = false;
+  std::vector<Factor> factors;
+  nlohmann::json source;  ///< the study file as read (kept in every output)
+};
+
+/// The factor names a study may use besides truth.PARAMETER.
+const std::vector<std::string>& FactorNames();
+
+/// Reads a study from its JSON (file comment). Throws plumb::InputError naming `path` and the
+/// key for anything out of place (an unknown factor, a range in a grid, runs < 1, ...).
+Study ParseStudy(const nlohmann::json& document, const std::string& path);
+
+/// One point of the design: the value of every factor, in Study::factors order.
+struct Point {
+  int index = 0;
+  std::vector<double> values;
+};
+
+/// The points of the design: the full grid (last factor fastest), one factor at a time (the
+/// base, then each factor's levels with the others at the base; a level equal to the base's is
+/// not repeated), or a latin hypercube of lhs_points over the ranges (seeded by the study
+/// seed; a factor with levels picks among them).
+std::vector<Point> DesignPoints(const Study& study);
+
+/// The base with a point's values applied. Throws plumb::Error for an unknown factor.
+Base Apply(const Study& study, const Point& point);
+
+/// The seed of run `run` of point `point`: from the study seed by std::seed_seq, so that any
+/// subset of runs reproduces bit for bit.
+std::uint64_t RunSeed(std::uint64_t study_seed, int point, int run);
+
+}  // namespace plumb::study

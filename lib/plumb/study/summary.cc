@@ -1,0 +1,183 @@
+#include "plumb/study/summary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "plumb/core/error.h"
+#include "plumb/signal/chi_square.h"
+
+namespace plumb::study {
+namespace {
+
+using nlohmann::json;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+double FromNum(const json& v) { return v.is_number() ? v.get<double>() : kNaN; }
+
+/// A number as CSV text: 17 significant digits, "" for NaN.
+std::string Csv(double v) {
+  if (!std::isfinite(v)) return "";
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+}  // namespace
+
+PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs) {
+  PointSummary s;
+  s.point = point;
+  s.runs = static_cast<int>(runs.size());
+  double nees_sum = 0.0, chi2_sum = 0.0;
+  int chi2_n = 0;
+  for (const RunOutcome& r : runs) {
+    s.failed += r.failed ? 1 : 0;
+    s.flagged += r.flagged ? 1 : 0;
+    if (r.failed && !r.failure.empty() &&
+        std::find(s.failures.begin(), s.failures.end(), r.failure) == s.failures.end()) {
+      s.failures.push_back(r.failure);
+    }
+    s.nees.push_back(r.failed ? kNaN : r.nees);
+    if (r.failed) continue;
+    if (std::isfinite(r.nees)) {
+      nees_sum += r.nees;
+      s.nees_dof += r.nees_dof;
+    }
+    if (std::isfinite(r.chi2_dof)) {
+      chi2_sum += r.chi2_dof;
+      ++chi2_n;
+    }
+    if (s.parameters.empty()) {
+      for (std::size_t i = 0; i < r.names.size(); ++i) {
+        s.parameters.push_back(ParameterSummary{r.names[i], r.units[i], 0, 0.0, 0.0, 0.0, 0.0});
+      }
+    }
+    for (std::size_t i = 0; i < r.error.size() && i < s.parameters.size(); ++i) {
+      if (!std::isfinite(r.error[i])) continue;
+      ParameterSummary& p = s.parameters[i];
+      ++p.runs;
+      p.mean_error += r.error[i];
+      p.rms_error += r.error[i] * r.error[i];
+      p.mean_sigma += r.sigma[i];
+    }
+  }
+  for (ParameterSummary& p : s.parameters) {
+    if (p.runs == 0) {
+      p.mean_error = p.rms_error = p.sd_error = p.mean_sigma = kNaN;
+      continue;
+    }
+    const double n = p.runs;
+    const double sum = p.mean_error, sum_sq = p.rms_error;
+    p.mean_error = sum / n;
+    p.rms_error = std::sqrt(sum_sq / n);
+    p.sd_error = p.runs > 1 ? std::sqrt(std::max(0.0, (sum_sq - sum * sum / n) / (n - 1.0))) : kNaN;
+    p.mean_sigma /= n;
+  }
+  if (s.nees_dof > 0) {
+    const double dof = s.nees_dof;
+    s.nees_per_dof = nees_sum / dof;
+    s.nees_low = signal::ChiSquareQuantileExact(0.025, dof) / dof;
+    s.nees_high = signal::ChiSquareQuantileExact(0.975, dof) / dof;
+  }
+  if (chi2_n > 0) s.mean_chi2_dof = chi2_sum / chi2_n;
+  return s;
+}
+
+json PointJson(const Study& study, const PointSummary& s) {
+  json params = json::array();
+  for (const ParameterSummary& p : s.parameters) {
+    params.push_back({{"name", p.name}, {"unit", p.unit}, {"runs", p.runs},
+                      {"mean_error", Num(p.mean_error)}, {"rms_error", Num(p.rms_error)},
+                      {"sd_error", Num(p.sd_error)}, {"mean_sigma", Num(p.mean_sigma)}});
+  }
+  json nees = json::array();
+  for (double v : s.nees) nees.push_back(Num(v));
+  json values = json::array();
+  for (double v : s.point.values) values.push_back(Num(v));
+  return json{{"study", study.source},
+              {"point", s.point.index},
+              {"values", values},
+              {"runs", s.runs},
+              {"failed", s.failed},
+              {"flagged", s.flagged},
+              {"failures", s.failures},
+              {"nees_per_dof", Num(s.nees_per_dof)},
+              {"nees_dof", s.nees_dof},
+              {"nees_band_95", {Num(s.nees_low), Num(s.nees_high)}},
+              {"mean_chi2_dof", Num(s.mean_chi2_dof)},
+              {"nees_per_run", nees},
+              {"parameters", params}};
+}
+
+PointSummary PointFromJson(const Study& study, const json& doc, const std::string& path) {
+  if (!doc.is_object() || !doc.contains("study") || !doc.contains("point")) {
+    throw InputError(path, "", "not a point of a study (written by plumb sweep)");
+  }
+  if (doc.at("study") != study.source) {
+    throw InputError(path, "key 'study'", "this point belongs to another study");
+  }
+  try {
+    PointSummary s;
+    s.point.index = doc.at("point").get<int>();
+    for (const json& v : doc.at("values")) s.point.values.push_back(FromNum(v));
+    s.runs = doc.at("runs").get<int>();
+    s.failed = doc.at("failed").get<int>();
+    s.flagged = doc.at("flagged").get<int>();
+    s.failures = doc.at("failures").get<std::vector<std::string>>();
+    s.nees_per_dof = FromNum(doc.at("nees_per_dof"));
+    s.nees_dof = doc.at("nees_dof").get<int>();
+    s.nees_low = FromNum(doc.at("nees_band_95").at(0));
+    s.nees_high = FromNum(doc.at("nees_band_95").at(1));
+    s.mean_chi2_dof = FromNum(doc.at("mean_chi2_dof"));
+    for (const json& v : doc.at("nees_per_run")) s.nees.push_back(FromNum(v));
+    for (const json& p : doc.at("parameters")) {
+      s.parameters.push_back(ParameterSummary{
+          p.at("name").get<std::string>(), p.at("unit").get<std::string>(), p.at("runs").get<int>(),
+          FromNum(p.at("mean_error")), FromNum(p.at("rms_error")), FromNum(p.at("sd_error")),
+          FromNum(p.at("mean_sigma"))});
+    }
+    return s;
+  } catch (const json::exception& e) {
+    throw InputError(path, "", std::string("a study point with a missing or malformed key: ") + e.what());
+  }
+}
+
+std::string ResultsCsv(const Study& study, const std::vector<PointSummary>& points) {
+  std::string out = "point";
+  for (const Factor& f : study.factors) out += "," + f.name;
+  out += ",parameter,unit,runs,failed,flagged,mean_error,rms_error,sd_error,mean_sigma,"
+         "nees_per_dof,nees_low,nees_high,mean_chi2_dof\n";
+  for (const PointSummary& s : points) {
+    std::string head = std::to_string(s.point.index);
+    for (double v : s.point.values) head += "," + Csv(v);
+    const std::string tail = "," + Csv(s.nees_per_dof) + "," + Csv(s.nees_low) + "," +
+                             Csv(s.nees_high) + "," + Csv(s.mean_chi2_dof) + "\n";
+    for (const ParameterSummary& p : s.parameters) {
+      out += head + "," + p.name + "," + p.unit + "," + std::to_string(p.runs) + "," +
+             std::to_string(s.failed) + "," + std::to_string(s.flagged) + "," +
+             Csv(p.mean_error) + "," + Csv(p.rms_error) + "," + Csv(p.sd_error) + "," +
+             Csv(p.mean_sigma) + tail;
+    }
+    if (s.parameters.empty()) {  // every run failed: one row that says so
+      out += head + ",,," + std::to_string(0) + "," + std::to_string(s.failed) + "," +
+             std::to_string(s.flagged) + ",,,," + tail;
+    }
+  }
+  return out;
+}
+
+json ResultsJson(const Study& study, const std::vector<PointSummary>& points) {
+  json factors = json::array();
+  for (const Factor& f : study.factors) factors.push_back(f.name);
+  json list = json::array();
+  for (const PointSummary& s : points) {
+    json p = PointJson(study, s);
+    p.erase("study");
+    list.push_back(p);
+  }
+  return json{{"study", study.source}, {"factors", factors}, {"points", list}};
+}
+
+}  // namespace plumb::study

@@ -1,0 +1,57 @@
+// plumb/study/summary.h — what a study point's runs say, and the study's results.
+//
+// Per point: the runs, how many failed (the fit threw or did not converge) and how many were
+// flagged (a gate failed); per parameter over the runs that determined it: the mean and RMS of
+// the error against the truth, its standard deviation, and the mean reported sigma; and the
+// NEES per degree of freedom pooled over the runs, sum NEES / sum dof, with the 95 % band of
+// chi^2(sum dof) / sum dof that honest sigmas put it in.
+//
+// A point is stored as JSON (PointJson, read back by PointFromJson), the unit a shard writes
+// and a merge joins; the results (ResultsCsv: one row per point and parameter; ResultsJson)
+// are made from the points alone, in point order, so one run and a merge of shards give the
+// same bytes.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "plumb/study/run.h"
+#include "plumb/study/study.h"
+
+namespace plumb::study {
+
+struct ParameterSummary {
+  std::string name, unit;
+  int runs = 0;  ///< runs that determined it
+  double mean_error = 0.0, rms_error = 0.0, sd_error = 0.0, mean_sigma = 0.0;
+};
+
+struct PointSummary {
+  Point point;
+  int runs = 0, failed = 0, flagged = 0;
+  double nees_per_dof = std::numeric_limits<double>::quiet_NaN();
+  int nees_dof = 0;  ///< sum of the runs' NEES degrees of freedom
+  double nees_low = 0.0, nees_high = 0.0;  ///< 95 % band of nees_per_dof
+  double mean_chi2_dof = std::numeric_limits<double>::quiet_NaN();
+  std::vector<ParameterSummary> parameters;
+  std::vector<double> nees;           ///< per run (NaN where none), run order
+  std::vector<std::string> failures;  ///< distinct failure messages, first seen first
+};
+
+PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs);
+
+/// A point as JSON, with the study it belongs to (Study::source) so that a merge or a resume
+/// can tell points of another study apart.
+nlohmann::json PointJson(const Study& study, const PointSummary& summary);
+/// Reads PointJson back; throws plumb::InputError naming `path` when it is not such a point or
+/// belongs to another study.
+PointSummary PointFromJson(const Study& study, const nlohmann::json& doc, const std::string& path);
+
+/// One row per point and parameter: point, the factors' values, parameter, unit, runs,
+/// failed, flagged, mean_error, rms_error, sd_error, mean_sigma, nees_per_dof, nees_low,
+/// nees_high, mean_chi2_dof. Points in index order.
+std::string ResultsCsv(const Study& study, const std::vector<PointSummary>& points);
+nlohmann::json ResultsJson(const Study& study, const std::vector<PointSummary>& points);
+
+}  // namespace plumb::study

@@ -1,0 +1,85 @@
+// `plumb sweep` as a user runs it: a small study, sharded and merged into the same files as
+// one run, byte for byte (whatever the threads); a rerun resumes; bad input names the file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "run_tool.h"
+
+namespace plumb::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Contains;
+using testing::Plumb;
+using testing::ReadAll;
+using testing::TempDir;
+using testing::ToolRun;
+
+constexpr const char* kStudy = R"({"name": "t", "seed": 3, "runs": 3, "design": "grid",
+  "base": {"poses": 9, "still_s": 3, "turn_s": 2, "rate_hz": 100},
+  "factors": [{"name": "poses", "levels": [9, 12, 15]}]})";
+
+/// Every file under `dir`, relative path -> contents.
+std::map<std::string, std::string> Files(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file()) out[fs::relative(e.path(), dir).string()] = ReadAll(e.path().string());
+  }
+  return out;
+}
+
+TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  std::ofstream(at("study.json")) << kStudy;
+  const ToolRun whole = Plumb({"sweep", at("study.json"), "--out", at("whole"), "--jobs", "2"}, dir);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_TRUE(Contains(whole.out, "point 2: poses=15; 3 runs, 0 failed")) << whole.out;
+  for (const char* shard : {"1/2", "2/2"}) {
+    const std::string out = std::string("shard") + shard[0];
+    const ToolRun r = Plumb({"sweep", at("study.json"), "--out", at(out.c_str()), "--shard", shard,
+                             "--jobs", "1"}, dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_FALSE(fs::exists(dir.path() / out / "results.csv"));
+  }
+  const ToolRun merged = Plumb({"sweep", "merge", at("shard1"), at("shard2"), "--out", at("merged")}, dir);
+  ASSERT_EQ(merged.exit_code, 0) << merged.err;
+  EXPECT_EQ(Files(dir.path() / "merged"), Files(dir.path() / "whole"));
+  const std::string csv = ReadAll(at("whole/results.csv"));
+  EXPECT_TRUE(Contains(csv, "point,poses,parameter,unit,runs,failed,flagged,mean_error")) << csv;
+  EXPECT_TRUE(Contains(csv, "\n2,15,gyro.bias.z,rad/s,3,0,")) << csv;
+  // A rerun resumes: a removed point is run again, the others kept, the result the same.
+  fs::remove(dir.path() / "whole/points/point-00001.json");
+  const ToolRun again = Plumb({"sweep", at("study.json"), "--out", at("whole")}, dir);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_TRUE(Contains(again.out, "2 already written, 1 to run")) << again.out;
+  EXPECT_EQ(Files(dir.path() / "merged"), Files(dir.path() / "whole"));
+  // A merge with a shard missing says which point.
+  const ToolRun missing = Plumb({"sweep", "merge", at("shard1"), "--out", at("m2")}, dir);
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_TRUE(Contains(missing.err, "point 1 is in none of the shards")) << missing.err;
+}
+
+TEST(SweepCli, BadStudiesAndOptionsAreSaid) {
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  std::ofstream(at("bad.json")) << R"({"runs": 2, "factors": [{"name": "pose", "levels": [3]}]})";
+  const ToolRun bad = Plumb({"sweep", at("bad.json"), "--out", at("o")}, dir);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_TRUE(Contains(bad.err, at("bad.json"))) << bad.err;
+  EXPECT_TRUE(Contains(bad.err, "unknown factor 'pose'")) << bad.err;
+  std::ofstream(at("broken.json")) << "{\"runs\": 2,";
+  const ToolRun broken = Plumb({"sweep", at("broken.json"), "--out", at("o")}, dir);
+  EXPECT_EQ(broken.exit_code, 1);
+  EXPECT_TRUE(Contains(broken.err, "not valid JSON")) << broken.err;
+  std::ofstream(at("s.json")) << kStudy;
+  const ToolRun shard = Plumb({"sweep", at("s.json"), "--out", at("o"), "--shard", "3/2"}, dir);
+  EXPECT_EQ(shard.exit_code, 2);
+  EXPECT_TRUE(Contains(shard.err, "--shard takes K/N with 1 <= K <= N")) << shard.err;
+}
+
+}  // namespace
+}  // namespace plumb::cli

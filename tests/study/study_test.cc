@@ -1,0 +1,146 @@
+// Sensitivity studies (plumb/study): the study file and its errors, the designs, the seeds,
+// runs that reproduce bit for bit, honest sigmas where the fitted model contains the simulated
+// one, and the bias a missing effect leaves.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "plumb/core/error.h"
+#include "plumb/study/run.h"
+#include "plumb/study/study.h"
+#include "plumb/study/summary.h"
+
+namespace plumb::study {
+namespace {
+
+using nlohmann::json;
+
+std::string ErrorOf(const json& doc) {
+  try {
+    ParseStudy(doc, "s.json");
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+json Small(int runs = 4) {
+  return json{{"name", "t"}, {"seed", 7}, {"runs", runs}, {"design", "grid"},
+              {"base", {{"poses", 9}, {"still_s", 3}, {"turn_s", 2}, {"rate_hz", 100}}},
+              {"factors", json::array({{{"name", "poses"}, {"levels", {9, 12}}}})}};
+}
+
+TEST(Study, ErrorsNameTheFileAndTheKey) {
+  json bad = Small();
+  bad["factors"][0]["name"] = "posses";
+  EXPECT_NE(ErrorOf(bad).find("s.json"), std::string::npos);
+  EXPECT_NE(ErrorOf(bad).find("factors[0].name"), std::string::npos) << ErrorOf(bad);
+  EXPECT_NE(ErrorOf(bad).find("unknown factor 'posses'"), std::string::npos);
+  json range = Small();
+  range["factors"][0] = {{"name", "still_s"}, {"range", {1, 10}}};
+  EXPECT_NE(ErrorOf(range).find("a range needs the latin_hypercube design"), std::string::npos);
+  json runs = Small();
+  runs["runs"] = 0;
+  EXPECT_NE(ErrorOf(runs).find("key 'runs'"), std::string::npos);
+  json base = Small();
+  base["base"]["schedule"] = "spiral";
+  EXPECT_NE(ErrorOf(base).find("base.schedule"), std::string::npos);
+  EXPECT_EQ(ErrorOf(Small()), "");
+}
+
+TEST(Study, GridOneAtATimeAndLatinHypercube) {
+  json doc = Small();
+  doc["factors"] = json::array({{{"name", "poses"}, {"levels", {9, 12, 18}}},
+                                {{"name", "still_s"}, {"levels", {3, 10}}}});
+  const std::vector<Point> grid = DesignPoints(ParseStudy(doc, "s.json"));
+  ASSERT_EQ(grid.size(), 6U);
+  EXPECT_EQ(grid[1].values, (std::vector<double>{9, 10}));  // last factor fastest
+  EXPECT_EQ(grid[5].values, (std::vector<double>{18, 10}));
+  doc["design"] = "one_at_a_time";
+  const std::vector<Point> oat = DesignPoints(ParseStudy(doc, "s.json"));
+  // The base (9, 3), then poses 12, 18 and still_s 10 with the other at the base.
+  ASSERT_EQ(oat.size(), 4U);
+  EXPECT_EQ(oat[0].values, (std::vector<double>{9, 3}));
+  EXPECT_EQ(oat[3].values, (std::vector<double>{9, 10}));
+  doc["design"] = {{"latin_hypercube", 10}};
+  doc["factors"][1] = {{"name", "still_s"}, {"range", {2, 12}}};
+  const std::vector<Point> lhs = DesignPoints(ParseStudy(doc, "s.json"));
+  ASSERT_EQ(lhs.size(), 10U);
+  std::set<int> strata;
+  for (const Point& p : lhs) strata.insert(static_cast<int>(std::floor(p.values[1] - 2.0)));
+  EXPECT_EQ(strata.size(), 10U);  // one draw in each tenth of the range
+  EXPECT_EQ(DesignPoints(ParseStudy(doc, "s.json"))[3].values, lhs[3].values);  // seeded
+}
+
+TEST(Study, SeedsDifferPerPointAndRunAndDoNotChange) {
+  EXPECT_NE(RunSeed(1, 0, 0), RunSeed(1, 0, 1));
+  EXPECT_NE(RunSeed(1, 0, 1), RunSeed(1, 1, 0));
+  EXPECT_NE(RunSeed(1, 0, 0), RunSeed(2, 0, 0));
+  EXPECT_EQ(RunSeed(1, 3, 5), RunSeed(1, 3, 5));
+}
+
+TEST(Study, ARunReproducesBitForBit) {
+  const Study s = ParseStudy(Small(), "s.json");
+  const Point p = DesignPoints(s)[1];
+  const RunOutcome a = RunOnce(s, p, 2), b = RunOnce(s, p, 2);
+  ASSERT_FALSE(a.failed) << a.failure;
+  EXPECT_EQ(a.error, b.error);
+  EXPECT_EQ(a.sigma, b.sigma);
+  EXPECT_EQ(a.nees, b.nees);
+  EXPECT_NE(RunOnce(s, p, 3).error, a.error);
+}
+
+TEST(Study, SigmasAreHonestWhereTheFitContainsTheSimulation) {
+  // The simulator's default sensor, 12 poses of 5 s, 40 runs: NEES/dof in its band.
+  json doc = Small(40);
+  doc["base"]["poses"] = 12;
+  doc["base"]["still_s"] = 5;
+  doc["factors"] = json::array();
+  const Study s = ParseStudy(doc, "s.json");
+  const Point p = DesignPoints(s).front();
+  std::vector<RunOutcome> runs;
+  for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
+  const PointSummary sum = Summarise(p, runs);
+  EXPECT_EQ(sum.failed, 0);
+  EXPECT_EQ(sum.nees_dof, 40 * 21);
+  EXPECT_GT(sum.nees_per_dof, sum.nees_low);
+  EXPECT_LT(sum.nees_per_dof, sum.nees_high);
+  // Mean sigma and RMS error agree for every parameter (within the RMS's own spread).
+  for (const ParameterSummary& q : sum.parameters) {
+    EXPECT_NEAR(q.rms_error / q.mean_sigma, 1.0, 0.45) << q.name;
+  }
+}
+
+TEST(Study, AMissingEffectShowsAsBias) {
+  // A g-sensitive gyroscope (G.zy = 2e-4 rad/s per m/s^2) fitted with the base model: the
+  // gyro biases absorb part of it, so NEES rises above its band and chi2/dof with it.
+  json doc = Small(10);
+  doc["base"]["poses"] = 12;
+  doc["simulate"] = "base+gyro_g_sensitivity";
+  doc["base"]["truth"] = {{"gyro_g_sensitivity.G.zy", 2e-4}};
+  doc["factors"] = json::array();
+  const Study s = ParseStudy(doc, "s.json");
+  const Point p = DesignPoints(s).front();
+  std::vector<RunOutcome> runs;
+  for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
+  const PointSummary sum = Summarise(p, runs);
+  EXPECT_GT(sum.nees_per_dof, sum.nees_high);
+  EXPECT_GT(sum.mean_chi2_dof, 2.0);
+}
+
+TEST(Study, PointsRoundTripThroughJson) {
+  const Study s = ParseStudy(Small(2), "s.json");
+  const Point p = DesignPoints(s)[0];
+  const PointSummary sum = Summarise(p, {RunOnce(s, p, 0), RunOnce(s, p, 1)});
+  const json doc = PointJson(s, sum);
+  const PointSummary back = PointFromJson(s, doc, "p.json");
+  EXPECT_EQ(PointJson(s, back), doc);
+  EXPECT_EQ(ResultsCsv(s, {back}), ResultsCsv(s, {sum}));
+  Study other = s;
+  other.source["seed"] = 8;
+  EXPECT_THROW(PointFromJson(other, doc, "p.json"), InputError);
+}
+
+}  // namespace
+}  // namespace plumb::study
