@@ -1,10 +1,14 @@
 #include "plumb/study/run.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/paper/backend.h"
+#include "plumb/paper/static_procedure.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
@@ -39,9 +43,56 @@ sim::SimulationOptions SensorOf(const Base& b, const model::Model& model, std::u
 }
 
 sim::Schedule ScheduleOf(const Base& b, std::uint64_t seed) {
-  if (b.schedule == "paper_static") return sim::PaperStatic(b.still_s);
+  if (b.schedule == "paper_static") {
+    // The hold as it truly is: turned from north, then tilted about body y (study.h).
+    const Quat R_n_b =
+        Quat(Eigen::AngleAxisd(b.heading_error_deg * units::kRadPerDeg, Vec3::UnitZ())) *
+        Quat(Eigen::AngleAxisd(b.level_error_deg * units::kRadPerDeg, Vec3::UnitY()));
+    sim::Schedule schedule(R_n_b);
+    schedule.Hold(b.still_s, "level, x north");
+    return schedule;
+  }
   if (b.schedule == "paper_benchmark") return sim::PaperBenchmark(b.still_s, b.turn_s);
   return sim::MultiPose(static_cast<int>(std::lround(b.poses)), b.still_s, b.turn_s, seed);
+}
+
+/// Where the data determine no parameter alone (one pose), the combinations they determine
+/// (estimation::Observability::determined) are scored instead, each a row named by its text,
+/// and the NEES is over their covariance.
+void Combinations(const estimation::CalibrationResult& result,
+                  const std::vector<std::string>& sim_names, const std::vector<double>& sim_values,
+                  const model::Model& fitted, RunOutcome& out) {
+  const auto& obs = result.calibration.observability;
+  if (obs.determined.empty()) return;
+  const std::vector<std::string> fit_names = fitted.ParameterNames();
+  const std::vector<double> nominal = model::ReportedValues(fitted, fitted.ZeroParameters());
+  auto truth_of = [&](const std::string& name) {
+    for (std::size_t j = 0; j < sim_names.size(); ++j) {
+      if (sim_names[j] == name) return sim_values[j];
+    }
+    for (std::size_t j = 0; j < fit_names.size(); ++j) {
+      if (fit_names[j] == name) return nominal[j];
+    }
+    return 0.0;
+  };
+  const auto m = static_cast<Eigen::Index>(obs.determined.size());
+  Eigen::VectorXd e(m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const estimation::Combination& c = obs.determined[static_cast<std::size_t>(k)];
+    double truth = 0.0;
+    for (std::size_t i = 0; i < c.names.size(); ++i) truth += c.coefficients[i] * truth_of(c.names[i]);
+    e[k] = c.value - truth;
+    out.names.push_back(c.text);
+    out.units.push_back("");
+    out.error.push_back(e[k]);
+    out.sigma.push_back(c.sigma);
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(obs.determined_covariance);
+  if (obs.determined_covariance.rows() == m && ldlt.info() == Eigen::Success &&
+      (ldlt.vectorD().array() > 0.0).all()) {
+    out.nees = e.dot(ldlt.solve(e));
+    out.nees_dof = static_cast<int>(m);
+  }
 }
 
 /// Errors, sigmas and the NEES of a calibration against the simulated truth.
@@ -66,7 +117,10 @@ void Score(const estimation::CalibrationResult& result, const sim::Simulation& s
     if (determined) in_nees.push_back(static_cast<Eigen::Index>(i));
   }
   const auto n = static_cast<Eigen::Index>(in_nees.size());
-  if (n == 0) return;
+  if (n == 0) {
+    Combinations(result, sim_names, sim_values, fitted, out);
+    return;
+  }
   Eigen::VectorXd e(n);
   Eigen::MatrixXd C(n, n);
   for (Eigen::Index a = 0; a < n; ++a) {
@@ -83,6 +137,39 @@ void Score(const estimation::CalibrationResult& result, const sim::Simulation& s
   }
 }
 
+/// The seed paper's closed forms (section 5) on the one hold: values only, no sigma.
+void PaperStatic(const sim::Simulation& s, const std::vector<StillSegment>& segments,
+                 const geo::Site& site, const model::Model& fitted, RunOutcome& out) {
+  const paper::PaperStaticResult r = paper::CalibratePaperStatic(
+      s.session.series, segments.front().begin, segments.front().end, site, {});
+  const std::vector<std::string> sim_names = s.model.ParameterNames();
+  const std::vector<double> sim_values = model::ReportedValues(s.model, s.truth);
+  const std::vector<double> nominal = model::ReportedValues(fitted, fitted.ZeroParameters());
+  const std::vector<std::string> names = fitted.ParameterNames();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const std::string& name = names[i];
+    // accel.matrix.RC, accel.bias.X, gyro.matrix.RC, gyro.bias.X (the base model's names).
+    const bool acc = name.rfind("accel.", 0) == 0;
+    const std::string tail = name.substr(name.rfind('.') + 1);
+    const bool matrix = name.find(".matrix.") != std::string::npos;
+    double value = kNaN;
+    if (matrix && tail.size() == 2) {
+      const Mat3& M = acc ? r.F : r.E;
+      value = M(tail[0] - 'x', tail[1] - 'x');
+    } else if (name.find(".bias.") != std::string::npos && tail.size() == 1) {
+      value = (acc ? r.b_a : r.b_g)[tail[0] - 'x'];
+    }
+    double truth = nominal[i];
+    for (std::size_t j = 0; j < sim_names.size(); ++j) {
+      if (sim_names[j] == name) truth = sim_values[j];
+    }
+    out.names.push_back(name);
+    out.units.push_back(matrix ? "1" : acc ? "m/s^2" : "rad/s");
+    out.error.push_back(value - truth);
+    out.sigma.push_back(kNaN);
+  }
+}
+
 }  // namespace
 
 RunOutcome RunOnce(const Study& study, const Point& point, int run) {
@@ -92,8 +179,13 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
       model::Model::Parse(study.simulate_model.empty() ? study.fit_model : study.simulate_model);
   const sim::Simulation s = sim::Simulate(ScheduleOf(b, seed), SensorOf(b, sim_model, seed));
   std::vector<StillSegment> segments = s.truth_segments;
-  if (b.schedule != "paper_static") {
-    for (auto& seg : segments) seg.known_R_n_b.reset();
+  for (auto& seg : segments) {
+    // Unknown attitudes, but on the paper's static design: level, x north, as assumed.
+    if (b.schedule == "paper_static") {
+      seg.known_R_n_b = Quat::Identity();
+    } else {
+      seg.known_R_n_b.reset();
+    }
   }
   geo::Site site = geo::Site::At(b.lat_deg + b.fit_lat_error_deg, b.lon_deg, b.height_m, "study");
   if (b.fit_gravity_m_s2 > 0.0) site.g_n = Vec3(0.0, 0.0, b.fit_gravity_m_s2);
@@ -103,6 +195,28 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
   estimation::CalibrationOptions options;
   options.constant_bias = study.constant_bias;
   RunOutcome out;
+  if (study.fit_method == "paper_static_backend") {
+    try {
+      const paper::PaperStaticBackend backend = paper::CalibratePaperStaticOnBackend(
+          s.session.series, segments.front().begin, segments.front().end, site);
+      out.chi2_dof = backend.fixed.fit.chi2_dof();
+      out.flagged = !backend.fixed.fit.gates.empty();
+      Score(backend.fixed, s, backend.fixed.calibration.model, out);
+    } catch (const Error& e) {
+      out.failed = true;
+      out.failure = e.what();
+    }
+    return out;
+  }
+  if (study.fit_method == "paper_static") {
+    try {
+      PaperStatic(s, segments, site, fitted, out);
+    } catch (const Error& e) {
+      out.failed = true;
+      out.failure = e.what();
+    }
+    return out;
+  }
   try {
     const estimation::CalibrationResult result =
         estimation::Calibrate(s.session.series, segments, fitted, site, options);

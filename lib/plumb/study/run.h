@@ -6,11 +6,15 @@
 // the fitted model's nominal value when the simulated model does not have it (an effect fitted
 // but not simulated is truly zero). A simulated effect the fit lacks shows only as the error it
 // leaves in the fitted parameters. Attitudes are unknown to the fit except on the paper's
-// static design (level, x north, as the paper assumes). The fit is given the simulated site,
+// static design, where the fit assumes level, x north (the truth may be off by
+// level_error_deg and heading_error_deg). The fit is given the simulated site,
 // off by fit_lat_error_deg in latitude, and fit_gravity_m_s2 instead of WGS84 gravity when > 0.
 //
 // NEES = e^T C^-1 e over the parameters that are free and observable (C their block of the
-// reported covariance, solved by LDLT); NaN when C is not positive definite.
+// reported covariance, solved by LDLT); NaN when C is not positive definite. Where the data
+// determine no parameter alone (one pose), the combinations they do determine are the rows
+// (named by their text, e.g. "accel.bias.z - 9.78 accel.matrix.zz") and the NEES is over
+// their covariance.
 #pragma once
 
 #include <limits>

@@ -35,6 +35,8 @@ double* Field(Base& b, const std::string& name) {
       {"height_m", &Base::height_m},
       {"fit_lat_error_deg", &Base::fit_lat_error_deg},
       {"fit_gravity_m_s2", &Base::fit_gravity_m_s2},
+      {"level_error_deg", &Base::level_error_deg},
+      {"heading_error_deg", &Base::heading_error_deg},
   };
   for (const Entry& e : kFields) {
     if (name == e.name) return &(b.*e.field);
@@ -145,7 +147,8 @@ const std::vector<std::string>& FactorNames() {
   static const std::vector<std::string> kNames = {
       "poses",   "still_s",  "turn_s",   "rate_hz",   "accel_noise", "gyro_noise",
       "accel_rw", "gyro_rw", "accel_bi", "gyro_bi",   "bi_time_s",   "temperature_rise_c",
-      "lat_deg", "height_m", "fit_lat_error_deg", "fit_gravity_m_s2"};
+      "lat_deg", "height_m", "fit_lat_error_deg", "fit_gravity_m_s2", "level_error_deg",
+      "heading_error_deg"};
   return kNames;
 }
 
@@ -180,10 +183,17 @@ Study ParseStudy(const json& doc, const std::string& path) {
       for (const auto& [k, v] : value.items()) {
         if (k == "model" && v.is_string()) {
           s.fit_model = v.get<std::string>();
+        } else if (k == "method" && v.is_string() &&
+                   (v.get<std::string>() == "generalized" || v.get<std::string>() == "paper_static" ||
+                    v.get<std::string>() == "paper_static_backend")) {
+          s.fit_method = v.get<std::string>();
         } else if (k == "constant_bias" && v.is_boolean()) {
           s.constant_bias = v.get<bool>();
         } else {
-          throw InputError(path, "key 'fit." + k + "'", "expected model (text) or constant_bias (true/false)");
+          throw InputError(path, "key 'fit." + k + "'",
+                           "expected method (generalized, paper_static or "
+                           "paper_static_backend), model (text) or "
+                           "constant_bias (true/false)");
         }
       }
     } else if (key != "factors") {
@@ -195,7 +205,16 @@ Study ParseStudy(const json& doc, const std::string& path) {
     if (!factors.is_array()) throw InputError(path, "key 'factors'", "expected a list");
     for (std::size_t i = 0; i < factors.size(); ++i) {
       s.factors.push_back(ReadFactor(factors[i], path, i, s.design));
+      const std::string& name = s.factors.back().name;
+      if ((name == "level_error_deg" || name == "heading_error_deg") &&
+          s.base.schedule != "paper_static") {
+        throw InputError(path, "key 'factors[" + std::to_string(i) + "].name'",
+                         name + " applies to the paper_static schedule (one level, x-north hold)");
+      }
     }
+  }
+  if (s.fit_method != "generalized" && s.base.schedule != "paper_static") {
+    throw InputError(path, "key 'fit.method'", s.fit_method + " needs the paper_static schedule");
   }
   return s;
 }

@@ -14,7 +14,7 @@
 //               "random_truth": 1,        scale of the random true parameters (sim/truth.h)
 //               "lat_deg": 51.64, "lon_deg": -1.2, "height_m": 100 },
 //     "simulate": "base",                 the model simulated (default: the fitted one)
-//     "fit": { "model": "base", "constant_bias": false },
+//     "fit": { "method": "generalized", "model": "base", "constant_bias": false },
 //     "factors": [ {"name": "poses", "levels": [6, 9, 12]},
 //                  {"name": "still_s", "range": [2, 30]} ] }   (a range: latin hypercube only)
 //
@@ -22,7 +22,9 @@
 // gyro_rw, accel_bi, gyro_bi, bi_time_s, temperature_rise_c, lat_deg, height_m (the site,
 // simulated and fitted), fit_lat_error_deg (the site the fit is given is off by this much in
 // latitude), fit_gravity_m_s2 (the fit uses this gravity instead of WGS84's at the site; 0:
-// WGS84), and truth.PARAMETER (a true parameter of the simulated model in its unit, e.g.
+// WGS84), level_error_deg and heading_error_deg (paper_static only: the true hold's tilt
+// about body y and its heading from north, while the fit assumes level, x north), and
+// truth.PARAMETER (a true parameter of the simulated model in its unit, e.g.
 // truth.gyro_g_sensitivity.G.xy). Each sets the field of the base of that name.
 #pragma once
 
@@ -54,6 +56,9 @@ struct Base {
   double accel_bi = kSensor, gyro_bi = kSensor;
   double bi_time_s = 30.0, temperature_rise_c = 10.0;
   double fit_lat_error_deg = 0.0, fit_gravity_m_s2 = 0.0;
+  /// paper_static only: the true hold is tilted about body y by level_error_deg and turned
+  /// from north by heading_error_deg, while the fit assumes level, x north.
+  double level_error_deg = 0.0, heading_error_deg = 0.0;
   /// truth.PARAMETER factors and the base's "truth" object: name -> value.
   std::vector<std::pair<std::string, double>> truth;
 };
@@ -69,6 +74,11 @@ struct Study {
   Base base;
   std::string simulate_model;  ///< the simulated model spec ("" = the fitted one)
   std::string fit_model = "base";
+  /// "generalized" (the backend, with sigma), "paper_static" (the seed paper's closed forms,
+  /// section 5, on the paper_static schedule: no sigma, so no NEES) or "paper_static_backend"
+  /// (the same procedure on the backend, the paper's constants held: with sigma;
+  /// paper/backend.h).
+  std::string fit_method = "generalized";
   bool constant_bias = false;
   std::vector<Factor> factors;
   nlohmann::json source;  ///< the study file as read (kept in every output)
