@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <regex>
 
 #include "plumb/core/error.h"
 #include "plumb/signal/chi_square.h"
@@ -24,6 +25,41 @@ std::string Csv(double v) {
   return buffer;
 }
 
+/// The runs with those whose rows differ from most runs' marked failed.
+std::vector<RunOutcome> PoolByShape(const std::vector<RunOutcome>& runs) {
+  // The rows are the parameters (or determined combinations, run.h) that most runs have, first
+  // seen first among equals; a run that determined other combinations cannot be pooled and
+  // counts as failed. Combinations are compared by their parameters and signs, not their
+  // printed coefficients.
+  const auto shape = [](const std::vector<std::string>& names) {
+    static const std::regex kNumber("[0-9]+(\\.[0-9]*)?(e[-+]?[0-9]+)?");
+    std::vector<std::string> out;
+    for (const std::string& n : names) out.push_back(std::regex_replace(n, kNumber, "#"));
+    return out;
+  };
+  std::vector<std::vector<std::string>> shapes;
+  std::size_t best = runs.size(), best_count = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    shapes.push_back(runs[i].failed ? std::vector<std::string>{} : shape(runs[i].names));
+    if (runs[i].failed) continue;
+    const auto count = static_cast<std::size_t>(std::count(shapes.begin(), shapes.end(), shapes[i]));
+    if (count > best_count) {
+      best_count = count;
+      best = i;
+    }
+  }
+  std::vector<RunOutcome> pooled = runs;
+  for (std::size_t i = 0; i < pooled.size(); ++i) {
+    RunOutcome& r = pooled[i];
+    if (!r.failed && shapes[i] != shapes[best]) {
+      r.failed = true;
+      r.failure = "the data determined other combinations of the parameters than most runs "
+                  "(an ill-conditioned design): not pooled";
+    }
+  }
+  return pooled;
+}
+
 }  // namespace
 
 PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs) {
@@ -32,7 +68,8 @@ PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs) 
   s.runs = static_cast<int>(runs.size());
   double nees_sum = 0.0, chi2_sum = 0.0;
   int chi2_n = 0;
-  for (const RunOutcome& r : runs) {
+  const std::vector<RunOutcome> pooled = PoolByShape(runs);
+  for (const RunOutcome& r : pooled) {
     s.failed += r.failed ? 1 : 0;
     s.flagged += r.flagged ? 1 : 0;
     if (r.failed && !r.failure.empty() &&

@@ -1,6 +1,7 @@
 // plumb/study/summary.h — what a study point's runs say, and the study's results.
 //
-// Per point: the runs, how many failed (the fit threw or did not converge) and how many were
+// Per point: the runs, how many failed (the fit threw or did not converge, or, where the rows
+// are determined combinations, a run determined other ones than the first) and how many were
 // flagged (a gate failed); per parameter over the runs that determined it: the mean and RMS of
 // the error against the truth, its standard deviation, and the mean reported sigma; and the
 // NEES per degree of freedom pooled over the runs, sum NEES / sum dof, with the 95 % band of
