@@ -1,4 +1,4 @@
-// plumb sweep STUDY.json --out DIR [--shard K/N] [--jobs N]
+// plumb sweep STUDY.json|yaml --out DIR [--shard K/N] [--jobs N]
 // plumb sweep merge DIR... --out DIR
 //
 // Runs a sensitivity study (plumb/study): every point of its design, its Monte Carlo runs in
@@ -17,6 +17,8 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+
+#include <yaml-cpp/yaml.h>
 
 #include "commands.h"
 #include "plumb/core/error.h"
@@ -39,6 +41,49 @@ struct SweepArgs {
   std::vector<std::string> merge_dirs;  ///< merge DIR...
   std::string merge_out;                ///< merge --out DIR
 };
+
+json ReadJsonFile(const std::string& path);
+
+/// A YAML node as JSON: mappings, sequences, and scalars as integers, numbers, true/false,
+/// null or text, in that order of trial.
+json FromYaml(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Map: {
+      json out = json::object();
+      for (const auto& item : node) out[item.first.as<std::string>()] = FromYaml(item.second);
+      return out;
+    }
+    case YAML::NodeType::Sequence: {
+      json out = json::array();
+      for (const auto& item : node) out.push_back(FromYaml(item));
+      return out;
+    }
+    case YAML::NodeType::Scalar: {
+      long long i = 0;
+      double d = 0.0;
+      bool b = false;
+      if (YAML::convert<long long>::decode(node, i)) return i;
+      if (YAML::convert<double>::decode(node, d)) return d;
+      if (YAML::convert<bool>::decode(node, b)) return b;
+      return node.as<std::string>();
+    }
+    default:
+      return nullptr;
+  }
+}
+
+/// The study file: YAML when its name ends in .yaml or .yml, else JSON.
+json ReadStudyFile(const std::string& path) {
+  const std::string ext = fs::path(path).extension().string();
+  if (ext != ".yaml" && ext != ".yml") return ReadJsonFile(path);
+  try {
+    return FromYaml(YAML::LoadFile(path));
+  } catch (const YAML::BadFile&) {
+    throw InputError(path, "", "cannot be read");
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
+  }
+}
 
 json ReadJsonFile(const std::string& path) {
   std::ifstream in(path);
@@ -105,8 +150,10 @@ class SweepCommand : public Command {
         "study's factors, fit it, and summarise the errors against the truth, the sigmas and "
         "the NEES per point (CSV and JSON)");
     SweepArgs& a = args_;
-    app_->add_option("STUDY", a.study_path, "The study file (JSON; see examples/studies/)")
-        ->type_name("STUDY.json");
+    app_->add_option("STUDY", a.study_path,
+                     "The study file: JSON, or YAML when it ends in .yaml or .yml (see "
+                     "examples/studies/)")
+        ->type_name("STUDY.json|yaml");
     app_->add_option("--out", a.out, "Folder for the results (created; a rerun resumes)")
         ->type_name("DIR");
     app_->add_option("--shard", a.shard,
@@ -127,7 +174,7 @@ class SweepCommand : public Command {
       throw UsageError("sweep needs a study file and --out DIR (or: sweep merge DIR... --out DIR)");
     }
     const auto [k, n] = ParseShard(a.shard);
-    const study::Study s = study::ParseStudy(ReadJsonFile(a.study_path), a.study_path);
+    const study::Study s = study::ParseStudy(ReadStudyFile(a.study_path), a.study_path);
     const std::vector<study::Point> points = study::DesignPoints(s);
     fs::create_directories(fs::path(a.out) / "points");
     report::WriteJson((fs::path(a.out) / "study.json").string(), s.source);

@@ -63,6 +63,23 @@ TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
   EXPECT_TRUE(Contains(missing.err, "point 1 is in none of the shards")) << missing.err;
 }
 
+TEST(SweepCli, AYamlStudyIsTheSameStudy) {
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  std::ofstream(at("s.json")) << kStudy;
+  std::ofstream(at("s.yaml")) << "name: t\nseed: 3\nruns: 3\ndesign: grid\n"
+                                 "base: {poses: 9, still_s: 3, turn_s: 2, rate_hz: 100}\n"
+                                 "factors:\n  - name: poses\n    levels: [9, 12, 15]\n";
+  ASSERT_EQ(Plumb({"sweep", at("s.json"), "--out", at("j")}, dir).exit_code, 0);
+  const ToolRun yaml = Plumb({"sweep", at("s.yaml"), "--out", at("y")}, dir);
+  ASSERT_EQ(yaml.exit_code, 0) << yaml.err;
+  EXPECT_EQ(ReadAll(at("y/results.csv")), ReadAll(at("j/results.csv")));
+  std::ofstream(at("bad.yaml")) << "runs: [1\n";
+  const ToolRun bad = Plumb({"sweep", at("bad.yaml"), "--out", at("b")}, dir);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_TRUE(Contains(bad.err, at("bad.yaml") + ":line 2: not valid YAML")) << bad.err;
+}
+
 TEST(SweepCli, BadStudiesAndOptionsAreSaid) {
   TempDir dir;
   auto at = [&](const char* name) { return (dir.path() / name).string(); };
