@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plumb/core/error.h"
 #include "plumb/residuals/bias_walk_residual.h"
 #include "plumb/residuals/manifolds.h"
 #include "plumb/residuals/motion_residual.h"
@@ -568,6 +569,17 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
   fit.velocity_segments = static_cast<int>(built.velocity.size());
   if (fit.velocity_segments > 0) {
     fit.rms_velocity = (ss_vel / static_cast<double>(fit.velocity_segments)).cwiseSqrt();
+  }
+}
+
+void CalibrationProblem::TakeValues(const CalibrationProblem& from) {
+  if (from.values_.size() != values_.size() || from.q_offset_ != q_offset_ ||
+      from.still_.poses.size() != still_.poses.size()) {
+    throw Error("calibration problem: TakeValues between problems of different layouts");
+  }
+  std::copy(from.values_.begin(), from.values_.end(), values_.begin());
+  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
+    if (still_.poses[k].known) std::copy(still_.poses[k].q.begin(), still_.poses[k].q.end(), q(k));
   }
 }
 

@@ -125,6 +125,11 @@ class CalibrationProblem {
   /// restart from the starting values, solve.h).
   void SaveValues();
   void RestoreValues();
+  /// Takes every unknown's value from `from` (a problem of the same model, segments and
+  /// wander), but for the attitudes this problem's poses know (held): what the same solution
+  /// looks like under this problem's assumptions (sensitivity.h). Throws plumb::Error when the
+  /// layouts differ.
+  void TakeValues(const CalibrationProblem& from);
   /// The processes the biases wander by (NoiseModel::Wander): BuiltProblem::walk_process
   /// indexes them.
   const std::vector<WanderProcess>& WanderProcesses() const { return wander_; }

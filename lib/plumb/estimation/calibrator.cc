@@ -10,6 +10,7 @@
 #include "plumb/estimation/advice.h"
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/covariance.h"
+#include "plumb/estimation/fitted_problem.h"
 #include "plumb/estimation/gates.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
@@ -58,13 +59,9 @@ int CountDistinctOrientations(const std::vector<Vec3>& acc_means, double min_ang
   return static_cast<int>(reps.size());
 }
 
-// The method, as docs/reference/model.md describes it: the still set, the noise model,
-// starting values, the problem, the solve with a gauge for unobservable directions, the
-// covariance, the fit's residuals and chi^2, and what the data cannot determine.
-CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegment>& segments,
-                            const model::Model& model_in, const geo::Site& site,
-                            const CalibrationOptions& options) {
-  CalibrationResult result;
+FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                         const model::Model& model_in, const geo::Site& site,
+                         const CalibrationOptions& options, CalibrationResult& result) {
   Calibration& cal = result.calibration;
   FitReport& fit = result.fit;
   cal.method = options.method;
@@ -78,12 +75,12 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   const bool earth_rate_seen = site.known && cal.has_gyro && options.use_still_gyro;
   const bool motion_on = options.use_motion && cal.has_gyro;
   StillSet still = MakeStillSet(series, segments, earth_rate_seen, motion_on, options);
-  NoiseModel noise = EstimateNoise(series, still, cal.has_gyro, options);
+  FittedProblem out;
+  out.noise = EstimateNoise(series, still, cal.has_gyro, options);
   model::ParameterBlocks theta = cal.model.ZeroParameters();
-  const StartingValues start = Initialize(series, cal.model, site.gravity(), cal.has_gyro,
-                                          options.first_heading_deg, still, theta);
+  out.start = Initialize(series, cal.model, site.gravity(), cal.has_gyro,
+                         options.first_heading_deg, still, theta);
   AssignHeadingGauge(still, cal.has_gyro);
-  std::string implausible_walk;
   if (options.ModelsWander()) {
     // 2a. The wander's levels: given, from the still data's Allan deviation, or typical;
     // 2b. the walk estimated over the fit (opt-in).
@@ -92,23 +89,40 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
         MeasureStillNoise(series, still, options.instability_time_s, fit.notes);
     if (own) measured.push_back(&*own);
     for (const signal::StillNoise& other : options.other_still_noise) measured.push_back(&other);
-    WanderLevels levels =
-        AssignWanderLevels(noise, measured, start, cal.has_gyro, series.duration_s(), options);
-    noise = levels.noise;
+    WanderLevels levels = AssignWanderLevels(out.noise, measured, out.start, cal.has_gyro,
+                                             series.duration_s(), options);
+    out.noise = levels.noise;
     fit.notes.insert(fit.notes.end(), levels.notes.begin(), levels.notes.end());
     WalkEstimate wander =
-        ResolveWander(series, cal.model, site, still, theta, noise, start, options);
-    noise = wander.noise;
+        ResolveWander(series, cal.model, site, still, theta, out.noise, out.start, options);
+    out.noise = wander.noise;
     fit.notes.insert(fit.notes.end(), wander.notes.begin(), wander.notes.end());
     fit.warnings.insert(fit.warnings.end(), wander.warnings.begin(), wander.warnings.end());
-    implausible_walk = wander.implausible;
+    out.implausible_walk = wander.implausible;
   }
-  cal.noise = noise.Levels();
+  cal.noise = out.noise.Levels();
 
-  // 4. The problem; 5. the solve; then the analysis of the solution with every unknown free.
-  CalibrationProblem problem(series, cal.model, site, std::move(still), std::move(theta), noise,
-                             start, options);
-  Solution solution = SolveWithGauge(problem, options, fit);
+  // 4. The problem; 5. the solve (the problem stays where Ceres points into its values).
+  out.problem = std::make_unique<CalibrationProblem>(series, cal.model, site, std::move(still),
+                                                     std::move(theta), out.noise, out.start,
+                                                     options);
+  out.solution = SolveWithGauge(*out.problem, options, fit);
+  return out;
+}
+
+// The method, as docs/reference/model.md describes it: the still set, the noise model,
+// starting values, the problem, the solve with a gauge for unobservable directions (stages
+// 1-5, FitProblem), then the analysis of the solution with every unknown free, the
+// covariance, the fit's residuals and chi^2, and what the data cannot determine.
+CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                            const model::Model& model_in, const geo::Site& site,
+                            const CalibrationOptions& options) {
+  CalibrationResult result;
+  FittedProblem fitted = FitProblem(series, segments, model_in, site, options, result);
+  CalibrationProblem& problem = *fitted.problem;
+  Solution& solution = fitted.solution;
+  Calibration& cal = result.calibration;
+  FitReport& fit = result.fit;
   UnknownColumns columns;
   double cost = 0;
   std::vector<double> residual_values;
@@ -137,7 +151,9 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
     fit.probes = problem.ProbeColumns(problem.Build({}, true), columns);
   }
   fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
-  if (!implausible_walk.empty()) fit.gates.push_back(Gate{"implausible_walk", implausible_walk});
+  if (!fitted.implausible_walk.empty()) {
+    fit.gates.push_back(Gate{"implausible_walk", fitted.implausible_walk});
+  }
   return result;
 }
 

@@ -1,0 +1,38 @@
+// plumb/estimation/fitted_problem.h — stages 1-5 of the backend (calibrator.cc): the problem
+// at its solution, for the stages after it (Calibrate's analysis, sensitivity.h).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "plumb/core/imu_series.h"
+#include "plumb/core/segment.h"
+#include "plumb/estimation/calibration_problem.h"
+#include "plumb/estimation/initialization.h"
+#include "plumb/estimation/noise_model.h"
+#include "plumb/estimation/options.h"
+#include "plumb/estimation/result.h"
+#include "plumb/estimation/solve.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+
+namespace plumb::estimation {
+
+struct FittedProblem {
+  /// On the heap: the Ceres problems of `solution` point into its values.
+  std::unique_ptr<CalibrationProblem> problem;
+  Solution solution;
+  NoiseModel noise;        ///< the noise the residuals are whitened with (stage 2)
+  StartingValues start;    ///< stage 3
+  std::string implausible_walk;  ///< the walk estimate's gate message, or ""
+};
+
+/// Stages 1-5 of Calibrate (the still set, the noise model and the wander's levels, starting
+/// values, the problem, the solve with its gauge); fills `result`'s method, site, model,
+/// units, noise, notes and warnings.
+FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                         const model::Model& model, const geo::Site& site,
+                         const CalibrationOptions& options, CalibrationResult& result);
+
+}  // namespace plumb::estimation
