@@ -228,7 +228,8 @@ class SweepCommand : public Command {
       if (++done[i] == runs) {
 #pragma omp critical(sweep_write)
         {
-          const study::PointSummary summary = study::Summarise(todo[i], outcomes[i]);
+          const study::PointSummary summary =
+              study::Summarise(todo[i], outcomes[i], study::SensitivityFactors(s));
           report::WriteJson(PointPath(args_.out, todo[i].index), study::PointJson(s, summary));
           std::cout << PointLine(s, summary) << "\n" << std::flush;
           if (progress) std::cerr << "\r" << i + 1 << " of " << todo.size() << " points" << std::flush;

@@ -129,6 +129,41 @@ TEST(Study, AMissingEffectShowsAsBias) {
   EXPECT_GT(sum.mean_chi2_dof, 2.0);
 }
 
+TEST(Study, AnalyticSensitivityAgreesWithMonteCarloFiniteDifferences) {
+  // The fit told a gravity about 0.05 m/s^2 below and above the truth (9.7803 at the site), 8 runs
+  // each: (mean error at g + 0.05 - mean error at g - 0.05) / 0.1 against the runs' mean
+  // analytic d/dg, within 4 of the finite difference's Monte Carlo standard errors.
+  json doc = Small(8);
+  doc["base"]["poses"] = 12;
+  doc["base"]["lat_deg"] = 6.67;
+  doc["base"]["lon_deg"] = -1.57;
+  doc["base"]["height_m"] = 250;
+  const double g = 9.7806849;  // near WGS84 normal gravity there (geo/site.h)
+  doc["factors"] = json::array({{{"name", "fit_gravity_m_s2"}, {"levels", {g - 0.05, g + 0.05}}}});
+  const Study s = ParseStudy(doc, "s.json");
+  ASSERT_EQ(SensitivityFactors(s), std::vector<std::string>{"fit_gravity_m_s2"});
+  std::vector<PointSummary> points;
+  for (const Point& p : DesignPoints(s)) {
+    std::vector<RunOutcome> runs;
+    for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
+    points.push_back(Summarise(p, runs, SensitivityFactors(s)));
+  }
+  int compared = 0;
+  for (std::size_t i = 0; i < points[0].parameters.size(); ++i) {
+    const ParameterSummary& lo = points[0].parameters[i];
+    const ParameterSummary& hi = points[1].parameters[i];
+    const double fd = (hi.mean_error - lo.mean_error) / 0.1;
+    const double se = std::hypot(lo.sd_error, hi.sd_error) / std::sqrt(s.runs) / 0.1;
+    const double analytic = 0.5 * (lo.mean_d_dp[0] + hi.mean_d_dp[0]);
+    EXPECT_LT(std::abs(fd - analytic), 4.0 * se + 1e-9) << lo.name << ": fd " << fd << ", analytic "
+                                                         << analytic << ", se " << se;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 21);
+  // The scale: about -F / g per m/s^2.
+  EXPECT_NEAR(points[0].parameters[0].mean_d_dp[0], -1.0 / g, 0.05 / g);
+}
+
 TEST(Study, PointsRoundTripThroughJson) {
   const Study s = ParseStudy(Small(2), "s.json");
   const Point p = DesignPoints(s)[0];

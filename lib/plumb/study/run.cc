@@ -7,6 +7,7 @@
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/sensitivity.h"
 #include "plumb/paper/backend.h"
 #include "plumb/paper/static_procedure.h"
 #include "plumb/sim/schedule.h"
@@ -170,7 +171,51 @@ void PaperStatic(const sim::Simulation& s, const std::vector<StillSegment>& segm
   }
 }
 
+/// The sensitivities of the study's fit-side factors at the run's fit (run.h).
+std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const Base& b,
+                                                      const sim::Simulation& s,
+                                                      const std::vector<StillSegment>& segments,
+                                                      const geo::Site& site,
+                                                      const model::Model& fitted,
+                                                      const estimation::CalibrationOptions& options) {
+  std::vector<estimation::AssumptionChange> changes;
+  for (const std::string& name : SensitivityFactors(study)) {
+    estimation::AssumptionChange c{name, 0.0, site, site, segments, segments};
+    if (name == "fit_gravity_m_s2") {
+      c.step = 0.01;  // m/s^2
+      c.site_minus.g_n = Vec3(0.0, 0.0, site.gravity() - c.step);
+      c.site_plus.g_n = Vec3(0.0, 0.0, site.gravity() + c.step);
+    } else {
+      c.step = 0.5;  // deg
+      const double lat = b.lat_deg + b.fit_lat_error_deg;
+      c.site_minus = geo::Site::At(lat - c.step, b.lon_deg, b.height_m, "study");
+      c.site_plus = geo::Site::At(lat + c.step, b.lon_deg, b.height_m, "study");
+      if (b.fit_gravity_m_s2 > 0.0) {
+        c.site_minus.g_n = c.site_plus.g_n = Vec3(0.0, 0.0, b.fit_gravity_m_s2);
+      }
+    }
+    changes.push_back(c);
+  }
+  std::vector<std::vector<double>> out;
+  if (changes.empty()) return out;
+  const estimation::Sensitivities S =
+      estimation::AssumptionSensitivity(s.session.series, segments, fitted, site, options, changes);
+  for (Eigen::Index c = 0; c < S.d_dp.cols(); ++c) {
+    out.emplace_back(S.d_dp.col(c).data(), S.d_dp.col(c).data() + S.d_dp.rows());
+  }
+  return out;
+}
+
 }  // namespace
+
+std::vector<std::string> SensitivityFactors(const Study& study) {
+  std::vector<std::string> out;
+  if (study.fit_method != "generalized") return out;
+  for (const Factor& f : study.factors) {
+    if (f.name == "fit_gravity_m_s2" || f.name == "fit_lat_error_deg") out.push_back(f.name);
+  }
+  return out;
+}
 
 RunOutcome RunOnce(const Study& study, const Point& point, int run) {
   const Base b = Apply(study, point);
@@ -227,6 +272,7 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
       out.failure = "not converged";
     }
     Score(result, s, fitted, out);
+    out.d_dp = FitSideSensitivities(study, b, s, segments, site, fitted, options);
   } catch (const Error& e) {
     out.failed = true;
     out.failure = e.what();

@@ -35,7 +35,15 @@ struct RunOutcome {
   double nees = std::numeric_limits<double>::quiet_NaN();
   int nees_dof = 0;  ///< parameters in the NEES
   double chi2_dof = std::numeric_limits<double>::quiet_NaN();
+  /// The analytic sensitivity of every parameter (rows as `names`) to each of the study's
+  /// fit-side factors (SensitivityFactors), estimation/sensitivity.h: d_dp[f][i], per unit of
+  /// the factor. Empty unless the study has such factors and the method is generalized.
+  std::vector<std::vector<double>> d_dp;
 };
+
+/// The study's factors whose analytic sensitivity a run computes: fit_gravity_m_s2 and
+/// fit_lat_error_deg (what the fit is told, not what is simulated), in Study::factors order.
+std::vector<std::string> SensitivityFactors(const Study& study);
 
 /// Run `run` of `point` (file comment). Never throws for a failed fit (failed, failure say
 /// it); throws plumb::Error for a study that cannot be simulated (an unknown model spec or

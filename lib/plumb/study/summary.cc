@@ -62,13 +62,15 @@ std::vector<RunOutcome> PoolByShape(const std::vector<RunOutcome>& runs) {
 
 }  // namespace
 
-PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs) {
+PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs,
+                       const std::vector<std::string>& sensitivity_factors) {
   PointSummary s;
   s.point = point;
   s.runs = static_cast<int>(runs.size());
   double nees_sum = 0.0, chi2_sum = 0.0;
   int chi2_n = 0;
   const std::vector<RunOutcome> pooled = PoolByShape(runs);
+  std::vector<int> d_dp_runs;  // per parameter and factor: runs with a sensitivity
   for (const RunOutcome& r : pooled) {
     s.failed += r.failed ? 1 : 0;
     s.flagged += r.flagged ? 1 : 0;
@@ -88,7 +90,17 @@ PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs) 
     }
     if (s.parameters.empty()) {
       for (std::size_t i = 0; i < r.names.size(); ++i) {
-        s.parameters.push_back(ParameterSummary{r.names[i], r.units[i], 0, 0.0, 0.0, 0.0, 0.0});
+        s.parameters.push_back(ParameterSummary{r.names[i], r.units[i], 0, 0.0, 0.0, 0.0, 0.0,
+                                                {}});
+      }
+      for (ParameterSummary& p : s.parameters) p.mean_d_dp.assign(sensitivity_factors.size(), 0.0);
+      d_dp_runs.assign(s.parameters.size() * sensitivity_factors.size(), 0);
+    }
+    for (std::size_t f = 0; f < r.d_dp.size() && f < sensitivity_factors.size(); ++f) {
+      for (std::size_t i = 0; i < r.d_dp[f].size() && i < s.parameters.size(); ++i) {
+        if (!std::isfinite(r.d_dp[f][i]) || r.d_dp[f].size() != s.parameters.size()) continue;
+        s.parameters[i].mean_d_dp[f] += r.d_dp[f][i];
+        ++d_dp_runs[i * sensitivity_factors.size() + f];
       }
     }
     for (std::size_t i = 0; i < r.error.size() && i < s.parameters.size(); ++i) {
@@ -98,6 +110,12 @@ PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs) 
       p.mean_error += r.error[i];
       p.rms_error += r.error[i] * r.error[i];
       p.mean_sigma += r.sigma[i];
+    }
+  }
+  for (std::size_t i = 0; i < s.parameters.size(); ++i) {
+    for (std::size_t f = 0; f < sensitivity_factors.size(); ++f) {
+      const int n = d_dp_runs[i * sensitivity_factors.size() + f];
+      s.parameters[i].mean_d_dp[f] = n > 0 ? s.parameters[i].mean_d_dp[f] / n : kNaN;
     }
   }
   for (ParameterSummary& p : s.parameters) {
@@ -125,9 +143,12 @@ PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs) 
 json PointJson(const Study& study, const PointSummary& s) {
   json params = json::array();
   for (const ParameterSummary& p : s.parameters) {
+    json d_dp = json::array();
+    for (double v : p.mean_d_dp) d_dp.push_back(Num(v));
     params.push_back({{"name", p.name}, {"unit", p.unit}, {"runs", p.runs},
                       {"mean_error", Num(p.mean_error)}, {"rms_error", Num(p.rms_error)},
-                      {"sd_error", Num(p.sd_error)}, {"mean_sigma", Num(p.mean_sigma)}});
+                      {"sd_error", Num(p.sd_error)}, {"mean_sigma", Num(p.mean_sigma)},
+                      {"mean_d_dp", d_dp}});
   }
   json nees = json::array();
   for (double v : s.nees) nees.push_back(Num(v));
@@ -170,10 +191,12 @@ PointSummary PointFromJson(const Study& study, const json& doc, const std::strin
     s.mean_chi2_dof = FromNum(doc.at("mean_chi2_dof"));
     for (const json& v : doc.at("nees_per_run")) s.nees.push_back(FromNum(v));
     for (const json& p : doc.at("parameters")) {
+      std::vector<double> d_dp;
+      for (const json& v : p.at("mean_d_dp")) d_dp.push_back(FromNum(v));
       s.parameters.push_back(ParameterSummary{
           p.at("name").get<std::string>(), p.at("unit").get<std::string>(), p.at("runs").get<int>(),
           FromNum(p.at("mean_error")), FromNum(p.at("rms_error")), FromNum(p.at("sd_error")),
-          FromNum(p.at("mean_sigma"))});
+          FromNum(p.at("mean_sigma")), d_dp});
     }
     return s;
   } catch (const json::exception& e) {
@@ -185,21 +208,28 @@ std::string ResultsCsv(const Study& study, const std::vector<PointSummary>& poin
   std::string out = "point";
   for (const Factor& f : study.factors) out += "," + f.name;
   out += ",parameter,unit,runs,failed,flagged,mean_error,rms_error,sd_error,mean_sigma,"
-         "nees_per_dof,nees_low,nees_high,mean_chi2_dof\n";
+         "nees_per_dof,nees_low,nees_high,mean_chi2_dof";
+  const std::vector<std::string> sensitivity = SensitivityFactors(study);
+  for (const std::string& f : sensitivity) out += ",d_" + f;
+  out += "\n";
   for (const PointSummary& s : points) {
     std::string head = std::to_string(s.point.index);
     for (double v : s.point.values) head += "," + Csv(v);
     const std::string tail = "," + Csv(s.nees_per_dof) + "," + Csv(s.nees_low) + "," +
-                             Csv(s.nees_high) + "," + Csv(s.mean_chi2_dof) + "\n";
+                             Csv(s.nees_high) + "," + Csv(s.mean_chi2_dof);
     for (const ParameterSummary& p : s.parameters) {
       out += head + "," + p.name + "," + p.unit + "," + std::to_string(p.runs) + "," +
              std::to_string(s.failed) + "," + std::to_string(s.flagged) + "," +
              Csv(p.mean_error) + "," + Csv(p.rms_error) + "," + Csv(p.sd_error) + "," +
              Csv(p.mean_sigma) + tail;
+      for (std::size_t f = 0; f < sensitivity.size(); ++f) {
+        out += "," + (f < p.mean_d_dp.size() ? Csv(p.mean_d_dp[f]) : std::string());
+      }
+      out += "\n";
     }
     if (s.parameters.empty()) {  // every run failed: one row that says so
       out += head + ",,," + std::to_string(0) + "," + std::to_string(s.failed) + "," +
-             std::to_string(s.flagged) + ",,,," + tail;
+             std::to_string(s.flagged) + ",,,," + tail + std::string(sensitivity.size(), ',') + "\n";
     }
   }
   return out;
@@ -208,13 +238,15 @@ std::string ResultsCsv(const Study& study, const std::vector<PointSummary>& poin
 json ResultsJson(const Study& study, const std::vector<PointSummary>& points) {
   json factors = json::array();
   for (const Factor& f : study.factors) factors.push_back(f.name);
+  const std::vector<std::string> sensitivity = SensitivityFactors(study);
   json list = json::array();
   for (const PointSummary& s : points) {
     json p = PointJson(study, s);
     p.erase("study");
     list.push_back(p);
   }
-  return json{{"study", study.source}, {"factors", factors}, {"points", list}};
+  return json{{"study", study.source}, {"factors", factors},
+              {"sensitivity_factors", sensitivity}, {"points", list}};
 }
 
 }  // namespace plumb::study

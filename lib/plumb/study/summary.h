@@ -5,7 +5,9 @@
 // flagged (a gate failed); per parameter over the runs that determined it: the mean and RMS of
 // the error against the truth, its standard deviation, and the mean reported sigma; and the
 // NEES per degree of freedom pooled over the runs, sum NEES / sum dof, with the 95 % band of
-// chi^2(sum dof) / sum dof that honest sigmas put it in.
+// chi^2(sum dof) / sum dof that honest sigmas put it in; and for the study's fit-side factors
+// (the gravity and latitude the fit is told), the mean analytic sensitivity of each parameter
+// (estimation/sensitivity.h).
 //
 // A point is stored as JSON (PointJson, read back by PointFromJson), the unit a shard writes
 // and a merge joins; the results (ResultsCsv: one row per point and parameter; ResultsJson)
@@ -26,6 +28,9 @@ struct ParameterSummary {
   std::string name, unit;
   int runs = 0;  ///< runs that determined it
   double mean_error = 0.0, rms_error = 0.0, sd_error = 0.0, mean_sigma = 0.0;
+  /// Mean analytic sensitivity to each of the study's fit-side factors (run.h), per unit of
+  /// the factor, in SensitivityFactors order; NaN where no run gave one.
+  std::vector<double> mean_d_dp;
 };
 
 struct PointSummary {
@@ -40,7 +45,9 @@ struct PointSummary {
   std::vector<std::string> failures;  ///< distinct failure messages, first seen first
 };
 
-PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs);
+/// `sensitivity_factors`: SensitivityFactors(study), the columns of the runs' d_dp.
+PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs,
+                       const std::vector<std::string>& sensitivity_factors = {});
 
 /// A point as JSON, with the study it belongs to (Study::source) so that a merge or a resume
 /// can tell points of another study apart.
@@ -51,7 +58,7 @@ PointSummary PointFromJson(const Study& study, const nlohmann::json& doc, const 
 
 /// One row per point and parameter: point, the factors' values, parameter, unit, runs,
 /// failed, flagged, mean_error, rms_error, sd_error, mean_sigma, nees_per_dof, nees_low,
-/// nees_high, mean_chi2_dof. Points in index order.
+/// nees_high, mean_chi2_dof, then d_FACTOR per fit-side factor (run.h). Points in index order.
 std::string ResultsCsv(const Study& study, const std::vector<PointSummary>& points);
 nlohmann::json ResultsJson(const Study& study, const std::vector<PointSummary>& points);
 
