@@ -6,7 +6,8 @@
 // are done (a rerun resumes: points already written are kept), then DIR/results.csv and
 // DIR/results.json from the point files. With --shard K/N only the points whose index is K-1
 // modulo N are run and the results are left to `sweep merge`, which joins the shards' points
-// into the same files, byte for byte, as one unsharded run.
+// into the same files, byte for byte, as one unsharded run. With the results, DIR/index.html
+// and its figures (plumb/report/study_page.h, drawn by gnuplot).
 #include <omp.h>
 #include <unistd.h>
 
@@ -23,7 +24,9 @@
 #include "commands.h"
 #include "plumb/core/error.h"
 #include "plumb/io/common/atomic_file.h"
+#include "plumb/report/gnuplot.h"
 #include "plumb/report/json_report.h"
+#include "plumb/report/study_page.h"
 #include "plumb/study/run.h"
 #include "plumb/study/summary.h"
 
@@ -123,6 +126,11 @@ void WriteResults(const study::Study& s, const std::vector<study::Point>& points
   }
   io::WriteFileAtomic((fs::path(dir) / "results.csv").string(), study::ResultsCsv(s, summaries));
   report::WriteJson((fs::path(dir) / "results.json").string(), study::ResultsJson(s, summaries));
+  // The page and its figures (gnuplot; without it the page says so and the data stay).
+  const report::GnuplotOutcome drawn = report::RunGnuplot(dir, report::StudyFigures(s, summaries));
+  io::WriteFileAtomic((fs::path(dir) / "index.html").string(),
+                      report::StudyPage(s, summaries, drawn.written, drawn.ran ? "" : drawn.message));
+  if (!drawn.ran) std::cerr << "warning: no figures: " << drawn.message << "\n";
 }
 
 std::string PointLine(const study::Study& s, const study::PointSummary& p) {
@@ -197,7 +205,8 @@ class SweepCommand : public Command {
     RunPoints(s, todo);
     if (n == 1) {
       WriteResults(s, points, a.out);
-      std::cout << "wrote " << (fs::path(a.out) / "results.csv").string() << " and results.json\n";
+      std::cout << "wrote " << (fs::path(a.out) / "results.csv").string()
+                << ", results.json and index.html\n";
     } else {
       std::cout << "shard " << a.shard << " done; join the shards with 'plumb sweep merge DIR... "
                    "--out DIR'\n";
@@ -269,7 +278,7 @@ class SweepCommand : public Command {
     WriteResults(s, points, a.merge_out);
     std::cout << "merged " << points.size() << " points from " << a.merge_dirs.size()
               << " folders; wrote " << (fs::path(a.merge_out) / "results.csv").string()
-              << " and results.json\n";
+              << ", results.json and index.html\n";
     return 0;
   }
 

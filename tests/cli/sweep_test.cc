@@ -48,6 +48,11 @@ TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
   const ToolRun merged = Plumb({"sweep", "merge", at("shard1"), at("shard2"), "--out", at("merged")}, dir);
   ASSERT_EQ(merged.exit_code, 0) << merged.err;
   EXPECT_EQ(Files(dir.path() / "merged"), Files(dir.path() / "whole"));
+  // The page and its figures (gnuplot is part of the set-up).
+  const std::string page = ReadAll(at("whole/index.html"));
+  EXPECT_TRUE(Contains(page, "<h1>plumb sweep: t</h1>")) << page;
+  EXPECT_TRUE(Contains(page, "<img src=\"nees_poses.png\"")) << page;
+  EXPECT_TRUE(fs::exists(dir.path() / "whole/error_poses.png"));
   const std::string csv = ReadAll(at("whole/results.csv"));
   EXPECT_TRUE(Contains(csv, "point,poses,parameter,unit,runs,failed,flagged,mean_error")) << csv;
   EXPECT_TRUE(Contains(csv, "\n2,15,gyro.bias.z,rad/s,3,0,")) << csv;

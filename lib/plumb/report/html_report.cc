@@ -528,6 +528,8 @@ std::string TailSection(const estimation::CalibrationResult& r, const PageExtras
 
 }  // namespace
 
+const char* PageStyle() { return kStyle; }
+
 std::string HtmlEscape(std::string_view text) {
   std::string out;
   out.reserve(text.size());

@@ -65,6 +65,9 @@ struct PageExtras {
 /// Escapes & < > " ' for HTML text and attribute values; invalid UTF-8 passes unchanged.
 std::string HtmlEscape(std::string_view text);
 
+/// The CSS of plumb's pages (the calibration report, the study page).
+const char* PageStyle();
+
 /// The whole page. `diagnosis` may be null (not run); `segmentation` is how the still
 /// segments were found; `analysis` is AnalyseResiduals of `result`.
 std::string HtmlReport(const InputSummary& input,

@@ -1,0 +1,143 @@
+#include "plumb/report/study_page.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "plumb/report/html_report.h"
+#include "plumb/report/version.h"
+
+namespace plumb::report {
+namespace {
+
+/// Rows drawn against each factor: the first four of the point's rows (the accelerometer's
+/// scale and cross terms come first in the base model; combinations when one pose).
+constexpr std::size_t kHeadline = 4;
+
+std::string Num(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char b[40];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+std::string Short(double v, const char* format = "%.3g") {
+  if (!std::isfinite(v)) return "n/a";
+  char b[40];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+/// The points along factor f: every other factor at the first point's value, sorted by f.
+std::vector<const study::PointSummary*> Along(const std::vector<study::PointSummary>& points,
+                                              std::size_t f) {
+  std::vector<const study::PointSummary*> out;
+  if (points.empty()) return out;
+  const std::vector<double>& base = points.front().point.values;
+  for (const study::PointSummary& p : points) {
+    bool others = true;
+    for (std::size_t g = 0; g < base.size(); ++g) others = others && (g == f || p.point.values[g] == base[g]);
+    if (others) out.push_back(&p);
+  }
+  std::sort(out.begin(), out.end(), [f](const auto* a, const auto* b) {
+    return a->point.values[f] < b->point.values[f];
+  });
+  return out;
+}
+
+std::string Safe(const std::string& name) {
+  std::string out;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
+}  // namespace
+
+GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::PointSummary>& points) {
+  GnuplotJob job;
+  job.script_name = "study.gp";
+  job.log_name = "study.log";
+  job.script = PngTerminal(800, 480) + "set datafile separator ','\nset grid\nset key outside right\n";
+  for (std::size_t f = 0; f < study.factors.size(); ++f) {
+    const auto along = Along(points, f);
+    if (along.size() < 2) continue;
+    const std::string name = study.factors[f].name, safe = Safe(name);
+    // NEES per degree of freedom with its band.
+    std::string nees = "value,nees_per_dof,low,high\n";
+    for (const auto* p : along) {
+      nees += Num(p->point.values[f]) + "," + Num(p->nees_per_dof) + "," + Num(p->nees_low) + "," +
+              Num(p->nees_high) + "\n";
+    }
+    job.data.push_back({"nees_" + safe + ".csv", nees});
+    job.script += "set output 'nees_" + safe + ".png'\nset logscale y\nset xlabel " +
+                  GnuplotQuote(name) + "\nset ylabel 'NEES / dof'\nset title " +
+                  GnuplotQuote("NEES per degree of freedom against " + name + " (95 % band)") +
+                  "\nplot 'nees_" + safe + ".csv' every ::1 using 1:3 with lines dt 2 lc rgb '#2e7d32' title 'band', " +
+                  "'' every ::1 using 1:4 with lines dt 2 lc rgb '#2e7d32' notitle, " +
+                  "'' every ::1 using 1:2 with linespoints pt 7 lc rgb '#1565c0' title 'NEES / dof'\n";
+    job.outputs.push_back("nees_" + safe + ".png");
+    // RMS error and mean sigma of the headline rows.
+    const std::size_t rows = std::min(kHeadline, along.front()->parameters.size());
+    if (rows == 0) continue;
+    std::string err = "value";
+    for (std::size_t i = 0; i < rows; ++i) err += ",rms" + std::to_string(i) + ",sigma" + std::to_string(i);
+    err += "\n";
+    for (const auto* p : along) {
+      err += Num(p->point.values[f]);
+      for (std::size_t i = 0; i < rows; ++i) {
+        const bool has = i < p->parameters.size();
+        err += "," + Num(has ? p->parameters[i].rms_error : NAN) + "," +
+               Num(has ? p->parameters[i].mean_sigma : NAN);
+      }
+      err += "\n";
+    }
+    job.data.push_back({"error_" + safe + ".csv", err});
+    job.script += "set output 'error_" + safe + ".png'\nset ylabel 'RMS error (points), mean sigma (dashed)'\nset title " +
+                  GnuplotQuote("error and sigma against " + name) + "\nplot ";
+    for (std::size_t i = 0; i < rows; ++i) {
+      const std::string label = along.front()->parameters[i].name;
+      const std::string col = std::to_string(2 + 2 * i);
+      const std::string sig = std::to_string(3 + 2 * i);
+      job.script += std::string(i ? ", " : "") + "'error_" + safe + ".csv' every ::1 using 1:" + col +
+                    " with points pt 7 lc " + std::to_string(i + 1) + " title " + GnuplotQuote(label) +
+                    ", '' every ::1 using 1:" + sig + " with lines dt 2 lc " + std::to_string(i + 1) +
+                    " notitle";
+    }
+    job.script += "\nunset logscale y\n";
+    job.outputs.push_back("error_" + safe + ".png");
+  }
+  return job;
+}
+
+std::string StudyPage(const study::Study& study, const std::vector<study::PointSummary>& points,
+                      const std::vector<std::string>& figures, const std::string& figure_note) {
+  std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>plumb sweep: " +
+                     HtmlEscape(study.name) + "</title><style>" + PageStyle() +
+                     "</style></head><body>\n<h1>plumb sweep: " + HtmlEscape(study.name) + "</h1>\n";
+  html += "<p class=\"muted\">plumb " + HtmlEscape(Version()) + "; " + std::to_string(points.size()) +
+          " points x " + std::to_string(study.runs) + " runs, seed " + std::to_string(study.seed) +
+          ", method " + HtmlEscape(study.fit_method) + ", fitted model " + HtmlEscape(study.fit_model) +
+          ". The numbers are in results.csv and results.json beside this page.</p>\n";
+  html += "<h2>Points</h2>\n<table><tr><th>point</th>";
+  for (const study::Factor& f : study.factors) html += "<th>" + HtmlEscape(f.name) + "</th>";
+  html += "<th>runs</th><th>failed</th><th>flagged</th><th>NEES / dof</th><th>95 % band</th></tr>\n";
+  for (const study::PointSummary& p : points) {
+    const bool outside = p.nees_dof > 0 && (p.nees_per_dof > p.nees_high || p.nees_per_dof < p.nees_low);
+    html += "<tr><td class=\"num\">" + std::to_string(p.point.index) + "</td>";
+    for (double v : p.point.values) html += "<td class=\"num\">" + Short(v, "%.6g") + "</td>";
+    html += "<td class=\"num\">" + std::to_string(p.runs) + "</td><td class=\"num\">" +
+            std::to_string(p.failed) + "</td><td class=\"num\">" + std::to_string(p.flagged) +
+            "</td><td class=\"num" + std::string(outside ? " warn" : "") + "\">" +
+            (p.nees_dof > 0 ? Short(p.nees_per_dof, "%.3f") : "n/a") + "</td><td class=\"num\">" +
+            (p.nees_dof > 0 ? Short(p.nees_low, "%.3f") + " .. " + Short(p.nees_high, "%.3f") : "") +
+            "</td></tr>\n";
+  }
+  html += "</table>\n<h2>Figures</h2>\n";
+  if (!figure_note.empty()) html += "<p class=\"warn\">No figures: " + HtmlEscape(figure_note) + "</p>\n";
+  for (const std::string& fig : figures) {
+    html += "<figure><img src=\"" + HtmlEscape(fig) + "\" alt=\"" + HtmlEscape(fig) + "\"></figure>\n";
+  }
+  return html + "</body></html>\n";
+}
+
+}  // namespace plumb::report
