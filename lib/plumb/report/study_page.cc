@@ -62,20 +62,23 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
     const auto along = Along(points, f);
     if (along.size() < 2) continue;
     const std::string name = study.factors[f].name, safe = Safe(name);
-    // NEES per degree of freedom with its band.
+    // NEES per degree of freedom with its band (none for closed forms: no sigma). gnuplot
+    // stops at a plot with no defined point, so such series are left out.
+    const bool any_nees = std::any_of(along.begin(), along.end(),
+                                      [](const auto* p) { return std::isfinite(p->nees_per_dof); });
     std::string nees = "value,nees_per_dof,low,high\n";
     for (const auto* p : along) {
       nees += Num(p->point.values[f]) + "," + Num(p->nees_per_dof) + "," + Num(p->nees_low) + "," +
               Num(p->nees_high) + "\n";
     }
-    job.data.push_back({"nees_" + safe + ".csv", nees});
-    job.script += "set output 'nees_" + safe + ".png'\nset logscale y\nset xlabel " +
+    if (any_nees) job.data.push_back({"nees_" + safe + ".csv", nees});
+    if (any_nees) job.script += "set output 'nees_" + safe + ".png'\nset logscale y\nset xlabel " +
                   GnuplotQuote(name) + "\nset ylabel 'NEES / dof'\nset title " +
                   GnuplotQuote("NEES per degree of freedom against " + name + " (95 % band)") +
                   "\nplot 'nees_" + safe + ".csv' every ::1 using 1:3 with lines dt 2 lc rgb '#2e7d32' title 'band', " +
                   "'' every ::1 using 1:4 with lines dt 2 lc rgb '#2e7d32' notitle, " +
                   "'' every ::1 using 1:2 with linespoints pt 7 lc rgb '#1565c0' title 'NEES / dof'\n";
-    job.outputs.push_back("nees_" + safe + ".png");
+    if (any_nees) job.outputs.push_back("nees_" + safe + ".png");
     // RMS error and mean sigma of the headline rows.
     const std::size_t rows = std::min(kHeadline, along.front()->parameters.size());
     if (rows == 0) continue;
@@ -94,15 +97,33 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
     job.data.push_back({"error_" + safe + ".csv", err});
     job.script += "set output 'error_" + safe + ".png'\nset ylabel 'RMS error (points), mean sigma (dashed)'\nset title " +
                   GnuplotQuote("error and sigma against " + name) + "\nplot ";
+    auto defined = [&](std::size_t i, bool sigma) {
+      return std::any_of(along.begin(), along.end(), [&](const auto* p) {
+        return i < p->parameters.size() &&
+               std::isfinite(sigma ? p->parameters[i].mean_sigma : p->parameters[i].rms_error);
+      });
+    };
+    std::string plots;
     for (std::size_t i = 0; i < rows; ++i) {
       const std::string label = along.front()->parameters[i].name;
       const std::string col = std::to_string(2 + 2 * i);
       const std::string sig = std::to_string(3 + 2 * i);
-      job.script += std::string(i ? ", " : "") + "'error_" + safe + ".csv' every ::1 using 1:" + col +
-                    " with points pt 7 lc " + std::to_string(i + 1) + " title " + GnuplotQuote(label) +
-                    ", '' every ::1 using 1:" + sig + " with lines dt 2 lc " + std::to_string(i + 1) +
-                    " notitle";
+      const std::string lc = " lc " + std::to_string(i + 1);
+      if (defined(i, false)) {
+        plots += std::string(plots.empty() ? "" : ", ") + "'error_" + safe + ".csv' every ::1 using 1:" +
+                 col + " with points pt 7" + lc + " title " + GnuplotQuote(label);
+      }
+      if (defined(i, true)) {
+        plots += std::string(plots.empty() ? "" : ", ") + "'error_" + safe + ".csv' every ::1 using 1:" +
+                 sig + " with lines dt 2" + lc + " notitle";
+      }
     }
+    if (plots.empty()) {  // nothing determined along this factor
+      job.data.pop_back();
+      job.script.resize(job.script.rfind("set output 'error_"));
+      continue;
+    }
+    job.script += plots;
     job.script += "\nunset logscale y\n";
     job.outputs.push_back("error_" + safe + ".png");
   }

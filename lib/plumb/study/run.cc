@@ -9,6 +9,7 @@
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/sensitivity.h"
 #include "plumb/paper/backend.h"
+#include "plumb/paper/benchmark.h"
 #include "plumb/paper/static_procedure.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
@@ -138,11 +139,10 @@ void Score(const estimation::CalibrationResult& result, const sim::Simulation& s
   }
 }
 
-/// The seed paper's closed forms (section 5) on the one hold: values only, no sigma.
-void PaperStatic(const sim::Simulation& s, const std::vector<StillSegment>& segments,
-                 const geo::Site& site, const model::Model& fitted, RunOutcome& out) {
-  const paper::PaperStaticResult r = paper::CalibratePaperStatic(
-      s.session.series, segments.front().begin, segments.front().end, site, {});
+/// A closed form's forward-form answer (F, b_a, E, b_g) scored against the truth by the
+/// fitted model's names: values only, no sigma.
+void ClosedForm(const Mat3& F, const Vec3& b_a, const Mat3& E, const Vec3& b_g,
+                const sim::Simulation& s, const model::Model& fitted, RunOutcome& out) {
   const std::vector<std::string> sim_names = s.model.ParameterNames();
   const std::vector<double> sim_values = model::ReportedValues(s.model, s.truth);
   const std::vector<double> nominal = model::ReportedValues(fitted, fitted.ZeroParameters());
@@ -155,10 +155,9 @@ void PaperStatic(const sim::Simulation& s, const std::vector<StillSegment>& segm
     const bool matrix = name.find(".matrix.") != std::string::npos;
     double value = kNaN;
     if (matrix && tail.size() == 2) {
-      const Mat3& M = acc ? r.F : r.E;
-      value = M(tail[0] - 'x', tail[1] - 'x');
+      value = (acc ? F : E)(tail[0] - 'x', tail[1] - 'x');
     } else if (name.find(".bias.") != std::string::npos && tail.size() == 1) {
-      value = (acc ? r.b_a : r.b_g)[tail[0] - 'x'];
+      value = (acc ? b_a : b_g)[tail[0] - 'x'];
     }
     double truth = nominal[i];
     for (std::size_t j = 0; j < sim_names.size(); ++j) {
@@ -169,6 +168,24 @@ void PaperStatic(const sim::Simulation& s, const std::vector<StillSegment>& segm
     out.error.push_back(value - truth);
     out.sigma.push_back(kNaN);
   }
+}
+
+/// The seed paper's closed forms: section 5 on the one hold, or section 4 on the benchmark
+/// schedule (its turns the gaps between holds of the same pose).
+void PaperClosedForm(const Study& study, const sim::Simulation& s,
+                     const std::vector<StillSegment>& segments, const geo::Site& site,
+                     const model::Model& fitted, RunOutcome& out) {
+  if (study.fit_method == "paper_static") {
+    const paper::PaperStaticResult r = paper::CalibratePaperStatic(
+        s.session.series, segments.front().begin, segments.front().end, site, {});
+    ClosedForm(r.F, r.b_a, r.E, r.b_g, s, fitted, out);
+    return;
+  }
+  paper::PaperBenchmarkOptions options;
+  options.gravity_m_s2 = site.gravity();
+  const paper::PaperBenchmarkResult r =
+      paper::CalibratePaperBenchmark(s.session.series, segments, {}, options);
+  ClosedForm(r.F, r.b_a, r.E, r.b_g, s, fitted, out);
 }
 
 /// The sensitivities of the study's fit-side factors at the run's fit (run.h).
@@ -253,9 +270,9 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
     }
     return out;
   }
-  if (study.fit_method == "paper_static") {
+  if (study.fit_method == "paper_static" || study.fit_method == "paper_benchmark") {
     try {
-      PaperStatic(s, segments, site, fitted, out);
+      PaperClosedForm(study, s, segments, site, fitted, out);
     } catch (const Error& e) {
       out.failed = true;
       out.failure = e.what();

@@ -185,14 +185,15 @@ Study ParseStudy(const json& doc, const std::string& path) {
           s.fit_model = v.get<std::string>();
         } else if (k == "method" && v.is_string() &&
                    (v.get<std::string>() == "generalized" || v.get<std::string>() == "paper_static" ||
-                    v.get<std::string>() == "paper_static_backend")) {
+                    v.get<std::string>() == "paper_static_backend" ||
+                    v.get<std::string>() == "paper_benchmark")) {
           s.fit_method = v.get<std::string>();
         } else if (k == "constant_bias" && v.is_boolean()) {
           s.constant_bias = v.get<bool>();
         } else {
           throw InputError(path, "key 'fit." + k + "'",
-                           "expected method (generalized, paper_static or "
-                           "paper_static_backend), model (text) or "
+                           "expected method (generalized, paper_static, paper_static_backend "
+                           "or paper_benchmark), model (text) or "
                            "constant_bias (true/false)");
         }
       }
@@ -213,8 +214,9 @@ Study ParseStudy(const json& doc, const std::string& path) {
       }
     }
   }
-  if (s.fit_method != "generalized" && s.base.schedule != "paper_static") {
-    throw InputError(path, "key 'fit.method'", s.fit_method + " needs the paper_static schedule");
+  const std::string needs = s.fit_method == "paper_benchmark" ? "paper_benchmark" : "paper_static";
+  if (s.fit_method != "generalized" && s.base.schedule != needs) {
+    throw InputError(path, "key 'fit.method'", s.fit_method + " needs the " + needs + " schedule");
   }
   return s;
 }

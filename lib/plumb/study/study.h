@@ -77,7 +77,8 @@ struct Study {
   /// "generalized" (the backend, with sigma), "paper_static" (the seed paper's closed forms,
   /// section 5, on the paper_static schedule: no sigma, so no NEES) or "paper_static_backend"
   /// (the same procedure on the backend, the paper's constants held: with sigma;
-  /// paper/backend.h).
+  /// paper/backend.h), or "paper_benchmark" (the paper's section 4 closed forms on the
+  /// paper_benchmark schedule: values only).
   std::string fit_method = "generalized";
   bool constant_bias = false;
   std::vector<Factor> factors;
