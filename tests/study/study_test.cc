@@ -186,6 +186,38 @@ TEST(Study, ThePapersClosedFormsLeaveTheNorthEarthRateInTheXGyroBias) {
   EXPECT_NE(ErrorOf(doc).find("paper_benchmark needs the paper_benchmark schedule"), std::string::npos);
 }
 
+TEST(Study, TheBiasAMissingEffectLeavesIsPredicted) {
+  // A g-sensitive gyroscope (G.zy) fitted with the base model: the analytic bias per unit of
+  // G.zy (from the effect's probe columns) against the finite difference of two runs that
+  // differ in G.zy only (the same point index and run: the same seed, poses and noise).
+  json doc = Small(1);
+  doc["base"]["poses"] = 12;
+  doc["base"]["lat_deg"] = 6.67;
+  doc["simulate"] = "base+gyro_g_sensitivity";
+  doc["factors"] = json::array({{{"name", "truth.gyro_g_sensitivity.G.zy"}, {"levels", {0.0}}}});
+  const Study s = ParseStudy(doc, "s.json");
+  ASSERT_EQ(SensitivityFactors(s), std::vector<std::string>{"truth.gyro_g_sensitivity.G.zy"});
+  constexpr double kD = 1e-4;
+  for (int run = 0; run < 3; ++run) {
+    const RunOutcome minus = RunOnce(s, Point{0, {-kD}}, run);
+    const RunOutcome plus = RunOnce(s, Point{0, {kD}}, run);
+    ASSERT_FALSE(minus.failed || plus.failed);
+    ASSERT_EQ(plus.d_dp.size(), 1U);
+    double scale = 0.0, worst = 0.0;
+    std::string worst_name;
+    for (std::size_t i = 0; i < plus.names.size(); ++i) {
+      const double fd = (plus.error[i] - minus.error[i]) / (2.0 * kD);
+      const double analytic = 0.5 * (plus.d_dp[0][i] + minus.d_dp[0][i]);
+      scale = std::max(scale, std::abs(analytic));
+      if (std::abs(fd - analytic) > worst) {
+        worst = std::abs(fd - analytic);
+        worst_name = plus.names[i];
+      }
+    }
+    EXPECT_LT(worst, 0.05 * scale) << "run " << run << ": " << worst_name << ", scale " << scale;
+  }
+}
+
 TEST(Study, PointsRoundTripThroughJson) {
   const Study s = ParseStudy(Small(2), "s.json");
   const Point p = DesignPoints(s)[0];

@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 
 #include "plumb/core/error.h"
@@ -188,6 +190,51 @@ void PaperClosedForm(const Study& study, const sim::Simulation& s,
   ClosedForm(r.F, r.b_a, r.E, r.b_g, s, fitted, out);
 }
 
+/// The effect of a true parameter's name ("gyro_g_sensitivity.G.zy" -> gyro_g_sensitivity;
+/// a temperature term's order from its coefficient: ".c2." -> ":2").
+std::pair<std::string, std::string> EffectOf(const std::string& parameter) {
+  const std::string effect = parameter.substr(0, parameter.find('.'));
+  std::string option;
+  for (const char* order : {"3", "2"}) {
+    if (option.empty() && parameter.find(std::string(".c") + order + ".") != std::string::npos) {
+      option = order;
+    }
+  }
+  return {effect, option};
+}
+
+/// For a truth.PARAMETER factor whose effect the fitted model lacks: the bias the missing
+/// effect leaves in every fitted parameter per unit of it, (J^T J)^+ J^T Z at the fit with
+/// the effect added as a probe (held at zero: the same fit), J the whitened Jacobian over the
+/// unknowns and Z the probe's columns (the residuals are measured minus predicted, so data
+/// carrying the effect move them by -Z per unit). Empty when the rows are not the fitted
+/// model's parameters one by one.
+std::vector<double> MissingEffectSensitivity(const std::string& parameter, const sim::Simulation& s,
+                                             const std::vector<StillSegment>& segments,
+                                             const geo::Site& site, const model::Model& fitted,
+                                             const estimation::CalibrationOptions& options,
+                                             const std::vector<std::string>& rows) {
+  model::Model probe = fitted;
+  const auto [effect, option] = EffectOf(parameter);
+  probe.AddProbe(effect, option);
+  const estimation::CalibrationResult r =
+      estimation::Calibrate(s.session.series, segments, probe, site, options);
+  if (!r.fit.probes) throw Error("study: the fit gave no probe columns for '" + parameter + "'");
+  const estimation::ProbeJacobian& pj = *r.fit.probes;
+  const auto col = std::find(pj.probe_names.begin(), pj.probe_names.end(), parameter);
+  if (col == pj.probe_names.end()) throw Error("study: '" + parameter + "' is not a probe's parameter");
+  const Eigen::VectorXd z = pj.Z.col(col - pj.probe_names.begin());
+  const Eigen::VectorXd d = pj.J.completeOrthogonalDecomposition().solve(z);
+  std::vector<double> out(rows.size(), kNaN);
+  for (std::size_t c = 0; c < pj.unknown_names.size(); ++c) {
+    const auto row = std::find(rows.begin(), rows.end(), pj.unknown_names[c]);
+    if (pj.unknown_is_model[c] && row != rows.end()) {
+      out[static_cast<std::size_t>(row - rows.begin())] = d[static_cast<Eigen::Index>(c)];
+    }
+  }
+  return out;
+}
+
 /// The sensitivities of the study's fit-side factors at the run's fit (run.h).
 std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const Base& b,
                                                       const sim::Simulation& s,
@@ -197,6 +244,7 @@ std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const 
                                                       const estimation::CalibrationOptions& options) {
   std::vector<estimation::AssumptionChange> changes;
   for (const std::string& name : SensitivityFactors(study)) {
+    if (name.rfind("truth.", 0) == 0) continue;  // below
     estimation::AssumptionChange c{name, 0.0, site, site, segments, segments};
     if (name == "fit_gravity_m_s2") {
       c.step = 0.01;  // m/s^2
@@ -213,12 +261,24 @@ std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const 
     }
     changes.push_back(c);
   }
+  std::vector<std::vector<double>> assumed;
+  if (!changes.empty()) {
+    const estimation::Sensitivities S = estimation::AssumptionSensitivity(
+        s.session.series, segments, fitted, site, options, changes);
+    for (Eigen::Index c = 0; c < S.d_dp.cols(); ++c) {
+      assumed.emplace_back(S.d_dp.col(c).data(), S.d_dp.col(c).data() + S.d_dp.rows());
+    }
+  }
+  // In SensitivityFactors order: the fit-side changes, then the missing effects.
   std::vector<std::vector<double>> out;
-  if (changes.empty()) return out;
-  const estimation::Sensitivities S =
-      estimation::AssumptionSensitivity(s.session.series, segments, fitted, site, options, changes);
-  for (Eigen::Index c = 0; c < S.d_dp.cols(); ++c) {
-    out.emplace_back(S.d_dp.col(c).data(), S.d_dp.col(c).data() + S.d_dp.rows());
+  std::size_t next = 0;
+  for (const std::string& name : SensitivityFactors(study)) {
+    if (name.rfind("truth.", 0) == 0) {
+      out.push_back(MissingEffectSensitivity(name.substr(6), s, segments, site, fitted, options,
+                                             fitted.ParameterNames()));
+    } else {
+      out.push_back(assumed[next++]);
+    }
   }
   return out;
 }
@@ -228,8 +288,13 @@ std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const 
 std::vector<std::string> SensitivityFactors(const Study& study) {
   std::vector<std::string> out;
   if (study.fit_method != "generalized") return out;
+  const model::Model fitted = model::Model::Parse(study.fit_model);
   for (const Factor& f : study.factors) {
     if (f.name == "fit_gravity_m_s2" || f.name == "fit_lat_error_deg") out.push_back(f.name);
+    // A true parameter of an effect the fit lacks: the bias it leaves (MissingEffectSensitivity).
+    if (f.name.rfind("truth.", 0) == 0 && !fitted.FindParameter(f.name.substr(6))) {
+      out.push_back(f.name);
+    }
   }
   return out;
 }

@@ -41,8 +41,10 @@ struct RunOutcome {
   std::vector<std::vector<double>> d_dp;
 };
 
-/// The study's factors whose analytic sensitivity a run computes: fit_gravity_m_s2 and
-/// fit_lat_error_deg (what the fit is told, not what is simulated), in Study::factors order.
+/// The study's factors whose analytic sensitivity a run computes, in Study::factors order:
+/// fit_gravity_m_s2 and fit_lat_error_deg (what the fit is told; estimation/sensitivity.h),
+/// and truth.PARAMETER of an effect the fitted model lacks (the bias a missing effect leaves
+/// per unit of it, from the effect's probe columns).
 std::vector<std::string> SensitivityFactors(const Study& study);
 
 /// Run `run` of `point` (file comment). Never throws for a failed fit (failed, failure say
