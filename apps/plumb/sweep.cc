@@ -182,7 +182,14 @@ class SweepCommand : public Command {
       throw UsageError("sweep needs a study file and --out DIR (or: sweep merge DIR... --out DIR)");
     }
     const auto [k, n] = ParseShard(a.shard);
-    const study::Study s = study::ParseStudy(ReadStudyFile(a.study_path), a.study_path);
+    study::Study s = study::ParseStudy(ReadStudyFile(a.study_path), a.study_path);
+    if (!s.base.template_path.empty()) {
+      // A session template: relative to the study file's folder.
+      fs::path t = s.base.template_path;
+      if (t.is_relative()) t = fs::path(a.study_path).parent_path() / t;
+      s.template_document = ReadJsonFile(t.string());
+      s.base.template_path = t.string();
+    }
     const std::vector<study::Point> points = study::DesignPoints(s);
     fs::create_directories(fs::path(a.out) / "points");
     report::WriteJson((fs::path(a.out) / "study.json").string(), s.source);

@@ -85,6 +85,25 @@ TEST(SweepCli, AYamlStudyIsTheSameStudy) {
   EXPECT_TRUE(Contains(bad.err, at("bad.yaml") + ":line 2: not valid YAML")) << bad.err;
 }
 
+TEST(SweepCli, ARealSessionIsTheTemplate) {
+  // mikoff's imu0 (bundled): calibrate it, then simulate its poses and timing with known truth.
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
+  ASSERT_EQ(Plumb({"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz", "--rate", "100", "--json",
+                   at("imu0.json")}, dir).exit_code, 0);
+  std::ofstream(at("s.json")) << R"({"seed": 1, "runs": 3, "design": "grid",
+    "base": {"schedule": "session", "template": "imu0.json", "rate_hz": 100},
+    "factors": [{"name": "gyro_noise", "levels": [7e-5]}]})";
+  const ToolRun run = Plumb({"sweep", at("s.json"), "--out", at("o")}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "3 runs, 0 failed")) << run.out;
+  std::ofstream(at("none.json")) << R"({"base": {"schedule": "session"}})";
+  const ToolRun none = Plumb({"sweep", at("none.json"), "--out", at("o2")}, dir);
+  EXPECT_EQ(none.exit_code, 1);
+  EXPECT_TRUE(Contains(none.err, "the session schedule takes a template")) << none.err;
+}
+
 TEST(SweepCli, BadStudiesAndOptionsAreSaid) {
   TempDir dir;
   auto at = [&](const char* name) { return (dir.path() / name).string(); };

@@ -218,6 +218,32 @@ TEST(Study, TheBiasAMissingEffectLeavesIsPredicted) {
   }
 }
 
+TEST(Study, ASessionIsATemplateOfPosesAndTiming) {
+  // Three segments at 100 Hz (t_mid and sample indices), level, then x down, then y down:
+  // holds of 2, 3 and 1 s joined by turns lasting the gaps (1 s, and 0.5 s at least).
+  const json doc = {{"segments",
+                     {{{"begin", 0}, {"end", 200}, {"t_mid_s", 1.0}, {"attitude_quaternion_wxyz", {1, 0, 0, 0}}},
+                      {{"begin", 300}, {"end", 600}, {"t_mid_s", 4.5},
+                       {"attitude_quaternion_wxyz", {std::sqrt(0.5), 0, std::sqrt(0.5), 0}}},
+                      {{"begin", 600}, {"end", 700}, {"t_mid_s", 6.5},
+                       {"attitude_quaternion_wxyz", {std::sqrt(0.5), std::sqrt(0.5), 0, 0}}}}}};
+  const sim::Schedule sched = TemplateSchedule(doc, "t.json");
+  ASSERT_EQ(sched.size(), 5U);  // hold, turn, hold, turn, hold
+  EXPECT_NEAR(sched.step_duration_s(0), 2.0, 1e-9);
+  EXPECT_NEAR(sched.step_duration_s(1), 1.0, 1e-9);
+  EXPECT_NEAR(sched.step_duration_s(2), 3.0, 1e-9);
+  EXPECT_NEAR(sched.step_duration_s(3), 0.5, 1e-9);
+  EXPECT_NEAR(sched.step_duration_s(4), 1.0, 1e-9);
+  EXPECT_LT(sched.end_R_n_b().angularDistance(Quat(std::sqrt(0.5), std::sqrt(0.5), 0, 0)), 1e-9);
+  const json bad = {{"segments", {{{"begin", 0}}}}};
+  try {
+    TemplateSchedule(bad, "t.json");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.json"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Study, PointsRoundTripThroughJson) {
   const Study s = ParseStudy(Small(2), "s.json");
   const Point p = DesignPoints(s)[0];

@@ -46,7 +46,8 @@ sim::SimulationOptions SensorOf(const Base& b, const model::Model& model, std::u
   return o;
 }
 
-sim::Schedule ScheduleOf(const Base& b, std::uint64_t seed) {
+sim::Schedule ScheduleOf(const Study& study, const Base& b, std::uint64_t seed) {
+  if (b.schedule == "session") return TemplateSchedule(study.template_document, b.template_path);
   if (b.schedule == "paper_static") {
     // The hold as it truly is: turned from north, then tilted about body y (study.h).
     const Quat R_n_b =
@@ -285,6 +286,42 @@ std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const 
 
 }  // namespace
 
+sim::Schedule TemplateSchedule(const nlohmann::json& doc, const std::string& path) {
+  struct Hold {
+    Quat R_n_b;
+    double begin, end, t_mid;
+  };
+  std::vector<Hold> holds;
+  const nlohmann::json* segments = doc.is_object() && doc.contains("segments") ? &doc.at("segments") : nullptr;
+  if (segments == nullptr || !segments->is_array() || segments->size() < 2) {
+    throw InputError(path, "key 'segments'", "a session template needs the still segments of "
+                                             "'plumb calibrate --json' (2 or more)");
+  }
+  for (std::size_t k = 0; k < segments->size(); ++k) {
+    const nlohmann::json& seg = segments->at(k);
+    const std::string where = "key 'segments[" + std::to_string(k) + "]'";
+    try {
+      const auto q = seg.at("attitude_quaternion_wxyz").get<std::vector<double>>();
+      if (q.size() != 4) throw InputError(path, where, "expected attitude_quaternion_wxyz [w, x, y, z]");
+      holds.push_back({Quat(q[0], q[1], q[2], q[3]).normalized(), seg.at("begin").get<double>(),
+                       seg.at("end").get<double>(), seg.at("t_mid_s").get<double>()});
+    } catch (const nlohmann::json::exception&) {
+      throw InputError(path, where, "expected attitude_quaternion_wxyz, begin, end and t_mid_s");
+    }
+  }
+  const Hold& first = holds.front();
+  const Hold& last = holds.back();
+  const double samples = 0.5 * ((last.begin + last.end) - (first.begin + first.end));
+  const double dt = samples > 0.0 ? (last.t_mid - first.t_mid) / samples : 0.0;
+  if (!(dt > 0.0)) throw InputError(path, "key 'segments'", "cannot tell the sample interval");
+  sim::Schedule schedule(first.R_n_b);
+  for (std::size_t k = 0; k < holds.size(); ++k) {
+    if (k > 0) schedule.TurnTo(holds[k].R_n_b, std::max(0.5, (holds[k].begin - holds[k - 1].end) * dt));
+    schedule.Hold(std::max(dt, (holds[k].end - holds[k].begin) * dt), "template still #" + std::to_string(k + 1));
+  }
+  return schedule;
+}
+
 std::vector<std::string> SensitivityFactors(const Study& study) {
   std::vector<std::string> out;
   if (study.fit_method != "generalized") return out;
@@ -304,7 +341,7 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
   const std::uint64_t seed = RunSeed(study.seed, point.index, run);
   const model::Model sim_model =
       model::Model::Parse(study.simulate_model.empty() ? study.fit_model : study.simulate_model);
-  const sim::Simulation s = sim::Simulate(ScheduleOf(b, seed), SensorOf(b, sim_model, seed));
+  const sim::Simulation s = sim::Simulate(ScheduleOf(study, b, seed), SensorOf(b, sim_model, seed));
   std::vector<StillSegment> segments = s.truth_segments;
   for (auto& seg : segments) {
     // Unknown attitudes, but on the paper's static design: level, x north, as assumed.

@@ -57,9 +57,10 @@ void ReadBase(const json& b, const std::string& path, Base& base) {
   if (!b.is_object()) throw InputError(path, "key 'base'", "expected an object");
   for (const auto& [key, value] : b.items()) {
     const std::string where = "base." + key;
-    if (key == "schedule" || key == "sensor") {
+    if (key == "schedule" || key == "sensor" || key == "template") {
       if (!value.is_string()) throw InputError(path, "key '" + where + "'", "expected a name");
-      (key == "schedule" ? base.schedule : base.sensor) = value.get<std::string>();
+      (key == "schedule" ? base.schedule : key == "sensor" ? base.sensor : base.template_path) =
+          value.get<std::string>();
     } else if (key == "random_truth") {
       base.random_truth = Number(value, path, where);
     } else if (key == "lon_deg") {
@@ -75,10 +76,16 @@ void ReadBase(const json& b, const std::string& path, Base& base) {
       throw InputError(path, "key '" + where + "'", "not a field of the base");
     }
   }
-  const std::vector<std::string> schedules = {"multipose", "paper_static", "paper_benchmark"};
+  const std::vector<std::string> schedules = {"multipose", "paper_static", "paper_benchmark",
+                                              "session"};
   if (std::find(schedules.begin(), schedules.end(), base.schedule) == schedules.end()) {
     throw InputError(path, "key 'base.schedule'",
-                     "expected multipose, paper_static or paper_benchmark");
+                     "expected multipose, paper_static, paper_benchmark or session");
+  }
+  if ((base.schedule == "session") != !base.template_path.empty()) {
+    throw InputError(path, "key 'base.template'",
+                     "the session schedule takes a template (a 'plumb calibrate --json' file), "
+                     "and only it");
   }
   if (base.sensor != "typical" && base.sensor != "white") {
     throw InputError(path, "key 'base.sensor'", "expected typical or white");

@@ -8,7 +8,8 @@
 //     "seed": 1,                          the study seed (every run's seed derives from it)
 //     "runs": 20,                         Monte Carlo runs per point, >= 1
 //     "design": "grid",                   "grid" | "one_at_a_time" | {"latin_hypercube": N}
-//     "base": { "schedule": "multipose",  "multipose" | "paper_static" | "paper_benchmark"
+//     "base": { "schedule": "multipose",  "multipose" | "paper_static" | "paper_benchmark" |
+//                                         "session" (with "template": a calibrate --json file)
 //               "poses": 12, "still_s": 5, "turn_s": 2, "rate_hz": 100,
 //               "sensor": "typical",      "typical" (white, instability, walk, warming) | "white"
 //               "random_truth": 1,        scale of the random true parameters (sim/truth.h)
@@ -45,7 +46,7 @@ struct Factor {
 
 /// The base of every point; each factor overrides its field.
 struct Base {
-  std::string schedule = "multipose";  ///< multipose | paper_static | paper_benchmark
+  std::string schedule = "multipose";  ///< multipose | paper_static | paper_benchmark | session
   double poses = 12, still_s = 5, turn_s = 2, rate_hz = 100;
   std::string sensor = "typical";  ///< typical | white
   double random_truth = 1.0;
@@ -59,6 +60,10 @@ struct Base {
   /// paper_static only: the true hold is tilted about body y by level_error_deg and turned
   /// from north by heading_error_deg, while the fit assumes level, x north.
   double level_error_deg = 0.0, heading_error_deg = 0.0;
+  /// schedule "session": the path of a `plumb calibrate --json` document whose still
+  /// segments (their fitted attitudes, lengths and the gaps between them) are the poses and
+  /// timing (TemplateSchedule).
+  std::string template_path;
   /// truth.PARAMETER factors and the base's "truth" object: name -> value.
   std::vector<std::pair<std::string, double>> truth;
 };
@@ -83,6 +88,9 @@ struct Study {
   bool constant_bias = false;
   std::vector<Factor> factors;
   nlohmann::json source;  ///< the study file as read (kept in every output)
+  /// schedule "session": the calibrate document at base.template_path, loaded by the caller
+  /// (the library reads no files); see TemplateSchedule.
+  nlohmann::json template_document;
 };
 
 /// The factor names a study may use besides truth.PARAMETER.
