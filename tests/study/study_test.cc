@@ -31,6 +31,13 @@ json Small(int runs = 4) {
               {"factors", json::array({{{"name", "poses"}, {"levels", {9, 12}}}})}};
 }
 
+/// Every run of `p` summarised.
+PointSummary RunPoint(const Study& s, const Point& p) {
+  std::vector<RunOutcome> runs;
+  for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
+  return Summarise(p, runs, SensitivityFactors(s));
+}
+
 TEST(Study, ErrorsNameTheFileAndTheKey) {
   json bad = Small();
   bad["factors"][0]["name"] = "posses";
@@ -98,10 +105,7 @@ TEST(Study, SigmasAreHonestWhereTheFitContainsTheSimulation) {
   doc["base"]["still_s"] = 5;
   doc["factors"] = json::array();
   const Study s = ParseStudy(doc, "s.json");
-  const Point p = DesignPoints(s).front();
-  std::vector<RunOutcome> runs;
-  for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
-  const PointSummary sum = Summarise(p, runs);
+  const PointSummary sum = RunPoint(s, DesignPoints(s).front());
   EXPECT_EQ(sum.failed, 0);
   EXPECT_EQ(sum.nees_dof, 40 * 21);
   EXPECT_GT(sum.nees_per_dof, sum.nees_low);
@@ -121,10 +125,7 @@ TEST(Study, AMissingEffectShowsAsBias) {
   doc["base"]["truth"] = {{"gyro_g_sensitivity.G.zy", 2e-4}};
   doc["factors"] = json::array();
   const Study s = ParseStudy(doc, "s.json");
-  const Point p = DesignPoints(s).front();
-  std::vector<RunOutcome> runs;
-  for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
-  const PointSummary sum = Summarise(p, runs);
+  const PointSummary sum = RunPoint(s, DesignPoints(s).front());
   EXPECT_GT(sum.nees_per_dof, sum.nees_high);
   EXPECT_GT(sum.mean_chi2_dof, 2.0);
 }
@@ -143,11 +144,7 @@ TEST(Study, AnalyticSensitivityAgreesWithMonteCarloFiniteDifferences) {
   const Study s = ParseStudy(doc, "s.json");
   ASSERT_EQ(SensitivityFactors(s), std::vector<std::string>{"fit_gravity_m_s2"});
   std::vector<PointSummary> points;
-  for (const Point& p : DesignPoints(s)) {
-    std::vector<RunOutcome> runs;
-    for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
-    points.push_back(Summarise(p, runs, SensitivityFactors(s)));
-  }
+  for (const Point& p : DesignPoints(s)) points.push_back(RunPoint(s, p));
   int compared = 0;
   for (std::size_t i = 0; i < points[0].parameters.size(); ++i) {
     const ParameterSummary& lo = points[0].parameters[i];
@@ -173,10 +170,7 @@ TEST(Study, ThePapersClosedFormsLeaveTheNorthEarthRateInTheXGyroBias) {
   doc["fit"] = {{"method", "paper_benchmark"}};
   doc["factors"] = json::array();
   const Study s = ParseStudy(doc, "s.json");
-  const Point p = DesignPoints(s).front();
-  std::vector<RunOutcome> runs;
-  for (int r = 0; r < s.runs; ++r) runs.push_back(RunOnce(s, p, r));
-  const PointSummary sum = Summarise(p, runs);
+  const PointSummary sum = RunPoint(s, DesignPoints(s).front());
   ASSERT_EQ(sum.failed, 0) << (sum.failures.empty() ? "" : sum.failures.front());
   EXPECT_EQ(sum.nees_dof, 0);  // no sigma, no NEES
   for (const ParameterSummary& q : sum.parameters) {

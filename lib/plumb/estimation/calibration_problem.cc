@@ -14,6 +14,18 @@
 namespace plumb::estimation {
 namespace {
 
+/// Adds the diagonal of M diag(v) M^T to the variances behind `sqrt_info` (1 / sigma).
+void AddVariance(Vec3& sqrt_info, const Mat3& M, const Vec3& v) {
+  const Mat3 cov = M * v.asDiagonal() * M.transpose();
+  for (int i = 0; i < 3; ++i) {
+    sqrt_info[i] = 1.0 / std::sqrt(1.0 / (sqrt_info[i] * sqrt_info[i]) + cov(i, i));
+  }
+}
+
+}  // namespace
+
+namespace {
+
 /// Shortest time a bias-walk factor spans, s: keeps its weight finite where two instants
 /// coincide.
 constexpr double kMinWalkSpan_s = 1e-3;
@@ -152,22 +164,10 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
     // (exact for T << tau; turns last seconds, correlation times tens of seconds and more).
     const double T = series_.t_s[mo.last] - series_.t_s[mo.first];
     for (std::size_t p : WanderOf(model::Sensor::kGyro)) {
-      const WanderProcess& w = wander_[p];
-      const Vec3 K2 = w.kind == WanderProcess::Kind::kWalk
-                          ? Vec3(w.level.cwiseAbs2())
-                          : Vec3(w.level.cwiseAbs2() * (2.0 / w.tau_s));
-      const Mat3 cov_bridge = E_inv * (K2 * (T * T * T / 12.0)).asDiagonal() * E_inv.transpose();
-      for (int i = 0; i < 3; ++i) {
-        const double var = 1.0 / (motion_samples_[k].sqrt_info[i] * motion_samples_[k].sqrt_info[i]);
-        motion_samples_[k].sqrt_info[i] = 1.0 / std::sqrt(var + cov_bridge(i, i));
-      }
+      AddVariance(motion_samples_[k].sqrt_info, E_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
     }
     // Quantisation: the integrated angle carries 2 Q^2 (noise_model.h).
-    const Mat3 cov_q = E_inv * (2.0 * noise_.quantisation_gyr.cwiseAbs2()).asDiagonal() * E_inv.transpose();
-    for (int i = 0; i < 3; ++i) {
-      const double var = 1.0 / (motion_samples_[k].sqrt_info[i] * motion_samples_[k].sqrt_info[i]);
-      motion_samples_[k].sqrt_info[i] = 1.0 / std::sqrt(var + cov_q(i, i));
-    }
+    AddVariance(motion_samples_[k].sqrt_info, E_inv, 2.0 * noise_.quantisation_gyr.cwiseAbs2());
     const double n = std::max(1.0, steps);
     const double var_w = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();
     const Vec3 d = start_.Down(still_.poses[mo.from]);
@@ -181,15 +181,7 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
     // off): its bridge's mean over T, times T, through F^-1; the instability as the walk of
     // equal short-time spread, as for the rotation above.
     for (std::size_t p : WanderOf(model::Sensor::kAccel)) {
-      const WanderProcess& w = wander_[p];
-      const Vec3 K2 = w.kind == WanderProcess::Kind::kWalk
-                          ? Vec3(w.level.cwiseAbs2())
-                          : Vec3(w.level.cwiseAbs2() * (2.0 / w.tau_s));
-      const Mat3 cov = F_inv * (K2 * (T * T * T / 12.0)).asDiagonal() * F_inv.transpose();
-      for (int i = 0; i < 3; ++i) {
-        const double var = 1.0 / (velocity_info_[k][i] * velocity_info_[k][i]);
-        velocity_info_[k][i] = 1.0 / std::sqrt(var + cov(i, i));
-      }
+      AddVariance(velocity_info_[k], F_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
     }
   }
 }

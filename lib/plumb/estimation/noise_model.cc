@@ -50,6 +50,10 @@ Vec3 WanderProcess::BridgeMeanVariance(double T_s) const {
   return level.cwiseAbs2() * std::max(unit, 0.0);
 }
 
+Vec3 WanderProcess::ShortTimeWalk2() const {
+  return kind == Kind::kWalk ? Vec3(level.cwiseAbs2()) : Vec3(level.cwiseAbs2() * (2.0 / tau_s));
+}
+
 std::vector<WanderProcess> NoiseModel::Wander(bool has_gyro) const {
   std::vector<WanderProcess> out;
   using Kind = WanderProcess::Kind;

@@ -46,6 +46,10 @@ struct WanderProcess {
   /// E[mean over the segment] = w (b_start + b_end), and the variance per axis about it.
   double BridgeMeanWeight(double T_s) const;
   Vec3 BridgeMeanVariance(double T_s) const;
+  /// Per axis, the squared density of the random walk with the same short-time spread: K^2
+  /// for the walk, 2 s^2 / tau for the instability (exact for intervals short against tau:
+  /// turns last seconds, correlation times tens of seconds and more).
+  Vec3 ShortTimeWalk2() const;
 };
 
 struct NoiseModel {
