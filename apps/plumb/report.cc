@@ -1,4 +1,5 @@
 // plumb report INPUT... --out DIR — one page that says what was calibrated and how well
+// (plumb report --study SWEEP_DIR --out DIR: the page of a sensitivity study instead)
 // (SPEC section 6): DIR/index.html, beside it result.json (calibrate's JSON), diagnose.json,
 // allan.json (plumb allan's JSON on the fit's still segments), residuals.csv and the figures
 // (PNG, drawn by gnuplot from figures.gp and its CSV files).
@@ -34,7 +35,9 @@
 #include "plumb/report/summary.h"
 #include "plumb/report/diagnosis_text.h"
 #include "plumb/signal/noise_terms.h"
+#include "plumb/study/study.h"
 #include "segment_options.h"
+#include "study_files.h"
 #include "site_options.h"
 
 namespace plumb::cli {
@@ -51,6 +54,7 @@ struct ReportArgs {
   int confirm = 3;                  ///< refit the best N significant candidates, >= 0
   bool no_figures = false;          ///< --no-figures: do not draw (nor write figure data)
   std::string gnuplot = "gnuplot";  ///< --gnuplot PROGRAM
+  std::string study;                ///< --study DIR: the page of a plumb sweep folder instead
 };
 
 /// `text` quoted for a POSIX shell when it holds anything but safe characters.
@@ -130,10 +134,16 @@ class ReportCommand : public Command {
         ->type_name("PROGRAM")
         ->capture_default_str();
     AddSegmentOptions(app_, a.segments);
+    app_->add_option("--study", a.study,
+                     "Instead of a calibration: the page of a sensitivity study's folder (what "
+                     "'plumb sweep' wrote): its points, and the NEES band and the error and "
+                     "sigma against every factor")
+        ->type_name("SWEEP_DIR");
   }
 
   int Run() override {
     const ReportArgs& a = args_;
+    if (!a.study.empty()) return RunStudy();
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
@@ -199,6 +209,24 @@ class ReportCommand : public Command {
   }
 
  private:
+  /// --study SWEEP_DIR --out DIR.
+  int RunStudy() const {
+    const ReportArgs& a = args_;
+    if (!a.input.inputs.empty() || !a.input.acc_file.empty()) {
+      throw UsageError("--study takes a plumb sweep folder instead of INPUT files");
+    }
+    const std::string study_path = (std::filesystem::path(a.study) / "study.json").string();
+    const study::Study s = study::ParseStudy(ReadJsonFile(study_path), study_path);
+    const std::vector<study::PointSummary> points =
+        ReadStudyPoints(s, study::DesignPoints(s), a.study);
+    std::filesystem::create_directories(a.out_dir);
+    const std::string why = WriteStudyPage(s, points, a.out_dir, !a.no_figures, a.gnuplot);
+    if (!why.empty() && !a.no_figures) std::cerr << "warning: no figures: " << why << "\n";
+    std::cout << "wrote " << (std::filesystem::path(a.out_dir) / "index.html").string() << " ("
+              << points.size() << " points of " << (s.name.empty() ? study_path : s.name) << ")\n";
+    return 0;
+  }
+
   /// diagnose's ranking; a failure is a warning on the page and on stdout, not the end of
   /// the report (the calibration itself succeeded).
   std::optional<diagnostics::Diagnosis> RunDiagnosis(

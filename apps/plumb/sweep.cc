@@ -22,11 +22,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include "commands.h"
+#include "study_files.h"
 #include "plumb/core/error.h"
 #include "plumb/io/common/atomic_file.h"
-#include "plumb/report/gnuplot.h"
 #include "plumb/report/json_report.h"
-#include "plumb/report/study_page.h"
 #include "plumb/study/run.h"
 #include "plumb/study/summary.h"
 
@@ -44,8 +43,6 @@ struct SweepArgs {
   std::vector<std::string> merge_dirs;  ///< merge DIR...
   std::string merge_out;                ///< merge --out DIR
 };
-
-json ReadJsonFile(const std::string& path);
 
 /// A YAML node as JSON: mappings, sequences, and scalars as integers, numbers, true/false,
 /// null or text, in that order of trial.
@@ -88,22 +85,6 @@ json ReadStudyFile(const std::string& path) {
   }
 }
 
-json ReadJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "", "cannot be read");
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
-  }
-}
-
-std::string PointPath(const std::string& dir, int index) {
-  char name[32];
-  std::snprintf(name, sizeof name, "point-%05d.json", index);
-  return (fs::path(dir) / "points" / name).string();
-}
-
 /// --shard K/N as {K, N}; {1, 1} when empty.
 std::pair<int, int> ParseShard(const std::string& text) {
   if (text.empty()) return {1, 1};
@@ -116,21 +97,15 @@ std::pair<int, int> ParseShard(const std::string& text) {
   return {k, n};
 }
 
-/// The results of every design point from the point files of `dir` (all must be there).
+/// The results of every design point from the point files of `dir` (all must be there),
+/// and the page.
 void WriteResults(const study::Study& s, const std::vector<study::Point>& points,
                   const std::string& dir) {
-  std::vector<study::PointSummary> summaries;
-  for (const study::Point& p : points) {
-    const std::string path = PointPath(dir, p.index);
-    summaries.push_back(study::PointFromJson(s, ReadJsonFile(path), path));
-  }
+  const std::vector<study::PointSummary> summaries = ReadStudyPoints(s, points, dir);
   io::WriteFileAtomic((fs::path(dir) / "results.csv").string(), study::ResultsCsv(s, summaries));
   report::WriteJson((fs::path(dir) / "results.json").string(), study::ResultsJson(s, summaries));
-  // The page and its figures (gnuplot; without it the page says so and the data stay).
-  const report::GnuplotOutcome drawn = report::RunGnuplot(dir, report::StudyFigures(s, summaries));
-  io::WriteFileAtomic((fs::path(dir) / "index.html").string(),
-                      report::StudyPage(s, summaries, drawn.written, drawn.ran ? "" : drawn.message));
-  if (!drawn.ran) std::cerr << "warning: no figures: " << drawn.message << "\n";
+  const std::string why = WriteStudyPage(s, summaries, dir);
+  if (!why.empty()) std::cerr << "warning: no figures: " << why << "\n";
 }
 
 std::string PointLine(const study::Study& s, const study::PointSummary& p) {

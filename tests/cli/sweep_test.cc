@@ -62,6 +62,11 @@ TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_TRUE(Contains(again.out, "2 already written, 1 to run")) << again.out;
   EXPECT_EQ(Files(dir.path() / "merged"), Files(dir.path() / "whole"));
+  // plumb report --study draws the same page elsewhere.
+  const ToolRun page_run = Plumb({"report", "--study", at("whole"), "--out", at("page")}, dir);
+  ASSERT_EQ(page_run.exit_code, 0) << page_run.err;
+  EXPECT_EQ(ReadAll(at("page/index.html")), ReadAll(at("whole/index.html")));
+  EXPECT_TRUE(fs::exists(dir.path() / "page/nees_poses.png"));
   // A merge with a shard missing says which point.
   const ToolRun missing = Plumb({"sweep", "merge", at("shard1"), "--out", at("m2")}, dir);
   EXPECT_EQ(missing.exit_code, 1);
