@@ -15,6 +15,7 @@ namespace plumb::cli {
 namespace fs = std::filesystem;
 
 nlohmann::json ReadJsonFile(const std::string& path) {
+  if (fs::is_directory(path)) throw InputError(path, "", "is a folder, not a JSON file");
   std::ifstream in(path);
   if (!in) throw InputError(path, "", "cannot be read");
   try {

@@ -121,6 +121,9 @@ TEST(SweepCli, BadStudiesAndOptionsAreSaid) {
   const ToolRun broken = Plumb({"sweep", at("broken.json"), "--out", at("o")}, dir);
   EXPECT_EQ(broken.exit_code, 1);
   EXPECT_TRUE(Contains(broken.err, "not valid JSON")) << broken.err;
+  const ToolRun folder = Plumb({"sweep", dir.path().string(), "--out", at("o")}, dir);
+  EXPECT_EQ(folder.exit_code, 1);
+  EXPECT_TRUE(Contains(folder.err, "is a folder, not a JSON file")) << folder.err;
   std::ofstream(at("s.json")) << kStudy;
   const ToolRun shard = Plumb({"sweep", at("s.json"), "--out", at("o"), "--shard", "3/2"}, dir);
   EXPECT_EQ(shard.exit_code, 2);
