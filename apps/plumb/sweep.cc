@@ -14,9 +14,7 @@
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <map>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>

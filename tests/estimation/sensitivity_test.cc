@@ -12,16 +12,14 @@
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
+#include "support/sim_options.h"
 
 namespace plumb::estimation {
 namespace {
 
 sim::Simulation Session(std::uint64_t seed) {
-  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
-  opt.rate_hz = 100.0;
-  opt.truth = sim::RandomParameters(opt.model, 1.0, seed);
-  opt.site = geo::Site::At(6.67, -1.57, 250.0, "flags");
-  opt.seed = seed;
+  const sim::SimulationOptions opt =
+      testing::TypicalMemsAt(geo::Site::At(6.67, -1.57, 250.0, "flags"), seed);
   sim::Simulation s = sim::Simulate(sim::MultiPose(12, 5.0, 2.0, seed), opt);
   for (auto& seg : s.truth_segments) seg.known_R_n_b.reset();
   return s;

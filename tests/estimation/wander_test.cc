@@ -15,6 +15,7 @@
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
+#include "support/sim_options.h"
 
 namespace plumb::estimation {
 namespace {
@@ -125,20 +126,12 @@ TEST(NoiseModel, WanderListsTheProcessesInStateOrder) {
   EXPECT_EQ(noise.Wander(false).size(), 1u);
 }
 
-}  // namespace
-}  // namespace plumb::estimation
-
-namespace plumb::estimation {
-namespace {
 
 TEST(WanderElimination, GivesTheDenseAnalysisCovariance) {
   // The analysis with the wander states eliminated (solve.cc) against the dense one over every
   // unknown: same rank, and the same covariance of the model parameters and attitudes.
-  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
-  opt.rate_hz = 100.0;
-  opt.truth = sim::RandomParameters(opt.model, 1.0, 31);
-  opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
-  opt.seed = 31;
+  const sim::SimulationOptions opt =
+      testing::TypicalMemsAt(geo::Site::At(51.64, -1.2, 100.0, "flags"), 31);
   const sim::Simulation s = sim::Simulate(sim::MultiPose(10, 5.0, 2.0, 31), opt);
   std::vector<StillSegment> segments = s.truth_segments;
   for (auto& seg : segments) seg.known_R_n_b.reset();

@@ -22,10 +22,6 @@ void AddVariance(Vec3& sqrt_info, const Mat3& M, const Vec3& v) {
   }
 }
 
-}  // namespace
-
-namespace {
-
 /// Shortest time a bias-walk factor spans, s: keeps its weight finite where two instants
 /// coincide.
 constexpr double kMinWalkSpan_s = 1e-3;

@@ -119,6 +119,13 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
                             const CalibrationOptions& options) {
   CalibrationResult result;
   FittedProblem fitted = FitProblem(series, segments, model_in, site, options, result);
+  FinishCalibration(series, segments, options, fitted, result);
+  return result;
+}
+
+void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                       const CalibrationOptions& options, FittedProblem& fitted,
+                       CalibrationResult& result) {
   CalibrationProblem& problem = *fitted.problem;
   Solution& solution = fitted.solution;
   Calibration& cal = result.calibration;
@@ -154,7 +161,6 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   if (!fitted.implausible_walk.empty()) {
     fit.gates.push_back(Gate{"implausible_walk", fitted.implausible_walk});
   }
-  return result;
 }
 
 }  // namespace plumb::estimation

@@ -1,5 +1,5 @@
-// plumb/estimation/fitted_problem.h — stages 1-5 of the backend (calibrator.cc): the problem
-// at its solution, for the stages after it (Calibrate's analysis, sensitivity.h).
+// plumb/estimation/fitted_problem.h — the backend (calibrator.cc) in two halves: stages 1-5,
+// the problem at its solution, and stages 6-8 on it; sensitivity.h works on the same solution.
 #pragma once
 
 #include <memory>
@@ -34,5 +34,11 @@ struct FittedProblem {
 FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
                          const model::Model& model, const geo::Site& site,
                          const CalibrationOptions& options, CalibrationResult& result);
+
+/// Stages 6-8 of Calibrate on a fitted problem (FitProblem's, same arguments): the analysis,
+/// parameters and covariance, the fit's residuals, advice and gates, into `result`.
+void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                       const CalibrationOptions& options, FittedProblem& fitted,
+                       CalibrationResult& result);
 
 }  // namespace plumb::estimation

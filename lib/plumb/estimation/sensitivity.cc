@@ -34,16 +34,14 @@ Eigen::VectorXd ResidualsUnder(const ImuSeries& series, const std::vector<StillS
   return Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
 }
 
-}  // namespace
-
-Sensitivities AssumptionSensitivity(const ImuSeries& series,
-                                    const std::vector<StillSegment>& segments,
-                                    const model::Model& model_in, const geo::Site& site,
-                                    const CalibrationOptions& options,
-                                    const std::vector<AssumptionChange>& changes) {
-  CalibrationResult result;
-  FittedProblem fitted = FitProblem(series, segments, model_in, site, options, result);
-  const model::Model& model = result.calibration.model;
+/// d(parameter)/d(change) at the fitted solution (file comment).
+Sensitivities SensitivityAt(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                            const CalibrationOptions& options, FittedProblem& fitted,
+                            const model::Model& model,
+                            const std::vector<AssumptionChange>& changes) {
+  Sensitivities out;
+  out.names = model.ParameterNames();
+  if (changes.empty()) return out;  // nothing to differentiate: no Jacobian, no factorisation
   CalibrationProblem& problem = *fitted.problem;
   ceres::Problem& at = fitted.solution.fitted();
   const UnknownColumns columns = problem.Columns(at);
@@ -54,8 +52,6 @@ Sensitivities AssumptionSensitivity(const ImuSeries& series,
     throw Error("sensitivity: the normal matrix at the solution cannot be factored");
   }
   // The reported parameters: term by term, in the model's order.
-  Sensitivities out;
-  out.names = model.ParameterNames();
   std::vector<Eigen::Index> offset;
   Eigen::Index n = 0;
   for (const auto& term : model.terms()) {
@@ -87,6 +83,30 @@ Sensitivities AssumptionSensitivity(const ImuSeries& series,
     }
   }
   return out;
+}
+
+}  // namespace
+
+SensitiveCalibration CalibrateWithSensitivities(const ImuSeries& series,
+                                                const std::vector<StillSegment>& segments,
+                                                const model::Model& model_in,
+                                                const geo::Site& site,
+                                                const CalibrationOptions& options,
+                                                const std::vector<AssumptionChange>& changes) {
+  SensitiveCalibration out;
+  FittedProblem fitted = FitProblem(series, segments, model_in, site, options, out.result);
+  FinishCalibration(series, segments, options, fitted, out.result);
+  out.sensitivities = SensitivityAt(series, segments, options, fitted,
+                                    out.result.calibration.model, changes);
+  return out;
+}
+
+Sensitivities AssumptionSensitivity(const ImuSeries& series,
+                                    const std::vector<StillSegment>& segments,
+                                    const model::Model& model, const geo::Site& site,
+                                    const CalibrationOptions& options,
+                                    const std::vector<AssumptionChange>& changes) {
+  return CalibrateWithSensitivities(series, segments, model, site, options, changes).sensitivities;
 }
 
 }  // namespace plumb::estimation

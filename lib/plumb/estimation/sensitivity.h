@@ -23,6 +23,7 @@
 #include "plumb/core/imu_series.h"
 #include "plumb/core/segment.h"
 #include "plumb/estimation/options.h"
+#include "plumb/estimation/result.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
 
@@ -39,15 +40,29 @@ struct AssumptionChange {
 
 struct Sensitivities {
   std::vector<std::string> names;  ///< the calibration's parameters (Calibration::parameters)
-  /// d(parameter)/d(assumption): a row per parameter, a column per change; NaN for a
+  /// d(parameter)/d(assumption): a row per parameter, a column per change (none without
+  /// changes); NaN for a
   /// parameter the fit holds (fixed, or a held pivot of an unobservable direction).
   Eigen::MatrixXd d_dp;
 };
 
-/// Fits like Calibrate(series, segments, model, site, options), then the derivative of every
-/// parameter with respect to each change (file comment). Throws what Calibrate throws, and
-/// plumb::Error when a change's segments differ from `segments` in anything but attitudes or
-/// the normal matrix cannot be factored.
+struct SensitiveCalibration {
+  CalibrationResult result;    ///< what Calibrate returns
+  Sensitivities sensitivities;  ///< at that very solution
+};
+
+/// Calibrate(series, segments, model, site, options), then, on the same solution (one fit),
+/// the derivative of every parameter with respect to each change (file comment). Throws what
+/// Calibrate throws, and plumb::Error when a change's segments differ from `segments` in
+/// anything but attitudes or the normal matrix cannot be factored.
+SensitiveCalibration CalibrateWithSensitivities(const ImuSeries& series,
+                                                const std::vector<StillSegment>& segments,
+                                                const model::Model& model,
+                                                const geo::Site& site,
+                                                const CalibrationOptions& options,
+                                                const std::vector<AssumptionChange>& changes);
+
+/// The sensitivities alone (CalibrateWithSensitivities(...).sensitivities).
 Sensitivities AssumptionSensitivity(const ImuSeries& series,
                                     const std::vector<StillSegment>& segments,
                                     const model::Model& model, const geo::Site& site,

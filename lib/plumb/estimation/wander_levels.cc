@@ -12,8 +12,6 @@
 namespace plumb::estimation {
 namespace {
 
-/// Confidence of the bounds (the noise terms' own, signal::NoiseTermsOptions::term_confidence).
-constexpr double kBoundConfidence = 0.95;
 /// Smallest level kept, as a fraction of the typical one.
 constexpr double kFloor = 1e-3;
 /// A record whose fitted Allan deviation reaches this fraction of the session's span covers
@@ -203,17 +201,15 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
   note += Quantisation(measured, has_gyro, n);
   if (note.empty()) return out;
   char head[160], tail[200];
-  if (measured.empty()) {
-    std::snprintf(head, sizeof head, "bias wander levels (no still data long enough for an Allan "
-                  "deviation): ");
-  } else {
-    std::snprintf(head, sizeof head, "bias wander levels (Allan deviation of %.0f s of still "
-                  "data): ", still_s);
-  }
+  std::snprintf(head, sizeof head, "bias wander levels (Allan deviation of %.0f s of still data): ",
+                still_s);
+  const std::string lead = measured.empty() ? "bias wander levels (no still data long enough for "
+                                              "an Allan deviation): "
+                                            : head;
   std::snprintf(tail, sizeof tail, "; instability: Gauss-Markov sigma, correlation time %.3g "
                 "s; override with --accel-rw/--gyro-rw/--accel-bi/--gyro-bi (a datasheet's "
                 "values) or --noise-from a long still recording", n.instability_time_s);
-  out.notes.push_back(head + note + tail);
+  out.notes.push_back(lead + note + tail);
   return out;
 }
 

@@ -61,25 +61,47 @@ sim::Schedule ScheduleOf(const Study& study, const Base& b, std::uint64_t seed) 
   return sim::MultiPose(static_cast<int>(std::lround(b.poses)), b.still_s, b.turn_s, seed);
 }
 
+/// The true value of a fitted parameter: the simulated model's, or, for a parameter the
+/// simulation lacks (an effect fitted but not simulated), the fitted model's nominal value.
+class Truth {
+ public:
+  Truth(const sim::Simulation& s, const model::Model& fitted)
+      : sim_names_(s.model.ParameterNames()), sim_values_(model::ReportedValues(s.model, s.truth)),
+        fit_names_(fitted.ParameterNames()),
+        nominal_(model::ReportedValues(fitted, fitted.ZeroParameters())) {}
+  double operator()(const std::string& name) const {
+    for (std::size_t j = 0; j < sim_names_.size(); ++j) {
+      if (sim_names_[j] == name) return sim_values_[j];
+    }
+    for (std::size_t j = 0; j < fit_names_.size(); ++j) {
+      if (fit_names_[j] == name) return nominal_[j];
+    }
+    return 0.0;
+  }
+
+ private:
+  std::vector<std::string> sim_names_;
+  std::vector<double> sim_values_;
+  std::vector<std::string> fit_names_;
+  std::vector<double> nominal_;
+};
+
+/// out.nees = e^T C^-1 e (LDLT), left NaN when C is not positive definite.
+void SetNees(const Eigen::VectorXd& e, const Eigen::MatrixXd& C, RunOutcome& out) {
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(C);
+  if (C.rows() == e.size() && ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0.0).all()) {
+    out.nees = e.dot(ldlt.solve(e));
+    out.nees_dof = static_cast<int>(e.size());
+  }
+}
+
 /// Where the data determine no parameter alone (one pose), the combinations they determine
 /// (estimation::Observability::determined) are scored instead, each a row named by its text,
 /// and the NEES is over their covariance.
-void Combinations(const estimation::CalibrationResult& result,
-                  const std::vector<std::string>& sim_names, const std::vector<double>& sim_values,
-                  const model::Model& fitted, RunOutcome& out) {
+void Combinations(const estimation::CalibrationResult& result, const Truth& truth_of,
+                  RunOutcome& out) {
   const auto& obs = result.calibration.observability;
   if (obs.determined.empty()) return;
-  const std::vector<std::string> fit_names = fitted.ParameterNames();
-  const std::vector<double> nominal = model::ReportedValues(fitted, fitted.ZeroParameters());
-  auto truth_of = [&](const std::string& name) {
-    for (std::size_t j = 0; j < sim_names.size(); ++j) {
-      if (sim_names[j] == name) return sim_values[j];
-    }
-    for (std::size_t j = 0; j < fit_names.size(); ++j) {
-      if (fit_names[j] == name) return nominal[j];
-    }
-    return 0.0;
-  };
   const auto m = static_cast<Eigen::Index>(obs.determined.size());
   Eigen::VectorXd e(m);
   for (Eigen::Index k = 0; k < m; ++k) {
@@ -92,38 +114,27 @@ void Combinations(const estimation::CalibrationResult& result,
     out.error.push_back(e[k]);
     out.sigma.push_back(c.sigma);
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(obs.determined_covariance);
-  if (obs.determined_covariance.rows() == m && ldlt.info() == Eigen::Success &&
-      (ldlt.vectorD().array() > 0.0).all()) {
-    out.nees = e.dot(ldlt.solve(e));
-    out.nees_dof = static_cast<int>(m);
-  }
+  SetNees(e, obs.determined_covariance, out);
 }
 
 /// Errors, sigmas and the NEES of a calibration against the simulated truth.
 void Score(const estimation::CalibrationResult& result, const sim::Simulation& s,
            const model::Model& fitted, RunOutcome& out) {
-  const std::vector<std::string> sim_names = s.model.ParameterNames();
-  const std::vector<double> sim_values = model::ReportedValues(s.model, s.truth);
-  const std::vector<double> nominal = model::ReportedValues(fitted, fitted.ZeroParameters());
+  const Truth truth_of(s, fitted);
   const auto& params = result.calibration.parameters;
   std::vector<Eigen::Index> in_nees;
   for (std::size_t i = 0; i < params.size(); ++i) {
     const auto& p = params[i];
-    double truth = nominal[i];
-    for (std::size_t j = 0; j < sim_names.size(); ++j) {
-      if (sim_names[j] == p.name) truth = sim_values[j];
-    }
     out.names.push_back(p.name);
     out.units.push_back(p.unit);
     const bool determined = !p.fixed && p.observable && std::isfinite(p.sigma);
-    out.error.push_back(determined ? p.value - truth : kNaN);
+    out.error.push_back(determined ? p.value - truth_of(p.name) : kNaN);
     out.sigma.push_back(determined ? p.sigma : kNaN);
     if (determined) in_nees.push_back(static_cast<Eigen::Index>(i));
   }
   const auto n = static_cast<Eigen::Index>(in_nees.size());
   if (n == 0) {
-    Combinations(result, sim_names, sim_values, fitted, out);
+    Combinations(result, truth_of, out);
     return;
   }
   Eigen::VectorXd e(n);
@@ -135,20 +146,14 @@ void Score(const estimation::CalibrationResult& result, const sim::Simulation& s
                                               in_nees[static_cast<std::size_t>(b)]);
     }
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(C);
-  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0.0).all()) {
-    out.nees = e.dot(ldlt.solve(e));
-    out.nees_dof = static_cast<int>(n);
-  }
+  SetNees(e, C, out);
 }
 
 /// A closed form's forward-form answer (F, b_a, E, b_g) scored against the truth by the
 /// fitted model's names: values only, no sigma.
 void ClosedForm(const Mat3& F, const Vec3& b_a, const Mat3& E, const Vec3& b_g,
                 const sim::Simulation& s, const model::Model& fitted, RunOutcome& out) {
-  const std::vector<std::string> sim_names = s.model.ParameterNames();
-  const std::vector<double> sim_values = model::ReportedValues(s.model, s.truth);
-  const std::vector<double> nominal = model::ReportedValues(fitted, fitted.ZeroParameters());
+  const Truth truth_of(s, fitted);
   const std::vector<std::string> names = fitted.ParameterNames();
   for (std::size_t i = 0; i < names.size(); ++i) {
     const std::string& name = names[i];
@@ -162,13 +167,9 @@ void ClosedForm(const Mat3& F, const Vec3& b_a, const Mat3& E, const Vec3& b_g,
     } else if (name.find(".bias.") != std::string::npos && tail.size() == 1) {
       value = (acc ? b_a : b_g)[tail[0] - 'x'];
     }
-    double truth = nominal[i];
-    for (std::size_t j = 0; j < sim_names.size(); ++j) {
-      if (sim_names[j] == name) truth = sim_values[j];
-    }
     out.names.push_back(name);
     out.units.push_back(matrix ? "1" : acc ? "m/s^2" : "rad/s");
-    out.error.push_back(value - truth);
+    out.error.push_back(value - truth_of(name));
     out.sigma.push_back(kNaN);
   }
 }
@@ -236,16 +237,14 @@ std::vector<double> MissingEffectSensitivity(const std::string& parameter, const
   return out;
 }
 
-/// The sensitivities of the study's fit-side factors at the run's fit (run.h).
-std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const Base& b,
-                                                      const sim::Simulation& s,
-                                                      const std::vector<StillSegment>& segments,
-                                                      const geo::Site& site,
-                                                      const model::Model& fitted,
-                                                      const estimation::CalibrationOptions& options) {
+/// The study's fit-side changes (the gravity and the latitude the fit is told), in
+/// SensitivityFactors order, moved about the point's values.
+std::vector<estimation::AssumptionChange> FitSideChanges(const Study& study, const Base& b,
+                                                         const std::vector<StillSegment>& segments,
+                                                         const geo::Site& site) {
   std::vector<estimation::AssumptionChange> changes;
   for (const std::string& name : SensitivityFactors(study)) {
-    if (name.rfind("truth.", 0) == 0) continue;  // below
+    if (name.rfind("truth.", 0) == 0) continue;  // MissingEffectSensitivity
     estimation::AssumptionChange c{name, 0.0, site, site, segments, segments};
     if (name == "fit_gravity_m_s2") {
       c.step = 0.01;  // m/s^2
@@ -262,23 +261,25 @@ std::vector<std::vector<double>> FitSideSensitivities(const Study& study, const 
     }
     changes.push_back(c);
   }
-  std::vector<std::vector<double>> assumed;
-  if (!changes.empty()) {
-    const estimation::Sensitivities S = estimation::AssumptionSensitivity(
-        s.session.series, segments, fitted, site, options, changes);
-    for (Eigen::Index c = 0; c < S.d_dp.cols(); ++c) {
-      assumed.emplace_back(S.d_dp.col(c).data(), S.d_dp.col(c).data() + S.d_dp.rows());
-    }
-  }
-  // In SensitivityFactors order: the fit-side changes, then the missing effects.
+  return changes;
+}
+
+/// The run's d_dp in SensitivityFactors order: the fit-side ones (`fit_side`, from the fit
+/// itself), then a refit with the probe for each missing effect.
+std::vector<std::vector<double>> Sensitivities(const Study& study, const sim::Simulation& s,
+                                               const std::vector<StillSegment>& segments,
+                                               const geo::Site& site, const model::Model& fitted,
+                                               const estimation::CalibrationOptions& options,
+                                               const estimation::Sensitivities& fit_side) {
   std::vector<std::vector<double>> out;
-  std::size_t next = 0;
+  Eigen::Index next = 0;
   for (const std::string& name : SensitivityFactors(study)) {
     if (name.rfind("truth.", 0) == 0) {
       out.push_back(MissingEffectSensitivity(name.substr(6), s, segments, site, fitted, options,
                                              fitted.ParameterNames()));
     } else {
-      out.push_back(assumed[next++]);
+      const auto col = fit_side.d_dp.col(next++);
+      out.emplace_back(col.data(), col.data() + col.size());
     }
   }
   return out;
@@ -382,8 +383,10 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
     return out;
   }
   try {
-    const estimation::CalibrationResult result =
-        estimation::Calibrate(s.session.series, segments, fitted, site, options);
+    // One fit, and the fit-side sensitivities on its solution.
+    const estimation::SensitiveCalibration fit = estimation::CalibrateWithSensitivities(
+        s.session.series, segments, fitted, site, options, FitSideChanges(study, b, segments, site));
+    const estimation::CalibrationResult& result = fit.result;
     out.chi2_dof = result.fit.chi2_dof();
     out.flagged = !result.fit.gates.empty();
     if (!result.fit.converged) {
@@ -391,7 +394,7 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
       out.failure = "not converged";
     }
     Score(result, s, fitted, out);
-    out.d_dp = FitSideSensitivities(study, b, s, segments, site, fitted, options);
+    out.d_dp = Sensitivities(study, s, segments, site, fitted, options, fit.sensitivities);
   } catch (const Error& e) {
     out.failed = true;
     out.failure = e.what();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <regex>
 
 #include "plumb/core/error.h"
@@ -38,11 +39,12 @@ std::vector<RunOutcome> PoolByShape(const std::vector<RunOutcome>& runs) {
     return out;
   };
   std::vector<std::vector<std::string>> shapes;
+  std::map<std::vector<std::string>, std::size_t> counts;
   std::size_t best = runs.size(), best_count = 0;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     shapes.push_back(runs[i].failed ? std::vector<std::string>{} : shape(runs[i].names));
     if (runs[i].failed) continue;
-    const auto count = static_cast<std::size_t>(std::count(shapes.begin(), shapes.end(), shapes[i]));
+    const std::size_t count = ++counts[shapes[i]];
     if (count > best_count) {
       best_count = count;
       best = i;
