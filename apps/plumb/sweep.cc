@@ -112,13 +112,20 @@ std::string PointLine(const study::Study& s, const study::PointSummary& p) {
   for (std::size_t f = 0; f < s.factors.size(); ++f) {
     os << " " << s.factors[f].name << "=" << p.point.values[f];
   }
-  char nees[96] = "no NEES";
-  if (p.nees_dof > 0) {
-    std::snprintf(nees, sizeof nees, "NEES/dof %.3f (band %.3f .. %.3f)%s", p.nees_per_dof,
-                  p.nees_low, p.nees_high,
-                  p.nees_per_dof > p.nees_high ? " above" : p.nees_per_dof < p.nees_low ? " below" : "");
+  const auto nees = [](double per_dof, int dof, double low, double high) {
+    if (dof <= 0) return std::string("no NEES");
+    char text[96];
+    std::snprintf(text, sizeof text, "NEES/dof %.3f (band %.3f .. %.3f)%s", per_dof, low, high,
+                  per_dof > high ? " above" : per_dof < low ? " below" : "");
+    return std::string(text);
+  };
+  os << "; " << p.runs << " runs, " << p.failed << " failed, " << p.flagged << " flagged; "
+     << nees(p.nees_per_dof, p.nees_dof, p.nees_low, p.nees_high);
+  if (p.flagged > 0) {
+    os << "; unflagged runs: "
+       << nees(p.nees_unflagged_per_dof, p.nees_unflagged_dof, p.nees_unflagged_low,
+               p.nees_unflagged_high);
   }
-  os << "; " << p.runs << " runs, " << p.failed << " failed, " << p.flagged << " flagged; " << nees;
   return os.str();
 }
 

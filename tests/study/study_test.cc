@@ -162,6 +162,112 @@ TEST(Study, AnalyticSensitivityAgreesWithMonteCarloFiniteDifferences) {
   EXPECT_NEAR(points[0].parameters[0].mean_d_dp[0], -1.0 / g, 0.05 / g);
 }
 
+TEST(Study, TheAssumedLevelAndHeadingAreDifferentiatedOnThePapersMinute) {
+  // The paper's minute, tilted 1 deg and turned 5 deg while the fit assumes level, x north:
+  // the analytic d/d(level) of the determined accel x combination (g cos(theta) F_xx per
+  // radian: about 0.171 per deg) and d/d(heading) of the gyro y one (-Omega_N per radian at
+  // 6.67 deg N: -1.264e-6 rad/s per deg) against the Monte Carlo finite difference between
+  // the point and the level one (12 runs), within 4 of its standard errors.
+  json doc = Small(12);
+  doc["base"] = {{"schedule", "paper_static"}, {"still_s", 60}, {"rate_hz", 100},
+                 {"lat_deg", 6.67}, {"lon_deg", -1.57}, {"height_m", 250}};
+  doc["design"] = "one_at_a_time";
+  doc["factors"] = json::array({{{"name", "level_error_deg"}, {"levels", {0, 1}}},
+                                {{"name", "heading_error_deg"}, {"levels", {0, 5}}}});
+  const Study s = ParseStudy(doc, "s.json");
+  ASSERT_EQ(SensitivityFactors(s), (std::vector<std::string>{"level_error_deg", "heading_error_deg"}));
+  const std::vector<Point> points = DesignPoints(s);
+  ASSERT_EQ(points.size(), 3U);  // the base, level 1, heading 5
+  std::vector<PointSummary> sums;
+  for (const Point& p : points) sums.push_back(RunPoint(s, p));
+  const auto row = [&](const PointSummary& sum, const std::string& prefix) {
+    for (const ParameterSummary& q : sum.parameters) {
+      if (q.name.rfind(prefix, 0) == 0 && q.name.size() > prefix.size() + 5) return q;
+    }
+    ADD_FAILURE() << "no combination " << prefix;
+    return ParameterSummary{};
+  };
+  const struct {
+    const char* prefix;
+    std::size_t point, factor;
+    double step, expected;
+  } cases[] = {{"accel.bias.x ", 1, 0, 1.0, 0.1707}, {"gyro.bias.y ", 2, 1, 5.0, -1.264e-6}};
+  for (const auto& c : cases) {
+    const ParameterSummary base = row(sums[0], c.prefix), moved = row(sums[c.point], c.prefix);
+    const double analytic = base.mean_d_dp[c.factor];
+    EXPECT_NEAR(analytic, c.expected, 0.01 * std::abs(c.expected)) << c.prefix;
+    const double fd = (moved.mean_error - base.mean_error) / c.step;
+    const double se = std::hypot(base.sd_error, moved.sd_error) / std::sqrt(s.runs) / c.step;
+    EXPECT_LT(std::abs(fd - analytic), 4.0 * se + 0.01 * std::abs(analytic))
+        << c.prefix << ": fd " << fd << ", analytic " << analytic << ", se " << se;
+  }
+}
+
+json UncertainGravity(int runs, double sigma) {
+  json doc = Small(runs);
+  doc["base"]["poses"] = 12;
+  doc["base"]["still_s"] = 5;
+  doc["base"]["lat_deg"] = 6.67;
+  doc["base"]["lon_deg"] = -1.57;
+  doc["base"]["height_m"] = 250;
+  doc["factors"] = json::array(
+      {{{"name", "fit_gravity_m_s2"}, {"levels", {9.7806849}}, {"sigma", sigma}}});
+  return doc;
+}
+
+TEST(Study, AnUncertainFactorIsDrawnPerRunOnItsOwnStream) {
+  const Study s = ParseStudy(UncertainGravity(4, 0.01), "s.json");
+  const Point p = DesignPoints(s).front();
+  const Point a = DrawUncertainFactors(s, p, 0), b = DrawUncertainFactors(s, p, 1);
+  EXPECT_NE(a.values[0], p.values[0]);
+  EXPECT_NE(a.values[0], b.values[0]);
+  EXPECT_EQ(DrawUncertainFactors(s, p, 0).values, a.values);  // reproducible
+  EXPECT_NE(FactorSeed(7, 0, 0), RunSeed(7, 0, 0));
+  // The same run without the sigma: the same simulated noise, only the gravity differs, so
+  // the error moves by the run's own analytic sensitivity times the draw (to second order).
+  const Study fixed = ParseStudy(UncertainGravity(4, 0.0), "s.json");
+  for (int run = 0; run < 2; ++run) {
+    const RunOutcome drawn = RunOnce(s, p, run), level = RunOnce(fixed, p, run);
+    ASSERT_FALSE(drawn.failed || level.failed);
+    const double dg = DrawUncertainFactors(s, p, run).values[0] - p.values[0];
+    for (std::size_t i = 0; i < 6; ++i) {  // the accelerometer matrix
+      EXPECT_NEAR(drawn.error[i] - level.error[i], level.d_dp[0][i] * dg,
+                  0.02 * std::abs(level.d_dp[0][i] * dg) + 1e-8)
+          << drawn.names[i] << ", run " << run;
+    }
+  }
+  json bad = UncertainGravity(4, 0.01);
+  bad["factors"][0]["levels"] = {0};
+  EXPECT_NE(ErrorOf(bad).find("needs levels > 0"), std::string::npos) << ErrorOf(bad);
+  bad = Small();
+  bad["factors"][0]["sigma"] = 1;
+  EXPECT_NE(ErrorOf(bad).find("poses is a count"), std::string::npos) << ErrorOf(bad);
+}
+
+TEST(Study, TheFirstOrderCovarianceOfAnUncertainFactorMatchesTheMonteCarloSpread) {
+  // Gravity known to 0.01 m/s^2 (1e-3 relative, 30 times the scale's noise sigma): over 40
+  // runs the scale's error spreads by sqrt(sigma^2 + S 0.01^2 S^T), the first-order
+  // prediction from the analytic d/dg, within the Monte Carlo spread of a standard deviation
+  // from 40 runs (11 %; 3 of it allowed).
+  const Study s = ParseStudy(UncertainGravity(40, 0.01), "s.json");
+  const PointSummary sum = RunPoint(s, DesignPoints(s).front());
+  const auto cov = FirstOrderCovariance(s, sum);
+  ASSERT_EQ(cov.size(), sum.parameters.size());
+  for (std::size_t i = 0; i < 3; ++i) {  // accel.matrix.xx, xy, xz: scale and cross terms
+    const ParameterSummary& q = sum.parameters[i];
+    const double predicted = std::sqrt(q.mean_sigma * q.mean_sigma + cov[i][i]);
+    EXPECT_NEAR(q.sd_error / predicted, 1.0, 0.33) << q.name << ": sd " << q.sd_error
+                                                   << ", predicted " << predicted;
+  }
+  EXPECT_GT(std::sqrt(cov[0][0]), 20.0 * sum.parameters[0].mean_sigma);
+  // Symmetric, and the scales move together (one gravity scales every axis).
+  EXPECT_EQ(cov[0][3], cov[3][0]);
+  EXPECT_GT(cov[0][3] / std::sqrt(cov[0][0] * cov[3][3]), 0.99);
+  // Without an uncertain factor there is no prediction.
+  const Study fixed = ParseStudy(UncertainGravity(1, 0.0), "s.json");
+  EXPECT_TRUE(FirstOrderCovariance(fixed, sum).empty());
+}
+
 TEST(Study, ThePapersClosedFormsLeaveTheNorthEarthRateInTheXGyroBias) {
   // The seed paper's benchmark closed forms (section 4) at 6.67 deg N: the x gyroscope's bias
   // comes out high by the Earth rate's north component, 7.24e-5 rad/s, run after run.

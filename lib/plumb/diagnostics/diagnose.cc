@@ -272,6 +272,7 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   if (plan.probed_motion.has_probes() && d.fit.fit.motion_segments > 0) {
     estimation::CalibrationOptions with = options.calibration;
     with.accel_in_motion = true;
+    with.check_linearity = false;  // its columns score candidates; its covariance is not shown
     fit_motion = estimation::Calibrate(series, segments, plan.probed_motion, site, with);
     d.fit_with_velocity = StripProbes(*fit_motion, model);
   }

@@ -367,7 +367,8 @@ BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
   return built;
 }
 
-UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem) {
+UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
+                                           const std::vector<ParameterIndex>& held) {
   UnknownColumns out;
   for (int t = 0; t < model_.num_terms(); ++t) {
     double* values = block(t);
@@ -376,7 +377,10 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem) {
     const auto& term = model_.terms()[static_cast<std::size_t>(t)];
     const auto& info = term.effect->info();
     for (int i = 0; i < info.size(); ++i) {
-      if (term.fixed[static_cast<std::size_t>(i)]) continue;
+      if (term.fixed[static_cast<std::size_t>(i)] ||
+          std::find(held.begin(), held.end(), ParameterIndex(t, i)) != held.end()) {
+        continue;
+      }
       out.names.push_back(info.ParameterName(i));
       out.values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal + values[i]);
       out.is_model.push_back(true);

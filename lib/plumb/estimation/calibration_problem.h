@@ -96,8 +96,9 @@ class CalibrationProblem {
   /// Jacobian columns only).
   BuiltProblem Build(const std::vector<ParameterIndex>& held, bool free_probes = false);
 
-  /// The free unknowns of `problem` (built by Build) as columns.
-  UnknownColumns Columns(const ceres::Problem& problem);
+  /// The free unknowns of `problem` (built by Build with `held` held) as columns.
+  UnknownColumns Columns(const ceres::Problem& problem,
+                         const std::vector<ParameterIndex>& held = {});
   /// Whitened residuals (optional) and Jacobian over `columns`, with the cost 0.5 r^T r.
   Eigen::MatrixXd Jacobian(ceres::Problem& problem, const UnknownColumns& columns,
                            double* cost, std::vector<double>* residuals) const;

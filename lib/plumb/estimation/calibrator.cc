@@ -11,6 +11,7 @@
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/covariance.h"
 #include "plumb/estimation/fitted_problem.h"
+#include "plumb/estimation/linearity.h"
 #include "plumb/estimation/gates.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
@@ -157,6 +158,7 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   if (cal.model.has_probes()) {
     fit.probes = problem.ProbeColumns(problem.Build({}, true), columns);
   }
+  if (options.check_linearity) fit.linearity = CheckLinearity(problem, solution.fitted(), solution.held_parameters);
   fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
   if (!fitted.implausible_walk.empty()) {
     fit.gates.push_back(Gate{"implausible_walk", fitted.implausible_walk});

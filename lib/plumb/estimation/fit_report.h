@@ -70,6 +70,19 @@ struct Gate {
   std::string message;  ///< what failed, in numbers, and what to do
 };
 
+/// Whether chi^2 is as quadratic in the unknowns as the covariance assumes, a few sigma out
+/// from the solution (estimation/linearity.h).
+struct LinearityReport {
+  bool checked = false;      ///< false: not run (options.check_linearity) or nothing to check
+  double step_sigmas = 0;    ///< the step c, in sigma of the direction
+  /// Per direction of the parameters' correlation matrix (in the order of its eigenvalues,
+  /// increasing): the larger of chi^2(+c d) - chi^2 and chi^2(-c d) - chi^2, over c^2 (1 for
+  /// a linear model).
+  std::vector<double> ratio;
+  double worst_ratio = 0;       ///< the largest of `ratio`
+  std::string worst_direction;  ///< its direction: the largest terms, in sigma of each parameter
+};
+
 struct FitReport {
   double chi2 = 0;   ///< sum of squared whitened residuals
   int num_residuals = 0;
@@ -96,6 +109,8 @@ struct FitReport {
   /// Distinct poses among the still segments at rest: consecutive segments with the same
   /// gravity direction and no turn between them count once (estimation/gates.h).
   int distinct_poses = 0;
+  /// How quadratic chi^2 is around the solution (the nonlinear gate).
+  LinearityReport linearity;
   /// Present when the model has probe terms.
   std::optional<ProbeJacobian> probes;
 };

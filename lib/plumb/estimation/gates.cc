@@ -329,6 +329,21 @@ Gate NotConverged(const FitReport& fit) {
                   "iterations (--max-iterations)"};
 }
 
+std::optional<Gate> Nonlinear(const FitReport& fit) {
+  const LinearityReport& lin = fit.linearity;
+  if (!lin.checked || !(lin.worst_ratio > kMaxLinearityRatio)) return std::nullopt;
+  const double c2 = lin.step_sigmas * lin.step_sigmas;
+  return Gate{"nonlinear",
+              "the covariance does not describe this fit: " + Num(lin.step_sigmas) +
+                  " sigma out along " + lin.worst_direction + " (in sigma of each) chi2 rises by " +
+                  Num(lin.worst_ratio * c2) + " where the covariance says " + Num(c2) +
+                  ". The fit lies in a curved valley of near-equal fits (the data tie these "
+                  "parameters together only nonlinearly): each sigma may still cover its "
+                  "parameter, the combinations' do not, and the values can be far off. Record "
+                  "more well-spread poses (9 or more gravity directions when the attitudes are "
+                  "free) or state the attitudes"};
+}
+
 /// "1-12" style list of the runs of merged segments (1-based), at most a few.
 std::string MergedRuns(const std::vector<bool>& same_as_previous) {
   std::string out;
@@ -526,6 +541,9 @@ std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibrati
   fit.distinct_poses = CountDistinctPoses(series, fit.still, calibration.noise);
   const auto one_pose = OnePose(series, calibration, fit);
   if (one_pose) gates.push_back(*one_pose);
+  if (fit.converged && !one_pose) {
+    if (auto g = Nonlinear(fit)) gates.push_back(*g);
+  }
   const auto rest = Plausible(AtRest(fit.still), calibration);
   if (rest.empty()) return gates;
   const bool usable = fit.converged && !one_pose;

@@ -21,6 +21,9 @@
 //                  are noise and the gates above say so)
 //   saturated      an axis sits at its extreme value for kSaturationRun samples or more in a
 //                  row outside the still segments (a clipped turn or shock)
+//   nonlinear      chi^2 is far from the quadratic the covariance assumes, a few sigma out from
+//                  the solution (linearity.h): the covariance does not describe the fit's
+//                  error (only on a converged fit of enough poses)
 //   implausible_walk  a bias random walk estimated from the session (--estimate-rw) more than
 //                  10 times the typical MEMS walk: more likely a missing effect seen between
 //                  the poses, which a walk that large hides from chi2 (walk_estimate.h)
@@ -43,7 +46,8 @@ namespace plumb::estimation {
 
 /// The gates' names, in the order they are checked.
 inline constexpr const char* kGateNames[] = {"out_of_range", "saturated", "not_converged",
-                                             "one_pose", "unit_or_rate", "implausible_walk"};
+                                             "one_pose", "nonlinear", "unit_or_rate",
+                                             "implausible_walk"};
 
 /// out_of_range: per-axis limits. 32 g is twice the largest common MEMS full scale (16 g;
 /// 24 g parts stay inside), 4000 deg/s twice the common 2000 deg/s; 2^20 counts holds any
@@ -78,6 +82,10 @@ inline constexpr double kMaxNormError = 0.25;
 inline constexpr double kMaxCorrectedNormError = 0.05;
 inline constexpr double kMaxScaleError = 0.25;
 inline constexpr double kMaxGyroBiasDegS = 25.0;
+
+/// nonlinear: chi^2 rises by more than this times c^2 at c sigma along some direction
+/// (LinearityReport::worst_ratio; a linear model gives 1, well-posed fits 1.00-1.2).
+inline constexpr double kMaxLinearityRatio = 1.5;
 
 /// out_of_range and saturated, on the samples and the still segments (given or detected).
 std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillSegment>& still);

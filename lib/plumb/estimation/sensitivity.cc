@@ -44,7 +44,7 @@ Sensitivities SensitivityAt(const ImuSeries& series, const std::vector<StillSegm
   if (changes.empty()) return out;  // nothing to differentiate: no Jacobian, no factorisation
   CalibrationProblem& problem = *fitted.problem;
   ceres::Problem& at = fitted.solution.fitted();
-  const UnknownColumns columns = problem.Columns(at);
+  const UnknownColumns columns = problem.Columns(at, fitted.solution.held_parameters);
   const Eigen::SparseMatrix<double> J = problem.SparseJacobian(at, columns, nullptr, nullptr);
   const Eigen::SparseMatrix<double> normal = Eigen::SparseMatrix<double>(J.transpose()) * J;
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);

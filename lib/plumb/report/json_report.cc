@@ -105,6 +105,13 @@ json EffectsJson(const estimation::CalibrationResult& r) {
   return effects;
 }
 
+json LinearityJson(const estimation::LinearityReport& l) {
+  if (!l.checked) return nullptr;
+  return json{{"step_sigmas", Number(l.step_sigmas)},
+              {"worst_ratio", Number(l.worst_ratio)},
+              {"worst_direction", l.worst_direction}};
+}
+
 json FitJson(const estimation::CalibrationResult& r) {
   const auto& f = r.fit;
   json rms{{"accel", Vector(f.rms_acc)},
@@ -121,7 +128,8 @@ json FitJson(const estimation::CalibrationResult& r) {
               {"solver", f.solver_report},
               {"chi2_above_band", estimation::Chi2AboveBand(f)},
               {"misfit_beyond_noise", estimation::MisfitBeyondNoise(f)},
-              {"distinct_poses", f.distinct_poses}};
+              {"distinct_poses", f.distinct_poses},
+              {"linearity", LinearityJson(f.linearity)}};
 }
 
 json ObservabilityJson(const estimation::Observability& o, double sigma_scale) {

@@ -19,7 +19,7 @@
 //                                                 see CovarianceJson
 //   fit {chi2, dof, chi2_dof, num_residuals, residual_rms {accel, gyro, motion},
 //        segments {still, motion}, converged, iterations, solver, chi2_above_band,
-//        distinct_poses}
+//        distinct_poses, linearity {step_sigmas, worst_ratio, worst_direction} or null}
 //   gates [{name, message}]                       the gates the fit failed (estimation/gates.h)
 //   observability {rank, unknowns, unobservable [],
 //                  determined [{combination, value, sigma, sigma_formal}]}

@@ -246,7 +246,21 @@ std::vector<estimation::AssumptionChange> FitSideChanges(const Study& study, con
   for (const std::string& name : SensitivityFactors(study)) {
     if (name.rfind("truth.", 0) == 0) continue;  // MissingEffectSensitivity
     estimation::AssumptionChange c{name, 0.0, site, site, segments, segments};
-    if (name == "fit_gravity_m_s2") {
+    if (name == "level_error_deg" || name == "heading_error_deg") {
+      // The true hold tilted (about body y) or turned (about down) by +-step while the fit
+      // assumes the same attitude is, to first order, the fit assuming the opposite turn on
+      // the same data: the data are what they are, the assumption moves.
+      c.step = 0.1;  // deg
+      const Vec3 axis = name == "level_error_deg" ? Vec3::UnitY() : Vec3::UnitZ();
+      const double step_rad = c.step * units::kRadPerDeg;
+      for (auto* segs : {&c.segments_minus, &c.segments_plus}) {
+        const double sign = segs == &c.segments_plus ? -1.0 : 1.0;
+        for (StillSegment& seg : *segs) {
+          seg.known_R_n_b = seg.known_R_n_b.value_or(Quat::Identity()) *
+                            Quat(Eigen::AngleAxisd(sign * step_rad, axis));
+        }
+      }
+    } else if (name == "fit_gravity_m_s2") {
       c.step = 0.01;  // m/s^2
       c.site_minus.g_n = Vec3(0.0, 0.0, site.gravity() - c.step);
       c.site_plus.g_n = Vec3(0.0, 0.0, site.gravity() + c.step);
@@ -283,6 +297,42 @@ std::vector<std::vector<double>> Sensitivities(const Study& study, const sim::Si
     }
   }
   return out;
+}
+
+/// d_dp per parameter (rows as `names`) carried to the rows a run scored: the parameters
+/// themselves, and the determined combinations sum_i c_i theta_i of a one-pose design
+/// (Combinations), whose sensitivity is sum_i c_i d theta_i / dp (the parameters the gauge
+/// holds, NaN in d_dp, do not move).
+std::vector<std::vector<double>> OnScoredRows(const std::vector<std::vector<double>>& d_dp,
+                                              const std::vector<std::string>& names,
+                                              const estimation::CalibrationResult& result,
+                                              const RunOutcome& out) {
+  if (out.names == names) return d_dp;
+  const auto& determined = result.calibration.observability.determined;
+  const auto index_of = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  std::vector<std::vector<double>> rows;
+  for (const std::vector<double>& column : d_dp) {
+    std::vector<double> scored;
+    for (const std::string& row : out.names) {
+      if (const std::size_t i = index_of(row); i < names.size()) {
+        scored.push_back(column[i]);
+        continue;
+      }
+      const auto c = std::find_if(determined.begin(), determined.end(),
+                                  [&](const estimation::Combination& d) { return d.text == row; });
+      double sum = c == determined.end() ? kNaN : 0.0;
+      for (std::size_t k = 0; c != determined.end() && k < c->names.size(); ++k) {
+        const std::size_t i = index_of(c->names[k]);
+        const double d = i < names.size() ? column[i] : kNaN;
+        sum += std::isnan(d) ? 0.0 : c->coefficients[k] * d;
+      }
+      scored.push_back(sum);
+    }
+    rows.push_back(scored);
+  }
+  return rows;
 }
 
 }  // namespace
@@ -329,6 +379,11 @@ std::vector<std::string> SensitivityFactors(const Study& study) {
   const model::Model fitted = model::Model::Parse(study.fit_model);
   for (const Factor& f : study.factors) {
     if (f.name == "fit_gravity_m_s2" || f.name == "fit_lat_error_deg") out.push_back(f.name);
+    // What the paper's static hold is assumed to be (level, x north) against what it is.
+    if ((f.name == "level_error_deg" || f.name == "heading_error_deg") &&
+        study.base.schedule == "paper_static") {
+      out.push_back(f.name);
+    }
     // A true parameter of an effect the fit lacks: the bias it leaves (MissingEffectSensitivity).
     if (f.name.rfind("truth.", 0) == 0 && !fitted.FindParameter(f.name.substr(6))) {
       out.push_back(f.name);
@@ -338,11 +393,12 @@ std::vector<std::string> SensitivityFactors(const Study& study) {
 }
 
 RunOutcome RunOnce(const Study& study, const Point& point, int run) {
-  const Base b = Apply(study, point);
+  const Base b = Apply(study, DrawUncertainFactors(study, point, run));
   const std::uint64_t seed = RunSeed(study.seed, point.index, run);
   const model::Model sim_model =
       model::Model::Parse(study.simulate_model.empty() ? study.fit_model : study.simulate_model);
-  const sim::Simulation s = sim::Simulate(ScheduleOf(study, b, seed), SensorOf(b, sim_model, seed));
+  const sim::SimulationOptions sensor = SensorOf(b, sim_model, seed);
+  const sim::Simulation s = sim::Simulate(ScheduleOf(study, b, seed), sensor);
   std::vector<StillSegment> segments = s.truth_segments;
   for (auto& seg : segments) {
     // Unknown attitudes, but on the paper's static design: level, x north, as assumed.
@@ -359,6 +415,13 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
   fitted.temp_ref_c = s.model.temp_ref_c;
   estimation::CalibrationOptions options;
   options.constant_bias = study.constant_bias;
+  if (study.wander_levels_given) {
+    options.accel_walk_density = sensor.accel_bias_walk_density;
+    options.gyro_walk_density = sensor.gyro_bias_walk_density;
+    options.accel_instability = sensor.accel_bias_instability;
+    options.gyro_instability = sensor.gyro_bias_instability;
+    options.instability_time_s = sensor.bias_instability_time_s;
+  }
   RunOutcome out;
   if (study.fit_method == "paper_static_backend") {
     try {
@@ -394,7 +457,8 @@ RunOutcome RunOnce(const Study& study, const Point& point, int run) {
       out.failure = "not converged";
     }
     Score(result, s, fitted, out);
-    out.d_dp = Sensitivities(study, s, segments, site, fitted, options, fit.sensitivities);
+    out.d_dp = OnScoredRows(Sensitivities(study, s, segments, site, fitted, options, fit.sensitivities),
+                            fitted.ParameterNames(), result, out);
   } catch (const Error& e) {
     out.failed = true;
     out.failure = e.what();

@@ -52,6 +52,8 @@ struct RunOutcome {
 
 /// The study's factors whose analytic sensitivity a run computes, in Study::factors order:
 /// fit_gravity_m_s2 and fit_lat_error_deg (what the fit is told; estimation/sensitivity.h),
+/// level_error_deg and heading_error_deg on the paper_static schedule (the attitude the fit
+/// assumes, moved the other way: to first order the same mismatch between hold and fit),
 /// and truth.PARAMETER of an effect the fitted model lacks (the bias a missing effect leaves
 /// per unit of it, from the effect's probe columns).
 std::vector<std::string> SensitivityFactors(const Study& study);

@@ -130,6 +130,21 @@ Factor ReadFactor(const json& f, const std::string& path, std::size_t i, DesignK
   } else {
     throw InputError(path, "key '" + where + "'", "expected levels or a range");
   }
+  if (f.contains("sigma")) {
+    out.sigma = Number(f.at("sigma"), path, where + ".sigma");
+    if (!(out.sigma >= 0.0)) throw InputError(path, "key '" + where + ".sigma'", "expected >= 0");
+    if (out.name == "poses" && out.sigma > 0.0) {
+      throw InputError(path, "key '" + where + ".sigma'", "poses is a count: it cannot be drawn");
+    }
+    const auto non_positive = [&] {
+      return std::any_of(out.levels.begin(), out.levels.end(), [](double v) { return v <= 0.0; }) ||
+             (out.levels.empty() && out.low <= 0.0);
+    };
+    if (out.name == "fit_gravity_m_s2" && out.sigma > 0.0 && non_positive()) {
+      throw InputError(path, "key '" + where + ".sigma'",
+                       "fit_gravity_m_s2 0 means WGS84's: an uncertain gravity needs levels > 0");
+    }
+  }
   return out;
 }
 
@@ -197,11 +212,14 @@ Study ParseStudy(const json& doc, const std::string& path) {
           s.fit_method = v.get<std::string>();
         } else if (k == "constant_bias" && v.is_boolean()) {
           s.constant_bias = v.get<bool>();
+        } else if (k == "wander_levels" && v.is_string() &&
+                   (v.get<std::string>() == "from_data" || v.get<std::string>() == "given")) {
+          s.wander_levels_given = v.get<std::string>() == "given";
         } else {
           throw InputError(path, "key 'fit." + k + "'",
                            "expected method (generalized, paper_static, paper_static_backend "
-                           "or paper_benchmark), model (text) or "
-                           "constant_bias (true/false)");
+                           "or paper_benchmark), model (text), constant_bias (true/false) or "
+                           "wander_levels (from_data or given)");
         }
       }
     } else if (key != "factors") {
@@ -315,12 +333,34 @@ Base Apply(const Study& study, const Point& point) {
   return b;
 }
 
-std::uint64_t RunSeed(std::uint64_t study_seed, int point, int run) {
+namespace {
+
+std::uint64_t TaggedSeed(std::uint64_t study_seed, int point, int run, std::uint32_t tag) {
   std::seed_seq seq{static_cast<std::uint32_t>(study_seed), static_cast<std::uint32_t>(study_seed >> 32),
-                    static_cast<std::uint32_t>(point), static_cast<std::uint32_t>(run), 0x706c756dU};
+                    static_cast<std::uint32_t>(point), static_cast<std::uint32_t>(run), tag};
   std::array<std::uint32_t, 2> out{};
   seq.generate(out.begin(), out.end());
   return (static_cast<std::uint64_t>(out[0]) << 32) | out[1];
+}
+
+}  // namespace
+
+std::uint64_t RunSeed(std::uint64_t study_seed, int point, int run) {
+  return TaggedSeed(study_seed, point, run, 0x706c756dU);  // "plum"
+}
+
+std::uint64_t FactorSeed(std::uint64_t study_seed, int point, int run) {
+  return TaggedSeed(study_seed, point, run, 0x66616374U);  // "fact"
+}
+
+Point DrawUncertainFactors(const Study& study, const Point& point, int run) {
+  Point drawn = point;
+  std::mt19937_64 rng(FactorSeed(study.seed, point.index, run));
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (std::size_t f = 0; f < study.factors.size() && f < drawn.values.size(); ++f) {
+    if (study.factors[f].sigma > 0.0) drawn.values[f] += study.factors[f].sigma * normal(rng);
+  }
+  return drawn;
 }
 
 }  // namespace plumb::study

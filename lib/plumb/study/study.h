@@ -15,9 +15,14 @@
 //               "random_truth": 1,        scale of the random true parameters (sim/truth.h)
 //               "lat_deg": 51.64, "lon_deg": -1.2, "height_m": 100 },
 //     "simulate": "base",                 the model simulated (default: the fitted one)
-//     "fit": { "method": "generalized", "model": "base", "constant_bias": false },
+//     "fit": { "method": "generalized", "model": "base", "constant_bias": false,
+//              "wander_levels": "from_data" },   or "given": the simulated sensor's levels
+//                                         are given to the fit (a datasheet, --noise-from)
 //     "factors": [ {"name": "poses", "levels": [6, 9, 12]},
-//                  {"name": "still_s", "range": [2, 30]} ] }   (a range: latin hypercube only)
+//                  {"name": "still_s", "range": [2, 30]},      (a range: latin hypercube only)
+//                  {"name": "fit_lat_error_deg", "levels": [0], "sigma": 1} ] }
+//                                         sigma: an uncertain factor, drawn in every run
+//                                         (Factor::sigma; not for poses)
 //
 // Factors (FactorNames()): poses, still_s, turn_s, rate_hz, accel_noise, gyro_noise, accel_rw,
 // gyro_rw, accel_bi, gyro_bi, bi_time_s, temperature_rise_c, lat_deg, height_m (the site,
@@ -42,6 +47,10 @@ struct Factor {
   std::string name;
   std::vector<double> levels;  ///< the values, in the factor's unit
   double low = 0.0, high = 0.0;  ///< the range; used when levels is empty
+  /// > 0: the factor is uncertain: every run draws its value from N(level, sigma^2) (a
+  /// stream of its own, FactorSeed), and the results give the first-order spread its
+  /// analytic sensitivity predicts (summary.h). 0: every run takes the level.
+  double sigma = 0.0;
 };
 
 /// The base of every point; each factor overrides its field.
@@ -86,6 +95,10 @@ struct Study {
   /// paper_benchmark schedule: values only).
   std::string fit_method = "generalized";
   bool constant_bias = false;
+  /// The generalized fit is given the simulated sensor's bias walk and instability levels
+  /// (as --accel-rw, --gyro-rw, --accel-bi, --gyro-bi from a datasheet), instead of taking
+  /// them from the still data or the typical sensor (estimation/wander_levels.h).
+  bool wander_levels_given = false;
   std::vector<Factor> factors;
   nlohmann::json source;  ///< the study file as read (kept in every output)
   /// schedule "session": the calibrate document at base.template_path, loaded by the caller
@@ -118,5 +131,13 @@ Base Apply(const Study& study, const Point& point);
 /// The seed of run `run` of point `point`: from the study seed by std::seed_seq, so that any
 /// subset of runs reproduces bit for bit.
 std::uint64_t RunSeed(std::uint64_t study_seed, int point, int run);
+
+/// The seed of the uncertain factors' draws of run `run` of point `point` (Factor::sigma):
+/// another stream than RunSeed's, so the simulated noise is the same with or without them.
+std::uint64_t FactorSeed(std::uint64_t study_seed, int point, int run);
+
+/// The point a run sees: `point` with every uncertain factor (Factor::sigma > 0) drawn from
+/// N(its value, sigma^2) with FactorSeed.
+Point DrawUncertainFactors(const Study& study, const Point& point, int run);
 
 }  // namespace plumb::study

@@ -64,12 +64,30 @@ std::vector<RunOutcome> PoolByShape(const std::vector<RunOutcome>& runs) {
 
 }  // namespace
 
+namespace {
+
+/// FirstOrderCovariance as JSON: {parameters, matrix}, null without uncertain factors.
+json FirstOrderJson(const Study& study, const PointSummary& s) {
+  const auto cov = FirstOrderCovariance(study, s);
+  if (cov.empty()) return nullptr;
+  json names = json::array(), matrix = json::array();
+  for (const ParameterSummary& p : s.parameters) names.push_back(p.name);
+  for (const auto& row : cov) {
+    json r = json::array();
+    for (double v : row) r.push_back(Num(v));
+    matrix.push_back(r);
+  }
+  return json{{"parameters", names}, {"matrix", matrix}};
+}
+
+}  // namespace
+
 PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs,
                        const std::vector<std::string>& sensitivity_factors) {
   PointSummary s;
   s.point = point;
   s.runs = static_cast<int>(runs.size());
-  double nees_sum = 0.0, chi2_sum = 0.0;
+  double nees_sum = 0.0, nees_unflagged_sum = 0.0, chi2_sum = 0.0;
   int chi2_n = 0;
   const std::vector<RunOutcome> pooled = PoolByShape(runs);
   std::vector<int> d_dp_runs;  // per parameter and factor: runs with a sensitivity
@@ -85,6 +103,10 @@ PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs,
     if (std::isfinite(r.nees)) {
       nees_sum += r.nees;
       s.nees_dof += r.nees_dof;
+      if (!r.flagged) {
+        nees_unflagged_sum += r.nees;
+        s.nees_unflagged_dof += r.nees_dof;
+      }
     }
     if (std::isfinite(r.chi2_dof)) {
       chi2_sum += r.chi2_dof;
@@ -132,14 +154,44 @@ PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs,
     p.sd_error = p.runs > 1 ? std::sqrt(std::max(0.0, (sum_sq - sum * sum / n) / (n - 1.0))) : kNaN;
     p.mean_sigma /= n;
   }
-  if (s.nees_dof > 0) {
-    const double dof = s.nees_dof;
-    s.nees_per_dof = nees_sum / dof;
-    s.nees_low = signal::ChiSquareQuantileExact(0.025, dof) / dof;
-    s.nees_high = signal::ChiSquareQuantileExact(0.975, dof) / dof;
-  }
+  const auto pool = [](double sum, int dof, double& per_dof, double& low, double& high) {
+    if (dof <= 0) return;
+    per_dof = sum / dof;
+    low = signal::ChiSquareQuantileExact(0.025, dof) / dof;
+    high = signal::ChiSquareQuantileExact(0.975, dof) / dof;
+  };
+  pool(nees_sum, s.nees_dof, s.nees_per_dof, s.nees_low, s.nees_high);
+  pool(nees_unflagged_sum, s.nees_unflagged_dof, s.nees_unflagged_per_dof, s.nees_unflagged_low,
+       s.nees_unflagged_high);
   if (chi2_n > 0) s.mean_chi2_dof = chi2_sum / chi2_n;
   return s;
+}
+
+std::vector<std::vector<double>> FirstOrderCovariance(const Study& study, const PointSummary& s) {
+  const std::vector<std::string> factors = SensitivityFactors(study);
+  std::vector<double> sigma(factors.size(), 0.0);
+  bool any = false;
+  for (std::size_t f = 0; f < factors.size(); ++f) {
+    for (const Factor& factor : study.factors) {
+      if (factor.name == factors[f]) sigma[f] = factor.sigma;
+    }
+    any = any || sigma[f] > 0.0;
+  }
+  if (!any) return {};
+  const std::size_t n = s.parameters.size();
+  std::vector<std::vector<double>> cov(n, std::vector<double>(n, 0.0));
+  for (std::size_t f = 0; f < factors.size(); ++f) {
+    if (!(sigma[f] > 0.0)) continue;
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = 0; j < n; ++j) {
+        const auto& di = s.parameters[i].mean_d_dp;
+        const auto& dj = s.parameters[j].mean_d_dp;
+        const double a = f < di.size() ? di[f] : kNaN, b = f < dj.size() ? dj[f] : kNaN;
+        cov[i][j] += sigma[f] * sigma[f] * a * b;  // NaN where a sensitivity is missing
+      }
+    }
+  }
+  return cov;
 }
 
 json PointJson(const Study& study, const PointSummary& s) {
@@ -167,7 +219,11 @@ json PointJson(const Study& study, const PointSummary& s) {
               {"nees_dof", s.nees_dof},
               {"nees_band_95", {Num(s.nees_low), Num(s.nees_high)}},
               {"mean_chi2_dof", Num(s.mean_chi2_dof)},
+              {"nees_unflagged_per_dof", Num(s.nees_unflagged_per_dof)},
+              {"nees_unflagged_dof", s.nees_unflagged_dof},
+              {"nees_unflagged_band_95", {Num(s.nees_unflagged_low), Num(s.nees_unflagged_high)}},
               {"nees_per_run", nees},
+              {"first_order_covariance", FirstOrderJson(study, s)},
               {"parameters", params}};
 }
 
@@ -191,6 +247,10 @@ PointSummary PointFromJson(const Study& study, const json& doc, const std::strin
     s.nees_low = FromNum(doc.at("nees_band_95").at(0));
     s.nees_high = FromNum(doc.at("nees_band_95").at(1));
     s.mean_chi2_dof = FromNum(doc.at("mean_chi2_dof"));
+    s.nees_unflagged_per_dof = FromNum(doc.at("nees_unflagged_per_dof"));
+    s.nees_unflagged_dof = doc.at("nees_unflagged_dof").get<int>();
+    s.nees_unflagged_low = FromNum(doc.at("nees_unflagged_band_95").at(0));
+    s.nees_unflagged_high = FromNum(doc.at("nees_unflagged_band_95").at(1));
     for (const json& v : doc.at("nees_per_run")) s.nees.push_back(FromNum(v));
     for (const json& p : doc.at("parameters")) {
       std::vector<double> d_dp;
@@ -213,13 +273,17 @@ std::string ResultsCsv(const Study& study, const std::vector<PointSummary>& poin
          "nees_per_dof,nees_low,nees_high,mean_chi2_dof";
   const std::vector<std::string> sensitivity = SensitivityFactors(study);
   for (const std::string& f : sensitivity) out += ",d_" + f;
-  out += "\n";
+  out += ",nees_unflagged_per_dof,nees_unflagged_low,nees_unflagged_high,sd_first_order\n";
   for (const PointSummary& s : points) {
     std::string head = std::to_string(s.point.index);
     for (double v : s.point.values) head += "," + Csv(v);
     const std::string tail = "," + Csv(s.nees_per_dof) + "," + Csv(s.nees_low) + "," +
                              Csv(s.nees_high) + "," + Csv(s.mean_chi2_dof);
-    for (const ParameterSummary& p : s.parameters) {
+    const std::string unflagged = "," + Csv(s.nees_unflagged_per_dof) + "," +
+                                  Csv(s.nees_unflagged_low) + "," + Csv(s.nees_unflagged_high);
+    const auto first_order = FirstOrderCovariance(study, s);
+    for (std::size_t i = 0; i < s.parameters.size(); ++i) {
+      const ParameterSummary& p = s.parameters[i];
       out += head + "," + p.name + "," + p.unit + "," + std::to_string(p.runs) + "," +
              std::to_string(s.failed) + "," + std::to_string(s.flagged) + "," +
              Csv(p.mean_error) + "," + Csv(p.rms_error) + "," + Csv(p.sd_error) + "," +
@@ -227,11 +291,13 @@ std::string ResultsCsv(const Study& study, const std::vector<PointSummary>& poin
       for (std::size_t f = 0; f < sensitivity.size(); ++f) {
         out += "," + (f < p.mean_d_dp.size() ? Csv(p.mean_d_dp[f]) : std::string());
       }
-      out += "\n";
+      out += unflagged + "," +
+             (first_order.empty() ? std::string() : Csv(std::sqrt(first_order[i][i]))) + "\n";
     }
     if (s.parameters.empty()) {  // every run failed: one row that says so
       out += head + ",,," + std::to_string(0) + "," + std::to_string(s.failed) + "," +
-             std::to_string(s.flagged) + ",,,," + tail + std::string(sensitivity.size(), ',') + "\n";
+             std::to_string(s.flagged) + ",,,," + tail + std::string(sensitivity.size(), ',') +
+             unflagged + ",\n";
     }
   }
   return out;
