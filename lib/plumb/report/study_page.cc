@@ -51,6 +51,15 @@ std::string Safe(const std::string& name) {
   return out;
 }
 
+/// Two table cells: a NEES per dof (marked when outside its band, "n/a" without runs) and
+/// its band.
+std::string NeesCells(double per_dof, int dof, double low, double high) {
+  if (dof <= 0) return "<td class=\"num\">n/a</td><td></td>";
+  const bool outside = per_dof > high || per_dof < low;
+  return "<td class=\"num" + std::string(outside ? " warn" : "") + "\">" + Short(per_dof, "%.3f") +
+         "</td><td class=\"num\">" + Short(low, "%.3f") + " .. " + Short(high, "%.3f") + "</td>";
+}
+
 }  // namespace
 
 GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::PointSummary>& points) {
@@ -141,7 +150,8 @@ std::string StudyPage(const study::Study& study, const std::vector<study::PointS
           ". The numbers are in results.csv and results.json beside this page.</p>\n";
   html += "<h2>Points</h2>\n<table><tr><th>point</th>";
   for (const study::Factor& f : study.factors) html += "<th>" + HtmlEscape(f.name) + "</th>";
-  html += "<th>runs</th><th>failed</th><th>flagged</th><th>NEES / dof</th><th>95 % band</th></tr>\n";
+  html += "<th>runs</th><th>failed</th><th>flagged</th><th>NEES / dof</th><th>95 % band</th>"
+          "<th>NEES / dof, runs not flagged</th><th>95 % band</th></tr>\n";
   for (const study::PointSummary& p : points) {
     const bool outside = p.nees_dof > 0 && (p.nees_per_dof > p.nees_high || p.nees_per_dof < p.nees_low);
     html += "<tr><td class=\"num\">" + std::to_string(p.point.index) + "</td>";
@@ -151,7 +161,9 @@ std::string StudyPage(const study::Study& study, const std::vector<study::PointS
             "</td><td class=\"num" + std::string(outside ? " warn" : "") + "\">" +
             (p.nees_dof > 0 ? Short(p.nees_per_dof, "%.3f") : "n/a") + "</td><td class=\"num\">" +
             (p.nees_dof > 0 ? Short(p.nees_low, "%.3f") + " .. " + Short(p.nees_high, "%.3f") : "") +
-            "</td></tr>\n";
+            "</td>" + NeesCells(p.nees_unflagged_per_dof, p.nees_unflagged_dof, p.nees_unflagged_low,
+                                p.nees_unflagged_high) +
+            "</tr>\n";
   }
   html += "</table>\n<h2>Figures</h2>\n";
   if (!figure_note.empty()) html += "<p class=\"warn\">No figures: " + HtmlEscape(figure_note) + "</p>\n";
