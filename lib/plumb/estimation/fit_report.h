@@ -75,9 +75,9 @@ struct Gate {
 struct LinearityReport {
   bool checked = false;      ///< false: not run (options.check_linearity) or nothing to check
   double step_sigmas = 0;    ///< the step c, in sigma of the direction
-  /// Per direction of the parameters' correlation matrix (in the order of its eigenvalues,
-  /// increasing): the larger of chi^2(+c d) - chi^2 and chi^2(-c d) - chi^2, over c^2 (1 for
-  /// a linear model).
+  /// Per direction checked (the loosest of the parameters' correlation matrix, linearity.h,
+  /// in the order of its eigenvalues, increasing): the larger of chi^2(+c d) - chi^2 and
+  /// chi^2(-c d) - chi^2, over c^2 (1 for a linear model).
   std::vector<double> ratio;
   double worst_ratio = 0;       ///< the largest of `ratio`
   std::string worst_direction;  ///< its direction: the largest terms, in sigma of each parameter

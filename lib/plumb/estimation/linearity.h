@@ -10,7 +10,8 @@
 //
 // The check measures the curvature (Bates and Watts) instead of expanding it. With C the
 // model parameters' covariance (attitudes and wander states marginalised), D its sigmas and
-// R = D^-1 C D^-1 = V diag(mu) V^T its correlation matrix, each d_k = D v_k sqrt(mu_k) is one
+// R = D^-1 C D^-1 = V diag(mu) V^T its correlation matrix, each d_k = D v_k sqrt(mu_k) (of the
+// loosest, kLinearityDirections below) is one
 // sigma in the fit's own metric (d_k^T C^-1 d_k = 1). The step +-c d_k, with the other
 // unknowns at their conditional optimum (-N_rr^-1 N_rm c d_k, N = J^T J), raises chi^2 by
 // exactly c^2 in a linear model. The actual rise, through the problem's own residuals and
@@ -30,6 +31,13 @@ namespace plumb::estimation {
 /// 2 sigma), near enough that a well-posed fit stays quadratic (ratios 1.00-1.2 on the
 /// simulated multi-pose and benchmark sessions and on every bundled real session).
 inline constexpr double kLinearityStepSigmas = 2.0;
+
+/// Directions checked: the kLinearityDirections loosest of the correlation matrix (largest mu).
+/// A curved valley of near-equal fits runs along the loose directions: on the six faces with
+/// free attitudes the largest ratios (1e5-1e7) are at the two largest mu, and every ratio
+/// above 2 within the six largest; the tight combinations stay quadratic. Each direction costs
+/// two evaluations of the residuals.
+inline constexpr int kLinearityDirections = 6;
 
 /// The check of the file comment on `problem` (built by `calibration` with `held` held, at
 /// its solution: Solution::fitted() and held_parameters), with steps of `step_sigmas` sigma. The values are left as they were. Not checked

@@ -92,9 +92,10 @@ struct CalibrationOptions {
   /// pivots held (default), or by the pseudo-inverse of the column-scaled Jacobian. Both give
   /// the same sigma for every observable parameter and determined combination (tested).
   bool use_ceres_covariance = true;
-  /// Check that chi^2 is as quadratic as the covariance assumes, 2 sigma out along every
-  /// direction of the parameters' correlation (estimation/linearity.h; the nonlinear gate).
-  /// Costs two evaluations of the residuals per free model parameter; off for fits whose
+  /// Check that chi^2 is as quadratic as the covariance assumes, 2 sigma out along the
+  /// loosest directions of the parameters' correlation (estimation/linearity.h; the nonlinear
+  /// gate).
+  /// Costs two evaluations of the residuals per direction checked; off for fits whose
   /// covariance nobody reads (diagnose's candidate scores).
   bool check_linearity = true;
 };
