@@ -12,6 +12,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "validators.h"
 #include "commands.h"
 #include "fit_options.h"
 #include "input_options.h"
@@ -34,24 +35,6 @@ struct AllanArgs {
   signal::StillNoiseOptions noise;  ///< --confidence, --points-per-decade, --tau-min, ...
   bool no_quantisation = false;   ///< --no-quantisation: Q left out of the model
 };
-
-/// An output that is one of the inputs is refused before anything is read or written.
-void RefuseInputAsOutput(const InputArgs& input, const std::string& output) {
-  if (output.empty() || output == "-" || !std::filesystem::exists(output)) return;
-  std::vector<std::string> files = input.inputs;
-  files.push_back(input.acc_file);
-  files.push_back(input.gyr_file);
-  for (const std::string& entry : files) {
-    std::stringstream parts(entry);  // an `acc,gyr` pair names two files
-    std::string file;
-    while (std::getline(parts, file, ',')) {
-      std::error_code ec;
-      if (!file.empty() && std::filesystem::equivalent(file, output, ec)) {
-        throw UsageError("--json " + output + " is one of the inputs; nothing was written");
-      }
-    }
-  }
-}
 
 constexpr const char* kExample =
     "Example (a 449 s still record of an MPU-6050, raw counts at 100 Hz):\n"
@@ -88,12 +71,12 @@ class AllanCommand : public Command {
     fit->add_option("--tau-min", a.noise.terms.tau_min_s,
                     "Shortest cluster time fitted, s (0: from the sample interval; raise it "
                     "past a low-pass filter's time constant)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     fit->add_option("--tau-max", a.noise.terms.tau_max_s,
                     "Longest cluster time fitted, s (0: as far as the data has 2 degrees of "
                     "freedom)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     fit->add_option("--term-confidence", a.noise.terms.term_confidence,
                     "Confidence of the test that resolves a term and of the upper bounds")
@@ -107,6 +90,16 @@ class AllanCommand : public Command {
     app_->footer(kExample);
   }
 
+  FileRoles Files() const override {
+    FileRoles roles;
+    AddInputFiles(args_.input, roles);
+    if (!args_.segments.segments_path.empty()) {
+      roles.inputs.push_back({"--segments", args_.segments.segments_path});
+    }
+    roles.output_files.push_back({"--json", args_.json_path});
+    return roles;
+  }
+
   int Run() override {
     AllanArgs& a = args_;
     if (a.whole && !a.segments.segments_path.empty()) {
@@ -114,7 +107,6 @@ class AllanCommand : public Command {
                        "input as one still record");
     }
     a.noise.terms.quantisation = !a.no_quantisation;
-    RefuseInputAsOutput(a.input, a.json_path);
     const Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const TextAsideForJson text_aside(a.json_path);  // "-": the JSON alone on stdout

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "file_roles.h"
+
 namespace plumb::cli {
 
 /// A mistake in the command line found after parsing (e.g. options that do not go together).
@@ -26,6 +28,9 @@ class Command {
   CLI::App* app() const { return app_; }
   /// Does the work; returns the process exit code.
   virtual int Run() = 0;
+  /// The files the parsed command line reads and writes (file_roles.h): main refuses it
+  /// before Run when an output would overwrite an input.
+  virtual FileRoles Files() const { return {}; }
 
  protected:
   CLI::App* app_ = nullptr;

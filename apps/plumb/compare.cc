@@ -9,6 +9,7 @@
 // (plumb/peers/truth.h), one line per result when there are several.
 #include <iostream>
 
+#include "validators.h"
 #include "commands.h"
 #include "plumb/peers/comparison.h"
 #include "plumb/peers/imu_tk.h"
@@ -66,9 +67,21 @@ class CompareCommand : public Command {
     app_->add_option("--gravity", a.gravity_m_s2,
                      "Gravity magnitude of imu_tk's cost, m/s^2 (default: the result's "
                      "site.gravity; imu_tk's demo used 9.81744)")
-        ->check(CLI::PositiveNumber);
+        ->check(Positive);
     app_->add_option("--json", a.json_path, "Also write the comparison as JSON to FILE (- for stdout, the text then on stderr)")
         ->type_name("FILE");
+  }
+
+  FileRoles Files() const override {
+    const CompareArgs& a = args_;
+    FileRoles roles;
+    for (const std::string& r : a.results) roles.inputs.push_back({"RESULT", r});
+    for (const std::string& f : a.imu_tk) roles.inputs.push_back({"--imu-tk", f});
+    if (!a.imu_tk_params.empty()) roles.inputs.push_back({"--imu-tk-params", a.imu_tk_params});
+    if (!a.imucal.empty()) roles.inputs.push_back({"--imucal", a.imucal});
+    if (!a.truth.empty()) roles.inputs.push_back({"--truth", a.truth});
+    roles.output_files.push_back({"--json", a.json_path});
+    return roles;
   }
 
   int Run() override {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "validators.h"
 #include "commands.h"
 #include "fit_options.h"
 #include "input_options.h"
@@ -67,7 +68,7 @@ class DiagnoseCommand : public Command {
     app_->add_option("--confirm", a.confirm,
                      "Refit the model with each of the best N significant effects (the actual "
                      "fall of chi2)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     app_->add_option("--candidates", a.candidates,
                      "Test only these effects (NAME or NAME:OPTION, comma-separated); default: "
@@ -79,6 +80,17 @@ class DiagnoseCommand : public Command {
                      "Reference temperature of the temperature terms, degC")
         ->capture_default_str();
     AddSegmentOptions(app_, a.segments);
+  }
+
+  FileRoles Files() const override {
+    const DiagnoseArgs& a = args_;
+    FileRoles roles;
+    AddInputFiles(a.input, roles);
+    if (!a.segments.segments_path.empty()) roles.inputs.push_back({"--segments", a.segments.segments_path});
+    if (!a.fit.noise_from.empty()) roles.inputs.push_back({"--noise-from", a.fit.noise_from});
+    roles.output_files.push_back({"--json", a.json_path});
+    roles.output_files.push_back({"--residuals", a.residuals_path});
+    return roles;
   }
 
   int Run() override {

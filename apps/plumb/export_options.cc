@@ -7,6 +7,7 @@
 #include "plumb/core/error.h"
 #include "plumb/export/export.h"
 #include "plumb/io/common/atomic_file.h"
+#include "validators.h"
 
 namespace plumb::cli {
 
@@ -22,7 +23,7 @@ void AddExportOptions(CLI::App* app, ExportArgs& a) {
                                  "IMU instance in the exported parameter names, 0-based "
                                  "(ArduPilot 0..2: INS_ACC, INS_ACC2, INS_ACC3; PX4 0..3: "
                                  "CAL_ACC0..3); default: --imu")
-                     ->check(CLI::NonNegativeNumber);
+                     ->check(NonNegative);
   app->add_flag("--export-undetermined", a.undetermined,
                 "Write ArduPilot/PX4 parameters even when the session leaves the plumb "
                 "parameters they come from undetermined (one still pose, say): those values are "

@@ -14,6 +14,7 @@
 #include "plumb/estimation/wander_levels.h"
 #include "plumb/signal/noise_terms.h"
 #include "segment_options.h"
+#include "validators.h"
 
 namespace plumb::cli {
 
@@ -143,7 +144,7 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
   app->add_option("--max-iterations", a.max_iterations,
                   "Iteration limit of each solve; a fit that reaches it has not converged "
                   "(the gate not_converged)")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive)
       ->capture_default_str();
   AddWanderOptions(app, a);
 }

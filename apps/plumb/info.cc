@@ -67,6 +67,13 @@ class InfoCommand : public Command {
         ->type_name("FILE");
   }
 
+  FileRoles Files() const override {
+    FileRoles roles;
+    roles.inputs.push_back({"LOG", args_.log_path});
+    roles.output_files.push_back({"--json", args_.json_path});
+    return roles;
+  }
+
   int Run() override {
     const InfoArgs& a = args_;
     const TextAsideForJson text_aside(a.json_path);

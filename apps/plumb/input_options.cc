@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "plumb/io/input/open_inputs.h"
+#include "validators.h"
 
 namespace plumb::cli {
 namespace {
@@ -243,6 +244,14 @@ double ParseScale(const std::string& text, const std::string& option) {
   return num / den;
 }
 
+void AddInputFiles(const InputArgs& args, FileRoles& roles) {
+  for (const std::string& input : args.inputs) {
+    for (const std::string& file : InputFiles(input)) roles.inputs.push_back({"INPUT", file});
+  }
+  if (!args.acc_file.empty()) roles.inputs.push_back({"--acc", args.acc_file});
+  if (!args.gyr_file.empty()) roles.inputs.push_back({"--gyr", args.gyr_file});
+}
+
 void AddInputOptions(CLI::App* app, InputArgs& a) {
   app->add_option("INPUT", a.inputs,
                   "Input files: plumb's native CSV, a text table (see --columns), an "
@@ -254,7 +263,7 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
       "Flight logs", "Reading an ArduPilot .bin/.log, MAVLink .tlog or PX4 .ulg log "
                      "(`plumb info LOG` lists its IMU streams)");
   logs->add_option("--imu", a.imu, "IMU instance of the log, 0-based (IMU = 0, IMU2 = 1, ...)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative)
       ->capture_default_str();
   logs->add_option("--stream", a.stream,
                    "IMU stream (message or topic) of that instance, as `plumb info` names it, "
@@ -286,7 +295,8 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
                         "form: t,x,y,z (the default there)"),
       group->add_option("--delimiter", a.delimiter,
                         "Field separator: , ; tab space (default: detected from the first row)"),
-      group->add_option("--skip-lines", a.skip_lines, "Lines dropped at the top of each file"),
+      group->add_option("--skip-lines", a.skip_lines, "Lines dropped at the top of each file")
+          ->check(NonNegative),
       group->add_flag("--header", a.header,
                       "The first line after the skipped ones is a header row (not data)"),
       group->add_option("--comment", a.comment,
@@ -294,11 +304,11 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
       group
           ->add_option("--time-scale", a.time_unit_s,
                        "Seconds per unit of the time column (1e-3 for ms, 1e-6 for us)")
-          ->check(CLI::PositiveNumber),
+          ->check(Positive),
       group
           ->add_option("--rate", a.rate_hz,
                        "Sample rate, Hz, when the table has no time column (time = row / rate)")
-          ->check(CLI::PositiveNumber),
+          ->check(Positive),
       group->add_option("--acc-unit", a.acc_unit,
                         "Accelerometer unit in the file: m/s^2, g, or counts (unscaled sensor "
                         "output: calibrated in counts, the matrix then in counts per m/s^2)")

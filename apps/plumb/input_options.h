@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "file_roles.h"
 #include "plumb/core/session.h"
 
 namespace plumb::cli {
@@ -61,6 +62,9 @@ struct InputArgs {
 
 /// Registers INPUT... and every input option on `app`.
 void AddInputOptions(CLI::App* app, InputArgs& args);
+
+/// Adds the files INPUT..., --acc and --gyr name to `roles`' inputs (file_roles.h).
+void AddInputFiles(const InputArgs& args, FileRoles& roles);
 
 /// Reads every input and joins them into one session (plumb::io::OpenInputs). Throws
 /// UsageError for contradictory or malformed options, plumb::InputError naming the file for bad

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "validators.h"
 #include "plumb/report/version.h"
 
 namespace {
@@ -86,6 +87,8 @@ int main(int argc, char** argv) {
   }
   if (selected == nullptr) return 2;  // unreachable: require_subcommand(1)
   try {
+    plumb::cli::RejectNonFiniteNumbers(*selected->app());
+    plumb::cli::RefuseOverwritingInputs(selected->Files());
     return selected->Run();
   } catch (const plumb::cli::UsageError& e) {
     std::cerr << "plumb: error: " << e.what() << "\nRun 'plumb " << selected->app()->get_name()

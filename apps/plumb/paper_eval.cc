@@ -20,6 +20,7 @@
 #include <optional>
 #include <sstream>
 
+#include "validators.h"
 #include "commands.h"
 #include "input_options.h"
 #include "plumb/core/error.h"
@@ -475,10 +476,20 @@ class PaperCommand : public Command {
                      "ICM-42688-P")
         ->capture_default_str();
     app_->add_option("--stride", a.stride, "Write every N-th sample to inputs.csv")
-        ->check(CLI::PositiveNumber)
+        ->check(Positive)
         ->capture_default_str();
     app_->add_flag("--no-plot", a.no_plot, "Write figures.gp but do not run gnuplot");
     AddGravityOption(app_, a.site);
+  }
+
+  FileRoles Files() const override {
+    const PaperArgs& a = args_;
+    FileRoles roles;
+    AddInputFiles(a.input, roles);
+    if (!a.segments_path.empty()) roles.inputs.push_back({"--segments", a.segments_path});
+    if (!a.static_path.empty()) roles.inputs.push_back({"--static", a.static_path});
+    roles.output_folders.push_back({"--out", a.out_dir});
+    return roles;
   }
 
   int Run() override {

@@ -17,6 +17,7 @@
 #include <iostream>
 #include <optional>
 
+#include "validators.h"
 #include "commands.h"
 #include "fit_options.h"
 #include "input_options.h"
@@ -125,7 +126,7 @@ class ReportCommand : public Command {
         ->capture_default_str();
     app_->add_option("--confirm", a.confirm,
                      "Refit the model with each of the best N significant effects")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     AddFitOptions(app_, a.fit);
     app_->add_flag("--no-figures", a.no_figures, "Write the page without figures (no gnuplot)");
@@ -139,6 +140,17 @@ class ReportCommand : public Command {
                      "'plumb sweep' wrote): its points, and the NEES band and the error and "
                      "sigma against every factor")
         ->type_name("SWEEP_DIR");
+  }
+
+  FileRoles Files() const override {
+    const ReportArgs& a = args_;
+    FileRoles roles;
+    AddInputFiles(a.input, roles);
+    if (!a.segments.segments_path.empty()) roles.inputs.push_back({"--segments", a.segments.segments_path});
+    if (!a.fit.noise_from.empty()) roles.inputs.push_back({"--noise-from", a.fit.noise_from});
+    if (!a.study.empty()) roles.inputs.push_back({"--study", a.study});
+    roles.output_folders.push_back({"--out", a.out_dir});
+    return roles;
   }
 
   int Run() override {

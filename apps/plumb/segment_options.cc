@@ -3,6 +3,7 @@
 
 #include "plumb/io/text/segments_file.h"
 #include "plumb/segmentation/given_segments.h"
+#include "validators.h"
 
 namespace plumb::cli {
 
@@ -15,13 +16,13 @@ void AddSegmentOptions(CLI::App* app, SegmentArgs& a) {
   det->add_option("--init-still", a.detector.init_still_s,
                   "Length of the still period at the start used for the noise, s (0 = the "
                   "quietest stretch, found automatically)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative)
       ->capture_default_str();
   det->add_option("--window", a.detector.window_s, "Length of the moving window, s")
-      ->check(CLI::PositiveNumber)
+      ->check(Positive)
       ->capture_default_str();
   det->add_option("--min-still", a.detector.min_still_s, "Shortest still segment kept, s")
-      ->check(CLI::NonNegativeNumber)
+      ->check(NonNegative)
       ->capture_default_str();
   det->add_option("--false-alarm", a.detector.false_alarm,
                   "Probability that a still window is called moving, all tests together "

@@ -18,6 +18,7 @@
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/truth.h"
 #include "site_options.h"
+#include "validators.h"
 
 namespace plumb::cli {
 namespace {
@@ -158,11 +159,11 @@ class SimulateCommand : public Command {
     a.still_option = app_->add_option("--still", a.still_s,
                                       "Length of each still hold, s (default: multipose 5, "
                                       "paper-static 60, paper-benchmark 20)")
-                         ->check(CLI::PositiveNumber);
+                         ->check(Positive);
     a.turn_option = app_->add_option("--turn", a.turn_s,
                                      "Length of each turn, s (default: multipose 2, "
                                      "paper-benchmark 3)")
-                        ->check(CLI::PositiveNumber);
+                        ->check(Positive);
     app_->add_option("--rate", a.rate_hz, "Sample rate, Hz")
         ->check(CLI::Range(1e-3, 1e5))
         ->capture_default_str();
@@ -176,53 +177,53 @@ class SimulateCommand : public Command {
     app_->add_option("--random-truth", a.random_truth,
                      "Draw every free parameter from N(nominal, (SCALE x typical size)^2) before "
                      "--truth applies; 0 = ideal IMU")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     auto* noise = app_->add_option_group("Noise", "Sensor noise (defaults: a typical MEMS IMU)");
     noise
         ->add_option("--accel-noise", a.noise.accel_noise_density,
                      "Accelerometer white-noise density, m/s^2/sqrt(Hz)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     noise
         ->add_option("--gyro-noise", a.noise.gyro_noise_density,
                      "Gyroscope white-noise density, rad/s/sqrt(Hz)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     noise
         ->add_option("--accel-rw", a.noise.accel_bias_walk_density,
                      "Accelerometer bias random-walk density, m/s^3/sqrt(Hz)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     noise
         ->add_option("--gyro-rw", a.noise.gyro_bias_walk_density,
                      "Gyroscope bias random-walk density, rad/s^2/sqrt(Hz)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     noise
         ->add_option("--accel-bi", a.noise.accel_bias_instability,
                      "Accelerometer bias instability: Gauss-Markov sigma, m/s^2")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     noise
         ->add_option("--gyro-bi", a.noise.gyro_bias_instability,
                      "Gyroscope bias instability: Gauss-Markov sigma, rad/s")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     noise
         ->add_option("--bi-time", a.noise.bias_instability_time_s,
                      "Correlation time of the bias instability, s")
-        ->check(CLI::PositiveNumber)
+        ->check(Positive)
         ->capture_default_str();
     noise
         ->add_option("--quantisation-acc", a.noise.accel_quantum,
                      "Accelerometer quantisation step, m/s^2 (0 = none)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     noise
         ->add_option("--quantisation-gyr", a.noise.gyro_quantum,
                      "Gyroscope quantisation step, rad/s (0 = none)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(NonNegative)
         ->capture_default_str();
     app_->add_option("--temperature", a.temperature,
                      "Sensor temperature profile, degC: const:T, ramp:T0:T1 (over the session) "
@@ -243,6 +244,14 @@ class SimulateCommand : public Command {
                      "Write the true still segments as a segments file (start,end,label sample "
                      "indices) for 'plumb calibrate --segments'")
         ->type_name("FILE");
+  }
+
+  FileRoles Files() const override {
+    FileRoles roles;
+    roles.output_files.push_back({"--out", args_.out_path});
+    roles.output_files.push_back({"--truth-json", args_.truth_json});
+    roles.output_files.push_back({"--segments-out", args_.segments_out});
+    return roles;
   }
 
   int Run() override {

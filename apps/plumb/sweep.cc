@@ -19,6 +19,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "validators.h"
 #include "commands.h"
 #include "study_files.h"
 #include "plumb/core/error.h"
@@ -149,10 +150,23 @@ class SweepCommand : public Command {
                      "the shards with 'plumb sweep merge'")
         ->type_name("K/N");
     app_->add_option("--jobs", a.jobs, "Runs in parallel (default: every core)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(NonNegative);
     merge_ = app_->add_subcommand("merge", "Join the folders of a study's shards into one result");
     merge_->add_option("DIR", a.merge_dirs, "The shards' --out folders")->required();
     merge_->add_option("--out", a.merge_out, "Folder for the joined result")->required();
+  }
+
+  FileRoles Files() const override {
+    const SweepArgs& a = args_;
+    FileRoles roles;
+    if (merge_->parsed()) {
+      for (const std::string& dir : a.merge_dirs) roles.inputs.push_back({"merge DIR", dir});
+      roles.output_folders.push_back({"merge --out", a.merge_out});
+    } else {
+      roles.inputs.push_back({"STUDY", a.study_path});
+      roles.output_folders.push_back({"--out", a.out});
+    }
+    return roles;
   }
 
   int Run() override {

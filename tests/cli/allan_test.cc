@@ -158,7 +158,7 @@ TEST(Allan, RefusesMistakesAndNamesTheInput) {
   EXPECT_EQ(Plumb({"allan", csv, "--confidence", "1.5"}, dir).exit_code, 2);
   const ToolRun self = Plumb({"allan", csv, "--whole", "--json", csv}, dir);
   EXPECT_EQ(self.exit_code, 2);
-  EXPECT_TRUE(Contains(self.err, "is one of the inputs")) << self.err;
+  EXPECT_TRUE(Contains(self.err, "is the same file as the input")) << self.err;
   // Five samples: too little for any Allan deviation; the message names the file.
   const std::string tiny = dir.Write(
       "tiny.csv",

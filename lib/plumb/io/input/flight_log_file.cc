@@ -2,6 +2,10 @@
 #include "plumb/io/input/flight_log_file.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 
 #include "plumb/core/error.h"
 #include "plumb/io/ardupilot/ardupilot_session.h"
@@ -64,6 +68,12 @@ const char* FlightLogFormatName(FlightLogFormat format) {
 }
 
 FlightLog FlightLog::Open(const std::string& path) {
+  {  // a missing, unreadable or folder path says so (not "not a flight log")
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a folder, not a file");
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw InputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
+  }
   FlightLog out;
   out.source_ = path;
   out.format_ = SniffFlightLog(path);

@@ -1,0 +1,81 @@
+#include "file_roles.h"
+
+#include <filesystem>
+#include <sstream>
+#include <system_error>
+
+#include "commands.h"
+
+namespace plumb::cli {
+namespace fs = std::filesystem;
+namespace {
+
+bool Exists(const std::string& path) {
+  std::error_code ec;
+  return !path.empty() && path != "-" && fs::exists(path, ec);
+}
+
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return Exists(a) && Exists(b) && fs::equivalent(a, b, ec) && !ec;
+}
+
+/// `inner` is `outer` or lies below it (both resolved, symlinks followed).
+bool Within(const std::string& inner, const std::string& outer) {
+  if (!Exists(inner) || !Exists(outer)) return false;
+  std::error_code ec;
+  const fs::path in = fs::canonical(inner, ec), out = fs::canonical(outer, ec);
+  if (ec) return false;
+  auto i = in.begin();
+  for (auto o = out.begin(); o != out.end(); ++o, ++i) {
+    if (i == in.end() || *i != *o) return false;
+  }
+  return true;
+}
+
+std::string Said(const NamedPath& p) { return p.option + " " + p.path; }
+
+[[noreturn]] void Refuse(const NamedPath& output, const NamedPath& input, const std::string& how) {
+  throw UsageError(Said(output) + " " + how + " " + Said(input) +
+                   ": refused, so that no input is overwritten; nothing was read or written. "
+                   "Choose another output");
+}
+
+}  // namespace
+
+std::vector<std::string> InputFiles(const std::string& input) {
+  if (Exists(input) || input.find(',') == std::string::npos) return {input};
+  std::vector<std::string> files;
+  std::stringstream parts(input);
+  std::string file;
+  while (std::getline(parts, file, ',')) {
+    if (!file.empty()) files.push_back(file);
+  }
+  return files;
+}
+
+void RefuseOverwritingInputs(const FileRoles& roles) {
+  for (const NamedPath& out : roles.output_files) {
+    for (const NamedPath& in : roles.inputs) {
+      if (SameFile(out.path, in.path)) Refuse(out, in, "is the same file as the input");
+    }
+  }
+  for (std::size_t i = 0; i < roles.output_files.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      const NamedPath &a = roles.output_files[j], &b = roles.output_files[i];
+      const bool same = SameFile(a.path, b.path) ||
+                        (!a.path.empty() && a.path != "-" && a.path == b.path);
+      if (same) {
+        throw UsageError(Said(a) + " and " + Said(b) +
+                         " are one file: one would overwrite the other; nothing was written");
+      }
+    }
+  }
+  for (const NamedPath& folder : roles.output_folders) {
+    for (const NamedPath& in : roles.inputs) {
+      if (Within(in.path, folder.path)) Refuse(folder, in, "is or holds the input");
+    }
+  }
+}
+
+}  // namespace plumb::cli

@@ -1,0 +1,23 @@
+// apps/plumb/validators.h — the checks every numeric option gets, in one place.
+//
+// Positive / NonNegative replace CLI11's PositiveNumber / NonNegativeNumber, whose message
+// prints the largest double in full (309 digits). RejectNonFiniteNumbers runs on the parsed
+// command line before any work: a nan, an inf or an overflowing number (1e999) in a numeric
+// option, or as the value of KEY=VALUE or a field of A:B:C in a text option (--truth,
+// --temperature), is refused with the option named (exit 2) instead of reaching the solver.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace plumb::cli {
+
+/// A finite number > 0; the message says the value given.
+extern const CLI::Validator Positive;
+/// A finite number >= 0.
+extern const CLI::Validator NonNegative;
+
+/// Throws UsageError naming the option and its value when a given option of `app` or of its
+/// parsed subcommands holds a number that is not finite (file comment).
+void RejectNonFiniteNumbers(const CLI::App& app);
+
+}  // namespace plumb::cli

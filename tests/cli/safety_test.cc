@@ -1,0 +1,187 @@
+// Bad input and mistaken command lines, as a user meets them: an output that is one of the
+// inputs (the same file by device and inode, through a symlink or a hard link), two outputs
+// that are one file, an output folder that holds an input. Each is refused with exit 2 before
+// anything is read or written, naming both options and paths, and the input is left byte for
+// byte as it was.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <utility>
+#include <string>
+#include <vector>
+
+#include "run_tool.h"
+
+namespace plumb::cli {
+namespace {
+
+using testing::Contains;
+using testing::Plumb;
+using testing::ReadAll;
+using testing::TempDir;
+using testing::ToolRun;
+namespace fs = std::filesystem;
+
+/// A small simulated session in `dir`: its path.
+std::string Session(const TempDir& dir) {
+  const std::string csv = dir.File("s.csv");
+  const ToolRun sim = Plumb({"simulate", "--out", csv, "--poses", "9", "--rate", "50", "--seed", "2"}, dir);
+  EXPECT_EQ(sim.exit_code, 0) << sim.err;
+  return csv;
+}
+
+/// Runs `args`, expects exit 2 with `message` and every file in `unchanged` as it was.
+void ExpectRefused(const std::vector<std::string>& args, const std::string& message,
+                   const std::vector<std::string>& unchanged, const TempDir& dir) {
+  std::vector<std::string> before;
+  for (const std::string& f : unchanged) before.push_back(ReadAll(f));
+  const ToolRun run = Plumb(args, dir);
+  std::string line;
+  for (const std::string& a : args) line += a + " ";
+  EXPECT_EQ(run.exit_code, 2) << line << "\n" << run.err;
+  EXPECT_TRUE(Contains(run.err, message)) << line << "\n" << run.err;
+  EXPECT_TRUE(Contains(run.err, "nothing was")) << run.err;
+  for (std::size_t i = 0; i < unchanged.size(); ++i) {
+    EXPECT_EQ(ReadAll(unchanged[i]), before[i]) << unchanged[i] << " changed by: " << line;
+  }
+}
+
+TEST(Safety, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
+  TempDir dir;
+  const std::string csv = Session(dir);
+  const std::string same = "is the same file as the input INPUT " + csv;
+  ExpectRefused({"calibrate", csv, "--json", csv}, "--json " + csv + " " + same, {csv}, dir);
+  ExpectRefused({"calibrate", csv, "--export", "ardupilot=" + csv}, "--export ardupilot " + csv,
+                {csv}, dir);
+  ExpectRefused({"diagnose", csv, "--json", csv, "--confirm", "0"}, same, {csv}, dir);
+  ExpectRefused({"allan", csv, "--json", csv}, same, {csv}, dir);
+  // Through a symlink and a hard link: the same device and inode.
+  const std::string link = dir.File("link.json"), hard = dir.File("hard.json");
+  fs::create_symlink(csv, link);
+  fs::create_hard_link(csv, hard);
+  ExpectRefused({"calibrate", csv, "--json", link}, "--json " + link + " " + same, {csv}, dir);
+  ExpectRefused({"calibrate", csv, "--json", hard}, "--json " + hard + " " + same, {csv}, dir);
+  EXPECT_TRUE(fs::is_symlink(link));
+  // The two-file form's files and the other inputs count too.
+  const std::string result = dir.File("r.json");
+  ASSERT_EQ(Plumb({"calibrate", csv, "--json", result}, dir).exit_code, 0);
+  ExpectRefused({"compare", result, "--json", result}, "is the same file as the input RESULT",
+                {result}, dir);
+  const std::string segments = dir.File("seg.csv");
+  ASSERT_EQ(Plumb({"simulate", "--out", dir.File("t.csv"), "--poses", "9", "--rate", "50",
+                   "--segments-out", segments},
+                  dir).exit_code,
+            0);
+  ExpectRefused({"calibrate", dir.File("t.csv"), "--segments", segments, "--json", segments},
+                "is the same file as the input --segments", {segments}, dir);
+}
+
+TEST(Safety, TwoOutputsThatAreOneFileAreRefused) {
+  TempDir dir;
+  const std::string out = dir.File("a.csv");
+  ExpectRefused({"simulate", "--out", out, "--truth-json", out}, "are one file", {}, dir);
+  EXPECT_FALSE(fs::exists(out));
+  const std::string csv = Session(dir);
+  const std::string json = dir.File("r.json");
+  ExpectRefused({"calibrate", csv, "--json", json, "--export", "px4=" + json}, "are one file",
+                {csv}, dir);
+  EXPECT_FALSE(fs::exists(json));
+}
+
+TEST(Safety, AnOutputFolderThatHoldsAnInputIsRefused) {
+  TempDir dir;
+  const std::string csv = Session(dir);
+  ExpectRefused({"report", csv, "--out", dir.path().string(), "--no-figures"},
+                "--out " + dir.path().string() + " is or holds the input INPUT " + csv, {csv}, dir);
+  // A study's folder as the input of its own page or merge.
+  const std::string study = dir.File("study.json");
+  std::ofstream(study) << R"({"name": "t", "seed": 1, "runs": 1, "design": "grid",
+    "base": {"poses": 9, "still_s": 3, "rate_hz": 50}, "factors": [{"name": "poses", "levels": [9]}]})";
+  const std::string sweep = dir.File("sweep");
+  ASSERT_EQ(Plumb({"sweep", study, "--out", sweep, "--jobs", "1"}, dir).exit_code, 0);
+  const std::string results = ReadAll(sweep + "/results.csv");
+  ExpectRefused({"sweep", "merge", sweep, "--out", sweep}, "is or holds the input merge DIR",
+                {sweep + "/results.csv"}, dir);
+  ExpectRefused({"report", "--study", sweep, "--out", sweep}, "is or holds the input --study",
+                {sweep + "/results.csv"}, dir);
+  ExpectRefused({"sweep", sweep + "/study.json", "--out", sweep}, "is or holds the input STUDY",
+                {sweep + "/study.json"}, dir);
+  EXPECT_EQ(ReadAll(sweep + "/results.csv"), results);
+}
+
+TEST(Safety, AMissingLogOrAFolderIsSaidAsSuch) {
+  TempDir dir;
+  const ToolRun missing = Plumb({"info", dir.File("nothing.bin")}, dir);
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_TRUE(Contains(missing.err, dir.File("nothing.bin") + ": cannot open the file")) << missing.err;
+  const ToolRun folder = Plumb({"info", dir.path().string()}, dir);
+  EXPECT_EQ(folder.exit_code, 1);
+  EXPECT_TRUE(Contains(folder.err, "is a folder, not a file")) << folder.err;
+}
+
+/// The numeric options of `command` as its --help lists them ("--heading FLOAT ...").
+std::vector<std::string> NumericOptions(const std::string& command, const TempDir& dir) {
+  std::vector<std::string> args = {command, "--help"};
+  if (command == "sweep merge") args = {"sweep", "merge", "--help"};
+  const ToolRun help = Plumb(args, dir);
+  std::vector<std::string> out;
+  std::istringstream lines(help.out);
+  std::string line;
+  while (std::getline(lines, line)) {
+    std::istringstream words(line);
+    std::string name, type;
+    words >> name >> type;
+    if (name.rfind("--", 0) != 0) continue;
+    if (const auto comma = name.find(','); comma != std::string::npos) name = name.substr(comma + 1);
+    if (type.rfind("FLOAT", 0) == 0 || type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0) {
+      out.push_back(name);
+    }
+  }
+  return out;
+}
+
+TEST(Safety, EveryNumericOptionRefusesNanInfAndOverflowBeforeAnyWork) {
+  // Every numeric option of every command, from its own --help, given nan, -inf and 1e999:
+  // exit 2 (never a signal: Ceres aborted on --heading nan), the option named, no file written.
+  TempDir dir;
+  const std::string csv = Session(dir);
+  const std::string study = dir.File("study.json");
+  std::ofstream(study) << R"({"name": "t", "runs": 1, "factors": [{"name": "poses", "levels": [9]}]})";
+  const std::vector<std::pair<std::string, std::vector<std::string>>> commands = {
+      {"calibrate", {csv, "--json", dir.File("o.json")}},
+      {"diagnose", {csv, "--json", dir.File("o.json")}},
+      {"report", {csv, "--out", dir.File("page")}},
+      {"paper", {csv, "--out", dir.File("paper")}},
+      {"allan", {csv, "--json", dir.File("o.json")}},
+      {"compare", {dir.File("missing.json")}},
+      {"simulate", {"--out", dir.File("o.csv")}},
+      {"sweep", {study, "--out", dir.File("sweep")}},
+  };
+  int checked = 0;
+  for (const auto& [command, base] : commands) {
+    const std::vector<std::string> options = NumericOptions(command, dir);
+    EXPECT_FALSE(options.empty()) << command;
+    for (const std::string& option : options) {
+      for (const char* bad : {"nan", "-inf", "1e999"}) {
+        std::vector<std::string> args = {command};
+        args.insert(args.end(), base.begin(), base.end());
+        args.push_back(option);
+        args.push_back(bad);
+        const ToolRun run = Plumb(args, dir);
+        EXPECT_EQ(run.exit_code, 2) << command << " " << option << " " << bad << ": " << run.err;
+        EXPECT_TRUE(Contains(run.err, option)) << command << " " << option << " " << bad << ": "
+                                               << run.err;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 150);
+  for (const char* written : {"o.json", "o.csv", "page", "paper", "sweep"}) {
+    EXPECT_FALSE(fs::exists(dir.File(written))) << written;
+  }
+}
+
+}  // namespace
+}  // namespace plumb::cli
