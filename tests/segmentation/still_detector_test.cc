@@ -88,6 +88,29 @@ TEST(StillDetector, FindsEveryPoseOfASyntheticSession) {
   EXPECT_GE(result.report.notes.size(), 5U);
 }
 
+TEST(StillDetector, AQuantisedStreamThatNeverChangesWhileStillIsFlooredAtItsStep) {
+  // The synthetic session rounded to steps far above its noise (0.1 m/s^2 and 0.05 rad/s, as a
+  // 4 Hz telemetry stream's 1 mG and 1 mrad/s are above a good IMU's noise): every still
+  // period reads constant values. The noise is the step's rounding noise, q / sqrt(12), and
+  // the still poses are found (it threw "zero variance" before).
+  std::vector<std::pair<double, double>> still;
+  ImuSeries series = testing::MakeSession(MultiPosePhases(), {}, &still);
+  constexpr double kAccStep = 0.1, kGyrStep = 0.05;
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      series.acc[i][a] = static_cast<float>(kAccStep * std::round(series.acc[i][a] / kAccStep));
+      series.gyr[i][a] = static_cast<float>(kGyrStep * std::round(series.gyr[i][a] / kGyrStep));
+    }
+  }
+  const SegmentationResult result = DetectStillSegments(series);
+  EXPECT_GE(result.segments.size(), 6U);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GE(result.noise.acc_sigma[a], 0.999 * kAccStep / std::sqrt(12.0)) << a;
+    EXPECT_GE(result.noise.gyr_sigma[a], 0.999 * kGyrStep / std::sqrt(12.0)) << a;
+    EXPECT_GE(result.noise.gyr_tau_int[a], 1.0) << a;
+  }
+}
+
 TEST(StillDetector, InitialStillPeriodGivesTheSameSegments) {
   std::vector<std::pair<double, double>> still;
   const ImuSeries series = testing::MakeSession(MultiPosePhases(), {}, &still);

@@ -35,7 +35,23 @@ struct Pooled {
   Vec3 scatter = Vec3::Zero();  ///< sum over runs of squared deviations from the run's mean
 };
 
+/// The output's resolution on `axis`: the smallest nonzero step between consecutive samples
+/// of the whole series, 0 when the axis never changes.
+double QuantisationStep(const ImuSeries& series, signal::Sensor sensor, int axis) {
+  const signal::AxisView v = signal::ViewAxis(series, sensor, axis, 0, series.size());
+  double step = 0.0;
+  for (Eigen::Index i = 1; i < v.size(); ++i) {
+    const double d = std::abs(static_cast<double>(v[i]) - static_cast<double>(v[i - 1]));
+    if (d > 0.0 && (step == 0.0 || d < step)) step = d;
+  }
+  return step;
+}
+
 /// Per-axis noise of a triad from pooled moments and the correlation time of its samples.
+/// A quantised output (a low-rate telemetry stream in steps of 1 mG and 1 mrad/s) may read one
+/// constant value through every still period: its scatter is then no measure of the noise,
+/// which is below the step, and the noise is floored at the quantisation noise of the step q,
+/// q / sqrt(12) (uniform rounding error); such an axis has no correlation to measure (white).
 void FinishTriad(const ImuSeries& series, const std::vector<StillSegment>& spans,
                  signal::Sensor sensor, const Pooled& pooled, const Vec3& reference,
                  double samples, double dof, Vec3& mean, Vec3& sigma, Vec3& tau_int,
@@ -43,10 +59,22 @@ void FinishTriad(const ImuSeries& series, const std::vector<StillSegment>& spans
   mean = reference + pooled.sum / samples;
   const double floor = 4.0 * kFloatEps * mean.cwiseAbs().maxCoeff();
   sigma = (pooled.scatter / dof).cwiseSqrt().cwiseMax(floor);
-  const auto ct = signal::EstimateCorrelationTime(series, spans, sensor);
-  for (std::size_t a = 0; a < 3; ++a) {
-    tau_int[static_cast<int>(a)] = std::max(1.0, ct[a].tau_int);
-    tau_sq[static_cast<int>(a)] = std::max(1.0, ct[a].tau_sq);
+  for (int a = 0; a < 3; ++a) {
+    sigma[a] = std::max(sigma[a], QuantisationStep(series, sensor, a) / std::sqrt(12.0));
+    std::vector<signal::AxisView> chunks;
+    for (const StillSegment& span : spans) {
+      chunks.push_back(signal::ViewAxis(series, sensor, a, span.begin, span.end));
+    }
+    const bool constant = std::all_of(chunks.begin(), chunks.end(), [](const signal::AxisView& c) {
+      return c.size() == 0 || (c.array() == c[0]).all();
+    });
+    if (constant) {
+      tau_int[a] = tau_sq[a] = 1.0;
+      continue;
+    }
+    const signal::CorrelationTime ct = signal::EstimateCorrelationTime(chunks, {});
+    tau_int[a] = std::max(1.0, ct.tau_int);
+    tau_sq[a] = std::max(1.0, ct.tau_sq);
   }
 }
 
