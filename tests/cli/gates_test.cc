@@ -247,7 +247,7 @@ TEST(GatesCli, AWrongRateIsNamedAndStrictExportWritesNothing) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(LineStarting(run.out, "gate failed: "),
             "gate failed: unit_or_rate: " + Mikoff() +
-                ": the gyroscope's scale came out 10.03 (gyro.matrix diagonal 9.988, 10.04, "
+                ": the gyroscope's scale came out 10.03 (gyro.matrix diagonal 9.987, 10.04, "
                 "10.07), not about 1: the turns integrate to 10.03 times the angles the "
                 "accelerometer sees between the poses, so the sample times are likely wrong by "
                 "that factor: the samples are 0.1 s apart (10 Hz), the turns say about 100.3 Hz "

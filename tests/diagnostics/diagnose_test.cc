@@ -142,7 +142,7 @@ const estimation::ParameterEstimate* FindParameter(const estimation::Calibration
 
 /// The 99% band of chi^2/dof around 1 for `dof` degrees of freedom.
 std::pair<double, double> Chi2DofBand(int dof) {
-  return {signal::ChiSquareQuantile(0.005, dof) / dof, signal::ChiSquareQuantile(0.995, dof) / dof};
+  return {signal::ChiSquareQuantileExact(0.005, dof) / dof, signal::ChiSquareQuantileExact(0.995, dof) / dof};
 }
 
 // --- 1. one hidden effect ------------------------------------------------------------------

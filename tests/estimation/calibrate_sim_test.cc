@@ -119,8 +119,8 @@ TEST(CalibrateSimulated, CovarianceIsHonestOverMonteCarlo) {
     sum += Nees(CalibrateMultiPose(1000 + static_cast<std::uint64_t>(run), "base", 12, 3.0));
   }
   const double mean = sum / kRuns;
-  const double lo = signal::ChiSquareQuantile(0.025, kRuns * kParams) / kRuns;
-  const double hi = signal::ChiSquareQuantile(0.975, kRuns * kParams) / kRuns;
+  const double lo = signal::ChiSquareQuantileExact(0.025, kRuns * kParams) / kRuns;
+  const double hi = signal::ChiSquareQuantileExact(0.975, kRuns * kParams) / kRuns;
   EXPECT_GT(mean, lo);
   EXPECT_LT(mean, hi);
   std::cout << "average NEES " << mean << " (95% band " << lo << " .. " << hi << ")\n";
@@ -135,8 +135,8 @@ double MeanNeesPerDof(int runs, double still_s, Fit fit, double* lo, double* hi)
     sum += Nees(CalibrateMultiPose(3000 + static_cast<std::uint64_t>(run), "base", 12, still_s,
                                    Noise::kRealistic, fit));
   }
-  *lo = signal::ChiSquareQuantile(0.025, runs * kParams) / (runs * kParams);
-  *hi = signal::ChiSquareQuantile(0.975, runs * kParams) / (runs * kParams);
+  *lo = signal::ChiSquareQuantileExact(0.025, runs * kParams) / (runs * kParams);
+  *hi = signal::ChiSquareQuantileExact(0.975, runs * kParams) / (runs * kParams);
   return sum / (runs * kParams);
 }
 
@@ -201,8 +201,8 @@ TEST(CalibrateSimulated, CovarianceIsHonestWithWanderLevelsFromALongStillRecordi
     typical += Nees(o);
   }
   const int dof = kRuns * kParams;
-  const double lo = signal::ChiSquareQuantile(0.025, dof) / dof;
-  const double hi = signal::ChiSquareQuantile(0.975, dof) / dof;
+  const double lo = signal::ChiSquareQuantileExact(0.025, dof) / dof;
+  const double hi = signal::ChiSquareQuantileExact(0.975, dof) / dof;
   EXPECT_GT(with_recording / dof, lo);
   EXPECT_LT(with_recording / dof, hi);
   EXPECT_GT(typical / dof, hi);
@@ -265,8 +265,8 @@ TEST(CalibrateSimulated, CovarianceIsHonestOnThePaperBenchmarkWithRealisticNoise
   }
   const int dof = kBenchmarkRuns * kParams;
   const double nees = sum / dof;
-  const double lo = signal::ChiSquareQuantile(0.025, dof) / dof;
-  const double hi = signal::ChiSquareQuantile(0.975, dof) / dof;
+  const double lo = signal::ChiSquareQuantileExact(0.025, dof) / dof;
+  const double hi = signal::ChiSquareQuantileExact(0.975, dof) / dof;
   EXPECT_GT(nees, lo);
   EXPECT_LT(nees, hi);
   std::cout << "paper benchmark: NEES/dof " << nees << " (95% band " << lo << " .. " << hi << ")\n";

@@ -96,11 +96,10 @@ TEST(HtmlReport, ShowsChi2TheRatioAndItsBand) {
 }
 
 TEST(HtmlReport, Chi2BandMatchesTheChiSquareQuantiles) {
-  // chi2(10) quantiles: 2.156 at 0.005 and 25.19 at 0.995 (tables); Wilson-Hilferty is within
-  // a few per cent at 10 degrees of freedom.
+  // chi2(10) quantiles: 2.155856 at 0.005 and 25.18818 at 0.995 (R: qchisq), exactly.
   const auto band = Chi2DofBand(10);
-  EXPECT_NEAR(band.first, 0.2156, 0.01);
-  EXPECT_NEAR(band.second, 2.519, 0.03);
+  EXPECT_NEAR(band.first, 0.2155856, 1e-6);
+  EXPECT_NEAR(band.second, 2.518818, 1e-6);
   EXPECT_TRUE(std::isnan(Chi2DofBand(0).first));
 }
 

@@ -14,17 +14,18 @@ TEST(NormalQuantile, MatchesTables) {
   EXPECT_NEAR(NormalQuantile(1e-6), -4.753424308817090, 1e-9);
 }
 
-TEST(ChiSquareQuantile, WilsonHilfertyIsCloseToExactValues) {
-  // Exact quantiles (R: qchisq) and the approximation's documented accuracy.
-  EXPECT_NEAR(ChiSquareQuantile(0.999, 3.0), 16.26624, 0.02 * 16.26624);
-  EXPECT_NEAR(ChiSquareQuantile(0.999, 100.0), 149.4493, 0.002 * 149.4493);
-  EXPECT_NEAR(ChiSquareQuantile(0.5, 10.0), 9.341818, 0.002 * 9.341818);
-  EXPECT_NEAR(ChiSquareQuantile(0.001, 30.0), 11.58790, 0.01 * 11.58790);
+TEST(ChiSquareQuantile, MatchesExactValues) {
+  // R: qchisq. The 99 % point of chi^2(1) is 6.635 (a cube-root approximation printed 6.59).
+  EXPECT_NEAR(ChiSquareQuantileExact(0.99, 1.0), 6.634897, 1e-6);
+  EXPECT_NEAR(ChiSquareQuantileExact(0.999, 3.0), 16.26624, 1e-5);
+  EXPECT_NEAR(ChiSquareQuantileExact(0.999, 100.0), 149.4493, 1e-4);
+  EXPECT_NEAR(ChiSquareQuantileExact(0.5, 10.0), 9.341818, 1e-6);
+  EXPECT_NEAR(ChiSquareQuantileExact(0.001, 30.0), 11.587951, 1e-6);
 }
 
 TEST(ChiSquareQuantile, RejectsBadArguments) {
-  EXPECT_THROW(ChiSquareQuantile(1.0, 3.0), Error);
-  EXPECT_THROW(ChiSquareQuantile(0.5, 0.0), Error);
+  EXPECT_THROW(ChiSquareQuantileExact(1.0, 3.0), Error);
+  EXPECT_THROW(ChiSquareQuantileExact(0.5, 0.0), Error);
   EXPECT_THROW(NormalQuantile(0.0), Error);
 }
 

@@ -186,7 +186,7 @@ void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& sour
   cand.identifiable = s.identifiable;
   cand.not_identifiable = s.not_identifiable;
   cand.evidence = cand.lm - s.dof * log_n;
-  cand.threshold = s.dof > 0 ? signal::ChiSquareQuantile(1.0 - options.significance, s.dof) : 0.0;
+  cand.threshold = s.dof > 0 ? signal::ChiSquareQuantileExact(1.0 - options.significance, s.dof) : 0.0;
   cand.significant = s.identifiable && s.dof > 0 && cand.lm > cand.threshold;
   cand.with_velocity = with_velocity;
   candidates.push_back(std::move(cand));

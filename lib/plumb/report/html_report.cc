@@ -552,8 +552,8 @@ std::pair<double, double> Chi2DofBand(int dof) {
     return {nan, nan};
   }
   const double n = static_cast<double>(dof);
-  return {signal::ChiSquareQuantile(0.5 * kBandOutside, n) / n,
-          signal::ChiSquareQuantile(1.0 - 0.5 * kBandOutside, n) / n};
+  return {signal::ChiSquareQuantileExact(0.5 * kBandOutside, n) / n,
+          signal::ChiSquareQuantileExact(1.0 - 0.5 * kBandOutside, n) / n};
 }
 
 std::string HtmlReport(const InputSummary& input,

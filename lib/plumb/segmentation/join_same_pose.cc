@@ -109,7 +109,7 @@ std::vector<Run> JoinSamePose(const ImuSeries& series, const BlockMoments& block
   // Without the gyroscope a turn about the vertical keeps the accelerometer means: never join.
   const bool gyro = noise.has_gyro && blocks.has_gyro() && options.use_gyro;
   if (runs.size() < 2 || !options.join_same_pose || !gyro) return runs;
-  const double threshold = signal::ChiSquareQuantile(1.0 - options.false_alarm, 3.0);
+  const double threshold = signal::ChiSquareQuantileExact(1.0 - options.false_alarm, 3.0);
   std::vector<Run> out{runs.front()};
   SpanStats a = AccStats(blocks, runs.front().begin, runs.front().end);
   for (std::size_t k = 1; k < runs.size(); ++k) {

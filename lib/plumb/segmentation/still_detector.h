@@ -30,7 +30,7 @@
 //      still rate changing between poses (Earth rate, g-sensitivity, bias drift).
 //    - a window spanning a time gap of over half a window is not still, nor one holding a
 //      NaN or infinite sample.
-//    The thresholds are chi^2 quantiles (Wilson-Hilferty, plumb/signal/chi_square.h) at
+//    The thresholds are exact chi^2 quantiles (Boost.Math, plumb/signal/chi_square.h) at
 //    1 - false_alarm / (tests x 17): Bonferroni over the tests and over the 17 overlapping
 //    window positions in one window length, so that a still IMU fails any test within a
 //    window length of data with probability at most false_alarm — no magic multiple.

@@ -228,7 +228,7 @@ std::vector<Run> RunsAtTheStillRate(const BlockMoments& blocks, const std::vecto
   Vec3 median;
   for (std::size_t a = 0; a < 3; ++a) median[static_cast<int>(a)] = WeightedMedian(per_axis[a]);
   const Vec3 allowance = RateAllowance(seed, options);
-  const double threshold = signal::ChiSquareQuantile(1.0 - options.false_alarm, 3.0);
+  const double threshold = signal::ChiSquareQuantileExact(1.0 - options.false_alarm, 3.0);
   std::vector<Run> kept;
   for (std::size_t r = 0; r < runs.size(); ++r) {
     const auto n = static_cast<double>(runs[r].size());
@@ -266,20 +266,20 @@ WindowTests MakeTests(const NoiseEstimate& noise, const BlockMoments& blocks,
   tests.acc_weight =
       (3.0 * (n - 1.0) * noise.acc_sigma.cwiseProduct(noise.acc_sigma)).cwiseInverse();
   detail.acc_dof = VarianceStatisticDof(n, n0, noise.acc_tau_sq);
-  tests.acc_threshold = signal::ChiSquareQuantile(p, detail.acc_dof) / detail.acc_dof;
+  tests.acc_threshold = signal::ChiSquareQuantileExact(p, detail.acc_dof) / detail.acc_dof;
   detail.acc_threshold = tests.acc_threshold;
   if (tests.gyro_variance) {
     tests.gyr_weight =
         (3.0 * (n - 1.0) * noise.gyr_sigma.cwiseProduct(noise.gyr_sigma)).cwiseInverse();
     detail.gyr_dof = VarianceStatisticDof(n, n0, noise.gyr_tau_sq);
-    tests.gyr_threshold = signal::ChiSquareQuantile(p, detail.gyr_dof) / detail.gyr_dof;
+    tests.gyr_threshold = signal::ChiSquareQuantileExact(p, detail.gyr_dof) / detail.gyr_dof;
     detail.gyr_threshold = tests.gyr_threshold;
   }
   if (tests.rate) {
     tests.rate_offset = n * (noise.gyr_still_rate - blocks.gyr_reference());
     detail.rate_allowance = RateAllowance(noise, options);
     tests.rate_weight = RateWeight(noise, detail.rate_allowance, n, n0) / (n * n);
-    tests.rate_threshold = signal::ChiSquareQuantile(p, 3.0);
+    tests.rate_threshold = signal::ChiSquareQuantileExact(p, 3.0);
     detail.rate_threshold = tests.rate_threshold;
   }
   detail.window_samples = geometry.window();
