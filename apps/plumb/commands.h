@@ -46,6 +46,7 @@ std::unique_ptr<Command> MakeInfoCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeReportCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeAllanCommand(CLI::App& parent);
 std::unique_ptr<Command> MakeSweepCommand(CLI::App& parent);
+std::unique_ptr<Command> MakeApplyCommand(CLI::App& parent);
 
 /// The command line as typed (argv), stored by main before parsing; `plumb report` prints it
 /// as the command that reproduces the page.

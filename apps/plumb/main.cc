@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   commands.push_back(plumb::cli::MakeReportCommand(app));
   commands.push_back(plumb::cli::MakeAllanCommand(app));
   commands.push_back(plumb::cli::MakeSweepCommand(app));
+  commands.push_back(plumb::cli::MakeApplyCommand(app));
 
   if (argc > 1 && argv[1][0] != '-') {
     const std::string name = argv[1];

@@ -1,0 +1,130 @@
+#include "plumb/correction/calibration_file.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plumb/core/error.h"
+
+namespace plumb::correction {
+namespace {
+
+using nlohmann::json;
+
+double FiniteNumber(const json& v, const std::string& path, const std::string& key) {
+  if (!v.is_number() || !std::isfinite(v.get<double>())) {
+    throw InputError(path, "key '" + key + "'", "expected a finite number");
+  }
+  return v.get<double>();
+}
+
+const json& Required(const json& doc, const char* key, const std::string& path) {
+  if (!doc.contains(key)) {
+    throw InputError(path, "key '" + std::string(key) + "'",
+                     "missing: not a calibration written by 'plumb calibrate --json'");
+  }
+  return doc.at(key);
+}
+
+/// The model of the document, with its reference time and temperature.
+model::Model ReadModel(const json& doc, const std::string& path) {
+  const json& spec = Required(doc, "model", path);
+  if (!spec.is_string()) throw InputError(path, "key 'model'", "expected a model spec (text)");
+  model::Model model = [&] {
+    try {
+      return model::Model::Parse(spec.get<std::string>());
+    } catch (const Error& e) {
+      throw InputError(path, "key 'model'", e.what());
+    }
+  }();
+  const json& ref = Required(doc, "model_reference", path);
+  if (!ref.is_object() || !ref.contains("t_ref_s") || !ref.contains("temp_ref_c")) {
+    throw InputError(path, "key 'model_reference'", "expected {t_ref_s, temp_ref_c}");
+  }
+  model.t_ref_s = FiniteNumber(ref.at("t_ref_s"), path, "model_reference.t_ref_s");
+  model.temp_ref_c = FiniteNumber(ref.at("temp_ref_c"), path, "model_reference.temp_ref_c");
+  return model;
+}
+
+/// The covariance over named parameters of the model (none: empty).
+void ReadCovariance(const json& doc, const std::string& path, CalibrationFile& out) {
+  if (!doc.contains("covariance") || doc.at("covariance").is_null()) return;
+  const json& cov = doc.at("covariance");
+  if (!cov.is_object() || !cov.contains("parameters") || !cov.contains("matrix") ||
+      !cov.at("parameters").is_array() || !cov.at("matrix").is_array()) {
+    throw InputError(path, "key 'covariance'", "expected {parameters [...], matrix [[...]]}");
+  }
+  const auto n = static_cast<Eigen::Index>(cov.at("parameters").size());
+  for (const json& name : cov.at("parameters")) {
+    if (!name.is_string() || !out.model.FindParameter(name.get<std::string>())) {
+      throw InputError(path, "key 'covariance.parameters'",
+                       "'" + name.dump() + "' is not a parameter of the model '" + out.model.spec() + "'");
+    }
+    out.covariance_names.push_back(name.get<std::string>());
+  }
+  const json& m = cov.at("matrix");
+  if (static_cast<Eigen::Index>(m.size()) != n) {
+    throw InputError(path, "key 'covariance.matrix'", "expected " + std::to_string(n) + " rows");
+  }
+  out.covariance.resize(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const json& row = m.at(static_cast<std::size_t>(i));
+    if (!row.is_array() || static_cast<Eigen::Index>(row.size()) != n) {
+      throw InputError(path, "key 'covariance.matrix[" + std::to_string(i) + "]'",
+                       "expected " + std::to_string(n) + " numbers");
+    }
+    for (Eigen::Index j = 0; j < n; ++j) {
+      out.covariance(i, j) = FiniteNumber(row.at(static_cast<std::size_t>(j)), path,
+                                          "covariance.matrix[" + std::to_string(i) + "]");
+    }
+  }
+}
+
+}  // namespace
+
+CalibrationFile ReadCalibrationFile(const json& doc, const std::string& path) {
+  if (!doc.is_object()) throw InputError(path, "", "not a JSON object: not a calibration");
+  CalibrationFile out;
+  out.path = path;
+  out.model = ReadModel(doc, path);
+  const json& params = Required(doc, "parameters", path);
+  if (!params.is_array()) throw InputError(path, "key 'parameters'", "expected a list");
+  // An accelerometer-only session's fit dropped the gyroscope terms of its spec.
+  const bool gyro_values = std::any_of(params.begin(), params.end(), [](const json& p) {
+    return p.is_object() && p.contains("name") && p.at("name").is_string() &&
+           p.at("name").get<std::string>().rfind("gyro", 0) == 0;
+  });
+  if (!gyro_values && out.model.has_gyro()) out.model.DropGyro();
+  out.theta = out.model.ZeroParameters();
+  std::vector<bool> seen(static_cast<std::size_t>(out.model.num_parameters()), false);
+  const std::vector<std::string> names = out.model.ParameterNames();
+  for (std::size_t k = 0; k < params.size(); ++k) {
+    const json& p = params[k];
+    const std::string key = "parameters[" + std::to_string(k) + "]";
+    if (!p.is_object() || !p.contains("name") || !p.at("name").is_string() || !p.contains("value")) {
+      throw InputError(path, "key '" + key + "'", "expected {name, value, ...}");
+    }
+    const std::string name = p.at("name").get<std::string>();
+    const auto where = out.model.FindParameter(name);
+    if (!where) {
+      throw InputError(path, "key '" + key + ".name'",
+                       "'" + name + "' is not a parameter of the model '" + out.model.spec() + "'");
+    }
+    const auto [t, i] = *where;
+    const double nominal =
+        out.model.terms()[static_cast<std::size_t>(t)].effect->info().parameters[static_cast<std::size_t>(i)].nominal;
+    out.theta[static_cast<std::size_t>(t)][static_cast<std::size_t>(i)] =
+        FiniteNumber(p.at("value"), path, key + ".value") - nominal;
+    seen[static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin())] = true;
+    if (p.contains("unit") && p.at("unit").is_string()) {
+      if (name == "accel.bias.x") out.acc_unit = p.at("unit").get<std::string>();
+      if (name == "gyro.bias.x") out.gyr_unit = p.at("unit").get<std::string>();
+    }
+  }
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    if (!seen[j]) throw InputError(path, "key 'parameters'", "no value for '" + names[j] + "'");
+  }
+  ReadCovariance(doc, path, out);
+  return out;
+}
+
+}  // namespace plumb::correction
