@@ -71,9 +71,7 @@ class CalibrateCommand : public Command {
   FileRoles Files() const override {
     const CalibrateArgs& a = args_;
     FileRoles roles;
-    AddInputFiles(a.input, roles);
-    if (!a.segments.segments_path.empty()) roles.inputs.push_back({"--segments", a.segments.segments_path});
-    if (!a.fit.noise_from.empty()) roles.inputs.push_back({"--noise-from", a.fit.noise_from});
+    AddFitInputFiles(a.input, a.segments.segments_path, a.fit, roles);
     roles.output_files.push_back({"--json", a.json_path});
     for (const ExportRequest& e : ParseExports(a.exports)) {
       roles.output_files.push_back({"--export " + e.format, e.path});

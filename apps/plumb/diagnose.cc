@@ -85,9 +85,7 @@ class DiagnoseCommand : public Command {
   FileRoles Files() const override {
     const DiagnoseArgs& a = args_;
     FileRoles roles;
-    AddInputFiles(a.input, roles);
-    if (!a.segments.segments_path.empty()) roles.inputs.push_back({"--segments", a.segments.segments_path});
-    if (!a.fit.noise_from.empty()) roles.inputs.push_back({"--noise-from", a.fit.noise_from});
+    AddFitInputFiles(a.input, a.segments.segments_path, a.fit, roles);
     roles.output_files.push_back({"--json", a.json_path});
     roles.output_files.push_back({"--residuals", a.residuals_path});
     return roles;

@@ -241,4 +241,11 @@ int StrictGateExit(const estimation::FitReport& fit, const std::string& source, 
   return kExitGateFailed;
 }
 
+void AddFitInputFiles(const InputArgs& input, const std::string& segments_path,
+                      const FitArgs& fit, FileRoles& roles) {
+  AddInputFiles(input, roles);
+  if (!segments_path.empty()) roles.inputs.push_back({"--segments", segments_path});
+  if (!fit.noise_from.empty()) roles.inputs.push_back({"--noise-from", fit.noise_from});
+}
+
 }  // namespace plumb::cli

@@ -75,6 +75,11 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
 /// "<source>: N samples, T s[, no gyroscope][, with temperature]" and the session's warnings.
 void PrintSession(const Session& session);
 
+/// The files a fit reads besides its calibration: INPUT..., --acc/--gyr, --segments and
+/// --noise-from, into `roles`' inputs (file_roles.h).
+void AddFitInputFiles(const InputArgs& input, const std::string& segments_path,
+                      const FitArgs& fit, FileRoles& roles);
+
 /// estimation::Calibrate on the session with `fit`. When it throws, the error also lists the
 /// samples' gates (estimation::CheckSamples: samples out of range, a saturated axis), often
 /// the reason, naming the input.

@@ -145,9 +145,7 @@ class ReportCommand : public Command {
   FileRoles Files() const override {
     const ReportArgs& a = args_;
     FileRoles roles;
-    AddInputFiles(a.input, roles);
-    if (!a.segments.segments_path.empty()) roles.inputs.push_back({"--segments", a.segments.segments_path});
-    if (!a.fit.noise_from.empty()) roles.inputs.push_back({"--noise-from", a.fit.noise_from});
+    AddFitInputFiles(a.input, a.segments.segments_path, a.fit, roles);
     if (!a.study.empty()) roles.inputs.push_back({"--study", a.study});
     roles.output_folders.push_back({"--out", a.out_dir});
     return roles;
