@@ -44,6 +44,7 @@ class CalibrateCommand : public Command {
     app_ = parent.add_subcommand("calibrate",
                                  "Calibrate the accelerometer and gyroscope from a session of "
                                  "still poses joined by turns");
+    app_->footer("Example (the bundled session: the result as JSON and ArduPilot parameters):\n  plumb calibrate data/mikoff/imu0.log --columns ax,ay,az,gx,gy,gz --rate 100 --json cal.json --export ardupilot=cal.param");
     CalibrateArgs& a = args_;
     AddInputOptions(app_, a.input);
     app_->add_option("--method", a.method,

@@ -39,6 +39,7 @@ class CompareCommand : public Command {
         "compare",
         "Compare plumb's calibration (calibrate --json) with another tool's answer on the same "
         "data, parameter by parameter in plumb's forward form");
+    app_->footer("Example (a calibration against the simulator's truth: errors in sigmas and the NEES):\n  plumb compare cal.json --truth truth.json");
     CompareArgs& a = args_;
     app_->add_option("RESULT", a.results,
                      "The JSON that 'plumb calibrate --json' wrote (several only with --truth)")

@@ -48,6 +48,7 @@ class DiagnoseCommand : public Command {
         "diagnose",
         "Find which effects of the catalogue the model is missing: the score test of every "
         "effect not in the model, ranked, the best confirmed by refitting");
+    app_->footer("Example (which effect the base model misses on the bundled session):\n  plumb diagnose data/mikoff/imu0.log --columns ax,ay,az,gx,gy,gz --rate 100 --json diagnosis.json");
     DiagnoseArgs& a = args_;
     AddInputOptions(app_, a.input);
     app_->add_option("--model", a.fit.model, "The model to diagnose (a spec, see 'plumb effects')")

@@ -16,6 +16,7 @@ class EffectsCommand : public Command {
     app_ = parent.add_subcommand("effects",
                                  "List the effects a model can be made of, with their terms, "
                                  "parameters and units");
+    app_->footer("Example:\n  plumb effects --json effects.json");
     app_->add_option("NAME", name_, "Show only this effect");
     app_->add_option("--json", json_path_, "Also write the catalogue as JSON to FILE (- for stdout, the text then on stderr)")
         ->type_name("FILE");

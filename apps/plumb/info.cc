@@ -62,6 +62,7 @@ class InfoCommand : public Command {
     app_ = parent.add_subcommand(
         "info", "What is inside a flight log (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg): IMU "
                 "streams, still periods, the site from GPS, the calibration parameters in force");
+    app_->footer("Example (the streams, still periods and firmware calibration of a PX4 log):\n  plumb info ../shared/data/px4/sample.ulg --json info.json");
     app_->add_option("LOG", args_.log_path, "The log file")->required()->type_name("LOG");
     app_->add_option("--json", args_.json_path, "Also write it as JSON to FILE (atomically; - for stdout, the text then on stderr)")
         ->type_name("FILE");

@@ -451,6 +451,7 @@ class PaperCommand : public Command {
         "The seed paper's results and evaluation on your data: its benchmark (section 4) and "
         "static (section 5) calibrations, Tables 1-5 and the reconstructed inputs of "
         "Figures 1-6, with the backend's sigma and rank for both");
+    app_->footer("Example (the paper's benchmark and static minute, simulated at its site):\n  plumb simulate --out bench.csv --schedule paper-benchmark --lat 6.67 --lon -1.57 --segments-out bench_segments.csv\n  plumb simulate --out static.csv --schedule paper-static --lat 6.67 --lon -1.57\n  plumb paper bench.csv --segments bench_segments.csv --static static.csv --lat 6.67 --lon -1.57 --out paper_out");
     PaperArgs& a = args_;
     AddInputOptions(app_, a.input);
     AddSiteOptions(app_, a.site);

@@ -106,6 +106,7 @@ class ReportCommand : public Command {
         "report",
         "Calibrate, diagnose and write one self-contained HTML page with figures: what was "
         "calibrated and how well (DIR/index.html)");
+    app_->footer("Example (calibration and diagnosis of the bundled session on one page):\n  plumb report data/mikoff/imu0.log --columns ax,ay,az,gx,gy,gz --rate 100 --out report");
     ReportArgs& a = args_;
     AddInputOptions(app_, a.input);
     app_->add_option("--out", a.out_dir,

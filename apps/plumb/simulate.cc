@@ -143,6 +143,7 @@ class SimulateCommand : public Command {
     app_ = parent.add_subcommand("simulate",
                                  "Simulate a session of an IMU with a chosen error model and "
                                  "write it as native CSV");
+    app_->footer("Example (12 poses of a random typical MEMS IMU at a known site, and its truth):\n  plumb simulate --out sim.csv --random-truth 1 --lat 51.64 --lon -1.2 --height 100 --truth-json truth.json");
     SimulateArgs& a = args_;
     app_->add_option("--out", a.out_path, "Native CSV file to write")
         ->required()

@@ -138,6 +138,7 @@ class SweepCommand : public Command {
         "Sensitivity study of the calibration procedure: simulate a design at every point of a "
         "study's factors, fit it, and summarise the errors against the truth, the sigmas and "
         "the NEES per point (CSV and JSON)");
+    app_->footer("Example (how many poses the base model needs; then two machines' halves joined):\n  plumb sweep examples/studies/poses.json --out poses --jobs 2\n  plumb sweep examples/studies/poses.json --out half1 --shard 1/2\n  plumb sweep merge half1 half2 --out poses");
     SweepArgs& a = args_;
     app_->add_option("STUDY", a.study_path,
                      "The study file: JSON, or YAML when it ends in .yaml or .yml (see "

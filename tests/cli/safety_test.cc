@@ -121,6 +121,19 @@ TEST(Safety, AMissingLogOrAFolderIsSaidAsSuch) {
   EXPECT_TRUE(Contains(folder.err, "is a folder, not a file")) << folder.err;
 }
 
+TEST(Safety, EveryCommandsHelpEndsWithAnExample) {
+  TempDir dir;
+  for (const char* command : {"calibrate", "diagnose", "simulate", "effects", "compare", "paper",
+                              "info", "report", "allan", "sweep", "apply"}) {
+    const ToolRun help = Plumb({command, "--help"}, dir);
+    EXPECT_EQ(help.exit_code, 0) << command;
+    const auto example = help.out.rfind("Example");
+    ASSERT_NE(example, std::string::npos) << command << ":\n" << help.out;
+    const std::string tail = help.out.substr(example);
+    EXPECT_TRUE(Contains(tail, std::string("\n  plumb ") + command + " ")) << command << ":\n" << tail;
+  }
+}
+
 /// The numeric options of `command` as its --help lists them ("--heading FLOAT ...").
 std::vector<std::string> NumericOptions(const std::string& command, const TempDir& dir) {
   std::vector<std::string> args = {command, "--help"};
