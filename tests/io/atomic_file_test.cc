@@ -5,6 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+
+#include <unistd.h>
 
 #include "io_test_util.h"
 #include "plumb/core/error.h"
@@ -59,6 +62,34 @@ TEST(AtomicFile, UncommittedWriterLeavesTheOldFile) {
   }
   EXPECT_EQ(Slurp(path), "old\n");
   EXPECT_EQ(CountEntries(dir.path()), 1u);
+}
+
+TEST(AtomicFile, ASymlinkStaysALinkAndAReplacedFileKeepsItsMode) {
+  namespace fs = std::filesystem;
+  TempDir dir;
+  const std::string target = dir.Write("target.csv", "old\n");
+  fs::permissions(target, fs::perms::owner_read | fs::perms::owner_write);  // 0600
+  const std::string link = dir.File("link.csv");
+  fs::create_symlink(target, link);
+  WriteFileAtomic(link, "new\n");
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(Slurp(target), "new\n");
+  EXPECT_EQ(fs::status(target).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(CountEntries(dir.path()), 2u);
+}
+
+TEST(AtomicFile, TemporariesOfKilledWritersAreRemovedByTheNextWrite) {
+  // A writer killed with SIGKILL cannot remove its temporary file: the next write into the
+  // folder removes those of processes that no longer run, and keeps a running one's.
+  TempDir dir;
+  const std::string dead = dir.Write(".out.csv.tmp.999999999.a1b2c3", "half a file");
+  const std::string alive =
+      dir.Write(".out.csv.tmp." + std::to_string(::getpid()) + ".d4e5f6", "being written");
+  WriteFileAtomic(dir.File("out.csv"), "done\n");
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(alive));
+  EXPECT_EQ(Slurp(dir.File("out.csv")), "done\n");
 }
 
 }  // namespace

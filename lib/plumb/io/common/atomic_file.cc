@@ -4,7 +4,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <signal.h>
+
 #include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <mutex>
+#include <set>
+#include <string>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -14,17 +21,69 @@
 
 namespace plumb::io {
 
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The file a write to `path` replaces: `path`, or where its symlinks lead (so that a link
+/// stays a link, to the new content).
+fs::path Destination(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_symlink(path, ec)) return path;
+  const fs::path target = fs::weakly_canonical(path, ec);
+  return ec ? fs::path(path) : target;
+}
+
+/// Removes the temporary files left in `dir` by writers that were killed: ".NAME.tmp.PID.*"
+/// whose process no longer runs, and the unnumbered ".NAME.tmp.XXXXXX" of earlier versions an
+/// hour old. Once per folder and process (a sweep writes thousands of files into one).
+void RemoveStaleTemporaries(const fs::path& dir) {
+  static std::mutex mutex;
+  static std::set<std::string> cleaned;
+  const std::string key = dir.empty() ? "." : dir.string();
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!cleaned.insert(key).second) return;
+  }
+  std::error_code ec;
+  for (fs::directory_iterator it(key, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const auto tmp = name.find(".tmp.");
+    if (name.empty() || name[0] != '.' || tmp == std::string::npos) continue;
+    const std::string tail = name.substr(tmp + 5);
+    const auto dot = tail.find('.');
+    bool stale = false;
+    if (dot != std::string::npos && dot > 0 &&
+        tail.find_first_not_of("0123456789") == dot) {  // ".tmp.PID.XXXXXX"
+      const long pid = std::strtol(tail.substr(0, dot).c_str(), nullptr, 10);
+      stale = pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+    } else if (tail.size() == 6 && dot == std::string::npos) {  // ".tmp.XXXXXX", old versions
+      std::error_code age_ec;
+      const auto age = fs::file_time_type::clock::now() - fs::last_write_time(it->path(), age_ec);
+      stale = !age_ec && age > std::chrono::hours(1);
+    }
+    if (stale) fs::remove(it->path(), ec), ec.clear();
+  }
+}
+
+}  // namespace
+
 AtomicFileWriter::AtomicFileWriter(std::string path) : path_(std::move(path)) {
-  const std::filesystem::path dest(path_);
-  const std::filesystem::path dir = dest.parent_path();
-  const std::string name = "." + dest.filename().string() + ".tmp.XXXXXX";
-  std::string templ = (dir.empty() ? std::filesystem::path(name) : dir / name).string();
+  const fs::path dest = Destination(path_);
+  const fs::path dir = dest.parent_path();
+  RemoveStaleTemporaries(dir);
+  const std::string name =
+      "." + dest.filename().string() + ".tmp." + std::to_string(::getpid()) + ".XXXXXX";
+  std::string templ = (dir.empty() ? fs::path(name) : dir / name).string();
   std::vector<char> buffer(templ.begin(), templ.end());
   buffer.push_back('\0');
   fd_ = ::mkstemp(buffer.data());
   if (fd_ < 0) Fail("cannot create a temporary file in its folder");
   temp_path_.assign(buffer.data());
-  ::fchmod(fd_, 0644);
+  target_ = dest.string();
+  // A file replaced keeps its mode; a new one gets 0644.
+  struct stat existing {};
+  ::fchmod(fd_, ::stat(target_.c_str(), &existing) == 0 ? (existing.st_mode & 07777) : 0644);
 }
 
 AtomicFileWriter::~AtomicFileWriter() {
@@ -53,7 +112,7 @@ void AtomicFileWriter::Commit() {
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) Fail("close of " + temp_path_ + " failed");
-  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
+  if (std::rename(temp_path_.c_str(), target_.c_str()) != 0) {
     Fail("rename from " + temp_path_ + " failed");
   }
   temp_path_.clear();

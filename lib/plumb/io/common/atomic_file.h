@@ -1,8 +1,11 @@
 // plumb/io/common/atomic_file.h — output files written atomically (SPEC section 8).
 //
-// The content goes to a temporary file in the destination's folder (`.<name>.tmp.XXXXXX`),
+// The content goes to a temporary file in the destination's folder (`.<name>.tmp.<pid>.XXXXXX`),
 // is flushed to disk (fsync) and then renamed over the destination, so a reader never sees a
-// half-written file and a failed write leaves the old file untouched. New files get mode 0644.
+// half-written file and a failed write leaves the old file untouched. A destination that is a
+// symlink stays one: the file it leads to is replaced. A replaced file keeps its mode; new files
+// get 0644. A writer killed before it could remove its temporary file (SIGKILL) leaves it
+// behind; the next write into that folder removes those whose process no longer runs.
 // Failures throw plumb::Error naming the destination path and the system's reason.
 #pragma once
 
@@ -33,7 +36,8 @@ class AtomicFileWriter {
 
  private:
   [[noreturn]] void Fail(const std::string& action);
-  std::string path_;
+  std::string path_;       ///< as the caller named it (messages)
+  std::string target_;     ///< the file replaced: path_, or where its symlinks lead
   std::string temp_path_;
   int fd_ = -1;
 };
