@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 
@@ -57,6 +58,28 @@ struct ReportArgs {
   std::string gnuplot = "gnuplot";  ///< --gnuplot PROGRAM
   std::string study;                ///< --study DIR: the page of a plumb sweep folder instead
 };
+
+/// A report's folder is replaced whole (io::StagedFolder): it must be new, empty, or a page
+/// plumb wrote before (its index.html says so), never a folder of the user's other files.
+void CheckReplaceable(const std::string& out_dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(out_dir, ec)) return;
+  if (!fs::is_directory(out_dir, ec)) throw UsageError("--out " + out_dir + " exists and is not a folder");
+  if (fs::is_empty(out_dir, ec)) return;
+  std::ifstream index(fs::path(out_dir) / "index.html");
+  std::string head(4096, '\0');
+  index.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(index.gcount()));
+  const bool plumb_page = head.find("<meta name=\"generator\" content=\"plumb") != std::string::npos ||
+                          head.find("<title>plumb report: ") != std::string::npos ||
+                          head.find("<title>plumb sweep: ") != std::string::npos;
+  if (!plumb_page) {
+    throw UsageError("--out " + out_dir + " holds files that are not a plumb report's, and a "
+                     "report replaces its folder whole: give a new or empty folder; nothing "
+                     "was written");
+  }
+}
 
 /// `text` quoted for a POSIX shell when it holds anything but safe characters.
 std::string ShellQuote(const std::string& text) {
@@ -155,6 +178,7 @@ class ReportCommand : public Command {
   int Run() override {
     const ReportArgs& a = args_;
     if (!a.study.empty()) return RunStudy();
+    CheckReplaceable(a.out_dir);
     Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
@@ -177,8 +201,9 @@ class ReportCommand : public Command {
     const diagnostics::ResidualAnalysis analysis =
         diagnostics::AnalyseResiduals(series, result, ra_options);
 
-    const std::filesystem::path dir(a.out_dir);
-    std::filesystem::create_directories(dir);
+    // Written as a whole: an interrupted report leaves the old folder as it was.
+    io::StagedFolder staged(a.out_dir);
+    const std::filesystem::path dir(staged.staging());
     std::vector<std::string> files = {"result.json", "residuals.csv"};
     report::WriteJson((dir / "result.json").string(),
                       report::CalibrationJson(result, seg, Summarise(session, a.input).inputs,
@@ -207,14 +232,16 @@ class ReportCommand : public Command {
     if (a.no_figures) {
       extras.figure_notes.push_back("not drawn (--no-figures)");
     } else {
-      DrawFigures(series, segments, result, ra_options, extras, files);
+      DrawFigures(dir.string(), series, segments, result, ra_options, extras, files);
     }
     extras.files = files;
     const std::string page = report::HtmlReport(Summarise(session, a.input), seg, result,
                                                 analysis, diagnosis ? &*diagnosis : nullptr,
                                                 extras);
     io::WriteFileAtomic((dir / "index.html").string(), page);
-    std::cout << "wrote " << (dir / "index.html").string() << " (" << extras.figures.size()
+    staged.Commit();
+    std::cout << "wrote " << (std::filesystem::path(a.out_dir) / "index.html").string() << " ("
+              << extras.figures.size()
               << " figures; also " << files.size() << " files beside it)\n";
     return 0;
   }
@@ -226,12 +253,14 @@ class ReportCommand : public Command {
     if (!a.input.inputs.empty() || !a.input.acc_file.empty()) {
       throw UsageError("--study takes a plumb sweep folder instead of INPUT files");
     }
+    CheckReplaceable(a.out_dir);
     const std::string study_path = (std::filesystem::path(a.study) / "study.json").string();
     const study::Study s = study::ParseStudy(ReadJsonFile(study_path), study_path);
     const std::vector<study::PointSummary> points =
         ReadStudyPoints(s, study::DesignPoints(s), a.study);
-    std::filesystem::create_directories(a.out_dir);
-    const std::string why = WriteStudyPage(s, points, a.out_dir, !a.no_figures, a.gnuplot);
+    io::StagedFolder staged(a.out_dir);  // written as a whole
+    const std::string why = WriteStudyPage(s, points, staged.staging(), !a.no_figures, a.gnuplot);
+    staged.Commit();
     if (!why.empty() && !a.no_figures) std::cerr << "warning: no figures: " << why << "\n";
     std::cout << "wrote " << (std::filesystem::path(a.out_dir) / "index.html").string() << " ("
               << points.size() << " points of " << (s.name.empty() ? study_path : s.name) << ")\n";
@@ -261,7 +290,8 @@ class ReportCommand : public Command {
 
   /// Plans the figures, runs gnuplot in the output folder, and keeps the figures it drew.
   /// The Allan figure pools only the longest still segment(s).
-  void DrawFigures(const ImuSeries& series, const std::vector<StillSegment>& segments,
+  void DrawFigures(const std::string& dir, const ImuSeries& series,
+                   const std::vector<StillSegment>& segments,
                    const estimation::CalibrationResult& result,
                    diagnostics::ResidualAnalysisOptions ra_options, report::PageExtras& extras,
                    std::vector<std::string>& files) const {
@@ -270,7 +300,7 @@ class ReportCommand : public Command {
         diagnostics::AnalyseResiduals(series, result, ra_options);
     report::FigurePlan plan = report::PlanFigures(series, segments, result, longest);
     if (extras.still_noise) report::AddStillNoiseFigure(*extras.still_noise, {}, plan);
-    const report::GnuplotOutcome outcome = report::RunGnuplot(args_.out_dir, plan.job, args_.gnuplot);
+    const report::GnuplotOutcome outcome = report::RunGnuplot(dir, plan.job, args_.gnuplot);
     for (const auto& figure : plan.figures) {
       if (std::find(outcome.written.begin(), outcome.written.end(), figure.file) !=
           outcome.written.end()) {

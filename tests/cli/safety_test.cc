@@ -111,6 +111,27 @@ TEST(Safety, AnOutputFolderThatHoldsAnInputIsRefused) {
   EXPECT_EQ(ReadAll(sweep + "/results.csv"), results);
 }
 
+TEST(Safety, AReportReplacesOnlyItsOwnFolder) {
+  // A report's folder is written whole (an interrupted run leaves the old one): a folder of
+  // other files is refused, an earlier report's is replaced without leftovers.
+  TempDir dir;
+  const std::string csv = Session(dir);
+  const std::string mine = dir.File("mine");
+  fs::create_directory(mine);
+  std::ofstream(mine + "/notes.txt") << "mine";
+  ExpectRefused({"report", csv, "--out", mine, "--no-figures", "--no-diagnose"},
+                "holds files that are not a plumb report's", {mine + "/notes.txt"}, dir);
+  const std::string page = dir.File("page");
+  ASSERT_EQ(Plumb({"report", csv, "--out", page, "--no-diagnose"}, dir).exit_code, 0);
+  std::ofstream(page + "/stale.png") << "from an older run";
+  ASSERT_EQ(Plumb({"report", csv, "--out", page, "--no-figures", "--no-diagnose"}, dir).exit_code, 0);
+  EXPECT_TRUE(fs::exists(page + "/index.html"));
+  EXPECT_FALSE(fs::exists(page + "/stale.png"));
+  for (const auto& entry : fs::directory_iterator(dir.path())) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp."), std::string::npos) << entry.path();
+  }
+}
+
 TEST(Safety, AMissingLogOrAFolderIsSaidAsSuch) {
   TempDir dir;
   const ToolRun missing = Plumb({"info", dir.File("nothing.bin")}, dir);

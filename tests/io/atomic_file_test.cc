@@ -92,5 +92,33 @@ TEST(AtomicFile, TemporariesOfKilledWritersAreRemovedByTheNextWrite) {
   EXPECT_EQ(Slurp(dir.File("out.csv")), "done\n");
 }
 
+TEST(StagedFolder, ReplacedWholeOnCommitAndUntouchedWithout) {
+  namespace fs = std::filesystem;
+  TempDir dir;
+  const std::string folder = dir.File("report");
+  fs::create_directory(folder);
+  WriteFileAtomic(folder + "/index.html", "old page");
+  WriteFileAtomic(folder + "/figure.png", "old figure");
+  {
+    StagedFolder staged(folder);  // interrupted: no Commit
+    WriteFileAtomic(staged.staging() + "/index.html", "new page");
+  }
+  EXPECT_EQ(Slurp(folder + "/index.html"), "old page");
+  EXPECT_EQ(Slurp(folder + "/figure.png"), "old figure");
+  EXPECT_EQ(CountEntries(dir.path()), 1u);  // no staging folder left
+  {
+    StagedFolder staged(folder);
+    WriteFileAtomic(staged.staging() + "/index.html", "new page");
+    staged.Commit();
+  }
+  EXPECT_EQ(Slurp(folder + "/index.html"), "new page");
+  EXPECT_FALSE(fs::exists(folder + "/figure.png"));  // not a file of two runs
+  EXPECT_EQ(CountEntries(dir.path()), 1u);
+  StagedFolder fresh(dir.File("new"));
+  WriteFileAtomic(fresh.staging() + "/a.txt", "a");
+  fresh.Commit();
+  EXPECT_EQ(Slurp(dir.File("new/a.txt")), "a");
+}
+
 }  // namespace
 }  // namespace plumb::io

@@ -563,6 +563,7 @@ std::string HtmlReport(const InputSummary& input,
                        const diagnostics::Diagnosis* diagnosis, const PageExtras& extras) {
   std::string page = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
                      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+                     "<meta name=\"generator\" content=\"plumb report\">\n"
                      "<title>" + HtmlEscape(extras.title) + "</title>\n<style>" + kStyle +
                      "</style>\n</head>\n<body>\n<h1>" + HtmlEscape(extras.title) + "</h1>\n" +
                      "<p class=\"muted\">" + HtmlEscape(input.source) + "</p>\n";

@@ -141,7 +141,7 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
 
 std::string StudyPage(const study::Study& study, const std::vector<study::PointSummary>& points,
                       const std::vector<std::string>& figures, const std::string& figure_note) {
-  std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>plumb sweep: " +
+  std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"generator\" content=\"plumb sweep\"><title>plumb sweep: " +
                      HtmlEscape(study.name) + "</title><style>" + PageStyle() +
                      "</style></head><body>\n<h1>plumb sweep: " + HtmlEscape(study.name) + "</h1>\n";
   html += "<p class=\"muted\">plumb " + HtmlEscape(Version()) + "; " + std::to_string(points.size()) +

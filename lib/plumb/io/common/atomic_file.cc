@@ -1,6 +1,7 @@
 #include "plumb/io/common/atomic_file.h"
 
 #include <fcntl.h>
+#include <stdio.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -62,7 +63,7 @@ void RemoveStaleTemporaries(const fs::path& dir) {
       const auto age = fs::file_time_type::clock::now() - fs::last_write_time(it->path(), age_ec);
       stale = !age_ec && age > std::chrono::hours(1);
     }
-    if (stale) fs::remove(it->path(), ec), ec.clear();
+    if (stale) fs::remove_all(it->path(), ec), ec.clear();
   }
 }
 
@@ -116,6 +117,61 @@ void AtomicFileWriter::Commit() {
     Fail("rename from " + temp_path_ + " failed");
   }
   temp_path_.clear();
+}
+
+StagedFolder::StagedFolder(std::string path) : path_(std::move(path)) {
+  fs::path dest(path_);
+  if (dest.filename().empty()) dest = dest.parent_path();  // "DIR/"
+  const fs::path dir = dest.parent_path();
+  RemoveStaleTemporaries(dir);
+  const std::string name =
+      "." + dest.filename().string() + ".tmp." + std::to_string(::getpid()) + ".XXXXXX";
+  std::string templ = (dir.empty() ? fs::path(name) : dir / name).string();
+  std::vector<char> buffer(templ.begin(), templ.end());
+  buffer.push_back('\0');
+  if (::mkdtemp(buffer.data()) == nullptr) {
+    throw Error("cannot write " + path_ + ": cannot create a temporary folder beside it (" +
+                std::strerror(errno) + ")");
+  }
+  staging_.assign(buffer.data());
+  ::chmod(staging_.c_str(), 0755);
+  path_ = dest.string();
+}
+
+StagedFolder::~StagedFolder() {
+  std::error_code ec;
+  if (!staging_.empty()) fs::remove_all(staging_, ec);
+}
+
+void StagedFolder::Commit() {
+  if (staging_.empty()) throw Error("cannot write " + path_ + ": folder already committed");
+  std::error_code ec;
+  if (fs::exists(path_, ec)) {
+    if (!fs::is_directory(path_, ec)) {
+      throw Error("cannot write " + path_ + ": it exists and is not a folder");
+    }
+    // Swap in one step; the staging name then holds the old folder, removed below.
+    if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, path_.c_str(), RENAME_EXCHANGE) != 0) {
+      if (errno != EINVAL && errno != ENOSYS) {
+        throw Error("cannot write " + path_ + ": cannot put the new folder in place (" +
+                    std::strerror(errno) + ")");
+      }
+      // A file system without the exchange: the old folder aside, then the new one in.
+      const std::string old = staging_ + ".old";
+      if (std::rename(path_.c_str(), old.c_str()) != 0 ||
+          std::rename(staging_.c_str(), path_.c_str()) != 0) {
+        throw Error("cannot write " + path_ + ": cannot put the new folder in place (" +
+                    std::strerror(errno) + ")");
+      }
+      fs::remove_all(old, ec);
+    } else {
+      fs::remove_all(staging_, ec);
+    }
+  } else if (std::rename(staging_.c_str(), path_.c_str()) != 0) {
+    throw Error("cannot write " + path_ + ": cannot put the new folder in place (" +
+                std::strerror(errno) + ")");
+  }
+  staging_.clear();
 }
 
 void WriteFileAtomic(const std::string& path, std::string_view content) {

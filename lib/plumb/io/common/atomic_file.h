@@ -42,4 +42,29 @@ class AtomicFileWriter {
   int fd_ = -1;
 };
 
+/// A folder written as a whole (`plumb report --out DIR`): its files go into a temporary
+/// sibling folder (`.<name>.tmp.<pid>.XXXXXX`), and Commit() puts that folder in place of the
+/// destination in one step (renameat2 RENAME_EXCHANGE with the old folder, which is then
+/// removed; a plain rename when there is none). Without Commit() (an error, an interruption)
+/// the destination is left as it was: never files of two runs side by side. A killed writer's
+/// temporary folder is removed by the next write into the same parent, as for files.
+class StagedFolder {
+ public:
+  /// Creates the temporary folder beside `path` (the parent must exist); throws plumb::Error
+  /// naming `path` when it cannot.
+  explicit StagedFolder(std::string path);
+  ~StagedFolder();
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+
+  /// Where to write the folder's files until Commit().
+  const std::string& staging() const { return staging_; }
+  /// Puts the staged folder in place of the destination.
+  void Commit();
+
+ private:
+  std::string path_;
+  std::string staging_;
+};
+
 }  // namespace plumb::io
