@@ -135,7 +135,7 @@ class CalibrateCommand : public Command {
     CheckGatesForExport(exports, a.exports, result.fit, session.source);
     nlohmann::json exported;
     if (!exports.empty()) {
-      exported = RunExports(exports, a.exports, a.input.imu, result, series, std::cout);
+      exported = RunExports(exports, a.exports, a.input.imu, result, session, std::cout);
     }
 
     if (!a.json_path.empty()) {

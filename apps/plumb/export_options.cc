@@ -35,6 +35,14 @@ void AddExportOptions(CLI::App* app, ExportArgs& a) {
                 "and nothing is written");
   app->add_option("--kalibr-topic", a.rostopic, "rostopic written in Kalibr's imu.yaml")
       ->capture_default_str();
+  app->add_flag("--keep-gyro-offsets", a.keep_gyro_offsets,
+                "Also write what keeps plumb's gyroscope offsets: INS_GYR_CAL 0 (ArduPilot "
+                "measures them at rest after every boot while it is 1) and SENS_IMU_AUTOCAL 0 "
+                "(PX4 likewise)");
+  a.sysid_option = app->add_option("--sysid", a.sysid,
+                                   "The vehicle's MAVLink system id, the first column of "
+                                   "QGroundControl's .params (default: the log's, else 1)")
+                       ->check(CLI::Range(1, 255));
 }
 
 std::vector<ExportRequest> ParseExports(const ExportArgs& a) {
@@ -75,12 +83,17 @@ void CheckGatesForExport(const std::vector<ExportRequest>& requests, const Expor
 
 nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const ExportArgs& a,
                           int imu, const estimation::CalibrationResult& result,
-                          const ImuSeries& series, std::ostream& out) {
+                          const Session& session, std::ostream& out) {
+  const ImuSeries& series = session.series;
   nlohmann::json doc = nlohmann::json::object();
   exporter::ExportOptions options;
   options.imu = a.imu_option != nullptr && a.imu_option->count() > 0 ? a.imu : imu;
   options.rostopic = a.rostopic;
   options.allow_undetermined = a.undetermined;
+  options.log_params = session.log_params;
+  options.system_id = session.system_id;
+  if (a.sysid_option != nullptr && a.sysid_option->count() > 0) options.system_id = a.sysid;
+  options.keep_gyro_offsets = a.keep_gyro_offsets;
   for (const ExportRequest& r : requests) {
     const exporter::ExportOutput e = exporter::Export(r.format, result.calibration, series, result.fit.still, options);
     io::WriteFileAtomic(r.path, e.text);

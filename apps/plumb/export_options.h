@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/session.h"
 #include "plumb/estimation/result.h"
 
 namespace plumb::cli {
@@ -21,6 +22,9 @@ struct ExportArgs {
   std::string rostopic = "/imu0";    ///< --kalibr-topic: Kalibr's rostopic
   bool undetermined = false;         ///< --export-undetermined: write undetermined values too
   bool anyway = false;               ///< --export-anyway: write even when the fit failed a gate
+  bool keep_gyro_offsets = false;    ///< --keep-gyro-offsets: INS_GYR_CAL 0, SENS_IMU_AUTOCAL 0
+  int sysid = 0;                     ///< --sysid N: the vehicle's MAVLink system id
+  CLI::Option* sysid_option = nullptr;
 };
 
 /// One requested export.
@@ -50,6 +54,6 @@ void CheckGatesForExport(const std::vector<ExportRequest>& requests, const Expor
 /// --export-imu is absent (the input's --imu).
 nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const ExportArgs& args,
                           int imu, const estimation::CalibrationResult& result,
-                          const ImuSeries& series, std::ostream& out);
+                          const Session& session, std::ostream& out);
 
 }  // namespace plumb::cli

@@ -231,6 +231,38 @@ TEST(Evaluate, DiagonalModelLeavesNoErrorThroughEitherFile) {
   }
 }
 
+TEST(VehicleState, TheFilesSayAndKeepWhatTheFirmwareWouldReplace) {
+  // The boot-time gyro calibration (said, or turned off on request), the device ids the log
+  // records (written, for the thermal terms too), the level left alone, the system id.
+  model::Model m = model::Model::Parse("base+accel_temperature_bias");
+  model::ParameterBlocks theta = m.ZeroParameters();
+  theta[2] = {2e-3, -1e-3, 5e-4};
+  const Session s = MakeSession("base+accel_temperature_bias", theta, SixFaces(), {20, 24, 29, 33, 38, 45});
+  ExportOptions options;
+  options.log_params = {{"INS_GYR_CAL", 1}, {"SENS_IMU_AUTOCAL", 1}, {"CAL_ACC0_ID", 1245450},
+                        {"CAL_GYRO0_ID", 2162688}};
+  options.system_id = 7;
+  const ExportOutput said = Export("ardupilot", s.r.calibration, s.series, s.r.fit.still, options);
+  EXPECT_NE(said.text.find("while INS_GYR_CAL is 1 (the log: INS_GYR_CAL 1)"), std::string::npos) << said.text;
+  EXPECT_NE(said.text.find("AHRS_TRIM_X/Y/Z"), std::string::npos);
+  EXPECT_EQ(said.text.find("\nINS_GYR_CAL,"), std::string::npos);
+  options.keep_gyro_offsets = true;
+  const ExportOutput kept = Export("ardupilot", s.r.calibration, s.series, s.r.fit.still, options);
+  EXPECT_NE(kept.text.find("\nINS_GYR_CAL,0\n"), std::string::npos) << kept.text;
+  const ExportOutput px4 = Export("px4", s.r.calibration, s.series, s.r.fit.still, options);
+  for (const char* line : {"\n7\t1\tSENS_IMU_AUTOCAL\t0\t6\n", "\n7\t1\tCAL_ACC0_ID\t1245450\t6\n",
+                           "\n7\t1\tTC_A0_ID\t1245450\t6\n", "\n7\t1\tCAL_GYRO0_ID\t2162688\t6\n"}) {
+    EXPECT_NE(px4.text.find(line), std::string::npos) << line << px4.text;
+  }
+  EXPECT_EQ(px4.text.find("TC_G0_ID"), std::string::npos);  // no gyro thermal term fitted
+  // Without the log: the ids are not written and said so; system id 1, said so.
+  const ExportOutput plain = Export("px4", s.r.calibration, s.series, s.r.fit.still, ExportOptions{});
+  EXPECT_EQ(plain.text.find("_ID\t"), std::string::npos) << plain.text;
+  EXPECT_NE(plain.text.find("are not written (the input does not record them)"), std::string::npos);
+  EXPECT_NE(plain.text.find("\n1\t1\tCAL_ACC0_XOFF"), std::string::npos);
+  EXPECT_NE(plain.text.find("--sysid N gives it"), std::string::npos);
+}
+
 TEST(Evaluate, OffDiagonalTermMatchesTheHandComputation) {
   model::Model m = model::Model::Parse("base");
   model::ParameterBlocks theta = m.ZeroParameters();

@@ -1,6 +1,7 @@
 // plumb/core/session.h — what a reader produces and the calibrator consumes.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,12 @@ struct Session {
   /// output, raw or fully reconstructed. Firmware parameters calibrated from samples that
   /// still carry a correction would replace it instead of adding to it.
   std::vector<std::string> firmware_left;
+  /// The firmware's parameters as a flight log records them (empty for other inputs): what
+  /// the exports say about the vehicle (INS_GYR_CAL, SENS_IMU_AUTOCAL, the device ids).
+  std::map<std::string, double> log_params;
+  /// The vehicle's MAVLink system id, when the log says it (SYSID_THISMAV, MAV_SYS_ID, or the
+  /// system that sent a tlog's IMU frames).
+  std::optional<int> system_id;
 };
 
 }  // namespace plumb

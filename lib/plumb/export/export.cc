@@ -65,6 +65,62 @@ void CheckDetermined(const std::string& format, const estimation::Calibration& c
               "anyway");
 }
 
+/// What the vehicle will do with the values, from the log's parameters: the boot-time gyro
+/// calibration that replaces the offsets (written off on request), the device ids the
+/// firmware matches a calibration by, the level left alone, the system id of the file.
+void AddVehicleState(const std::string& format, const ExportOptions& options, ParameterSet& set) {
+  const auto logged = [&](const std::string& name) -> std::optional<double> {
+    const auto it = options.log_params.find(name);
+    return it == options.log_params.end() ? std::nullopt : std::optional<double>(it->second);
+  };
+  const auto said = [&](const std::string& name, const char* otherwise) {
+    const auto v = logged(name);
+    return v ? "the log: " + name + " " + std::to_string(std::lround(*v)) : std::string(otherwise);
+  };
+  const bool ardupilot = format == "ardupilot";
+  const std::string flag = ardupilot ? "INS_GYR_CAL" : "SENS_IMU_AUTOCAL";
+  const std::string offsets = ardupilot ? "INS_GYR*OFFS" : "CAL_GYRO" + std::to_string(set.imu) + "_*OFF";
+  if (options.keep_gyro_offsets) {
+    set.parameters.push_back({flag, 0.0, true});
+    set.notes.push_back(flag + " 0 (--keep-gyro-offsets): the firmware keeps these " + offsets +
+                        " instead of measuring new ones at rest after boot");
+  } else if (!logged(flag) || *logged(flag) != 0.0) {
+    set.notes.push_back("the firmware measures the gyro offsets at rest after boot while " + flag +
+                        " is 1 (" + said(flag, "its default") + ") and they replace these " +
+                        offsets + ": write " + flag + " 0 (--keep-gyro-offsets) to keep plumb's");
+  }
+  if (ardupilot) {
+    set.notes.push_back("AHRS_TRIM_X/Y/Z (the level: how the board sits in the frame) are left "
+                        "as they are: plumb calibrates the sensor, not its mounting");
+  } else {
+    const std::string i = std::to_string(set.imu);
+    const std::pair<const char*, const char*> ids[] = {{"CAL_ACC", "TC_A"}, {"CAL_GYRO", "TC_G"}};
+    for (const auto& [cal, tc] : ids) {
+      const auto id = logged(std::string(cal) + i + "_ID");
+      if (!id || *id == 0.0) {
+        set.notes.push_back(std::string(cal) + i + "_ID and " + tc + i +
+                            "_ID are not written (the input does not record them): the "
+                            "vehicle's device ids stay");
+        continue;
+      }
+      set.parameters.push_back({std::string(cal) + i + "_ID", *id, true});
+      const bool thermal = std::any_of(set.parameters.begin(), set.parameters.end(), [&](const Parameter& p) {
+        return p.name.rfind(std::string(tc) + i + "_", 0) == 0;
+      });
+      if (thermal) set.parameters.push_back({std::string(tc) + i + "_ID", *id, true});
+      set.notes.push_back(std::string(cal) + i + "_ID" + (thermal ? " and " + std::string(tc) + i + "_ID" : "") +
+                          " " + std::to_string(std::lround(*id)) +
+                          ": the device id the log records (the firmware applies these values only to it)");
+    }
+  }
+  set.system_id = options.system_id.value_or(1);
+  if (!ardupilot) {
+    set.notes.push_back("vehicle (system) id " + std::to_string(set.system_id) +
+                        (options.system_id ? "" : " (the input does not say it; --sysid N gives it)") +
+                        ": QGroundControl loads a .params file only onto that vehicle");
+  }
+}
+
 /// A firmware format: parameters, their read-back correction, and the report.
 ExportOutput Firmware(const std::string& format, const estimation::Calibration& c,
                       const ImuSeries& series, const std::vector<estimation::StillSegmentFit>& still,
@@ -77,10 +133,12 @@ ExportOutput Firmware(const std::string& format, const estimation::Calibration& 
   FirmwareCorrection applied;
   if (format == "ardupilot") {
     set = ArdupilotParameters(target, options.imu);
+    AddVehicleState(format, options, set);
     out.text = ArdupilotParamFile(set);
     applied = ArdupilotCorrection(ReadArdupilotParamFile(out.text, format), options.imu);
   } else {
     set = Px4Parameters(target, options.imu);
+    AddVehicleState(format, options, set);
     out.text = Px4ParamsFile(set);
     applied = Px4Correction(ReadPx4ParamsFile(out.text, format), options.imu);
   }

@@ -10,7 +10,9 @@
 // ArdupilotCorrection / Px4Correction), so the reported error is that of the file.
 #pragma once
 
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,15 @@ struct ExportOptions {
   /// Off: Export() refuses, naming them — a single still pose would otherwise overwrite the
   /// vehicle's offsets and scales with values held at nominal, not measured.
   bool allow_undetermined = false;
+  /// The vehicle as the log records it (Session::log_params, Session::system_id): the files
+  /// say what the firmware will do with the values (INS_GYR_CAL, SENS_IMU_AUTOCAL) and carry
+  /// the device ids (CAL_*_ID, TC_*_ID) and the system id (QGroundControl's first column).
+  std::map<std::string, double> log_params;
+  std::optional<int> system_id;
+  /// Write what keeps plumb's gyroscope offsets: INS_GYR_CAL 0 (ArduPilot measures them at
+  /// every boot while it is 1, the default) and SENS_IMU_AUTOCAL 0 (PX4 overwrites CAL_GYRO
+  /// offsets at rest while it is 1).
+  bool keep_gyro_offsets = false;
 };
 
 /// The formats Export() knows, in the order above.

@@ -239,8 +239,7 @@ ParameterSet Px4Parameters(const FirmwareCorrection& fw, int imu) {
   set.notes.push_back("PX4 parameters from plumb for instance " + i +
                       ": acc = (acc_sensor - thermal - CAL_ACC" + i + "_OFF) .* CAL_ACC" + i +
                       "_SCALE, gyr = gyr_sensor - thermal - CAL_GYRO" + i + "_OFF");
-  set.notes.push_back("CAL_ACC" + i + "_ID, CAL_GYRO" + i + "_ID and TC_*" + i +
-                      "_ID are not written: they must stay the vehicle's device ids");
+
   const std::pair<const DiagonalCorrection*, const char*> sensors[] = {{&fw.accel, "A"},
                                                                        {&fw.gyro, "G"}};
   for (const auto& [c, letter] : sensors) {
@@ -320,7 +319,7 @@ std::string Px4ParamsFile(const ParameterSet& set) {
   for (const std::string& note : set.notes) text += "# " + note + "\n";
   text += "#\n# Vehicle-Id Component-Id Name Value Type\n";
   for (const Parameter& p : set.parameters) {
-    text += "1\t1\t" + p.name + "\t" +
+    text += std::to_string(set.system_id) + "\t1\t" + p.name + "\t" +
             (p.integer ? std::to_string(std::lround(p.value)) : Number(p.value)) + "\t" +
             std::to_string(p.integer ? kQgcTypeInt32 : kQgcTypeReal32) + "\n";
   }

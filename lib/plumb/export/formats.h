@@ -44,6 +44,7 @@ struct ParameterSet {
   int imu = 0;         ///< IMU instance, 0-based
   std::vector<Parameter> parameters;
   std::vector<std::string> notes;  ///< written as comments at the top of the file
+  int system_id = 1;  ///< the vehicle's MAVLink system id (QGroundControl's first column)
 
   /// Name -> value.
   std::map<std::string, double> Values() const;
@@ -72,8 +73,8 @@ std::map<std::string, double> ReadArdupilotParamFile(const std::string& text,
                                                      const std::string& path);
 
 /// QGroundControl's .params text: `#` comment lines, then per parameter
-/// `1<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE` (vehicle id, component id, MAV_PARAM_TYPE: 9 for
-/// REAL32, 6 for INT32).
+/// `SYSID<TAB>1<TAB>NAME<TAB>VALUE<TAB>TYPE` (the vehicle's system id, set.system_id, which
+/// QGroundControl checks; component id; MAV_PARAM_TYPE: 9 for REAL32, 6 for INT32).
 std::string Px4ParamsFile(const ParameterSet& set);
 /// Reads QGroundControl's layout; throws plumb::InputError naming the line when malformed.
 std::map<std::string, double> ReadPx4ParamsFile(const std::string& text, const std::string& path);

@@ -91,6 +91,10 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
   s.warnings.insert(s.warnings.end(), undone.begin(), undone.end());
   WarnCorrectionChanges(log, label + ": ", &s.warnings);
   s.site = SiteFromDataflash(log);
+  s.log_params = log.params;
+  if (const auto id = log.params.find("SYSID_THISMAV"); id != log.params.end()) {
+    s.system_id = static_cast<int>(id->second);
+  }
   return s;
 }
 

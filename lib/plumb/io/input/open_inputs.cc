@@ -152,6 +152,8 @@ void Append(Session& joined, Session next) {
   for (auto& w : next.warnings) joined.warnings.push_back(next.source + ": " + w);
   for (auto& l : next.firmware_left) joined.firmware_left.push_back(next.source + ": " + l);
   if (!joined.site) joined.site = next.site;
+  if (joined.log_params.empty()) joined.log_params = std::move(next.log_params);
+  if (!joined.system_id) joined.system_id = next.system_id;
 }
 
 }  // namespace

@@ -429,6 +429,8 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
 
   Session s;
   s.source = log.source + " (" + info.name + " instance " + std::to_string(d.instance) + ")";
+  s.log_params = params;
+  s.system_id = v.system_id;
   for (const auto& w : log.warnings.Describe(log.message_counts)) {
     s.warnings.push_back(log.source + ": " + w);
   }

@@ -428,6 +428,10 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   Session s;
   s.source = log.source + " (" + KindName(src->kind) + " instance " +
              std::to_string(src->instance) + ")";
+  s.log_params = log.params;
+  if (const auto id = log.params.find("MAV_SYS_ID"); id != log.params.end()) {
+    s.system_id = static_cast<int>(id->second);
+  }
   for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
   if (log.dropouts > 0) {
     s.warnings.push_back(log.source + ": " + std::to_string(log.dropouts) +
