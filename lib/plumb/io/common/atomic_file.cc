@@ -67,17 +67,24 @@ void RemoveStaleTemporaries(const fs::path& dir) {
   }
 }
 
-}  // namespace
-
-AtomicFileWriter::AtomicFileWriter(std::string path) : path_(std::move(path)) {
-  const fs::path dest = Destination(path_);
+/// The mkstemp/mkdtemp template of a temporary beside `dest`, ".NAME.tmp.PID.XXXXXX" (NUL
+/// ended), after removing the stale ones of that folder.
+std::vector<char> TemporaryTemplate(const fs::path& dest) {
   const fs::path dir = dest.parent_path();
   RemoveStaleTemporaries(dir);
   const std::string name =
       "." + dest.filename().string() + ".tmp." + std::to_string(::getpid()) + ".XXXXXX";
-  std::string templ = (dir.empty() ? fs::path(name) : dir / name).string();
+  const std::string templ = (dir.empty() ? fs::path(name) : dir / name).string();
   std::vector<char> buffer(templ.begin(), templ.end());
   buffer.push_back('\0');
+  return buffer;
+}
+
+}  // namespace
+
+AtomicFileWriter::AtomicFileWriter(std::string path) : path_(std::move(path)) {
+  const fs::path dest = Destination(path_);
+  std::vector<char> buffer = TemporaryTemplate(dest);
   fd_ = ::mkstemp(buffer.data());
   if (fd_ < 0) Fail("cannot create a temporary file in its folder");
   temp_path_.assign(buffer.data());
@@ -122,13 +129,7 @@ void AtomicFileWriter::Commit() {
 StagedFolder::StagedFolder(std::string path) : path_(std::move(path)) {
   fs::path dest(path_);
   if (dest.filename().empty()) dest = dest.parent_path();  // "DIR/"
-  const fs::path dir = dest.parent_path();
-  RemoveStaleTemporaries(dir);
-  const std::string name =
-      "." + dest.filename().string() + ".tmp." + std::to_string(::getpid()) + ".XXXXXX";
-  std::string templ = (dir.empty() ? fs::path(name) : dir / name).string();
-  std::vector<char> buffer(templ.begin(), templ.end());
-  buffer.push_back('\0');
+  std::vector<char> buffer = TemporaryTemplate(dest);
   if (::mkdtemp(buffer.data()) == nullptr) {
     throw Error("cannot write " + path_ + ": cannot create a temporary folder beside it (" +
                 std::strerror(errno) + ")");
