@@ -68,7 +68,7 @@ class CompareCommand : public Command {
     app_->add_option("--gravity", a.gravity_m_s2,
                      "Gravity magnitude of imu_tk's cost, m/s^2 (default: the result's "
                      "site.gravity; imu_tk's demo used 9.81744)")
-        ->check(Positive);
+        ->check(EarthGravity);
     app_->add_option("--json", a.json_path, "Also write the comparison as JSON to FILE (- for stdout, the text then on stderr)")
         ->type_name("FILE");
   }

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "validators.h"
+#include "progress.h"
 #include "commands.h"
 #include "fit_options.h"
 #include "input_options.h"
@@ -76,9 +77,11 @@ class DiagnoseCommand : public Command {
                      "every catalogue effect not in the model")
         ->delimiter(',');
     a.fit.heading = app_->add_option("--heading", a.fit.heading_deg,
-                                 "Heading of the first still pose's x axis from north, degrees");
+                                 "Heading of the first still pose's x axis from north, degrees")
+                     ->check(CLI::Range(-360.0, 360.0));
     app_->add_option("--temp-ref", a.fit.temp_ref_c,
                      "Reference temperature of the temperature terms, degC")
+        ->check(CLI::Range(-100.0, 200.0))
         ->capture_default_str();
     AddSegmentOptions(app_, a.segments);
   }
@@ -107,6 +110,7 @@ class DiagnoseCommand : public Command {
     options.candidates = a.candidates;
     options.calibration = fit.options;
     options.calibration.method = "generalized";
+    options.on_stage = [](const std::string& stage) { Progress::Of().Stage(stage); };
 
     PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose)

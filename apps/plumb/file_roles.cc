@@ -1,5 +1,6 @@
 #include "file_roles.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <system_error>
@@ -76,6 +77,28 @@ void RefuseOverwritingInputs(const FileRoles& roles) {
       if (Within(in.path, folder.path)) Refuse(folder, in, "is or holds the input");
     }
   }
+}
+
+std::string WithInputsNamed(const std::string& message, const FileRoles& roles) {
+  std::vector<std::string> named;
+  for (const NamedPath& p : roles.inputs) {
+    if (p.path.empty() || p.path == "-") continue;
+    if (message.find(p.path) != std::string::npos) return message;
+    if (p.option == "INPUT") named.push_back(p.path);
+  }
+  if (named.empty()) {
+    for (const NamedPath& p : roles.inputs) {
+      if (!p.path.empty() && p.path != "-") named.push_back(p.path);
+    }
+  }
+  if (named.empty()) return message;
+  constexpr std::size_t kListed = 3;
+  std::string prefix;
+  for (std::size_t i = 0; i < std::min(named.size(), kListed); ++i) {
+    prefix += (i == 0 ? "" : ", ") + named[i];
+  }
+  if (named.size() > kListed) prefix += " and " + std::to_string(named.size() - kListed) + " more";
+  return prefix + ": " + message;
 }
 
 }  // namespace plumb::cli

@@ -34,4 +34,10 @@ std::vector<std::string> InputFiles(const std::string& input);
 /// two outputs are one file, or an output folder is or holds an input.
 void RefuseOverwritingInputs(const FileRoles& roles);
 
+/// `message` (an error of the run) as the user reads it: when it names none of the command's
+/// input files -- an error of a stage after reading, such as still detection or the fit --
+/// it is prefixed with the INPUT files (the first three and how many more), so every error
+/// says which input it is about.
+std::string WithInputsNamed(const std::string& message, const FileRoles& roles);
+
 }  // namespace plumb::cli

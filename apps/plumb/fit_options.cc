@@ -1,5 +1,6 @@
 // See fit_options.h.
 #include "fit_options.h"
+#include "progress.h"
 
 #include <algorithm>
 #include <cmath>
@@ -133,13 +134,15 @@ void AddFitOptions(CLI::App* app, FitArgs& a) {
                 "samples out of range, a unit or rate the data contradict, a saturated axis");
   a.heading = app->add_option("--heading", a.heading_deg,
                               "Heading of the first still pose's x axis from north, degrees "
-                              "(0 = x north); otherwise the heading is an arbitrary gauge");
+                              "(0 = x north); otherwise the heading is an arbitrary gauge")
+                ->check(CLI::Range(-360.0, 360.0));
   auto* level = app->add_flag("--level-north", a.level_north,
                               "The first still pose is level with x north (the paper's pose): "
                               "its attitude is known and held");
   level->excludes(a.heading);
   app->add_option("--temp-ref", a.temp_ref_c,
                   "Reference temperature of the temperature terms, degC")
+      ->check(CLI::Range(-100.0, 200.0))
       ->capture_default_str();
   app->add_option("--max-iterations", a.max_iterations,
                   "Iteration limit of each solve; a fit that reaches it has not converged "
@@ -214,6 +217,8 @@ void PrintSession(const Session& session) {
 }
 
 estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit) {
+  Progress::Of().Stage("fitting " + fit.model.spec() + " to " + std::to_string(fit.segments.size()) +
+                       " still segments");
   try {
     return estimation::Calibrate(session.series, fit.segments, fit.model, fit.site, fit.options);
   } catch (const Error& e) {

@@ -1,4 +1,5 @@
 #include "input_options.h"
+#include "progress.h"
 
 #include <array>
 #include <cerrno>
@@ -349,6 +350,9 @@ Session ReadInputs(const InputArgs& a) {
   if (a.format == "native" && TableOptionsGiven(a)) {
     throw UsageError("--format native takes no table options (--columns, --rate, ...)");
   }
+  std::string names;
+  for (const std::string& input : inputs) names += (names.empty() ? "" : ", ") + input;
+  Progress::Of().Stage("reading " + names);
   std::vector<io::InputFile> files;
   for (const std::string& input : inputs) {
     const auto parts = SplitList(input, ',');

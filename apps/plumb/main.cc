@@ -1,8 +1,10 @@
 // plumb — IMU accelerometer and gyroscope calibration with honest uncertainty.
 //
 // The only place that catches exceptions: usage mistakes exit 2 (CLI11's parse errors and
-// UsageError), every other error prints `plumb: error: <message>` on stderr and exits 1.
+// UsageError), every other error prints `plumb: error: <message>` on stderr and exits 1; a
+// message that names no input file gets the INPUT files in front (WithInputsNamed).
 #include <glog/logging.h>
+#include <unistd.h>
 
 #include <exception>
 #include <iostream>
@@ -10,10 +12,17 @@
 #include <vector>
 
 #include "commands.h"
+#include "file_roles.h"
+#include "progress.h"
+#include "plumb/core/error.h"
 #include "validators.h"
 #include "plumb/report/version.h"
 
 namespace {
+
+/// Error messages are printed through plumb::Printable (a NUL or a binary byte quoted from a
+/// file shows as \\xNN), at most this long.
+constexpr std::size_t kMessageBytes = 4000;
 
 std::string UsageMessage(const CLI::App* app, const CLI::Error& e) {
   const std::string name = app->get_parent() ? "plumb " + app->get_name() : "plumb";
@@ -87,18 +96,29 @@ int main(int argc, char** argv) {
     if (command->app()->parsed()) selected = command.get();
   }
   if (selected == nullptr) return 2;  // unreachable: require_subcommand(1)
+  plumb::cli::FileRoles files;
+  plumb::cli::Progress& progress = plumb::cli::Progress::Of();
   try {
     plumb::cli::RejectNonFiniteNumbers(*selected->app());
-    plumb::cli::RefuseOverwritingInputs(selected->Files());
-    return selected->Run();
+    files = selected->Files();
+    plumb::cli::RefuseOverwritingInputs(files);
+    progress.Start(selected->app()->get_name(), ::isatty(STDERR_FILENO) == 1);
+    const int code = selected->Run();
+    progress.Stop();
+    return code;
   } catch (const plumb::cli::UsageError& e) {
-    std::cerr << "plumb: error: " << e.what() << "\nRun 'plumb " << selected->app()->get_name()
-              << " --help' for the options.\n";
+    progress.Stop();
+    std::cerr << "plumb: error: " << plumb::Printable(e.what(), kMessageBytes) << "\nRun 'plumb "
+              << selected->app()->get_name() << " --help' for the options.\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "plumb: error: " << e.what() << "\n";
+    progress.Stop();
+    std::cerr << "plumb: error: "
+              << plumb::Printable(plumb::cli::WithInputsNamed(e.what(), files), kMessageBytes)
+              << "\n";
     return 1;
   } catch (...) {
+    progress.Stop();
     std::cerr << "plumb: error: unknown exception\n";
     return 1;
   }

@@ -1,5 +1,6 @@
 // apps/plumb/segment_options.cc — see segment_options.h.
 #include "segment_options.h"
+#include "progress.h"
 
 #include "plumb/io/text/segments_file.h"
 #include "plumb/segmentation/given_segments.h"
@@ -39,6 +40,7 @@ segmentation::SegmentationResult FindSegments(const ImuSeries& series, const Seg
   if (!a.segments_path.empty()) {
     return segmentation::UseGivenSegments(series, io::ReadSegments(a.segments_path, series));
   }
+  Progress::Of().Stage("finding still segments in " + std::to_string(series.size()) + " samples");
   segmentation::StillDetectorOptions detector = a.detector;
   detector.use_gyro = !a.still_accel_only;
   detector.acc_unit = series.acc_unit;

@@ -233,6 +233,7 @@ class SimulateCommand : public Command {
     app_->add_flag("--no-temperature", a.no_temperature, "Leave the temp_c column out");
     app_->add_option("--temp-ref", a.temp_ref_c,
                      "Reference temperature of the true temperature terms, degC")
+        ->check(CLI::Range(-100.0, 200.0))
         ->capture_default_str();
     app_->add_option("--t0", a.t0_s, "Time of the first sample, s")->capture_default_str();
     AddSiteOptions(app_, a.site);

@@ -37,7 +37,7 @@ void AddGravityOption(CLI::App* app, SiteArgs& args) {
   args.gravity = app->add_option("--gravity", args.gravity_m_s2,
                                  "Use this fixed gravity magnitude, m/s^2, instead of WGS84 "
                                  "normal gravity at the site (only when you know better)")
-                     ->check(Positive);
+                     ->check(EarthGravity);
 }
 
 }  // namespace plumb::cli

@@ -9,7 +9,6 @@
 // into the same files, byte for byte, as one unsharded run. With the results, DIR/index.html
 // and its figures (plumb/report/study_page.h, drawn by gnuplot).
 #include <omp.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <cstdio>
@@ -20,6 +19,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "validators.h"
+#include "progress.h"
 #include "commands.h"
 #include "study_files.h"
 #include "plumb/core/error.h"
@@ -225,7 +225,8 @@ class SweepCommand : public Command {
                                                          std::vector<study::RunOutcome>(runs));
     std::vector<std::atomic<std::size_t>> done(todo.size());
     const int jobs = args_.jobs > 0 ? args_.jobs : omp_get_num_procs();
-    const bool progress = isatty(STDERR_FILENO) != 0;
+    std::size_t written = 0;
+    Progress::Of().Stage("0 of " + std::to_string(todo.size()) + " points");
     std::string error;
 #pragma omp parallel for schedule(dynamic) num_threads(jobs)
     for (std::size_t t = 0; t < tasks; ++t) {
@@ -243,11 +244,12 @@ class SweepCommand : public Command {
               study::Summarise(todo[i], outcomes[i], study::SensitivityFactors(s));
           report::WriteJson(PointPath(args_.out, todo[i].index), study::PointJson(s, summary));
           std::cout << PointLine(s, summary) << "\n" << std::flush;
-          if (progress) std::cerr << "\r" << i + 1 << " of " << todo.size() << " points" << std::flush;
+          Progress::Of().Stage(std::to_string(++written) + " of " + std::to_string(todo.size()) +
+                               " points");
         }
       }
     }
-    if (progress) std::cerr << "\n";
+    Progress::Of().Clear();
     if (!error.empty()) throw Error("sweep: " + error);
   }
 

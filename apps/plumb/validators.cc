@@ -3,9 +3,11 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 
 #include "commands.h"
+#include "plumb/core/units.h"
 
 namespace plumb::cli {
 namespace {
@@ -80,6 +82,18 @@ void CheckOptions(const CLI::App& app) {
 
 const CLI::Validator Positive = Bound(true);
 const CLI::Validator NonNegative = Bound(false);
+const CLI::Validator EarthGravity(
+    [](std::string& text) {
+      double v = 0.0;
+      const bool ok = ReadNumber(text, v) && v >= units::kMinEarthGravity &&
+                      v <= units::kMaxEarthGravity;
+      std::ostringstream range;
+      range << units::kMinEarthGravity << "-" << units::kMaxEarthGravity;
+      return ok ? std::string()
+                : "must be a gravity magnitude found on Earth, " + range.str() +
+                      " m/s^2 (got '" + text + "')";
+    },
+    "m/s^2 on Earth", "GRAVITY");
 
 void RejectNonFiniteNumbers(const CLI::App& app) { CheckOptions(app); }
 

@@ -16,6 +16,9 @@ extern const CLI::Validator Positive;
 /// A finite number >= 0.
 extern const CLI::Validator NonNegative;
 
+/// A gravity magnitude found on Earth, m/s^2 (units::kMinEarthGravity..kMaxEarthGravity).
+extern const CLI::Validator EarthGravity;
+
 /// Throws UsageError naming the option and its value when a given option of `app` or of its
 /// parsed subcommands holds a number that is not finite (file comment).
 void RejectNonFiniteNumbers(const CLI::App& app);

@@ -155,6 +155,22 @@ TEST(Safety, EveryCommandsHelpEndsWithAnExample) {
   }
 }
 
+TEST(Safety, GravityNotFoundOnEarthIsRefused) {
+  // --gravity 1e300 (finite, positive) overflowed the residuals and aborted inside Ceres.
+  TempDir dir;
+  const std::string csv = Session(dir);
+  for (const char* g : {"1e300", "0.5", "98.1"}) {
+    for (const char* command : {"calibrate", "diagnose", "report"}) {
+      std::vector<std::string> args = {command, csv, "--gravity", g};
+      if (std::string(command) == "report") args.insert(args.end(), {"--out", dir.File("page")});
+      const ToolRun run = Plumb(args, dir);
+      EXPECT_EQ(run.exit_code, 2) << command << " --gravity " << g << ": " << run.err;
+      EXPECT_TRUE(Contains(run.err, "--gravity: must be a gravity magnitude found on Earth"))
+          << run.err;
+    }
+  }
+}
+
 /// The numeric options of `command` as its --help lists them ("--heading FLOAT ...").
 std::vector<std::string> NumericOptions(const std::string& command, const TempDir& dir) {
   std::vector<std::string> args = {command, "--help"};

@@ -5,15 +5,24 @@
 // Only the command-line `main` catches it.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace plumb {
 
+std::string Printable(std::string_view text, std::size_t max_chars);
+
+/// The message is kept printable (see Printable): a NUL quoted from a file would otherwise cut
+/// what() short, and binary bytes would garble the terminal.
 class Error : public std::runtime_error {
  public:
-  explicit Error(const std::string& what) : std::runtime_error(what) {}
+  explicit Error(const std::string& what) : std::runtime_error(Printable(what, kMaxMessage)) {}
+
+  /// Longest message kept, bytes.
+  static constexpr std::size_t kMaxMessage = 16000;
 };
 
 /// Error about an input file. `where` is e.g. "line 12" or "byte 4096"; may be empty.
@@ -36,5 +45,15 @@ class InsufficientDataError : public Error {
  public:
   explicit InsufficientDataError(const std::string& what) : Error(what) {}
 };
+
+/// `text` as a message may quote it: control bytes (NUL included, tab and newline excepted)
+/// and bytes that are not part of valid UTF-8 written as \xNN, cut after `max_chars` bytes
+/// of the input with "..." appended. A file's binary content then reads as bytes instead of
+/// garbling the terminal or cutting the message at a NUL.
+std::string Printable(std::string_view text, std::size_t max_chars);
+
+/// A number as messages print it: 6 significant digits ("1e+300", "0.0199", "200"), never
+/// std::to_string's fixed 6 decimals (309 digits for 1e300, "0.000000" for 1e-9).
+std::string Number(double value);
 
 }  // namespace plumb

@@ -19,6 +19,10 @@ inline constexpr double kDegPerRad = 180.0 / kPi;
 /// Standard gravity g0 (CGPM 1901, ISO 80000-3), m/s^2: the "g" of datasheets and of
 /// firmware units (mg, mG); not local gravity, which plumb takes from the site (geo::Site).
 inline constexpr double kStandardGravity = 9.80665;
+/// The gravity magnitudes found on Earth, m/s^2: 9.78 at the equator to 9.83 at the poles at
+/// sea level, down to about 9.75 at 10 km; a --gravity outside this range is a typing mistake.
+inline constexpr double kMinEarthGravity = 9.7;
+inline constexpr double kMaxEarthGravity = 9.9;
 /// m/s^2 per milli-g and per micro-g.
 inline constexpr double kMilliG = kStandardGravity * 1e-3;
 inline constexpr double kMicroG = kStandardGravity * 1e-6;

@@ -219,6 +219,11 @@ void Rank(std::vector<Candidate>& candidates) {
                    });
 }
 
+/// Tells options.on_stage, when set, that `stage` begins.
+void Tell(const DiagnoseOptions& options, const std::string& stage) {
+  if (options.on_stage) options.on_stage(stage);
+}
+
 /// Refits the model plus each of the best `options.confirm` significant candidates: the
 /// actual fall of chi^2 from its probe fit (`fit` or, with velocity residuals, `fit_motion`).
 void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segments,
@@ -232,6 +237,8 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
     if (!cand.significant) continue;
     model::Model with = model;
     with.Add(cand.effect, cand.option);
+    Tell(options, "refit with " + with.spec() + " (" + std::to_string(confirmed + 1) + " of at most " +
+                      std::to_string(options.confirm) + ")");
     estimation::CalibrationOptions refit_options = options.calibration;
     refit_options.accel_in_motion = cand.with_velocity;
     estimation::CalibrationResult refit =
@@ -265,11 +272,13 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   const ProbePlan plan = PlanProbes(wanted, series, site, model, d.skipped);
   estimation::CalibrationOptions own = options.calibration;
   if (!own.accel_in_motion) own.accel_in_motion = false;
+  Tell(options, "probe fit of " + plan.probed.spec());
   const estimation::CalibrationResult fit =
       estimation::Calibrate(series, segments, plan.probed, site, own);
   d.fit = StripProbes(fit, model);
   std::optional<estimation::CalibrationResult> fit_motion;
   if (plan.probed_motion.has_probes() && d.fit.fit.motion_segments > 0) {
+    Tell(options, "probe fit with velocity residuals");
     estimation::CalibrationOptions with = options.calibration;
     with.accel_in_motion = true;
     with.check_linearity = false;  // its columns score candidates; its covariance is not shown

@@ -20,6 +20,7 @@
 //   std::cout << report::DiagnosisText(d);   // plumb/report/diagnosis_text.h
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +46,9 @@ struct DiagnoseOptions {
   /// Options of every fit (the probe fit and the refits).
   estimation::CalibrationOptions calibration;
   ScoreTestOptions score;
+  /// Told what Diagnose starts next ("probe fit", "refit with base+EFFECT (1 of 3)"), for a
+  /// command's progress display; empty: nobody is told. The library itself never prints.
+  std::function<void(const std::string& stage)> on_stage;
 };
 
 /// One candidate effect.

@@ -65,7 +65,7 @@ void AddAdvice(const Calibration& calibration, const StillSet& still,
       !options.first_heading_deg) {
     fit.warnings.push_back(
         "the heading of the first still pose is held at 0 (x north) as the gauge; with a site, "
-        "Earth rate (" + std::to_string(site.omega_ie_n.head<2>().norm()) +
+        "Earth rate (" + Number(site.omega_ie_n.head<2>().norm()) +
         " rad/s horizontal) is predicted for that heading: state it (--heading DEG or "
         "--level-north) or the gyroscope biases absorb up to that much");
   }

@@ -120,7 +120,7 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
   }
   if (!(std::isfinite(options.instability_time_s) && options.instability_time_s > 0)) {
     throw Error("the bias instability's correlation time must be finite and > 0 s (got " +
-                std::to_string(options.instability_time_s) + ")");
+                Number(options.instability_time_s) + ")");
   }
   noise.instability_time_s = options.instability_time_s;
   if (options.constant_bias) return noise;  // no walk, no instability

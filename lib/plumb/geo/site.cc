@@ -14,13 +14,13 @@ double EarthRate() { return GeographicLib::NormalGravity::WGS84().AngularVelocit
 
 Site Site::At(double lat_deg, double lon_deg, double height_m, const std::string& source) {
   if (!std::isfinite(lat_deg) || lat_deg < -90.0 || lat_deg > 90.0) {
-    throw Error("site latitude " + std::to_string(lat_deg) + " deg is outside [-90, 90]");
+    throw Error("site latitude " + Number(lat_deg) + " deg is outside [-90, 90]");
   }
   if (!std::isfinite(lon_deg) || lon_deg < -180.0 || lon_deg > 360.0) {
-    throw Error("site longitude " + std::to_string(lon_deg) + " deg is outside [-180, 360]");
+    throw Error("site longitude " + Number(lon_deg) + " deg is outside [-180, 360]");
   }
   if (!std::isfinite(height_m) || height_m < -12000.0 || height_m > 100000.0) {
-    throw Error("site height " + std::to_string(height_m) + " m is outside [-12000, 100000]");
+    throw Error("site height " + Number(height_m) + " m is outside [-12000, 100000]");
   }
   Site s;
   s.lat_deg = lat_deg;

@@ -111,7 +111,7 @@ PaperStaticResult CalibratePaperStatic(const ImuSeries& series, std::size_t begi
     r.gyro = Gyroscope(series, begin, end, hp, site, options);
     r.E = r.gyro.E_paper;
     r.b_g = r.gyro.bias;
-    r.notes.push_back("sigma = 0 and E_xx = E_yy = " + std::to_string(options.gyro_diagonal) +
+    r.notes.push_back("sigma = 0 and E_xx = E_yy = " + Number(options.gyro_diagonal) +
                       " are fixed; tau, xi, nu come from Earth rate alone");
   }
   return r;

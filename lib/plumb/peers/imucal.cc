@@ -95,7 +95,7 @@ ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string&
   f.notes.push_back(
       "imucal applies acc_cal = R_a^-1 K_a^-1 (acc - b_a), gyr_cal = R_g^-1 K_g^-1 (gyr - K_ga "
       "acc_cal - b_g); forward form F = K_a R_a R, E = K_g R_g R, G = K_ga R, converted to SI");
-  f.notes.push_back("imucal's frame (its six poses) is turned by " + std::to_string(angle_deg) +
+  f.notes.push_back("imucal's frame (its six poses) is turned by " + Number(angle_deg) +
                     " deg from plumb's accelerometer-defined frame (R_peer_b)");
   f.notes.push_back(
       "imucal's gyroscope bias is the mean of its six static poses, Earth rate included");

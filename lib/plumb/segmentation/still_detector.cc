@@ -21,15 +21,15 @@ void CheckOptions(const StillDetectorOptions& o) {
     if (!ok) throw Error("still detector option " + what);
   };
   require(std::isfinite(o.init_still_s) && o.init_still_s >= 0.0,
-          "init_still_s = " + std::to_string(o.init_still_s) + " s must be >= 0 (0 = auto)");
+          "init_still_s = " + Number(o.init_still_s) + " s must be >= 0 (0 = auto)");
   require(std::isfinite(o.window_s) && o.window_s > 0.0,
-          "window_s = " + std::to_string(o.window_s) + " s must be > 0");
+          "window_s = " + Number(o.window_s) + " s must be > 0");
   require(o.false_alarm > 0.0 && o.false_alarm < 0.5,
           "false_alarm = " + std::to_string(o.false_alarm) + " must be in (0, 0.5)");
   require(std::isfinite(o.min_still_s) && o.min_still_s >= 0.0,
-          "min_still_s = " + std::to_string(o.min_still_s) + " s must be >= 0");
+          "min_still_s = " + Number(o.min_still_s) + " s must be >= 0");
   require(std::isfinite(o.edge_s) && o.edge_s >= 0.0,
-          "edge_s = " + std::to_string(o.edge_s) + " s must be >= 0");
+          "edge_s = " + Number(o.edge_s) + " s must be >= 0");
   require(!std::isnan(o.rate_allowance),
           "rate_allowance must be a number (negative = automatic)");
 }

@@ -142,7 +142,7 @@ double PooledAllanEdf(const std::vector<std::size_t>& record_sizes, std::size_t 
 std::pair<double, double> AllanInterval(double adev, double edf, double confidence) {
   CheckConfidence(confidence);
   if (!(edf > 0.0) || !std::isfinite(edf)) {
-    throw Error("Allan interval: degrees of freedom " + std::to_string(edf) +
+    throw Error("Allan interval: degrees of freedom " + Number(edf) +
                 " must be positive and finite");
   }
   const double tail = 0.5 * (1.0 - confidence);
@@ -154,7 +154,7 @@ std::pair<double, double> AllanInterval(double adev, double edf, double confiden
 AllanDeviation PooledAllanDeviation(const std::vector<AxisView>& records, double dt_s,
                                     const AllanOptions& options) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) {
-    throw Error("Allan deviation: sample interval " + std::to_string(dt_s) +
+    throw Error("Allan deviation: sample interval " + Number(dt_s) +
                 " s must be positive and finite");
   }
   CheckConfidence(options.confidence);

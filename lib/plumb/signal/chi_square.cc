@@ -18,7 +18,7 @@ double NormalQuantile(double p) {
 
 double ChiSquareQuantileExact(double p, double dof) {
   if (!(dof > 0.0) || !std::isfinite(dof)) {
-    throw Error("chi-square quantile: degrees of freedom " + std::to_string(dof) +
+    throw Error("chi-square quantile: degrees of freedom " + Number(dof) +
                 " must be positive and finite");
   }
   if (!(p > 0.0 && p < 1.0)) {

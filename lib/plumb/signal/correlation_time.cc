@@ -69,7 +69,7 @@ double PooledAutocovariance(const CentredChunks& data, std::size_t k) {
 
 void CheckOptions(const CorrelationTimeOptions& options) {
   if (!(options.sokal_c > 1.0 && options.sokal_c <= 20.0)) {
-    throw Error("correlation time: Sokal window factor c = " + std::to_string(options.sokal_c) +
+    throw Error("correlation time: Sokal window factor c = " + Number(options.sokal_c) +
                 " is not in (1, 20]");
   }
   if (options.max_lag < 1) throw Error("correlation time: max_lag must be at least 1");
@@ -96,7 +96,7 @@ CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
   const double c0 = sum_sq / static_cast<double>(out.samples);
   if (!(c0 > 0.0) || !std::isfinite(c0)) {
     throw Error("correlation time: the samples have zero or non-finite variance (" +
-                std::to_string(out.variance) + ")");
+                Number(out.variance) + ")");
   }
 
   const std::size_t last_lag = std::min(options.max_lag, data.longest / 2);

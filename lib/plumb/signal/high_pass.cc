@@ -13,7 +13,7 @@ Biquad ButterworthHighPass(double cutoff_hz, double rate_hz) {
   if (!std::isfinite(cutoff_hz) || !std::isfinite(rate_hz) || !(cutoff_hz > 0.0) ||
       !(rate_hz > 0.0) || !(cutoff_hz < rate_hz / 2.0)) {
     throw Error("high-pass filter: need 0 < cutoff_hz < rate_hz / 2, got cutoff_hz " +
-                std::to_string(cutoff_hz) + ", rate_hz " + std::to_string(rate_hz));
+                Number(cutoff_hz) + ", rate_hz " + Number(rate_hz));
   }
   const double q = 1.0 / std::sqrt(2.0);
   const double w = units::kTwoPi * cutoff_hz / rate_hz;

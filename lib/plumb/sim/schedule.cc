@@ -16,7 +16,7 @@ using units::kTwoPi;
 
 void CheckDuration(double duration_s, const char* what) {
   if (!std::isfinite(duration_s) || duration_s <= 0.0) {
-    throw Error(std::string(what) + " duration " + std::to_string(duration_s) +
+    throw Error(std::string(what) + " duration " + Number(duration_s) +
                 " s must be finite and > 0");
   }
 }

@@ -18,14 +18,14 @@ constexpr double kGridTolerance = 1e-6;
 
 void CheckNonNegative(double value, const char* name) {
   if (!std::isfinite(value) || value < 0.0) {
-    throw Error(std::string("simulation option ") + name + " = " + std::to_string(value) +
+    throw Error(std::string("simulation option ") + name + " = " + Number(value) +
                 " must be finite and >= 0");
   }
 }
 
 void ValidateOptions(const SimulationOptions& o) {
   if (!std::isfinite(o.rate_hz) || o.rate_hz <= 0.0 || o.rate_hz > kMaxRateHz) {
-    throw Error("simulation option rate_hz = " + std::to_string(o.rate_hz) +
+    throw Error("simulation option rate_hz = " + Number(o.rate_hz) +
                 " must be in (0, 100000] Hz");
   }
   CheckNonNegative(o.accel_noise_density, "accel_noise_density (m/s^2/sqrt(Hz))");
@@ -36,7 +36,7 @@ void ValidateOptions(const SimulationOptions& o) {
   CheckNonNegative(o.gyro_bias_instability, "gyro_bias_instability (rad/s)");
   if (!(std::isfinite(o.bias_instability_time_s) && o.bias_instability_time_s > 0.0)) {
     throw Error("simulation option bias_instability_time_s = " +
-                std::to_string(o.bias_instability_time_s) + " must be finite and > 0 (s)");
+                Number(o.bias_instability_time_s) + " must be finite and > 0 (s)");
   }
   CheckNonNegative(o.accel_quantum, "accel_quantum (m/s^2)");
   CheckNonNegative(o.gyro_quantum, "gyro_quantum (rad/s)");
@@ -167,7 +167,7 @@ void TemperatureProfile::Validate() const {
     throw Error("temperature profile values must be finite degC");
   }
   if (kind == Kind::kUpDown && (!std::isfinite(period_s) || period_s <= 0.0)) {
-    throw Error("temperature profile period_s = " + std::to_string(period_s) +
+    throw Error("temperature profile period_s = " + Number(period_s) +
                 " must be finite and > 0");
   }
 }
@@ -202,8 +202,8 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
   const double rate_hz = options.rate_hz;
   const double n_real = std::ceil(schedule.duration_s() * rate_hz - kGridTolerance);
   if (n_real > kMaxSamples) {
-    throw Error("simulation of " + std::to_string(schedule.duration_s()) + " s at " +
-                std::to_string(rate_hz) + " Hz exceeds 200 million samples");
+    throw Error("simulation of " + Number(schedule.duration_s()) + " s at " +
+                Number(rate_hz) + " Hz exceeds 200 million samples");
   }
   const std::size_t n = static_cast<std::size_t>(std::max(0.0, n_real));
 

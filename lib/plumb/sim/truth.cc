@@ -32,7 +32,7 @@ void SetParameter(const model::Model& model, model::ParameterBlocks& theta,
 model::ParameterBlocks RandomParameters(const model::Model& model, double scale,
                                         std::uint64_t seed) {
   if (!std::isfinite(scale) || scale < 0.0) {
-    throw Error("random parameter scale " + std::to_string(scale) + " must be finite and >= 0");
+    throw Error("random parameter scale " + Number(scale) + " must be finite and >= 0");
   }
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);

@@ -112,10 +112,8 @@ std::vector<std::string> SplitNames(std::string_view line, char delimiter) {
 
 std::string Quote(std::string_view field) {
   constexpr std::size_t kMax = 40;
-  std::string out = "'";
-  out.append(field.substr(0, kMax));
-  if (field.size() > kMax) out += "...";
-  return out + "'";
+  // Printable: a NUL would cut the message (what() is a C string), binary bytes garble it.
+  return "'" + Printable(field, kMax) + "'";
 }
 
 std::string FormatNumber(double value) {

@@ -1,10 +1,12 @@
 // plumb/io/input/open_inputs.cc — see open_inputs.h.
 #include "plumb/io/input/open_inputs.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <optional>
+#include <sstream>
 #include <string_view>
 
 #include "plumb/core/error.h"
@@ -21,12 +23,22 @@ namespace {
 /// longest integrated motion (120 s), so no motion is assumed across files.
 constexpr double kJoinGap_s = 1000.0;
 
+/// A header line is looked for in the first 64 KiB, lines cut at 4 KiB: a binary file with
+/// no newline is not read whole to find one.
+constexpr std::streamsize kHeaderSearchBytes = 64 * 1024;
+constexpr std::streamsize kHeaderLineBytes = 4 * 1024;
+
 /// The first line that is neither blank nor a comment, or "" when there is none.
 std::string FirstContentLine(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
+  std::string head(kHeaderSearchBytes, '\0');
+  in.read(head.data(), kHeaderSearchBytes);
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  std::istringstream lines(head);
   std::string line;
-  for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
+  for (int n = 0; n < 1000 && std::getline(lines, line); ++n) {
+    if (line.size() > static_cast<std::size_t>(kHeaderLineBytes)) line.resize(kHeaderLineBytes);
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
@@ -46,17 +58,32 @@ bool IsNativeHeader(std::string_view line) {
   return found == 4;
 }
 
+/// True when `line` holds bytes text does not: NUL and the other control bytes but tab, CR,
+/// LF and form feed.
+bool LooksBinary(std::string_view line) {
+  return std::any_of(line.begin(), line.end(), [](char ch) {
+    const auto c = static_cast<unsigned char>(ch);
+    return (c < 0x20 && c != '\t' && c != '\r' && c != '\n' && c != '\f') || c == 0x7f;
+  });
+}
+
 /// Reads one file in the native format; unless `insist`, first checks its header and fails
 /// with `hint` when it is not native CSV.
 Session ReadNative(const std::string& path, bool insist, const std::string& hint) {
   const std::string first = FirstContentLine(path);
   // An empty file (or a missing one) gets the reader's own message.
   if (first.empty()) return ReadNativeCsv(path);
+  if (!insist && LooksBinary(first)) {
+    throw InputError(path, "",
+                     "neither a flight log plumb recognises by its first bytes (ArduPilot "
+                     "DataFlash .bin, MAVLink .tlog, PX4 .ulg) nor text: it starts '" +
+                         Printable(first, 24) + "' (a damaged log, or a format plumb does not read)");
+  }
   if (!insist && !IsNativeHeader(first)) {
     throw InputError(path, "",
                      "not plumb's native CSV (header time_s,acc_x,acc_y,acc_z[,gyr_x,gyr_y,gyr_z]"
                      "[,temp_c] expected, found '" +
-                         first.substr(0, 60) + "'); " + hint);
+                         Printable(first, 60) + "'); " + hint);
   }
   return ReadNativeCsv(path);
 }

@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "plumb/core/error.h"
 #include "plumb/core/units.h"
 #include "plumb/io/common/log_common.h"
 
@@ -105,9 +106,9 @@ void UndoSensor(const Params& params, const Px4Sensors& sensors, bool acc,
       thermal_text = " + thermal offset " + thermal->prefix + "_X0..X3 (X0 " +
                      Format(thermal->x[0]) + ", X1 " + Format(thermal->x[1]) + ", X2 " +
                      Format(thermal->x[2]) + ", X3 " + Format(thermal->x[3]) + ", TREF " +
-                     std::to_string(thermal->t_ref_c) + " degC, clamped to [" +
-                     std::to_string(thermal->t_min_c) + ", " +
-                     std::to_string(thermal->t_max_c) + "]) at the temperature of " +
+                     Number(thermal->t_ref_c) + " degC, clamped to [" +
+                     Number(thermal->t_min_c) + ", " +
+                     Number(thermal->t_max_c) + "]) at the temperature of " +
                      temp->source;
     }
   }

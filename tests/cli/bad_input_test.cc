@@ -1,0 +1,226 @@
+// The bad-input battery: every command that reads a file runs on empty, garbage, truncated,
+// byte-flipped and NaN versions of each kind of input plumb reads (native CSV; ArduPilot .bin
+// and text .log, PX4 .ulg and MAVLink .tlog from ../shared/data when present; calibration,
+// truth and study JSON). For every run: the process exits by itself with a code below 128 (no
+// abort, no signal), a failure's message names the damaged file and holds no NUL or raw
+// binary byte, and no input file is changed. The damage is drawn from fixed seeds, so every
+// run of the battery is the same.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "run_tool.h"
+
+namespace plumb::cli {
+namespace {
+
+using testing::Contains;
+using testing::Plumb;
+using testing::ReadAll;
+using testing::TempDir;
+using testing::ToolRun;
+namespace fs = std::filesystem;
+
+void Write(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+/// The damaged versions of `good`, by name: empty, garbage (random bytes), truncated (a third
+/// and a few bytes), flipped (one bit in every 500 bytes of the first 200 kB), each drawn from
+/// `seed`.
+std::map<std::string, std::string> Damaged(const std::string& good, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> byte(0, 255), bit(0, 7);
+  std::map<std::string, std::string> out;
+  out["empty"] = "";
+  std::string garbage(4096, '\0');
+  for (char& c : garbage) c = static_cast<char>(byte(rng));
+  out["garbage"] = garbage;
+  out["truncated"] = good.substr(0, good.size() / 3 + 7);
+  std::string flipped = good.substr(0, 200000);
+  std::uniform_int_distribution<std::size_t> at(0, flipped.size() - 1);
+  for (std::size_t k = 0; k < flipped.size() / 500 + 1; ++k) {
+    flipped[at(rng)] ^= static_cast<char>(1 << bit(rng));
+  }
+  out["flipped"] = flipped;
+  return out;
+}
+
+/// True when `text` holds a NUL or a byte that is not part of valid UTF-8.
+bool HasRawBytes(const std::string& text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c == 0) return true;
+    std::size_t n = c < 0x80 ? 1 : c >= 0xf0 ? 4 : c >= 0xe0 ? 3 : c >= 0xc2 ? 2 : 0;
+    if (n == 0 || i + n > text.size()) return true;
+    for (std::size_t k = 1; k < n; ++k) {
+      if ((static_cast<unsigned char>(text[i + k]) & 0xc0) != 0x80) return true;
+    }
+    i += n;
+  }
+  return false;
+}
+
+class BadInput : public ::testing::Test {
+ protected:
+  /// A small simulated session, its calibration and its truth, once per test.
+  void SetUp() override {
+    session_ = dir_.File("good.csv");
+    truth_ = dir_.File("good.truth.json");
+    const ToolRun sim = Plumb({"simulate", "--out", session_, "--poses", "9", "--rate", "50",
+                               "--seed", "5", "--truth-json", truth_}, dir_);
+    ASSERT_EQ(sim.exit_code, 0) << sim.err;
+    calibration_ = dir_.File("good.cal.json");
+    const ToolRun cal = Plumb({"calibrate", session_, "--json", calibration_}, dir_);
+    ASSERT_EQ(cal.exit_code, 0) << cal.err;
+  }
+
+  /// Runs `args`; checks the exit, that a failure names `damaged` in clean text, and that no
+  /// file of the folder changed.
+  void Check(const std::vector<std::string>& args, const std::string& damaged) {
+    std::map<std::string, std::string> before;
+    for (const auto& e : fs::directory_iterator(dir_.path())) {
+      if (e.is_regular_file() && e.path().filename().string()[0] != '.') {
+        before[e.path().string()] = ReadAll(e.path().string());
+      }
+    }
+    const ToolRun run = Plumb(args, dir_);
+    std::string line = "plumb";
+    for (const std::string& a : args) line += " " + fs::path(a).filename().string();
+    ++runs_;
+    EXPECT_GE(run.exit_code, 0) << line << ": killed by a signal\n" << run.err;
+    EXPECT_LT(run.exit_code, 128) << line << "\n" << run.err;
+    if (run.exit_code != 0) {
+      EXPECT_TRUE(Contains(run.err, damaged)) << line << ": the message does not name "
+                                              << damaged << "\n" << run.err;
+      EXPECT_FALSE(HasRawBytes(run.err)) << line << "\n" << run.err;
+    }
+    for (const auto& [path, bytes] : before) {
+      EXPECT_EQ(ReadAll(path), bytes) << path << " changed by: " << line;
+    }
+  }
+
+  /// Every command that reads a session, on `input`.
+  void EveryCommandOn(const std::string& input) {
+    const std::string out = dir_.File("out");
+    fs::remove_all(out);
+    fs::create_directories(out);
+    Check({"info", input}, input);
+    Check({"allan", input}, input);
+    Check({"calibrate", input, "--json", out + "/c.json"}, input);
+    Check({"diagnose", input, "--confirm", "0", "--json", out + "/d.json"}, input);
+    Check({"report", input, "--out", out + "/page"}, input);
+    Check({"apply", calibration_, input, "--out", out + "/a.csv"}, input);
+    Check({"paper", input, "--static", input, "--lat", "50", "--lon", "8", "--out",
+           out + "/paper"}, input);
+  }
+
+  /// The damaged versions of `good` (and those in `extra`) as files NAME.EXT, each run
+  /// through every command.
+  void Battery(const std::string& good, const std::string& ext, std::uint32_t seed,
+               std::map<std::string, std::string> extra = {}) {
+    std::map<std::string, std::string> cases = Damaged(good, seed);
+    cases.insert(extra.begin(), extra.end());
+    for (const auto& [name, bytes] : cases) {
+      const std::string path = dir_.File(name + "." + ext);
+      Write(path, bytes);
+      EveryCommandOn(path);
+      fs::remove(path);
+    }
+    EXPECT_GE(runs_, 7 * cases.size());
+  }
+
+  /// A log from ../shared/data, or "" (the test then skips).
+  static std::string SharedLog(const std::string& relative) {
+    const std::string path = std::string(PLUMB_SHARED_DATA_DIR) + "/" + relative;
+    return fs::exists(path) ? ReadAll(path) : std::string();
+  }
+
+  TempDir dir_;
+  std::string session_, truth_, calibration_;
+  std::size_t runs_ = 0;
+};
+
+TEST_F(BadInput, NativeCsv) {
+  const std::string good = ReadAll(session_);
+  // Every 97th row's acc_y replaced by nan: finite numbers expected (or --drop-nan).
+  std::istringstream rows(good);
+  std::string nan, row;
+  for (int k = 0; std::getline(rows, row); ++k) {
+    const auto first = row.find(','), second = row.find(',', first + 1),
+               third = row.find(',', second + 1);
+    if (k > 0 && k % 97 == 0 && third != std::string::npos) {
+      row.replace(second + 1, third - second - 1, "nan");
+    }
+    nan += row + "\n";
+  }
+  std::string nul = good;
+  nul.insert(1000, std::string("\0abc", 4));
+  Battery(good, "csv", 1, {{"nan", nan}, {"nul", nul}});
+}
+
+TEST_F(BadInput, ArduPilotBin) {
+  const std::string good = SharedLog("ardupilot/plane382_pymavlink_test.BIN");
+  if (good.empty()) GTEST_SKIP() << "shared data absent: " << PLUMB_SHARED_DATA_DIR;
+  Battery(good, "bin", 2);
+}
+
+TEST_F(BadInput, ArduPilotTextLog) {
+  const std::string good = SharedLog("ardupilot/copter311_nan.log");
+  if (good.empty()) GTEST_SKIP() << "shared data absent: " << PLUMB_SHARED_DATA_DIR;
+  Battery(good, "log", 3);
+}
+
+TEST_F(BadInput, Px4ULog) {
+  const std::string good = SharedLog("px4/sample_log_small.ulg");
+  if (good.empty()) GTEST_SKIP() << "shared data absent: " << PLUMB_SHARED_DATA_DIR;
+  Battery(good, "ulg", 4);
+}
+
+TEST_F(BadInput, MavlinkTlog) {
+  const std::string good = SharedLog("mavlink/plane385_disarmed.tlog");
+  if (good.empty()) GTEST_SKIP() << "shared data absent: " << PLUMB_SHARED_DATA_DIR;
+  Battery(good, "tlog", 5);
+}
+
+TEST_F(BadInput, CalibrationTruthAndStudyFiles) {
+  // JSON files other commands read: a calibration (apply, compare), a truth (compare --truth),
+  // a study (sweep); damaged, and with a NaN where a number belongs.
+  const std::string study = R"({"name": "t", "runs": 1, "factors": [{"name": "poses", "levels": [9]}]})";
+  std::string nan_cal = ReadAll(calibration_);
+  nan_cal.replace(nan_cal.find("\"bias\": [") + 9, 0, "NaN, ");
+  const std::map<std::string, std::string> goods = {
+      {"cal", ReadAll(calibration_)}, {"truth", ReadAll(truth_)}, {"study", study}};
+  std::uint32_t seed = 10;
+  for (const auto& [kind, good] : goods) {
+    std::map<std::string, std::string> cases = Damaged(good, ++seed);
+    if (kind == "cal") cases["nan"] = nan_cal;
+    for (const auto& [name, bytes] : cases) {
+      const std::string path = dir_.File(kind + "_" + name + ".json");
+      Write(path, bytes);
+      const std::string out = dir_.File("out");
+      fs::remove_all(out);
+      if (kind == "cal") {
+        Check({"apply", path, session_, "--out", out + ".csv"}, path);
+        Check({"compare", path, "--truth", truth_}, path);
+      } else if (kind == "truth") {
+        Check({"compare", calibration_, "--truth", path}, path);
+      } else {
+        Check({"sweep", path, "--out", out}, path);
+      }
+      fs::remove(path);
+      fs::remove(out + ".csv");
+    }
+  }
+  EXPECT_GE(runs_, 12u);
+}
+
+}  // namespace
+}  // namespace plumb::cli
