@@ -483,7 +483,9 @@ const MavlinkMessageInfo* FindMavlinkMessage(std::uint32_t msgid) {
 
 std::string MavlinkDefinitionsSource() {
   std::string dialects;
-  for (const char* d : kMavlinkDialects) dialects += (dialects.empty() ? "" : ", ") + std::string(d);
+  for (const char* d : kMavlinkDialects) {
+    dialects += (dialects.empty() ? "" : ", ") + std::string(d);
+  }
   return dialects + " (" + kMavlinkDefinitions + ")";
 }
 
