@@ -4,6 +4,7 @@
 //
 // Built by tests/fuzz/CMakeLists.txt (scripts/fuzz); by hand:
 //   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I lib -I /usr/include/eigen3 \
+//     -I build/lib/plumb/io/mavlink/generated \
 //     tests/fuzz/mavlink_tlog_fuzz.cc lib/plumb/io/mavlink/mavlink_tlog.cc \
 //     lib/plumb/io/mavlink/mavlink_session.cc lib/plumb/io/ardupilot/ardupilot_correction.cc \
 //     lib/plumb/io/common/log_common.cc lib/plumb/core/imu_series.cc

@@ -36,6 +36,8 @@ const std::string kLog = std::string(PLUMB_SHARED_DATA_DIR) + "/mavlink/" + kLog
 const std::string kGolden =
     std::string(PLUMB_SOURCE_DIR) + "/tests/data/mavlink/" + kLogName + ".golden.json";
 constexpr std::uint64_t kT0_us = 1532076292000000ull;  // 2018-07-20, a plausible tlog time
+/// An 8-bit id in none of the known dialects (the tests assert it before relying on it).
+constexpr std::uint32_t kUnknownId = 199;
 
 nlohmann::json ReadGolden() {
   std::ifstream in(kGolden);
@@ -170,9 +172,73 @@ TEST(MavlinkTlog, CrcMatchesKnownValues) {
   const std::uint8_t extra = static_cast<std::uint8_t>(MavlinkCrcExtra(kMavHeartbeat));
   EXPECT_EQ(extra, 50);
   EXPECT_EQ(MavlinkCrc(&extra, 1, crc), 0xDFA1);
-  EXPECT_EQ(MavlinkCrcExtra(kMavRawImu), 144);
-  EXPECT_EQ(MavlinkCrcExtra(kMavHighresImu), 93);
   EXPECT_EQ(MavlinkCrcExtra(1u << 20), -1);
+}
+
+// The generated table (scripts/gen-mavlink-dialect computes every CRC_EXTRA from the fields
+// and checks it against the package) against values the MAVLink project's generated C headers
+// state (MAVLINK_MSG_ID_<NAME>_CRC, _MIN_LEN, _LEN), typed here, and the dialect file of the
+// package each message is in.
+TEST(MavlinkTlog, GeneratedTableHasTheDialectsKnownValues) {
+  struct Known {
+    std::uint32_t id;
+    const char* name;
+    int crc_extra;
+    int min_length;
+    int max_length;
+    const char* dialect;
+  };
+  const Known known[] = {
+      {0, "HEARTBEAT", 50, 9, 9, "minimal"},
+      {22, "PARAM_VALUE", 220, 25, 25, "common"},
+      {24, "GPS_RAW_INT", 24, 30, 52, "common"},
+      {26, "SCALED_IMU", 170, 22, 24, "common"},
+      {27, "RAW_IMU", 144, 26, 29, "common"},
+      {105, "HIGHRES_IMU", 93, 62, 63, "common"},
+      {116, "SCALED_IMU2", 76, 22, 24, "common"},
+      {129, "SCALED_IMU3", 46, 22, 24, "common"},
+      {253, "STATUSTEXT", 83, 51, 54, "common"},
+      {300, "PROTOCOL_VERSION", 217, 22, 22, "common"},
+      {150, "SENSOR_OFFSETS", 134, 42, 42, "ardupilotmega"},
+      {152, "MEMINFO", 208, 4, 8, "ardupilotmega"},
+      {163, "AHRS", 127, 28, 28, "ardupilotmega"},
+      {182, "AHRS3", 229, 40, 40, "ardupilotmega"},
+      {193, "EKF_STATUS_REPORT", 71, 22, 26, "ardupilotmega"},
+  };
+  for (const Known& k : known) {
+    const MavlinkMessageInfo* m = FindMavlinkMessage(k.id);
+    ASSERT_NE(m, nullptr) << k.name;
+    EXPECT_EQ(m->id, k.id);
+    EXPECT_STREQ(m->name, k.name);
+    EXPECT_EQ(m->crc_extra, k.crc_extra) << k.name;
+    EXPECT_EQ(MavlinkCrcExtra(k.id), k.crc_extra) << k.name;
+    EXPECT_EQ(m->min_length, k.min_length) << k.name;
+    EXPECT_EQ(m->max_length, k.max_length) << k.name;
+    EXPECT_STREQ(m->dialect, k.dialect) << k.name;
+    EXPECT_EQ(MavlinkMessageName(k.id), k.name);
+  }
+  // The table: sorted by id, names unique, lengths consistent, the lookups agree with it.
+  const std::vector<MavlinkMessageInfo>& all = MavlinkMessages();
+  ASSERT_GT(all.size(), 250u);  // common alone has over 200 messages
+  std::set<std::string> names;
+  std::set<std::string> dialects;
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    if (k > 0) EXPECT_LT(all[k - 1].id, all[k].id);
+    EXPECT_TRUE(names.insert(all[k].name).second) << all[k].name;
+    dialects.insert(all[k].dialect);
+    EXPECT_GT(all[k].min_length, 0) << all[k].name;
+    EXPECT_LE(all[k].min_length, all[k].max_length) << all[k].name;
+    EXPECT_EQ(FindMavlinkMessage(all[k].id), &all[k]);
+  }
+  for (const char* d : {"minimal", "standard", "common", "ardupilotmega", "uavionix", "icarous"}) {
+    EXPECT_EQ(dialects.count(d), 1u) << d;
+  }
+  EXPECT_EQ(dialects.size(), 6u);
+  EXPECT_EQ(FindMavlinkMessage(kUnknownId), nullptr);
+  EXPECT_EQ(MavlinkMessageName(kUnknownId), "MSG199");
+  EXPECT_EQ(MavlinkCrcExtra(kUnknownId), -1);
+  EXPECT_NE(MavlinkDefinitionsSource().find("common, ardupilotmega"), std::string::npos);
+  EXPECT_NE(MavlinkDefinitionsSource().find("mavlink-mappings "), std::string::npos);
 }
 
 /// X.25 bit by bit, the textbook form (independent of the library's sliced tables).
@@ -236,6 +302,12 @@ TEST(MavlinkTlog, RealLogMatchesIndependentDecoder) {
   EXPECT_EQ(log.warnings.crc_failures, g["crc_failures"].get<std::size_t>());
   EXPECT_EQ(log.warnings.bytes_skipped, g["bytes_skipped"].get<std::size_t>());
   EXPECT_EQ(log.warnings.unchecked_frames, g["unchecked_frames"].get<std::size_t>());
+  // Every frame of this ArduPilot log is of the common or ardupilotmega dialect: all checked.
+  EXPECT_EQ(log.warnings.unchecked_frames, 0u);
+  EXPECT_EQ(log.checked_frames, log.frames_v1 + log.frames_v2);
+  for (const auto& [id, n] : log.message_counts) {
+    EXPECT_NE(FindMavlinkMessage(id), nullptr) << "id " << id;
+  }
   EXPECT_EQ(log.warnings.truncated_bytes, g["truncated_bytes"].get<std::size_t>());
   ExpectBytesAccounted(log);
   ASSERT_EQ(log.message_counts.size(), g["message_counts"].size());
@@ -398,7 +470,8 @@ TEST(MavlinkTlog, V1AndV2FramesWithTruncatedPayloadsAndSignatures) {
                      1, true, true, true, kT0_us + 500000}));
   // v2 message with a 24-bit id nobody knows, then a v1 frame of an unknown 8-bit id.
   Append(&t, Record({0x012345, {1, 2, 3}, 1, 1, true, false, true, kT0_us + 600000}));
-  Append(&t, Record({200, {9, 9}, 1, 1, false, false, true, kT0_us + 700000}));
+  ASSERT_EQ(FindMavlinkMessage(kUnknownId), nullptr);
+  Append(&t, Record({kUnknownId, {9, 9}, 1, 1, false, false, true, kT0_us + 700000}));
   // v2 HIGHRES_IMU, full length.
   Payload h;
   h.Put<std::uint64_t>(2000000);
@@ -415,7 +488,8 @@ TEST(MavlinkTlog, V1AndV2FramesWithTruncatedPayloadsAndSignatures) {
   EXPECT_EQ(log.frames_signed, 1u);
   EXPECT_EQ(log.warnings.unchecked_frames, 2u);
   EXPECT_EQ(log.message_counts.at(0x012345), 1u);
-  EXPECT_EQ(log.message_counts.at(200), 1u);
+  EXPECT_EQ(log.message_counts.at(kUnknownId), 1u);
+  EXPECT_EQ(log.checked_frames, 4u);
   EXPECT_EQ(log.warnings.bytes_skipped, 0u);
   ExpectBytesAccounted(log);
   ASSERT_EQ(log.raw_imu.size(), 2u);
@@ -443,11 +517,12 @@ TEST(MavlinkTlog, V1AndV2FramesWithTruncatedPayloadsAndSignatures) {
 }
 
 TEST(MavlinkTlog, UnknownIdFollowedByGarbageIsNotAFrame) {
-  Bytes t = Record({200, {1, 2, 3, 4}, 1, 1, false});
+  ASSERT_EQ(FindMavlinkMessage(kUnknownId), nullptr);
+  Bytes t = Record({kUnknownId, {1, 2, 3, 4}, 1, 1, false});
   t.insert(t.end(), {0x01, 0x02, 0x03});  // no record after the unknown frame
   Append(&t, Record({kMavHeartbeat, Heartbeat(3), 1, 1, false}));
   const MavlinkLog log = Parse(t);
-  EXPECT_EQ(log.message_counts.count(200), 0u);
+  EXPECT_EQ(log.message_counts.count(kUnknownId), 0u);
   EXPECT_EQ(log.heartbeat.size(), 1u);
   EXPECT_EQ(log.warnings.bytes_skipped, 8u + 6u + 4u + 2u + 3u);
   ExpectBytesAccounted(log);
@@ -657,14 +732,17 @@ TEST(MavlinkSession, RealLogStreamsAndSessions) {
   const FlightLogSummary summary = TlogSummary(log);
   EXPECT_EQ(summary.format, "mavlink-tlog");
   EXPECT_EQ(summary.format_detail,
-            "MAVLink v1 8164 frames, v2 0 frames (0 signed), ArduPilot (system 1, component 1)");
+            "MAVLink v1 8164 frames, v2 0 frames (0 signed), 8164 CRC-checked, ArduPilot "
+            "(system 1, component 1)");
   EXPECT_EQ(summary.imus.size(), 3u);
   EXPECT_FALSE(summary.site.has_value());
   EXPECT_EQ(summary.params.at("INS_ACC2OFFS_Z"), params.at("INS_ACC2OFFS_Z"));
   EXPECT_EQ(summary.params.count("SYSID_THISMAV"), 0u);
   EXPECT_EQ(summary.messages.size(), log.message_counts.size());
-  ASSERT_EQ(summary.warnings.size(), 1u);  // the unchecked ardupilotmega messages
-  EXPECT_NE(summary.warnings[0].find("MEMINFO (id 152) x295"), std::string::npos);
+  EXPECT_TRUE(summary.warnings.empty());  // every frame CRC-checked, none skipped
+  bool meminfo_named = false;
+  for (const auto& [name, n] : summary.messages) meminfo_named |= name == "MEMINFO" && n == 295;
+  EXPECT_TRUE(meminfo_named);
   // A time window.
   FlightLogSelection window;
   window.from_s = 1560.0;

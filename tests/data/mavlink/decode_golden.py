@@ -31,7 +31,8 @@ import struct
 T_MIN = 946684800 * 1000000
 T_MAX = 4102444800 * 1000000
 
-# msgid -> (name, CRC_EXTRA); from common.xml (the generated C headers' *_CRC values).
+# msgid -> (name, CRC_EXTRA), typed here (the C++ reader generates its table from the definitions):
+# common.xml (the generated C headers' *_CRC values) and the ardupilotmega.xml ids this log holds.
 CHECKED = {
     0: ("HEARTBEAT", 50), 1: ("SYS_STATUS", 124), 2: ("SYSTEM_TIME", 137),
     21: ("PARAM_REQUEST_LIST", 159), 22: ("PARAM_VALUE", 220), 24: ("GPS_RAW_INT", 24),
@@ -43,6 +44,10 @@ CHECKED = {
     87: ("POSITION_TARGET_GLOBAL_INT", 150), 105: ("HIGHRES_IMU", 93),
     116: ("SCALED_IMU2", 76), 125: ("POWER_STATUS", 203), 129: ("SCALED_IMU3", 46),
     137: ("SCALED_PRESSURE2", 195), 241: ("VIBRATION", 90), 253: ("STATUSTEXT", 83),
+    # ardupilotmega.xml (the generated C headers' *_CRC values, as for common.xml).
+    150: ("SENSOR_OFFSETS", 134), 152: ("MEMINFO", 208), 163: ("AHRS", 127),
+    165: ("HWSTATUS", 21), 168: ("WIND", 1), 182: ("AHRS3", 229),
+    193: ("EKF_STATUS_REPORT", 71),
 }
 
 # Decoded payloads: msgid -> (full length, struct format, field names). Wire order: by size,

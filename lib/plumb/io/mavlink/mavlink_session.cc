@@ -484,7 +484,8 @@ FlightLogSummary TlogSummary(const MavlinkLog& log) {
   out.size_bytes = log.size_bytes;
   out.format_detail = "MAVLink v1 " + std::to_string(log.frames_v1) + " frames, v2 " +
                       std::to_string(log.frames_v2) + " frames (" +
-                      std::to_string(log.frames_signed) + " signed)";
+                      std::to_string(log.frames_signed) + " signed), " +
+                      std::to_string(log.checked_frames) + " CRC-checked";
   if (const std::optional<MavlinkVehicle> v = TlogVehicle(log)) {
     out.format_detail += ", " + AutopilotName(v->autopilot) + " (system " +
                          std::to_string(v->system_id) + ", component " +

@@ -89,7 +89,8 @@ std::map<std::string, double> TlogParams(const MavlinkLog& log);
 Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection);
 
 /// The log as `plumb info` shows it: format "mavlink-tlog", format_detail "MAVLink v1 N
-/// frames, v2 M frames (K signed), autopilot A (system S, component C)", the streams, the site,
+/// frames, v2 M frames (K signed), C CRC-checked, autopilot A (system S, component C)" (the
+/// frames not CRC-checked are in a warning, by message id), the streams, the site,
 /// the calibration parameters in force (names starting INS_ACC, INS_GYR, INS_TCAL,
 /// AHRS_ORIENTATION, CAL_ACC, CAL_GYRO), the message counts by name and the reader's warnings.
 FlightLogSummary TlogSummary(const MavlinkLog& log);

@@ -24,53 +24,63 @@ constexpr std::uint64_t kMinTimeUs = 946684800ull * 1000000ull;
 constexpr std::uint64_t kMaxTimeUs = 4102444800ull * 1000000ull;
 constexpr std::size_t kMaxPayload = 255;
 
-/// One message the reader knows: its CRC_EXTRA (common.xml; checked against the real logs
-/// under ../shared/data/mavlink, every frame of which passes) and, for decoded messages, the
-/// full payload length including extensions.
-struct KnownMessage {
+/// One row of the generated table (mavlink_messages.inc, see MavlinkMessageInfo).
+struct MavlinkMessageInfoRow {
   std::uint32_t id;
   const char* name;
-  int crc_extra;         // -1: name known (dialect-specific id), CRC not checked
-  std::size_t full_len;  // 0: not decoded
+  std::uint8_t crc_extra;
+  std::uint8_t min_length;
+  std::uint8_t max_length;
+  std::uint8_t dialect;  // index into kMavlinkDialects
 };
 
-constexpr KnownMessage kKnown[] = {
-    {0, "HEARTBEAT", 50, 9},
-    {1, "SYS_STATUS", 124, 0},
-    {2, "SYSTEM_TIME", 137, 0},
-    {21, "PARAM_REQUEST_LIST", 159, 0},
-    {22, "PARAM_VALUE", 220, 25},
-    {24, "GPS_RAW_INT", 24, 52},
-    {26, "SCALED_IMU", 170, 24},
-    {27, "RAW_IMU", 144, 29},
-    {29, "SCALED_PRESSURE", 115, 0},
-    {30, "ATTITUDE", 39, 0},
-    {33, "GLOBAL_POSITION_INT", 104, 0},
-    {35, "RC_CHANNELS_RAW", 244, 0},
-    {36, "SERVO_OUTPUT_RAW", 222, 0},
-    {42, "MISSION_CURRENT", 28, 0},
-    {62, "NAV_CONTROLLER_OUTPUT", 183, 0},
-    {65, "RC_CHANNELS", 118, 0},
-    {66, "REQUEST_DATA_STREAM", 148, 0},
-    {74, "VFR_HUD", 20, 0},
-    {87, "POSITION_TARGET_GLOBAL_INT", 150, 0},
-    {105, "HIGHRES_IMU", 93, 63},
-    {116, "SCALED_IMU2", 76, 24},
-    {125, "POWER_STATUS", 203, 0},
-    {129, "SCALED_IMU3", 46, 24},
-    {137, "SCALED_PRESSURE2", 195, 0},
-    // ardupilotmega.xml ids: named, not checked (other dialects reuse the range).
-    {150, "SENSOR_OFFSETS", -1, 0},
-    {152, "MEMINFO", -1, 0},
-    {163, "AHRS", -1, 0},
-    {165, "HWSTATUS", -1, 0},
-    {168, "WIND", -1, 0},
-    {178, "AHRS2", -1, 0},
-    {182, "AHRS3", -1, 0},
-    {193, "EKF_STATUS_REPORT", -1, 0},
-    {241, "VIBRATION", 90, 0},
-    {253, "STATUSTEXT", 83, 0},
+// kMavlinkDefinitions, kMavlinkDialects, kMavlinkMessages (sorted by id): generated at build
+// time by scripts/gen-mavlink-dialect (lib/plumb/io/mavlink/CMakeLists.txt).
+#include "mavlink_messages.inc"
+
+constexpr std::size_t kMessageCount = sizeof(kMavlinkMessages) / sizeof(kMavlinkMessages[0]);
+
+/// The row of `msgid`, or nullptr (binary search: the table is sorted by id).
+constexpr const MavlinkMessageInfoRow* FindRow(std::uint32_t msgid) {
+  std::size_t lo = 0, hi = kMessageCount;
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (kMavlinkMessages[mid].id < msgid) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo < kMessageCount && kMavlinkMessages[lo].id == msgid ? &kMavlinkMessages[lo] : nullptr;
+}
+
+constexpr bool SortedById() {
+  for (std::size_t k = 1; k < kMessageCount; ++k) {
+    if (kMavlinkMessages[k - 1].id >= kMavlinkMessages[k].id) return false;
+  }
+  return true;
+}
+static_assert(SortedById(), "the generated MAVLink table must be sorted by id");
+
+/// The messages Decode reads, with the full payload length its offsets assume; each must be
+/// the dialect's (checked at compile time against the generated table).
+struct DecodedMessage {
+  std::uint32_t id;
+  std::size_t full_len;
 };
+constexpr DecodedMessage kDecoded[] = {
+    {kMavHeartbeat, 9},  {kMavParamValue, 25}, {kMavGpsRawInt, 52},  {kMavScaledImu, 24},
+    {kMavRawImu, 29},    {kMavHighresImu, 63}, {kMavScaledImu2, 24}, {kMavScaledImu3, 24},
+};
+constexpr bool DecodedLengthsMatchTheDialect() {
+  for (const DecodedMessage& d : kDecoded) {
+    const MavlinkMessageInfoRow* row = FindRow(d.id);
+    if (row == nullptr || row->max_length != d.full_len) return false;
+  }
+  return true;
+}
+static_assert(DecodedLengthsMatchTheDialect(),
+              "a decoded message's payload length differs from the generated MAVLink table");
 
 /// CRC-16/MCRF4XX tables (reflected polynomial 0x8408) for slicing by 8, built once.
 /// t[0] is the classic byte table: crc' = (crc >> 8) ^ t[0][(crc ^ byte) & 0xFF]. t[k][v] is
@@ -117,19 +127,27 @@ inline std::uint16_t Crc(const std::uint8_t* data, std::size_t size, std::uint16
   return crc;
 }
 
-/// Per low id (< 256): CRC_EXTRA (-1 unknown) and full decoded length (0 not decoded).
+/// Per low id (< 256), for the byte-by-byte scan: CRC_EXTRA (-1 unknown) and full decoded
+/// length (0 not decoded). Higher ids are looked up in the table (FindRow).
 struct IdTable {
   std::array<std::int16_t, 256> crc_extra{};
   std::array<std::uint8_t, 256> full_len{};
   IdTable() {
     crc_extra.fill(-1);
-    for (const KnownMessage& m : kKnown) {
-      crc_extra[m.id] = static_cast<std::int16_t>(m.crc_extra);
-      full_len[m.id] = static_cast<std::uint8_t>(m.full_len);
+    for (const MavlinkMessageInfoRow& m : kMavlinkMessages) {
+      if (m.id < 256) crc_extra[m.id] = m.crc_extra;
     }
+    for (const DecodedMessage& d : kDecoded) full_len[d.id] = static_cast<std::uint8_t>(d.full_len);
   }
 };
 const IdTable kIds;
+
+/// CRC_EXTRA of any id, -1 when unknown.
+inline int CrcExtraOf(std::uint32_t msgid) {
+  if (msgid < 256) return kIds.crc_extra[msgid];
+  const MavlinkMessageInfoRow* row = FindRow(msgid);
+  return row ? row->crc_extra : -1;
+}
 
 template <typename T>
 T Load(const std::uint8_t* p) {
@@ -208,7 +226,7 @@ Verdict Examine(const std::uint8_t* data, std::size_t size, std::size_t pos, Fra
   if (frame_left < frame_bytes) return Verdict::kIncomplete;
   f->record_bytes = kTimeBytes + frame_bytes;
   f->payload = frame + header;
-  const int crc_extra = f->msgid < 256 ? kIds.crc_extra[f->msgid] : -1;
+  const int crc_extra = CrcExtraOf(f->msgid);
   if (crc_extra < 0) return Verdict::kUnchecked;
   const std::uint16_t crc = CrcByte(Crc(frame + 1, header - 1 + f->len, 0xFFFF),
                                     static_cast<std::uint8_t>(crc_extra));
@@ -298,7 +316,11 @@ class Parser {
       ++log_->frames_v1;
     }
     log_->record_bytes += f.record_bytes;
-    if (!checked) ++log_->warnings.unchecked_frames;
+    if (checked) {
+      ++log_->checked_frames;
+    } else {
+      ++log_->warnings.unchecked_frames;
+    }
     if (f.msgid >= 256) {
       ++log_->message_counts[f.msgid];
       return;
@@ -441,14 +463,38 @@ bool LooksLikeTlogRecord(const std::uint8_t* data, std::size_t size) {
   return PlausibleTime(LoadBigEndian64(data)) && (stx == kStxV1 || stx == kStxV2);
 }
 
-std::string MavlinkMessageName(std::uint32_t msgid) {
-  for (const KnownMessage& m : kKnown) {
-    if (m.id == msgid) return m.name;
-  }
-  return "MSG" + std::to_string(msgid);
+const std::vector<MavlinkMessageInfo>& MavlinkMessages() {
+  static const std::vector<MavlinkMessageInfo> all = [] {
+    std::vector<MavlinkMessageInfo> out;
+    out.reserve(kMessageCount);
+    for (const MavlinkMessageInfoRow& m : kMavlinkMessages) {
+      out.push_back({m.id, m.name, m.crc_extra, m.min_length, m.max_length,
+                     kMavlinkDialects[m.dialect]});
+    }
+    return out;
+  }();
+  return all;
 }
 
-int MavlinkCrcExtra(std::uint32_t msgid) { return msgid < 256 ? kIds.crc_extra[msgid] : -1; }
+const MavlinkMessageInfo* FindMavlinkMessage(std::uint32_t msgid) {
+  const MavlinkMessageInfoRow* row = FindRow(msgid);
+  return row ? &MavlinkMessages()[static_cast<std::size_t>(row - kMavlinkMessages)] : nullptr;
+}
+
+std::string MavlinkDefinitionsSource() {
+  std::string dialects;
+  for (const char* d : kMavlinkDialects) {
+    dialects += (dialects.empty() ? "" : ", ") + std::string(d);
+  }
+  return dialects + " (" + kMavlinkDefinitions + ")";
+}
+
+std::string MavlinkMessageName(std::uint32_t msgid) {
+  const MavlinkMessageInfoRow* row = FindRow(msgid);
+  return row ? std::string(row->name) : "MSG" + std::to_string(msgid);
+}
+
+int MavlinkCrcExtra(std::uint32_t msgid) { return CrcExtraOf(msgid); }
 
 std::string MavlinkParamValue::Name() const {
   return std::string(id.data(), strnlen(id.data(), id.size()));
@@ -479,8 +525,9 @@ std::vector<std::string> MavlinkWarnings::Describe(
              ") x" + std::to_string(n);
     }
     out.push_back(std::to_string(unchecked_frames) +
-                  " frame(s) of messages without a known CRC_EXTRA kept unchecked and not "
-                  "decoded: " + ids);
+                  " frame(s) of messages outside the known MAVLink dialects (" +
+                  MavlinkDefinitionsSource() + "), so without a CRC_EXTRA, kept unchecked and "
+                  "not decoded: " + ids);
   }
   return out;
 }

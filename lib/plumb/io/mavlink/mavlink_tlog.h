@@ -8,7 +8,14 @@
 //    payload (len bytes; trailing zero bytes truncated by the sender: zero-extended here to the
 //    message's full length), crc16 (LE), then a 13-byte signature when incompat_flags & 1.
 // CRC: X.25 / CRC-16/MCRF4XX (init 0xFFFF, reflected polynomial 0x8408) over every byte after
-// the STX up to the end of the payload, then the message's CRC_EXTRA byte (common.xml).
+// the STX up to the end of the payload, then the message's CRC_EXTRA byte.
+//
+// Messages known (MavlinkMessages()): the whole common dialect (common.xml with minimal.xml and
+// standard.xml) and ArduPilot's (ardupilotmega.xml with uAvionix.xml and icarous.xml), a table
+// generated at build time by scripts/gen-mavlink-dialect from the npm package pinned in
+// scripts/mavlink-definitions.pin (the MAVLink XML definitions as JavaScript); the generator
+// computes each CRC_EXTRA from the message's fields and refuses to build when one differs from
+// the package's own value.
 // Payload fields are little-endian, ordered by size (largest first), extension fields last in
 // declaration order.
 //
@@ -16,12 +23,11 @@
 //  * A record starts where the 8-byte time is plausible (unix time between 2000-01-01 and
 //    2100-01-01) and is followed by 0xFE or 0xFD (v2 with incompat_flags other than 1 is
 //    rejected: unknown incompatible features).
-//  * Messages with a known CRC_EXTRA (the decoded ones below, and the common.xml messages
-//    an ArduPilot vehicle streams, see MavlinkMessageName) are accepted only when their CRC
-//    matches; a mismatch is counted (crc_failures) and the reader resynchronises.
-//  * Other message ids cannot be CRC-checked: such a frame is accepted (counted per id in
-//    message_counts, total in unchecked_frames, never decoded) only when the next record
-//    starts right after it (plausible time and STX) or the file ends there.
+//  * Messages of the known dialects are accepted only when their CRC matches (counted in
+//    checked_frames); a mismatch is counted (crc_failures) and the reader resynchronises.
+//  * Other message ids (outside those dialects) cannot be CRC-checked: such a frame is
+//    accepted (counted per id in message_counts, total in unchecked_frames, never decoded) only
+//    when the next record starts right after it (plausible time and STX) or the file ends there.
 //  * Bytes that start no accepted record are skipped one by one (counted, with the number of
 //    separate runs = resyncs). A record whose frame runs past the end of the file, with no
 //    valid record after it, is the truncated last record: dropped and counted. So is a tail of
@@ -154,7 +160,7 @@ struct MavlinkWarnings {
   std::size_t first_crc_failure_offset = 0;  ///< byte offset of the first one (if any)
   std::size_t truncated_records = 0;   ///< 0 or 1: the cut last record, dropped
   std::size_t truncated_bytes = 0;     ///< bytes of that dropped record
-  std::size_t unchecked_frames = 0;    ///< frames of ids without a known CRC_EXTRA, accepted
+  std::size_t unchecked_frames = 0;    ///< frames of ids outside the known dialects, accepted
 
   /// One readable line per non-zero count (unchecked ids listed from `counts`).
   std::vector<std::string> Describe(const std::map<std::uint32_t, std::size_t>& counts) const;
@@ -167,6 +173,9 @@ struct MavlinkLog {
   std::size_t frames_v1 = 0;        ///< accepted MAVLink 1 frames
   std::size_t frames_v2 = 0;        ///< accepted MAVLink 2 frames
   std::size_t frames_signed = 0;    ///< accepted v2 frames carrying a signature (not verified)
+  /// Accepted frames whose CRC was checked (with their message's CRC_EXTRA); the others are
+  /// warnings.unchecked_frames: checked_frames + unchecked_frames == frames_v1 + frames_v2.
+  std::size_t checked_frames = 0;
   /// Bytes in accepted records (times included): record_bytes + bytes_skipped +
   /// truncated_bytes == size_bytes.
   std::size_t record_bytes = 0;
@@ -185,10 +194,30 @@ struct MavlinkLog {
   std::vector<std::pair<std::string, std::size_t>> MessageCounts() const;
 };
 
-/// Name of a message id this reader knows ("RAW_IMU", "ATTITUDE", ...), else "MSG<id>".
+/// A message of the known dialects (one row of the generated table).
+struct MavlinkMessageInfo {
+  std::uint32_t id = 0;          ///< message id, 0..2^24-1
+  const char* name = "";         ///< MAVLink name ("RAW_IMU")
+  std::uint8_t crc_extra = 0;    ///< CRC_EXTRA, computed from the fields by the generator
+  std::uint8_t min_length = 0;   ///< payload bytes without extension fields (MAVLink 1)
+  std::uint8_t max_length = 0;   ///< payload bytes with every extension field
+  const char* dialect = "";      ///< its dialect as the package names it ("common", "uavionix")
+};
+
+/// Every message of the known dialects, by increasing id.
+const std::vector<MavlinkMessageInfo>& MavlinkMessages();
+
+/// The message `msgid` of the known dialects, or nullptr.
+const MavlinkMessageInfo* FindMavlinkMessage(std::uint32_t msgid);
+
+/// Where the known dialects come from: "<dialects> (mavlink-mappings <version>)".
+std::string MavlinkDefinitionsSource();
+
+/// Name of a message id of the known dialects ("RAW_IMU", "AHRS3", ...), else "MSG<id>".
 std::string MavlinkMessageName(std::uint32_t msgid);
 
-/// CRC_EXTRA of `msgid`, or -1 when the reader does not know it (frame cannot be checked).
+/// CRC_EXTRA of `msgid`, or -1 when it is in none of the known dialects (frame cannot be
+/// checked).
 int MavlinkCrcExtra(std::uint32_t msgid);
 
 /// X.25 / CRC-16/MCRF4XX of `size` bytes continuing from `crc` (start with 0xFFFF).
