@@ -106,9 +106,9 @@ ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string&
   f.g_sensitivity = (out_g / cal_a) * cal.K_ga * f.R_peer_b;
   f.notes.push_back(
       "imucal applies acc_cal = R_a^-1 K_a^-1 (acc - b_a), gyr_cal = R_g^-1 K_g^-1 (gyr - K_ga "
-      "acc_cal - b_g); forward form F = s_a K_a R_a R, E = s_g K_g R_g R, G = K_ga R (per " +
-      cal.acc_unit + "), b_a, b_g, with R = R_peer_b and s = (SI per output unit) / (SI per "
-      "calibrated unit): output " + cal.from_acc_unit + ", " + cal.from_gyr_unit +
+      "acc_cal - b_g); forward form F = s_a K_a R_a R, E = s_g K_g R_g R, G = (S_g / C_a) K_ga "
+      "R, S_a b_a, S_g b_g, with R = R_peer_b, S (C) the SI value of one output (calibrated) "
+      "unit, s = S / C: output " + cal.from_acc_unit + ", " + cal.from_gyr_unit +
       " -> " + f.acc_unit + ", " + f.gyr_unit + " (plumb's units for data read with "
       "--gyr-unit deg/s); calibrated " + cal.acc_unit + ", " + cal.gyr_unit + " -> m/s^2, rad/s");
   if (frame == ImucalFrame::kPoses) {

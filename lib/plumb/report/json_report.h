@@ -1,5 +1,8 @@
 // plumb/report/json_report.h — the JSON documents that `plumb calibrate --json` writes
-// (SPEC section 6).
+// (SPEC section 6), whose contract is docs/reference/calibration.schema.json (its version is
+// kSchemaVersion; tests/cli/json_contract_test.cc validates every method's output against it).
+// The paper methods write the same keys for their closed form's answer
+// (apps/plumb/paper_methods.cc), their own detail under the method's name.
 //
 // Every number is SI (m/s^2, rad/s, s, degC; degrees only in `*_deg` site fields). A value
 // that is not finite (an unobservable parameter's sigma, chi^2/dof without degrees of
