@@ -102,6 +102,7 @@ class AllanCommand : public Command {
 
   int Run() override {
     AllanArgs& a = args_;
+    const TextAsideForJson text_aside(a.json_path);  // "-": the JSON alone on stdout
     if (a.whole && !a.segments.segments_path.empty()) {
       throw UsageError("--whole and --segments do not go together: --whole takes the whole "
                        "input as one still record");
@@ -109,7 +110,6 @@ class AllanCommand : public Command {
     a.noise.terms.quantisation = !a.no_quantisation;
     const Session session = ReadInputs(a.input);
     const ImuSeries& series = session.series;
-    const TextAsideForJson text_aside(a.json_path);  // "-": the JSON alone on stdout
     std::ostream& out = std::cout;
     std::vector<StillSegment> still;
     segmentation::SegmentationResult seg;

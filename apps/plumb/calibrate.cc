@@ -139,9 +139,7 @@ class CalibrateCommand : public Command {
     }
 
     if (!a.json_path.empty()) {
-      std::vector<std::string> inputs = a.input.inputs;
-      if (!a.input.acc_file.empty()) inputs.push_back(a.input.acc_file + "," + a.input.gyr_file);
-      nlohmann::json doc = report::CalibrationJson(result, seg, inputs, session.warnings);
+      nlohmann::json doc = report::CalibrationJson(result, seg, InputNames(), session.warnings);
       if (baseline) {
         doc["baseline"] = {{"model", baseline->calibration.model.spec()},
                            {"fit", report::ToJson(*baseline)["fit"]},
@@ -172,7 +170,7 @@ class CalibrateCommand : public Command {
         begin = given.front().begin;
         end = given.front().end;
       }
-      return RunPaperStatic(session, begin, end, site, a.json_path, a.fit.strict);
+      return RunPaperStatic(session, begin, end, site, InputNames(), a.json_path, a.fit.strict);
     }
     std::vector<StillSegment> still;
     std::vector<paper::MotionRange> motion;
@@ -185,7 +183,16 @@ class CalibrateCommand : public Command {
       std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose) << "\n";
       still = seg.segments;
     }
-    return RunPaperBenchmark(session, still, motion, site, a.json_path, a.fit.strict);
+    return RunPaperBenchmark(session, still, motion, site, InputNames(), a.json_path,
+                             a.fit.strict);
+  }
+
+  /// The input files as given, a two-file input as "acc,gyr" (the document's "inputs").
+  std::vector<std::string> InputNames() const {
+    const CalibrateArgs& a = args_;
+    std::vector<std::string> inputs = a.input.inputs;
+    if (!a.input.acc_file.empty()) inputs.push_back(a.input.acc_file + "," + a.input.gyr_file);
+    return inputs;
   }
 
   CalibrateArgs args_;

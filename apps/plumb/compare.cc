@@ -93,8 +93,8 @@ class CompareCommand : public Command {
       throw UsageError("compare takes one RESULT.json against another tool (several only with "
                        "--truth)");
     }
-    const peers::ForwardCalibration peer = ReadPeer();
     const peers::PlumbResult result = peers::ReadPlumbResult(a.results.front());
+    const peers::ForwardCalibration peer = ReadPeer(result);
     peers::CompareOptions options;
     options.gravity_m_s2 = a.gravity_m_s2;
     const peers::Comparison comparison = peers::Compare(result, peer, options);
@@ -121,7 +121,9 @@ class CompareCommand : public Command {
     return 0;
   }
 
-  peers::ForwardCalibration ReadPeer() const {
+  /// The peer's answer in plumb's forward form, in the frame of `result`: imucal's own (its
+  /// poses') when plumb's F is full and determined (known faces define plumb's frame too).
+  peers::ForwardCalibration ReadPeer(const peers::PlumbResult& result) const {
     const CompareArgs& a = args_;
     if (!a.imu_tk.empty()) {
       peers::ImuTkCalibration c;
@@ -134,7 +136,11 @@ class CompareCommand : public Command {
                                    {a.imu_tk_params});
     }
     if (!a.imucal.empty()) {
-      return peers::ImucalToForward(peers::ReadImucalJson(a.imucal), a.imucal);
+      const peers::PlumbParameter* lower = peers::FindParameter(result, "accel.matrix.yx");
+      const bool poses = lower != nullptr && !lower->fixed && lower->observable;
+      return peers::ImucalToForward(
+          peers::ReadImucalJson(a.imucal), a.imucal,
+          poses ? peers::ImucalFrame::kPoses : peers::ImucalFrame::kAccelerometerDefined);
     }
     throw UsageError("name the other tool's answer: --imu-tk ACC.calib GYRO.calib, "
                      "--imu-tk-params FILE or --imucal CAL.json");

@@ -2,12 +2,14 @@
 #include "paper_methods.h"
 
 #include <iomanip>
+#include <map>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "commands.h"
 #include "fit_options.h"
+#include "plumb/core/error.h"
 #include "plumb/core/units.h"
 #include "plumb/paper/backend.h"
 #include "plumb/paper/static_procedure.h"
@@ -47,21 +49,97 @@ void Finish(const nlohmann::json& doc, const std::vector<std::string>& notes,
   }
 }
 
-/// The keys every calibrate document has (SPEC section 6): the schema version, and the
-/// covariance and gates of the method's configuration of the backend (the closed forms have
-/// none), the same as under "backend".
-void AddSchema(nlohmann::json& doc, const estimation::CalibrationResult& backend) {
-  doc["schema_version"] = report::kSchemaVersion;
-  doc["covariance"] = report::CovarianceJson(backend);
-  doc["covariance"]["source"] = "backend";
-  doc["gates"] = report::GatesJson(backend.fit);
+/// Every forward quantity of a closed form by plumb's parameter name (accel.matrix.xy = F(x, y),
+/// ...), the gyroscope's only when `gyro`.
+std::map<std::string, double> ForwardValues(const Mat3& F, const Vec3& b_a, bool gyro,
+                                            const Mat3& E, const Vec3& b_g) {
+  std::map<std::string, double> v;
+  const char* axis = "xyz";
+  for (int i = 0; i < 3; ++i) {
+    v[std::string("accel.bias.") + axis[i]] = b_a(i);
+    if (gyro) v[std::string("gyro.bias.") + axis[i]] = b_g(i);
+    for (int j = 0; j < 3; ++j) {
+      const std::string ij = std::string(1, axis[i]) + axis[j];
+      v["accel.matrix." + ij] = F(i, j);
+      if (gyro) v["gyro.matrix." + ij] = E(i, j);
+    }
+  }
+  return v;
+}
+
+/// The headline of a paper method's document (SPEC section 6): its configuration's result on
+/// the backend with every parameter's value replaced by the closed form's (`values`, by name),
+/// so that accel, gyro, effects and parameters are the closed form's answer, and sigma,
+/// covariance, fit and observability the backend's on the same data (the closed form has no
+/// noise model). A closed-form value of a parameter the model does not have must be 0 (the
+/// lower triangle of an upper-triangular F); anything else is a programming error.
+estimation::CalibrationResult ClosedFormHeadline(estimation::CalibrationResult r,
+                                                 const std::map<std::string, double>& values,
+                                                 const std::string& method) {
+  estimation::Calibration& c = r.calibration;
+  c.method = method;
+  for (estimation::ParameterEstimate& p : c.parameters) {
+    const auto value = values.find(p.name);
+    const auto where = c.model.FindParameter(p.name);
+    if (value == values.end() || !where) {
+      throw Error(method + ": the closed form has no value for " + p.name);
+    }
+    const auto [t, i] = *where;
+    const double nominal = c.model.terms()[static_cast<std::size_t>(t)]
+                               .effect->info().parameters[static_cast<std::size_t>(i)].nominal;
+    c.theta[static_cast<std::size_t>(t)][static_cast<std::size_t>(i)] = value->second - nominal;
+    p.value = value->second;
+  }
+  for (const auto& [name, value] : values) {
+    const bool gyro_dropped = !c.has_gyro && name.rfind("gyro", 0) == 0;
+    if (!c.model.FindParameter(name) && !gyro_dropped && value != 0.0) {
+      throw Error(method + ": the closed form's " + name + " is not in the model " +
+                  c.model.spec());
+    }
+  }
+  return r;
+}
+
+/// The document of a paper method: the keys of every calibrate document for the closed
+/// form's answer (ClosedFormHeadline), marked where they are the backend's ("source"), with
+/// the method's own detail (`detail`, its "backend" among them) under the method's name.
+nlohmann::json PaperDocument(const estimation::CalibrationResult& headline,
+                             const nlohmann::json& detail, const std::vector<std::string>& notes,
+                             const Session& session, const std::vector<std::string>& inputs) {
+  nlohmann::json doc = report::ToJson(headline);
+  const std::string source = "backend";
+  doc["covariance"]["source"] = source;
+  doc["fit"]["source"] = source;
+  doc["observability"]["source"] = source;
+  // The still segments' data stay; their residuals and attitudes are the backend's fit, in
+  // the method's "backend" document, as are the turns.
+  for (nlohmann::json& s : doc["segments"]) {
+    for (const char* key : {"acc_residual", "gyr_residual", "acc_whitened", "gyr_whitened",
+                            "attitude_quaternion_wxyz", "attitude_known", "acc_walk", "gyr_walk"}) {
+      s.erase(key);
+    }
+  }
+  doc.erase("motion");
+  doc["notes"] = notes;
+  doc["notes"].push_back(
+      "accel, gyro, effects and parameters values are the closed form's; sigma, covariance, "
+      "fit, observability and gates are those of the same procedure on the backend (\"" +
+      headline.calibration.method + "\".backend): the closed form has no noise model, and it "
+      "uses the same means without weighting them, so its own uncertainty is not smaller");
+  std::vector<std::string> warnings = session.warnings;
+  for (const auto& w : headline.fit.warnings) warnings.push_back(w);
+  doc["warnings"] = warnings;
+  doc["inputs"] = inputs;
+  doc[headline.calibration.method] = detail;
+  return doc;
 }
 
 }  // namespace
 
 int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& still,
                       const std::vector<paper::MotionRange>& motion, const geo::Site& site,
-                      const std::string& json_path, bool strict) {
+                      const std::vector<std::string>& inputs, const std::string& json_path,
+                      bool strict) {
   paper::PaperBenchmarkOptions options;
   options.gravity_m_s2 = site.gravity();
   const paper::PaperBenchmarkResult r =
@@ -92,21 +170,16 @@ int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& s
   PrintVector("gyro.bias (at the first sample), " + gu + ":", r.b_g);
   PrintVector("gyro_bias_drift.d, " + gu + "/s:", r.gyro_bias_drift);
 
-  nlohmann::json doc;
-  doc["method"] = "paper-benchmark";
-  doc["paper_convention"] = {
+  nlohmann::json detail;
+  detail["paper_convention"] = {
       {"accel", {{"bias", ToJson(r.accel_bias)}, {"U_plus", ToJson(r.U_plus)},
                  {"U_minus", ToJson(r.U_minus)}, {"Q", r.Q},
                  {"coupling", ToJson(r.accel_coupling_paper)}}},
       {"gyro", {{"bias_b0", ToJson(r.gyro_bias_b0)}, {"bias_b1", ToJson(r.gyro_bias_b1)},
                 {"t0_s", r.t0_s}, {"coupling", ToJson(r.gyro_coupling_paper)},
                 {"total_angle_rad", ToJson(r.total_angle_rad)}}}};
-  doc["forward"] = {
-      {"accel", {{"matrix", ToJson(r.F)}, {"bias", ToJson(r.b_a)}}},
-      {"gyro", {{"matrix", ToJson(r.E)}, {"bias", ToJson(r.b_g)},
-                {"bias_drift", ToJson(r.gyro_bias_drift)}, {"t_ref_s", r.t0_s}}},
-      {"gravity", r.gravity_m_s2}};
-  doc["notes"] = r.notes;
+  detail["gravity"] = r.gravity_m_s2;
+  detail["notes"] = r.notes;
 
   std::cout << "\nThe same procedure on the backend (the faces' tilts known, headings estimated; "
                "turns at their known mean rate; model "
@@ -114,15 +187,22 @@ int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& s
   const paper::PaperBenchmarkBackend backend =
       paper::CalibratePaperBenchmarkOnBackend(session.series, r, site);
   std::cout << report::CalibrationSummary(backend.result, session.source);
-  doc["backend"] = report::ToJson(backend.result);
-  AddSchema(doc, backend.result);
+  detail["backend"] = report::ToJson(backend.result);
+  std::map<std::string, double> values = ForwardValues(r.F, r.b_a, true, r.E, r.b_g);
+  for (int i = 0; i < 3; ++i) {
+    values[std::string("gyro_bias_drift.d.") + "xyz"[i]] = r.gyro_bias_drift(i);
+  }
+  estimation::CalibrationResult headline = ClosedFormHeadline(backend.result, values, "paper-benchmark");
+  headline.calibration.model.t_ref_s = r.t0_s;  // Eq. (5)'s origin: the drift is zero there
+  const nlohmann::json doc = PaperDocument(headline, detail, r.notes, session, inputs);
   if (const int code = StrictGateExit(backend.result.fit, session.source, strict)) return code;
   Finish(doc, r.notes, json_path);
   return 0;
 }
 
 int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
-                   const geo::Site& site, const std::string& json_path, bool strict) {
+                   const geo::Site& site, const std::vector<std::string>& inputs,
+                   const std::string& json_path, bool strict) {
   const paper::PaperStaticResult r =
       paper::CalibratePaperStatic(session.series, begin, end, site, paper::PaperStaticOptions{});
   const std::string au = session.series.acc_unit;
@@ -149,23 +229,19 @@ int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
     PrintVector("gyro.bias, " + gu + ":", r.b_g);
   }
 
-  nlohmann::json doc;
-  doc["method"] = "paper-static";
-  doc["paper_convention"]["accel"] = {
+  nlohmann::json detail;
+  detail["paper_convention"]["accel"] = {
       {"mean", ToJson(r.accel.mean)}, {"g", r.accel.norm},
       {"filtered_mean", ToJson(r.accel.filtered_mean)}, {"bias", ToJson(r.accel.bias)},
       {"matrix", ToJson(r.accel.F_paper)}};
-  doc["forward"]["accel"] = {{"matrix", ToJson(r.F)}, {"bias", ToJson(r.b_a)}};
   if (r.has_gyro) {
-    doc["paper_convention"]["gyro"] = {
+    detail["paper_convention"]["gyro"] = {
         {"mean", ToJson(r.gyro.mean)}, {"filtered_mean", ToJson(r.gyro.filtered_mean)},
         {"bias", ToJson(r.gyro.bias)}, {"omega_p", ToJson(r.gyro.omega_p)},
         {"matrix", ToJson(r.gyro.E_paper)}};
-    doc["forward"]["gyro"] = {{"matrix", ToJson(r.E)}, {"bias", ToJson(r.b_g)}};
   }
-  doc["site"] = {{"lat_deg", site.lat_deg}, {"lon_deg", site.lon_deg},
-                 {"height_m", site.height_m}, {"source", site.source}};
-  doc["notes"] = r.notes;
+  detail["samples"] = {begin, end};
+  detail["notes"] = r.notes;
 
   std::cout << "\nThe same procedure on the backend (one segment, attitude known level x north; "
                "the paper's constants held):\n";
@@ -180,11 +256,13 @@ int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
   std::cout << "The paper's fixed constants, freed on the same data: unobservable: "
             << join(backend.fixed_unobservable)
             << "; observable: " << join(backend.fixed_observable) << "\n";
-  doc["backend"] = report::ToJson(backend.fixed);
-  doc["backend_freed"] = {{"unobservable", backend.fixed_unobservable},
-                          {"observable", backend.fixed_observable},
-                          {"result", report::ToJson(backend.freed)}};
-  AddSchema(doc, backend.fixed);
+  detail["backend"] = report::ToJson(backend.fixed);
+  detail["backend_freed"] = {{"unobservable", backend.fixed_unobservable},
+                             {"observable", backend.fixed_observable},
+                             {"result", report::ToJson(backend.freed)}};
+  const estimation::CalibrationResult headline = ClosedFormHeadline(
+      backend.fixed, ForwardValues(r.F, r.b_a, r.has_gyro, r.E, r.b_g), "paper-static");
+  const nlohmann::json doc = PaperDocument(headline, detail, r.notes, session, inputs);
   if (const int code = StrictGateExit(backend.fixed.fit, session.source, strict)) return code;
   Finish(doc, r.notes, json_path);
   return 0;

@@ -19,11 +19,13 @@ namespace plumb::cli {
 /// `strict` and the backend's fit failed a gate (estimation/gates.h).
 int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& still,
                       const std::vector<paper::MotionRange>& motion, const geo::Site& site,
-                      const std::string& json_path, bool strict);
+                      const std::vector<std::string>& inputs, const std::string& json_path,
+                      bool strict);
 
 /// Runs paper-static on samples [begin, end) at `site` (must be known); prints both
 /// conventions; writes `json_path` when not empty. Returns the exit code, as above.
 int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
-                   const geo::Site& site, const std::string& json_path, bool strict);
+                   const geo::Site& site, const std::vector<std::string>& inputs,
+                   const std::string& json_path, bool strict);
 
 }  // namespace plumb::cli

@@ -461,7 +461,19 @@ TEST(Cli, PaperBenchmarkMethodRunsOnThePapersSchedule) {
   EXPECT_NE(run.out.find("Forward convention"), std::string::npos) << run.out;
   const json doc = ReadJson(out);
   EXPECT_EQ(doc["method"], "paper-benchmark");
-  EXPECT_NEAR(doc["forward"]["accel"]["bias"][0].get<double>(), 0.2, 0.01) << doc.dump(2);
+  // The headline (SPEC section 6) is the closed form's answer in the forward convention, the
+  // same as the parameter of that name; the backend's fit of the same procedure is beside it.
+  EXPECT_NEAR(doc["accel"]["bias"][0].get<double>(), 0.2, 0.01) << doc.dump(2);
+  for (const auto& p : doc["parameters"]) {
+    if (p["name"] == "accel.bias.x") EXPECT_EQ(p["value"], doc["accel"]["bias"][0]);
+  }
+  EXPECT_EQ(doc["paper-benchmark"]["paper_convention"]["accel"]["bias"][0],
+            doc["accel"]["bias"][0]);
+  EXPECT_NE(doc["paper-benchmark"]["backend"]["accel"]["bias"][0], doc["accel"]["bias"][0]);
+  json backend_covariance = doc["paper-benchmark"]["backend"]["covariance"];
+  backend_covariance["source"] = "backend";
+  EXPECT_EQ(doc["covariance"], backend_covariance);
+  EXPECT_EQ(doc["fit"]["source"], "backend");
 }
 
 TEST(Cli, PaperStaticMethodGyroscopeNeedsASiteAndTheBackendMarksTheFixedConstants) {
@@ -484,8 +496,14 @@ TEST(Cli, PaperStaticMethodGyroscopeNeedsASiteAndTheBackendMarksTheFixedConstant
   EXPECT_TRUE(Contains(run.out, "accel.bias.x + 1 accel.matrix.xz")) << run.out;
   EXPECT_TRUE(Contains(run.out, "freed on the same data: unobservable: accel.matrix.xx")) << run.out;
   const json doc = ReadJson(out);
-  EXPECT_EQ(doc["backend"]["observability"]["unobservable"].size(), 6u) << doc["backend"].dump(2);
-  EXPECT_EQ(doc["backend_freed"]["unobservable"].size(), 6u);
+  const json& detail = doc["paper-static"];
+  EXPECT_EQ(detail["backend"]["observability"]["unobservable"].size(), 6u) << detail.dump(2);
+  EXPECT_EQ(detail["backend_freed"]["unobservable"].size(), 6u);
+  // One pose: the headline's covariance is over the determined combinations, as the backend's.
+  EXPECT_EQ(doc["observability"]["unobservable"].size(), 6u);
+  EXPECT_EQ(doc["covariance"]["determined"]["combinations"].size(), 6u) << doc["covariance"];
+  EXPECT_EQ(doc["accel"]["matrix"][0][0], 1.0) << "the paper's fixed F_xx";
+  EXPECT_EQ(doc["accel"]["matrix"][0][1], 0.0) << "the paper's fixed alpha";
 }
 
 TEST(Cli, PaperCommandWritesTablesInputsAndFigures) {

@@ -218,5 +218,108 @@ TEST(CompareCli, AgainstTheSimulatedTruthGivesTheNees) {
   EXPECT_TRUE(Contains(many.err, "several only with --truth")) << many.err;
 }
 
+// --- imucal's own answer on its Ferraris session (shared data) ---------------------------------
+
+const std::string kImucal = std::string(PLUMB_SHARED_DATA_DIR) + "/ferraris/imucal";
+
+/// plumb calibrate on imucal's session, read as imucal read it (gyroscope in deg/s, turned
+/// into rad/s by plumb; gravity 9.81 as imucal's `grav`), with `extra` options.
+ToolRun CalibrateImucalSession(const TempDir& dir, const std::vector<std::string>& extra) {
+  std::vector<std::string> args = {"calibrate", kImucal + "/example_ferraris_session.csv",
+                                   "--skip-lines", "1", "--columns", "t,gx,gy,gz,ax,ay,az",
+                                   "--time-scale", "0.009765625", "--gravity", "9.81"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return Plumb(args, dir);
+}
+
+TEST(CliCompare, ImucalsAnswerAgainstThePaperBenchmarkOfTheSameSession) {
+  // Both run the same Ferraris closed form: set side by side in imucal's frame (plumb's F is
+  // full and fixed by the faces, like imucal's), with imucal's deg/s turned into rad/s, the
+  // accelerometer agrees to float storage, the gyroscope to what imucal's K_ga (absent from
+  // plumb's model) and plumb's bias drift move it, about 1e-4.
+  const std::string cal = kImucal + "/example_ferraris_session_cal_102.4Hz.json";
+  if (!std::filesystem::exists(cal)) GTEST_SKIP() << "shared data absent: " << cal;
+  TempDir dir;
+  const std::string result = dir.File("bench.json"), out = dir.File("compare.json");
+  const ToolRun run = CalibrateImucalSession(
+      dir, {"--gyr-unit", "deg/s", "--segments", kImucal + "/example_ferraris_session_list.json",
+            "--method", "paper-benchmark", "--json", result});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const ToolRun compare = Plumb({"compare", result, "--imucal", cal, "--json", out}, dir);
+  ASSERT_EQ(compare.exit_code, 0) << compare.err;
+  EXPECT_TRUE(Contains(compare.out, "compared in imucal's own frame")) << compare.out;
+  const json c = ReadJson(out);
+  EXPECT_EQ(c["peer"]["R_peer_b"], json::parse("[[1,0,0],[0,1,0],[0,0,1]]"));
+  EXPECT_EQ(c["peer"]["units"]["gyro"], "rad/s");
+  for (const char* a : {"x", "y", "z"}) {
+    for (const char* b : {"x", "y", "z"}) {
+      const std::string ij = std::string(a) + b;
+      EXPECT_NEAR(Row(c, "accel.matrix." + ij)["difference"].get<double>(), 0.0, 1e-6) << ij;
+      EXPECT_NEAR(Row(c, "gyro.matrix." + ij)["difference"].get<double>(), 0.0, 2e-4) << ij;
+    }
+    EXPECT_NEAR(Row(c, std::string("accel.bias.") + a)["difference"].get<double>(), 0.0, 1e-6);
+    // imucal's b_g is in deg/s (-0.5997 on x): compared in rad/s.
+    EXPECT_NEAR(Row(c, std::string("gyro.bias.") + a)["difference"].get<double>(), 0.0, 1e-4);
+  }
+  EXPECT_NEAR(Row(c, "gyro.bias.x")["peer"].get<double>(), -0.5996686296674446 * M_PI / 180.0,
+              1e-12);
+}
+
+TEST(CliCompare, ImucalGyroscopeNotComparedAcrossUnitsOrSignConventions) {
+  const std::string cal = kImucal + "/example_ferraris_session_cal_102.4Hz.json";
+  if (!std::filesystem::exists(cal)) GTEST_SKIP() << "shared data absent: " << cal;
+  TempDir dir;
+  // deg/s read as rad/s: every gyroscope row is "not compared", with the reason.
+  const std::string raw = dir.File("raw.json"), out = dir.File("compare.json");
+  ASSERT_EQ(CalibrateImucalSession(dir, {"--constant-bias", "--json", raw}).exit_code, 0);
+  ToolRun compare = Plumb({"compare", raw, "--imucal", cal, "--json", out}, dir);
+  ASSERT_EQ(compare.exit_code, 0) << compare.err;
+  EXPECT_TRUE(Contains(compare.out, "differs by 180/pi")) << compare.out;
+  json c = ReadJson(out);
+  EXPECT_TRUE(Row(c, "gyro.bias.x")["difference"].is_null());
+  EXPECT_TRUE(Contains(Row(c, "gyro.matrix.xx")["not_compared"].get<std::string>(), "deg/s"));
+  EXPECT_FALSE(Row(c, "accel.bias.x")["difference"].is_null()) << "the accelerometer is compared";
+  // imucal's turns taken the other way (R_g negated, as expected_angle +360 on these turns
+  // gives): the gyroscope matrix is not compared, the bias still is.
+  json flipped = ReadJson(cal);
+  for (auto& row : flipped["R_g"]) {
+    for (auto& v : row) v = -v.get<double>();
+  }
+  const std::string flipped_path = dir.File("flipped.json");
+  std::ofstream(flipped_path) << flipped.dump();
+  const std::string si = dir.File("si.json");
+  ASSERT_EQ(CalibrateImucalSession(dir, {"--gyr-unit", "deg/s", "--constant-bias", "--json", si})
+                .exit_code,
+            0);
+  compare = Plumb({"compare", si, "--imucal", flipped_path, "--json", out}, dir);
+  ASSERT_EQ(compare.exit_code, 0) << compare.err;
+  EXPECT_TRUE(Contains(compare.out, "expected_angle")) << compare.out;
+  c = ReadJson(out);
+  EXPECT_TRUE(Row(c, "gyro.matrix.yy")["difference"].is_null());
+  EXPECT_FALSE(Row(c, "gyro.bias.y")["difference"].is_null());
+  // The same result against imucal's own file: everything compared.
+  compare = Plumb({"compare", si, "--imucal", cal, "--json", out}, dir);
+  c = ReadJson(out);
+  EXPECT_FALSE(Row(c, "gyro.matrix.yy")["difference"].is_null());
+  EXPECT_FALSE(Contains(compare.out, "not compared:")) << compare.out;
+}
+
+TEST(CliCompare, AcceptsEveryMethodsOutput) {
+  // compare reads a paper method's document by its headline keys (SPEC section 6).
+  TempDir dir;
+  const std::string csv = dir.File("bench.csv");
+  ASSERT_EQ(Plumb({"simulate", "--out", csv, "--schedule", "paper-benchmark", "--still", "5",
+                   "--turn", "2", "--rate", "100", "--truth-json", dir.File("truth.json"),
+                   "--seed", "4"},
+                  dir)
+                .exit_code,
+            0);
+  const std::string bench = dir.File("bench.json");
+  ASSERT_EQ(Plumb({"calibrate", csv, "--method", "paper-benchmark", "--json", bench}, dir).exit_code, 0);
+  const ToolRun run = Plumb({"compare", bench, "--truth", dir.File("truth.json")}, dir);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "accel.bias.x")) << run.out;
+}
+
 }  // namespace
 }  // namespace plumb::cli

@@ -376,7 +376,7 @@ TEST(CovarianceCli, JsonCarriesTheCovarianceWithItsParameterOrder) {
   const std::string out = dir.File("cal.json");
   ASSERT_EQ(Calibrate(csv, {"--json", out}, dir).exit_code, 0);
   const json doc = ReadJson(out);
-  EXPECT_EQ(doc["schema_version"], 1);
+  EXPECT_EQ(doc["schema_version"], 2);
   EXPECT_TRUE(doc["gates"].empty());
   const json& cov = doc["covariance"];
   EXPECT_EQ(cov["sigma_scaled_by_chi2"], false);
@@ -466,10 +466,12 @@ TEST(CovarianceCli, PaperMethodsCarryTheSchemaVersionAndTheBackendsCovariance) {
                             dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const json doc = ReadJson(out);
-  EXPECT_EQ(doc["schema_version"], 1);
+  EXPECT_EQ(doc["schema_version"], 2);
   EXPECT_EQ(doc["covariance"]["source"], "backend");
-  EXPECT_EQ(doc["covariance"]["parameters"], doc["backend"]["covariance"]["parameters"]);
-  EXPECT_EQ(doc["covariance"]["determined"], doc["backend"]["covariance"]["determined"]);
+  const json& backend = doc["paper-static"]["backend"];
+  EXPECT_EQ(doc["covariance"]["parameters"], backend["covariance"]["parameters"]);
+  EXPECT_EQ(doc["covariance"]["determined"], backend["covariance"]["determined"]);
+  EXPECT_EQ(doc["gates"], backend["gates"]);
   EXPECT_TRUE(doc["gates"].is_array());
 }
 

@@ -101,5 +101,17 @@ TEST(Correction, ACalibrationDocumentReadsBackBitForBit) {
   EXPECT_THROW(ReadCalibrationFile(bad, "cal.json"), InputError);
 }
 
+TEST(Correction, AnAccelerometerOnlyDocumentReadsBack) {
+  // An accelerometer-only fit writes its spec as "paper (accelerometer only)" (DropGyro).
+  model::Model m = model::Model::Parse("paper+accel_bias_drift");
+  m.DropGyro();
+  ASSERT_EQ(m.spec(), "paper+accel_bias_drift (accelerometer only)");
+  const model::ParameterBlocks theta = sim::RandomParameters(m, 1.0, 3);
+  const CalibrationFile file = ReadCalibrationFile(json::parse(Document(m, theta).dump()), "a.json");
+  EXPECT_EQ(file.model.spec(), m.spec());
+  EXPECT_FALSE(file.model.has_gyro());
+  EXPECT_EQ(model::ReportedValues(file.model, file.theta), model::ReportedValues(m, theta));
+}
+
 }  // namespace
 }  // namespace plumb::correction

@@ -29,13 +29,21 @@ const json& Required(const json& doc, const char* key, const std::string& path) 
 model::Model ReadModel(const json& doc, const std::string& path) {
   const json& spec = Required(doc, "model", path);
   if (!spec.is_string()) throw InputError(path, "key 'model'", "expected a model spec (text)");
+  // An accelerometer-only fit writes its spec with this suffix (model::Model::DropGyro).
+  std::string text = spec.get<std::string>();
+  const std::string accel_only = " (accelerometer only)";
+  const bool drop_gyro = text.size() > accel_only.size() &&
+                         text.compare(text.size() - accel_only.size(), accel_only.size(),
+                                      accel_only) == 0;
+  if (drop_gyro) text.resize(text.size() - accel_only.size());
   model::Model model = [&] {
     try {
-      return model::Model::Parse(spec.get<std::string>());
+      return model::Model::Parse(text);
     } catch (const Error& e) {
       throw InputError(path, "key 'model'", e.what());
     }
   }();
+  if (drop_gyro) model.DropGyro();
   const json& ref = Required(doc, "model_reference", path);
   if (!ref.is_object() || !ref.contains("t_ref_s") || !ref.contains("temp_ref_c")) {
     throw InputError(path, "key 'model_reference'", "expected {t_ref_s, temp_ref_c}");

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "plumb/core/units.h"
+
 namespace plumb::peers {
 namespace {
 
@@ -39,7 +41,7 @@ void CheckUnits(const Mat3& plumb, const Mat3& peer, const std::string& sensor,
                 std::vector<std::string>& notes) {
   for (int i = 0; i < 3; ++i) {
     const double ratio = plumb(i, i) / peer(i, i);
-    if (!(ratio > 0.5 && ratio < 2.0)) {
+    if (!(std::abs(ratio) > 0.5 && std::abs(ratio) < 2.0)) {
       notes.push_back("WARNING: the " + sensor + " scales (matrix diagonals) differ by a factor " +
                       std::to_string(ratio) +
                       ": were plumb and the peer given data in different units? (plumb must read "
@@ -48,6 +50,68 @@ void CheckUnits(const Mat3& plumb, const Mat3& peer, const std::string& sensor,
       return;
     }
   }
+}
+
+bool IsSi(const std::string& unit) { return unit == "m/s^2" || unit == "rad/s"; }
+
+/// Why the rows of a sensor cannot be compared for units, or "": plumb's outputs in SI and the
+/// peer's not (or the reverse), or every scale 180/pi apart (deg/s data read as rad/s).
+std::string UnitMismatch(const std::string& plumb_unit, const std::string& peer_unit,
+                         const Mat3& plumb, const Mat3& peer, const std::string& sensor) {
+  if (!plumb_unit.empty() && !peer_unit.empty() && IsSi(plumb_unit) != IsSi(peer_unit)) {
+    return "plumb's " + sensor + " outputs are in " + plumb_unit + ", the peer's in " +
+           peer_unit + ": give both the same data in the same units";
+  }
+  const double deg = 180.0 / units::kPi;
+  bool apart = true;
+  for (int i = 0; i < 3; ++i) {
+    const double ratio = std::abs(plumb(i, i) / peer(i, i));
+    apart = apart && (std::abs(ratio / deg - 1.0) < 0.1 || std::abs(ratio * deg - 1.0) < 0.1);
+  }
+  if (apart) {
+    return "every " + sensor + " scale differs by 180/pi: data in deg/s were read as rad/s on "
+           "one side (plumb converts deg/s with --gyr-unit deg/s)";
+  }
+  return "";
+}
+
+/// Why the gyroscope matrices cannot be compared for their sign, or "".
+std::string SignMismatch(const Mat3& plumb, const Mat3& peer, const std::string& peer_name) {
+  std::string axes;
+  for (int i = 0; i < 3; ++i) {
+    if ((plumb(i, i) > 0.0) != (peer(i, i) > 0.0)) axes += kAxisName[i];
+  }
+  if (axes.empty()) return "";
+  std::string why = "the gyroscope matrix's diagonal has the opposite sign in plumb and " +
+                    peer_name + " on axes " + axes +
+                    ": the two take the rate with opposite signs there";
+  if (peer_name == "imucal") {
+    why += " (imucal takes its turns as clockwise, expected_angle -360: turns made the other "
+           "way give a negative R_g diagonal; recompute with expected_angle +360)";
+  }
+  return why;
+}
+
+void MarkNotCompared(std::vector<ComparisonRow>& rows, const std::vector<std::string>& prefixes,
+                     const std::string& why, std::vector<std::string>& notes) {
+  if (why.empty()) return;
+  std::string which;
+  for (const auto& p : prefixes) which += (which.empty() ? "" : ", ") + p + "*";
+  notes.push_back("not compared: " + which + ": " + why);
+  for (ComparisonRow& row : rows) {
+    for (const auto& p : prefixes) {
+      if (row.name.rfind(p, 0) != 0) continue;
+      row.not_compared = why;
+      row.difference = 0.0;
+      row.z.reset();
+      row.z_scaled.reset();
+    }
+  }
+}
+
+std::string BiasUnit(const PlumbResult& r, const std::string& name) {
+  const PlumbParameter* p = FindParameter(r, name);
+  return p ? p->unit : "";
 }
 
 GravityNormComparison Costs(const PlumbResult& r, const ForwardCalibration& peer,
@@ -129,8 +193,8 @@ void WriteTable(const Comparison& c, std::ostream& os) {
     os << Cell(row.name, 26) << Cell(row.in_plumb_model ? row.unit : "(not in model)", 18)
        << Cell(row.in_plumb_model ? Fmt("%.9g", row.plumb_value) : "0", 15)
        << Cell(SigmaCell(row), 11) << Cell(Fmt("%.9g", row.peer_value), 15)
-       << Cell(Fmt("%.4g", row.difference), 14) << Cell(OptionalCell(row.z, "%.2f"), 9)
-       << OptionalCell(row.z_scaled, "%.2f") << "\n";
+       << Cell(row.not_compared.empty() ? Fmt("%.4g", row.difference) : "not compared", 14)
+       << Cell(OptionalCell(row.z, "%.2f"), 9) << OptionalCell(row.z_scaled, "%.2f") << "\n";
   }
   os << "largest |d/sigma|: accel " << Largest(c.rows, "accel.") << ", gyro "
      << Largest(c.rows, "gyro") << "\n";
@@ -183,6 +247,7 @@ json PeerJson(const ForwardCalibration& p) {
            {"sources", p.sources},
            {"notes", p.notes},
            {"R_peer_b", Mat(p.R_peer_b)},
+           {"units", {{"accel", p.acc_unit}, {"gyro", p.gyr_unit}}},
            {"accel", {{"matrix", Mat(p.accel_matrix)}, {"bias", Vec(p.accel_bias)}}}};
   out["gyro"] = p.has_gyro ? json{{"matrix", Mat(p.gyro_matrix)}, {"bias", Vec(p.gyro_bias)}}
                            : json(nullptr);
@@ -232,9 +297,22 @@ Comparison Compare(const PlumbResult& result, const ForwardCalibration& peer,
                                      [&](const NamedValue& v) { return v.name == p.name; });
     if (!matched) c.plumb_only.push_back(p.name);
   }
-  CheckUnits(result.accel_matrix, peer.accel_matrix, "accelerometer", c.notes);
+  const std::string acc_units = UnitMismatch(BiasUnit(result, "accel.bias.x"), peer.acc_unit,
+                                             result.accel_matrix, peer.accel_matrix,
+                                             "accelerometer");
+  MarkNotCompared(c.rows, {"accel."}, acc_units, c.notes);
+  if (acc_units.empty()) {
+    CheckUnits(result.accel_matrix, peer.accel_matrix, "accelerometer", c.notes);
+  }
   if (result.has_gyro && peer.has_gyro) {
-    CheckUnits(result.gyro_matrix, peer.gyro_matrix, "gyroscope", c.notes);
+    const std::string gyr_units = UnitMismatch(BiasUnit(result, "gyro.bias.x"), peer.gyr_unit,
+                                               result.gyro_matrix, peer.gyro_matrix, "gyroscope");
+    MarkNotCompared(c.rows, {"gyro.", "gyro_g_sensitivity."}, gyr_units, c.notes);
+    if (gyr_units.empty()) {
+      MarkNotCompared(c.rows, {"gyro.matrix."},
+                      SignMismatch(result.gyro_matrix, peer.gyro_matrix, peer.peer), c.notes);
+      CheckUnits(result.gyro_matrix, peer.gyro_matrix, "gyroscope", c.notes);
+    }
   }
   c.cost = Costs(result, peer, options);
   return c;
@@ -273,7 +351,8 @@ json ComparisonJson(const Comparison& c) {
                     {"fixed", r.plumb_fixed},
                     {"observable", r.plumb_observable},
                     {"peer", Num(r.peer_value)},
-                    {"difference", Num(r.difference)},
+                    {"difference", r.not_compared.empty() ? Num(r.difference) : json(nullptr)},
+                    {"not_compared", r.not_compared.empty() ? json(nullptr) : json(r.not_compared)},
                     {"z", Opt(r.z)},
                     {"z_scaled", Opt(r.z_scaled)}});
   }

@@ -27,7 +27,10 @@ struct ComparisonRow {
   bool plumb_fixed = false;     ///< plumb held the parameter fixed
   bool plumb_observable = true; ///< false: plumb's data cannot determine it
   double peer_value = 0.0;      ///< the peer's value in plumb's form and units
-  double difference = 0.0;      ///< plumb_value - peer_value
+  double difference = 0.0;      ///< plumb_value - peer_value (0 when not compared)
+  /// Why the two values cannot be set against each other (units or sign conventions that
+  /// differ); "" when they are compared. Then difference, z and z_scaled are left out.
+  std::string not_compared;
   std::optional<double> z;      ///< difference / plumb_sigma
   std::optional<double> z_scaled;  ///< z / sqrt(max(1, chi^2/dof))
 };
@@ -55,7 +58,7 @@ struct Comparison {
   std::vector<ComparisonRow> rows;
   std::vector<std::string> plumb_only;  ///< plumb's parameters the peer has no value for
   GravityNormComparison cost;
-  std::vector<std::string> notes;       ///< warnings (e.g. units that do not match)
+  std::vector<std::string> notes;       ///< warnings, and why rows are not compared
 };
 
 struct CompareOptions {
@@ -63,7 +66,11 @@ struct CompareOptions {
   double gravity_m_s2 = 0.0;
 };
 
-/// Sets `peer` beside `result` (see the file comment).
+/// Sets `peer` beside `result` (see the file comment). A sensor's rows are not compared
+/// (ComparisonRow::not_compared, and a note) when its units differ: SI on one side and not on
+/// the other (ForwardCalibration::acc_unit / gyr_unit against the unit of plumb's bias), or
+/// every diagonal of the matrix 180/pi apart (deg/s read as rad/s); the gyroscope matrix's rows
+/// also when a diagonal has the opposite sign in the two (a sign convention of the rate).
 Comparison Compare(const PlumbResult& result, const ForwardCalibration& peer,
                    const CompareOptions& options = {});
 
@@ -72,7 +79,8 @@ std::string ComparisonText(const Comparison& comparison);
 
 /// The comparison as JSON: {result, plumb {method, model, chi2_dof, dof}, peer {name, sources,
 /// notes, R_peer_b, accel {matrix, bias}, gyro {matrix, bias}, g_sensitivity}, rows [{name,
-/// unit, in_plumb_model, plumb, sigma, fixed, observable, peer, difference, z, z_scaled}], plumb_only [],
+/// unit, in_plumb_model, plumb, sigma, fixed, observable, peer, difference, not_compared, z, z_scaled}],
+/// plumb_only [],
 /// gravity_norm_cost {available, reason, gravity, gravity_source, segments, formula,
 /// means {plumb, peer}, samples_estimate {plumb, peer} | null}, notes []}; non-finite
 /// numbers are null. Each cost is {cost, rms, max_abs, terms, weight}.

@@ -35,6 +35,10 @@ struct ForwardCalibration {
   /// Rotation from plumb's body frame into the frame the peer calibrated to (f_peer =
   /// R_peer_b f_b); identity when the peer already uses the accelerometer-defined frame.
   Mat3 R_peer_b = Mat3::Identity();
+  /// Units of the outputs y_a, y_g after the conversion: "m/s^2" / "rad/s" when the peer's
+  /// were converted to SI, the peer's own unit when kept ("a.u."), "" when the peer does not
+  /// say (imu_tk: the data's as given).
+  std::string acc_unit, gyr_unit;
   /// How the peer's numbers were converted, and anything a reader must know about them.
   std::vector<std::string> notes;
 };

@@ -75,7 +75,8 @@ ImucalFerraris ReadImucalJson(const std::string& path) {
   return c;
 }
 
-ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string& source) {
+ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string& source,
+                                   ImucalFrame frame) {
   ForwardCalibration f;
   f.peer = "imucal";
   f.sources = {source};
@@ -83,22 +84,46 @@ ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string&
   const double out_g = OutputScale(cal.from_gyr_unit, "gyroscope", f);
   const double cal_a = CalibratedScale(cal.acc_unit, "accelerometer");
   const double cal_g = CalibratedScale(cal.gyr_unit, "gyroscope");
-  f.accel_matrix = UpperTriangularFrame((out_a / cal_a) * cal.K_a * cal.R_a, f.R_peer_b);
+  // The outputs' units after conversion: SI for a unit plumb converts, else kept.
+  f.acc_unit = SiPerUnit(cal.from_acc_unit) > 0.0 ? "m/s^2" : cal.from_acc_unit;
+  f.gyr_unit = SiPerUnit(cal.from_gyr_unit) > 0.0 ? "rad/s" : cal.from_gyr_unit;
+  const Mat3 M = (out_a / cal_a) * cal.K_a * cal.R_a;
+  if (frame == ImucalFrame::kPoses) {
+    if (!(M.determinant() > 0.0)) {
+      throw Error("imucal's K_a R_a is singular or a reflection (determinant " +
+                  std::to_string(M.determinant()) + ")");
+    }
+    f.accel_matrix = M;
+    f.R_peer_b = Mat3::Identity();
+  } else {
+    f.accel_matrix = UpperTriangularFrame(M, f.R_peer_b);
+  }
   f.accel_bias = out_a * cal.b_a;
   f.has_gyro = true;
   f.gyro_matrix = (out_g / cal_g) * cal.K_g * cal.R_g * f.R_peer_b;
   f.gyro_bias = out_g * cal.b_g;
   f.has_g_sensitivity = true;
   f.g_sensitivity = (out_g / cal_a) * cal.K_ga * f.R_peer_b;
-  const double angle_deg =
-      std::acos(std::clamp((f.R_peer_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / units::kPi;
   f.notes.push_back(
       "imucal applies acc_cal = R_a^-1 K_a^-1 (acc - b_a), gyr_cal = R_g^-1 K_g^-1 (gyr - K_ga "
-      "acc_cal - b_g); forward form F = K_a R_a R, E = K_g R_g R, G = K_ga R, converted to SI");
-  f.notes.push_back("imucal's frame (its six poses) is turned by " + Number(angle_deg) +
-                    " deg from plumb's accelerometer-defined frame (R_peer_b)");
+      "acc_cal - b_g); forward form F = s_a K_a R_a R, E = s_g K_g R_g R, G = (S_g / C_a) K_ga "
+      "R, S_a b_a, S_g b_g, with R = R_peer_b, S (C) the SI value of one output (calibrated) "
+      "unit, s = S / C: output " + cal.from_acc_unit + ", " + cal.from_gyr_unit +
+      " -> " + f.acc_unit + ", " + f.gyr_unit + " (plumb's units for data read with "
+      "--gyr-unit deg/s); calibrated " + cal.acc_unit + ", " + cal.gyr_unit + " -> m/s^2, rad/s");
+  if (frame == ImucalFrame::kPoses) {
+    f.notes.push_back("compared in imucal's own frame, that of its six poses (R_peer_b = I): "
+                      "plumb's F is full and determined, its frame also the poses'");
+  } else {
+    const double angle_deg =
+        std::acos(std::clamp((f.R_peer_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / units::kPi;
+    f.notes.push_back("imucal's frame (its six poses) is turned by " +
+                      Number(angle_deg) +
+                      " deg from plumb's accelerometer-defined frame (R_peer_b)");
+  }
   f.notes.push_back(
-      "imucal's gyroscope bias is the mean of its six static poses, Earth rate included");
+      "imucal's gyroscope bias is the mean of its six static poses, Earth rate included; its "
+      "turns are taken as clockwise (expected_angle -360), a right-handed rate like plumb's");
   return f;
 }
 

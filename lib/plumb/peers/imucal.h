@@ -19,6 +19,18 @@
 // with S the SI value of one output unit (deg/s -> pi/180; plumb turns recognised units into
 // SI when it reads the data), C the SI value of one calibrated unit, s = S / C. An output unit
 // plumb does not know (imucal's "a.u.") is kept as it is (S = 1), with a note.
+//
+// The frame: against a plumb result whose F is full and determined (known faces define the
+// frame, as `--method paper-benchmark` has them), the comparison is made in the frame of the
+// poses, imucal's own: R_peer_b = I (ImucalFrame::kPoses). Rotating it into the accelerometer-
+// defined frame there would set two answers in different frames side by side.
+//
+// The sign: imucal takes its turns as clockwise (expected_angle -360: "x-gyro shows negative
+// values"), a right-handed rate, like plumb's omega_b; K_g is positive by construction, so a
+// gyroscope whose output runs against the rate, or turns made the other way than
+// expected_angle says, show as a negative diagonal of R_g. That is kept as imucal wrote it;
+// peers::Compare declines to compare matrices whose diagonals differ in sign from plumb's and
+// says why.
 #pragma once
 
 #include <string>
@@ -53,8 +65,15 @@ ImucalFerraris ReadImucalJson(const std::string& path);
 /// "deg/s" pi/180; 0 when unknown.
 double SiPerUnit(const std::string& unit);
 
+/// The frame imucal's answer is expressed in (see the file comment).
+enum class ImucalFrame {
+  kAccelerometerDefined,  ///< plumb's usual frame: F upper triangular (R_peer_b from an RQ)
+  kPoses,                 ///< imucal's own frame, that of its six poses (R_peer_b = I)
+};
+
 /// imucal's answer in plumb's forward form (see the file comment); `source` names the file.
 /// Throws plumb::Error when K_a R_a is singular or a reflection.
-ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string& source);
+ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string& source,
+                                   ImucalFrame frame = ImucalFrame::kAccelerometerDefined);
 
 }  // namespace plumb::peers

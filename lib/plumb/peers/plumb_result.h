@@ -1,5 +1,7 @@
 // plumb/peers/plumb_result.h — reads back what `plumb calibrate --json` wrote
-// (plumb/report/json_report.h), the part a comparison with another tool needs.
+// (plumb/report/json_report.h), the part a comparison with another tool needs: the headline
+// keys of SPEC section 6, which every method's document has (a paper method's are its closed
+// form's answer).
 //
 // Values are in the units of the data plumb was given (SI after plumb's own conversion; raw
 // counts when it was given counts), as in the file.

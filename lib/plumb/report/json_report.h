@@ -1,5 +1,8 @@
 // plumb/report/json_report.h — the JSON documents that `plumb calibrate --json` writes
-// (SPEC section 6).
+// (SPEC section 6), whose contract is docs/reference/calibration.schema.json (its version is
+// kSchemaVersion; tests/cli/json_contract_test.cc validates every method's output against it).
+// The paper methods write the same keys for their closed form's answer
+// (apps/plumb/paper_methods.cc), their own detail under the method's name.
 //
 // Every number is SI (m/s^2, rad/s, s, degC; degrees only in `*_deg` site fields). A value
 // that is not finite (an unobservable parameter's sigma, chi^2/dof without degrees of
@@ -54,9 +57,12 @@ nlohmann::json Vector(const Vec3& v);
 /// [[row x], [row y], [row z]], non-finite entries null.
 nlohmann::json Matrix(const Mat3& m);
 
-/// Version of the calibrate document's layout, "schema_version": 1 adds covariance, gates,
-/// sigma_formal, fit.chi2_above_band and fit.distinct_poses to the earlier unversioned layout.
-inline constexpr int kSchemaVersion = 1;
+/// Version of the calibrate document's layout, "schema_version" (docs/reference/
+/// calibration.schema.json has the same version): 1 added covariance, gates, sigma_formal,
+/// fit.chi2_above_band and fit.distinct_poses to the earlier unversioned layout; 2 gives the
+/// paper methods' documents these keys for the closed form's answer, with their own detail
+/// (paper_convention, backend, ...) under the method's name instead of at the top.
+inline constexpr int kSchemaVersion = 2;
 
 /// The covariance of the free, observable parameters in the order of "parameters" (their
 /// names and units), times chi2/dof when chi^2/dof is above its band
