@@ -1,4 +1,4 @@
-// What plumb allan prints and writes, the page's noise section and noise.png: names and units
+// What plumb allan prints and writes, the page's noise section and noise figure: names and units
 // of the IEEE terms per sensor, bounds marked, the JSON keys, the figure's data blocks.
 #include "plumb/report/noise_text.h"
 
