@@ -1,8 +1,10 @@
 // plumb report INPUT... --out DIR — one page that says what was calibrated and how well
 // (plumb report --study SWEEP_DIR --out DIR: the page of a sensitivity study instead)
-// (SPEC section 6): DIR/index.html, beside it result.json (calibrate's JSON), diagnose.json,
-// allan.json (plumb allan's JSON on the fit's still segments), residuals.csv and the figures
-// (PNG, drawn by gnuplot from figures.gp and its CSV files).
+// (SPEC section 6): DIR/index.html, a page that stands alone: its figures (SVG, drawn by
+// gnuplot) are inside it, it names no other file and makes no request. Beside it, for other
+// programs: result.json (calibrate's JSON), diagnose.json, allan.json (plumb allan's JSON on
+// the fit's still segments), residuals.csv, figures.gp and the CSV files it draws from
+// (`gnuplot figures.gp` there redraws the SVGs).
 //
 // Reads the inputs, finds the still segments and resolves the site exactly as calibrate does
 // (the same options), fits, runs diagnose's ranking of the missing-effect catalogue unless
@@ -26,6 +28,7 @@
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/diagnostics/residual_analysis.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/export/export.h"
 #include "plumb/io/common/atomic_file.h"
 #include "plumb/model/model.h"
 #include "plumb/report/diagnosis_json.h"
@@ -93,10 +96,49 @@ std::string ShellQuote(const std::string& text) {
   return out + "'";
 }
 
-std::string CommandText() {
+std::string CommandText(const std::vector<std::string>& args = CommandLineArgs()) {
   std::string out;
-  for (const auto& arg : CommandLineArgs()) out += (out.empty() ? "" : " ") + ShellQuote(arg);
+  for (const auto& arg : args) out += (out.empty() ? "" : " ") + ShellQuote(arg);
   return out;
+}
+
+/// The report's command line as the `plumb calibrate` command that fits the same data the
+/// same way: the subcommand renamed, the options only `plumb report` has dropped (with their
+/// values), the options in `replaced` dropped too, `extra` appended. calibrate takes every
+/// other option of report (input, site, segments, model and fit options).
+std::string CalibrateCommand(const std::vector<std::string>& replaced,
+                             const std::vector<std::string>& extra) {
+  // Report's own options, and whether each takes a value.
+  const std::vector<std::pair<std::string, bool>> own = {
+      {"--out", true},         {"--significance", true}, {"--confirm", true},
+      {"--gnuplot", true},     {"--study", true},        {"--diagnose", false},
+      {"--no-diagnose", false}, {"--no-figures", false}};
+  const std::vector<std::string>& args = CommandLineArgs();
+  std::vector<std::string> out;
+  bool in_report = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (!in_report) {
+      in_report = i > 0 && arg == "report";
+      out.push_back(in_report ? "calibrate" : arg);
+      continue;
+    }
+    const std::string name = arg.rfind("--", 0) == 0 ? arg.substr(0, arg.find('=')) : "";
+    bool takes_value = false, drop = false;
+    for (const auto& [option, value] : own) {
+      if (name == option) drop = true, takes_value = value;
+    }
+    for (const auto& option : replaced) {
+      if (name == option) drop = true, takes_value = true;
+    }
+    if (!drop) {
+      out.push_back(arg);
+    } else if (takes_value && arg.find('=') == std::string::npos) {
+      ++i;  // its value
+    }
+  }
+  out.insert(out.end(), extra.begin(), extra.end());
+  return CommandText(out);
 }
 
 report::InputSummary Summarise(const Session& session, const InputArgs& args) {
@@ -133,9 +175,9 @@ class ReportCommand : public Command {
     ReportArgs& a = args_;
     AddInputOptions(app_, a.input);
     app_->add_option("--out", a.out_dir,
-                     "Folder of the page (created when missing): index.html, result.json, "
-                     "diagnose.json, allan.json, residuals.csv, figures.gp, its CSV data and "
-                     "the PNGs")
+                     "Folder of the page (created when missing): index.html (the figures inside "
+                     "it), and beside it result.json, diagnose.json, allan.json, residuals.csv, "
+                     "figures.gp and its CSV data")
         ->type_name("DIR")
         ->required();
     AddModelOption(app_, a.fit);
@@ -235,6 +277,12 @@ class ReportCommand : public Command {
       DrawFigures(dir.string(), series, segments, result, ra_options, extras, files);
     }
     extras.files = files;
+    if (diagnosis) {
+      if (const auto spec = diagnostics::NextModelSpec(*diagnosis)) {
+        extras.next_command = CalibrateCommand({"--model"}, {"--model", *spec});
+      }
+    }
+    PreviewExports(session, result, extras);
     const std::string page = report::HtmlReport(Summarise(session, a.input), seg, result,
                                                 analysis, diagnosis ? &*diagnosis : nullptr,
                                                 extras);
@@ -288,6 +336,42 @@ class ReportCommand : public Command {
     }
   }
 
+  /// The page's firmware section: what each --export would write and leave, or why not.
+  void PreviewExports(const Session& session, const estimation::CalibrationResult& result,
+                      report::PageExtras& extras) const {
+    const ImuSeries& series = session.series;
+    if (series.acc_unit != "m/s^2" || (series.has_gyro() && series.gyr_unit != "rad/s")) {
+      extras.exports_note = "the samples are in " + series.acc_unit + " and " + series.gyr_unit +
+                            ", not m/s^2 and rad/s: no export acts on them";
+      return;
+    }
+    exporter::ExportOptions options;
+    options.imu = args_.input.imu;
+    options.log_params = session.log_params;
+    options.system_id = session.system_id;
+    std::string firmware_refused;
+    if (args_.input.as_logged) {
+      firmware_refused = "--as-logged: the samples keep the log's correction, so parameters "
+                         "fitted to them would replace it instead of adding to it";
+    } else if (!session.firmware_left.empty()) {
+      firmware_refused = "the samples still carry corrections the flight controller applied "
+                         "and plumb could not undo:";
+      for (const std::string& left : session.firmware_left) firmware_refused += " " + left + ";";
+    }
+    extras.exports = exporter::PreviewExports(result.calibration, series, result.fit.still,
+                                              options, firmware_refused);
+    const std::pair<const char*, const char*> files[] = {
+        {"ardupilot", "calibration.param"}, {"px4", "calibration.params"}, {"kalibr", "imu.yaml"}};
+    for (const auto& [format, file] : files) {
+      extras.export_commands[format] =
+          CalibrateCommand({}, {"--export", std::string(format) + "=" + file});
+    }
+    if (!result.fit.gates.empty()) {
+      extras.exports_note = "The fit failed a gate: plumb calibrate refuses these exports "
+                            "unless --export-anyway is given (see the summary).";
+    }
+  }
+
   /// Plans the figures, runs gnuplot in the output folder, and keeps the figures it drew.
   /// The Allan figure pools only the longest still segment(s).
   void DrawFigures(const std::string& dir, const ImuSeries& series,
@@ -301,12 +385,7 @@ class ReportCommand : public Command {
     report::FigurePlan plan = report::PlanFigures(series, segments, result, longest);
     if (extras.still_noise) report::AddStillNoiseFigure(*extras.still_noise, {}, plan);
     const report::GnuplotOutcome outcome = report::RunGnuplot(dir, plan.job, args_.gnuplot);
-    for (const auto& figure : plan.figures) {
-      if (std::find(outcome.written.begin(), outcome.written.end(), figure.file) !=
-          outcome.written.end()) {
-        extras.figures.push_back(figure);
-      }
-    }
+    extras.figures = report::EmbedDrawnFigures(dir, plan, outcome);  // inside the page
     if (!outcome.message.empty()) {
       extras.figure_notes.push_back(outcome.message);
       std::cerr << "plumb: warning: " << outcome.message << "\n";

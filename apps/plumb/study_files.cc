@@ -46,12 +46,12 @@ std::string WriteStudyPage(const study::Study& study,
                            const std::vector<study::PointSummary>& points, const std::string& dir,
                            bool figures, const std::string& gnuplot) {
   std::string note = "not drawn (--no-figures)";
-  std::vector<std::string> drawn;
+  std::vector<report::InlineFigure> drawn;
   if (figures) {
     const report::GnuplotOutcome out =
         report::RunGnuplot(dir, report::StudyFigures(study, points), gnuplot);
     note = out.ran ? "" : out.message;
-    drawn = out.written;
+    drawn = report::TakeSvgFiles(dir, out.written);  // inside the page, not beside it
   }
   io::WriteFileAtomic((fs::path(dir) / "index.html").string(),
                       report::StudyPage(study, points, drawn, note));

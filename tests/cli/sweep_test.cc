@@ -51,8 +51,10 @@ TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
   // The page and its figures (gnuplot is part of the set-up).
   const std::string page = ReadAll(at("whole/index.html"));
   EXPECT_TRUE(Contains(page, "<h1>plumb sweep: t</h1>")) << page;
-  EXPECT_TRUE(Contains(page, "<img src=\"nees_poses.png\"")) << page;
-  EXPECT_TRUE(fs::exists(dir.path() / "whole/error_poses.png"));
+  EXPECT_TRUE(Contains(page, "<figure>\n<svg")) << page;  // inside the page, own ids
+  EXPECT_TRUE(Contains(page, "id='nees_poses-gpDot'")) << page;
+  EXPECT_TRUE(Contains(page, "id='error_poses-gpDot'")) << page;
+  EXPECT_FALSE(fs::exists(dir.path() / "whole/error_poses.svg"));
   const std::string csv = ReadAll(at("whole/results.csv"));
   EXPECT_TRUE(Contains(csv, "point,poses,parameter,unit,runs,failed,flagged,mean_error")) << csv;
   EXPECT_TRUE(Contains(csv, "\n2,15,gyro.bias.z,rad/s,3,0,")) << csv;
@@ -66,7 +68,7 @@ TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
   const ToolRun page_run = Plumb({"report", "--study", at("whole"), "--out", at("page")}, dir);
   ASSERT_EQ(page_run.exit_code, 0) << page_run.err;
   EXPECT_EQ(ReadAll(at("page/index.html")), ReadAll(at("whole/index.html")));
-  EXPECT_TRUE(fs::exists(dir.path() / "page/nees_poses.png"));
+  EXPECT_TRUE(Contains(ReadAll(at("page/index.html")), "id='nees_poses-gpDot'"));
   // A merge with a shard missing says which point.
   const ToolRun missing = Plumb({"sweep", "merge", at("shard1"), "--out", at("m2")}, dir);
   EXPECT_EQ(missing.exit_code, 1);

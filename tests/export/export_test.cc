@@ -304,6 +304,47 @@ TEST(Evaluate, CountsAreRefused) {
   EXPECT_THROW(Export("ardupilot", s.r.calibration, s.series, s.r.fit.still, ExportOptions{}), Error);
 }
 
+// ---- what each format would write, for a page ------------------------------------------------
+
+TEST(PreviewExports, EveryFormatWithItsNumbersOrWhyNot) {
+  model::Model m = model::Model::Parse("base");
+  model::ParameterBlocks theta = m.ZeroParameters();
+  theta[0][1] = 0.01;  // F_xy: what a diagonal correction cannot carry
+  const std::vector<Vec3> f = {Vec3(0, 0, -kG), Vec3(0, -kG, 0), Vec3(0, kG, 0)};
+  Session s = MakeSession("base", theta, f, {25, 25, 25});
+  std::vector<ExportPreview> previews =
+      PreviewExports(s.r.calibration, s.series, s.r.fit.still, ExportOptions{});
+  ASSERT_EQ(previews.size(), 3u);
+  EXPECT_EQ(previews[0].format, "ardupilot");
+  EXPECT_EQ(previews[1].format, "px4");
+  EXPECT_EQ(previews[2].format, "kalibr");
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_TRUE(previews[i].output) << previews[i].refused;
+    const ExportOutput& out = *previews[i].output;
+    ASSERT_TRUE(out.report && out.parameters);
+    // The same numbers as Export()'s JSON, and the hand computation's (Evaluate test above).
+    EXPECT_NEAR(out.report->accel_still.max_abs.x(), 0.01 * kG, 1e-6);
+    EXPECT_EQ(out.json["accel_still"]["max_abs"][0].get<double>(), out.report->accel_still.max_abs.x());
+    EXPECT_EQ(out.parameters->Values().count(i == 0 ? "INS_ACCSCAL_X" : "CAL_ACC0_XSCALE"), 1u);
+  }
+  // A reason known beforehand refuses the firmware formats without building them.
+  previews = PreviewExports(s.r.calibration, s.series, s.r.fit.still, ExportOptions{},
+                            "the log's rotation is not undone");
+  EXPECT_FALSE(previews[0].output);
+  EXPECT_EQ(previews[1].refused, "the log's rotation is not undone");
+  EXPECT_NE(previews[2].refused, "the log's rotation is not undone");
+  // What Export() refuses is carried, not thrown.
+  estimation::ParameterEstimate lost;
+  lost.name = "accel.bias.x";
+  lost.unit = "m/s^2";
+  lost.observable = false;
+  s.r.calibration.parameters = {lost};
+  previews = PreviewExports(s.r.calibration, s.series, s.r.fit.still, ExportOptions{});
+  EXPECT_FALSE(previews[0].output);
+  EXPECT_NE(previews[0].refused.find("does not determine accel.bias.x"), std::string::npos)
+      << previews[0].refused;
+}
+
 // ---- Kalibr ----------------------------------------------------------------------------------
 
 /// Key -> value of a flat `key: value  # comment` YAML text.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <sstream>
 
@@ -34,14 +35,14 @@ bool GnuplotOnPath() {
   return false;
 }
 
-/// A line, drawn to line.png.
+/// A line, drawn to line.svg.
 GnuplotJob LineJob() {
   GnuplotJob job;
   job.data.push_back({"line.csv", "# x,y\n0,0\n1,1\n2,4\n"});
-  job.script = PngTerminal(320, 240) +
-               "set datafile separator ','\nset output 'line.png'\n"
+  job.script = SvgTerminal(320, 240) +
+               "set datafile separator ','\nset output 'line.svg'\n"
                "plot 'line.csv' using 1:2 with lines title 'y'\nset output\n";
-  job.outputs = {"line.png"};
+  job.outputs = {"line.svg"};
   return job;
 }
 
@@ -105,8 +106,8 @@ TEST(Gnuplot, DrawsTheImageInTheFolder) {
   const GnuplotOutcome out = RunGnuplot(dir.path().string(), LineJob());
   EXPECT_TRUE(out.ran) << out.message;
   EXPECT_TRUE(out.message.empty()) << out.message;
-  ASSERT_EQ(out.written, std::vector<std::string>{"line.png"});
-  EXPECT_GT(std::filesystem::file_size(dir.File("line.png")), 0u);
+  ASSERT_EQ(out.written, std::vector<std::string>{"line.svg"});
+  EXPECT_GT(std::filesystem::file_size(dir.File("line.svg")), 0u);
 }
 
 TEST(Figures, PlansSeriesAndResidualsWithoutTemperature) {
@@ -115,9 +116,9 @@ TEST(Figures, PlansSeriesAndResidualsWithoutTemperature) {
                                               {120, 200, "b", {}, false, {}}};
   const FigurePlan plan =
       PlanFigures(series, segments, testing::MakeResult(), Analysis(false));
-  EXPECT_EQ(plan.job.outputs, (std::vector<std::string>{"series.png", "residuals.png"}));
+  EXPECT_EQ(plan.job.outputs, (std::vector<std::string>{"series.svg", "residuals.svg"}));
   ASSERT_EQ(plan.figures.size(), 2u);
-  EXPECT_EQ(plan.figures[0].file, "series.png");
+  EXPECT_EQ(plan.figures[0].file, "series.svg");
   // Both still segments are shaded, in seconds since the first sample.
   EXPECT_TRUE(Contains(plan.job.script, "rect from first 0, graph 0 to first 0.79, graph 1"));
   EXPECT_TRUE(Contains(plan.job.script, "rect from first 1.2, graph 0 to first 1.99, graph 1"));
@@ -131,7 +132,7 @@ TEST(Figures, AddsTheTemperatureFigureWhenTheSessionHasTemperature) {
   const FigurePlan plan =
       PlanFigures(Series(true), {{0, 80, "a", {}, false, {}}}, testing::MakeResult(),
                   Analysis(true));
-  EXPECT_NE(std::find(plan.job.outputs.begin(), plan.job.outputs.end(), "temperature.png"),
+  EXPECT_NE(std::find(plan.job.outputs.begin(), plan.job.outputs.end(), "temperature.svg"),
             plan.job.outputs.end());
   EXPECT_EQ(plan.figures.size(), plan.job.outputs.size());
 }
@@ -153,6 +154,29 @@ TEST(Figures, DrawsEveryPlannedFigure) {
   const GnuplotOutcome out = RunGnuplot(dir.path().string(), plan.job);
   EXPECT_TRUE(out.ran) << out.message;
   EXPECT_EQ(out.written, plan.job.outputs) << out.message;
+  // Each drawn figure goes inside the page, with ids of its own; the files beside are gone.
+  const std::vector<ReportFigure> drawn = EmbedDrawnFigures(dir.path().string(), plan, out);
+  ASSERT_EQ(drawn.size(), plan.figures.size());
+  for (const ReportFigure& figure : drawn) {
+    const std::string stem = figure.file.substr(0, figure.file.find('.'));
+    EXPECT_EQ(figure.svg.rfind("<svg", 0), 0u) << figure.file;
+    EXPECT_TRUE(Contains(figure.svg, "id='" + stem + "-gpPt7'")) << figure.file;
+    EXPECT_FALSE(Contains(figure.svg, "'#gpPt")) << figure.file;
+    EXPECT_FALSE(std::filesystem::exists(dir.File(figure.file))) << figure.file;
+  }
+}
+
+TEST(Figures, EmbedsOnlyTheFiguresGnuplotWrote) {
+  FigurePlan plan;
+  plan.figures = {{"series.svg", "Input", "", ""}, {"allan.svg", "Allan", "", ""}};
+  testing::TempDir dir;
+  std::ofstream(dir.File("allan.svg")) << "<svg width=\"1\" height=\"1\"><g id='a'/></svg>\n";
+  GnuplotOutcome out;
+  out.written = {"allan.svg"};
+  const std::vector<ReportFigure> drawn = EmbedDrawnFigures(dir.path().string(), plan, out);
+  ASSERT_EQ(drawn.size(), 1u);
+  EXPECT_EQ(drawn[0].title, "Allan");
+  EXPECT_EQ(drawn[0].svg, "<svg width=\"1\" height=\"1\"><g id='allan-a'/></svg>");
 }
 
 }  // namespace

@@ -111,15 +111,88 @@ TEST(HtmlReport, ShowsUnobservableDirectionsAndDeterminedCombinations) {
   EXPECT_TRUE(Contains(page, "<code>accel.bias.z - 9.81 accel.matrix.zz</code>"));
 }
 
-TEST(HtmlReport, ReferencesTheDrawnFiguresRelatively) {
+TEST(HtmlReport, PutsTheDrawnFiguresInsideThePage) {
   PageParts parts;
-  parts.extras.figures = {{"series.png", "Input time series", "shaded < still"},
-                          {"residuals.png", "Whitened residuals", "dashed: +-3"}};
+  parts.extras.figures = {{"series.svg", "Input time series", "shaded < still",
+                           "<svg width=\"10\" height=\"5\"><g id='series-gpPt0'/></svg>"},
+                          {"residuals.svg", "Whitened residuals", "dashed: +-3",
+                           "<svg width=\"10\" height=\"5\"></svg>"}};
   const std::string page = parts.Page();
-  EXPECT_TRUE(Contains(page, "<img src=\"series.png\" alt=\"Input time series\">"));
-  EXPECT_TRUE(Contains(page, "<img src=\"residuals.png\""));
-  EXPECT_TRUE(Contains(page, "shaded &lt; still"));
+  EXPECT_TRUE(Contains(page, "<figure id=\"figure-series\">\n<svg width=\"10\" height=\"5\">"
+                             "<g id='series-gpPt0'/></svg>\n<figcaption><b>Input time series."
+                             "</b> shaded &lt; still</figcaption></figure>"));
+  EXPECT_TRUE(Contains(page, "<figure id=\"figure-residuals\">"));
   EXPECT_FALSE(Contains(page, "No figures"));
+  // Nothing the browser would fetch: no image, script, stylesheet or frame by reference.
+  for (const char* fetched : {"<img", "<script", "<link", "<iframe", "src=", "url(", "@import"}) {
+    EXPECT_FALSE(Contains(page, fetched)) << fetched;
+  }
+}
+
+TEST(HtmlReport, NamesTheFilesBesideThePageWithoutLinkingThem) {
+  PageParts parts;
+  parts.extras.files = {"result.json", "figures.gp"};
+  const std::string page = parts.Page();
+  EXPECT_TRUE(Contains(page, "<li><code>result.json</code></li>"));
+  EXPECT_FALSE(Contains(page, "href=\"result.json\""));
+}
+
+TEST(HtmlReport, ShowsTheCommandToRunNext) {
+  PageParts parts;
+  diagnostics::Diagnosis d;
+  d.fit = parts.result;
+  diagnostics::Candidate best;
+  best.effect = "gyro_g_sensitivity";
+  best.significant = true;
+  d.candidates = {best};
+  parts.extras.next_command = "plumb calibrate s.csv --model 'base+gyro_g_sensitivity'";
+  const std::string page = parts.Page(&d);
+  const std::string block = "<pre class=\"next\">plumb calibrate s.csv --model "
+                            "&#39;base+gyro_g_sensitivity&#39;</pre>";
+  // In the summary and under the ranking of the missing effects.
+  const std::size_t first = page.find(block);
+  ASSERT_NE(first, std::string::npos) << page;
+  EXPECT_LT(first, page.find("id=\"input\""));
+  EXPECT_NE(page.find(block, page.find("id=\"diagnosis\"")), std::string::npos);
+  EXPECT_FALSE(Contains(PageParts().Page(&d), "class=\"next\""));  // none given, none shown
+}
+
+TEST(HtmlReport, ShowsWhatEachExportWritesAndLeaves) {
+  PageParts parts;
+  exporter::ExportOutput ardupilot;
+  ardupilot.format = "ardupilot";
+  ardupilot.text = "# a note in the file\nINS_ACCSCAL_X,0.99\n";
+  exporter::ParameterSet set;
+  set.parameters = {{"INS_ACCSCAL_X", 0.99, false}};
+  ardupilot.parameters = set;
+  exporter::ExportReport report;
+  report.has_gyro = true;
+  report.accel_still.segments = 6;
+  report.accel_still.rms = Vec3(0.0980665, 0, 0);  // 10 mg
+  report.accel_still.max_abs = Vec3(0.196133, 0, 0);  // 20 mg
+  report.gyro_still.rms = Vec3(0, 1e-5, 0);  // 2.06 deg/h
+  report.accel_per_input(0, 1) = 0.01;  // 10000 ppm
+  report.dropped = {{"gyro_g_sensitivity", {"gyro_g_sensitivity.G.xx"}, {1e-4}, {"rad/s/(m/s^2)"}, true}};
+  report.notes = {"a note in the file", "a note for the page only"};
+  ardupilot.report = report;
+  parts.extras.exports = {{"ardupilot", ardupilot, ""},
+                          {"px4", std::nullopt, "the session does not determine accel.bias.x"}};
+  parts.extras.export_commands = {{"ardupilot", "plumb calibrate s.csv --export ardupilot=c.param"}};
+  const std::string page = parts.Page();
+  EXPECT_TRUE(Contains(page, "<h2 id=\"firmware\">Firmware</h2>"));
+  EXPECT_TRUE(Contains(page, "over the 6 still segments"));
+  EXPECT_TRUE(Contains(page, "<td>ardupilot</td><td>accelerometer</td><td class=\"num\">10</td>"
+                             "<td class=\"num\">0</td><td class=\"num\">0</td><td class=\"num\">20"
+                             "</td><td class=\"num\">0</td><td class=\"num\">0</td><td>mg</td>"
+                             "<td class=\"num\">1e+04</td>"));
+  EXPECT_TRUE(Contains(page, "<td>ardupilot</td><td>gyroscope</td><td class=\"num\">0</td>"
+                             "<td class=\"num\">2.06</td>"));
+  EXPECT_TRUE(Contains(page, "<pre>plumb calibrate s.csv --export ardupilot=c.param</pre>"));
+  EXPECT_TRUE(Contains(page, "gyro_g_sensitivity: gyro_g_sensitivity.G.xx 0.0001 rad/s/(m/s^2)"));
+  EXPECT_TRUE(Contains(page, "<li>a note for the page only</li>"));
+  EXPECT_FALSE(Contains(page, "<li>a note in the file</li>"));  // the file shows it
+  EXPECT_TRUE(Contains(page, "<pre># a note in the file\nINS_ACCSCAL_X,0.99\n</pre>"));
+  EXPECT_TRUE(Contains(page, "Not written: the session does not determine accel.bias.x"));
 }
 
 TEST(HtmlReport, SaysWhyThereAreNoFigures) {

@@ -1,4 +1,4 @@
-// What plumb allan prints and writes, the page's noise section and noise.png: names and units
+// What plumb allan prints and writes, the page's noise section and noise figure: names and units
 // of the IEEE terms per sensor, bounds marked, the JSON keys, the figure's data blocks.
 #include "plumb/report/noise_text.h"
 
@@ -122,8 +122,8 @@ TEST(NoiseText, FigureHasOneDataBlockPerAxisAndAPanelPerSensor) {
   FigurePlan plan;
   AddStillNoiseFigure(n.noise, FigureOptions{}, plan);
   ASSERT_EQ(plan.figures.size(), 1u);
-  EXPECT_EQ(plan.figures[0].file, "noise.png");
-  EXPECT_EQ(plan.job.outputs, std::vector<std::string>{"noise.png"});
+  EXPECT_EQ(plan.figures[0].file, "noise.svg");
+  EXPECT_EQ(plan.job.outputs, std::vector<std::string>{"noise.svg"});
   ASSERT_EQ(plan.job.data.size(), 1u);
   EXPECT_EQ(plan.job.data[0].name, "noise.csv");
   const std::string& csv = plan.job.data[0].content;

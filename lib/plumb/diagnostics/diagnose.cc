@@ -257,6 +257,13 @@ std::string SpecWith(const model::Model& model, const std::string& effect,
   return model.spec() + "+" + effect + (option.empty() ? "" : ":" + option);
 }
 
+std::optional<std::string> NextModelSpec(const Diagnosis& d) {
+  for (const Candidate& c : d.candidates) {
+    if (c.significant) return SpecWith(d.fit.calibration.model, c.effect, c.option);
+  }
+  return std::nullopt;
+}
+
 Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& segments,
                    const model::Model& model, const geo::Site& site,
                    const DiagnoseOptions& options) {

@@ -107,4 +107,9 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
 std::string SpecWith(const model::Model& model, const std::string& effect,
                      const std::string& option);
 
+/// The model to fit next: the spec of the diagnosed model plus its best significant candidate
+/// (the first significant one in the ranking), or nullopt when none is significant. What
+/// `plumb diagnose` suggests and `plumb report` shows as the next command.
+std::optional<std::string> NextModelSpec(const Diagnosis& diagnosis);
+
 }  // namespace plumb::diagnostics

@@ -150,6 +150,8 @@ ExportOutput Firmware(const std::string& format, const estimation::Calibration& 
   out.json = ToJson(report);
   out.json["imu"] = options.imu;
   out.json["parameters"] = ParametersJson(set);
+  out.parameters = std::move(set);
+  out.report = std::move(report);
   return out;
 }
 
@@ -199,6 +201,7 @@ ExportOutput Kalibr(const estimation::Calibration& c, const ImuSeries& series,
   if (imu.has_gyro) detail("gyro", imu.gyro);
   for (const std::string& note : imu.notes) out.lines.push_back("  note: " + note);
   out.json = ToJson(imu);
+  out.kalibr = imu;
   return out;
 }
 
@@ -226,6 +229,29 @@ ExportOutput Export(const std::string& format, const estimation::Calibration& c,
     return out;
   }
   throw Error("unknown export format '" + format + "' (ardupilot, px4, kalibr, json)");
+}
+
+std::vector<ExportPreview> PreviewExports(const estimation::Calibration& c,
+                                          const ImuSeries& series,
+                                          const std::vector<estimation::StillSegmentFit>& still,
+                                          const ExportOptions& options,
+                                          const std::string& firmware_refused) {
+  std::vector<ExportPreview> out;
+  for (const char* format : {"ardupilot", "px4", "kalibr"}) {
+    ExportPreview preview;
+    preview.format = format;
+    if (preview.format != "kalibr" && !firmware_refused.empty()) {
+      preview.refused = firmware_refused;
+    } else {
+      try {
+        preview.output = Export(format, c, series, still, options);
+      } catch (const Error& e) {
+        preview.refused = e.what();
+      }
+    }
+    out.push_back(std::move(preview));
+  }
+  return out;
 }
 
 json ToJson(const ExportReport& rep) {

@@ -53,6 +53,11 @@ struct ExportOutput {
   std::string text;                ///< the file's content
   std::vector<std::string> lines;  ///< the report for the terminal
   nlohmann::json json;             ///< parameters and report, for "export" in calibrate's JSON
+  /// ardupilot, px4: the parameters written (with the notes at the top of the file) and what
+  /// the firmware's correction, read back from them, leaves against plumb's (Evaluate).
+  std::optional<ParameterSet> parameters;
+  std::optional<ExportReport> report;
+  std::optional<KalibrImu> kalibr;  ///< kalibr: the values written and the numbers behind them
 };
 
 /// Builds one format for the calibration `calibration` of the session `series`, whose still
@@ -65,6 +70,24 @@ ExportOutput Export(const std::string& format, const estimation::Calibration& ca
                     const ImuSeries& series,
                     const std::vector<estimation::StillSegmentFit>& still,
                     const ExportOptions& options);
+
+/// What one format would write for a page (plumb report): its output, or why there is none.
+struct ExportPreview {
+  std::string format;                 ///< "ardupilot", "px4" or "kalibr"
+  std::optional<ExportOutput> output;  ///< Export()'s, when it writes the format
+  std::string refused;                ///< otherwise why not: the message Export() threw
+};
+
+/// Export() of ardupilot, px4 and kalibr in that order, for a page: a format Export() refuses
+/// (undetermined parameters, outputs not in SI, ...) carries the refusal instead of throwing.
+/// `firmware_refused`, when not empty, is a reason known beforehand not to write the firmware
+/// formats (the samples keep corrections plumb could not undo: Session::firmware_left); they
+/// carry it without being built.
+std::vector<ExportPreview> PreviewExports(const estimation::Calibration& calibration,
+                                          const ImuSeries& series,
+                                          const std::vector<estimation::StillSegmentFit>& still,
+                                          const ExportOptions& options,
+                                          const std::string& firmware_refused = "");
 
 /// JSON of a report: errors in SI and in mg / deg/h, per-input matrices, dropped effects.
 nlohmann::json ToJson(const ExportReport& report);

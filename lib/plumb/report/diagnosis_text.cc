@@ -95,7 +95,7 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
     out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
   } else {
     out << "best: " << best->effect << (best->option.empty() ? "" : ":" + best->option)
-        << " -> refit with --model " << diagnostics::SpecWith(d.fit.calibration.model, best->effect, best->option) << "\n";
+        << " -> refit with --model " << diagnostics::NextModelSpec(d).value_or("") << "\n";
   }
   return out.str();
 }

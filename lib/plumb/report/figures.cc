@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "plumb/core/error.h"
+#include "plumb/report/inline_svg.h"
 
 namespace plumb::report {
 namespace {
@@ -15,7 +16,7 @@ using diagnostics::ResidualKind;
 /// Line colours of the x, y and z axes in every figure.
 constexpr const char* kAxisColour[3] = {"#d62728", "#2ca02c", "#1f77b4"};
 constexpr const char* kAxisName[3] = {"x", "y", "z"};
-/// Fill of the still segments in series.png.
+/// Fill of the still segments in series.svg.
 constexpr const char* kStillShade = "#dce6f2";
 /// Whitened residuals beyond this many sigma are unlikely under a complete model.
 constexpr double kWhitenedBand = 3.0;
@@ -59,14 +60,14 @@ std::string BandClauses() {
 }
 
 std::string Begin(const FigureOptions& o, const std::string& file, int panels) {
-  return "\n# " + file + "\n" + PngTerminal(o.width_px, o.panel_height_px * panels) +
+  return "\n# " + file + "\n" + SvgTerminal(o.width_px, o.panel_height_px * panels) +
          "set output " + GnuplotQuote(file) + "\nset multiplot layout " +
          std::to_string(panels) + ",1\n";
 }
 
 std::string End() { return "unset multiplot\nset output\n"; }
 
-/// series.png and its data file.
+/// series.svg and its data file.
 void SeriesFigure(const ImuSeries& series, const std::vector<StillSegment>& segments,
                   const FigureOptions& o, FigurePlan& plan) {
   const double t0 = series.t_s.front();
@@ -85,7 +86,7 @@ void SeriesFigure(const ImuSeries& series, const std::vector<StillSegment>& segm
 
   const int panels = 1 + (series.has_gyro() ? 1 : 0) + (series.has_temperature() ? 1 : 0);
   std::ostringstream gp;
-  gp << Begin(o, "series.png", panels);
+  gp << Begin(o, "series.svg", panels);
   int tag = 1;
   for (const auto& s : segments) {
     if (s.end <= s.begin || s.end > series.size()) continue;
@@ -106,15 +107,15 @@ void SeriesFigure(const ImuSeries& series, const std::vector<StillSegment>& segm
   }
   gp << End() << "unset object\n";
   plan.job.script += gp.str();
-  plan.job.outputs.push_back("series.png");
+  plan.job.outputs.push_back("series.svg");
   plan.figures.push_back(
-      {"series.png", "Input time series",
+      {"series.svg", "Input time series",
        "The samples against time since the first one (" + Fixed(t0, "%.6g") + " s in the log), " +
            (stride > 1 ? "one sample in " + std::to_string(stride) + " drawn; " : std::string()) +
            "shaded: the " + std::to_string(segments.size()) +
            " still segments the fit used. Accelerometer in " + series.acc_unit +
            (series.has_gyro() ? ", gyroscope in " + series.gyr_unit : std::string()) +
-           (series.has_temperature() ? ", temperature in degC." : std::string("."))});
+           (series.has_temperature() ? ", temperature in degC." : std::string(".")), ""});
 }
 
 /// still.csv and motion.csv: per-segment and per-interval residuals.
@@ -145,7 +146,7 @@ void ResidualData(const ImuSeries& series, const diagnostics::ResidualAnalysis& 
   plan.job.data.push_back({"motion.csv", motion.str()});
 }
 
-/// residuals.png.
+/// residuals.svg.
 void ResidualFigure(const diagnostics::ResidualAnalysis& a, const FigureOptions& o,
                     FigurePlan& plan) {
   const bool acc = std::any_of(a.still.begin(), a.still.end(), [](const auto& c) { return c.has_acc; });
@@ -156,7 +157,7 @@ void ResidualFigure(const diagnostics::ResidualAnalysis& a, const FigureOptions&
   std::ostringstream gp;
   // The y range reaches at least the +-band lines so that both are always drawn.
   const std::string reach = Fixed(kWhitenedBand + 0.5, "%g");
-  gp << Begin(o, "residuals.png", panels) << "set xlabel 'time since the first sample (s)'\n"
+  gp << Begin(o, "residuals.svg", panels) << "set xlabel 'time since the first sample (s)'\n"
      << "set yrange [*<-" << reach << ":" << reach << "<*]\n";
   const std::string style = "linespoints pt 7 ps 0.6";
   if (acc) {
@@ -173,17 +174,17 @@ void ResidualFigure(const diagnostics::ResidualAnalysis& a, const FigureOptions&
   }
   gp << End() << "set autoscale y\n";
   plan.job.script += gp.str();
-  plan.job.outputs.push_back("residuals.png");
+  plan.job.outputs.push_back("residuals.svg");
   plan.figures.push_back(
-      {"residuals.png", "Whitened residuals against time",
+      {"residuals.svg", "Whitened residuals against time",
        "Measured minus predicted, divided by its standard deviation (dimensionless; about "
        "N(0, 1) per axis when the model is complete; dashed: +-3): the still accelerometer and "
        "gyroscope per segment at its mean time" +
            std::string(motion ? ", the rotation over each motion interval at its middle" : "") +
-           ". A trend or a jump shows what the model misses and when."});
+           ". A trend or a jump shows what the model misses and when.", ""});
 }
 
-/// temperature.png, when the segments have temperatures.
+/// temperature.svg, when the segments have temperatures.
 void TemperatureFigure(const ImuSeries& series, const diagnostics::ResidualAnalysis& a,
                        const FigureOptions& o, FigurePlan& plan) {
   const bool has = series.has_temperature() &&
@@ -195,7 +196,7 @@ void TemperatureFigure(const ImuSeries& series, const diagnostics::ResidualAnaly
   const int panels = (acc ? 1 : 0) + (gyr ? 1 : 0);
   if (panels == 0) return;
   std::ostringstream gp;
-  gp << Begin(o, "temperature.png", panels) << "set xlabel 'segment mean temperature (degC)'\n";
+  gp << Begin(o, "temperature.svg", panels) << "set xlabel 'segment mean temperature (degC)'\n";
   if (acc) {
     gp << "set ylabel " << GnuplotQuote("accelerometer residual (" + series.acc_unit + ")")
        << "\nplot " << AxisClauses("still.csv", 2, 9, "points pt 7 ps 0.8") << "\n";
@@ -206,16 +207,16 @@ void TemperatureFigure(const ImuSeries& series, const diagnostics::ResidualAnaly
   }
   gp << End();
   plan.job.script += gp.str();
-  plan.job.outputs.push_back("temperature.png");
+  plan.job.outputs.push_back("temperature.svg");
   plan.figures.push_back(
-      {"temperature.png", "Residuals against temperature",
+      {"temperature.svg", "Residuals against temperature",
        "Still residual per segment (measured minus predicted mean; accelerometer in " +
            series.acc_unit + ", gyroscope in " + series.gyr_unit +
            ") against the segment's mean temperature. A slope is a temperature effect the "
-           "model lacks (accel_temperature_bias, gyro_temperature_bias)."});
+           "model lacks (accel_temperature_bias, gyro_temperature_bias).", ""});
 }
 
-/// allan.png and allan.csv (gnuplot data blocks, one per entry of a.allan).
+/// allan.svg and allan.csv (gnuplot data blocks, one per entry of a.allan).
 void AllanFigure(const ImuSeries& series, const estimation::CalibrationResult& fit,
                  const diagnostics::ResidualAnalysis& a, const FigureOptions& o,
                  FigurePlan& plan) {
@@ -259,18 +260,18 @@ void AllanFigure(const ImuSeries& series, const estimation::CalibrationResult& f
   for (std::size_t k : a.allan_segments) {
     if (k < fit.fit.still.size()) labels += (labels.empty() ? "'" : ", '") + fit.fit.still[k].segment.label + "'";
   }
-  plan.job.script += Begin(o, "allan.png", panels) +
+  plan.job.script += Begin(o, "allan.svg", panels) +
                      "set logscale xy\nset format y '%g'\nset xlabel 'cluster time tau (s)'\n" +
                      gp.str() + End() + "unset logscale\nset format y\n";
-  plan.job.outputs.push_back("allan.png");
+  plan.job.outputs.push_back("allan.svg");
   plan.figures.push_back(
-      {"allan.png", "Allan deviation of the still residual",
+      {"allan.svg", "Allan deviation of the still residual",
        "Allan deviation of the per-sample still residual (measured minus predicted) of the "
        "still segment" + std::string(a.allan_segments.size() == 1 ? " " : "s ") + labels +
            ", per axis (solid), beside the white-noise line sigma_white / sqrt(m) (dashed). "
            "Where the curve rises above its line, something slow (drift, random walk, "
            "temperature) is left in the residual. Ratio at the largest cluster: " +
-           ratios + "."});
+           ratios + ".", ""});
 }
 
 /// One gnuplot data block per axis of `noise`, in its order: tau, adev, lower, upper, model
@@ -321,20 +322,20 @@ void AddStillNoiseFigure(const signal::StillNoise& noise, const FigureOptions& o
                        (accel ? noise.acc_unit : noise.gyr_unit) + ")")
        << "\nplot " << clauses << "\n";
   }
-  plan.job.script += Begin(o, "noise.png", panels) +
+  plan.job.script += Begin(o, "noise.svg", panels) +
                      "set logscale xy\nset format y '%g'\nset xlabel 'cluster time tau (s)'\n" +
                      gp.str() + End() + "unset logscale\nset format y\n";
-  plan.job.outputs.push_back("noise.png");
+  plan.job.outputs.push_back("noise.svg");
   const double confidence = noise.axes.front().adev.confidence;
   plan.figures.push_back(
-      {"noise.png", "Allan deviation of the still data and the IEEE noise model",
+      {"noise.svg", "Allan deviation of the still data and the IEEE noise model",
        "Overlapping Allan deviation of the raw samples over " + Fixed(noise.still_s, "%.4g") +
            " s of still data in " + std::to_string(noise.segments.size()) +
            " segment(s), per axis (points, with " + Fixed(100.0 * confidence, "%.3g") +
            " % chi-square intervals for the noise type the fit finds at each tau), and the "
            "fitted model 3Q^2/tau^2 + N^2/tau + 0.44 B^2 + K^2 tau/3 (line, over the fitted "
            "taus). Slopes -1, -1/2, 0, +1/2: quantisation, white noise, bias instability, "
-           "random walk. The terms are in the 'Sensor noise' table."});
+           "random walk. The terms are in the 'Sensor noise' table.", ""});
 }
 
 FigurePlan PlanFigures(const ImuSeries& series, const std::vector<StillSegment>& segments,
@@ -355,6 +356,23 @@ FigurePlan PlanFigures(const ImuSeries& series, const std::vector<StillSegment>&
   TemperatureFigure(series, analysis, o, plan);
   AllanFigure(series, fit, analysis, o, plan);
   return plan;
+}
+
+std::vector<ReportFigure> EmbedDrawnFigures(const std::string& folder, const FigurePlan& plan,
+                                            const GnuplotOutcome& outcome) {
+  std::vector<ReportFigure> drawn;
+  std::vector<std::string> files;
+  for (const ReportFigure& figure : plan.figures) {
+    if (std::find(outcome.written.begin(), outcome.written.end(), figure.file) ==
+        outcome.written.end()) {
+      continue;
+    }
+    drawn.push_back(figure);
+    files.push_back(figure.file);
+  }
+  const std::vector<InlineFigure> inline_svgs = TakeSvgFiles(folder, files);
+  for (std::size_t i = 0; i < drawn.size(); ++i) drawn[i].svg = inline_svgs[i].svg;
+  return drawn;
 }
 
 }  // namespace plumb::report

@@ -64,13 +64,9 @@ int Spawn(const std::string& folder, const std::string& program, const std::stri
 
 }  // namespace
 
-std::string PngTerminal(int width_px, int height_px) {
-  const std::string size = " size " + std::to_string(width_px) + "," + std::to_string(height_px);
-  return "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
-         "  set terminal pngcairo noenhanced font 'sans,10'" + size + "\n"
-         "} else {\n"
-         "  set terminal png noenhanced" + size + "\n"
-         "}\n";
+std::string SvgTerminal(int width_px, int height_px) {
+  return "set terminal svg size " + std::to_string(width_px) + "," + std::to_string(height_px) +
+         " noenhanced font 'sans,10' background rgb 'white'\n";
 }
 
 std::string GnuplotQuote(const std::string& text) {

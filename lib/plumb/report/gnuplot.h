@@ -6,7 +6,8 @@
 // is set with posix_spawn_file_actions_addchdir_np, glibc 2.29 or later), its working folder
 // is the output folder, its stdin is /dev/null and its stdout and stderr go to LOG in that
 // folder (the library never prints). Data and script files are written atomically
-// (plumb/io/common/atomic_file.h); the PNGs are gnuplot's own.
+// (plumb/io/common/atomic_file.h); the images are gnuplot's own. plumb's pages draw with the
+// svg terminal (SvgTerminal) and put the SVGs inside the page (inline_svg.h).
 //
 // A missing gnuplot is not an error: the outcome says so (`ran` false, `message` naming the
 // program and how to install it), the data and the script stay in the folder so that the
@@ -16,9 +17,9 @@
 // Example:
 //   GnuplotJob job;
 //   job.data.push_back({"line.csv", "0,0\n1,1\n"});
-//   job.script = PngTerminal(640, 480) + "set output 'line.png'\n"
+//   job.script = SvgTerminal(640, 480) + "set output 'line.svg'\n"
 //                "set datafile separator ','\nplot 'line.csv' using 1:2 with lines\n";
-//   job.outputs = {"line.png"};
+//   job.outputs = {"line.svg"};
 //   GnuplotOutcome out = RunGnuplot("out", job);
 //   if (!out.ran) warn(out.message);
 #pragma once
@@ -52,9 +53,10 @@ struct GnuplotOutcome {
   std::vector<std::string> written;  ///< outputs that exist and are non-empty afterwards
 };
 
-/// gnuplot commands that select a PNG terminal of `width_px` x `height_px` pixels (> 0):
-/// pngcairo when this gnuplot has it (antialiased), else the libgd png terminal.
-std::string PngTerminal(int width_px, int height_px);
+/// gnuplot commands that select the svg terminal (every gnuplot has it, gnuplot-nox too) for a
+/// drawing of `width_px` x `height_px` (> 0; the SVG's viewBox, it scales), no enhanced-text
+/// markup, the generic 'sans' font (no font file is named or fetched), a white background.
+std::string SvgTerminal(int width_px, int height_px);
 
 /// A string as a gnuplot single-quoted literal: 'text', with ' doubled.
 std::string GnuplotQuote(const std::string& text);

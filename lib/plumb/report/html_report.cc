@@ -9,6 +9,7 @@
 
 #include "plumb/estimation/uncertainty.h"
 #include "plumb/report/calibration_text.h"
+#include "plumb/report/export_section.h"
 #include "plumb/report/noise_text.h"
 #include "plumb/report/summary.h"
 #include "plumb/report/version.h"
@@ -38,7 +39,7 @@ pre { background: #f6f8fa; padding: 0.8em; overflow-x: auto; white-space: pre-wr
 .warn { color: #8a4b00; }
 .muted { color: #666; }
 figure { margin: 1em 0; }
-figure img { max-width: 100%; border: 1px solid #ddd; }
+figure svg { display: block; max-width: 100%; height: auto; border: 1px solid #ddd; }
 figcaption { font-size: 0.92em; color: #444; }
 )css";
 
@@ -84,8 +85,15 @@ std::string SiteSourceWords(const std::string& source) {
   return source;
 }
 
+/// The command to run next, as a paragraph and a block to copy ("" without one).
+std::string NextCommandHtml(const std::string& command) {
+  if (command.empty()) return "";
+  return "<p>Next: refit with the effect added:</p>\n<pre class=\"next\">" + HtmlEscape(command) +
+         "</pre>\n";
+}
+
 std::string SummarySection(const estimation::CalibrationResult& r,
-                           const diagnostics::Diagnosis* d) {
+                           const diagnostics::Diagnosis* d, const std::string& next_command) {
   const auto band = Chi2DofBand(r.fit.dof);
   const double ratio = r.fit.chi2_dof();
   const bool good = r.fit.dof > 0 && ratio >= band.first && ratio <= band.second &&
@@ -124,7 +132,7 @@ std::string SummarySection(const estimation::CalibrationResult& r,
                      (best->refit_drop ? ", refit " + G3(*best->refit_drop) : std::string()) +
                      "): see <a href=\"#diagnosis\">missing effects</a>.</li>\n";
   }
-  return out + "</ul>\n";
+  return out + "</ul>\n" + NextCommandHtml(next_command);
 }
 
 std::string SiteHtml(const geo::Site& site) {
@@ -285,14 +293,17 @@ std::string NoiseSection(const PageExtras& extras) {
   return out;
 }
 
+/// "series" of "series.svg".
+std::string FigureStem(const std::string& file) { return file.substr(0, file.rfind('.')); }
+
 std::string FigureSection(const PageExtras& extras) {
   std::string out = "<h2 id=\"figures\">Figures</h2>\n";
   for (const auto& note : extras.figure_notes) {
     out += "<p class=\"warn\">No figures: " + HtmlEscape(note) + "</p>\n";
   }
   for (const auto& fig : extras.figures) {
-    out += "<figure><img src=\"" + HtmlEscape(fig.file) + "\" alt=\"" + HtmlEscape(fig.title) +
-           "\"><figcaption><b>" + HtmlEscape(fig.title) + ".</b> " + HtmlEscape(fig.caption) +
+    out += "<figure id=\"figure-" + HtmlEscape(FigureStem(fig.file)) + "\">\n" + fig.svg +
+           "\n<figcaption><b>" + HtmlEscape(fig.title) + ".</b> " + HtmlEscape(fig.caption) +
            "</figcaption></figure>\n";
   }
   return out;
@@ -452,7 +463,7 @@ std::string CandidateRow(const diagnostics::Candidate& c) {
          Td(HtmlEscape(CandidateNotes(c))) + "</tr>\n";
 }
 
-std::string DiagnosisSection(const diagnostics::Diagnosis* d) {
+std::string DiagnosisSection(const diagnostics::Diagnosis* d, const std::string& next_command) {
   std::string out = "<h2 id=\"diagnosis\">Missing effects</h2>\n";
   if (d == nullptr) return out + "<p class=\"muted\">Not run (--no-diagnose).</p>\n";
   out += "<p>The score test of every catalogue effect not in the model, at the fit: LM is the "
@@ -476,7 +487,7 @@ std::string DiagnosisSection(const diagnostics::Diagnosis* d) {
   std::vector<std::string> skipped;
   for (const auto& s : d->skipped) skipped.push_back(s.effect + ": " + s.reason);
   if (!skipped.empty()) out += "<p>Not tested:</p>\n" + List(skipped, "muted");
-  return out;
+  return out + NextCommandHtml(next_command);
 }
 
 std::string WorstSection(const diagnostics::ResidualAnalysis& a) {
@@ -515,10 +526,9 @@ std::string TailSection(const estimation::CalibrationResult& r, const PageExtras
     out += "<h2 id=\"warnings\">Warnings</h2>\n" + List(r.fit.warnings, "warn");
   }
   if (!extras.files.empty()) {
-    out += "<h2 id=\"files\">Files</h2>\n<ul>\n";
-    for (const auto& f : extras.files) {
-      out += "<li><a href=\"" + HtmlEscape(f) + "\">" + HtmlEscape(f) + "</a></li>\n";
-    }
+    out += "<h2 id=\"files\">Files</h2>\n<p>Written beside this page in its folder, for other "
+           "programs (the page needs none of them):</p>\n<ul>\n";
+    for (const auto& f : extras.files) out += "<li>" + Code(f) + "</li>\n";
     out += "</ul>\n";
   }
   out += "<h2 id=\"reproduce\">Reproduce</h2>\n<pre>" + HtmlEscape(extras.command) + "</pre>\n";
@@ -567,7 +577,7 @@ std::string HtmlReport(const InputSummary& input,
                      "<title>" + HtmlEscape(extras.title) + "</title>\n<style>" + kStyle +
                      "</style>\n</head>\n<body>\n<h1>" + HtmlEscape(extras.title) + "</h1>\n" +
                      "<p class=\"muted\">" + HtmlEscape(input.source) + "</p>\n";
-  page += SummarySection(result, diagnosis);
+  page += SummarySection(result, diagnosis, extras.next_command);
   page += InputSection(input, segmentation, result, extras);
   page += ModelSection(result);
   page += FitSection(result);
@@ -575,8 +585,9 @@ std::string HtmlReport(const InputSummary& input,
   page += FigureSection(extras);
   page += ParameterSection(result);
   page += MatrixSection(result);
+  page += ExportSection(extras.exports, extras.export_commands, extras.exports_note);
   page += ObservabilitySection(result);
-  page += DiagnosisSection(diagnosis);
+  page += DiagnosisSection(diagnosis, extras.next_command);
   page += WorstSection(analysis);
   page += TailSection(result, extras);
   return page + "</body>\n</html>\n";

@@ -1,16 +1,20 @@
 // plumb/report/html_report.h — the page of `plumb report`: one self-contained HTML file (inline
-// CSS, no script, images referenced by relative names) that says what was calibrated and how
-// well, for a browser and for sharing.
+// CSS and SVG figures, no script, nothing fetched) that says what was calibrated and how well,
+// for a browser and for sharing.
 //
 // Sections, in order: summary (the verdict on chi^2/dof, unobservable directions, the best
-// candidate), input (source, samples, rate, duration, site and where it came from, still
+// candidate and the command to run next), input (source, samples, rate, duration, site and where it came from, still
 // segments, reader warnings), model (spec, terms), fit quality (chi^2, dof, chi^2/dof with
 // the 99 % band of a complete model, per-axis RMS, noise), sensor noise (the IEEE terms of the
 // still data per axis, noise_text.h, when PageExtras has them), figures, parameters (value +- sigma
-// with units, or "unobservable"/"fixed"), forward model and correction matrices,
-// observability (unobservable directions in words, determined combinations), missing effects
-// (diagnose's ranking), worst residual ranges and residual signatures, warnings, files, and
-// the command that reproduces the page.
+// with units, or "unobservable"/"fixed"), forward model and correction matrices, firmware (what
+// each export would write and the error it leaves, export_section.h), observability
+// (unobservable directions in words, determined combinations), missing effects (diagnose's
+// ranking and the command to run next), worst residual ranges and residual signatures,
+// warnings, the files beside the page, and the command that reproduces the page.
+//
+// The page stands alone: the CSS is inline, the figures are inline SVG (figures.h), and it
+// has no script, no link to another file and no reference that a browser would fetch.
 //
 // The 99 % band: under a complete model chi^2 ~ chi^2(dof), so chi^2/dof lies in
 // [Q(0.005), Q(0.995)] / dof with probability 0.99 (Q the chi^2(dof) quantile,
@@ -21,6 +25,7 @@
 #pragma once
 
 #include <cstddef>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -29,6 +34,7 @@
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/diagnostics/residual_analysis.h"
 #include "plumb/estimation/result.h"
+#include "plumb/export/export.h"
 #include "plumb/report/figures.h"
 #include "plumb/segmentation/still_detector.h"
 #include "plumb/signal/noise_terms.h"
@@ -60,6 +66,14 @@ struct PageExtras {
   /// The still data's noise (plumb allan's analysis of the fit's still segments), if measured.
   std::optional<signal::StillNoise> still_noise;
   std::string still_noise_note;  ///< why it is missing, when it is
+  /// The firmware section (export_section.h): what each export would write and the error it
+  /// leaves (exporter::PreviewExports); empty: not computed, `exports_note` says why.
+  std::vector<exporter::ExportPreview> exports;
+  std::map<std::string, std::string> export_commands;  ///< format -> the command writing it
+  std::string exports_note;  ///< a line above the firmware table, or why there is none
+  /// The command to run next when the diagnosis finds a significant effect (the refit with
+  /// diagnostics::NextModelSpec); "" for none.
+  std::string next_command;
 };
 
 /// Escapes & < > " ' for HTML text and attribute values; invalid UTF-8 passes unchanged.

@@ -66,7 +66,7 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
   GnuplotJob job;
   job.script_name = "study.gp";
   job.log_name = "study.log";
-  job.script = PngTerminal(800, 480) + "set datafile separator ','\nset grid\nset key outside right\n";
+  job.script = SvgTerminal(800, 480) + "set datafile separator ','\nset grid\nset key outside right\n";
   for (std::size_t f = 0; f < study.factors.size(); ++f) {
     const auto along = Along(points, f);
     if (along.size() < 2) continue;
@@ -81,13 +81,13 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
               Num(p->nees_high) + "\n";
     }
     if (any_nees) job.data.push_back({"nees_" + safe + ".csv", nees});
-    if (any_nees) job.script += "set output 'nees_" + safe + ".png'\nset logscale y\nset xlabel " +
+    if (any_nees) job.script += "set output 'nees_" + safe + ".svg'\nset logscale y\nset xlabel " +
                   GnuplotQuote(name) + "\nset ylabel 'NEES / dof'\nset title " +
                   GnuplotQuote("NEES per degree of freedom against " + name + " (95 % band)") +
                   "\nplot 'nees_" + safe + ".csv' every ::1 using 1:3 with lines dt 2 lc rgb '#2e7d32' title 'band', " +
                   "'' every ::1 using 1:4 with lines dt 2 lc rgb '#2e7d32' notitle, " +
                   "'' every ::1 using 1:2 with linespoints pt 7 lc rgb '#1565c0' title 'NEES / dof'\n";
-    if (any_nees) job.outputs.push_back("nees_" + safe + ".png");
+    if (any_nees) job.outputs.push_back("nees_" + safe + ".svg");
     // RMS error and mean sigma of the headline rows.
     const std::size_t rows = std::min(kHeadline, along.front()->parameters.size());
     if (rows == 0) continue;
@@ -104,7 +104,7 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
       err += "\n";
     }
     job.data.push_back({"error_" + safe + ".csv", err});
-    job.script += "set output 'error_" + safe + ".png'\nset ylabel 'RMS error (points), mean sigma (dashed)'\nset title " +
+    job.script += "set output 'error_" + safe + ".svg'\nset ylabel 'RMS error (points), mean sigma (dashed)'\nset title " +
                   GnuplotQuote("error and sigma against " + name) + "\nplot ";
     auto defined = [&](std::size_t i, bool sigma) {
       return std::any_of(along.begin(), along.end(), [&](const auto* p) {
@@ -134,13 +134,13 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
     }
     job.script += plots;
     job.script += "\nunset logscale y\n";
-    job.outputs.push_back("error_" + safe + ".png");
+    job.outputs.push_back("error_" + safe + ".svg");
   }
   return job;
 }
 
 std::string StudyPage(const study::Study& study, const std::vector<study::PointSummary>& points,
-                      const std::vector<std::string>& figures, const std::string& figure_note) {
+                      const std::vector<InlineFigure>& figures, const std::string& figure_note) {
   std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"generator\" content=\"plumb sweep\"><title>plumb sweep: " +
                      HtmlEscape(study.name) + "</title><style>" + PageStyle() +
                      "</style></head><body>\n<h1>plumb sweep: " + HtmlEscape(study.name) + "</h1>\n";
@@ -167,9 +167,7 @@ std::string StudyPage(const study::Study& study, const std::vector<study::PointS
   }
   html += "</table>\n<h2>Figures</h2>\n";
   if (!figure_note.empty()) html += "<p class=\"warn\">No figures: " + HtmlEscape(figure_note) + "</p>\n";
-  for (const std::string& fig : figures) {
-    html += "<figure><img src=\"" + HtmlEscape(fig) + "\" alt=\"" + HtmlEscape(fig) + "\"></figure>\n";
-  }
+  for (const InlineFigure& fig : figures) html += "<figure>\n" + fig.svg + "\n</figure>\n";
   return html + "</body></html>\n";
 }
 
