@@ -122,7 +122,7 @@ class CalibrateCommand : public Command {
     std::cout << report::CalibrationSummary(result, session.source);
     std::optional<estimation::CalibrationResult> baseline;
     if (!a.baseline.empty()) {
-      model::Model before = model::Model::Parse(a.baseline);
+      model::Model before = ParseModelOption("--baseline", a.baseline);
       before.t_ref_s = model.t_ref_s;
       before.temp_ref_c = model.temp_ref_c;
       estimation::CalibrationOptions same = options;  // the same residuals in both fits

@@ -1,5 +1,6 @@
 // See fit_options.h.
 #include "fit_options.h"
+#include "commands.h"
 #include "progress.h"
 
 #include <algorithm>
@@ -173,6 +174,14 @@ signal::StillNoise StillNoiseFrom(const std::string& path, const InputArgs& inpu
 
 }  // namespace
 
+model::Model ParseModelOption(const std::string& option, const std::string& spec) {
+  try {
+    return model::Model::Parse(spec);
+  } catch (const Error& e) {
+    throw UsageError(option + ": " + e.what());
+  }
+}
+
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
                     const SiteArgs& site_args, const FitArgs& fit, const InputArgs& input) {
   FitSetup out;
@@ -186,7 +195,7 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
     session.warnings.push_back("gravity fixed at " + std::to_string(*gravity) +
                                " m/s^2 by --gravity instead of WGS84 normal gravity");
   }
-  out.model = model::Model::Parse(fit.model);
+  out.model = ParseModelOption("--model", fit.model);
   out.model.t_ref_s = session.series.t_s.front();
   out.model.temp_ref_c = fit.temp_ref_c;
   if (fit.heading != nullptr && fit.heading->count() > 0) {

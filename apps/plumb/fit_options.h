@@ -51,6 +51,10 @@ inline constexpr int kExitGateFailed = 3;
 /// Registers --model on `app`.
 void AddModelOption(CLI::App* app, FitArgs& args);
 
+/// The model `spec` given to `option` (--model, --baseline); a spec that names no model (an
+/// unknown effect, a repeated one, no base) is a usage error naming the option (exit 2).
+model::Model ParseModelOption(const std::string& option, const std::string& spec);
+
 /// Registers --strict, --heading, --level-north, --temp-ref, --max-iterations, the bias
 /// wander (--accel-rw, --gyro-rw, --estimate-rw, --accel-bi, --gyro-bi, --bi-time,
 /// --noise-from, --constant-bias) on `app`.

@@ -22,6 +22,7 @@
 
 #include "validators.h"
 #include "commands.h"
+#include "progress.h"
 #include "fit_options.h"
 #include "input_options.h"
 #include "plumb/core/error.h"
@@ -274,6 +275,7 @@ class ReportCommand : public Command {
     if (a.no_figures) {
       extras.figure_notes.push_back("not drawn (--no-figures)");
     } else {
+      Progress::Of().Stage("drawing the figures with gnuplot");
       DrawFigures(dir.string(), series, segments, result, ra_options, extras, files);
     }
     extras.files = files;
@@ -326,6 +328,7 @@ class ReportCommand : public Command {
     options.confirm = args_.confirm;
     options.calibration = calibration;
     options.calibration.on_insufficient = estimation::InsufficientData::kReport;
+    options.on_stage = [](const std::string& stage) { Progress::Of().Stage(stage); };
     try {
       diagnostics::Diagnosis d = diagnostics::Diagnose(series, segments, model, site, options);
       std::cout << report::DiagnosisText(d);

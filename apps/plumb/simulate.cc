@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "fit_options.h"
 #include "plumb/io/common/atomic_file.h"
 #include "plumb/io/text/native_csv.h"
 #include "plumb/model/model.h"
@@ -261,7 +262,7 @@ class SimulateCommand : public Command {
     const sim::Schedule schedule = MakeSchedule();
     sim::SimulationOptions options = a.noise;
     options.rate_hz = a.rate_hz;
-    options.model = model::Model::Parse(a.model);
+    options.model = ParseModelOption("--model", a.model);
     options.model.temp_ref_c = a.temp_ref_c;
     options.truth = a.random_truth > 0
                         ? sim::RandomParameters(options.model, a.random_truth, a.seed)

@@ -35,9 +35,9 @@ std::string FormatVec(const Vec3& v, const char* format) {
 }
 
 std::string TimeRange(const ImuSeries& series, Run run) {
-  const double t0 = series.t_s.front();
-  return Format("%.2f", series.t_s[run.begin] - t0) + "-" +
-         Format("%.2f", series.t_s[run.end - 1] - t0) + " s";
+  // Log times, as `plumb info` shows them, so a stretch named here can be found in the log.
+  return Format("%.2f", series.t_s[run.begin]) + "-" + Format("%.2f", series.t_s[run.end - 1]) +
+         " s";
 }
 
 std::string NoiseNote(const NoiseEstimate& noise, const StillDetectorOptions& options) {

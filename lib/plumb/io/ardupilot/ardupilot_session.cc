@@ -82,7 +82,9 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
   s.source = log.source + " " + stream + " (IMU instance " + std::to_string(instance) + ")";
   for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
   if (s.series.size() < 2) {
-    throw InputError(log.source, label, "fewer than 2 samples in the time window");
+    throw InputError(log.source, label,
+                     EmptyWindowMessage(selection.from_s, selection.to_s,
+                                        info ? info->t_start_s : 0.0, info ? info->t_end_s : 0.0));
   }
   const ArdupilotCorrection correction = ArdupilotCorrectionFor(log.params, instance);
   const std::vector<std::string> undone =

@@ -73,4 +73,15 @@ std::optional<SiteInput> MedianSite(std::vector<double> lat_deg, std::vector<dou
   return site;
 }
 
+std::string EmptyWindowMessage(const std::optional<double>& from_s,
+                               const std::optional<double>& to_s, double t_start_s,
+                               double t_end_s) {
+  const auto at = [](const std::optional<double>& t, const char* open) {
+    return t ? Number(*t) + " s" : std::string(open);
+  };
+  return "fewer than 2 samples in the time window " + at(from_s, "start") + " .. " +
+         at(to_s, "end") + "; the stream spans " + Number(t_start_s) + " .. " +
+         Number(t_end_s) + " s (log times, as plumb info shows them)";
+}
+
 }  // namespace plumb::io

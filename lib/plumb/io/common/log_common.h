@@ -34,6 +34,12 @@ class LogFile {
   std::vector<std::uint8_t> buffer_;    ///< the bytes when not mapped
 };
 
+/// The message of a time window (--from/--to, log times) that holds fewer than 2 samples of a
+/// stream spanning [t_start_s, t_end_s]: both in log times, as `plumb info` shows them.
+std::string EmptyWindowMessage(const std::optional<double>& from_s,
+                               const std::optional<double>& to_s, double t_start_s,
+                               double t_end_s);
+
 /// Counts the bytes [from, to) as skipped in a reader's warnings `w` (any struct with
 /// bytes_skipped, skip_runs and first_skip_offset): a new run unless `from` is `skip_end`, the
 /// end of the previous skipped range, which is then moved to `to` (from <= to).

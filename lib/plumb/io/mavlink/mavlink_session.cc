@@ -457,7 +457,8 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
   }
   if (out.size() < 2) {
     throw InputError(log.source, info.name + " instance " + std::to_string(d.instance),
-                     "fewer than 2 samples in the time window");
+                     EmptyWindowMessage(selection.from_s, selection.to_s, info.t_start_s,
+                                        info.t_end_s));
   }
 
   // ArduPilot's correction, undone (ardupilot_correction.h has the equations).

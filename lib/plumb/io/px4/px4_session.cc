@@ -454,7 +454,9 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   if (out.size() < 2) {
     throw InputError(log.source, std::string(KindName(src->kind)) + " instance " +
                                      std::to_string(src->instance),
-                     "fewer than 2 samples in the time window");
+                     EmptyWindowMessage(selection.from_s, selection.to_s,
+                                        whole.t_s.empty() ? 0.0 : whole.t_s.front(),
+                                        whole.t_s.empty() ? 0.0 : whole.t_s.back()));
   }
   const std::string who = Who(*src);
   if (src->kind == StreamKind::kSensorAccel) {
