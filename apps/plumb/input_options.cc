@@ -344,7 +344,8 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
 
 void AddMaxMemoryOption(CLI::App* app, std::uint64_t& max_memory) {
   app->add_option("--max-memory", max_memory,
-                  "Refuse inputs whose estimated memory exceeds SIZE (e.g. 500M, 2G, 2GiB); "
+                  "Refuse inputs whose estimated memory exceeds SIZE (bytes, a whole number with an "
+                  "optional unit: 500M, 2G, 2GiB); "
                   "default: the memory available (MemAvailable)")
       ->transform(CLI::AsSizeValue(true))
       ->type_name("SIZE");
