@@ -14,6 +14,8 @@
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/report/json_report.h"
 #include "plumb/segmentation/still_detector.h"
+#include "input_options.h"
+#include "plumb/io/input/open_inputs.h"
 #include "segment_options.h"
 #include "json_output.h"
 
@@ -23,6 +25,7 @@ namespace {
 struct InfoArgs {
   std::string log_path;   ///< LOG
   std::string json_path;  ///< --json FILE
+  std::uint64_t max_memory = 0;  ///< --max-memory SIZE, bytes; 0 = MemAvailable
 };
 
 /// The still periods of one stream, into `j["still"]`, printed as they are found: the still
@@ -66,6 +69,7 @@ class InfoCommand : public Command {
     app_->add_option("LOG", args_.log_path, "The log file")->required()->type_name("LOG");
     app_->add_option("--json", args_.json_path, "Also write it as JSON to FILE (atomically; - for stdout, the text then on stderr)")
         ->type_name("FILE");
+    AddMaxMemoryOption(app_, args_.max_memory);
   }
 
   FileRoles Files() const override {
@@ -78,6 +82,7 @@ class InfoCommand : public Command {
   int Run() override {
     const InfoArgs& a = args_;
     const TextAsideForJson text_aside(a.json_path);
+    CheckMemory({a.log_path}, a.max_memory);
     const io::FlightLog log = io::FlightLog::Open(a.log_path);
     const io::FlightLogSummary summary = log.Summary();
     nlohmann::json doc;
@@ -87,6 +92,8 @@ class InfoCommand : public Command {
     doc["size_bytes"] = summary.size_bytes;
     std::cout << a.log_path << ": " << summary.format_detail << " (" << summary.format << "), "
               << summary.size_bytes << " bytes\n";
+    std::cout << "memory to read it: about " << FormatBytes(io::EstimateReadMemory(a.log_path))
+              << " (estimate)\n";
 
     doc["imus"] = nlohmann::json::array();
     for (const io::ImuStreamInfo& imu : summary.imus) {

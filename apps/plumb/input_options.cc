@@ -5,9 +5,12 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "commands.h"
+#include "plumb/core/error.h"
 #include "plumb/io/input/open_inputs.h"
 #include "validators.h"
 
@@ -278,6 +281,7 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
                  "Keep the firmware's correction (ArduPilot INS_*, PX4 CAL_*/TC_*) in the "
                  "samples instead of undoing it (the calibration is then of the corrected "
                  "signal)");
+  AddMaxMemoryOption(app, a.max_memory);
   app->add_option("--acc", a.acc_file,
                   "Accelerometer table of the two-file form (imu_tk's `t x y z`), with --gyr")
       ->type_name("FILE");
@@ -338,6 +342,46 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
   };
 }
 
+void AddMaxMemoryOption(CLI::App* app, std::uint64_t& max_memory) {
+  app->add_option("--max-memory", max_memory,
+                  "Refuse inputs whose estimated memory exceeds SIZE (bytes, a whole number with an "
+                  "optional unit: 500M, 2G, 2GiB); "
+                  "default: the memory available (MemAvailable)")
+      ->transform(CLI::AsSizeValue(true))
+      ->type_name("SIZE");
+}
+
+std::string FormatBytes(std::uint64_t bytes) {
+  static const char* const kUnits[] = {"B", "kB", "MB", "GB", "TB"};
+  double v = static_cast<double>(bytes);
+  std::size_t u = 0;
+  while (v >= 1000.0 && u + 1 < std::size(kUnits)) {
+    v /= 1000.0;
+    ++u;
+  }
+  std::ostringstream out;
+  out << std::setprecision(3) << v << " " << kUnits[u];
+  return out.str();
+}
+
+void CheckMemory(const std::vector<std::string>& files, std::uint64_t max_memory) {
+  std::uint64_t need = 0;
+  std::string names;
+  for (const std::string& f : files) {
+    const std::uint64_t e = io::EstimateReadMemory(f);
+    if (e == 0) continue;  // not a regular file: its reader says what is wrong
+    // The process itself counts once, however many files are read.
+    need += need == 0 ? e : e - io::kReadMemoryBaseBytes;
+    names += (names.empty() ? "" : ", ") + f;
+  }
+  const std::optional<std::uint64_t> available =
+      max_memory > 0 ? std::optional<std::uint64_t>(max_memory) : io::AvailableMemory();
+  if (need == 0 || !available || need <= *available) return;
+  throw Error("reading " + names + " needs about " + FormatBytes(need) + "; " +
+              FormatBytes(*available) + " is available (" +
+              (max_memory > 0 ? "--max-memory" : "MemAvailable in /proc/meminfo") + ")");
+}
+
 Session ReadInputs(const InputArgs& a) {
   std::vector<std::string> inputs = a.inputs;
   if (!a.acc_file.empty() || !a.gyr_file.empty()) {
@@ -352,12 +396,15 @@ Session ReadInputs(const InputArgs& a) {
   }
   std::string names;
   for (const std::string& input : inputs) names += (names.empty() ? "" : ", ") + input;
-  Progress::Of().Stage("reading " + names);
   std::vector<io::InputFile> files;
+  std::vector<std::string> paths;
   for (const std::string& input : inputs) {
     const auto parts = SplitList(input, ',');
     files.push_back(parts.size() == 2 ? io::InputFile(parts[0], parts[1]) : io::InputFile(input));
+    paths.insert(paths.end(), parts.begin(), parts.end());
   }
+  CheckMemory(paths, a.max_memory);
+  Progress::Of().Stage("reading " + names);
   return io::OpenInputs(files, MakeInputOptions(a, inputs));
 }
 

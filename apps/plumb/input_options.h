@@ -21,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,9 @@ struct InputArgs {
   CLI::Option* from = nullptr;
   CLI::Option* to = nullptr;
   bool as_logged = false;          ///< --as-logged: keep the firmware's correction
+  /// --max-memory: bytes the run may use (SIZE: 1e6, 500M, 2G, 2GiB); 0 = the memory the
+  /// system says is available (MemAvailable).
+  std::uint64_t max_memory = 0;
 
   /// Options that only describe text tables, to tell the user when they are given in vain.
   std::vector<CLI::Option*> table_only;
@@ -70,6 +74,18 @@ void AddInputFiles(const InputArgs& args, FileRoles& roles);
 /// UsageError for contradictory or malformed options, plumb::InputError naming the file for bad
 /// input, plumb::Error when the session has no samples.
 Session ReadInputs(const InputArgs& args);
+
+/// Registers --max-memory SIZE on `app`, into `max_memory` (see InputArgs::max_memory).
+void AddMaxMemoryOption(CLI::App* app, std::uint64_t& max_memory);
+
+/// Refuses, before anything is read, inputs whose estimated memory (plumb::io::
+/// EstimateReadMemory, summed over `files`) exceeds `max_memory` (0: MemAvailable; no check
+/// when the system does not say): throws plumb::Error "reading FILE needs about 1.9 GB;
+/// 1.2 GB is available (--max-memory)" (exit 1).
+void CheckMemory(const std::vector<std::string>& files, std::uint64_t max_memory);
+
+/// `bytes` for people: "850 kB", "25.2 MB", "1.9 GB" (powers of 1000, 3 significant digits).
+std::string FormatBytes(std::uint64_t bytes);
 
 /// Parses a positive scale "x" or "a/b" (e.g. "9.80665/16384"); throws UsageError naming
 /// `option` otherwise.

@@ -27,6 +27,23 @@ const char kNative[] =
     "0.1,0.1,0.2,-9.8,0.01,0.02,0.03\n"
     "0.2,0.1,0.2,-9.8,0.01,0.02,0.03\n";
 
+// The memory estimate: 20 MiB + a factor per format (recognised by content, not name) times
+// the file size; 0 for what is not a file.
+TEST(OpenInputs, MemoryEstimateFromSizeAndFormat) {
+  TempDir dir;
+  std::string csv = "time_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z\n";
+  for (int k = 0; k < 1000; ++k) csv += std::to_string(k) + ",0,0,-9.8,0,0,0\n";
+  const std::string table = dir.Write("x.bin", csv);  // a text table whatever its name
+  EXPECT_EQ(EstimateReadMemory(table),
+            kReadMemoryBaseBytes + static_cast<std::uint64_t>(0.8 * static_cast<double>(csv.size())));
+  std::string bin = "\xA3\x95\x80";
+  bin.resize(1000000, '\0');
+  const std::string log = dir.Write("x.csv", bin);
+  EXPECT_EQ(EstimateReadMemory(log), kReadMemoryBaseBytes + 1200000u);
+  EXPECT_EQ(EstimateReadMemory(dir.File("absent")), 0u);
+  EXPECT_EQ(EstimateReadMemory(dir.File("")), 0u);  // the folder
+}
+
 TEST(OpenInputs, NativeCsvByItsHeader) {
   TempDir dir;
   const std::string path = dir.Write("a.csv", kNative);

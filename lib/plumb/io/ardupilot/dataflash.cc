@@ -40,9 +40,10 @@ class Parser {
  public:
   /// `expected_rows`: records per type id from a counting pass (to size each type's storage
   /// once), or nullptr for a counting pass itself, which stores no bodies.
+  /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
   Parser(const std::uint8_t* data, std::size_t size, DataflashLog* log,
-         const std::array<std::size_t, 256>* expected_rows)
-      : data_(data), size_(size), log_(log), expected_rows_(expected_rows) {
+         const std::array<std::size_t, 256>* expected_rows, const LogFile* file)
+      : data_(data), size_(size), log_(log), expected_rows_(expected_rows), file_(file) {
     index_.fill(-1);
     AddType(detail::DataflashFmtType(&log_->warnings));
   }
@@ -50,6 +51,7 @@ class Parser {
   void Run() {
     std::size_t pos = 0;
     while (size_ - pos >= kHeaderSize) {
+      if (file_ != nullptr) file_->Release(pos);
       if (data_[pos] == kHead1 && data_[pos + 1] == kHead2) {
         const int idx = index_[data_[pos + 2]];
         if (idx >= 0) {
@@ -113,6 +115,7 @@ class Parser {
   std::size_t size_;
   DataflashLog* log_;
   const std::array<std::size_t, 256>* expected_rows_;
+  const LogFile* file_;
   std::array<int, 256> index_;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
@@ -266,8 +269,11 @@ std::vector<std::pair<std::string, std::size_t>> DataflashLog::MessageCounts() c
   return out;
 }
 
-DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
-                            const std::string& source) {
+namespace {
+
+/// ParseDataflash, telling `file` (nullptr: none) what each pass has read.
+DataflashLog ParseDataflashFrom(const std::uint8_t* data, std::size_t size,
+                                const std::string& source, const LogFile* file) {
   DataflashLog log;
   log.source = source;
   log.size_bytes = size;
@@ -276,11 +282,11 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
   std::array<std::size_t, 256> rows{};
   {
     DataflashLog counted;
-    Parser counter(data, size, &counted, nullptr);
+    Parser counter(data, size, &counted, nullptr, file);
     counter.Run();
     for (const DataflashType& t : counted.types) rows[t.id] = t.rows;
   }
-  Parser parser(data, size, &log, &rows);
+  Parser parser(data, size, &log, &rows, file);
   parser.Run();
   if (log.types.front().rows == 0) {
     throw InputError(source, "byte 0",
@@ -291,9 +297,16 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
   return log;
 }
 
+}  // namespace
+
+DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
+                            const std::string& source) {
+  return ParseDataflashFrom(data, size, source, nullptr);
+}
+
 DataflashLog ReadDataflash(const std::string& path) {
   const LogFile file(path, "DataFlash log");
-  return ParseDataflash(file.data(), file.size(), path);
+  return ParseDataflashFrom(file.data(), file.size(), path, &file);
 }
 
 std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {

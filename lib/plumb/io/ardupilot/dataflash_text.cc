@@ -165,14 +165,12 @@ bool EncodeField(char format, std::string_view text, std::uint8_t* p, std::size_
 
 class TextParser {
  public:
-  TextParser(const char* data, std::size_t size, DataflashLog* log)
-      : data_(data), size_(size), log_(log) {
+  explicit TextParser(DataflashLog* log) : log_(log) {
     AddType(detail::DataflashFmtType(&log_->warnings));
   }
 
-  void Run() {
-    detail::LineSource source =
-        detail::LineSource::FromText(std::string_view(data_, size_), log_->source);
+  /// Decodes every line of `source` (a file read in chunks or text in memory).
+  void Run(detail::LineSource& source) {
     std::string_view line;
     while (source.Next(line)) {
       line_number_ = source.line_number();
@@ -300,8 +298,6 @@ class TextParser {
     AddType(std::move(t));
   }
 
-  const char* data_;
-  std::size_t size_;
   DataflashLog* log_;
   std::array<int, 256> index_ = MinusOnes();
   std::map<std::string, int> by_name_;
@@ -317,14 +313,13 @@ class TextParser {
   }
 };
 
-}  // namespace
-
-DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::string& source) {
+/// Decodes the lines of `lines`; `source` names the log in errors.
+DataflashLog ParseDataflashLines(detail::LineSource& lines, const std::string& source) {
   DataflashLog log;
   log.source = source;
-  log.size_bytes = size;
-  TextParser parser(data, size, &log);
-  parser.Run();
+  log.size_bytes = lines.size_bytes();
+  TextParser parser(&log);
+  parser.Run(lines);
   if (log.types.front().rows == 0) {
     throw InputError(source, "line " + std::to_string(std::max<std::size_t>(parser.lines(), 1)),
                      "no valid FMT line (\"FMT, <type>, <length>, <name>, <format>, <columns>\") "
@@ -335,9 +330,17 @@ DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::s
   return log;
 }
 
+}  // namespace
+
+DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::string& source) {
+  detail::LineSource lines = detail::LineSource::FromText(std::string_view(data, size), source);
+  return ParseDataflashLines(lines, source);
+}
+
 DataflashLog ReadDataflashText(const std::string& path) {
-  const std::string text = detail::ReadWholeFile(path);
-  return ParseDataflashText(text.data(), text.size(), path);
+  // Streamed: the file is read in chunks (1 MiB, more only for a longer line), never held whole (issue 13 point 4).
+  detail::LineSource lines = detail::LineSource::FromFile(path);
+  return ParseDataflashLines(lines, path);
 }
 
 bool LooksLikeDataflashText(const std::string& path) {

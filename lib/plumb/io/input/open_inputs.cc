@@ -2,12 +2,15 @@
 #include "plumb/io/input/open_inputs.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <optional>
 #include <sstream>
 #include <string_view>
+
+#include <sys/stat.h>
 
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
@@ -202,6 +205,32 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
   }
   if (joined->series.empty()) throw Error(joined->source + ": no samples");
   return std::move(*joined);
+}
+
+std::uint64_t EstimateReadMemory(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) return 0;
+  double factor = 0.8;  // text table / CSV
+  switch (SniffFlightLog(path)) {
+    case FlightLogFormat::kDataflashBinary: factor = 1.2; break;
+    case FlightLogFormat::kPx4ULog: factor = 1.2; break;
+    case FlightLogFormat::kMavlinkTlog: factor = 0.75; break;
+    case FlightLogFormat::kDataflashText: factor = 0.6; break;
+    case FlightLogFormat::kNone: break;
+  }
+  return kReadMemoryBaseBytes +
+         static_cast<std::uint64_t>(factor * static_cast<double>(info.st_size));
+}
+
+std::optional<std::uint64_t> AvailableMemory() {
+  std::ifstream in("/proc/meminfo");
+  std::string key, unit;
+  std::uint64_t value = 0;
+  while (in >> key >> value) {
+    std::getline(in, unit);
+    if (key == "MemAvailable:") return value * 1024;  // the file says kB (KiB)
+  }
+  return std::nullopt;
 }
 
 }  // namespace plumb::io

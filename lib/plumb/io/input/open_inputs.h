@@ -45,6 +45,8 @@
 #include <array>
 #include <cstddef>
 #include <functional>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -173,5 +175,21 @@ struct InputOptions {
 /// two-file input is given with InputFormat::kNative, when `inputs` is empty or when the
 /// session has no samples; and whatever `before_read` throws.
 Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& options = {});
+
+/// Peak memory, bytes, a run reading the file at `path` is expected to need (the process, the
+/// reader's storage and the decoded samples): kReadMemoryBaseBytes + factor * file size, the
+/// factor by format (SniffFlightLog; anything else is a text table):
+///   DataFlash .bin 1.2 and PX4 .ulg 1.2 (the readers keep every record body, about the file
+///   size, plus the decoded series), MAVLink .tlog 0.75, ArduPilot text .log 0.6 (bodies
+///   stored in binary, smaller than their text), text tables and CSV 0.8 (about 50 bytes per
+///   decoded sample). Calibrated on the peak RSS of `plumb info` / `plumb calibrate` on
+///   ~450 MB inputs (docs/performance.md, "Memory"), rounded up. 0 when `path` cannot be sized.
+std::uint64_t EstimateReadMemory(const std::string& path);
+
+/// The fixed part of EstimateReadMemory: the process with its libraries (20 MiB).
+inline constexpr std::uint64_t kReadMemoryBaseBytes = std::uint64_t{20} << 20;
+
+/// MemAvailable from /proc/meminfo, bytes; nullopt where the system does not say.
+std::optional<std::uint64_t> AvailableMemory();
 
 }  // namespace plumb::io

@@ -243,8 +243,9 @@ bool NextLooksLikeRecord(const std::uint8_t* data, std::size_t size, std::size_t
 /// The one-pass decoder.
 class Parser {
  public:
-  Parser(const std::uint8_t* data, std::size_t size, MavlinkLog* log)
-      : data_(data), size_(size), log_(log) {
+  /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
+  Parser(const std::uint8_t* data, std::size_t size, MavlinkLog* log, const LogFile* file)
+      : data_(data), size_(size), log_(log), file_(file) {
     low_counts_.fill(0);
   }
 
@@ -253,6 +254,7 @@ class Parser {
     std::size_t last_end = 0;  // end of the last accepted record
     Frame f;
     while (pos < size_) {
+      if (file_ != nullptr) file_->Release(pos);
       const Verdict v = Examine(data_, size_, pos, &f);
       if (v == Verdict::kChecked ||
           (v == Verdict::kUnchecked && NextLooksLikeRecord(data_, size_, pos + f.record_bytes))) {
@@ -446,6 +448,7 @@ class Parser {
   const std::uint8_t* data_;
   std::size_t size_;
   MavlinkLog* log_;
+  const LogFile* file_;
   std::array<std::size_t, 256> low_counts_;
   std::array<std::uint8_t, kMaxPayload + 1> buffer_{};
   std::size_t skip_end_ = 0;
@@ -538,11 +541,15 @@ std::vector<std::pair<std::string, std::size_t>> MavlinkLog::MessageCounts() con
   return out;
 }
 
-MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source) {
+namespace {
+
+/// ParseTlog, telling `file` (nullptr: none) what the parser has read.
+MavlinkLog ParseTlogFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
+                         const LogFile* file) {
   MavlinkLog log;
   log.source = source;
   log.size_bytes = size;
-  Parser parser(data, size, &log);
+  Parser parser(data, size, &log, file);
   parser.Run();
   if (log.frames_v1 + log.frames_v2 == 0) {
     throw InputError(source, "byte 0",
@@ -553,9 +560,15 @@ MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::stri
   return log;
 }
 
+}  // namespace
+
+MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source) {
+  return ParseTlogFrom(data, size, source, nullptr);
+}
+
 MavlinkLog ReadTlog(const std::string& path) {
   const LogFile file(path, "MAVLink tlog");
-  return ParseTlog(file.data(), file.size(), path);
+  return ParseTlogFrom(file.data(), file.size(), path, &file);
 }
 
 }  // namespace plumb::io

@@ -102,8 +102,9 @@ std::string InfoText(const KeyValue& kv) {
 /// The one-pass decoder state.
 class Parser {
  public:
-  Parser(const std::uint8_t* data, std::size_t size, ULog* log)
-      : data_(data), size_(size), log_(log),
+  /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
+  Parser(const std::uint8_t* data, std::size_t size, ULog* log, const LogFile* file)
+      : data_(data), size_(size), log_(log), file_(file),
         resolver_(log->formats, size + kMinColumnBudget) {}
 
   void Run() {
@@ -113,6 +114,7 @@ class Parser {
     std::size_t next_segment = 0;  // index into log_->appended_offsets
     bool resync = false;
     while (true) {
+      if (file_ != nullptr) file_->Release(pos);
       if (pos >= end) {
         if (next_segment < log_->appended_offsets.size()) {
           pos = static_cast<std::size_t>(log_->appended_offsets[next_segment]);
@@ -269,6 +271,7 @@ class Parser {
     expected_bytes_.assign(std::size_t{65536}, 0);
     std::size_t pos = kFileHeaderSize;
     while (size_ - pos >= kMsgHeaderSize + 2) {
+      if (file_ != nullptr) file_->Release(pos);
       const std::size_t size = Load<std::uint16_t>(data_ + pos);
       if (size == 0 || size > size_ - pos - kMsgHeaderSize) break;
       if (data_[pos + 2] == 'D' && size >= 2) {
@@ -410,6 +413,7 @@ class Parser {
   const std::uint8_t* data_;
   std::size_t size_;
   ULog* log_;
+  const LogFile* file_;
   std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
   std::vector<std::uint32_t> expected_rows_;  // PreScan() counts per msg_id, or empty
   std::vector<std::size_t> expected_bytes_;   // PreScan() D body bytes per msg_id, or empty
@@ -523,7 +527,11 @@ std::vector<std::pair<std::string, std::size_t>> ULog::MessageCounts() const {
   return out;
 }
 
-ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source) {
+namespace {
+
+/// ParseULog, telling `file` (nullptr: none) what the parser has read.
+ULog ParseULogFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
+                   const LogFile* file) {
   ULog log;
   log.source = source;
   log.size_bytes = size;
@@ -539,14 +547,20 @@ ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& so
   log.version = data[7];
   log.warnings.unknown_version = log.version > 1;
   log.start_timestamp_us = Load<std::uint64_t>(data + 8);
-  Parser parser(data, size, &log);
+  Parser parser(data, size, &log, file);
   parser.Run();
   return log;
 }
 
+}  // namespace
+
+ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source) {
+  return ParseULogFrom(data, size, source, nullptr);
+}
+
 ULog ReadULog(const std::string& path) {
   const LogFile file(path, "ULog file");
-  return ParseULog(file.data(), file.size(), path);
+  return ParseULogFrom(file.data(), file.size(), path, &file);
 }
 
 }  // namespace plumb::io
