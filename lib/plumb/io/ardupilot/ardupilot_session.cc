@@ -117,4 +117,23 @@ bool LooksLikeDataflash(const std::string& path) {
          head[1] == detail::kDataflashHead2;
 }
 
+RecordFilter ArdupilotSessionRecords() {
+  RecordFilter filter;
+  filter.keep = [](std::string_view name) {
+    for (const char* exact : {"FMT", "FMTU", "UNIT", "MULT", "PARM", "ISBH", "ISBD"}) {
+      if (name == exact) return true;
+    }
+    // A family and its numbered instances: IMU, IMU2, IMU3; ACC, ACC1; GPS, GPS2.
+    for (std::string_view family : {"IMU", "ACC", "GYR", "GPS"}) {
+      if (name.substr(0, family.size()) != family) continue;
+      const std::string_view rest = name.substr(family.size());
+      if (std::all_of(rest.begin(), rest.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        return true;
+      }
+    }
+    return false;
+  };
+  return filter;
+}
+
 }  // namespace plumb::io

@@ -50,4 +50,9 @@ Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions&
 /// True when the file starts with a DataFlash record header (0xA3 0x95).
 bool LooksLikeDataflash(const std::string& path);
 
+/// The DataFlash types a session and `plumb info` read the values of (the format tables FMT,
+/// FMTU, UNIT, MULT; PARM; GPS; the IMU messages IMU*, ACC*, GYR*, ISBH, ISBD): the filter
+/// FlightLog reads .bin and .log files with, so a big log keeps only these bodies in memory.
+RecordFilter ArdupilotSessionRecords();
+
 }  // namespace plumb::io

@@ -29,6 +29,11 @@ T Load(const std::uint8_t* p) {
   return v;
 }
 
+/// A value asked of a type whose bodies the reader's RecordFilter left out: a caller's bug.
+[[noreturn]] void NotKept(const std::string& name) {
+  throw Error("DataFlash type " + name + ": its record bodies were not kept (RecordFilter)");
+}
+
 /// Text of a fixed-width char field up to its first NUL.
 std::string FixedText(const std::uint8_t* p, std::size_t n) {
   const auto* c = reinterpret_cast<const char*>(p);
@@ -41,9 +46,12 @@ class Parser {
   /// `expected_rows`: records per type id from a counting pass (to size each type's storage
   /// once), or nullptr for a counting pass itself, which stores no bodies.
   /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
+  /// `filter`: the types whose bodies the storing pass keeps.
   Parser(const std::uint8_t* data, std::size_t size, DataflashLog* log,
-         const std::array<std::size_t, 256>* expected_rows, const LogFile* file)
-      : data_(data), size_(size), log_(log), expected_rows_(expected_rows), file_(file) {
+         const std::array<std::size_t, 256>* expected_rows, const LogFile* file,
+         const RecordFilter& filter)
+      : data_(data), size_(size), log_(log), expected_rows_(expected_rows), file_(file),
+        filter_(filter) {
     index_.fill(-1);
     AddType(detail::DataflashFmtType(&log_->warnings));
   }
@@ -61,7 +69,9 @@ class Parser {
             return;
           }
           const std::uint8_t* body = data_ + pos + kHeaderSize;
-          if (expected_rows_ != nullptr) t.bodies.insert(t.bodies.end(), body, body + t.body_size);
+          if (expected_rows_ != nullptr && t.bodies_kept) {
+            t.bodies.insert(t.bodies.end(), body, body + t.body_size);
+          }
           ++t.rows;
           pos += t.length;
           if (t.id == kFmtType) HandleFmt(body, t.body_size);
@@ -83,7 +93,10 @@ class Parser {
 
  private:
   void AddType(DataflashType t) {
-    if (expected_rows_ != nullptr) t.bodies.reserve((*expected_rows_)[t.id] * t.body_size);
+    t.bodies_kept = t.id == kFmtType || filter_.Keeps(t.name);
+    if (expected_rows_ != nullptr && t.bodies_kept) {
+      t.bodies.reserve((*expected_rows_)[t.id] * t.body_size);
+    }
     index_[t.id] = static_cast<int>(log_->types.size());
     log_->types.push_back(std::move(t));
   }
@@ -116,6 +129,7 @@ class Parser {
   DataflashLog* log_;
   const std::array<std::size_t, 256>* expected_rows_;
   const LogFile* file_;
+  const RecordFilter& filter_;
   std::array<int, 256> index_;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
@@ -163,6 +177,7 @@ int DataflashType::ColumnIndex(std::string_view column) const {
 }
 
 double DataflashType::Value(std::size_t row, std::size_t col) const {
+  if (!bodies_kept) NotKept(name);
   const DataflashColumn& c = columns[col];
   const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
   const detail::DataflashFormatChar& f = DataflashFormat(c.format);
@@ -185,12 +200,14 @@ double DataflashType::Value(std::size_t row, std::size_t col) const {
 }
 
 std::string DataflashType::Text(std::size_t row, std::size_t col) const {
+  if (!bodies_kept) NotKept(name);
   const DataflashColumn& c = columns[col];
   if (DataflashFormat(c.format).storage != DataflashStorage::kText) return {};
   return FixedText(bodies.data() + row * body_size + c.offset, c.size);
 }
 
 std::array<std::int16_t, 32> DataflashType::Array(std::size_t row, std::size_t col) const {
+  if (!bodies_kept) NotKept(name);
   std::array<std::int16_t, 32> out{};
   const DataflashColumn& c = columns[col];
   if (DataflashFormat(c.format).storage == DataflashStorage::kArray) {
@@ -273,7 +290,8 @@ namespace {
 
 /// ParseDataflash, telling `file` (nullptr: none) what each pass has read.
 DataflashLog ParseDataflashFrom(const std::uint8_t* data, std::size_t size,
-                                const std::string& source, const LogFile* file) {
+                                const std::string& source, const LogFile* file,
+                                const RecordFilter& filter) {
   DataflashLog log;
   log.source = source;
   log.size_bytes = size;
@@ -282,11 +300,11 @@ DataflashLog ParseDataflashFrom(const std::uint8_t* data, std::size_t size,
   std::array<std::size_t, 256> rows{};
   {
     DataflashLog counted;
-    Parser counter(data, size, &counted, nullptr, file);
+    Parser counter(data, size, &counted, nullptr, file, filter);
     counter.Run();
     for (const DataflashType& t : counted.types) rows[t.id] = t.rows;
   }
-  Parser parser(data, size, &log, &rows, file);
+  Parser parser(data, size, &log, &rows, file, filter);
   parser.Run();
   if (log.types.front().rows == 0) {
     throw InputError(source, "byte 0",
@@ -300,13 +318,13 @@ DataflashLog ParseDataflashFrom(const std::uint8_t* data, std::size_t size,
 }  // namespace
 
 DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
-                            const std::string& source) {
-  return ParseDataflashFrom(data, size, source, nullptr);
+                            const std::string& source, const RecordFilter& filter) {
+  return ParseDataflashFrom(data, size, source, nullptr, filter);
 }
 
-DataflashLog ReadDataflash(const std::string& path) {
+DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter) {
   const LogFile file(path, "DataFlash log");
-  return ParseDataflashFrom(file.data(), file.size(), path, &file);
+  return ParseDataflashFrom(file.data(), file.size(), path, &file, filter);
 }
 
 std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {

@@ -40,6 +40,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/io/common/flight_log.h"
+#include "plumb/io/common/log_common.h"
 
 namespace plumb::io {
 
@@ -66,6 +67,9 @@ struct DataflashType {
   std::size_t body_size = 0;    ///< length - 3, bytes per stored record
   std::size_t rows = 0;         ///< number of records decoded
   std::vector<std::uint8_t> bodies;  ///< rows * body_size bytes, the record bodies in order
+  /// False when the reader's RecordFilter left this type's bodies out (rows still counted):
+  /// Value, Text, Array and Column then throw plumb::Error.
+  bool bodies_kept = true;
 
   /// Index of the column called `column`, or -1.
   int ColumnIndex(std::string_view column) const;
@@ -119,16 +123,17 @@ struct DataflashLog {
 
 /// Reads and decodes a .bin log. Throws plumb::InputError(path, "byte N", what) when the file
 /// cannot be read or holds no FMT record at all.
-DataflashLog ReadDataflash(const std::string& path);
+/// `filter`: the types whose record bodies are kept (RecordFilter; default all).
+DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter = {});
 
 /// Decodes a log held in memory; `source` names it in errors. Same contract as ReadDataflash.
 DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
-                            const std::string& source);
+                            const std::string& source, const RecordFilter& filter = {});
 
 /// Reads and decodes an ArduPilot TEXT log (.log, as Mission Planner writes it) into the same
 /// DataflashLog a .bin gives; see ParseDataflashText. Throws plumb::InputError(path, "", what)
 /// when the file cannot be read, and as ParseDataflashText.
-DataflashLog ReadDataflashText(const std::string& path);
+DataflashLog ReadDataflashText(const std::string& path, const RecordFilter& filter = {});
 
 /// Decodes a text log held in memory; `source` names it in errors.
 ///
@@ -151,7 +156,8 @@ DataflashLog ReadDataflashText(const std::string& path);
 /// is skipped and counted with the number of the first one, never fatal. FMT lines follow the
 /// binary rules (first definition of a type id or name wins, length < 3 ignored, ...).
 /// Throws plumb::InputError(source, "line N", what) when there is no FMT line at all.
-DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::string& source);
+DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::string& source,
+                                const RecordFilter& filter = {});
 
 /// True when the file looks like a text DataFlash log: no binary header (0xA3 0x95) at the
 /// start, only printable text, and a line starting with "FMT," among the first 16 non-blank

@@ -165,7 +165,8 @@ bool EncodeField(char format, std::string_view text, std::uint8_t* p, std::size_
 
 class TextParser {
  public:
-  explicit TextParser(DataflashLog* log) : log_(log) {
+  /// `filter`: the types whose rows are stored (all are still checked and counted).
+  TextParser(DataflashLog* log, const RecordFilter& filter) : log_(log), filter_(filter) {
     AddType(detail::DataflashFmtType(&log_->warnings));
   }
 
@@ -193,6 +194,7 @@ class TextParser {
 
  private:
   void AddType(DataflashType t) {
+    t.bodies_kept = t.id == detail::kDataflashFmtType || filter_.Keeps(t.name);
     index_[t.id] = static_cast<int>(log_->types.size());
     by_name_[t.name] = static_cast<int>(log_->types.size());
     log_->types.push_back(std::move(t));
@@ -249,7 +251,7 @@ class TextParser {
     }
     if (t.id == detail::kDataflashFmtType && !CheckFmt(f)) return;
     if (mode_name) ++log_->warnings.text_mode_names;
-    t.bodies.insert(t.bodies.end(), row_.begin(), row_.end());
+    if (t.bodies_kept) t.bodies.insert(t.bodies.end(), row_.begin(), row_.end());
     ++t.rows;
     if (t.id == detail::kDataflashFmtType) DefineType(f);
   }
@@ -299,6 +301,7 @@ class TextParser {
   }
 
   DataflashLog* log_;
+  const RecordFilter& filter_;
   std::array<int, 256> index_ = MinusOnes();
   std::map<std::string, int> by_name_;
   SplitLine split_;
@@ -314,11 +317,12 @@ class TextParser {
 };
 
 /// Decodes the lines of `lines`; `source` names the log in errors.
-DataflashLog ParseDataflashLines(detail::LineSource& lines, const std::string& source) {
+DataflashLog ParseDataflashLines(detail::LineSource& lines, const std::string& source,
+                                 const RecordFilter& filter) {
   DataflashLog log;
   log.source = source;
   log.size_bytes = lines.size_bytes();
-  TextParser parser(&log);
+  TextParser parser(&log, filter);
   parser.Run(lines);
   if (log.types.front().rows == 0) {
     throw InputError(source, "line " + std::to_string(std::max<std::size_t>(parser.lines(), 1)),
@@ -332,15 +336,16 @@ DataflashLog ParseDataflashLines(detail::LineSource& lines, const std::string& s
 
 }  // namespace
 
-DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::string& source) {
+DataflashLog ParseDataflashText(const char* data, std::size_t size, const std::string& source,
+                                const RecordFilter& filter) {
   detail::LineSource lines = detail::LineSource::FromText(std::string_view(data, size), source);
-  return ParseDataflashLines(lines, source);
+  return ParseDataflashLines(lines, source, filter);
 }
 
-DataflashLog ReadDataflashText(const std::string& path) {
+DataflashLog ReadDataflashText(const std::string& path, const RecordFilter& filter) {
   // Streamed: the file is read in chunks (1 MiB, more only for a longer line), never held whole (issue 13 point 4).
   detail::LineSource lines = detail::LineSource::FromFile(path);
-  return ParseDataflashLines(lines, path);
+  return ParseDataflashLines(lines, path, filter);
 }
 
 bool LooksLikeDataflashText(const std::string& path) {

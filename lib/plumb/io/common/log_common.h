@@ -3,9 +3,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "plumb/core/session.h"
@@ -50,6 +52,18 @@ class LogFile {
   void* mapping_ = nullptr;             ///< the mmap'ed region, or nullptr
   std::vector<std::uint8_t> buffer_;    ///< the bytes when not mapped
   mutable std::size_t released_ = 0;    ///< bytes [0, released_) were last released
+};
+
+/// Which messages (DataFlash types, ULog topics) a binary-log reader keeps the record bodies
+/// of: every record is still read, checked and counted (rows, skipped bytes, warnings), but
+/// only the bodies of kept messages are stored. Sessions need a few messages of a log (its IMU,
+/// parameters, GPS); keeping only those bounds a big log's memory by its IMU samples instead
+/// of its size. Default: every message is kept.
+struct RecordFilter {
+  /// True for the names whose bodies are stored; empty: all.
+  std::function<bool(std::string_view name)> keep;
+
+  bool Keeps(std::string_view name) const { return !keep || keep(name); }
 };
 
 /// The message of a time window (--from/--to, log times) that holds fewer than 2 samples of a

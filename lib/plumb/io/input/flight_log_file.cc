@@ -79,16 +79,16 @@ FlightLog FlightLog::Open(const std::string& path) {
   out.format_ = SniffFlightLog(path);
   switch (out.format_) {
     case FlightLogFormat::kDataflashBinary:
-      out.log_ = ReadDataflash(path);
+      out.log_ = ReadDataflash(path, ArdupilotSessionRecords());
       break;
     case FlightLogFormat::kDataflashText:
-      out.log_ = ReadDataflashText(path);
+      out.log_ = ReadDataflashText(path, ArdupilotSessionRecords());
       break;
     case FlightLogFormat::kMavlinkTlog:
       out.log_ = ReadTlog(path);
       break;
     case FlightLogFormat::kPx4ULog:
-      out.log_ = ReadULog(path);
+      out.log_ = ReadULog(path, Px4SessionTopics());
       break;
     case FlightLogFormat::kNone:
       throw InputError(path, "byte 0",

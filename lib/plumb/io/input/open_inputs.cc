@@ -15,7 +15,11 @@
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
 #include "plumb/io/common/text_scan.h"
+#include "plumb/io/ardupilot/ardupilot_session.h"
+#include "plumb/io/ardupilot/dataflash.h"
 #include "plumb/io/input/flight_log_file.h"
+#include "plumb/io/px4/px4_session.h"
+#include "plumb/io/px4/ulog.h"
 #include "plumb/io/text/native_csv.h"
 #include "plumb/io/text/text_table.h"
 
@@ -207,15 +211,61 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
   return std::move(*joined);
 }
 
+namespace {
+
+/// Bytes of record bodies a session's reader keeps (ArdupilotSessionRecords,
+/// Px4SessionTopics) per byte of file, measured on the first kEstimatePrefixBytes of `path`;
+/// 1 (the most it can be) when that start does not decode.
+double KeptFraction(const std::string& path, FlightLogFormat format) {
+  std::ifstream in(path, std::ios::binary);
+  std::string prefix(kEstimatePrefixBytes, '\0');
+  in.read(prefix.data(), static_cast<std::streamsize>(prefix.size()));
+  prefix.resize(static_cast<std::size_t>(in.gcount()));
+  if (prefix.empty()) return 1.0;
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(prefix.data());
+  std::size_t kept = 0;
+  try {
+    switch (format) {
+      case FlightLogFormat::kDataflashBinary:
+        for (const DataflashType& t :
+             ParseDataflash(bytes, prefix.size(), path, ArdupilotSessionRecords()).types) {
+          kept += t.bodies.size();
+        }
+        break;
+      case FlightLogFormat::kDataflashText:
+        for (const DataflashType& t : ParseDataflashText(prefix.data(), prefix.size(), path,
+                                                         ArdupilotSessionRecords()).types) {
+          kept += t.bodies.size();
+        }
+        break;
+      case FlightLogFormat::kPx4ULog:
+        for (const ULogTopic& t : ParseULog(bytes, prefix.size(), path, Px4SessionTopics()).topics) {
+          kept += t.bodies.size();
+        }
+        break;
+      case FlightLogFormat::kMavlinkTlog:
+      case FlightLogFormat::kNone:
+        return 1.0;
+    }
+  } catch (const Error&) {
+    return 1.0;  // a start that does not decode: assume the most
+  }
+  return std::min(1.0, static_cast<double>(kept) / static_cast<double>(prefix.size()));
+}
+
+}  // namespace
+
 std::uint64_t EstimateReadMemory(const std::string& path) {
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) return 0;
-  double factor = 0.8;  // text table / CSV
-  switch (SniffFlightLog(path)) {
-    case FlightLogFormat::kDataflashBinary: factor = 1.2; break;
-    case FlightLogFormat::kPx4ULog: factor = 1.2; break;
-    case FlightLogFormat::kMavlinkTlog: factor = 0.75; break;
-    case FlightLogFormat::kDataflashText: factor = 0.6; break;
+  double factor = kTableMemoryFactor;
+  switch (const FlightLogFormat format = SniffFlightLog(path)) {
+    case FlightLogFormat::kDataflashBinary:
+    case FlightLogFormat::kPx4ULog:
+    case FlightLogFormat::kDataflashText:
+      factor = kKeptMemoryFactor * KeptFraction(path, format);
+      break;
+    case FlightLogFormat::kMavlinkTlog: factor = kTlogMemoryFactor; break;
     case FlightLogFormat::kNone: break;
   }
   return kReadMemoryBaseBytes +

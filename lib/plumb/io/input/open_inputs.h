@@ -179,12 +179,24 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
 /// Peak memory, bytes, a run reading the file at `path` is expected to need (the process, the
 /// reader's storage and the decoded samples): kReadMemoryBaseBytes + factor * file size, the
 /// factor by format (SniffFlightLog; anything else is a text table):
-///   DataFlash .bin 1.2 and PX4 .ulg 1.2 (the readers keep every record body, about the file
-///   size, plus the decoded series), MAVLink .tlog 0.75, ArduPilot text .log 0.6 (bodies
-///   stored in binary, smaller than their text), text tables and CSV 0.8 (about 50 bytes per
-///   decoded sample). Calibrated on the peak RSS of `plumb info` / `plumb calibrate` on
-///   ~450 MB inputs (docs/performance.md, "Memory"), rounded up. 0 when `path` cannot be sized.
+///   DataFlash .bin and .log, PX4 .ulg: kKeptMemoryFactor times the share of the file that
+///   the session's reader keeps (the bodies of its IMU, parameter and GPS messages, measured
+///   on the first kEstimatePrefixBytes: FlightLog reads with ArdupilotSessionRecords /
+///   Px4SessionTopics); MAVLink .tlog kTlogMemoryFactor; text tables and CSV
+///   kTableMemoryFactor (about 50 bytes per decoded sample). Calibrated on the peak RSS of
+///   `plumb info` / `plumb calibrate` on ~450 MB inputs (docs/performance.md, "Memory"),
+///   rounded up. 0 when `path` cannot be sized.
 std::uint64_t EstimateReadMemory(const std::string& path);
+
+/// EstimateReadMemory's sample of a log's start, bytes.
+inline constexpr std::size_t kEstimatePrefixBytes = std::size_t{8} << 20;
+/// Memory per byte of kept record bodies: the bodies, the decoded series (64 bytes per sample
+/// against 30-50 bytes per IMU record) and the session's copy of it.
+inline constexpr double kKeptMemoryFactor = 3.0;
+/// Memory per byte of a .tlog (its frames are kept as decoded messages).
+inline constexpr double kTlogMemoryFactor = 0.75;
+/// Memory per byte of a text table or CSV.
+inline constexpr double kTableMemoryFactor = 0.8;
 
 /// The fixed part of EstimateReadMemory: the process with its libraries (20 MiB).
 inline constexpr std::uint64_t kReadMemoryBaseBytes = std::uint64_t{20} << 20;

@@ -505,4 +505,17 @@ bool LooksLikeULog(const std::string& path) {
          std::equal(head, head + sizeof(head), detail::kULogMagic);
 }
 
+RecordFilter Px4SessionTopics() {
+  RecordFilter filter;
+  filter.keep = [](std::string_view name) {
+    for (const char* topic : {"sensor_combined", "vehicle_imu", "vehicle_imu_status",
+                              "sensor_accel", "sensor_gyro", "sensor_gps",
+                              "vehicle_gps_position"}) {
+      if (name == topic) return true;
+    }
+    return false;
+  };
+  return filter;
+}
+
 }  // namespace plumb::io

@@ -72,4 +72,10 @@ FlightLogSummary ULogSummary(const ULog& log);
 /// True when the file starts with the ULog magic 'U' 'L' 'o' 'g' 0x01 0x12 0x35.
 bool LooksLikeULog(const std::string& path);
 
+/// The ULog topics a session and `plumb info` read the values of (sensor_combined,
+/// vehicle_imu, vehicle_imu_status, sensor_accel, sensor_gyro, sensor_gps,
+/// vehicle_gps_position): the filter FlightLog reads .ulg files with, so a big log keeps only
+/// these bodies in memory.
+RecordFilter Px4SessionTopics();
+
 }  // namespace plumb::io

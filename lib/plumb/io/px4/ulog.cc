@@ -99,12 +99,34 @@ std::string InfoText(const KeyValue& kv) {
   return out;
 }
 
+/// The "timestamp" field of the message body `body` of `t`, us (uint8 timestamps are
+/// milliseconds by the format); 0 when the topic has none.
+std::uint64_t TimestampOf(const ULogTopic& t, const std::uint8_t* body) {
+  if (t.timestamp_col < 0) return 0;
+  const ULogColumn& c = t.columns[static_cast<std::size_t>(t.timestamp_col)];
+  const std::uint8_t* p = body + c.offset;
+  switch (c.type) {
+    case ULogType::kUInt64: return Load<std::uint64_t>(p);
+    case ULogType::kUInt32: return Load<std::uint32_t>(p);
+    case ULogType::kUInt16: return Load<std::uint16_t>(p);
+    case ULogType::kUInt8: return std::uint64_t{Load<std::uint8_t>(p)} * 1000u;
+    default: return 0;
+  }
+}
+
+/// A value asked of a topic whose bodies the reader's RecordFilter left out: a caller's bug.
+[[noreturn]] void NotKept(const std::string& name) {
+  throw Error("ULog topic " + name + ": its message bodies were not kept (RecordFilter)");
+}
+
 /// The one-pass decoder state.
 class Parser {
  public:
   /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
-  Parser(const std::uint8_t* data, std::size_t size, ULog* log, const LogFile* file)
-      : data_(data), size_(size), log_(log), file_(file),
+  /// `filter`: the topics whose bodies are kept.
+  Parser(const std::uint8_t* data, std::size_t size, ULog* log, const LogFile* file,
+         const RecordFilter& filter)
+      : data_(data), size_(size), log_(log), file_(file), filter_(filter),
         resolver_(log->formats, size + kMinColumnBudget) {}
 
   void Run() {
@@ -226,7 +248,8 @@ class Parser {
     }
     ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
     (void)size;  // checked by Corrupt(): body_size <= size - 2 <= full_size
-    t.bodies.insert(t.bodies.end(), body + 2, body + 2 + t.body_size);
+    t.last_timestamp_us = TimestampOf(t, body + 2);
+    if (t.bodies_kept) t.bodies.insert(t.bodies.end(), body + 2, body + 2 + t.body_size);
     ++t.rows;
   }
 
@@ -234,7 +257,7 @@ class Parser {
   std::uint64_t NewestTimestampUs() const {
     std::uint64_t newest = 0;
     for (const ULogTopic& t : log_->topics) {
-      if (t.rows > 0) newest = std::max(newest, t.TimestampUs(t.rows - 1));
+      if (t.rows > 0) newest = std::max(newest, t.last_timestamp_us);
     }
     return newest;
   }
@@ -284,7 +307,8 @@ class Parser {
   }
 
   void Reserve(ULogTopic* t) {
-    if (expected_rows_.empty()) return;
+    t->bodies_kept = filter_.Keeps(t->name);
+    if (expected_rows_.empty() || !t->bodies_kept) return;
     // Never more than the D bytes seen for this id: the reservations add up to at most the
     // input size.
     t->bodies.reserve(std::min(std::size_t{expected_rows_[t->msg_id]} * t->body_size,
@@ -414,6 +438,7 @@ class Parser {
   std::size_t size_;
   ULog* log_;
   const LogFile* file_;
+  const RecordFilter& filter_;
   std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
   std::vector<std::uint32_t> expected_rows_;  // PreScan() counts per msg_id, or empty
   std::vector<std::size_t> expected_bytes_;   // PreScan() D body bytes per msg_id, or empty
@@ -432,6 +457,7 @@ int ULogTopic::ColumnIndex(std::string_view column) const {
 }
 
 double ULogTopic::Value(std::size_t row, std::size_t col) const {
+  if (!bodies_kept) NotKept(name);
   const ULogColumn& c = columns[col];
   const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
   switch (c.type) {
@@ -451,16 +477,8 @@ double ULogTopic::Value(std::size_t row, std::size_t col) const {
 }
 
 std::uint64_t ULogTopic::TimestampUs(std::size_t row) const {
-  if (timestamp_col < 0) return 0;
-  const ULogColumn& c = columns[static_cast<std::size_t>(timestamp_col)];
-  const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
-  switch (c.type) {
-    case ULogType::kUInt64: return Load<std::uint64_t>(p);
-    case ULogType::kUInt32: return Load<std::uint32_t>(p);
-    case ULogType::kUInt16: return Load<std::uint16_t>(p);
-    case ULogType::kUInt8: return std::uint64_t{Load<std::uint8_t>(p)} * 1000u;
-    default: return 0;
-  }
+  if (!bodies_kept) NotKept(name);
+  return TimestampOf(*this, bodies.data() + row * body_size);
 }
 
 std::vector<double> ULogTopic::Column(std::string_view column) const {
@@ -531,7 +549,7 @@ namespace {
 
 /// ParseULog, telling `file` (nullptr: none) what the parser has read.
 ULog ParseULogFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
-                   const LogFile* file) {
+                   const LogFile* file, const RecordFilter& filter) {
   ULog log;
   log.source = source;
   log.size_bytes = size;
@@ -547,20 +565,21 @@ ULog ParseULogFrom(const std::uint8_t* data, std::size_t size, const std::string
   log.version = data[7];
   log.warnings.unknown_version = log.version > 1;
   log.start_timestamp_us = Load<std::uint64_t>(data + 8);
-  Parser parser(data, size, &log, file);
+  Parser parser(data, size, &log, file, filter);
   parser.Run();
   return log;
 }
 
 }  // namespace
 
-ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source) {
-  return ParseULogFrom(data, size, source, nullptr);
+ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source,
+               const RecordFilter& filter) {
+  return ParseULogFrom(data, size, source, nullptr, filter);
 }
 
-ULog ReadULog(const std::string& path) {
+ULog ReadULog(const std::string& path, const RecordFilter& filter) {
   const LogFile file(path, "ULog file");
-  return ParseULogFrom(file.data(), file.size(), path, &file);
+  return ParseULogFrom(file.data(), file.size(), path, &file, filter);
 }
 
 }  // namespace plumb::io

@@ -60,6 +60,8 @@
 #include <utility>
 #include <vector>
 
+#include "plumb/io/common/log_common.h"
+
 namespace plumb::io {
 
 /// The basic ULog field types.
@@ -85,6 +87,11 @@ struct ULogTopic {
   int timestamp_col = -1;        ///< column of the top-level "timestamp" field, -1 if none
   std::size_t rows = 0;          ///< D messages stored
   std::vector<std::uint8_t> bodies;  ///< rows * body_size bytes, in log order
+  /// False when the reader's RecordFilter left this topic's bodies out (rows still counted):
+  /// Value, TimestampUs and Column then throw plumb::Error.
+  bool bodies_kept = true;
+  /// The "timestamp" of the last message, us (as TimestampUs), kept or not; 0 before any.
+  std::uint64_t last_timestamp_us = 0;
 
   /// Index of the column called `column`, or -1.
   int ColumnIndex(std::string_view column) const;
@@ -179,9 +186,11 @@ struct ULog {
 /// Reads and decodes a .ulg file. Throws plumb::InputError(path, "byte N", what) when the file
 /// cannot be read, is shorter than the 16-byte header, lacks the magic, or sets an
 /// incompatible flag bit this reader does not know.
-ULog ReadULog(const std::string& path);
+/// `filter`: the topics whose message bodies are kept (RecordFilter; default all).
+ULog ReadULog(const std::string& path, const RecordFilter& filter = {});
 
 /// Decodes a log held in memory; `source` names it in errors. Same contract as ReadULog.
-ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source);
+ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source,
+               const RecordFilter& filter = {});
 
 }  // namespace plumb::io
