@@ -197,8 +197,9 @@ TEST(Cli, ConstantBiasExcludesTheWanderLevels) {
             std::string::npos)
       << wander.out;
   EXPECT_NE(wander.out.find("note: bias wander levels (Allan deviation of 89 s of still data): "
-                            "accel instability 0.0004 m/s^2 typical (bound 0.051..0.054), accel "
-                            "walk 0.0001 m/s^3/sqrt(Hz) typical (bound 0.013..0.014)"),
+                            "accel instability 0.0004 m/s^2 typical (bound 0.051..0.054 "
+                            "m/s^2), accel walk 0.0001 m/s^3/sqrt(Hz) typical (bound "
+                            "0.013..0.014 m/s^3/sqrt(Hz))"),
             std::string::npos)
       << wander.out;
 }

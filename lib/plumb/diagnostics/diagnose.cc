@@ -130,6 +130,7 @@ void AddUnexcited(const CandidateSpec& c, std::vector<Candidate>& candidates,
     n.parameter = effect->info().ParameterName(i);
     n.excited = false;
     n.typical = effect->info().parameters[static_cast<std::size_t>(i)].typical;
+    n.unit = effect->info().parameters[static_cast<std::size_t>(i)].unit;
     cand.not_identifiable.push_back(n);
   }
   candidates.push_back(std::move(cand));
@@ -167,13 +168,15 @@ void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& sour
     if (p.probe_term[j] == term) cols.push_back(static_cast<Eigen::Index>(j));
   }
   Eigen::MatrixXd Z(p.Z.rows(), static_cast<Eigen::Index>(cols.size()));
-  std::vector<std::string> names;
+  std::vector<std::string> names, units;
   std::vector<double> typical;
   const auto& info = source.calibration.model.terms()[static_cast<std::size_t>(term)].effect->info();
   for (std::size_t k = 0; k < cols.size(); ++k) {
     Z.col(static_cast<Eigen::Index>(k)) = p.Z.col(cols[k]);
     names.push_back(p.probe_names[static_cast<std::size_t>(cols[k])]);
-    typical.push_back(info.parameters[k].typical * OutputScale(info, k, series, source));
+    const double scale = OutputScale(info, k, series, source);
+    typical.push_back(info.parameters[k].typical * scale);
+    units.push_back(scale == 1.0 ? info.parameters[k].unit : std::string());
   }
   const ScoreTestResult s = ScoreTest(p.r, p.J, Z, p.unknown_names, names, typical, options.score);
   Candidate cand;
@@ -185,6 +188,10 @@ void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& sour
   cand.num_parameters = s.num_parameters;
   cand.identifiable = s.identifiable;
   cand.not_identifiable = s.not_identifiable;
+  for (Confounding& n : cand.not_identifiable) {
+    const auto at = std::find(names.begin(), names.end(), n.parameter);
+    if (at != names.end()) n.unit = units[static_cast<std::size_t>(at - names.begin())];
+  }
   cand.evidence = cand.lm - s.dof * log_n;
   cand.threshold = s.dof > 0 ? signal::ChiSquareQuantileExact(1.0 - options.significance, s.dof) : 0.0;
   cand.significant = s.identifiable && s.dof > 0 && cand.lm > cand.threshold;

@@ -54,6 +54,9 @@ struct Confounding {
   /// The sigma the data would give the parameter, 1 / |P Z_j|, its unit; infinite when 0.
   double sigma = 0.0;
   double typical = 0.0;                   ///< the parameter's typical size, its unit
+  /// The unit of sigma and typical (the catalogue's, e.g. "rad/s"); empty where the fit's
+  /// data are in sensor units and the catalogue's unit does not apply.
+  std::string unit;
   /// Excited and not confounded, but determined only to more than its typical size.
   bool too_weak = false;
   std::vector<std::string> confounders;   ///< the fit's unknowns that absorb it, most first

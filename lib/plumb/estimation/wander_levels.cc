@@ -106,7 +106,7 @@ std::string Describe(const std::string& what, const std::string& unit,
       hi = std::max(hi, a.bound);
     }
     if (axes[0].from == LevelSource::kTypical && std::isfinite(hi)) {
-      out += " (bound " + number(lo) + (hi > lo ? ".." + number(hi) : "") + ")";
+      out += " (bound " + number(lo) + (hi > lo ? ".." + number(hi) : "") + " " + unit + ")";
     }
     return out;
   }
@@ -115,7 +115,7 @@ std::string Describe(const std::string& what, const std::string& unit,
   for (std::size_t i = 0; i < 3; ++i) {
     out += names[i] + number(axes[i].level) + " " + source(axes[i].from);
     if (axes[i].from == LevelSource::kTypical && std::isfinite(axes[i].bound)) {
-      out += " (bound " + number(axes[i].bound) + ")";
+      out += " (bound " + number(axes[i].bound) + " " + unit + ")";
     }
   }
   return out;

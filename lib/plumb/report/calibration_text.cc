@@ -82,8 +82,8 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   os << "\nnoise per sample: accel " << Vec(c.noise.acc) << " " << c.acc_unit << " (tau "
      << Format("%.2f", c.noise.tau_acc) << " samples)";
   if (c.has_gyro) {
-    os << ", gyro " << Vec(c.noise.gyr) << " " << c.gyr_unit << " (tau " << Format("%.2f", c.noise.tau_gyr)
-       << ")";
+    os << ", gyro " << Vec(c.noise.gyr) << " " << c.gyr_unit << " (tau "
+       << Format("%.2f", c.noise.tau_gyr) << " samples)";
   }
   os << "\n";
   const bool acc_walk = c.noise.walk_acc.minCoeff() > 0, gyr_walk = c.noise.walk_gyr.minCoeff() > 0;

@@ -63,8 +63,9 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
     if (weak_columns.size() <= 2) {
       for (const Confounding* n : weak_columns) {
         std::ostringstream w;
-        w << n->parameter << " only to +-" << std::setprecision(2) << n->sigma << " (typical "
-          << n->typical << ")";
+        const std::string unit = n->unit.empty() || n->unit == "1" ? "" : " " + n->unit;
+        w << n->parameter << " only to +-" << std::setprecision(2) << n->sigma << unit
+          << " (typical " << n->typical << unit << ")";
         weak.push_back(w.str());
       }
     } else {

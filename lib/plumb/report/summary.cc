@@ -35,8 +35,8 @@ std::string DetectedLines(const segmentation::SegmentationResult& s) {
   os << ")\n";
   os << "  noise from " << n.samples << " samples in " << n.periods.size() << " still period"
      << (n.periods.size() == 1 ? "" : "s") << " (" << n.source << "): accel sigma "
-     << Vec(n.acc_sigma);
-  if (n.has_gyro) os << ", gyro sigma " << Vec(n.gyr_sigma);
+     << Vec(n.acc_sigma) << " " << n.acc_unit;
+  if (n.has_gyro) os << ", gyro sigma " << Vec(n.gyr_sigma) << " " << n.gyr_unit;
   os << " per sample\n";
   os << "  thresholds: accel variance ratio " << Format("%.3g", d.acc_threshold);
   if (d.gyr_threshold > 0) os << ", gyro variance ratio " << Format("%.3g", d.gyr_threshold);

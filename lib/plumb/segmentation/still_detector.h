@@ -101,6 +101,8 @@ struct NoiseEstimate {
   std::vector<StillSegment> periods;
   std::size_t samples = 0;  ///< samples in those periods, n_0
   std::string source;       ///< "initial" (init_still_s) or "auto" (pooled first pass)
+  std::string acc_unit = "m/s^2";  ///< the series' accelerometer unit (of the means and sigmas)
+  std::string gyr_unit = "rad/s";  ///< the series' gyroscope unit
   Vec3 acc_mean = Vec3::Zero();     ///< mean accelerometer output over the periods, series units
   Vec3 acc_sigma = Vec3::Zero();    ///< per-axis accelerometer noise std, series units
   Vec3 acc_tau_int = Vec3::Ones();  ///< integrated autocorrelation time, samples

@@ -83,6 +83,8 @@ NoiseEstimate EstimateNoise(const ImuSeries& series, const BlockMoments& blocks,
                             const std::vector<Run>& runs, const std::string& source) {
   NoiseEstimate noise;
   noise.source = source;
+  noise.acc_unit = series.acc_unit;
+  noise.gyr_unit = series.gyr_unit;
   noise.has_gyro = blocks.has_gyro();
   Pooled acc;
   Pooled gyr;
