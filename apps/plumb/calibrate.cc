@@ -120,6 +120,7 @@ class CalibrateCommand : public Command {
 
     const estimation::CalibrationResult result = CalibrateSession(session, fit);
     std::cout << report::CalibrationSummary(result, session.source);
+    PrintWarnings(result.fit.warnings);
     std::optional<estimation::CalibrationResult> baseline;
     if (!a.baseline.empty()) {
       model::Model before = ParseModelOption("--baseline", a.baseline);
@@ -159,7 +160,7 @@ class CalibrateCommand : public Command {
     const geo::Site site = ResolveSite(a.site, session.site, gravity);
     std::cout << session.source << ": " << session.series.size() << " samples, "
               << session.series.duration_s() << " s\n";
-    for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+    PrintWarnings(session.warnings);
     if (a.method == "paper-static") {
       // The paper's minute is the whole record; a section file picks its first still section.
       std::size_t begin = 0;

@@ -130,7 +130,7 @@ class DiagnoseCommand : public Command {
                 << report::BeforeAfterSummary(velocity ? *d.fit_with_velocity : d.fit,
                                               *best->refit);
     }
-    for (const auto& w : d.fit.fit.warnings) std::cout << "warning: " << w << "\n";
+    PrintWarnings(d.fit.fit.warnings);
 
     if (!a.json_path.empty()) {
       WriteJsonOutput(a.json_path, report::DiagnosisJson(d, ra));

@@ -222,7 +222,11 @@ void PrintSession(const Session& session) {
   std::cout << session.source << ": " << series.size() << " samples, " << series.duration_s()
             << " s" << (series.has_gyro() ? "" : ", no gyroscope")
             << (series.has_temperature() ? ", with temperature" : "") << "\n";
-  for (const auto& w : session.warnings) std::cout << "warning: " << w << "\n";
+  PrintWarnings(session.warnings);
+}
+
+void PrintWarnings(const std::vector<std::string>& warnings) {
+  for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
 }
 
 estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit) {

@@ -79,6 +79,9 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
 /// "<source>: N samples, T s[, no gyroscope][, with temperature]" and the session's warnings.
 void PrintSession(const Session& session);
 
+/// Each of `warnings` as "warning: ..." on standard error (SPEC 6: warnings go to stderr).
+void PrintWarnings(const std::vector<std::string>& warnings);
+
 /// The files a fit reads besides its calibration: INPUT..., --acc/--gyr, --segments and
 /// --noise-from, into `roles`' inputs (file_roles.h).
 void AddFitInputFiles(const InputArgs& input, const std::string& segments_path,

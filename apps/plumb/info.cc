@@ -151,7 +151,7 @@ class InfoCommand : public Command {
     for (const auto& [name, count] : summary.messages) messages[name] = count;
     doc["messages"] = messages;
     doc["warnings"] = summary.warnings;
-    for (const auto& w : summary.warnings) std::cout << "warning: " << w << "\n";
+    for (const auto& w : summary.warnings) std::cerr << "warning: " << w << "\n";
     if (!a.json_path.empty()) {
       WriteJsonOutput(a.json_path, doc);
     }

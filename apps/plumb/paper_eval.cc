@@ -439,7 +439,7 @@ void DrawFigures(const std::string& out_dir, const std::string& dir) {
   if (std::system(command.c_str()) == 0) {
     std::cout << "wrote " << dir << "figure1.png ... figure6.png (gnuplot)\n";
   } else {
-    std::cout << "warning: gnuplot did not run; draw the figures with '" << command << "'\n";
+    std::cerr << "warning: gnuplot did not run; draw the figures with '" << command << "'\n";
   }
 }
 

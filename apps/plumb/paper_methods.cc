@@ -187,6 +187,7 @@ int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& s
   const paper::PaperBenchmarkBackend backend =
       paper::CalibratePaperBenchmarkOnBackend(session.series, r, site);
   std::cout << report::CalibrationSummary(backend.result, session.source);
+  PrintWarnings(backend.result.fit.warnings);
   detail["backend"] = report::ToJson(backend.result);
   std::map<std::string, double> values = ForwardValues(r.F, r.b_a, true, r.E, r.b_g);
   for (int i = 0; i < 3; ++i) {
@@ -248,6 +249,7 @@ int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
   const paper::PaperStaticBackend backend =
       paper::CalibratePaperStaticOnBackend(session.series, begin, end, site);
   std::cout << report::CalibrationSummary(backend.fixed, session.source);
+  PrintWarnings(backend.fixed.fit.warnings);
   auto join = [](const std::vector<std::string>& names) {
     std::string out;
     for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;

@@ -270,7 +270,7 @@ class ReportCommand : public Command {
       files.push_back("allan.json");
     } catch (const InsufficientDataError& e) {
       extras.still_noise_note = e.what();
-      std::cout << "warning: no noise terms: " << e.what() << "\n";
+      std::cerr << "warning: no noise terms: " << e.what() << "\n";
     }
     if (a.no_figures) {
       extras.figure_notes.push_back("not drawn (--no-figures)");
@@ -334,7 +334,7 @@ class ReportCommand : public Command {
       std::cout << report::DiagnosisText(d);
       return d;
     } catch (const Error& e) {
-      std::cout << "warning: the diagnosis failed: " << e.what() << "\n";
+      std::cerr << "warning: the diagnosis failed: " << e.what() << "\n";
       return std::nullopt;
     }
   }

@@ -141,7 +141,6 @@ std::string FullReport(const estimation::CalibrationResult& result) {
     }
   }
   for (const auto& n : fit.notes) os << "note: " << n << "\n";
-  for (const auto& w : fit.warnings) os << "warning: " << w << "\n";
   return os.str();
 }
 

@@ -29,7 +29,8 @@ std::string FitVerdict(const estimation::FitReport& fit);
 std::string GateLines(const estimation::FitReport& fit, const std::string& source = "");
 
 /// Header (with the verdict and the failed gates, naming `source`, the input, when given)
-/// plus the full report of the result.
+/// plus the full report of the result and its notes; its warnings (result.fit.warnings) are
+/// not in it: a command prints them on standard error.
 std::string CalibrationSummary(const estimation::CalibrationResult& result,
                                const std::string& source = "");
 
