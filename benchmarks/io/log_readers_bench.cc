@@ -4,12 +4,18 @@
 // Each benchmark reads a large log made by repeating a real one from ../shared/data end to end
 // (about 150 MB, written once into a temporary file, removed at exit; the page cache holds it,
 // so this measures the reader, not the disk), then decodes every IMU sample of it, as
-// `plumb calibrate LOG` does. Counters: MB/s of log and IMU samples/s. Skipped with the reason
-// when the shared data is absent.
+// `plumb calibrate LOG` does. A repeated DataFlash log gets a continuing clock (each copy's
+// TimeUS/TimeMS fields shifted past the previous copy's), so the IMU samples of every copy are
+// decoded and counted, not only the first copy's. Counters: MB/s of log and IMU samples/s.
+// Skipped with the reason when the shared data is absent.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -18,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/ardupilot/dataflash.h"
 #include "plumb/io/mavlink/mavlink_tlog.h"
 #include "plumb/io/px4/ulog.h"
@@ -27,18 +34,105 @@ namespace {
 constexpr std::size_t kTargetBytes = 150u * 1000u * 1000u;
 
 /// A temporary file holding `source` repeated up to about kTargetBytes; removed at exit.
+/// Where each DataFlash record type keeps its time: byte offset in the record (header
+/// included) and format ('Q' TimeUS in us, 'I' TimeMS in ms); offset 0 when it has none.
+struct TimeField {
+  std::size_t offset = 0;
+  char format = 0;
+};
+
+/// Calls `visit(record_start, type_id)` for every record of the DataFlash log `bytes`, walking
+/// them as the reader does (a record is 0xA3 0x95, a known type and its FMT length).
+template <typename Visit>
+void ForEachRecord(std::vector<char>& bytes, const std::array<std::size_t, 256>& length,
+                   Visit visit) {
+  for (std::size_t pos = 0; pos + 3 <= bytes.size();) {
+    const auto id = static_cast<std::uint8_t>(bytes[pos + 2]);
+    if (static_cast<std::uint8_t>(bytes[pos]) == 0xA3 &&
+        static_cast<std::uint8_t>(bytes[pos + 1]) == 0x95 && length[id] > 0 &&
+        pos + length[id] <= bytes.size()) {
+      visit(pos, id);
+      pos += length[id];
+    } else {
+      ++pos;
+    }
+  }
+}
+
+/// `copies` copies of the DataFlash log `bytes`, copy k's clock shifted by k times (the log's
+/// last time + 1 s), so that times keep increasing across copies.
+std::vector<char> ContinuingDataflash(std::vector<char> bytes, std::size_t copies) {
+  const plumb::io::DataflashLog log = plumb::io::ParseDataflash(
+      reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "benchmark");
+  std::array<std::size_t, 256> length{};
+  std::array<TimeField, 256> time{};
+  for (const plumb::io::DataflashType& t : log.types) {
+    length[t.id] = t.length;
+    for (const char* name : {"TimeUS", "TimeMS"}) {
+      const int c = t.ColumnIndex(name);
+      if (c >= 0 && time[t.id].offset == 0) {
+        time[t.id] = {3 + t.columns[static_cast<std::size_t>(c)].offset,
+                      t.columns[static_cast<std::size_t>(c)].format};
+      }
+    }
+  }
+  std::uint64_t last_us = 0;
+  ForEachRecord(bytes, length, [&](std::size_t pos, std::uint8_t id) {
+    const TimeField& f = time[id];
+    if (f.format == 'Q') {
+      std::uint64_t v;
+      std::memcpy(&v, &bytes[pos + f.offset], sizeof v);
+      last_us = std::max(last_us, v);
+    } else if (f.format == 'I') {
+      std::uint32_t v;
+      std::memcpy(&v, &bytes[pos + f.offset], sizeof v);
+      last_us = std::max<std::uint64_t>(last_us, std::uint64_t{v} * 1000u);
+    }
+  });
+  const std::uint64_t shift_us = last_us + 1000000u;
+  std::vector<char> out;
+  out.reserve(bytes.size() * copies);
+  std::vector<char> copy = bytes;
+  for (std::size_t k = 0; k < copies; ++k) {
+    copy = bytes;
+    ForEachRecord(copy, length, [&](std::size_t pos, std::uint8_t id) {
+      const TimeField& f = time[id];
+      if (f.format == 'Q') {
+        std::uint64_t v;
+        std::memcpy(&v, &copy[pos + f.offset], sizeof v);
+        v += k * shift_us;
+        std::memcpy(&copy[pos + f.offset], &v, sizeof v);
+      } else if (f.format == 'I') {
+        std::uint32_t v;
+        std::memcpy(&v, &copy[pos + f.offset], sizeof v);
+        v += static_cast<std::uint32_t>(k * shift_us / 1000u);
+        std::memcpy(&copy[pos + f.offset], &v, sizeof v);
+      }
+    });
+    out.insert(out.end(), copy.begin(), copy.end());
+  }
+  return out;
+}
+
 class RepeatedLog {
  public:
-  explicit RepeatedLog(const std::string& source) {
+  /// `continuing_clock`: shift each DataFlash copy's times past the previous copy's.
+  RepeatedLog(const std::string& source, bool continuing_clock) {
     std::ifstream in(source, std::ios::binary);
-    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
     path_ = (std::filesystem::temp_directory_path() /
              ("plumb_bench_" + std::to_string(::getpid()) + "_" +
               std::filesystem::path(source).filename().string()))
                 .string();
     std::ofstream out(path_, std::ios::binary);
-    for (std::size_t written = 0; !bytes.empty() && written < kTargetBytes;
-         written += bytes.size()) {
+    if (bytes.empty()) return;
+    const std::size_t copies = (kTargetBytes + bytes.size() - 1) / bytes.size();
+    if (continuing_clock) {
+      const std::vector<char> all = ContinuingDataflash(std::move(bytes), copies);
+      out.write(all.data(), static_cast<std::streamsize>(all.size()));
+      return;
+    }
+    for (std::size_t k = 0; k < copies; ++k) {
       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     }
   }
@@ -55,7 +149,11 @@ const RepeatedLog* Repeated(const std::string& relative) {
   const std::string source = std::string(PLUMB_SHARED_DATA_DIR) + "/" + relative;
   if (!std::filesystem::exists(source)) return nullptr;
   auto& slot = logs[relative];
-  if (!slot) slot = std::make_unique<RepeatedLog>(source);
+  if (!slot) {
+    const bool dataflash = relative.rfind("ardupilot/", 0) == 0 &&
+                           plumb::io::LooksLikeDataflash(source);
+    slot = std::make_unique<RepeatedLog>(source, dataflash);
+  }
   return slot.get();
 }
 
@@ -82,10 +180,12 @@ void ReadRepeated(benchmark::State& state, const std::string& relative, Read rea
   SetCounters(state, std::filesystem::file_size(log->path()), samples);
 }
 
-/// ArduPilot DataFlash .bin: decode the log and every IMU instance's samples.
+/// ArduPilot DataFlash .bin: decode the log as FlightLog does (the bodies a session reads)
+/// and every IMU instance's samples, of every copy.
 void BM_ReadDataflash(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative, [](const std::string& path) {
-    const plumb::io::DataflashLog decoded = plumb::io::ReadDataflash(path);
+    const plumb::io::DataflashLog decoded =
+        plumb::io::ReadDataflash(path, plumb::io::ArdupilotSessionRecords());
     std::size_t samples = 0;
     for (const auto& imu : plumb::io::DataflashImuInstances(decoded)) {
       const plumb::ImuSeries s = plumb::io::ImuFromDataflash(decoded, imu.instance);
