@@ -92,9 +92,8 @@ std::vector<char> ContinuingDataflash(std::vector<char> bytes, std::size_t copie
   const std::uint64_t shift_us = last_us + 1000000u;
   std::vector<char> out;
   out.reserve(bytes.size() * copies);
-  std::vector<char> copy = bytes;
   for (std::size_t k = 0; k < copies; ++k) {
-    copy = bytes;
+    std::vector<char> copy = bytes;
     ForEachRecord(copy, length, [&](std::size_t pos, std::uint8_t id) {
       const TimeField& f = time[id];
       if (f.format == 'Q') {

@@ -13,6 +13,10 @@
 
 namespace plumb {
 
+/// `text` as a message may quote it: control bytes (NUL included, tab and newline excepted)
+/// and bytes that are not part of valid UTF-8 written as \xNN, cut after `max_chars` bytes
+/// of the input with "..." appended. A file's binary content then reads as bytes instead of
+/// garbling the terminal or cutting the message at a NUL.
 std::string Printable(std::string_view text, std::size_t max_chars);
 
 /// The message is kept printable (see Printable): a NUL quoted from a file would otherwise cut
@@ -46,11 +50,6 @@ class InsufficientDataError : public Error {
   explicit InsufficientDataError(const std::string& what) : Error(what) {}
 };
 
-/// `text` as a message may quote it: control bytes (NUL included, tab and newline excepted)
-/// and bytes that are not part of valid UTF-8 written as \xNN, cut after `max_chars` bytes
-/// of the input with "..." appended. A file's binary content then reads as bytes instead of
-/// garbling the terminal or cutting the message at a NUL.
-std::string Printable(std::string_view text, std::size_t max_chars);
 
 /// A number as messages print it: 6 significant digits ("1e+300", "0.0199", "200"), never
 /// std::to_string's fixed 6 decimals (309 digits for 1e300, "0.000000" for 1e-9).

@@ -62,13 +62,6 @@ std::string ErrorTable(const std::vector<exporter::ExportPreview>& previews) {
          "<th>z</th><th>x</th><th>y</th><th>z</th></tr>\n" + rows + "</table>\n";
 }
 
-std::string List(const std::vector<std::string>& items) {
-  if (items.empty()) return "";
-  std::string out = "<ul>\n";
-  for (const auto& item : items) out += "<li>" + HtmlEscape(item) + "</li>\n";
-  return out + "</ul>\n";
-}
-
 /// `line` without leading blanks and a leading "note: ".
 std::string Trimmed(const std::string& line) {
   const std::size_t first = line.find_first_not_of(' ');
@@ -89,12 +82,12 @@ std::string FirmwareDetails(const exporter::ExportReport& r, const std::string& 
     dropped.push_back(text);
   }
   std::string out;
-  if (!dropped.empty()) out += "<p>Effects it has no parameter for (dropped):</p>\n" + List(dropped);
+  if (!dropped.empty()) out += "<p>Effects it has no parameter for (dropped):</p>\n" + HtmlList(dropped);
   std::vector<std::string> notes;  // those the file does not carry as comments
   for (const std::string& note : r.notes) {
     if (text.find("# " + note + "\n") == std::string::npos) notes.push_back(note);
   }
-  if (!notes.empty()) out += List(notes);
+  if (!notes.empty()) out += HtmlList(notes);
   return out;
 }
 
@@ -113,7 +106,7 @@ std::string FormatPart(const exporter::ExportPreview& p,
   } else {
     std::vector<std::string> lines;
     for (const std::string& line : p.output->lines) lines.push_back(Trimmed(line));
-    out += List(lines);
+    out += HtmlList(lines);
   }
   const std::size_t count = p.output->parameters ? p.output->parameters->parameters.size() : 0;
   out += "<p>The file" + (count > 0 ? " (" + std::to_string(count) + " parameters)" : std::string()) +

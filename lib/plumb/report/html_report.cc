@@ -70,12 +70,6 @@ std::string KeyRow(const std::string& what, const std::string& html) {
   return "<tr>" + Th(HtmlEscape(what)) + Td(html) + "</tr>\n";
 }
 
-std::string List(const std::vector<std::string>& items, const std::string& css_class = "") {
-  std::string out = css_class.empty() ? "<ul>\n" : "<ul class=\"" + css_class + "\">\n";
-  for (const auto& item : items) out += "<li>" + HtmlEscape(item) + "</li>\n";
-  return out + "</ul>\n";
-}
-
 std::string VecCells(const Vec3& v) { return TdNum(G3(v.x())) + TdNum(G3(v.y())) + TdNum(G3(v.z())); }
 
 std::string SiteSourceWords(const std::string& source) {
@@ -174,7 +168,7 @@ std::string InputSection(const InputSummary& in, const segmentation::Segmentatio
                                     " s, shortest kept " + G3(seg.report.min_still_s) + " s)";
   out += KeyRow("still segments", std::to_string(seg.segments.size()) + ", " + how);
   out += "</table>\n";
-  if (!in.warnings.empty()) out += "<p>Reader warnings:</p>\n" + List(in.warnings, "warn");
+  if (!in.warnings.empty()) out += "<p>Reader warnings:</p>\n" + HtmlList(in.warnings, "warn");
   return out;
 }
 
@@ -483,10 +477,10 @@ std::string DiagnosisSection(const diagnostics::Diagnosis* d, const std::string&
     notes.push_back(c.effect + ": " + why);
   }
   out += "</table>\n";
-  if (!notes.empty()) out += "<p>Not identifiable from this data (not absent):</p>\n" + List(notes);
+  if (!notes.empty()) out += "<p>Not identifiable from this data (not absent):</p>\n" + HtmlList(notes);
   std::vector<std::string> skipped;
   for (const auto& s : d->skipped) skipped.push_back(s.effect + ": " + s.reason);
-  if (!skipped.empty()) out += "<p>Not tested:</p>\n" + List(skipped, "muted");
+  if (!skipped.empty()) out += "<p>Not tested:</p>\n" + HtmlList(skipped, "muted");
   return out + NextCommandHtml(next_command);
 }
 
@@ -523,7 +517,7 @@ std::string WorstSection(const diagnostics::ResidualAnalysis& a) {
 std::string TailSection(const estimation::CalibrationResult& r, const PageExtras& extras) {
   std::string out;
   if (!r.fit.warnings.empty()) {
-    out += "<h2 id=\"warnings\">Warnings</h2>\n" + List(r.fit.warnings, "warn");
+    out += "<h2 id=\"warnings\">Warnings</h2>\n" + HtmlList(r.fit.warnings, "warn");
   }
   if (!extras.files.empty()) {
     out += "<h2 id=\"files\">Files</h2>\n<p>Written beside this page in its folder, for other "
@@ -539,6 +533,13 @@ std::string TailSection(const estimation::CalibrationResult& r, const PageExtras
 }  // namespace
 
 const char* PageStyle() { return kStyle; }
+
+std::string HtmlList(const std::vector<std::string>& items, const std::string& css_class) {
+  if (items.empty()) return "";
+  std::string out = css_class.empty() ? "<ul>\n" : "<ul class=\"" + css_class + "\">\n";
+  for (const auto& item : items) out += "<li>" + HtmlEscape(item) + "</li>\n";
+  return out + "</ul>\n";
+}
 
 std::string HtmlEscape(std::string_view text) {
   std::string out;

@@ -79,6 +79,9 @@ struct PageExtras {
 /// Escapes & < > " ' for HTML text and attribute values; invalid UTF-8 passes unchanged.
 std::string HtmlEscape(std::string_view text);
 
+/// `items` as an HTML list (each escaped), with `css_class` when given; "" for no items.
+std::string HtmlList(const std::vector<std::string>& items, const std::string& css_class = "");
+
 /// The CSS of plumb's pages (the calibration report, the study page).
 const char* PageStyle();
 
