@@ -1,6 +1,6 @@
 // Speed of the full calibration (SPEC section 7): imu_tk's own data (imu_tk takes about 1 s
 // of calibration on this kind of machine), mikoff's imu0 (bundled), and a simulated one-hour
-// 1 kHz session. Reading and segmentation are measured apart (io and segmentation benches)
+// 1 kHz session; the cost of many poses (BM_CalibratePoses/60 and /600). Reading and segmentation are measured apart (io and segmentation benches)
 // and, for the end-to-end figure, together in BM_EndToEndImuTk.
 //
 //   build/benchmarks/estimation/plumb_bench_estimation --benchmark_counters_tabular=true
@@ -42,6 +42,7 @@ void CalibrateSession(benchmark::State& state, const Session& s, const geo::Site
   state.counters["unknowns"] = static_cast<double>(r.calibration.observability.num_unknowns);
   state.counters["chi2_dof"] = r.fit.chi2_dof();
   state.counters["samples"] = static_cast<double>(s.series.size());
+  state.counters["iterations"] = r.fit.iterations;
 }
 
 void BM_CalibrateImuTk(benchmark::State& state) {
@@ -97,6 +98,21 @@ void BM_CalibrateSimulatedHour(benchmark::State& state) {
       sizeof(double) + 2 * sizeof(Vec3f) + sizeof(float));
 }
 BENCHMARK(BM_CalibrateSimulatedHour)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+/// The cost of poses (issue 14): N still poses of 57 s joined by 3 s turns at 100 Hz, the
+/// same 6000 samples per pose whatever N; 600 poses should cost at most 12 times 60 poses.
+void BM_CalibratePoses(benchmark::State& state) {
+  const auto poses = static_cast<int>(state.range(0));
+  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  opt.rate_hz = 100.0;
+  opt.truth = sim::RandomParameters(opt.model, 1.0, 3);
+  opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
+  opt.seed = 3;
+  const sim::Simulation sim = sim::Simulate(sim::MultiPose(poses, 57.0, 3.0, 3), opt);
+  CalibrateSession(state, sim.session, sim.site, 0.0);
+  state.counters["poses"] = poses;
+}
+BENCHMARK(BM_CalibratePoses)->Arg(60)->Arg(600)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 }  // namespace plumb

@@ -1,7 +1,7 @@
 // The bias wander's processes (estimation/noise_model.h): the Markov factors whiten simulated
 // processes, and the bridge mean and variance of a segment match a Monte Carlo of the process
-// between known ends; the Gauss-Markov bridge tends to the walk's for short segments; the
-// analysis that eliminates the wander states gives the dense analysis's covariance.
+// between known ends; the Gauss-Markov bridge tends to the walk's for short segments.
+// (The analysis that eliminates the wander states: elimination_test.cc.)
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -126,50 +126,6 @@ TEST(NoiseModel, WanderListsTheProcessesInStateOrder) {
   EXPECT_EQ(noise.Wander(false).size(), 1u);
 }
 
-
-TEST(WanderElimination, GivesTheDenseAnalysisCovariance) {
-  // The analysis with the wander states eliminated (solve.cc) against the dense one over every
-  // unknown: same rank, and the same covariance of the model parameters and attitudes.
-  const sim::SimulationOptions opt =
-      testing::TypicalMemsAt(geo::Site::At(51.64, -1.2, 100.0, "flags"), 31);
-  const sim::Simulation s = sim::Simulate(sim::MultiPose(10, 5.0, 2.0, 31), opt);
-  std::vector<StillSegment> segments = s.truth_segments;
-  for (auto& seg : segments) seg.known_R_n_b.reset();
-  CalibrationOptions options;
-  StillSet still = MakeStillSet(s.session.series, segments, true, true, options);
-  const NoiseModel noise = [&] {
-    NoiseModel n = EstimateNoise(s.session.series, still, true, options);
-    n.walk_acc.setConstant(1e-4);
-    n.walk_gyr.setConstant(2e-6);
-    n.instability_acc.setConstant(4e-4);
-    n.instability_gyr.setConstant(2e-5);
-    return n;
-  }();
-  model::ParameterBlocks theta = s.model.ZeroParameters();
-  const StartingValues start = Initialize(s.session.series, s.model, s.site.gravity(), true,
-                                          options.first_heading_deg, still, theta);
-  AssignHeadingGauge(still, true);
-  CalibrationProblem problem(s.session.series, s.model, s.site, std::move(still), std::move(theta),
-                             noise, start, options);
-  FitReport fit;
-  Solution solution = SolveWithGauge(problem, options, fit);
-  UnknownColumns columns;
-  double cost = 0;
-  const ObservabilityAnalysis eliminated =
-      AnalyseAt(problem, *solution.all_free.problem, options, columns, &cost, nullptr);
-  Eigen::MatrixXd J;
-  const ObservabilityAnalysis dense =
-      AnalyseAt(problem, *solution.all_free.problem, options, columns, &cost, nullptr, &J);
-  const auto n = static_cast<Eigen::Index>(columns.first_wander);
-  ASSERT_GT(columns.names.size(), columns.first_wander);  // there are wander states
-  EXPECT_EQ(eliminated.summary.rank + eliminated.summary.wander_states, dense.summary.rank);
-  const Eigen::MatrixXd a = eliminated.covariance, b = dense.covariance.topLeftCorner(n, n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (Eigen::Index j = 0; j < n; ++j) {
-      EXPECT_NEAR(a(i, j), b(i, j), 1e-6 * std::sqrt(b(i, i) * b(j, j))) << i << " " << j;
-    }
-  }
-}
 
 }  // namespace
 }  // namespace plumb::estimation

@@ -72,10 +72,12 @@ std::string FormatCombination(const Eigen::VectorXd& c, const std::vector<std::s
 
 ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
   const Eigen::Index n = in.J.cols();
+  const auto n_e = static_cast<Eigen::Index>(in.eliminated_names.size());
   ObservabilityAnalysis out;
-  out.summary.num_unknowns = static_cast<int>(n);
+  out.summary.num_unknowns = static_cast<int>(n + n_e);
+  out.summary.rank = static_cast<int>(n_e);
   out.covariance = Eigen::MatrixXd::Zero(n, n);
-  out.observable.assign(static_cast<std::size_t>(n), true);
+  out.observable.assign(static_cast<std::size_t>(n + n_e), true);
   if (n == 0) return out;
 
   // Column scaling: unit-norm columns; all-zero columns are unobservable by construction.
@@ -93,7 +95,7 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
   const double s_max = s.size() > 0 ? s[0] : 0.0;
   int rank = 0;
   while (rank < s.size() && s[rank] > in.rank_tolerance * s_max) ++rank;
-  out.summary.rank = rank;
+  out.summary.rank += rank;
   out.summary.smallest_kept = rank > 0 ? s[rank - 1] / s_max : 0.0;
   out.summary.largest_dropped = rank < s.size() ? s[rank] / s_max : 0.0;
 
@@ -109,15 +111,23 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
     out.observable[static_cast<std::size_t>(j)] = Ns.row(j).norm() < 1e-6;
   }
 
-  // Null directions in original units, in row-echelon form with model parameters first.
-  const Eigen::MatrixXd N = d.asDiagonal() * Ns;  // n x k
+  // Null directions in original units, with the eliminated unknowns' components after J's
+  // columns, in row-echelon form with model parameters first.
+  const Eigen::Index n_all = n + n_e;
+  Eigen::MatrixXd N(n_all, Ns.cols());
+  N.topRows(n) = d.asDiagonal() * Ns;
+  if (n_e > 0) N.bottomRows(n_e) = in.eliminated_response(N.topRows(n));
+  std::vector<std::string> names = in.names;
+  names.insert(names.end(), in.eliminated_names.begin(), in.eliminated_names.end());
+  std::vector<bool> is_model = in.is_model;
+  is_model.resize(static_cast<std::size_t>(n_all), false);
   std::vector<int> order;
   for (int pass = 0; pass < 2; ++pass) {
-    for (int j = 0; j < n; ++j) {
-      if (in.is_model[static_cast<std::size_t>(j)] == (pass == 0)) order.push_back(j);
+    for (int j = 0; j < n_all; ++j) {
+      if (is_model[static_cast<std::size_t>(j)] == (pass == 0)) order.push_back(j);
     }
   }
-  const Eigen::MatrixXd B = Rref(N.transpose(), order);  // k x n
+  const Eigen::MatrixXd B = Rref(N.transpose(), order);  // k x n_all
   for (Eigen::Index r = 0; r < B.rows(); ++r) {
     for (int j : order) {
       if (B(r, j) != 0.0) {
@@ -127,19 +137,19 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
     }
   }
   for (Eigen::Index r = 0; r < B.rows(); ++r) {
-    out.summary.unobservable.push_back(FormatCombination(B.row(r).transpose(), in.names, true));
+    out.summary.unobservable.push_back(FormatCombination(B.row(r).transpose(), names, true));
   }
 
   // Groups of model parameters joined by null directions that involve model parameters only.
-  std::vector<int> group(static_cast<std::size_t>(n), -1);
+  std::vector<int> group(static_cast<std::size_t>(n_all), -1);
   std::vector<std::vector<int>> rows_of_group;
   for (Eigen::Index r = 0; r < B.rows(); ++r) {
     std::vector<int> support;
     bool model_only = true;
-    for (int j = 0; j < n; ++j) {
+    for (int j = 0; j < n_all; ++j) {
       if (B(r, j) != 0.0) {
         support.push_back(j);
-        model_only = model_only && in.is_model[static_cast<std::size_t>(j)];
+        model_only = model_only && is_model[static_cast<std::size_t>(j)];
       }
     }
     if (!model_only || support.size() < 2) continue;
@@ -167,7 +177,7 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
   std::vector<Eigen::VectorXd> determined_vectors;  // over all n unknowns
   for (std::size_t g = 0; g < rows_of_group.size(); ++g) {
     if (rows_of_group[g].empty()) continue;
-    std::vector<int> support;
+    std::vector<int> support;  // model parameters only: all among J's columns
     for (int j = 0; j < n; ++j) {
       if (group[static_cast<std::size_t>(j)] == static_cast<int>(g)) support.push_back(j);
     }
@@ -187,10 +197,10 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
     std::vector<int> rev(support.size());
     std::iota(rev.rbegin(), rev.rend(), 0);  // pivots from the end: biases before matrices
     const Eigen::MatrixXd Cr = Rref(Cbasis.transpose(), rev);
-    std::vector<std::string> names;
+    std::vector<std::string> group_names;
     Eigen::VectorXd values(static_cast<Eigen::Index>(support.size()));
     for (std::size_t a = 0; a < support.size(); ++a) {
-      names.push_back(in.names[static_cast<std::size_t>(support[a])]);
+      group_names.push_back(in.names[static_cast<std::size_t>(support[a])]);
       values[static_cast<Eigen::Index>(a)] = in.values[static_cast<std::size_t>(support[a])];
     }
     for (Eigen::Index r = 0; r < Cr.rows(); ++r) {
@@ -198,10 +208,10 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
       Eigen::VectorXd c_full = Eigen::VectorXd::Zero(n);
       for (std::size_t a = 0; a < support.size(); ++a) c_full[support[a]] = c[static_cast<Eigen::Index>(a)];
       Combination comb;
-      comb.text = FormatCombination(c, names, false);
+      comb.text = FormatCombination(c, group_names, false);
       comb.value = c.dot(values);
       comb.sigma = std::sqrt(std::max(0.0, c_full.dot(out.covariance * c_full)));
-      comb.names = names;
+      comb.names = group_names;
       comb.coefficients.assign(c.data(), c.data() + c.size());
       out.summary.determined.push_back(comb);
       determined_vectors.push_back(c_full);

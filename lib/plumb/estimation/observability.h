@@ -17,6 +17,7 @@
 // sigma.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,14 +33,23 @@ struct ObservabilityInput {
   std::vector<double> values;        ///< n reported values (NaN for attitude increments)
   std::vector<bool> is_model;        ///< n flags: model parameter (true) or attitude (false)
   double rank_tolerance = 1e-9;      ///< relative singular-value threshold, (0, 1)
+  /// Unknowns eliminated before the analysis (a Schur complement: J is then the part of the
+  /// other columns their columns cannot absorb, solve.cc), which the data determines: each
+  /// counts in the rank and the unknowns, and the null directions show their components.
+  std::vector<std::string> eliminated_names;
+  /// Their components in null directions: from directions over J's n columns (n x k, original
+  /// units) to the eliminated unknowns' (eliminated_names.size() x k). Required when there
+  /// are eliminated names.
+  std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)> eliminated_response;
 };
 
 struct ObservabilityAnalysis {
   Observability summary;
-  Eigen::MatrixXd covariance;        ///< n x n, pseudo-inverse on the observed subspace
-  std::vector<bool> observable;      ///< n flags
-  /// One column per null direction: the row-echelon pivot (model parameters first), a set of
-  /// unknowns whose values, once held, make the rest observable.
+  Eigen::MatrixXd covariance;        ///< n x n (J's columns), pseudo-inverse on the observed subspace
+  std::vector<bool> observable;      ///< n flags (J's columns), then true per eliminated unknown
+  /// One column per null direction: the row-echelon pivot (model parameters first, then J's
+  /// other columns, then the eliminated ones), a set of unknowns whose values, once held, make
+  /// the rest observable.
   std::vector<int> pivots;
 };
 

@@ -4,12 +4,14 @@
 
 #include <Eigen/SVD>
 #include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <memory>
 #include <string>
 
 namespace plumb::estimation {
 
 void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& options,
-           FitReport& fit) {
+           FitReport& fit, bool refine) {
   ceres::Solver::Options solver_options;
   // Problems with bias-wander states have several unknowns per pose, most of them in a
   // banded chain: a sparse factorisation keeps their cost linear in the poses.
@@ -23,6 +25,10 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
   solver_options.function_tolerance = rough ? kRoughFunctionTolerance : options.function_tolerance;
   solver_options.parameter_tolerance = rough ? kRoughParameterTolerance : options.parameter_tolerance;
   solver_options.gradient_tolerance = kGradientTolerance;
+  // A solve that refines another starts next to the optimum: Gauss-Newton's full step is
+  // right there, and a trust region grown from Ceres's default (1e4, three times per step)
+  // would damp the weakly determined directions for several iterations.
+  if (refine) solver_options.initial_trust_region_radius = kRefineTrustRegion;
   solver_options.num_threads = 1;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
@@ -35,51 +41,95 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 
 namespace {
 
-/// The whitened Jacobian J = [J_a J_w] split at `first_wander`, and the projection P_w onto
-/// the range of the wander states' columns J_w, through the sparse Cholesky factor of
-/// J_w^T J_w (J_w has full column rank and a banded normal matrix: every state is tied to
-/// zero at t_ref by its Markov factors). (I - P_w) J_a is the part of J_a the wander states
-/// cannot absorb: its SVD gives the rank, null space and covariance of the other unknowns
-/// with the wander marginalised, as the full dense analysis would, at the cost of a banded
-/// factorisation instead of an SVD over every state. One step of iterative refinement (the
-/// corrected semi-normal equations) keeps it as accurate as a QR of J_w.
-class WanderElimination {
+/// Smallest pivot of the column-scaled normal matrix of the attitudes and wander states (unit
+/// diagonal) for them to be eliminated before the analysis: their columns then have singular
+/// values above about 1e-5 of a unit column, well inside what the corrected semi-normal
+/// equations resolve. Below it the analysis keeps the attitudes and decides their rank itself.
+constexpr double kEliminationPivot = 1e-10;
+
+/// The whitened Jacobian J = [J_k J_e] split at `first`, and the projection P_e onto the range
+/// of the eliminated columns J_e, through the sparse LDL^T factor of D J_e^T J_e D (D scales
+/// J_e's columns to unit norm; the factor is banded up to the model's few columns: every
+/// attitude is tied to its neighbours by the motion residuals, every wander state by its Markov
+/// factors). (I - P_e) J_k is the part of J_k the eliminated unknowns cannot absorb: its SVD
+/// gives the rank, null space and covariance of the kept unknowns with the eliminated ones
+/// marginalised (the Schur complement), as the dense analysis over every unknown would, at the
+/// cost of a banded factorisation instead of an SVD over every state. One step of iterative
+/// refinement (the corrected semi-normal equations) keeps it as accurate as a QR of J_e.
+class Elimination {
  public:
-  WanderElimination(const Eigen::SparseMatrix<double>& J, Eigen::Index first_wander)
-      : J_(J), first_(first_wander), J_w_(J.rightCols(J.cols() - first_wander)) {
-    chol_.compute(Eigen::SparseMatrix<double>(J_w_.transpose() * J_w_));
-    if (chol_.info() != Eigen::Success) {
-      throw Error("the bias-wander states are not determined by their factors (their normal "
-                  "matrix is not positive definite)");
-    }
+  /// Null when J_e's columns are not clearly independent (a pivot at or below `min_pivot`).
+  static std::unique_ptr<Elimination> Make(const Eigen::SparseMatrix<double>& J,
+                                           Eigen::Index first, double min_pivot) {
+    std::unique_ptr<Elimination> out(new Elimination(J, first));
+    const auto& ldlt = out->ldlt_;
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > min_pivot)) return nullptr;
+    return out;
   }
-  /// (I - P_w) A for a dense A with J's rows.
-  Eigen::MatrixXd Project(const Eigen::MatrixXd& A) const {
-    Eigen::MatrixXd X = chol_.solve(J_w_.transpose() * A);
-    Eigen::MatrixXd R = A - J_w_ * X;
-    X = chol_.solve(J_w_.transpose() * R);  // refinement
-    return R - J_w_ * X;
+  /// X minimising |A - J_e X| (eliminated unknowns in J's units), for a dense A with J's rows.
+  Eigen::MatrixXd Solve(const Eigen::MatrixXd& A) const {
+    return scale_.asDiagonal() * ScaledSolve(A);
   }
-  /// (I - P_w) J_a: rows x first_wander.
+  /// (I - P_e) A for a dense A with J's rows.
+  Eigen::MatrixXd Project(const Eigen::MatrixXd& A) const { return A - J_e_ * ScaledSolve(A); }
+  /// (I - P_e) J_k: rows x first.
   Eigen::MatrixXd Reduced() const { return Project(Eigen::MatrixXd(J_.leftCols(first_))); }
-  /// The diagonal of P_w at `rows`.
-  Eigen::VectorXd WanderLeverage(const std::vector<Eigen::Index>& rows) const {
-    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(J_.rows(), static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t i = 0; i < rows.size(); ++i) E(rows[i], static_cast<Eigen::Index>(i)) = 1.0;
-    const Eigen::MatrixXd P = E - Project(E);  // P_w E
+  /// The diagonal of P_e at `rows`, a panel of rows at a time.
+  Eigen::VectorXd Leverage(const std::vector<Eigen::Index>& rows) const {
+    constexpr std::size_t kPanel = 256;
     Eigen::VectorXd out(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      out[static_cast<Eigen::Index>(i)] = P(rows[i], static_cast<Eigen::Index>(i));
+    for (std::size_t at = 0; at < rows.size(); at += kPanel) {
+      const std::size_t m = std::min(kPanel, rows.size() - at);
+      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(J_.rows(), static_cast<Eigen::Index>(m));
+      for (std::size_t i = 0; i < m; ++i) E(rows[at + i], static_cast<Eigen::Index>(i)) = 1.0;
+      const Eigen::MatrixXd P = E - Project(E);  // P_e E
+      for (std::size_t i = 0; i < m; ++i) {
+        out[static_cast<Eigen::Index>(at + i)] = P(rows[at + i], static_cast<Eigen::Index>(i));
+      }
     }
     return out;
   }
 
  private:
+  Elimination(const Eigen::SparseMatrix<double>& J, Eigen::Index first)
+      : J_(J), first_(first), J_e_(J.rightCols(J.cols() - first)), scale_(J_e_.cols()) {
+    for (Eigen::Index c = 0; c < J_e_.cols(); ++c) {
+      const double norm = J_e_.col(c).norm();
+      scale_[c] = norm > 0 ? 1.0 / norm : 1.0;
+    }
+    J_e_ = J_e_ * scale_.asDiagonal();
+    ldlt_.compute(Eigen::SparseMatrix<double>(J_e_.transpose() * J_e_));
+  }
+  /// The scaled unknowns' least-squares solution, with one refinement step.
+  Eigen::MatrixXd ScaledSolve(const Eigen::MatrixXd& A) const {
+    Eigen::MatrixXd X = ldlt_.solve(J_e_.transpose() * A);
+    const Eigen::MatrixXd R = A - J_e_ * X;
+    X += ldlt_.solve(J_e_.transpose() * R);
+    return X;
+  }
+
   const Eigen::SparseMatrix<double>& J_;
   Eigen::Index first_;
-  Eigen::SparseMatrix<double> J_w_;
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> chol_;
+  Eigen::SparseMatrix<double> J_e_;  ///< J's eliminated columns, scaled to unit norm
+  Eigen::VectorXd scale_;            ///< D
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
 };
+
+/// The wander states alone eliminated (the attitudes not clearly determined): they always are.
+std::unique_ptr<Elimination> WanderElimination(const Eigen::SparseMatrix<double>& J,
+                                               Eigen::Index first_wander) {
+  auto out = Elimination::Make(J, first_wander, 0.0);
+  if (out == nullptr) {
+    throw Error("the bias-wander states are not determined by their factors (their normal "
+                "matrix is not positive definite)");
+  }
+  return out;
+}
+
+Eigen::Index ModelColumns(const UnknownColumns& columns) {
+  return static_cast<Eigen::Index>(
+      std::find(columns.is_model.begin(), columns.is_model.end(), false) - columns.is_model.begin());
+}
 
 }  // namespace
 
@@ -93,21 +143,44 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   in.values = columns.values;
   in.is_model = columns.is_model;
   in.rank_tolerance = options.rank_tolerance;
-  const auto n_w = static_cast<int>(columns.names.size() - columns.first_wander);
-  if (jacobian != nullptr || n_w == 0) {
+  const auto n = static_cast<Eigen::Index>(columns.names.size());
+  const auto first_wander = static_cast<Eigen::Index>(columns.first_wander);
+  const Eigen::Index n_m = ModelColumns(columns);
+  if (jacobian != nullptr || n_m == n) {
     in.J = calibration.Jacobian(problem, columns, cost, residuals);
     ObservabilityAnalysis out = AnalyseObservability(in);
     if (jacobian != nullptr) *jacobian = std::move(in.J);
     return out;
   }
   const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, cost, residuals);
-  in.J = WanderElimination(J, static_cast<Eigen::Index>(columns.first_wander)).Reduced();
-  in.names.resize(columns.first_wander);
-  in.values.resize(columns.first_wander);
-  in.is_model.resize(columns.first_wander);
+  // The attitudes and wander states eliminated together when the data determine the attitudes
+  // clearly (the cost is then linear in the poses), else the wander states alone.
+  std::unique_ptr<Elimination> elimination = Elimination::Make(J, n_m, kEliminationPivot);
+  Eigen::Index kept = n_m;
+  if (elimination == nullptr && first_wander < n) {
+    elimination = WanderElimination(J, first_wander);
+    kept = first_wander;
+  }
+  if (elimination == nullptr) {
+    in.J = Eigen::MatrixXd(J);
+    return AnalyseObservability(in);
+  }
+  in.J = elimination->Reduced();
+  in.names.resize(static_cast<std::size_t>(kept));
+  in.values.resize(static_cast<std::size_t>(kept));
+  in.is_model.resize(static_cast<std::size_t>(kept));
+  const Eigen::Index n_attitudes = first_wander - kept;
+  const Eigen::SparseMatrix<double> J_k = J.leftCols(kept);
+  if (n_attitudes > 0) {
+    in.eliminated_names.assign(columns.names.begin() + kept, columns.names.begin() + first_wander);
+    in.eliminated_response = [&](const Eigen::MatrixXd& directions) -> Eigen::MatrixXd {
+      // J_k x_k + J_e x_e = 0: x_e = -argmin |J_k x_k + J_e x_e|, its attitudes' rows.
+      return -elimination->Solve(J_k * directions).topRows(n_attitudes);
+    };
+  }
   ObservabilityAnalysis out = AnalyseObservability(in);
   // The wander states are always determined (their factors tie them down): counted apart.
-  out.summary.wander_states = n_w;
+  out.summary.wander_states = static_cast<int>(n - first_wander);
   return out;
 }
 
@@ -117,16 +190,21 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
   const UnknownColumns columns = calibration.Columns(problem);
   double cost = 0;
   const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, &cost, residuals);
-  // The projector onto range(J) is P_w (the wander columns' range) plus the projector U_r U_r^T
-  // onto the range of the reduced Jacobian M = (I - P_w) J_a, M's rank as the analysis
-  // decides it on unit-norm columns: h_ii = (P_w)_ii + |U_r^T e_i|^2.
-  const auto first = static_cast<Eigen::Index>(columns.first_wander);
+  // The projector onto range(J) is P_e (the eliminated columns' range) plus the projector
+  // U_r U_r^T onto the range of the reduced Jacobian M = (I - P_e) J_k, M's rank as the
+  // analysis decides it on unit-norm columns: h_ii = (P_e)_ii + |U_r^T e_i|^2.
+  const auto first_wander = static_cast<Eigen::Index>(columns.first_wander);
+  const Eigen::Index n_m = ModelColumns(columns);
   Eigen::MatrixXd M;
   Eigen::VectorXd h = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
-  if (first < J.cols()) {
-    const WanderElimination elimination(J, first);
-    M = elimination.Reduced();
-    h = elimination.WanderLeverage(rows);
+  std::unique_ptr<Elimination> elimination;
+  if (n_m < J.cols()) elimination = Elimination::Make(J, n_m, kEliminationPivot);
+  if (elimination == nullptr && first_wander < J.cols()) {
+    elimination = WanderElimination(J, first_wander);
+  }
+  if (elimination != nullptr) {
+    M = elimination->Reduced();
+    h = elimination->Leverage(rows);
   } else {
     M = Eigen::MatrixXd(J);
   }
@@ -165,7 +243,9 @@ Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOption
   out.all_free = calibration.Build({});
   if (!out.held_parameters.empty()) out.held = calibration.Build(out.held_parameters);
   if (!out.held_parameters.empty() || calibration.has_motion()) {
-    Solve(out.fitted(), false, options, fit);
+    // From the first solution (new motion weights), or again from the starting values with
+    // the null directions' pivots held.
+    Solve(out.fitted(), false, options, fit, out.held_parameters.empty());
   }
   return out;
 }

@@ -29,15 +29,19 @@ inline constexpr int kDenseUnknowns = 400;
 /// and parameter_tolerance apply to the final one).
 inline constexpr double kRoughFunctionTolerance = 1e-6;
 inline constexpr double kRoughParameterTolerance = 1e-8;
+/// Initial trust-region radius of a solve that refines another's solution (Ceres's default is
+/// 1e4): nearly Gauss-Newton, as a solve from next to the optimum can be; a step that fails
+/// shrinks it.
+inline constexpr double kRefineTrustRegion = 1e12;
 /// Gradient tolerance of every solve: small enough that the function and parameter
 /// tolerances decide convergence.
 inline constexpr double kGradientTolerance = 1e-14;
 
-/// One solve of `problem`; `rough` uses the rough tolerances. Adds its iterations to `fit`,
-/// records convergence and Ceres's brief report; throws plumb::Error when the solution is not
-/// usable.
+/// One solve of `problem`; `rough` uses the rough tolerances; `refine` says it starts from
+/// another solve's solution (kRefineTrustRegion). Adds its iterations to `fit`, records
+/// convergence and Ceres's brief report; throws plumb::Error when the solution is not usable.
 void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& options,
-           FitReport& fit);
+           FitReport& fit, bool refine = false);
 
 /// The observability analysis (observability.h) of `problem` at the current values: its free
 /// unknowns go to `columns`, the cost and whitened residuals (optional) to `cost` and
