@@ -48,17 +48,18 @@ std::string RunOnTerminal(const std::vector<std::string>& args, int& exit_code) 
 TEST(Progress, DrawnOnATerminalAndNeverIntoAFile) {
   TempDir dir;
   const std::string csv = dir.File("s.csv");
-  // 30 poses at 400 Hz: diagnose's probe fits take several seconds.
-  ASSERT_EQ(Plumb({"simulate", "--out", csv, "--poses", "30", "--rate", "400", "--seed", "4"}, dir)
+  // 150 poses at 400 Hz: each of diagnose's probe fits takes more than the second progress
+  // waits before it draws (about 2 s each on a 2 GHz core).
+  ASSERT_EQ(Plumb({"simulate", "--out", csv, "--poses", "150", "--rate", "400", "--seed", "4"}, dir)
                 .exit_code, 0);
   int code = -1;
-  const std::string terminal = RunOnTerminal({"diagnose", csv}, code);
+  const std::string terminal = RunOnTerminal({"diagnose", csv, "--confirm", "0"}, code);
   EXPECT_EQ(code, 0) << terminal;
   EXPECT_TRUE(Contains(terminal, "\r\033[Kplumb diagnose: probe fit")) << terminal;
   EXPECT_TRUE(Contains(terminal, " s\r\033[K")) << "the line is erased before the next text";
   EXPECT_TRUE(Contains(terminal, "plumb diagnose: ")) << terminal;
 
-  const ToolRun file = Plumb({"diagnose", csv}, dir);
+  const ToolRun file = Plumb({"diagnose", csv, "--confirm", "0"}, dir);
   EXPECT_EQ(file.exit_code, 0) << file.err;
   EXPECT_FALSE(Contains(file.err, "\033[K")) << file.err;
   EXPECT_FALSE(Contains(file.err, "probe fit")) << file.err;

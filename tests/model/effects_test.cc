@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/model/effects/accel_linear.h"
 #include "plumb/model/model.h"
 #include "plumb/model/registry.h"
 #include "support/effect_battery.h"
@@ -106,6 +107,28 @@ TEST(TimeOffset, FirstOrderShiftOfTheRate) {
   in.omega_b = Vec3(0.1, 0.0, 0.0);
   in.alpha_b = Vec3(3.0, 0.0, 0.0);
   EXPECT_NEAR(m.Predict(theta, in).gyr.x(), 0.1 + 3.0 * 0.002, 1e-15);
+}
+
+}  // namespace
+}  // namespace plumb::model
+
+namespace plumb::model {
+namespace {
+
+TEST(AccelLinearBlock, MatrixRowAndColumnNameTheEntryEachValueMoves) {
+  // The block layout of accel_linear.h, as SubtractForceJacobian reads it: value j moves
+  // F(MatrixRow(j), MatrixCol(j)) and nothing else.
+  for (const bool full : {false, true}) {
+    const int size = full ? accel_linear::kSizeFull : accel_linear::kSize;
+    for (int j = 0; j < size; ++j) {
+      if (j >= accel_linear::kBias && j < accel_linear::kLower) continue;
+      std::vector<double> block(static_cast<std::size_t>(size), 0.0);
+      block[static_cast<std::size_t>(j)] = 0.5;
+      Mat3 expected = Mat3::Identity();
+      expected(accel_linear::MatrixRow(j), accel_linear::MatrixCol(j)) += 0.5;
+      EXPECT_EQ(accel_linear::Matrix(block.data(), full), expected) << "value " << j;
+    }
+  }
 }
 
 }  // namespace

@@ -153,7 +153,8 @@ double VelocityDispersion(const estimation::ProbeJacobian& p) {
 /// Jacobian Z with their typical sizes (in the fit's units), LM (divided by the velocity
 /// residuals' dispersion when tested with them), evidence and significance.
 void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& source,
-               bool with_velocity, const ImuSeries& series, const DiagnoseOptions& options,
+               const estimation::JacobianRange& range, bool with_velocity,
+               const ImuSeries& series, const DiagnoseOptions& options,
                std::vector<Candidate>& candidates, std::vector<Eigen::MatrixXd>& bases) {
   const estimation::ProbeJacobian& p = *source.fit.probes;
   // N counts the observations: the bias-wander factors are priors, not measurements.
@@ -178,7 +179,7 @@ void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& sour
     typical.push_back(info.parameters[k].typical * scale);
     units.push_back(scale == 1.0 ? info.parameters[k].unit : std::string());
   }
-  const ScoreTestResult s = ScoreTest(p.r, p.J, Z, p.unknown_names, names, typical, options.score);
+  const ScoreTestResult s = ScoreTest(p.r, range, Z, p.unknown_names, names, typical, options.score);
   Candidate cand;
   cand.effect = c.name;
   cand.option = c.option;
@@ -308,16 +309,25 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
                               }))
                         : 0;
 
-  // 2. Score each candidate in its probe fit.
+  // 2. Score each candidate in its probe fit, whose Jacobian is factorised once.
+  const auto range_of = [&](const estimation::CalibrationResult* source) {
+    if (source == nullptr || !source->fit.probes) return std::unique_ptr<estimation::JacobianRange>();
+    return estimation::ProbeRange(*source->fit.probes, options.score.rank_tolerance);
+  };
+  const std::unique_ptr<estimation::JacobianRange> range = range_of(&fit);
+  const std::unique_ptr<estimation::JacobianRange> range_motion =
+      range_of(fit_motion ? &*fit_motion : nullptr);
   std::vector<Eigen::MatrixXd> bases;
   for (std::size_t ci = 0; ci < plan.tested.size(); ++ci) {
     const bool motion = plan.needs_motion[ci];
     const estimation::CalibrationResult* source =
         motion ? (fit_motion ? &*fit_motion : nullptr) : &fit;
-    if (source == nullptr || !source->fit.probes) {
+    const estimation::JacobianRange* source_range = motion ? range_motion.get() : range.get();
+    if (source_range == nullptr) {
       AddUnexcited(plan.tested[ci], d.candidates, bases);
     } else {
-      AddScored(plan.tested[ci], *source, motion, series, options, d.candidates, bases);
+      AddScored(plan.tested[ci], *source, *source_range, motion, series, options, d.candidates,
+                bases);
     }
   }
 

@@ -1,7 +1,6 @@
 // plumb/diagnostics/score_test.cc — see score_test.h.
 #include "plumb/diagnostics/score_test.h"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,27 +9,16 @@
 #include "plumb/core/error.h"
 
 namespace plumb::diagnostics {
-namespace {
-
-/// Orthonormal basis of the range of A (columns scaled to unit norm first), from the SVD;
-/// singular values below tolerance x the largest are dropped.
-Eigen::MatrixXd RangeBasis(const Eigen::MatrixXd& A, double tolerance) {
-  if (A.cols() == 0 || A.rows() == 0) return Eigen::MatrixXd(A.rows(), 0);
-  Eigen::MatrixXd scaled = A;
-  for (Eigen::Index c = 0; c < A.cols(); ++c) {
-    const double n = A.col(c).norm();
-    if (n > 0.0) scaled.col(c) /= n;
-  }
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinU);
-  const Eigen::VectorXd& s = svd.singularValues();
-  Eigen::Index rank = 0;
-  while (rank < s.size() && s(rank) > tolerance * s(0) && s(rank) > 0.0) ++rank;
-  return svd.matrixU().leftCols(rank);
+ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
+                          const Eigen::MatrixXd& Z, const std::vector<std::string>& j_names,
+                          const std::vector<std::string>& z_names,
+                          const std::vector<double>& z_typical, const ScoreTestOptions& options) {
+  if (J.rows() != r.size()) throw Error("ScoreTest: r, J and Z must have the same number of rows");
+  const estimation::JacobianRange range(J, options.rank_tolerance);
+  return ScoreTest(r, range, Z, j_names, z_names, z_typical, options);
 }
 
-}  // namespace
-
-ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
+ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const estimation::JacobianRange& J,
                           const Eigen::MatrixXd& Z, const std::vector<std::string>& j_names,
                           const std::vector<std::string>& z_names,
                           const std::vector<double>& z_typical, const ScoreTestOptions& options) {
@@ -43,8 +31,7 @@ ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
   }
   ScoreTestResult out;
   out.num_parameters = static_cast<int>(Z.cols());
-  const Eigen::MatrixXd Q = RangeBasis(J, options.rank_tolerance);
-  const Eigen::MatrixXd PZ = Z - Q * (Q.transpose() * Z);
+  const Eigen::MatrixXd PZ = J.Residual(Z);
 
   // Identifiability, column by column.
   std::vector<Eigen::Index> usable;
@@ -69,10 +56,10 @@ ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
     c.too_weak = excited && separate && !strong;
     if (excited && !separate && J.cols() > 0) {
       // Z_j ~ J coef: which unknowns make up the part of Z_j that the fit absorbs.
-      const Eigen::VectorXd coef = J.completeOrthogonalDecomposition().solve(Z.col(j));
+      const Eigen::VectorXd coef = J.Coefficients(Z.col(j));
       std::vector<double> part(static_cast<std::size_t>(J.cols()));
       for (Eigen::Index k = 0; k < J.cols(); ++k) {
-        part[static_cast<std::size_t>(k)] = std::abs(coef(k)) * J.col(k).norm();
+        part[static_cast<std::size_t>(k)] = std::abs(coef(k)) * J.ColumnNorm(k);
       }
       const double total = std::accumulate(part.begin(), part.end(), 0.0);
       std::vector<std::size_t> order(part.size());
@@ -92,7 +79,7 @@ ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
   if (!usable.empty()) {
     Eigen::MatrixXd PZu(PZ.rows(), static_cast<Eigen::Index>(usable.size()));
     for (std::size_t k = 0; k < usable.size(); ++k) PZu.col(static_cast<Eigen::Index>(k)) = PZ.col(usable[k]);
-    const Eigen::MatrixXd B = RangeBasis(PZu, options.identifiable_ratio);
+    const Eigen::MatrixXd B = estimation::RangeBasis(PZu, options.identifiable_ratio);
     out.dof = static_cast<int>(B.cols());
     out.lm = (B.transpose() * r).squaredNorm();
     out.basis = B;

@@ -26,6 +26,8 @@
 #include <string>
 #include <vector>
 
+#include "plumb/estimation/elimination.h"
+
 namespace plumb::diagnostics {
 
 struct ScoreTestOptions {
@@ -74,8 +76,17 @@ struct ScoreTestResult {
   Eigen::MatrixXd basis;
 };
 
-/// The score test for one candidate. `z_names` name Z's columns; `z_typical` their typical sizes
-/// (same order, > 0); `j_names` name J's columns. Throws plumb::Error on size mismatches.
+/// The score test for one candidate against the fit's Jacobian `J`, factorised once for all
+/// candidates of the same fit (estimation/elimination.h: the per-pose unknowns eliminated; P
+/// is formed from it with the rank tolerance it was built with). `z_names` name Z's columns;
+/// `z_typical` their typical sizes (same order, > 0); `j_names` name J's columns. Throws
+/// plumb::Error on size mismatches.
+ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const estimation::JacobianRange& J,
+                          const Eigen::MatrixXd& Z, const std::vector<std::string>& j_names,
+                          const std::vector<std::string>& z_names,
+                          const std::vector<double>& z_typical,
+                          const ScoreTestOptions& options = {});
+/// The same with a dense J, factorised here with options.rank_tolerance.
 ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,
                           const Eigen::MatrixXd& Z, const std::vector<std::string>& j_names,
                           const std::vector<std::string>& z_names,

@@ -38,6 +38,15 @@ Eigen::MatrixXd Dense(const ceres::CRSMatrix& crs) {
   return out;
 }
 
+/// Sparse (column-major) copy of a Ceres CRS matrix, which is Eigen's compressed row-major
+/// layout.
+Eigen::SparseMatrix<double> Sparse(const ceres::CRSMatrix& crs) {
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> rows(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
+      crs.cols.data(), crs.values.data());
+  return Eigen::SparseMatrix<double>(rows);
+}
+
 }  // namespace
 
 CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model model,
@@ -440,11 +449,7 @@ Eigen::SparseMatrix<double> CalibrationProblem::SparseJacobian(
   eval.parameter_blocks = columns.blocks;
   ceres::CRSMatrix crs;
   problem.Evaluate(eval, cost, residuals, nullptr, &crs);
-  // Ceres' CRS is Eigen's compressed row-major layout.
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> rows(
-      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
-      crs.cols.data(), crs.values.data());
-  return Eigen::SparseMatrix<double>(rows);
+  return Sparse(crs);
 }
 
 ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
@@ -489,11 +494,12 @@ ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
   std::vector<double> r;
   ceres::CRSMatrix crs;
   probe.problem->Evaluate(eval, nullptr, &r, nullptr, &crs);
-  const Eigen::MatrixXd all = Dense(crs);
+  const Eigen::SparseMatrix<double> all = Sparse(crs);
   const auto n_free = static_cast<Eigen::Index>(columns.names.size());
   out.r = Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
   out.J = all.leftCols(n_free);
-  out.Z = all.rightCols(all.cols() - n_free);
+  out.first_wander = columns.first_wander;
+  out.Z = Eigen::MatrixXd(all.rightCols(all.cols() - n_free));
   return out;
 }
 

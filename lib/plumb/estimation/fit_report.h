@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <limits>
 #include <optional>
 #include <string>
@@ -50,7 +51,10 @@ struct MotionFit {
 /// motion intervals; each row is labelled.
 struct ProbeJacobian {
   Eigen::VectorXd r;  ///< whitened residuals (measured minus predicted), dimensionless
-  Eigen::MatrixXd J;  ///< d r / d(free unknowns: model parameters, then attitude tangents)
+  /// d r / d(free unknowns: model parameters, then attitude tangents, then from first_wander
+  /// the bias-wander states); sparse (elimination.h's JacobianRange factorises it)
+  Eigen::SparseMatrix<double> J;
+  std::size_t first_wander = 0;
   Eigen::MatrixXd Z;  ///< d r / d(probe parameters) at zero
   std::vector<std::string> unknown_names;  ///< J's columns
   std::vector<bool> unknown_is_model;      ///< J's columns: model parameter (else attitude)

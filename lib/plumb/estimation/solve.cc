@@ -1,6 +1,7 @@
 #include "plumb/estimation/solve.h"
 
 #include "plumb/core/error.h"
+#include "plumb/estimation/elimination.h"
 
 #include <Eigen/SVD>
 #include <Eigen/SparseCholesky>
@@ -41,91 +42,6 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 
 namespace {
 
-/// Smallest pivot of the column-scaled normal matrix of the attitudes and wander states (unit
-/// diagonal) for them to be eliminated before the analysis: their columns then have singular
-/// values above about 1e-5 of a unit column, well inside what the corrected semi-normal
-/// equations resolve. Below it the analysis keeps the attitudes and decides their rank itself.
-constexpr double kEliminationPivot = 1e-10;
-
-/// The whitened Jacobian J = [J_k J_e] split at `first`, and the projection P_e onto the range
-/// of the eliminated columns J_e, through the sparse LDL^T factor of D J_e^T J_e D (D scales
-/// J_e's columns to unit norm; the factor is banded up to the model's few columns: every
-/// attitude is tied to its neighbours by the motion residuals, every wander state by its Markov
-/// factors). (I - P_e) J_k is the part of J_k the eliminated unknowns cannot absorb: its SVD
-/// gives the rank, null space and covariance of the kept unknowns with the eliminated ones
-/// marginalised (the Schur complement), as the dense analysis over every unknown would, at the
-/// cost of a banded factorisation instead of an SVD over every state. One step of iterative
-/// refinement (the corrected semi-normal equations) keeps it as accurate as a QR of J_e.
-class Elimination {
- public:
-  /// Null when J_e's columns are not clearly independent (a pivot at or below `min_pivot`).
-  static std::unique_ptr<Elimination> Make(const Eigen::SparseMatrix<double>& J,
-                                           Eigen::Index first, double min_pivot) {
-    std::unique_ptr<Elimination> out(new Elimination(J, first));
-    const auto& ldlt = out->ldlt_;
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > min_pivot)) return nullptr;
-    return out;
-  }
-  /// X minimising |A - J_e X| (eliminated unknowns in J's units), for a dense A with J's rows.
-  Eigen::MatrixXd Solve(const Eigen::MatrixXd& A) const {
-    return scale_.asDiagonal() * ScaledSolve(A);
-  }
-  /// (I - P_e) A for a dense A with J's rows.
-  Eigen::MatrixXd Project(const Eigen::MatrixXd& A) const { return A - J_e_ * ScaledSolve(A); }
-  /// (I - P_e) J_k: rows x first.
-  Eigen::MatrixXd Reduced() const { return Project(Eigen::MatrixXd(J_.leftCols(first_))); }
-  /// The diagonal of P_e at `rows`, a panel of rows at a time.
-  Eigen::VectorXd Leverage(const std::vector<Eigen::Index>& rows) const {
-    constexpr std::size_t kPanel = 256;
-    Eigen::VectorXd out(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t at = 0; at < rows.size(); at += kPanel) {
-      const std::size_t m = std::min(kPanel, rows.size() - at);
-      Eigen::MatrixXd E = Eigen::MatrixXd::Zero(J_.rows(), static_cast<Eigen::Index>(m));
-      for (std::size_t i = 0; i < m; ++i) E(rows[at + i], static_cast<Eigen::Index>(i)) = 1.0;
-      const Eigen::MatrixXd P = E - Project(E);  // P_e E
-      for (std::size_t i = 0; i < m; ++i) {
-        out[static_cast<Eigen::Index>(at + i)] = P(rows[at + i], static_cast<Eigen::Index>(i));
-      }
-    }
-    return out;
-  }
-
- private:
-  Elimination(const Eigen::SparseMatrix<double>& J, Eigen::Index first)
-      : J_(J), first_(first), J_e_(J.rightCols(J.cols() - first)), scale_(J_e_.cols()) {
-    for (Eigen::Index c = 0; c < J_e_.cols(); ++c) {
-      const double norm = J_e_.col(c).norm();
-      scale_[c] = norm > 0 ? 1.0 / norm : 1.0;
-    }
-    J_e_ = J_e_ * scale_.asDiagonal();
-    ldlt_.compute(Eigen::SparseMatrix<double>(J_e_.transpose() * J_e_));
-  }
-  /// The scaled unknowns' least-squares solution, with one refinement step.
-  Eigen::MatrixXd ScaledSolve(const Eigen::MatrixXd& A) const {
-    Eigen::MatrixXd X = ldlt_.solve(J_e_.transpose() * A);
-    const Eigen::MatrixXd R = A - J_e_ * X;
-    X += ldlt_.solve(J_e_.transpose() * R);
-    return X;
-  }
-
-  const Eigen::SparseMatrix<double>& J_;
-  Eigen::Index first_;
-  Eigen::SparseMatrix<double> J_e_;  ///< J's eliminated columns, scaled to unit norm
-  Eigen::VectorXd scale_;            ///< D
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
-};
-
-/// The wander states alone eliminated (the attitudes not clearly determined): they always are.
-std::unique_ptr<Elimination> WanderElimination(const Eigen::SparseMatrix<double>& J,
-                                               Eigen::Index first_wander) {
-  auto out = Elimination::Make(J, first_wander, 0.0);
-  if (out == nullptr) {
-    throw Error("the bias-wander states are not determined by their factors (their normal "
-                "matrix is not positive definite)");
-  }
-  return out;
-}
-
 Eigen::Index ModelColumns(const UnknownColumns& columns) {
   return static_cast<Eigen::Index>(
       std::find(columns.is_model.begin(), columns.is_model.end(), false) - columns.is_model.begin());
@@ -155,16 +71,12 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, cost, residuals);
   // The attitudes and wander states eliminated together when the data determine the attitudes
   // clearly (the cost is then linear in the poses), else the wander states alone.
-  std::unique_ptr<Elimination> elimination = Elimination::Make(J, n_m, kEliminationPivot);
-  Eigen::Index kept = n_m;
-  if (elimination == nullptr && first_wander < n) {
-    elimination = WanderElimination(J, first_wander);
-    kept = first_wander;
-  }
+  const std::unique_ptr<Elimination> elimination = EliminatePoses(J, n_m, first_wander);
   if (elimination == nullptr) {
     in.J = Eigen::MatrixXd(J);
     return AnalyseObservability(in);
   }
+  const Eigen::Index kept = elimination->first();
   in.J = elimination->Reduced();
   in.names.resize(static_cast<std::size_t>(kept));
   in.values.resize(static_cast<std::size_t>(kept));
@@ -193,15 +105,10 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
   // The projector onto range(J) is P_e (the eliminated columns' range) plus the projector
   // U_r U_r^T onto the range of the reduced Jacobian M = (I - P_e) J_k, M's rank as the
   // analysis decides it on unit-norm columns: h_ii = (P_e)_ii + |U_r^T e_i|^2.
-  const auto first_wander = static_cast<Eigen::Index>(columns.first_wander);
-  const Eigen::Index n_m = ModelColumns(columns);
   Eigen::MatrixXd M;
   Eigen::VectorXd h = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
-  std::unique_ptr<Elimination> elimination;
-  if (n_m < J.cols()) elimination = Elimination::Make(J, n_m, kEliminationPivot);
-  if (elimination == nullptr && first_wander < J.cols()) {
-    elimination = WanderElimination(J, first_wander);
-  }
+  const std::unique_ptr<Elimination> elimination =
+      EliminatePoses(J, ModelColumns(columns), static_cast<Eigen::Index>(columns.first_wander));
   if (elimination != nullptr) {
     M = elimination->Reduced();
     h = elimination->Leverage(rows);

@@ -214,6 +214,27 @@ std::pair<Vec3T<T>, Vec3T<T>> Model::Correct(const T* const* theta, const Vec3T<
                  iterations + 1);
 }
 
+std::pair<Vec3, Vec3> Model::CorrectToFixedPoint(const double* const* theta, const Vec3& y_a,
+                                                 const Vec3& y_g, SensorInput<double> in,
+                                                 const Mat3& F_inv, const Mat3& E_inv,
+                                                 int max_steps, double tolerance) const {
+  const bool gyro = has_gyro();
+  in.f_b.setZero();
+  in.omega_b.setZero();
+  for (int it = 0; it < max_steps; ++it) {
+    const SensorOutput<double> out = Predict(theta, in);
+    const Vec3 df = F_inv * (y_a - out.acc);
+    const Vec3 dw = gyro ? Vec3(E_inv * (y_g - out.gyr)) : Vec3::Zero();
+    in.f_b += df;
+    in.omega_b += dw;
+    if (df.norm() <= tolerance * std::max(in.f_b.norm(), 1e-300) &&
+        dw.norm() <= tolerance * std::max(in.omega_b.norm(), 1e-300)) {
+      break;
+    }
+  }
+  return {in.f_b, in.omega_b};
+}
+
 SensorOutput<double> Model::Predict(const ParameterBlocks& theta,
                                     const SensorInput<double>& in) const {
   std::vector<const double*> ptr;

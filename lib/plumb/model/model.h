@@ -99,6 +99,14 @@ class Model {
                                         const Mat3T<T>& F_inv, const Mat3T<T>& E_inv,
                                         int steps) const;
 
+  /// The same on doubles, Newton steps until a step moves f_b and omega_b by at most
+  /// `tolerance` times their size (or 1e-300), at most `max_steps`: the fixed point
+  /// y = Predict(theta, x) to rounding, for implicit derivatives of the correction.
+  std::pair<Vec3, Vec3> CorrectToFixedPoint(const double* const* theta, const Vec3& y_a,
+                                            const Vec3& y_g, SensorInput<double> in,
+                                            const Mat3& F_inv, const Mat3& E_inv, int max_steps,
+                                            double tolerance) const;
+
   /// Convenience: the same on double blocks.
   SensorOutput<double> Predict(const ParameterBlocks& theta, const SensorInput<double>& in) const;
   std::pair<Vec3, Vec3> Correct(const ParameterBlocks& theta, const Vec3& y_a, const Vec3& y_g,

@@ -1,7 +1,9 @@
 #include "plumb/residuals/motion_residual.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "plumb/core/so3.h"
 #include "plumb/model/effects/gyro_linear.h"
@@ -9,6 +11,21 @@
 namespace plumb::residuals {
 using so3::Skew;
 namespace {
+
+/// Newton steps of the general model's correction, at most: each shrinks the error by about
+/// twice the relative size of the nonlinear effects (a 1e-3 scale nonlinearity at 5 rad/s:
+/// 1e-2), so they reach the fixed point to rounding (kNewtonTolerance, relative) and the
+/// implicit derivative is the derivative of the rates computed.
+constexpr int kNewtonSteps = 8;
+constexpr double kNewtonTolerance = 1e-15;
+
+/// Whether some term of `model` writes the accelerometer's output.
+bool HasAccelTerms(const model::Model& model) {
+  for (const auto& t : model.terms()) {
+    if (t.effect->info().sensor == model::Sensor::kAccel) return true;
+  }
+  return false;
+}
 
 }  // namespace
 
@@ -83,23 +100,29 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
     return;
   }
 
-  // General model: Model::Correct (Newton on the forward model), with Jets for dw/dtheta.
-  auto correct = [&](auto const* const* th, const auto& Finv, const auto& Einv, std::size_t i) {
-    using T = std::decay_t<decltype(Finv(0, 0))>;
-    model::SensorInput<T> in;
-    in.alpha_b = s_.alpha_b[i].cast<T>();
-    in.dt_s = T(s_.dt_s[i]);
-    in.dtemp_c = T(s_.dtemp_c[i]);
-    return model_->Correct<T>(th, s_.acc[i].cast<T>(), gyr[i].cast<T>(), in, Finv, Einv, 3)
-        .second;
-  };
-  for (std::size_t i = 0; i < n; ++i) (*w)[i] = correct(theta, F_inv, E_inv, i);
+  // General model: Model::Correct (Newton on the forward model). Its rates satisfy
+  // y = Predict(theta, x), x = (f, w), so dw/dtheta is implicit: with D_x = d Predict / d x
+  // (6 x 6) and D_theta = d Predict / d theta from one Jet pass of the forward model each,
+  // dx/dtheta = -D_x^-1 D_theta (instead of Jets through every Newton step). The rates are
+  // taken to the fixed point (kNewtonSteps) so that this is their derivative.
+  std::vector<Vec3> f(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    model::SensorInput<double> in;
+    in.alpha_b = s_.alpha_b[i];
+    in.dt_s = s_.dt_s[i];
+    in.dtemp_c = s_.dtemp_c[i];
+    std::tie(f[i], (*w)[i]) = model_->CorrectToFixedPoint(theta, s_.acc[i], gyr[i], in, F_inv,
+                                                          E_inv, kNewtonSteps, kNewtonTolerance);
+  }
   if (!W) return;
   using Jet = model::Jet;
   constexpr int kStride = model::kJetStride;
+  static_assert(kStride >= 6, "one Jet pass differentiates the six inputs");
+  const bool accel = HasAccelTerms(*model_);
+  // theta as Jets: constants, or the chunk [chunk, chunk + kStride) of the P parameters.
   std::vector<std::vector<Jet>> blocks(static_cast<std::size_t>(model_->num_terms()));
   std::vector<const Jet*> ptr(blocks.size());
-  for (int chunk = 0; chunk < P; chunk += kStride) {
+  auto set_theta = [&](int chunk) {
     for (int t = 0; t < model_->num_terms(); ++t) {
       const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
       auto& b = blocks[static_cast<std::size_t>(t)];
@@ -107,16 +130,53 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
       for (int j = 0; j < size; ++j) {
         const int global = block_offset_[static_cast<std::size_t>(t)] + j;
         b[static_cast<std::size_t>(j)] = Jet(theta[t][j]);
-        if (global >= chunk && global < chunk + kStride) b[static_cast<std::size_t>(j)].v[global - chunk] = 1.0;
+        if (chunk >= 0 && global >= chunk && global < chunk + kStride) {
+          b[static_cast<std::size_t>(j)].v[global - chunk] = 1.0;
+        }
       }
       ptr[static_cast<std::size_t>(t)] = b.data();
     }
-    const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), model::SensorInput<Jet>());
-    const Mat3T<Jet> Fi = z.F.inverse(), Ei = z.E.inverse();
+  };
+  auto input = [&](std::size_t i, bool differentiate) {
+    model::SensorInput<Jet> in;
+    for (int k = 0; k < 3; ++k) {
+      in.f_b[k] = Jet(f[i][k]);
+      in.omega_b[k] = Jet((*w)[i][k]);
+      in.alpha_b[k] = Jet(s_.alpha_b[i][k]);
+      if (differentiate) {
+        in.f_b[k].v[k] = 1.0;
+        in.omega_b[k].v[3 + k] = 1.0;
+      }
+    }
+    in.dt_s = Jet(s_.dt_s[i]);
+    in.dtemp_c = Jet(s_.dtemp_c[i]);
+    return in;
+  };
+  // -D_x^-1 per sample (without accelerometer terms f is the output itself: d f = 0).
+  std::vector<Eigen::Matrix<double, 6, 6>> minus_inv_D_x(n);
+  set_theta(-1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), input(i, true));
+    Eigen::Matrix<double, 6, 6> D;
+    for (int r = 0; r < 3; ++r) {
+      D.row(r) = z.acc[r].v.head<6>().transpose();
+      D.row(3 + r) = z.gyr[r].v.head<6>().transpose();
+    }
+    if (!accel) D.topRows<3>() << Mat3::Identity(), Mat3::Zero();
+    minus_inv_D_x[i] = -D.partialPivLu().inverse();
+  }
+  for (int chunk = 0; chunk < P; chunk += kStride) {
+    set_theta(chunk);
     const int width = std::min(kStride, P - chunk);
     for (std::size_t i = 0; i < n; ++i) {
-      const Vec3T<Jet> wj = correct(ptr.data(), Fi, Ei, i);
-      for (int r = 0; r < 3; ++r) (*W)[i].block(r, chunk, 1, width) = wj[r].v.head(width).transpose();
+      const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), input(i, false));
+      Eigen::Matrix<double, 6, kStride> D_theta;
+      for (int r = 0; r < 3; ++r) {
+        D_theta.row(r) = z.acc[r].v.transpose();  // zero without accelerometer terms
+        D_theta.row(3 + r) = z.gyr[r].v.transpose();
+      }
+      (*W)[i].middleCols(chunk, width) =
+          (minus_inv_D_x[i].bottomRows<3>() * D_theta).leftCols(width);
     }
   }
 }
@@ -130,11 +190,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   double const* const* theta = parameters + 2;
   const bool want_jacobians = jacobians != nullptr;
   const int P = num_model_parameters_;
-  // Unknowns: model parameters, the left perturbation of R_k, then (wander) b_from and b_to.
   const bool walk = wander_ > 0;
-  const int U = P + 3 + (walk ? 6 : 0);
-  const int att = P;      // column of R_k's perturbation
-  const int from = P + 3;  // columns of b_from, then b_to
 
   // The outputs with the bias walk taken off (the samples themselves without a walk).
   std::vector<Vec3> walked;
@@ -168,8 +224,15 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
       E_inv = model_->Predict(theta, model::SensorInput<double>()).E.inverse();
     }
   }
-  // Adds K dw_i/dtheta to the first P columns of `out` and, with a walk, K dw_i/d b_from and
-  // K dw_i/d b_to (d w_i / d b_g weighted by 1 - a_i and a_i) to the walk's columns.
+  // Columns of the propagated sensitivities: the model parameters that move the rates (all P
+  // in general; in closed form the gyroscope's linear block only, the others' columns being
+  // zero), the left perturbation of R_k, then (wander) b_from and b_to.
+  const int rate_cols = !closed_form ? P : gyro_offset >= 0 ? model::gyro_linear::kSize : 0;
+  const int att = rate_cols;
+  const int from = rate_cols + 3;
+  const int U = rate_cols + 3 + (walk ? 6 : 0);
+  // Adds K dw_i/dtheta to the first rate_cols columns of `out` and, with a walk, K dw_i/d
+  // b_from and K dw_i/d b_to (d w_i / d b_g weighted by 1 - a_i and a_i) to the walk's columns.
   auto add_rate_jacobian = [&](const Mat3& K, std::size_t i,
                                Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
     if (!closed_form) {
@@ -183,8 +246,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     }
     if (gyro_offset < 0) return;
     const Mat3 KE_inv = K * E_inv;
-    model::gyro_linear::SubtractRateJacobian(
-        KE_inv, w[i], out.middleCols(gyro_offset, model::gyro_linear::kSize));
+    model::gyro_linear::SubtractRateJacobian(KE_inv, w[i], out.leftCols(model::gyro_linear::kSize));
     if (walk) {
       out.middleCols<3>(from).noalias() -= (1.0 - a[i]) * KE_inv;
       out.middleCols<3>(from + 3).noalias() -= a[i] * KE_inv;
@@ -241,7 +303,9 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   };
   if (jacobians[0]) ambient(J_k, q_k, jacobians[0]);
   if (jacobians[1]) ambient(J_k1, q_k1, jacobians[1]);
-  const Eigen::Matrix<double, 3, Eigen::Dynamic> J_theta = Wsi * (-Jli * A.leftCols(P));
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J_theta = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, P);
+  J_theta.middleCols(closed_form ? std::max(gyro_offset, 0) : 0, rate_cols) =
+      Wsi * (-Jli * A.leftCols(rate_cols));
   for (int t = 0; t < model_->num_terms(); ++t) {
     double* out = jacobians[t + 2];
     if (!out) continue;

@@ -6,9 +6,13 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
+#include <memory>
 #include <utility>
 
 #include "plumb/core/so3.h"
+#include "plumb/model/effects/accel_linear.h"
+#include "plumb/model/effects/gyro_linear.h"
+#include "plumb/residuals/motion_residual.h"
 
 namespace plumb::residuals {
 
@@ -18,18 +22,64 @@ VelocityResidual::VelocityResidual(const model::Model& model, MotionSamples samp
     : model_(&model), s_(std::move(samples)), g_n_(g_n), omega_ie_n_(omega_ie_n),
       sqrt_info_(sqrt_info), accel_wander_(accel_wander), gyro_wander_(gyro_wander) {}
 
+namespace {
+
+/// The velocity residual's cost function: analytic where the model acts as its linear stage,
+/// central differences elsewhere (file comment).
+class VelocityCost final : public ceres::CostFunction {
+ public:
+  explicit VelocityCost(std::unique_ptr<VelocityResidual> functor) : functor_(functor.get()) {
+    auto numeric = std::make_unique<
+        ceres::DynamicNumericDiffCostFunction<VelocityResidual, ceres::CENTRAL>>(functor.release());
+    numeric->SetNumResiduals(3);
+    numeric_ = std::move(numeric);
+    set_num_residuals(3);
+  }
+  void AddParameterBlock(int size) {
+    mutable_parameter_block_sizes()->push_back(size);
+    static_cast<ceres::DynamicNumericDiffCostFunction<VelocityResidual, ceres::CENTRAL>*>(
+        numeric_.get())->AddParameterBlock(size);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    if (jacobians == nullptr) return (*functor_)(parameters, residuals);
+    if (!functor_->LinearAt(parameters)) {
+      return numeric_->Evaluate(parameters, residuals, jacobians);
+    }
+    // The other effects at zero: analytic columns for the rest, central differences for
+    // theirs when they are asked for (diagnose's probe columns).
+    const std::size_t blocks = parameter_block_sizes().size();
+    std::vector<double*> linear(jacobians, jacobians + blocks);
+    std::vector<double*> other(blocks, nullptr);
+    bool any_other = false;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      if (linear[b] != nullptr && !functor_->IsLinearBlock(b)) {
+        std::swap(linear[b], other[b]);
+        any_other = true;
+      }
+    }
+    functor_->EvaluateLinear(parameters, residuals, linear.data());
+    double unused[3];
+    return !any_other || numeric_->Evaluate(parameters, unused, other.data());
+  }
+
+ private:
+  const VelocityResidual* functor_;             // owned by numeric_
+  std::unique_ptr<ceres::CostFunction> numeric_;
+};
+
+}  // namespace
+
 ceres::CostFunction* VelocityResidual::Create(const model::Model& model, MotionSamples samples,
                                               const Vec3& g_n, const Vec3& omega_ie_n,
                                               const Vec3& sqrt_info, int accel_wander,
                                               int gyro_wander) {
-  auto* functor = new VelocityResidual(model, std::move(samples), g_n, omega_ie_n, sqrt_info,
-                                       accel_wander, gyro_wander);
-  auto* cost = new ceres::DynamicNumericDiffCostFunction<VelocityResidual, ceres::CENTRAL>(functor);
+  auto cost = std::make_unique<VelocityCost>(std::make_unique<VelocityResidual>(
+      model, std::move(samples), g_n, omega_ie_n, sqrt_info, accel_wander, gyro_wander));
   cost->AddParameterBlock(4);
   for (const auto& t : model.terms()) cost->AddParameterBlock(t.effect->info().size());
   for (int p = 0; p < 2 * (accel_wander + gyro_wander); ++p) cost->AddParameterBlock(3);
-  cost->SetNumResiduals(3);
-  return cost;
+  return cost.release();
 }
 
 namespace {
@@ -97,6 +147,146 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
   }
   const double T = s_.dt_s[n - 1] - s_.dt_s[0];
   return dv + R_b_n * g_n_ * T;
+}
+
+bool VelocityResidual::IsLinearBlock(std::size_t block) const {
+  const auto t = static_cast<int>(block) - 1;  // q_k, then the model's terms, then the wander
+  return t < 0 || t >= model_->num_terms() ||
+         model_->terms()[static_cast<std::size_t>(t)].effect->info().linear_stage;
+}
+
+bool VelocityResidual::LinearAt(double const* const* parameters) const {
+  for (int t = 0; t < model_->num_terms(); ++t) {
+    const auto& info = model_->terms()[static_cast<std::size_t>(t)].effect->info();
+    if (info.linear_stage) continue;
+    for (int j = 0; j < info.size(); ++j) {
+      if (parameters[1 + t][j] != 0.0) return false;
+    }
+  }
+  return true;
+}
+
+void VelocityResidual::EvaluateLinear(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  const Quat q_k(parameters[0][3], parameters[0][0], parameters[0][1], parameters[0][2]);
+  const Mat3 R_b_n = q_k.normalized().toRotationMatrix().transpose();
+  double const* const* theta = parameters + 1;
+  const model::SensorOutput<double> linear = model_->Predict(theta, model::SensorInput<double>());
+  const Mat3 F_inv = linear.F.inverse();
+  const Mat3 E_inv = linear.E.inverse();
+  const Vec3 b_a = linear.acc, b_g = linear.gyr;
+  const std::size_t n = s_.size();
+  // Columns of the unknowns: the model's P parameters (block by block), the left perturbation
+  // of R_k, then the wander's ends: accelerometer from, to, gyroscope from, to (every process
+  // of a sensor has the same columns).
+  std::vector<int> offset;
+  int P = 0;
+  for (const auto& t : model_->terms()) {
+    offset.push_back(P);
+    P += t.effect->info().size();
+  }
+  const int att = P, acc_from = P + 3, acc_to = P + 6, gyr_from = P + 9, gyr_to = P + 12;
+  const int U = P + 15;
+  const int a_term = model_->BaseTerm(model::Sensor::kAccel);
+  const int g_term = model_->BaseTerm(model::Sensor::kGyro);
+  double const* const* wander = theta + model_->num_terms();
+  const auto [acc0, acc1] = WanderEnds(wander, accel_wander_);
+  const auto [gyr0, gyr1] = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
+  const double t0 = n > 0 ? s_.dt_s[0] : 0.0;
+  const double span = n > 0 ? std::max(s_.dt_s[n - 1] - t0, 1e-12) : 1.0;
+  struct Sample {
+    Vec3 f, w;
+    double u;
+  };
+  auto correct = [&](std::size_t i) {
+    const double u = (s_.dt_s[i] - t0) / span;
+    return Sample{F_inv * (s_.acc[i] - (acc0 + u * (acc1 - acc0)) - b_a),
+                  E_inv * (s_.gyr[i] - (gyr0 + u * (gyr1 - gyr0)) - b_g), u};
+  };
+  using Cols = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+  // Adds K d w / dx (rate) or K d f / dx (force) of sample `x` to `out`.
+  auto add_rate = [&](const Mat3& K, const Sample& x, Cols& out) {
+    if (g_term < 0) return;
+    const Mat3 KE_inv = K * E_inv;
+    model::gyro_linear::SubtractRateJacobian(
+        KE_inv, x.w, out.middleCols(offset[static_cast<std::size_t>(g_term)], model::gyro_linear::kSize));
+    out.middleCols<3>(gyr_from).noalias() -= (1.0 - x.u) * KE_inv;
+    out.middleCols<3>(gyr_to).noalias() -= x.u * KE_inv;
+  };
+  auto force_jacobian = [&](const Sample& x) {
+    Cols out = Cols::Zero(3, U);
+    if (a_term >= 0) {
+      const int size = model_->terms()[static_cast<std::size_t>(a_term)].effect->info().size();
+      model::accel_linear::SubtractForceJacobian(
+          F_inv, x.f, size == model::accel_linear::kSizeFull,
+          out.middleCols(offset[static_cast<std::size_t>(a_term)], size));
+    }
+    out.middleCols<3>(acc_from) -= (1.0 - x.u) * F_inv;
+    out.middleCols<3>(acc_to) -= x.u * F_inv;
+    return out;
+  };
+
+  const Vec3 omega_k = R_b_n * omega_ie_n_;
+  const Mat3 d_omega_k = R_b_n * so3::Skew(omega_ie_n_);  // d omega_k / d delta_k
+  Mat3 dR = Mat3::Identity();
+  Vec3 dv = Vec3::Zero();
+  // A: d(right perturbation of dR_i)/dx; D: d(dR_i f_i)/dx; B: d(dv)/dx (file comment).
+  Cols A = Cols::Zero(3, U), A_next(3, U), B = Cols::Zero(3, U);
+  Sample x0 = n > 0 ? correct(0) : Sample{Vec3::Zero(), Vec3::Zero(), 0.0};
+  Cols D0 = n > 0 ? force_jacobian(x0) : Cols::Zero(3, U);
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const double h = s_.dt_s[i + 1] - s_.dt_s[i];
+    const Sample x1 = correct(i + 1);
+    const Vec3 e = dR.transpose() * omega_k;
+    const Vec3 u0 = x0.w - e, u1 = x1.w - e;
+    const Vec3 phi = so3::ConingIncrement(u0, u1, h);
+    const Mat3 Ex = so3::Exp(phi);
+    const Mat3 dR_next = dR * Ex;
+    dv += 0.5 * h * (dR * x0.f + dR_next * x1.f);
+    const Mat3 Jr = so3::RightJacobian(phi);
+    const Mat3 K0 = Jr * (0.5 * h * Mat3::Identity() - (h * h / 12.0) * so3::Skew(u1));
+    const Mat3 K1 = Jr * (0.5 * h * Mat3::Identity() + (h * h / 12.0) * so3::Skew(u0));
+    const Mat3 K = K0 + K1;
+    A_next.noalias() = (Ex.transpose() - K * so3::Skew(e)) * A;
+    add_rate(K0, x0, A_next);
+    add_rate(K1, x1, A_next);
+    A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
+    Cols D1 = force_jacobian(x1);
+    D1.noalias() -= so3::Skew(x1.f) * A_next;
+    D1 = dR_next * D1;
+    B += 0.5 * h * (D0 + D1);
+    D0.swap(D1);
+    A.swap(A_next);
+    dR = dR_next;
+    x0 = x1;
+  }
+  const double T = n > 0 ? s_.dt_s[n - 1] - s_.dt_s[0] : 0.0;
+  const Vec3 r = n < 2 ? Vec3::Zero() : Vec3(dv + R_b_n * g_n_ * T);
+  if (n >= 2) B.middleCols<3>(att) += R_b_n * so3::Skew(g_n_) * T;
+  else B.setZero();
+  const Eigen::DiagonalMatrix<double, 3> W(sqrt_info_);
+  for (int k = 0; k < 3; ++k) residuals[k] = sqrt_info_[k] * r[k];
+  const Cols J = W * B;
+  using RowMajor = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
+  if (jacobians[0] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>> out(jacobians[0]);
+    out = J.middleCols<3>(att) * 4.0 * LeftPlusJacobian(q_k).transpose();
+  }
+  for (int t = 0; t < model_->num_terms(); ++t) {
+    if (jacobians[1 + t] == nullptr) continue;
+    const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
+    Eigen::Map<RowMajor>(jacobians[1 + t], 3, size) = J.middleCols(offset[static_cast<std::size_t>(t)], size);
+  }
+  const int first_wander = 1 + model_->num_terms();
+  for (int b = 0; b < 2 * (accel_wander_ + gyro_wander_); ++b) {
+    double* out = jacobians[first_wander + b];
+    if (out == nullptr) continue;
+    const bool accel = b < 2 * accel_wander_;
+    const bool to = b % 2 == 1;
+    const int col = accel ? (to ? acc_to : acc_from) : (to ? gyr_to : gyr_from);
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> J_out(out);
+    J_out = J.middleCols<3>(col);
+  }
 }
 
 bool VelocityResidual::operator()(double const* const* parameters, double* residuals) const {

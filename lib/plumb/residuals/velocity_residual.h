@@ -24,8 +24,14 @@
 // outputs before the correction: y(t) - (b_from + (b_to - b_from) (t - t_0) / T). (The bridge
 // about that line is in sqrt_info.)
 //
-// Jacobians: central differences (ceres::DynamicNumericDiffCostFunction), one pass over the
-// samples per parameter: the backend adds these residuals only when the model has an effect
+// Jacobians: analytic where the model acts as its linear stage (every other effect at zero:
+// the base model, and diagnose's probe fits, whose probe columns alone are then
+// differentiated numerically), in the same pass:
+// with A_i the right-perturbation sensitivity of dR_i (propagated as in MotionResidual) and
+// df_i/dx closed-form (f = F^-1 (y_a - b_a): d f / d F_rc = -F^-1 e_r f_c, d f / d b_a = -F^-1),
+//   d(dR_i f_i) = dR_i (d f_i - [f_i]x A_i dx),   d(R_k^T g_n T) / d delta_k = R_k^T [g_n]x T.
+// Otherwise central differences (ceres::DynamicNumericDiffCostFunction), one pass over the
+// samples per parameter. The backend adds these residuals only when the model has an effect
 // that needs them (EffectInfo::excitation.angular_acceleration).
 //
 // Parameter blocks, in order: q_k (4, R_n_b in Eigen order x y z w), then every block of the
@@ -48,8 +54,8 @@ class VelocityResidual {
                    const Vec3& omega_ie_n, const Vec3& sqrt_info, int accel_wander = 0,
                    int gyro_wander = 0);
 
-  /// The cost function (numeric differentiation over q_k, every model block and the wander
-  /// blocks).
+  /// The cost function (analytic Jacobians at the linear stage, else numeric differentiation
+  /// over q_k, every model block and the wander blocks).
   static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
                                      const Vec3& g_n, const Vec3& omega_ie_n,
                                      const Vec3& sqrt_info, int accel_wander = 0,
@@ -60,6 +66,17 @@ class VelocityResidual {
 
   /// The velocity change sum (unwhitened, m/s, body frame of k).
   Vec3 VelocityChange(double const* const* parameters) const;
+
+  /// True when the model acts as its linear stage at `parameters`: every other effect is at
+  /// zero.
+  bool LinearAt(double const* const* parameters) const;
+  /// Whether parameter block `block` is q_k, a linear-stage term's or a wander block: the
+  /// blocks EvaluateLinear differentiates.
+  bool IsLinearBlock(std::size_t block) const;
+  /// r and its analytic Jacobians (Ceres's layout: row-major, ambient for q_k; null blocks
+  /// skipped) where LinearAt holds (the other terms' blocks must be null).
+  void EvaluateLinear(double const* const* parameters, double* residuals,
+                      double** jacobians) const;
 
  private:
   const model::Model* model_;

@@ -9,6 +9,7 @@
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/elimination.h"
 #include "plumb/estimation/sensitivity.h"
 #include "plumb/paper/backend.h"
 #include "plumb/paper/benchmark.h"
@@ -226,7 +227,7 @@ std::vector<double> MissingEffectSensitivity(const std::string& parameter, const
   const auto col = std::find(pj.probe_names.begin(), pj.probe_names.end(), parameter);
   if (col == pj.probe_names.end()) throw Error("study: '" + parameter + "' is not a probe's parameter");
   const Eigen::VectorXd z = pj.Z.col(col - pj.probe_names.begin());
-  const Eigen::VectorXd d = pj.J.completeOrthogonalDecomposition().solve(z);
+  const Eigen::VectorXd d = estimation::ProbeRange(pj, options.rank_tolerance)->Coefficients(z);
   std::vector<double> out(rows.size(), kNaN);
   for (std::size_t c = 0; c < pj.unknown_names.size(); ++c) {
     const auto row = std::find(rows.begin(), rows.end(), pj.unknown_names[c]);

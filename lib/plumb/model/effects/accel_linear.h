@@ -44,6 +44,25 @@ inline Vec3 Bias(const std::vector<double>& block) {
   return Vec3(block[kBias + 0], block[kBias + 1], block[kBias + 2]);
 }
 
+/// Row and column of F that block value j (< kSizeFull, not a bias) moves.
+inline constexpr int MatrixRow(int j) { return j < 3 ? 0 : j < 5 ? 1 : j < kBias ? 2 : j == kLower ? 1 : 2; }
+inline constexpr int MatrixCol(int j) {
+  return j < 3 ? j : j < 5 ? j - 2 : j < kBias ? 2 : j == kLower + 2 ? 1 : 0;
+}
+
+/// The corrected specific force of the base model is f = F^-1 (y_a - b_a), so
+///   d f / d F_rc = -F^-1 e_r f_c,   d f / d b_a = -F^-1.
+/// Subtracts K d f / d block from the block's columns `cols` (3 x kSize, or kSizeFull with
+/// `full`), given KF_inv = K F^-1 and f.
+template <class Columns>
+void SubtractForceJacobian(const Mat3& KF_inv, const Vec3& f, bool full, Columns&& cols) {
+  for (int j = 0; j < (full ? kSizeFull : kSize); ++j) {
+    if (j >= kBias && j < kLower) continue;
+    cols.col(j) -= KF_inv.col(MatrixRow(j)) * f[MatrixCol(j)];
+  }
+  cols.template middleCols<3>(kBias) -= KF_inv;
+}
+
 /// Sets the block to F = scale I (off-diagonals zero) and b_a = bias: the starting values of
 /// the fit (estimation/initialization.h).
 inline void SetIsotropic(std::vector<double>& block, double scale, const Vec3& bias) {

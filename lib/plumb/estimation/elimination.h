@@ -1,0 +1,111 @@
+// plumb/estimation/elimination.h — the structure of a calibration's whitened Jacobian, used so
+// that the analysis costs grow linearly in the poses.
+//
+// The unknowns are the model's parameters (a few dozen, in every residual), then per pose an
+// attitude (3) and the bias-wander states (up to 24), each tied only to its neighbours by the
+// motion residuals and the Markov factors. Split J = [J_k J_e] with J_e those per-pose
+// columns: the projection onto their range, P_e = J_e (J_e^T J_e)^-1 J_e^T, needs only a
+// sparse (banded, after ordering) LDL^T factorisation of J_e^T J_e, and
+//
+//   M = (I - P_e) J_k          (rows x kept columns, dense but narrow)
+//
+// carries everything the kept unknowns can still be told by: its SVD gives their rank, null
+// space and marginal covariance (M^T M is the Schur complement of J^T J on them), and
+// range(J) = range(J_e) + range(M), orthogonal. So the observability analysis (solve.h) and
+// the score tests of diagnose (diagnostics/score_test.h) need a factorisation linear in the
+// poses and an SVD of M, never an SVD over every unknown.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
+
+#include "plumb/estimation/fit_report.h"
+
+namespace plumb::estimation {
+
+/// Smallest pivot of the column-scaled normal matrix of the per-pose columns (unit diagonal)
+/// for them to be eliminated: their singular values are then above about 1e-5 of a unit
+/// column, well inside what the corrected semi-normal equations resolve. Below it (e.g. an
+/// attitude the data barely determine) the analysis keeps those columns and decides their
+/// rank itself.
+inline constexpr double kEliminationPivot = 1e-10;
+
+/// Columns [first, n) of a whitened Jacobian J = [J_k J_e], eliminated: the projection P_e onto
+/// range(J_e) through the sparse LDL^T factor of D J_e^T J_e D (D scales J_e's columns to unit
+/// norm), with one step of iterative refinement (the corrected semi-normal equations), which
+/// keeps it as accurate as a QR of J_e.
+class Elimination {
+ public:
+  /// Null when J_e's columns are not clearly independent (a pivot at or below `min_pivot`).
+  /// `J` must outlive the result.
+  static std::unique_ptr<Elimination> Make(const Eigen::SparseMatrix<double>& J,
+                                           Eigen::Index first, double min_pivot);
+  /// X minimising |A - J_e X| (the eliminated unknowns in J's units), for a dense A with J's rows.
+  Eigen::MatrixXd Solve(const Eigen::MatrixXd& A) const;
+  /// (I - P_e) A for a dense A with J's rows.
+  Eigen::MatrixXd Project(const Eigen::MatrixXd& A) const;
+  /// M = (I - P_e) J_k: rows x first.
+  Eigen::MatrixXd Reduced() const;
+  /// The diagonal of P_e at `rows`.
+  Eigen::VectorXd Leverage(const std::vector<Eigen::Index>& rows) const;
+  Eigen::Index first() const { return first_; }
+
+ private:
+  Elimination(const Eigen::SparseMatrix<double>& J, Eigen::Index first);
+  Eigen::MatrixXd ScaledSolve(const Eigen::MatrixXd& A) const;
+
+  const Eigen::SparseMatrix<double>& J_;
+  Eigen::Index first_;
+  Eigen::SparseMatrix<double> J_e_;  ///< J's eliminated columns, scaled to unit norm
+  Eigen::VectorXd scale_;            ///< D
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+};
+
+/// The per-pose columns of `J` eliminated: attitudes and wander together (from column
+/// `model_columns`) when the data determine the attitudes clearly, else the wander alone (from
+/// `first_wander`; throws plumb::Error when even they are not determined), else none (null).
+std::unique_ptr<Elimination> EliminatePoses(const Eigen::SparseMatrix<double>& J,
+                                            Eigen::Index model_columns, Eigen::Index first_wander);
+
+/// Orthonormal basis of the range of A, its columns scaled to unit norm first, from the thin
+/// SVD; singular values at or below `tolerance` times the largest (or zero) are dropped.
+Eigen::MatrixXd RangeBasis(const Eigen::MatrixXd& A, double tolerance);
+
+/// The range of a whitened Jacobian J, for projecting other columns off it and for
+/// least-squares coefficients on it, factorised once (diagnose scores every candidate against
+/// the same fit). Sparse J: the per-pose columns are eliminated (EliminatePoses); dense J:
+/// the SVD of all of it.
+class JacobianRange {
+ public:
+  /// `rank_tolerance`: relative singular value of the column-scaled M below which a direction
+  /// is not in the range (the fit's rank tolerance), in (0, 1).
+  JacobianRange(Eigen::SparseMatrix<double> J, Eigen::Index model_columns,
+                Eigen::Index first_wander, double rank_tolerance);
+  JacobianRange(const Eigen::MatrixXd& J, double rank_tolerance);
+  JacobianRange(const JacobianRange&) = delete;  // the elimination refers to J_
+  JacobianRange& operator=(const JacobianRange&) = delete;
+
+  Eigen::Index rows() const { return J_.rows(); }
+  Eigen::Index cols() const { return J_.cols(); }
+  /// (I - P_J) Z: what of Z's columns the fit cannot absorb.
+  Eigen::MatrixXd Residual(const Eigen::MatrixXd& Z) const;
+  /// The least-squares coefficients c of J c ~ z, one per column of J.
+  Eigen::VectorXd Coefficients(const Eigen::VectorXd& z) const;
+  /// |J_k|, the norm of column k.
+  double ColumnNorm(Eigen::Index k) const { return J_.col(k).norm(); }
+
+ private:
+  Eigen::SparseMatrix<double> J_;
+  std::unique_ptr<Elimination> elimination_;  ///< null: M = J
+  Eigen::MatrixXd M_;                         ///< (I - P_e) J_k
+  Eigen::MatrixXd Q_;                         ///< orthonormal basis of range(M)
+};
+
+/// The range of a probe fit's Jacobian over its free unknowns (diagnose's score tests, the
+/// studies' missing-effect sensitivities).
+std::unique_ptr<JacobianRange> ProbeRange(const ProbeJacobian& probes, double rank_tolerance);
+
+}  // namespace plumb::estimation
