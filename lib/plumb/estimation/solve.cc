@@ -29,7 +29,7 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
   // A solve that refines another starts next to the optimum: Gauss-Newton's full step is
   // right there, and a trust region grown from Ceres's default (1e4, three times per step)
   // would damp the weakly determined directions for several iterations.
-  if (refine) solver_options.initial_trust_region_radius = kRefineTrustRegion;
+  solver_options.initial_trust_region_radius = refine ? kRefineTrustRegion : kStartTrustRegion;
   solver_options.num_threads = 1;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;

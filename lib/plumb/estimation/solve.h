@@ -29,6 +29,10 @@ inline constexpr int kDenseUnknowns = 400;
 /// and parameter_tolerance apply to the final one).
 inline constexpr double kRoughFunctionTolerance = 1e-6;
 inline constexpr double kRoughParameterTolerance = 1e-8;
+/// Initial trust-region radius of a solve from the starting values (initialization.h: closed
+/// forms and a scale search, within a few percent): Ceres's default of 1e4 took two to three
+/// more iterations on sessions of many poses, growing threefold per step.
+inline constexpr double kStartTrustRegion = 1e6;
 /// Initial trust-region radius of a solve that refines another's solution (Ceres's default is
 /// 1e4): nearly Gauss-Newton, as a solve from next to the optimum can be; a step that fails
 /// shrinks it.
