@@ -122,6 +122,12 @@ void CalibrationProblem::SetMotionSamples() {
   for (const auto& mo : still_.motions) {
     residuals::MotionSamples ms;
     std::vector<Vec3> dy;
+    const std::size_t n = mo.last + 1 - mo.first;
+    ms.dt_s.reserve(n);
+    ms.acc.reserve(n);
+    ms.gyr.reserve(n);
+    ms.dtemp_c.reserve(n);
+    dy.reserve(n);
     for (std::size_t i = mo.first; i <= mo.last; ++i) {
       ms.dt_s.push_back(series.t_s[i] - model_.t_ref_s);
       ms.acc.push_back(series.acc[i].cast<double>());
@@ -132,7 +138,7 @@ void CalibrationProblem::SetMotionSamples() {
       dy.push_back(h > 0 ? Vec3((series.gyr[b] - series.gyr[a]).cast<double>() / h) : Vec3::Zero());
     }
     ms.alpha_b.resize(dy.size());
-    motion_samples_.push_back(std::move(ms));
+    motion_samples_.push_back(std::make_shared<residuals::MotionSamples>(std::move(ms)));
     output_rate_.push_back(std::move(dy));
   }
 }
@@ -147,20 +153,20 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
   const Mat3 E_inv = E.inverse();
   const Mat3 F_inv = F.inverse();
   const Mat3 cov_f = F_inv * noise_.sigma_acc.cwiseAbs2().asDiagonal() * F_inv.transpose();
-  for (std::size_t k = 0; k < motions.size(); ++k) {
-    for (std::size_t i = 0; i < output_rate_[k].size(); ++i) {
-      motion_samples_[k].alpha_b[i] = E_inv * output_rate_[k][i];
-    }
-  }
   const Mat3 cov_rate = E_inv * noise_.sigma_gyr.cwiseAbs2().asDiagonal() * E_inv.transpose();
   const double g = site_.gravity();
   for (std::size_t k = 0; k < motions.size(); ++k) {
+    // New samples (problems built before keep reading theirs).
+    auto samples = std::make_shared<residuals::MotionSamples>(*motion_samples_[k]);
+    for (std::size_t i = 0; i < output_rate_[k].size(); ++i) {
+      samples->alpha_b[i] = E_inv * output_rate_[k][i];
+    }
     const auto& mo = motions[k];
     const double steps = static_cast<double>(mo.last - mo.first);
     const double dt = (series_.t_s[mo.last] - series_.t_s[mo.first]) / std::max(1.0, steps);
     for (int i = 0; i < 3; ++i) {
       const double sigma_rate = std::sqrt(cov_rate(i, i));  // rad/s per sample
-      motion_samples_[k].sqrt_info[i] =
+      samples->sqrt_info[i] =
           1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * noise_.tau_gyr[i]));
     }
     // Each gyroscope wander process about the line from e_k to s_k+1 integrates to an angle:
@@ -169,10 +175,11 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
     // (exact for T << tau; turns last seconds, correlation times tens of seconds and more).
     const double T = series_.t_s[mo.last] - series_.t_s[mo.first];
     for (std::size_t p : WanderOf(model::Sensor::kGyro)) {
-      AddVariance(motion_samples_[k].sqrt_info, E_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
+      AddVariance(samples->sqrt_info, E_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
     }
     // Quantisation: the integrated angle carries 2 Q^2 (noise_model.h).
-    AddVariance(motion_samples_[k].sqrt_info, E_inv, 2.0 * noise_.quantisation_gyr.cwiseAbs2());
+    AddVariance(samples->sqrt_info, E_inv, 2.0 * noise_.quantisation_gyr.cwiseAbs2());
+    motion_samples_[k] = std::move(samples);
     const double n = std::max(1.0, steps);
     const double var_w = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();
     const Vec3 d = start_.Down(still_.poses[mo.from]);
@@ -549,7 +556,7 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     double w[3];
     problem.EvaluateResidualBlock(built.motion[k], false, nullptr, w, nullptr);
     f.whitened = Vec3(w[0], w[1], w[2]);
-    f.rotation_residual = f.whitened.cwiseQuotient(motion_samples_[k].sqrt_info);
+    f.rotation_residual = f.whitened.cwiseQuotient(motion_samples_[k]->sqrt_info);
     ss_mot += f.rotation_residual.cwiseAbs2();
     if (k < built.velocity.size()) {
       problem.EvaluateResidualBlock(built.velocity[k], false, nullptr, w, nullptr);

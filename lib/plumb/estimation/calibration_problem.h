@@ -180,7 +180,9 @@ class CalibrationProblem {
   bool has_gyro_ = false;
   bool still_gyro_ = false;   // still gyroscope residuals are used
   bool velocity_on_ = false;  // velocity residuals are used
-  std::vector<residuals::MotionSamples> motion_samples_;
+  /// Per motion: its samples, shared by the residuals of every problem built (SetMotionWeights
+  /// replaces them rather than changing what a built problem reads).
+  std::vector<residuals::SharedMotionSamples> motion_samples_;
   std::vector<std::vector<Vec3>> output_rate_;  // per motion, per sample: d y_g / dt, units/s
   std::vector<Vec3> velocity_info_;             // per motion: 1 / sigma of the velocity residual
   std::vector<double> saved_values_;

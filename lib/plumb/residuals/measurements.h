@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "plumb/core/types.h"
@@ -26,5 +27,8 @@ struct MotionSamples {
   Vec3 sqrt_info = Vec3::Ones(); ///< 1 / sigma of the rotation residual per axis, 1/rad
   std::size_t size() const { return dt_s.size(); }
 };
+
+/// Motion samples shared by the residuals of every problem built on them (they are only read).
+using SharedMotionSamples = std::shared_ptr<const MotionSamples>;
 
 }  // namespace plumb::residuals

@@ -41,9 +41,10 @@ Eigen::Matrix<double, 4, 3> LeftPlusJacobian(const Quat& q) {
   return P;
 }
 
-MotionResidual::MotionResidual(const model::Model& model, MotionSamples samples,
+MotionResidual::MotionResidual(const model::Model& model, SharedMotionSamples samples,
                                const Vec3& omega_ie_n, int wander_processes)
-    : model_(&model), s_(std::move(samples)), omega_ie_n_(omega_ie_n), wander_(wander_processes) {
+    : model_(&model), samples_(std::move(samples)), s_(*samples_), omega_ie_n_(omega_ie_n),
+      wander_(wander_processes) {
   for (const auto& t : model.terms()) {
     block_offset_.push_back(num_model_parameters_);
     num_model_parameters_ += t.effect->info().size();
@@ -264,10 +265,11 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   //        - [0 | J_r (C0 + C1) dR^T d omega_k].
   Eigen::Matrix<double, 3, Eigen::Dynamic> A = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, U);
   Eigen::Matrix<double, 3, Eigen::Dynamic> A_next(3, U);
+  const bool earth = omega_ie_n_.squaredNorm() > 0.0;  // without a site: e = 0, no att terms
   for (std::size_t i = 0; i + 1 < s_.size(); ++i) {
     const double h = s_.dt_s[i + 1] - s_.dt_s[i];
     // Earth rate at the start of the step, held over the step.
-    const Vec3 e = dR.transpose() * omega_k;
+    const Vec3 e = earth ? Vec3(dR.transpose() * omega_k) : Vec3::Zero();
     const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
     const Vec3 phi = so3::ConingIncrement(u0, u1, h);
     const Mat3 Ex = so3::Exp(phi);
@@ -275,12 +277,15 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
       const Mat3 Jr = so3::RightJacobian(phi);
       const Mat3 K0 = Jr * (0.5 * h * Mat3::Identity() - (h * h / 12.0) * Skew(u1));
       const Mat3 K1 = Jr * (0.5 * h * Mat3::Identity() + (h * h / 12.0) * Skew(u0));
-      const Mat3 K = K0 + K1;
-      const Mat3 G = Ex.transpose() - K * Skew(e);
-      A_next.noalias() = G * A;
+      if (earth) {
+        const Mat3 K = K0 + K1;
+        A_next.noalias() = (Ex.transpose() - K * Skew(e)) * A;
+        A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
+      } else {
+        A_next.noalias() = Ex.transpose() * A;
+      }
       add_rate_jacobian(K0, i, A_next);
       add_rate_jacobian(K1, i + 1, A_next);
-      A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
       A.swap(A_next);
     }
     dR = dR * Ex;

@@ -36,6 +36,8 @@
 
 #include <ceres/cost_function.h>
 
+#include <memory>
+
 #include "plumb/model/model.h"
 #include "plumb/residuals/measurements.h"
 
@@ -45,9 +47,17 @@ class MotionResidual final : public ceres::CostFunction {
  public:
   /// `omega_ie_n`: Earth rate in NED, rad/s (zero without a site). The model must outlive
   /// the cost function.
-  MotionResidual(const model::Model& model, MotionSamples samples, const Vec3& omega_ie_n,
+  MotionResidual(const model::Model& model, SharedMotionSamples samples, const Vec3& omega_ie_n,
                  int wander_processes = 0);
+  MotionResidual(const model::Model& model, MotionSamples samples, const Vec3& omega_ie_n,
+                 int wander_processes = 0)
+      : MotionResidual(model, std::make_shared<const MotionSamples>(std::move(samples)),
+                       omega_ie_n, wander_processes) {}
 
+  static ceres::CostFunction* Create(const model::Model& model, SharedMotionSamples samples,
+                                     const Vec3& omega_ie_n, int wander_processes = 0) {
+    return new MotionResidual(model, std::move(samples), omega_ie_n, wander_processes);
+  }
   static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
                                      const Vec3& omega_ie_n, int wander_processes = 0) {
     return new MotionResidual(model, std::move(samples), omega_ie_n, wander_processes);
@@ -72,7 +82,8 @@ class MotionResidual final : public ceres::CostFunction {
                       std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const;
 
   const model::Model* model_;
-  MotionSamples s_;
+  SharedMotionSamples samples_;  // shared with the other problems built on the same samples
+  const MotionSamples& s_;
   Vec3 omega_ie_n_;
   int num_model_parameters_ = 0;
   std::vector<int> block_offset_;  // offset of each model block in the P parameters

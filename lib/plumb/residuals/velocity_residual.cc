@@ -16,10 +16,10 @@
 
 namespace plumb::residuals {
 
-VelocityResidual::VelocityResidual(const model::Model& model, MotionSamples samples,
+VelocityResidual::VelocityResidual(const model::Model& model, SharedMotionSamples samples,
                                    const Vec3& g_n, const Vec3& omega_ie_n,
                                    const Vec3& sqrt_info, int accel_wander, int gyro_wander)
-    : model_(&model), s_(std::move(samples)), g_n_(g_n), omega_ie_n_(omega_ie_n),
+    : model_(&model), samples_(std::move(samples)), s_(*samples_), g_n_(g_n), omega_ie_n_(omega_ie_n),
       sqrt_info_(sqrt_info), accel_wander_(accel_wander), gyro_wander_(gyro_wander) {}
 
 namespace {
@@ -70,7 +70,7 @@ class VelocityCost final : public ceres::CostFunction {
 
 }  // namespace
 
-ceres::CostFunction* VelocityResidual::Create(const model::Model& model, MotionSamples samples,
+ceres::CostFunction* VelocityResidual::Create(const model::Model& model, SharedMotionSamples samples,
                                               const Vec3& g_n, const Vec3& omega_ie_n,
                                               const Vec3& sqrt_info, int accel_wander,
                                               int gyro_wander) {

@@ -41,6 +41,8 @@
 
 #include <ceres/cost_function.h>
 
+#include <memory>
+
 #include "plumb/model/model.h"
 #include "plumb/residuals/measurements.h"
 
@@ -50,16 +52,28 @@ class VelocityResidual {
  public:
   /// `g_n` gravity in NED, m/s^2; `omega_ie_n` Earth rate in NED, rad/s; `sqrt_info` 1 / sigma_v
   /// per axis, s/m. The model must outlive the cost function.
-  VelocityResidual(const model::Model& model, MotionSamples samples, const Vec3& g_n,
+  VelocityResidual(const model::Model& model, SharedMotionSamples samples, const Vec3& g_n,
                    const Vec3& omega_ie_n, const Vec3& sqrt_info, int accel_wander = 0,
                    int gyro_wander = 0);
+  VelocityResidual(const model::Model& model, MotionSamples samples, const Vec3& g_n,
+                   const Vec3& omega_ie_n, const Vec3& sqrt_info, int accel_wander = 0,
+                   int gyro_wander = 0)
+      : VelocityResidual(model, std::make_shared<const MotionSamples>(std::move(samples)), g_n,
+                         omega_ie_n, sqrt_info, accel_wander, gyro_wander) {}
 
   /// The cost function (analytic Jacobians at the linear stage, else numeric differentiation
   /// over q_k, every model block and the wander blocks).
-  static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
+  static ceres::CostFunction* Create(const model::Model& model, SharedMotionSamples samples,
                                      const Vec3& g_n, const Vec3& omega_ie_n,
                                      const Vec3& sqrt_info, int accel_wander = 0,
                                      int gyro_wander = 0);
+  static ceres::CostFunction* Create(const model::Model& model, MotionSamples samples,
+                                     const Vec3& g_n, const Vec3& omega_ie_n,
+                                     const Vec3& sqrt_info, int accel_wander = 0,
+                                     int gyro_wander = 0) {
+    return Create(model, std::make_shared<const MotionSamples>(std::move(samples)), g_n,
+                  omega_ie_n, sqrt_info, accel_wander, gyro_wander);
+  }
 
   /// r (3 values, whitened) at the given blocks.
   bool operator()(double const* const* parameters, double* residuals) const;
@@ -80,7 +94,8 @@ class VelocityResidual {
 
  private:
   const model::Model* model_;
-  MotionSamples s_;
+  SharedMotionSamples samples_;  // shared with the other problems built on the same samples
+  const MotionSamples& s_;
   Vec3 g_n_, omega_ie_n_, sqrt_info_;
   int accel_wander_ = 0, gyro_wander_ = 0;  // wander processes; their block pairs follow the model's
 };
