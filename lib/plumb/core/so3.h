@@ -17,16 +17,16 @@ inline Mat3 Skew(const Vec3& v) {
   return S;
 }
 
-/// sin(a)/a and (1 - cos a)/a^2, by series below 0.05 rad (error < 1e-17) to avoid sincos
-/// on the many small steps of an integration.
-inline void ExpCoefficients(double a, double* A, double* B) {
-  if (a < 0.05) {
-    const double a2 = a * a;
+/// sin(a)/a and (1 - cos a)/a^2 from a2 = a^2, by series below 0.05 rad (error < 1e-17; no
+/// square root) to avoid sincos on the many small steps of an integration.
+inline void ExpCoefficients(double a2, double* A, double* B) {
+  if (a2 < 0.05 * 0.05) {
     *A = 1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0));
     *B = 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0));
   } else {
+    const double a = std::sqrt(a2);
     *A = std::sin(a) / a;
-    *B = (1.0 - std::cos(a)) / (a * a);
+    *B = (1.0 - std::cos(a)) / a2;
   }
 }
 
@@ -34,7 +34,7 @@ inline void ExpCoefficients(double a, double* A, double* B) {
 inline Mat3 Exp(const Vec3& phi) {
   const double a2 = phi.squaredNorm();
   double A, B;
-  ExpCoefficients(std::sqrt(a2), &A, &B);
+  ExpCoefficients(a2, &A, &B);
   // Rodrigues with S^2 = phi phi^T - |phi|^2 I.
   Mat3 R = B * (phi * phi.transpose());
   R.diagonal().array() += 1.0 - B * a2;
@@ -49,14 +49,17 @@ inline Mat3 Exp(const Vec3& phi) {
 
 /// Unit quaternion of Exp(phi).
 inline Quat ExpQuat(const Vec3& phi) {
-  const double a = phi.norm();
-  const double half = 0.5 * a;
-  // sin(a/2)/a by series for small angles.
-  const double x2 = half * half;
-  const double s = a < 0.05 ? 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
-                            : std::sin(half) / a;
-  const double c = a < 0.05 ? 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0)) : std::cos(half);
-  return Quat(c, s * phi.x(), s * phi.y(), s * phi.z());
+  const double a2 = phi.squaredNorm();
+  if (a2 < 0.05 * 0.05) {
+    // sin(a/2)/a and cos(a/2) by series for small angles (no square root).
+    const double x2 = 0.25 * a2;
+    const double s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)));
+    const double c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0));
+    return Quat(c, s * phi.x(), s * phi.y(), s * phi.z());
+  }
+  const double a = std::sqrt(a2);
+  const double s = std::sin(0.5 * a) / a;
+  return Quat(std::cos(0.5 * a), s * phi.x(), s * phi.y(), s * phi.z());
 }
 
 /// Rotation vector of R, rad, angle in [0, pi].
@@ -67,17 +70,16 @@ inline Vec3 Log(const Mat3& R) {
 
 /// Right Jacobian J_r(phi).
 inline Mat3 RightJacobian(const Vec3& phi) {
-  const double a = phi.norm();
+  const double a2 = phi.squaredNorm();
   const Mat3 S = Skew(phi);
-  if (a < 0.05) {
+  if (a2 < 0.05 * 0.05) {
     // (1 - cos a)/a^2 and (a - sin a)/a^3 by series (error < 1e-17).
-    const double a2 = a * a;
     const double B = 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0));
     const double C = 1.0 / 6.0 - a2 / 120.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0));
     return Mat3::Identity() - B * S + C * S * S;
   }
-  return Mat3::Identity() - (1 - std::cos(a)) / (a * a) * S +
-         (a - std::sin(a)) / (a * a * a) * S * S;
+  const double a = std::sqrt(a2);
+  return Mat3::Identity() - (1 - std::cos(a)) / a2 * S + (a - std::sin(a)) / (a2 * a) * S * S;
 }
 
 /// Rotation vector of one integration step of a rate varying linearly from u0 to u1 over h

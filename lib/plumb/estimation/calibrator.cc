@@ -134,8 +134,9 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   UnknownColumns columns;
   double cost = 0;
   std::vector<double> residual_values;
+  Eigen::SparseMatrix<double> J;  // at the solution, for the linearity check
   const ObservabilityAnalysis analysis = AnalyseAt(problem, *solution.all_free.problem, options,
-                                                   columns, &cost, &residual_values);
+                                                   columns, &cost, &residual_values, nullptr, &J);
   cal.observability = analysis.summary;
 
   // 6. Parameters and their covariance.
@@ -158,7 +159,12 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   if (cal.model.has_probes()) {
     fit.probes = problem.ProbeColumns(problem.Build({}, true), columns);
   }
-  if (options.check_linearity) fit.linearity = CheckLinearity(problem, solution.fitted(), solution.held_parameters);
+  if (options.check_linearity) {
+    // The analysis's Jacobian is the fitted problem's when no parameter is held.
+    const bool same = solution.held_parameters.empty();
+    fit.linearity = CheckLinearity(problem, solution.fitted(), solution.held_parameters,
+                                   kLinearityStepSigmas, same ? &J : nullptr, cost);
+  }
   fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
   if (!fitted.implausible_walk.empty()) {
     fit.gates.push_back(Gate{"implausible_walk", fitted.implausible_walk});

@@ -8,9 +8,19 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
+#include <boost/math/tools/minima.hpp>
 #include <cmath>
+#include <cstdint>
 
 namespace plumb::estimation {
+namespace {
+
+/// Brent's search for the gyroscope scale: bits of log10(scale) (about 1e-4 decade at the
+/// scales of raw counts), and the most evaluations (each integrates every turn).
+constexpr int kScaleSearchBits = 14;
+constexpr std::uintmax_t kScaleSearchEvaluations = 40;
+
+}  // namespace
 
 AccelGuess GuessAccel(const std::vector<Vec3>& means, double g) {
   AccelGuess guess;
@@ -126,21 +136,15 @@ double GuessGyroScale(const ImuSeries& series,
       }
     }
   }
-  // Golden-section refinement: within 0.15 decade of the ratio estimate, or one grid step
-  // either side of the grid's best.
+  // Brent's refinement (Boost.Math): within 0.15 decade of the ratio estimate, or one grid
+  // step either side of the grid's best, to about 1e-4 decade (kScaleSearchBits); a starting
+  // value: the fit refines it.
   const double half_width = ratios.empty() ? 0.25 : 0.15;
-  double a = best - half_width, b = best + half_width;
-  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-  double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
-  double f1 = cost(x1), f2 = cost(x2);
-  for (int it = 0; it < 14; ++it) {
-    if (f1 < f2) {
-      b = x2; x2 = x1; f2 = f1; x1 = b - phi * (b - a); f1 = cost(x1);
-    } else {
-      a = x1; x1 = x2; f1 = f2; x2 = a + phi * (b - a); f2 = cost(x2);
-    }
-  }
-  return std::pow(10.0, 0.5 * (a + b));
+  std::uintmax_t evaluations = kScaleSearchEvaluations;
+  const auto found = boost::math::tools::brent_find_minima(cost, best - half_width,
+                                                           best + half_width, kScaleSearchBits,
+                                                           evaluations);
+  return std::pow(10.0, found.first);
 }
 
 Vec3 StartingValues::Down(const StillPose& pose) const {

@@ -56,7 +56,8 @@ std::string LargestTerms(const Eigen::VectorXd& v, const std::vector<std::string
 }  // namespace
 
 LinearityReport CheckLinearity(CalibrationProblem& calibration, ceres::Problem& problem,
-                               const std::vector<ParameterIndex>& held, double step_sigmas) {
+                               const std::vector<ParameterIndex>& held, double step_sigmas,
+                               const Eigen::SparseMatrix<double>* jacobian, double cost) {
   LinearityReport out;
   out.step_sigmas = step_sigmas;
   const UnknownColumns columns = calibration.Columns(problem, held);
@@ -64,8 +65,10 @@ LinearityReport CheckLinearity(CalibrationProblem& calibration, ceres::Problem& 
   const auto n_m = static_cast<Eigen::Index>(
       std::count(columns.is_model.begin(), columns.is_model.end(), true));
   if (n_m == 0) return out;
-  double cost0 = 0;
-  const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, &cost0, nullptr);
+  double cost0 = cost;
+  Eigen::SparseMatrix<double> J_local;
+  if (jacobian == nullptr) J_local = calibration.SparseJacobian(problem, columns, &cost0, nullptr);
+  const Eigen::SparseMatrix<double>& J = jacobian != nullptr ? *jacobian : J_local;
   const double chi2_0 = 2.0 * cost0;
   const Eigen::SparseMatrix<double> N = Eigen::SparseMatrix<double>(J.transpose()) * J;
   const Eigen::Index n_r = n - n_m;

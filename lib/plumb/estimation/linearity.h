@@ -44,8 +44,13 @@ inline constexpr int kLinearityDirections = 6;
 /// its solution: Solution::fitted() and held_parameters), with steps of `step_sigmas` sigma. The values are left as they were. Not checked
 /// (LinearityReport::checked false) without free model parameters or when the reduced normal
 /// matrix is not positive definite (the observability analysis then says why).
+/// `jacobian` (optional): the whitened Jacobian of `problem` at its solution over
+/// calibration.Columns(problem, held), and `cost` its cost there, when the caller has them
+/// (the analysis's, FinishCalibration), so as not to evaluate them again.
 LinearityReport CheckLinearity(CalibrationProblem& calibration, ceres::Problem& problem,
                                const std::vector<ParameterIndex>& held,
-                               double step_sigmas = kLinearityStepSigmas);
+                               double step_sigmas = kLinearityStepSigmas,
+                               const Eigen::SparseMatrix<double>* jacobian = nullptr,
+                               double cost = 0.0);
 
 }  // namespace plumb::estimation

@@ -52,7 +52,8 @@ Eigen::Index ModelColumns(const UnknownColumns& columns) {
 ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
                                 const CalibrationOptions& options, UnknownColumns& columns,
                                 double* cost, std::vector<double>* residuals,
-                                Eigen::MatrixXd* jacobian) {
+                                Eigen::MatrixXd* jacobian,
+                                Eigen::SparseMatrix<double>* sparse_jacobian) {
   columns = calibration.Columns(problem);
   ObservabilityInput in;
   in.names = columns.names;
@@ -62,13 +63,15 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   const auto n = static_cast<Eigen::Index>(columns.names.size());
   const auto first_wander = static_cast<Eigen::Index>(columns.first_wander);
   const Eigen::Index n_m = ModelColumns(columns);
-  if (jacobian != nullptr || n_m == n) {
+  if (jacobian != nullptr || (n_m == n && sparse_jacobian == nullptr)) {
     in.J = calibration.Jacobian(problem, columns, cost, residuals);
     ObservabilityAnalysis out = AnalyseObservability(in);
     if (jacobian != nullptr) *jacobian = std::move(in.J);
     return out;
   }
-  const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, cost, residuals);
+  Eigen::SparseMatrix<double> J_local;
+  Eigen::SparseMatrix<double>& J = sparse_jacobian != nullptr ? *sparse_jacobian : J_local;
+  J = calibration.SparseJacobian(problem, columns, cost, residuals);
   // The attitudes and wander states eliminated together when the data determine the attitudes
   // clearly (the cost is then linear in the poses), else the wander states alone.
   const std::unique_ptr<Elimination> elimination = EliminatePoses(J, n_m, first_wander);

@@ -52,11 +52,13 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 /// `residuals`, and the whitened Jacobian it analysed to `jacobian` (optional). Without
 /// `jacobian`, bias-wander states are eliminated first (a sparse QR): the analysis and its
 /// covariance are then over the columns before columns.first_wander, the wander marginalised;
-/// with it, over every column (dense, O(unknowns^3)).
+/// with it, over every column (dense, O(unknowns^3)). `sparse_jacobian` (optional, without
+/// `jacobian`) receives the whitened Jacobian over `columns` for other checks at the same point.
 ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
                                 const CalibrationOptions& options, UnknownColumns& columns,
                                 double* cost, std::vector<double>* residuals,
-                                Eigen::MatrixXd* jacobian = nullptr);
+                                Eigen::MatrixXd* jacobian = nullptr,
+                                Eigen::SparseMatrix<double>* sparse_jacobian = nullptr);
 
 /// The leverages h_ii = J_i (J^T J)^+ J_i^T of the whitened residual rows `rows` of `problem`
 /// (every free unknown, the wander states eliminated by a sparse QR first), and its whitened
