@@ -174,14 +174,22 @@ AllanDeviation PooledAllanDeviation(const std::vector<AxisView>& records, double
     for (const AxisView& x : records) most = std::max(most, static_cast<std::size_t>(x.size()));
     throw Error("Allan deviation: needs at least 2 samples, got " + std::to_string(most));
   }
-  for (std::size_t m : ClusterSizes(options, longest)) {
-    std::size_t terms = 0;
-    double sum = 0.0;
-    for (const auto& theta : thetas) {
+  // Record by record (each stays in cache for all its cluster sizes), every cluster size's sum
+  // accumulated over the records in their order.
+  const std::vector<std::size_t> sizes = ClusterSizes(options, longest);
+  std::vector<double> sums(sizes.size(), 0.0);
+  std::vector<std::size_t> term_counts(sizes.size(), 0);
+  for (const auto& theta : thetas) {
+    for (std::size_t j = 0; j < sizes.size(); ++j) {
+      const std::size_t m = sizes[j];
       if (theta.size() < 2 * m + 1) continue;
-      terms += theta.size() - 2 * m;
-      sum += SecondDifferenceSum(theta, m);
+      term_counts[j] += theta.size() - 2 * m;
+      sums[j] += SecondDifferenceSum(theta, m);
     }
+  }
+  for (std::size_t j = 0; j < sizes.size(); ++j) {
+    const std::size_t m = sizes[j], terms = term_counts[j];
+    const double sum = sums[j];
     // theta is in units of dt, so tau^2 = m^2 dt^2 cancels the dt^2 of the differences.
     const double md = static_cast<double>(m);
     const double avar = sum / (2.0 * md * md * static_cast<double>(terms));

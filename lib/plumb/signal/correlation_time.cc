@@ -1,6 +1,7 @@
 #include "plumb/signal/correlation_time.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -49,22 +50,37 @@ CentredChunks Centre(const std::vector<AxisView>& chunks, bool detrend) {
   return out;
 }
 
-/// Autocovariance at lag k pooled over chunks (divided by the number of pairs), or NaN when
-/// no chunk is longer than k.
-double PooledAutocovariance(const CentredChunks& data, std::size_t k) {
-  double sum = 0.0;
-  std::size_t pairs = 0;
+/// Lags computed per pass over the data: the window usually stops within a few lags, and
+/// one pass for several keeps the samples in cache once instead of streaming them per lag.
+constexpr std::size_t kLagsPerPass = 8;
+
+/// Autocovariances at lags first .. first + count - 1 pooled over chunks (each divided by its
+/// number of pairs), NaN for a lag no chunk is longer than. One pass over each chunk; each
+/// lag's sum is accumulated in the same order as a pass of its own would.
+std::array<double, kLagsPerPass> PooledAutocovariances(const CentredChunks& data,
+                                                       std::size_t first, std::size_t count) {
+  std::array<double, kLagsPerPass> sum{}, out{};
+  std::array<std::size_t, kLagsPerPass> pairs{};
   for (std::size_t c = 0; c < data.count(); ++c) {
     const std::size_t n = data.length(c);
-    if (n <= k) continue;
+    if (n <= first) continue;
     const double* y = data.values.data() + data.offsets[c];
-    double chunk_sum = 0.0;
-    for (std::size_t i = 0; i + k < n; ++i) chunk_sum += y[i] * y[i + k];
-    sum += chunk_sum;
-    pairs += n - k;
+    std::array<double, kLagsPerPass> chunk_sum{};
+    const std::size_t lags = std::min(count, n - first);  // lags this chunk has pairs for
+    for (std::size_t i = 0; i + first < n; ++i) {
+      const std::size_t reach = std::min(lags, n - first - i);
+      for (std::size_t j = 0; j < reach; ++j) chunk_sum[j] += y[i] * y[i + first + j];
+    }
+    for (std::size_t j = 0; j < lags; ++j) {
+      sum[j] += chunk_sum[j];
+      pairs[j] += n - first - j;
+    }
   }
-  return pairs == 0 ? std::numeric_limits<double>::quiet_NaN()
-                    : sum / static_cast<double>(pairs);
+  for (std::size_t j = 0; j < count; ++j) {
+    out[j] = pairs[j] == 0 ? std::numeric_limits<double>::quiet_NaN()
+                           : sum[j] / static_cast<double>(pairs[j]);
+  }
+  return out;
 }
 
 void CheckOptions(const CorrelationTimeOptions& options) {
@@ -102,8 +118,13 @@ CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
   const std::size_t last_lag = std::min(options.max_lag, data.longest / 2);
   double tau = 1.0;
   double tau_sq = 1.0;
+  std::array<double, kLagsPerPass> covariances{};
   for (std::size_t k = 1; k <= last_lag; ++k) {
-    const double rho = PooledAutocovariance(data, k) / c0;
+    const std::size_t slot = (k - 1) % kLagsPerPass;
+    if (slot == 0) {
+      covariances = PooledAutocovariances(data, k, std::min(kLagsPerPass, last_lag + 1 - k));
+    }
+    const double rho = covariances[slot] / c0;
     tau += 2.0 * rho;
     tau_sq += 2.0 * rho * rho;
     out.window = k;
