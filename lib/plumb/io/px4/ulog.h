@@ -17,7 +17,7 @@
 //     uint8 level, uint16 tag, uint64 time, text; S sync: 8 magic bytes 2F 73 13 20 25 0C BB
 //     12; O dropout: uint16 duration (ms).
 //
-// Decoding contract (one pass over the file held in memory):
+// Decoding contract (one pass over the file, read forward in chunks by ReadULog):
 //  * Parameters: P messages before the first A, L or C are the initial values (`params`);
 //    later ones are changes (`param_changes`).
 //  * A subscription's format is resolved when its A message arrives: nested formats are
@@ -46,9 +46,10 @@
 //    of an unknown letter type (a future ULog message, counted). A known message whose body
 //    does not parse (e.g. a key length past its end) is skipped (counted as malformed).
 //
-// Storage ("compact per-topic table", as the DataFlash reader): each subscription keeps the
-// bodies of its D messages contiguously (row-major, `body_size` bytes each, as in the file);
-// columns are decoded on access from their byte offsets. No allocation per data message.
+// Storage ("compact per-topic table", as the DataFlash reader): each kept subscription
+// (RecordFilter) keeps the bodies of its D messages (RecordStore: row-major blocks, `body_size`
+// bytes each, as in the file); columns are decoded on access from their byte offsets. No
+// allocation per data message, no counting pass.
 #pragma once
 
 #include <array>
@@ -86,7 +87,7 @@ struct ULogTopic {
   std::size_t full_size = 0;     ///< format size with trailing padding, bytes (>= body_size)
   int timestamp_col = -1;        ///< column of the top-level "timestamp" field, -1 if none
   std::size_t rows = 0;          ///< D messages stored
-  std::vector<std::uint8_t> bodies;  ///< rows * body_size bytes, in log order
+  RecordStore bodies;            ///< the kept D bodies in log order, body_size bytes each
   /// False when the reader's RecordFilter left this topic's bodies out (rows still counted):
   /// Value, TimestampUs and Column then throw plumb::Error.
   bool bodies_kept = true;
