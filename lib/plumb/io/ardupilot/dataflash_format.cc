@@ -124,6 +124,12 @@ const DataflashFormatChar& DataflashFormat(char c) {
   return kByCode[static_cast<unsigned char>(c)];
 }
 
+DataflashColumnReader DataflashColumnReader::Of(const DataflashType& t, int col) {
+  const DataflashColumn& c = t.columns[static_cast<std::size_t>(col)];
+  const DataflashFormatChar& f = DataflashFormat(c.format);
+  return {c.offset, f.storage, f.scale};
+}
+
 DataflashType MakeDataflashType(std::uint8_t id, std::size_t length, const std::string& name,
                                 const std::string& format, const std::string& columns,
                                 DataflashWarnings* w) {
@@ -133,6 +139,7 @@ DataflashType MakeDataflashType(std::uint8_t id, std::size_t length, const std::
   t.length = length;
   t.format = format;
   t.body_size = length - kDataflashHeaderSize;
+  t.bodies = RecordStore(t.body_size);
   const std::vector<std::string> names = SplitColumns(columns);
   std::size_t offset = 0;
   bool known = true;

@@ -306,16 +306,11 @@ double IsbdRate(const DataflashLog& log, int sensor, int instance) {
   return rates[rates.size() / 2];
 }
 
-ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
+/// The description of the stream `ref` whose samples are `s` (as ReadStream gives them).
+ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref, const ImuSeries& s) {
   ImuStreamInfo info;
   info.name = ref.name;
   info.instance = ref.instance;
-  ImuSeries s;
-  try {
-    s = ReadStream(log, ref);
-  } catch (const InputError&) {
-    // An IMU FMT without rows (or without time/Acc columns): listed with 0 samples.
-  }
   info.samples = s.size();
   if (!s.empty()) {
     info.t_start_s = s.t_s.front();
@@ -336,16 +331,31 @@ ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
   return info;
 }
 
-bool HasSamples(const DataflashLog& log, const StreamRef& ref) {
+ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
+  ImuSeries s;
   try {
-    return !ReadStream(log, ref).empty();
+    s = ReadStream(log, ref);
+  } catch (const InputError&) {
+    // An IMU FMT without rows (or without time/Acc columns): listed with 0 samples.
+  }
+  return Describe(log, ref, s);
+}
+
+/// True when the stream `ref` has samples; they are then in `*samples`.
+bool HasSamples(const DataflashLog& log, const StreamRef& ref, ImuSeries* samples) {
+  try {
+    *samples = ReadStream(log, ref);
+    return !samples->empty();
   } catch (const InputError&) {
     return false;  // e.g. an IMU FMT without rows
   }
 }
 
-/// The stream `selection` names, or nullopt (see DataflashStream for the default).
-std::optional<StreamRef> Select(const DataflashLog& log, const FlightLogSelection& selection) {
+/// The stream `selection` names, or nullopt (see DataflashStream for the default). When the
+/// choice read the stream's samples, they are in `*samples` and `*read` is true.
+std::optional<StreamRef> Select(const DataflashLog& log, const FlightLogSelection& selection,
+                                ImuSeries* samples, bool* read) {
+  *read = false;
   const std::vector<StreamRef> refs = StreamRefs(log);
   if (selection.stream.empty()) {
     std::optional<StreamRef> first;
@@ -354,7 +364,10 @@ std::optional<StreamRef> Select(const DataflashLog& log, const FlightLogSelectio
         continue;
       }
       if (!first) first = r;
-      if (HasSamples(log, r)) return r;
+      if (HasSamples(log, r, samples)) {
+        *read = true;
+        return r;
+      }
     }
     return first;
   }
@@ -402,13 +415,18 @@ std::vector<ImuStreamInfo> DataflashImuStreams(const DataflashLog& log) {
 
 std::optional<ImuStreamInfo> FindDataflashStream(const DataflashLog& log,
                                                  const FlightLogSelection& selection) {
-  const std::optional<StreamRef> ref = Select(log, selection);
+  ImuSeries samples;
+  bool read = false;
+  const std::optional<StreamRef> ref = Select(log, selection, &samples, &read);
   if (!ref) return std::nullopt;
-  return Describe(log, *ref);
+  return read ? Describe(log, *ref, samples) : Describe(log, *ref);
 }
 
-ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& selection) {
-  const std::optional<StreamRef> ref = Select(log, selection);
+ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& selection,
+                          ImuStreamInfo* info) {
+  ImuSeries all;
+  bool read = false;
+  const std::optional<StreamRef> ref = Select(log, selection, &all, &read);
   const std::string label = StreamLabel(selection);
   if (!ref) {
     std::string known;
@@ -424,11 +442,12 @@ ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& sel
                          " carries gyroscope samples only; plumb needs accelerometer samples: "
                          "select IMU, ACC+GYR or ACC of that instance");
   }
-  const ImuSeries all = ReadStream(log, *ref);
+  if (!read) all = ReadStream(log, *ref);  // the samples once, for the session and `info`
   if (all.empty()) {
     throw InputError(log.source, "", ref->name + " of IMU instance " +
                                          std::to_string(ref->instance) + " has no samples");
   }
+  if (info != nullptr) *info = Describe(log, *ref, all);
   ImuSeries s = Window(all, selection);
   if (s.empty()) {
     throw InputError(log.source, "", "no samples of " + ref->name + " of IMU instance " +
