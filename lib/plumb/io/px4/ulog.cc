@@ -135,8 +135,9 @@ class Parser {
         resolver_(log->formats, size + kMinColumnBudget) {}
 
   /// Decodes the messages starting in the bytes [offset, offset + n) of the input held at
-  /// `data` and returns the offset to go on from: unless `at_end`, at least kLookahead bytes
-  /// before offset + n, or the start of the next appended segment (a jump forward). `at_end`:
+  /// `data` and returns the offset to go on from: unless `at_end`, the first message not
+  /// whole in the bytes (or, resynchronising, the first position less than kLookahead bytes
+  /// before offset + n), or the start of the next appended segment (a jump forward). `at_end`:
   /// the bytes end the input. The first call starts at offset 0 (the file header).
   std::size_t Feed(const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
     data_ = data;
@@ -171,7 +172,7 @@ class Parser {
         pos_ = std::max(pos_, size_);
         return;
       }
-      if (!at_end && pos_ + kLookahead > avail_) return;
+      if (!at_end && !Held(pos_)) return;
       if (resync_) {
         if (!ResyncPoint(pos_, end_)) {
           Skip(pos_);
@@ -208,6 +209,14 @@ class Parser {
   }
 
  private:
+  /// True when the bytes held decide the message at `pos`: while resynchronising, kLookahead
+  /// bytes (a chain of messages); else its header and body.
+  bool Held(std::size_t pos) const {
+    if (resync_) return pos + kLookahead <= avail_;
+    return pos + kMsgHeaderSize <= avail_ &&
+           pos + kMsgHeaderSize + Load<std::uint16_t>(At(pos)) <= avail_;
+  }
+
   /// The byte of the input at file offset `pos` (in the bytes held).
   const std::uint8_t* At(std::size_t pos) const { return data_ + (pos - base_); }
 
@@ -478,25 +487,7 @@ int ULogTopic::ColumnIndex(std::string_view column) const {
   return -1;
 }
 
-double ULogTopic::Value(std::size_t row, std::size_t col) const {
-  if (!bodies_kept) NotKept(name);
-  const ULogColumn& c = columns[col];
-  const std::uint8_t* p = bodies.Row(row) + c.offset;
-  switch (c.type) {
-    case ULogType::kInt8: return Load<std::int8_t>(p);
-    case ULogType::kUInt8: case ULogType::kChar: return Load<std::uint8_t>(p);
-    case ULogType::kBool: return Load<std::uint8_t>(p) != 0 ? 1.0 : 0.0;
-    case ULogType::kInt16: return Load<std::int16_t>(p);
-    case ULogType::kUInt16: return Load<std::uint16_t>(p);
-    case ULogType::kInt32: return Load<std::int32_t>(p);
-    case ULogType::kUInt32: return Load<std::uint32_t>(p);
-    case ULogType::kInt64: return static_cast<double>(Load<std::int64_t>(p));
-    case ULogType::kUInt64: return static_cast<double>(Load<std::uint64_t>(p));
-    case ULogType::kFloat: return Load<float>(p);
-    case ULogType::kDouble: return Load<double>(p);
-  }
-  return 0.0;
-}
+void ULogTopic::ThrowNotKept() const { NotKept(name); }
 
 std::uint64_t ULogTopic::TimestampUs(std::size_t row) const {
   if (!bodies_kept) NotKept(name);
