@@ -15,7 +15,8 @@
 // bytes out of the page cache. Each reader benchmark registered after it also reports `x_cat`,
 // its MB/s over the MB/s of the BM_Cat of the same file measured last in the same process (run
 // both in one invocation: --benchmark_filter='BM_(Cat|Read)').
-// Skipped with the reason when the shared data is absent.
+// Skipped with the reason when the shared data is absent. With PLUMB_BENCH_LOG_DIR=DIR set, the
+// repeated logs are written to DIR/big_<name> and kept (to time `plumb info` on them).
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <spawn.h>
@@ -27,6 +28,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -177,10 +179,15 @@ class RepeatedLog {
   RepeatedLog(const std::string& source, Clock clock) {
     std::ifstream in(source, std::ios::binary);
     std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
-    path_ = (std::filesystem::temp_directory_path() /
-             ("plumb_bench_" + std::to_string(::getpid()) + "_" +
-              std::filesystem::path(source).filename().string()))
-                .string();
+    const char* keep_dir = std::getenv("PLUMB_BENCH_LOG_DIR");
+    keep_ = keep_dir != nullptr && *keep_dir != '\0';
+    path_ = keep_ ? (std::filesystem::path(keep_dir) /
+                     ("big_" + std::filesystem::path(source).filename().string()))
+                        .string()
+                  : (std::filesystem::temp_directory_path() /
+                     ("plumb_bench_" + std::to_string(::getpid()) + "_" +
+                      std::filesystem::path(source).filename().string()))
+                        .string();
     std::ofstream out(path_, std::ios::binary);
     if (bytes.empty()) return;
     const std::size_t copies = (kTargetBytes + bytes.size() - 1) / bytes.size();
@@ -195,11 +202,14 @@ class RepeatedLog {
       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     }
   }
-  ~RepeatedLog() { std::remove(path_.c_str()); }
+  ~RepeatedLog() {
+    if (!keep_) std::remove(path_.c_str());
+  }
   const std::string& path() const { return path_; }
 
  private:
   std::string path_;
+  bool keep_ = false;  ///< PLUMB_BENCH_LOG_DIR given: the file stays there
 };
 
 /// The repeated copy of shared-data file `relative`, made on first use; nullptr if absent.

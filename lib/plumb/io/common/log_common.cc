@@ -67,8 +67,9 @@ void LogFile::DropPages(std::size_t up_to) const {
 
 namespace {
 
-/// Bytes read per call of the ReadForward buffer (beyond the consumer's look-ahead).
-constexpr std::size_t kReadChunk = std::size_t{1} << 20;
+/// Bytes read per call into the ReadForward buffer (beyond the consumer's look-ahead): 256 KiB,
+/// about what stays in the L2 cache while the parser goes over it (cat reads 128 KiB).
+constexpr std::size_t kReadChunk = std::size_t{1} << 18;
 
 /// Reads up to `n` bytes at file offset `at` into `out`: fewer only at the end of the file.
 std::size_t ReadAt(int fd, std::uint8_t* out, std::size_t n, std::size_t at,
