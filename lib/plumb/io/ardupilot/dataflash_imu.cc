@@ -55,8 +55,10 @@ double ValueAt(const DataflashType& t, std::size_t row, int col) {
 /// {0} / {} when it has no I column (defined / not defined).
 std::vector<int> InstancesOf(const DataflashType& t, int instance_col) {
   std::array<bool, 256> seen{};
+  if (t.rows > 0 && !t.bodies_kept) ValueAt(t, 0, instance_col);  // throws: not kept
+  const auto column = detail::DataflashColumnReader::Of(t, instance_col);
   for (std::size_t r = 0; r < t.rows; ++r) {
-    const double v = ValueAt(t, r, instance_col);
+    const double v = column.Read(t.bodies.Row(r));
     if (v >= 0 && v < 256 && v == std::floor(v)) seen[static_cast<std::size_t>(v)] = true;
   }
   std::vector<int> out;
@@ -112,19 +114,24 @@ ImuSeries ReadRawMessage(const DataflashLog& log, const std::string& base, int i
   const int axes[3] = {Col(*t, vector_prefix + "X"), Col(*t, vector_prefix + "Y"),
                        Col(*t, vector_prefix + "Z")};
   if (time < 0 || axes[0] < 0 || axes[1] < 0 || axes[2] < 0) return s;
-  std::vector<std::size_t> rows;
+  if (t->rows > 0 && !t->bodies_kept) ValueAt(*t, 0, time);  // throws: not kept
+  using Reader = detail::DataflashColumnReader;
+  const Reader inst = instance_col >= 0 ? Reader::Of(*t, instance_col) : Reader{};
+  const Reader time_col = Reader::Of(*t, time);
+  const Reader a[3] = {Reader::Of(*t, axes[0]), Reader::Of(*t, axes[1]), Reader::Of(*t, axes[2])};
+  std::vector<const std::uint8_t*> rows;
   std::vector<double> times;
   for (std::size_t r = 0; r < t->rows; ++r) {
-    if (instance_col >= 0 && ValueAt(*t, r, instance_col) != instance) continue;
-    rows.push_back(r);
-    times.push_back(ValueAt(*t, r, time) * 1e-6);
+    const std::uint8_t* body = t->bodies.Row(r);
+    if (instance_col >= 0 && inst.Read(body) != instance) continue;
+    rows.push_back(body);
+    times.push_back(time_col.Read(body) * 1e-6);
   }
   std::vector<Vec3f>& out = vector_prefix == "Acc" ? s.acc : s.gyr;
   for (std::size_t i : IncreasingIndices(times)) {
     s.t_s.push_back(times[i]);
-    out.emplace_back(static_cast<float>(ValueAt(*t, rows[i], axes[0])),
-                     static_cast<float>(ValueAt(*t, rows[i], axes[1])),
-                     static_cast<float>(ValueAt(*t, rows[i], axes[2])));
+    out.emplace_back(static_cast<float>(a[0].Read(rows[i])), static_cast<float>(a[1].Read(rows[i])),
+                     static_cast<float>(a[2].Read(rows[i])));
   }
   return s;
 }
