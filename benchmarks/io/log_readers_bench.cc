@@ -15,6 +15,8 @@
 // bytes out of the page cache. Each reader benchmark registered after it also reports `x_cat`,
 // its MB/s over the MB/s of the BM_Cat of the same file measured last in the same process (run
 // both in one invocation: --benchmark_filter='BM_(Cat|Read)').
+// BM_WalkDataflash/<log> walks the records of the same file (ReadForward, headers and FMT
+// lengths only): the floor under the DataFlash reader's record loop.
 // Skipped with the reason when the shared data is absent. With PLUMB_BENCH_LOG_DIR=DIR set, the
 // repeated logs are written to DIR/big_<name> and kept (to time `plumb info` on them).
 #include <benchmark/benchmark.h>
@@ -40,6 +42,7 @@
 
 #include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/ardupilot/dataflash.h"
+#include "plumb/io/common/log_common.h"
 #include "plumb/io/mavlink/mavlink_tlog.h"
 #include "plumb/io/px4/px4_session.h"
 #include "plumb/io/px4/ulog.h"
@@ -335,6 +338,38 @@ BENCHMARK_CAPTURE(BM_ReadDataflash, copter36_chibios, std::string("ardupilot/cop
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ReadDataflash, plane408_centre_point,
                   std::string("ardupilot/plane408_centre_point.BIN"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// The floor under the DataFlash reader: the same file read the same way (ReadForward) and its
+/// records walked (header, type, FMT lengths), nothing checked, stored or decoded. "samples"
+/// counts records here.
+void BM_WalkDataflash(benchmark::State& state, const std::string& relative) {
+  ReadRepeated(state, relative, [](const std::string& path) {
+    std::array<std::size_t, 256> length{};
+    length[128] = 89;  // FMT
+    std::size_t records = 0;
+    plumb::io::ReadForward(
+        path, "DataFlash log", 255,
+        [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+          std::size_t i = 0;
+          while (n - i >= 3 && (at_end || n - i >= 255)) {
+            const std::size_t len = length[data[i + 2]];
+            if (data[i] == 0xA3 && data[i + 1] == 0x95 && len > 0 && len <= n - i) {
+              if (data[i + 2] == 128) length[data[i + 3]] = data[i + 4];
+              ++records;
+              i += len;
+            } else {
+              ++i;
+            }
+          }
+          return offset + (at_end ? n : i);
+        });
+    return records;
+  });
+}
+BENCHMARK_CAPTURE(BM_WalkDataflash, copter36_chibios,
+                  std::string("ardupilot/copter36_chibios.bin"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

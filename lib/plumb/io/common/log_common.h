@@ -1,4 +1,6 @@
-// plumb/io/common/log_common.h — pieces every flight-log reader shares: reading the whole file,
+// plumb/io/common/log_common.h — pieces every flight-log reader shares: reading the file forward
+// in chunks (ReadForward; the DataFlash and ULog readers) or whole (LogFile; the tlog reader,
+// whose resync search looks ahead without bound), storing record bodies (RecordStore),
 // counting skipped bytes, saturating float conversion, and the site from a log's GPS fixes.
 #pragma once
 
