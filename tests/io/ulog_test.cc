@@ -3,6 +3,7 @@
 // (tests/data/px4/decode_golden.py, see README.md there), damaged copies of real logs, small
 // hand-built logs for each message type and rule, and a session on a real still period.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <cstring>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "io_test_util.h"
@@ -790,6 +792,32 @@ TEST(ULogBuilt, ReadingInChunksDecodesWhatTheWholeInputDoes) {
     EXPECT_TRUE(from_file.topics[k].bodies == in_memory.topics[k].bodies) << k;
   }
   EXPECT_EQ(in_memory.Find("t", 0)->rows + 1, t_us);  // the cut message is the only one lost
+}
+
+// Read from a pipe (not a regular file: read whole, its size known only at its end), the
+// shared sample.ulg decodes as from the file, subscriptions and all.
+TEST(ULog, ReadFromAPipeDecodesAsTheFile) {
+  const std::string path = SharedLog("sample.ulg");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  ::plumb::testing::TempDir dir;
+  const std::string fifo = dir.File("log.fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const Bytes bytes = ReadBytes(path);
+  std::thread writer([&] {
+    std::ofstream out(fifo, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+  });
+  const ULog piped = ReadULog(fifo);
+  writer.join();
+  const ULog file = ReadULog(path);
+  EXPECT_EQ(piped.size_bytes, file.size_bytes);
+  EXPECT_EQ(piped.MessageCounts(), file.MessageCounts());
+  EXPECT_EQ(piped.warnings.Describe(), file.warnings.Describe());
+  ASSERT_EQ(piped.topics.size(), file.topics.size());
+  for (std::size_t k = 0; k < file.topics.size(); ++k) {
+    EXPECT_TRUE(piped.topics[k].bodies == file.topics[k].bodies) << file.topics[k].name;
+  }
 }
 
 }  // namespace

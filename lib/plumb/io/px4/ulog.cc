@@ -575,13 +575,14 @@ ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& so
 ULog ReadULog(const std::string& path, const RecordFilter& filter) {
   ULog log;
   log.source = path;
-  log.size_bytes = RegularFileSize(path);
-  Parser parser(log.size_bytes, &log, filter);
+  log.size_bytes = RegularFileSize(path);  // 0 for a pipe: read whole, in one call
+  std::optional<Parser> parser;  // made at the first call, when the size is known
   // One pass, in chunks: every message is decoded from the read buffer as it goes by.
   ReadForward(path, "ULog file", Parser::kLookahead,
               [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
                 if (at_end) log.size_bytes = offset + n;
-                return parser.Feed(data, n, offset, at_end);
+                if (!parser) parser.emplace(log.size_bytes, &log, filter);
+                return parser->Feed(data, n, offset, at_end);
               });
   return log;
 }
