@@ -364,7 +364,7 @@ std::string FormatBytes(std::uint64_t bytes) {
   return out.str();
 }
 
-void CheckMemory(const std::vector<std::string>& files, std::uint64_t max_memory) {
+std::uint64_t CheckMemory(const std::vector<std::string>& files, std::uint64_t max_memory) {
   std::uint64_t need = 0;
   std::string names;
   for (const std::string& f : files) {
@@ -376,7 +376,7 @@ void CheckMemory(const std::vector<std::string>& files, std::uint64_t max_memory
   }
   const std::optional<std::uint64_t> available =
       max_memory > 0 ? std::optional<std::uint64_t>(max_memory) : io::AvailableMemory();
-  if (need == 0 || !available || need <= *available) return;
+  if (need == 0 || !available || need <= *available) return need;
   throw Error("reading " + names + " needs about " + FormatBytes(need) + "; " +
               FormatBytes(*available) + " is available (" +
               (max_memory > 0 ? "--max-memory" : "MemAvailable in /proc/meminfo") + ")");

@@ -82,7 +82,8 @@ void AddMaxMemoryOption(CLI::App* app, std::uint64_t& max_memory);
 /// EstimateReadMemory, summed over `files`) exceeds `max_memory` (0: MemAvailable; no check
 /// when the system does not say): throws plumb::Error "reading FILE needs about 1.9 GB;
 /// 1.2 GB is available (--max-memory)" (exit 1).
-void CheckMemory(const std::vector<std::string>& files, std::uint64_t max_memory);
+/// Returns the estimate it compared (bytes; 0 when no file is a regular file).
+std::uint64_t CheckMemory(const std::vector<std::string>& files, std::uint64_t max_memory);
 
 /// `bytes` for people: "850 kB", "25.2 MB", "1.9 GB" (powers of 1000, 3 significant digits).
 std::string FormatBytes(std::uint64_t bytes);

@@ -5,16 +5,32 @@
 // (about 150 MB, written once into a temporary file, removed at exit; the page cache holds it,
 // so this measures the reader, not the disk), then decodes every IMU sample of it, as
 // `plumb calibrate LOG` does. A repeated DataFlash log gets a continuing clock (each copy's
-// TimeUS/TimeMS fields shifted past the previous copy's), so the IMU samples of every copy are
-// decoded and counted, not only the first copy's. Counters: MB/s of log and IMU samples/s.
-// Skipped with the reason when the shared data is absent.
+// TimeUS/TimeMS fields shifted past the previous copy's), and so does a repeated ULog (the
+// file once, then its D messages again and again with their timestamp/timestamp_sample fields
+// shifted), so the IMU samples of every copy are decoded and counted, not only the first
+// copy's. Counters: MB/s of log and IMU samples/s.
+//
+// BM_Cat/<log> runs the system `cat LOG` (posix_spawn, standard output to /dev/null, the whole
+// process as a shell would run it) on the very same temporary file: the speed of getting the
+// bytes out of the page cache. Each reader benchmark registered after it also reports `x_cat`,
+// its MB/s over the MB/s of the BM_Cat of the same file measured last in the same process (run
+// both in one invocation: --benchmark_filter='BM_(Cat|Read)').
+// BM_WalkDataflash/<log> walks the records of the same file (ReadForward, headers and FMT
+// lengths only): the floor under the DataFlash reader's record loop.
+// Skipped with the reason when the shared data is absent. With PLUMB_BENCH_LOG_DIR=DIR set, the
+// repeated logs are written to DIR/big_<name> and kept (to time `plumb info` on them).
 #include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -26,7 +42,9 @@
 
 #include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/ardupilot/dataflash.h"
+#include "plumb/io/common/log_common.h"
 #include "plumb/io/mavlink/mavlink_tlog.h"
+#include "plumb/io/px4/px4_session.h"
 #include "plumb/io/px4/ulog.h"
 
 namespace {
@@ -113,21 +131,73 @@ std::vector<char> ContinuingDataflash(std::vector<char> bytes, std::size_t copie
   return out;
 }
 
+/// `copies` copies of the ULog `bytes` with a continuing clock: the file once, then its D
+/// messages `copies - 1` more times, copy k's top-level uint64 "timestamp" and
+/// "timestamp_sample" fields shifted by k times (the log's last timestamp + 1 s).
+std::vector<char> ContinuingULog(const std::vector<char>& bytes, std::size_t copies) {
+  const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
+  const plumb::io::ULog log = plumb::io::ParseULog(data, bytes.size(), "benchmark");
+  std::map<std::uint16_t, std::vector<std::size_t>> clocks;  // msg_id -> field offsets
+  std::uint64_t last_us = 0;
+  for (const plumb::io::ULogTopic& t : log.topics) {
+    for (const plumb::io::ULogColumn& c : t.columns) {
+      if ((c.name == "timestamp" || c.name == "timestamp_sample") &&
+          c.type == plumb::io::ULogType::kUInt64) {
+        clocks[t.msg_id].push_back(c.offset);
+      }
+    }
+    if (t.rows > 0) last_us = std::max(last_us, t.TimestampUs(t.rows - 1));
+  }
+  const std::uint64_t shift_us = last_us + 1000000u;
+  std::vector<char> out(bytes);
+  out.reserve(bytes.size() * copies);
+  for (std::size_t k = 1; k < copies; ++k) {
+    for (std::size_t pos = 16; pos + 5 <= bytes.size();) {  // after the 16-byte file header
+      std::uint16_t size, msg_id;
+      std::memcpy(&size, data + pos, 2);
+      if (size == 0 || pos + 3 + size > bytes.size()) break;
+      std::memcpy(&msg_id, data + pos + 3, 2);
+      if (data[pos + 2] == 'D' && size >= 2) {
+        const std::size_t at = out.size();
+        out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(pos),
+                   bytes.begin() + static_cast<std::ptrdiff_t>(pos + 3 + size));
+        for (std::size_t offset : clocks[msg_id]) {
+          if (5 + offset + 8 > 3u + size) continue;
+          std::uint64_t v;
+          std::memcpy(&v, &out[at + 5 + offset], 8);
+          v += k * shift_us;
+          std::memcpy(&out[at + 5 + offset], &v, 8);
+        }
+      }
+      pos += 3 + size;
+    }
+  }
+  return out;
+}
+
 class RepeatedLog {
  public:
-  /// `continuing_clock`: shift each DataFlash copy's times past the previous copy's.
-  RepeatedLog(const std::string& source, bool continuing_clock) {
+  enum class Clock { kRepeated, kDataflash, kULog };
+  /// `clock`: shift each DataFlash or ULog copy's times past the previous copy's.
+  RepeatedLog(const std::string& source, Clock clock) {
     std::ifstream in(source, std::ios::binary);
     std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
-    path_ = (std::filesystem::temp_directory_path() /
-             ("plumb_bench_" + std::to_string(::getpid()) + "_" +
-              std::filesystem::path(source).filename().string()))
-                .string();
+    const char* keep_dir = std::getenv("PLUMB_BENCH_LOG_DIR");
+    keep_ = keep_dir != nullptr && *keep_dir != '\0';
+    path_ = keep_ ? (std::filesystem::path(keep_dir) /
+                     ("big_" + std::filesystem::path(source).filename().string()))
+                        .string()
+                  : (std::filesystem::temp_directory_path() /
+                     ("plumb_bench_" + std::to_string(::getpid()) + "_" +
+                      std::filesystem::path(source).filename().string()))
+                        .string();
     std::ofstream out(path_, std::ios::binary);
     if (bytes.empty()) return;
     const std::size_t copies = (kTargetBytes + bytes.size() - 1) / bytes.size();
-    if (continuing_clock) {
-      const std::vector<char> all = ContinuingDataflash(std::move(bytes), copies);
+    if (clock != Clock::kRepeated) {
+      const std::vector<char> all = clock == Clock::kDataflash
+                                        ? ContinuingDataflash(std::move(bytes), copies)
+                                        : ContinuingULog(bytes, copies);
       out.write(all.data(), static_cast<std::streamsize>(all.size()));
       return;
     }
@@ -135,11 +205,14 @@ class RepeatedLog {
       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     }
   }
-  ~RepeatedLog() { std::remove(path_.c_str()); }
+  ~RepeatedLog() {
+    if (!keep_) std::remove(path_.c_str());
+  }
   const std::string& path() const { return path_; }
 
  private:
   std::string path_;
+  bool keep_ = false;  ///< PLUMB_BENCH_LOG_DIR given: the file stays there
 };
 
 /// The repeated copy of shared-data file `relative`, made on first use; nullptr if absent.
@@ -149,17 +222,50 @@ const RepeatedLog* Repeated(const std::string& relative) {
   if (!std::filesystem::exists(source)) return nullptr;
   auto& slot = logs[relative];
   if (!slot) {
-    const bool dataflash = relative.rfind("ardupilot/", 0) == 0 &&
-                           plumb::io::LooksLikeDataflash(source);
-    slot = std::make_unique<RepeatedLog>(source, dataflash);
+    using Clock = RepeatedLog::Clock;
+    Clock clock = Clock::kRepeated;
+    if (plumb::io::LooksLikeDataflash(source)) clock = Clock::kDataflash;
+    if (plumb::io::LooksLikeULog(source)) clock = Clock::kULog;
+    slot = std::make_unique<RepeatedLog>(source, clock);
   }
   return slot.get();
 }
 
-void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t samples) {
+/// MB/s of the last BM_Cat of each file (by its shared-data name) in this process.
+std::map<std::string, double>& CatSpeeds() {
+  static std::map<std::string, double> speeds;
+  return speeds;
+}
+
+/// `cat path > /dev/null` as a separate process, waited for. False when it could not run or
+/// failed.
+bool RunCat(const std::string& path) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  const std::string cat = "cat";
+  char* argv[] = {const_cast<char*>(cat.c_str()), const_cast<char*>(path.c_str()), nullptr};
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, "cat", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return false;
+  int status = 0;
+  if (::waitpid(pid, &status, 0) != pid) return false;
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t samples,
+                 const std::string& relative = "") {
   const double iterations = static_cast<double>(state.iterations());
   state.counters["MB/s"] = benchmark::Counter(iterations * static_cast<double>(bytes) / 1e6,
                                               benchmark::Counter::kIsRate);
+  // The same rate against the last cat of this file (counters are divided by the real time
+  // after the run, so the ratio is made from the figures by hand here).
+  const auto cat = CatSpeeds().find(relative);
+  if (cat != CatSpeeds().end() && cat->second > 0.0) {
+    state.counters["x_cat"] = benchmark::Counter(
+        iterations * static_cast<double>(bytes) / 1e6 / cat->second, benchmark::Counter::kIsRate);
+  }
   state.counters["samples/s"] =
       benchmark::Counter(iterations * static_cast<double>(samples), benchmark::Counter::kIsRate);
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
@@ -176,8 +282,41 @@ void ReadRepeated(benchmark::State& state, const std::string& relative, Read rea
   }
   std::size_t samples = 0;
   for (auto _ : state) samples = read(log->path());
-  SetCounters(state, std::filesystem::file_size(log->path()), samples);
+  SetCounters(state, std::filesystem::file_size(log->path()), samples, relative);
 }
+
+/// The system's `cat` of the same repeated file, to /dev/null: the baseline of the readers.
+void BM_Cat(benchmark::State& state, const std::string& relative) {
+  const RepeatedLog* log = Repeated(relative);
+  if (log == nullptr) {
+    state.SkipWithError(("shared data absent: " + relative).c_str());
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    if (!RunCat(log->path())) {
+      state.SkipWithError("cat failed");
+      return;
+    }
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto bytes = static_cast<double>(std::filesystem::file_size(log->path()));
+  CatSpeeds()[relative] = static_cast<double>(state.iterations()) * bytes / 1e6 / seconds;
+  SetCounters(state, std::filesystem::file_size(log->path()), 0);
+}
+BENCHMARK_CAPTURE(BM_Cat, copter36_chibios, std::string("ardupilot/copter36_chibios.bin"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Cat, plane408_centre_point, std::string("ardupilot/plane408_centre_point.BIN"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Cat, plane385_disarmed, std::string("mavlink/plane385_disarmed.tlog"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Cat, sample, std::string("px4/sample.ulg"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 /// ArduPilot DataFlash .bin: decode the log as FlightLog does (the bodies a session reads)
 /// and every IMU instance's samples, of every copy.
@@ -202,6 +341,38 @@ BENCHMARK_CAPTURE(BM_ReadDataflash, plane408_centre_point,
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+/// The floor under the DataFlash reader: the same file read the same way (ReadForward) and its
+/// records walked (header, type, FMT lengths), nothing checked, stored or decoded. "samples"
+/// counts records here.
+void BM_WalkDataflash(benchmark::State& state, const std::string& relative) {
+  ReadRepeated(state, relative, [](const std::string& path) {
+    std::array<std::size_t, 256> length{};
+    length[128] = 89;  // FMT
+    std::size_t records = 0;
+    plumb::io::ReadForward(
+        path, "DataFlash log", 255,
+        [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+          std::size_t i = 0;
+          while (n - i >= 3 && (at_end || n - i >= 255)) {
+            const std::size_t len = length[data[i + 2]];
+            if (data[i] == 0xA3 && data[i + 1] == 0x95 && len > 0 && len <= n - i) {
+              if (data[i + 2] == 128) length[data[i + 3]] = data[i + 4];
+              ++records;
+              i += len;
+            } else {
+              ++i;
+            }
+          }
+          return offset + (at_end ? n : i);
+        });
+    return records;
+  });
+}
+BENCHMARK_CAPTURE(BM_WalkDataflash, copter36_chibios,
+                  std::string("ardupilot/copter36_chibios.bin"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 /// MAVLink .tlog: every frame's CRC checked and the IMU messages decoded.
 void BM_ReadTlog(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative, [](const std::string& path) {
@@ -214,15 +385,15 @@ BENCHMARK_CAPTURE(BM_ReadTlog, plane385_disarmed, std::string("mavlink/plane385_
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// PX4 ULog: decode the log (every topic). A repeated ULog is one header and definitions
-/// followed by the data of every copy (later copies' headers are resynchronised over), so the
-/// bytes are all walked.
+/// PX4 ULog: decode the log as FlightLog does (the bodies of the topics a session reads) and
+/// the samples of every IMU stream (sensor_combined, vehicle_imu, sensor_accel paired with
+/// sensor_gyro), of every copy.
 void BM_ReadULog(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative, [](const std::string& path) {
-    const plumb::io::ULog decoded = plumb::io::ReadULog(path);
+    const plumb::io::ULog decoded = plumb::io::ReadULog(path, plumb::io::Px4SessionTopics());
     std::size_t samples = 0;
-    for (const auto& topic : decoded.topics) {
-      if (topic.name == "sensor_combined") samples += topic.rows;
+    for (const plumb::io::ImuStreamInfo& s : plumb::io::ULogImuStreams(decoded)) {
+      samples += s.samples;
     }
     benchmark::DoNotOptimize(decoded.topics.data());
     return samples;

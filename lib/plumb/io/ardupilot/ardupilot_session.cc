@@ -73,18 +73,19 @@ std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
 
 Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection) {
   if (selection.imu < 0) throw Error("ArdupilotSession: the IMU instance must be >= 0");
-  const std::optional<ImuStreamInfo> info = FindDataflashStream(log, selection);
+  ImuStreamInfo info;
   Session s;
-  s.series = DataflashStream(log, selection);  // throws when absent, gyro-only or empty
-  const std::string stream = info ? info->name : selection.stream;
-  const int instance = info ? info->instance : selection.imu;
+  // Throws when absent, gyro-only or empty; the stream's samples are decoded once.
+  s.series = DataflashStream(log, selection, &info);
+  const std::string stream = info.name;
+  const int instance = info.instance;
   const std::string label = stream + " of IMU instance " + std::to_string(instance);
   s.source = log.source + " " + stream + " (IMU instance " + std::to_string(instance) + ")";
   for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
   if (s.series.size() < 2) {
     throw InputError(log.source, label,
                      EmptyWindowMessage(selection.from_s, selection.to_s,
-                                        info ? info->t_start_s : 0.0, info ? info->t_end_s : 0.0));
+                                        info.t_start_s, info.t_end_s));
   }
   const ArdupilotCorrection correction = ArdupilotCorrectionFor(log.params, instance);
   const std::vector<std::string> undone =

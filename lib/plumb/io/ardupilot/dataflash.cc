@@ -20,14 +20,6 @@ constexpr std::uint8_t kHead1 = detail::kDataflashHead1;
 constexpr std::uint8_t kHead2 = detail::kDataflashHead2;
 constexpr std::uint8_t kFmtType = detail::kDataflashFmtType;
 constexpr std::size_t kHeaderSize = detail::kDataflashHeaderSize;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-template <typename T>
-T Load(const std::uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));  // little endian on every supported host
-  return v;
-}
 
 /// A value asked of a type whose bodies the reader's RecordFilter left out: a caller's bug.
 [[noreturn]] void NotKept(const std::string& name) {
@@ -40,63 +32,61 @@ std::string FixedText(const std::uint8_t* p, std::size_t n) {
   return std::string(c, strnlen(c, n));
 }
 
-/// The one-pass decoder state.
+/// The one-pass decoder state: fed the file's bytes in order, in one piece (ParseDataflash) or
+/// in chunks (ReadDataflash, through ReadForward).
 class Parser {
  public:
-  /// `expected_rows`: records per type id from a counting pass (to size each type's storage
-  /// once), or nullptr for a counting pass itself, which stores no bodies.
-  /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
-  /// `filter`: the types whose bodies the storing pass keeps.
-  Parser(const std::uint8_t* data, std::size_t size, DataflashLog* log,
-         const std::array<std::size_t, 256>* expected_rows, const LogFile* file,
-         const RecordFilter& filter)
-      : data_(data), size_(size), log_(log), expected_rows_(expected_rows), file_(file),
-        filter_(filter) {
+  /// The longest record: its length is one byte, header included.
+  static constexpr std::size_t kMaxRecord = 255;
+
+  /// `filter`: the types whose bodies are kept.
+  Parser(DataflashLog* log, const RecordFilter& filter) : log_(log), filter_(filter) {
     index_.fill(-1);
     AddType(detail::DataflashFmtType(&log_->warnings));
   }
 
-  void Run() {
-    std::size_t pos = 0;
-    while (size_ - pos >= kHeaderSize) {
-      if (file_ != nullptr) file_->Release(pos);
-      if (data_[pos] == kHead1 && data_[pos + 1] == kHead2) {
-        const int idx = index_[data_[pos + 2]];
+  /// Decodes the records starting in the bytes [offset, offset + n) of the input held at
+  /// `data`; returns the offset to go on from (unless `at_end`, at least kMaxRecord bytes
+  /// before offset + n, so that every record starting before it is whole). `at_end`: the bytes
+  /// end the input (the truncated last record and trailing bytes are counted).
+  std::size_t Feed(const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    std::size_t i = 0;
+    while (n - i >= kHeaderSize) {
+      if (!at_end && n - i < kMaxRecord) return offset + i;
+      if (data[i] == kHead1 && data[i + 1] == kHead2) {
+        const int idx = index_[data[i + 2]];
         if (idx >= 0) {
           DataflashType& t = log_->types[static_cast<std::size_t>(idx)];
-          if (t.length > size_ - pos) {
-            Truncated(size_ - pos);
-            return;
+          if (t.length > n - i) {
+            Truncated(n - i);
+            return offset + n;
           }
-          const std::uint8_t* body = data_ + pos + kHeaderSize;
-          if (expected_rows_ != nullptr && t.bodies_kept) {
-            t.bodies.insert(t.bodies.end(), body, body + t.body_size);
-          }
+          const std::uint8_t* body = data + i + kHeaderSize;
+          if (t.bodies_kept) t.bodies.Append(body);
           ++t.rows;
-          pos += t.length;
+          i += t.length;
           if (t.id == kFmtType) HandleFmt(body, t.body_size);
           continue;
         }
       }
-      Skip(pos);
-      ++pos;
+      Skip(offset + i);
+      ++i;
     }
-    const std::size_t tail = size_ - pos;
-    if (tail == 0) return;
-    const bool header_prefix = data_[pos] == kHead1 && (tail == 1 || data_[pos + 1] == kHead2);
+    if (!at_end) return offset + i;
+    const std::size_t tail = n - i;
+    if (tail == 0) return offset + n;
+    const bool header_prefix = data[i] == kHead1 && (tail == 1 || data[i + 1] == kHead2);
     if (header_prefix) {
       Truncated(tail);
     } else {
-      for (std::size_t k = 0; k < tail; ++k) Skip(pos + k);
+      for (std::size_t k = 0; k < tail; ++k) Skip(offset + i + k);
     }
+    return offset + n;
   }
 
  private:
   void AddType(DataflashType t) {
     t.bodies_kept = t.id == kFmtType || filter_.Keeps(t.name);
-    if (expected_rows_ != nullptr && t.bodies_kept) {
-      t.bodies.reserve((*expected_rows_)[t.id] * t.body_size);
-    }
     index_[t.id] = static_cast<int>(log_->types.size());
     log_->types.push_back(std::move(t));
   }
@@ -124,26 +114,11 @@ class Parser {
     AddType(detail::MakeDataflashType(id, length, name, format, columns, &log_->warnings));
   }
 
-  const std::uint8_t* data_;
-  std::size_t size_;
   DataflashLog* log_;
-  const std::array<std::size_t, 256>* expected_rows_;
-  const LogFile* file_;
   const RecordFilter& filter_;
   std::array<int, 256> index_;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
-
-/// Rows of `type` that belong to IMU `instance` (all rows when `instance_col` < 0).
-std::vector<std::size_t> InstanceRows(const DataflashType& type, int instance_col,
-                                      int instance) {
-  std::vector<std::size_t> rows;
-  rows.reserve(instance_col < 0 ? type.rows : type.rows / 2);
-  for (std::size_t r = 0; r < type.rows; ++r) {
-    if (instance_col < 0 || type.Value(r, instance_col) == instance) rows.push_back(r);
-  }
-  return rows;
-}
 
 /// The message holding IMU `instance` and the column of its instance field (-1 if none).
 const DataflashType* ImuType(const DataflashLog& log, int instance, int* instance_col) {
@@ -179,31 +154,15 @@ int DataflashType::ColumnIndex(std::string_view column) const {
 double DataflashType::Value(std::size_t row, std::size_t col) const {
   if (!bodies_kept) NotKept(name);
   const DataflashColumn& c = columns[col];
-  const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
   const detail::DataflashFormatChar& f = DataflashFormat(c.format);
-  double v = 0.0;
-  switch (f.storage) {
-    case DataflashStorage::kInt8: v = Load<std::int8_t>(p); break;
-    case DataflashStorage::kUInt8: v = Load<std::uint8_t>(p); break;
-    case DataflashStorage::kInt16: v = Load<std::int16_t>(p); break;
-    case DataflashStorage::kUInt16: v = Load<std::uint16_t>(p); break;
-    case DataflashStorage::kInt32: v = Load<std::int32_t>(p); break;
-    case DataflashStorage::kUInt32: v = Load<std::uint32_t>(p); break;
-    case DataflashStorage::kInt64: v = static_cast<double>(Load<std::int64_t>(p)); break;
-    case DataflashStorage::kUInt64: v = static_cast<double>(Load<std::uint64_t>(p)); break;
-    case DataflashStorage::kFloat: v = Load<float>(p); break;
-    case DataflashStorage::kDouble: v = Load<double>(p); break;
-    case DataflashStorage::kText: case DataflashStorage::kArray: case DataflashStorage::kUnknown:
-      return kNaN;
-  }
-  return f.scale == 1.0 ? v : v * f.scale;
+  return detail::DecodeDataflashValue(bodies.Row(row) + c.offset, f.storage, f.scale);
 }
 
 std::string DataflashType::Text(std::size_t row, std::size_t col) const {
   if (!bodies_kept) NotKept(name);
   const DataflashColumn& c = columns[col];
   if (DataflashFormat(c.format).storage != DataflashStorage::kText) return {};
-  return FixedText(bodies.data() + row * body_size + c.offset, c.size);
+  return FixedText(bodies.Row(row) + c.offset, c.size);
 }
 
 std::array<std::int16_t, 32> DataflashType::Array(std::size_t row, std::size_t col) const {
@@ -211,7 +170,7 @@ std::array<std::int16_t, 32> DataflashType::Array(std::size_t row, std::size_t c
   std::array<std::int16_t, 32> out{};
   const DataflashColumn& c = columns[col];
   if (DataflashFormat(c.format).storage == DataflashStorage::kArray) {
-    std::memcpy(out.data(), bodies.data() + row * body_size + c.offset, sizeof(out));
+    std::memcpy(out.data(), bodies.Row(row) + c.offset, sizeof(out));
   }
   return out;
 }
@@ -288,54 +247,55 @@ std::vector<std::pair<std::string, std::size_t>> DataflashLog::MessageCounts() c
 
 namespace {
 
-/// ParseDataflash, telling `file` (nullptr: none) what each pass has read.
-DataflashLog ParseDataflashFrom(const std::uint8_t* data, std::size_t size,
-                                const std::string& source, const LogFile* file,
-                                const RecordFilter& filter) {
-  DataflashLog log;
-  log.source = source;
-  log.size_bytes = size;
-  // Two passes: the first counts the records of each type (no copy), so that the second
-  // copies every body once into storage of the right size (no reallocation).
-  std::array<std::size_t, 256> rows{};
-  {
-    DataflashLog counted;
-    Parser counter(data, size, &counted, nullptr, file, filter);
-    counter.Run();
-    for (const DataflashType& t : counted.types) rows[t.id] = t.rows;
-  }
-  Parser parser(data, size, &log, &rows, file, filter);
-  parser.Run();
-  if (log.types.front().rows == 0) {
-    throw InputError(source, "byte 0",
+/// Checks that `log`, fed by `parser`, held an FMT record and completes it (units, params).
+void FinishParse(DataflashLog* log, std::size_t size) {
+  if (log->types.front().rows == 0) {
+    throw InputError(log->source, "byte 0",
                      "no FMT record (0xA3 0x95 0x80) in " + std::to_string(size) +
                          " bytes: not an ArduPilot DataFlash .bin log");
   }
-  detail::FinishDataflashLog(&log);
-  return log;
+  detail::FinishDataflashLog(log);
 }
 
 }  // namespace
 
 DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
                             const std::string& source, const RecordFilter& filter) {
-  return ParseDataflashFrom(data, size, source, nullptr, filter);
+  DataflashLog log;
+  log.source = source;
+  log.size_bytes = size;
+  Parser parser(&log, filter);
+  parser.Feed(data, size, 0, true);
+  FinishParse(&log, size);
+  return log;
 }
 
 DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter) {
-  const LogFile file(path, "DataFlash log");
-  return ParseDataflashFrom(file.data(), file.size(), path, &file, filter);
+  DataflashLog log;
+  log.source = path;
+  Parser parser(&log, filter);
+  // One pass, in chunks: every record is decoded from the read buffer as it goes by.
+  ReadForward(path, "DataFlash log", Parser::kMaxRecord,
+              [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+                if (at_end) log.size_bytes = offset + n;
+                return parser.Feed(data, n, offset, at_end);
+              });
+  FinishParse(&log, log.size_bytes);
+  return log;
 }
 
 std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {
+  using Reader = detail::DataflashColumnReader;
   // Candidate (instance, message) pairs: the I values of IMU, or IMU, IMU2, IMU3, ...
   std::vector<int> instances;
   int probe_col = -1;
   const DataflashType* probe = ImuType(log, 0, &probe_col);
   if (probe != nullptr && probe_col >= 0) {
+    if (!probe->bodies_kept) NotKept(probe->name);
+    const Reader inst = Reader::Of(*probe, probe_col);
     std::array<bool, 256> seen{};
     for (std::size_t r = 0; r < probe->rows; ++r) {
-      const double v = probe->Value(r, static_cast<std::size_t>(probe_col));
+      const double v = inst.Read(probe->bodies.Row(r));
       if (v >= 0 && v < 256) seen[static_cast<std::size_t>(v)] = true;
     }
     for (int k = 0; k < 256; ++k) {
@@ -348,20 +308,28 @@ std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {
   for (int instance : instances) {
     int instance_col = -1;
     const DataflashType* type = ImuType(log, instance, &instance_col);
-    if (type == nullptr) continue;
-    const std::vector<std::size_t> rows = InstanceRows(*type, instance_col, instance);
-    if (rows.empty()) continue;
+    if (type == nullptr || type->rows == 0) continue;
+    if (!type->bodies_kept) NotKept(type->name);
+    const Reader inst = instance_col >= 0 ? Reader::Of(*type, instance_col) : Reader{};
+    const TimeColumn time = FindTime(*type);
+    const Reader t_col = time.col >= 0 ? Reader::Of(*type, time.col) : Reader{};
+    std::size_t samples = 0;
+    double first = 0.0, last = 0.0;  // raw times of the instance's first and last rows
+    for (std::size_t r = 0; r < type->rows; ++r) {
+      const std::uint8_t* body = type->bodies.Row(r);
+      if (instance_col >= 0 && inst.Read(body) != instance) continue;
+      if (time.col >= 0) (samples == 0 ? first : last) = t_col.Read(body);
+      ++samples;
+    }
+    if (samples == 0) continue;
     DataflashImuInfo info;
     info.instance = instance;
     info.message = type->name;
-    info.samples = rows.size();
+    info.samples = samples;
     info.has_temperature = TemperatureColumn(*type) >= 0;
-    const TimeColumn time = FindTime(*type);
-    if (time.col >= 0 && rows.size() >= 2) {
-      const auto col = static_cast<std::size_t>(time.col);
-      const double span =
-          (type->Value(rows.back(), col) - type->Value(rows.front(), col)) * time.scale;
-      if (span > 0.0) info.rate_hz = static_cast<double>(rows.size() - 1) / span;
+    if (time.col >= 0 && samples >= 2) {
+      const double span = (last - first) * time.scale;
+      if (span > 0.0) info.rate_hz = static_cast<double>(samples - 1) / span;
     }
     out.push_back(info);
   }
@@ -386,38 +354,63 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
     throw InputError(log.source, "",
                      type->name + " has no TimeUS/TimeMS or AccX/AccY/AccZ column");
   }
-  const std::vector<std::size_t> rows = InstanceRows(*type, instance_col, instance);
   if (type->rows == 0) {
     throw InputError(log.source, "",
                      "the log defines " + type->name + " (FMT) but holds no " + type->name +
                          " rows: no IMU samples were logged (LOG_BITMASK without IMU?)");
   }
-  if (rows.empty()) {
+  if (!type->bodies_kept) NotKept(type->name);
+  using Reader = detail::DataflashColumnReader;
+  const Reader inst = instance_col >= 0 ? Reader::Of(*type, instance_col) : Reader{};
+  const auto mine = [&](const std::uint8_t* body) {
+    return instance_col < 0 || inst.Read(body) == instance;
+  };
+  std::size_t count = 0;
+  for (std::size_t r = 0; r < type->rows; ++r) count += mine(type->bodies.Row(r)) ? 1 : 0;
+  if (count == 0) {
     throw InputError(log.source, "", "no " + type->name + " rows with I == " +
                                          std::to_string(instance) + " for " + what);
   }
-
-  ImuSeries s;
-  s.reserve(rows.size());
-  const auto time_col = static_cast<std::size_t>(time.col);
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const std::size_t r = rows[i];
-    const double t_s = type->Value(r, time_col) * time.scale;
-    if (!std::isfinite(t_s) || (!s.t_s.empty() && !(t_s > s.t_s.back()))) continue;
-    // A time above the next record's is a corrupted spike: keeping it would drop every later
-    // sample.
-    if (i + 1 < rows.size() && !(t_s < type->Value(rows[i + 1], time_col) * time.scale)) continue;
-    s.t_s.push_back(t_s);
-    s.acc.emplace_back(static_cast<float>(type->Value(r, acc[0])),
-                       static_cast<float>(type->Value(r, acc[1])),
-                       static_cast<float>(type->Value(r, acc[2])));
-    if (has_gyr) {
-      s.gyr.emplace_back(static_cast<float>(type->Value(r, gyr[0])),
-                         static_cast<float>(type->Value(r, gyr[1])),
-                         static_cast<float>(type->Value(r, gyr[2])));
-    }
-    if (temp >= 0) s.temp_c.push_back(static_cast<float>(type->Value(r, temp)));
+  const Reader t_col = Reader::Of(*type, time.col);
+  const Reader a[3] = {Reader::Of(*type, acc[0]), Reader::Of(*type, acc[1]),
+                       Reader::Of(*type, acc[2])};
+  Reader g[3];
+  if (has_gyr) {
+    for (int k = 0; k < 3; ++k) g[k] = Reader::Of(*type, gyr[k]);
   }
+  const Reader temp_col = temp >= 0 ? Reader::Of(*type, temp) : Reader{};
+  ImuSeries s;
+  s.reserve(count);
+  const auto keep = [&](const std::uint8_t* body, double t_s) {
+    s.t_s.push_back(t_s);
+    s.acc.emplace_back(static_cast<float>(a[0].Read(body)), static_cast<float>(a[1].Read(body)),
+                       static_cast<float>(a[2].Read(body)));
+    if (has_gyr) {
+      s.gyr.emplace_back(static_cast<float>(g[0].Read(body)),
+                         static_cast<float>(g[1].Read(body)),
+                         static_cast<float>(g[2].Read(body)));
+    }
+    if (temp >= 0) s.temp_c.push_back(static_cast<float>(temp_col.Read(body)));
+  };
+  // A sample is kept when its time is finite, above the last kept one and below the next
+  // record's (a time above the next record's is a corrupted spike: keeping it would drop every
+  // later sample); each record is decided when the next one of the instance is met.
+  const std::uint8_t* pending = nullptr;
+  double pending_t = 0.0;
+  const auto decide = [&](bool below_next) {
+    if (pending == nullptr || !std::isfinite(pending_t)) return;
+    if (!s.t_s.empty() && !(pending_t > s.t_s.back())) return;
+    if (below_next) keep(pending, pending_t);
+  };
+  for (std::size_t r = 0; r < type->rows; ++r) {
+    const std::uint8_t* body = type->bodies.Row(r);
+    if (!mine(body)) continue;
+    const double t_s = t_col.Read(body) * time.scale;
+    decide(pending_t < t_s);
+    pending = body;
+    pending_t = t_s;
+  }
+  decide(true);
   return s;
 }
 

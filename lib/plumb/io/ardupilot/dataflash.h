@@ -9,7 +9,7 @@
 // * 0.01), e/E 4 (int32/uint32 * 0.01), L 4 (int32 lat/lon * 1e-7 degrees), M 1 (uint8 flight
 // mode), a 64 (int16[32]).
 //
-// Decoding contract (one pass over the whole file held in memory):
+// Decoding contract (one pass over the file, read forward in chunks by ReadDataflash):
 //  * The first FMT seen for a type wins; a later FMT that differs is ignored and counted.
 //  * The FMT length is trusted: fields are decoded while they fit in the body; extra body
 //    bytes are ignored; a mismatch between the field sizes and the length is counted
@@ -22,10 +22,11 @@
 //  * A type whose FMT has an unknown format character keeps its records (counted, bytes kept)
 //    but only the columns before that character are decodable.
 //
-// Storage ("compact per-type table"): each type keeps the raw bodies of its records
-// contiguously (row-major, body_size bytes per record, exactly as in the file), and columns
-// are decoded on access with their byte offsets. Memory is about the file size; reading is a
-// bounds-checked copy per record with no per-record allocation.
+// Storage ("compact per-type table"): each kept type (RecordFilter) keeps the raw bodies of its
+// records (RecordStore: row-major blocks, body_size bytes per record, exactly as in the file),
+// and columns are decoded on access with their byte offsets. Memory is about the kept bodies;
+// reading is a bounds-checked copy per kept record, with no per-record allocation and no
+// counting pass.
 #pragma once
 
 #include <array>
@@ -66,7 +67,7 @@ struct DataflashType {
   std::vector<DataflashColumn> columns;  ///< decodable columns, in record order
   std::size_t body_size = 0;    ///< length - 3, bytes per stored record
   std::size_t rows = 0;         ///< number of records decoded
-  std::vector<std::uint8_t> bodies;  ///< rows * body_size bytes, the record bodies in order
+  RecordStore bodies;           ///< the record bodies in order, body_size bytes each
   /// False when the reader's RecordFilter left this type's bodies out (rows still counted):
   /// Value, Text, Array and Column then throw plumb::Error.
   bool bodies_kept = true;
@@ -216,7 +217,10 @@ std::vector<ImuStreamInfo> DataflashImuStreams(const DataflashLog& log);
 /// be selected: plumb needs accelerometer samples (plumb::InputError says so). Samples whose
 /// time does not increase are dropped (see ImuFromDataflash). Throws plumb::InputError naming
 /// the log when the stream is absent, gyroscope-only or has no samples in the window.
-ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& selection);
+/// `info` (optional): set to the stream's description (as FindDataflashStream gives it), from
+/// the same decoded samples.
+ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& selection,
+                          ImuStreamInfo* info = nullptr);
 
 /// The stream DataflashStream would read for `selection`, or nullopt.
 std::optional<ImuStreamInfo> FindDataflashStream(const DataflashLog& log,

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <vector>
 
@@ -91,11 +92,13 @@ void ApplyUnits(DataflashLog* log) {
   const int unit_col = fmtu->ColumnIndex("UnitIds");
   const int mult_col = fmtu->ColumnIndex("MultIds");
   if (type_col < 0) return;
+  std::array<DataflashType*, 256> by_id{};  // the first type of each id (as a search finds)
+  for (auto t = log->types.rbegin(); t != log->types.rend(); ++t) by_id[t->id] = &*t;
   for (std::size_t r = 0; r < fmtu->rows; ++r) {
     const double type_id = fmtu->Value(r, type_col);
-    auto it = std::find_if(log->types.begin(), log->types.end(),
-                           [&](const DataflashType& t) { return t.id == type_id; });
-    if (it == log->types.end()) continue;
+    if (!(type_id >= 0 && type_id < 256) || type_id != std::floor(type_id)) continue;
+    DataflashType* const it = by_id[static_cast<std::size_t>(type_id)];
+    if (it == nullptr) continue;
     const std::string unit_ids = unit_col >= 0 ? fmtu->Text(r, unit_col) : "";
     const std::string mult_ids = mult_col >= 0 ? fmtu->Text(r, mult_col) : "";
     for (std::size_t c = 0; c < it->columns.size(); ++c) {
@@ -124,6 +127,12 @@ const DataflashFormatChar& DataflashFormat(char c) {
   return kByCode[static_cast<unsigned char>(c)];
 }
 
+DataflashColumnReader DataflashColumnReader::Of(const DataflashType& t, int col) {
+  const DataflashColumn& c = t.columns[static_cast<std::size_t>(col)];
+  const DataflashFormatChar& f = DataflashFormat(c.format);
+  return {c.offset, f.storage, f.scale};
+}
+
 DataflashType MakeDataflashType(std::uint8_t id, std::size_t length, const std::string& name,
                                 const std::string& format, const std::string& columns,
                                 DataflashWarnings* w) {
@@ -133,6 +142,7 @@ DataflashType MakeDataflashType(std::uint8_t id, std::size_t length, const std::
   t.length = length;
   t.format = format;
   t.body_size = length - kDataflashHeaderSize;
+  t.bodies = RecordStore(t.body_size);
   const std::vector<std::string> names = SplitColumns(columns);
   std::size_t offset = 0;
   bool known = true;

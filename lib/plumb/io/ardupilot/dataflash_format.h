@@ -7,6 +7,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <string>
 
 #include "plumb/io/ardupilot/dataflash.h"
@@ -59,6 +61,49 @@ struct DataflashFormatChar {
 /// The entry of format character `c`; size 0 and storage kUnknown when it is not a DataFlash
 /// format character.
 const DataflashFormatChar& DataflashFormat(char c);
+
+/// The numeric value of a field stored as `storage` at `p` (little endian), times `scale` when
+/// it is not 1 (the format character's scale, DataflashFormatChar::scale); NaN for text,
+/// arrays and unknown storage. THE decoding of a field: DataflashType::Value and the column
+/// readers of the IMU streams use it.
+inline double DecodeDataflashValue(const std::uint8_t* p, DataflashStorage storage,
+                                   double scale) {
+  const auto load = [p](auto v) {
+    std::memcpy(&v, p, sizeof v);  // little endian on every supported host
+    return v;
+  };
+  double v = 0.0;
+  switch (storage) {
+    case DataflashStorage::kInt8: v = load(std::int8_t{}); break;
+    case DataflashStorage::kUInt8: v = load(std::uint8_t{}); break;
+    case DataflashStorage::kInt16: v = load(std::int16_t{}); break;
+    case DataflashStorage::kUInt16: v = load(std::uint16_t{}); break;
+    case DataflashStorage::kInt32: v = load(std::int32_t{}); break;
+    case DataflashStorage::kUInt32: v = load(std::uint32_t{}); break;
+    case DataflashStorage::kInt64: v = static_cast<double>(load(std::int64_t{})); break;
+    case DataflashStorage::kUInt64: v = static_cast<double>(load(std::uint64_t{})); break;
+    case DataflashStorage::kFloat: v = load(float{}); break;
+    case DataflashStorage::kDouble: v = load(double{}); break;
+    case DataflashStorage::kText: case DataflashStorage::kArray: case DataflashStorage::kUnknown:
+      return std::numeric_limits<double>::quiet_NaN();
+  }
+  return scale == 1.0 ? v : v * scale;
+}
+
+/// One numeric column of a type, read straight from record bodies: DataflashType::Value
+/// without looking the column and its format character up for every value.
+struct DataflashColumnReader {
+  std::size_t offset = 0;  ///< byte offset in the body
+  DataflashStorage storage = DataflashStorage::kUnknown;
+  double scale = 1.0;      ///< the format character's scale
+
+  /// The reader of column `col` (>= 0) of `t`.
+  static DataflashColumnReader Of(const DataflashType& t, int col);
+  /// The value in the record body `body` (as DataflashType::Value).
+  double Read(const std::uint8_t* body) const {
+    return DecodeDataflashValue(body + offset, storage, scale);
+  }
+};
 
 /// Size in bytes of a DataFlash format character, 0 when unknown.
 inline std::size_t DataflashFormatSize(char c) { return DataflashFormat(c).size; }

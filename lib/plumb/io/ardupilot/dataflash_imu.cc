@@ -55,8 +55,10 @@ double ValueAt(const DataflashType& t, std::size_t row, int col) {
 /// {0} / {} when it has no I column (defined / not defined).
 std::vector<int> InstancesOf(const DataflashType& t, int instance_col) {
   std::array<bool, 256> seen{};
+  if (t.rows > 0 && !t.bodies_kept) ValueAt(t, 0, instance_col);  // throws: not kept
+  const auto column = detail::DataflashColumnReader::Of(t, instance_col);
   for (std::size_t r = 0; r < t.rows; ++r) {
-    const double v = ValueAt(t, r, instance_col);
+    const double v = column.Read(t.bodies.Row(r));
     if (v >= 0 && v < 256 && v == std::floor(v)) seen[static_cast<std::size_t>(v)] = true;
   }
   std::vector<int> out;
@@ -112,19 +114,24 @@ ImuSeries ReadRawMessage(const DataflashLog& log, const std::string& base, int i
   const int axes[3] = {Col(*t, vector_prefix + "X"), Col(*t, vector_prefix + "Y"),
                        Col(*t, vector_prefix + "Z")};
   if (time < 0 || axes[0] < 0 || axes[1] < 0 || axes[2] < 0) return s;
-  std::vector<std::size_t> rows;
+  if (t->rows > 0 && !t->bodies_kept) ValueAt(*t, 0, time);  // throws: not kept
+  using Reader = detail::DataflashColumnReader;
+  const Reader inst = instance_col >= 0 ? Reader::Of(*t, instance_col) : Reader{};
+  const Reader time_col = Reader::Of(*t, time);
+  const Reader a[3] = {Reader::Of(*t, axes[0]), Reader::Of(*t, axes[1]), Reader::Of(*t, axes[2])};
+  std::vector<const std::uint8_t*> rows;
   std::vector<double> times;
   for (std::size_t r = 0; r < t->rows; ++r) {
-    if (instance_col >= 0 && ValueAt(*t, r, instance_col) != instance) continue;
-    rows.push_back(r);
-    times.push_back(ValueAt(*t, r, time) * 1e-6);
+    const std::uint8_t* body = t->bodies.Row(r);
+    if (instance_col >= 0 && inst.Read(body) != instance) continue;
+    rows.push_back(body);
+    times.push_back(time_col.Read(body) * 1e-6);
   }
   std::vector<Vec3f>& out = vector_prefix == "Acc" ? s.acc : s.gyr;
   for (std::size_t i : IncreasingIndices(times)) {
     s.t_s.push_back(times[i]);
-    out.emplace_back(static_cast<float>(ValueAt(*t, rows[i], axes[0])),
-                     static_cast<float>(ValueAt(*t, rows[i], axes[1])),
-                     static_cast<float>(ValueAt(*t, rows[i], axes[2])));
+    out.emplace_back(static_cast<float>(a[0].Read(rows[i])), static_cast<float>(a[1].Read(rows[i])),
+                     static_cast<float>(a[2].Read(rows[i])));
   }
   return s;
 }
@@ -306,16 +313,11 @@ double IsbdRate(const DataflashLog& log, int sensor, int instance) {
   return rates[rates.size() / 2];
 }
 
-ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
+/// The description of the stream `ref` whose samples are `s` (as ReadStream gives them).
+ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref, const ImuSeries& s) {
   ImuStreamInfo info;
   info.name = ref.name;
   info.instance = ref.instance;
-  ImuSeries s;
-  try {
-    s = ReadStream(log, ref);
-  } catch (const InputError&) {
-    // An IMU FMT without rows (or without time/Acc columns): listed with 0 samples.
-  }
   info.samples = s.size();
   if (!s.empty()) {
     info.t_start_s = s.t_s.front();
@@ -336,16 +338,31 @@ ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
   return info;
 }
 
-bool HasSamples(const DataflashLog& log, const StreamRef& ref) {
+ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
+  ImuSeries s;
   try {
-    return !ReadStream(log, ref).empty();
+    s = ReadStream(log, ref);
+  } catch (const InputError&) {
+    // An IMU FMT without rows (or without time/Acc columns): listed with 0 samples.
+  }
+  return Describe(log, ref, s);
+}
+
+/// True when the stream `ref` has samples; they are then in `*samples`.
+bool HasSamples(const DataflashLog& log, const StreamRef& ref, ImuSeries* samples) {
+  try {
+    *samples = ReadStream(log, ref);
+    return !samples->empty();
   } catch (const InputError&) {
     return false;  // e.g. an IMU FMT without rows
   }
 }
 
-/// The stream `selection` names, or nullopt (see DataflashStream for the default).
-std::optional<StreamRef> Select(const DataflashLog& log, const FlightLogSelection& selection) {
+/// The stream `selection` names, or nullopt (see DataflashStream for the default). When the
+/// choice read the stream's samples, they are in `*samples` and `*read` is true.
+std::optional<StreamRef> Select(const DataflashLog& log, const FlightLogSelection& selection,
+                                ImuSeries* samples, bool* read) {
+  *read = false;
   const std::vector<StreamRef> refs = StreamRefs(log);
   if (selection.stream.empty()) {
     std::optional<StreamRef> first;
@@ -354,7 +371,10 @@ std::optional<StreamRef> Select(const DataflashLog& log, const FlightLogSelectio
         continue;
       }
       if (!first) first = r;
-      if (HasSamples(log, r)) return r;
+      if (HasSamples(log, r, samples)) {
+        *read = true;
+        return r;
+      }
     }
     return first;
   }
@@ -402,13 +422,18 @@ std::vector<ImuStreamInfo> DataflashImuStreams(const DataflashLog& log) {
 
 std::optional<ImuStreamInfo> FindDataflashStream(const DataflashLog& log,
                                                  const FlightLogSelection& selection) {
-  const std::optional<StreamRef> ref = Select(log, selection);
+  ImuSeries samples;
+  bool read = false;
+  const std::optional<StreamRef> ref = Select(log, selection, &samples, &read);
   if (!ref) return std::nullopt;
-  return Describe(log, *ref);
+  return read ? Describe(log, *ref, samples) : Describe(log, *ref);
 }
 
-ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& selection) {
-  const std::optional<StreamRef> ref = Select(log, selection);
+ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& selection,
+                          ImuStreamInfo* info) {
+  ImuSeries all;
+  bool read = false;
+  const std::optional<StreamRef> ref = Select(log, selection, &all, &read);
   const std::string label = StreamLabel(selection);
   if (!ref) {
     std::string known;
@@ -424,11 +449,12 @@ ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& sel
                          " carries gyroscope samples only; plumb needs accelerometer samples: "
                          "select IMU, ACC+GYR or ACC of that instance");
   }
-  const ImuSeries all = ReadStream(log, *ref);
+  if (!read) all = ReadStream(log, *ref);  // the samples once, for the session and `info`
   if (all.empty()) {
     throw InputError(log.source, "", ref->name + " of IMU instance " +
                                          std::to_string(ref->instance) + " has no samples");
   }
+  if (info != nullptr) *info = Describe(log, *ref, all);
   ImuSeries s = Window(all, selection);
   if (s.empty()) {
     throw InputError(log.source, "", "no samples of " + ref->name + " of IMU instance " +

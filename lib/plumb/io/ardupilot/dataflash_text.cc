@@ -251,7 +251,7 @@ class TextParser {
     }
     if (t.id == detail::kDataflashFmtType && !CheckFmt(f)) return;
     if (mode_name) ++log_->warnings.text_mode_names;
-    if (t.bodies_kept) t.bodies.insert(t.bodies.end(), row_.begin(), row_.end());
+    if (t.bodies_kept) t.bodies.Append(row_.data());
     ++t.rows;
     if (t.id == detail::kDataflashFmtType) DefineType(f);
   }

@@ -1,10 +1,14 @@
-// plumb/io/common/log_common.h — pieces every flight-log reader shares: reading the whole file,
+// plumb/io/common/log_common.h — pieces every flight-log reader shares: reading the file forward
+// in chunks (ReadForward; the DataFlash and ULog readers) or whole (LogFile; the tlog reader,
+// whose resync search looks ahead without bound), storing record bodies (RecordStore),
 // counting skipped bytes, saturating float conversion, and the site from a log's GPS fixes.
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -52,6 +56,73 @@ class LogFile {
   void* mapping_ = nullptr;             ///< the mmap'ed region, or nullptr
   std::vector<std::uint8_t> buffer_;    ///< the bytes when not mapped
   mutable std::size_t released_ = 0;    ///< bytes [0, released_) were last released
+};
+
+/// Reads the file at `path` forward in chunks with read(2) into one reusable buffer (never
+/// mapped, never held whole: the page cache is copied from as `cat` does, without the page
+/// faults and TLB misses of walking a mapping), for parsers that decide at each position from
+/// a bounded look-ahead. `consume(data, n, offset, at_end)` gets the bytes [offset, offset + n)
+/// of the file (`at_end`: they reach its end) and returns the file offset it needs the bytes
+/// from next, in [offset, offset + n] or beyond (a forward jump: the bytes in between are not
+/// read). The bytes from that offset to offset + n are passed again at the start of the next
+/// call, followed by the next chunk; a parser returns a position `lookahead` bytes or more
+/// before the end of its data unless `at_end`. Reading stops after the call with `at_end` (or
+/// when the returned offset is the file size or beyond). `what` names the format in errors:
+/// throws plumb::InputError(path, "byte N", ...) when the file cannot be opened or read. A
+/// file that is not a regular file (a pipe) is read whole first.
+void ReadForward(const std::string& path, const std::string& what, std::size_t lookahead,
+                 const std::function<std::size_t(const std::uint8_t* data, std::size_t n,
+                                                 std::size_t offset, bool at_end)>& consume);
+
+/// The size of the file at `path` in bytes (0 when it is not a regular file or cannot be
+/// read).
+std::size_t RegularFileSize(const std::string& path);
+
+/// The record bodies of one message (DataFlash type, ULog topic), in log order: rows of
+/// `body_size` bytes each, exactly as in the file, in blocks of a power-of-two number of rows
+/// (about kBlockBytes each), so that appending never moves the rows already stored (no
+/// counting pass to size the storage, no reallocation copy; the last block's unused rows are
+/// never written, so they cost address space, not resident memory).
+class RecordStore {
+ public:
+  /// Bytes per block, about (a block holds at least one row).
+  static constexpr std::size_t kBlockBytes = std::size_t{256} << 10;
+
+  RecordStore() = default;
+  explicit RecordStore(std::size_t body_size);
+  RecordStore(const RecordStore& other);
+  RecordStore& operator=(const RecordStore& other);
+  RecordStore(RecordStore&&) noexcept = default;
+  RecordStore& operator=(RecordStore&&) noexcept = default;
+
+  /// Appends one row: body_size() bytes from `body`.
+  void Append(const std::uint8_t* body) {
+    if ((rows_ & mask_) == 0 && (rows_ >> shift_) == blocks_.size()) AddBlock();
+    std::memcpy(MutableRow(rows_), body, body_size_);
+    ++rows_;
+  }
+  /// The bytes of row `r` (< rows()).
+  const std::uint8_t* Row(std::size_t r) const {
+    return blocks_[r >> shift_].get() + (r & mask_) * body_size_;
+  }
+  std::size_t rows() const { return rows_; }
+  std::size_t body_size() const { return body_size_; }
+  /// rows() * body_size(): the bytes stored.
+  std::size_t size() const { return rows_ * body_size_; }
+  /// True when both hold the same rows (sizes and bytes).
+  bool operator==(const RecordStore& other) const;
+
+ private:
+  std::uint8_t* MutableRow(std::size_t r) {
+    return blocks_[r >> shift_].get() + (r & mask_) * body_size_;
+  }
+  void AddBlock();
+
+  std::size_t body_size_ = 0;
+  std::size_t rows_ = 0;
+  unsigned shift_ = 0;      ///< rows per block = 1 << shift_
+  std::size_t mask_ = 0;    ///< (1 << shift_) - 1
+  std::vector<std::unique_ptr<std::uint8_t[]>> blocks_;
 };
 
 /// Which messages (DataFlash types, ULog topics) a binary-log reader keeps the record bodies

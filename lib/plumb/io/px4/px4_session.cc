@@ -409,7 +409,14 @@ std::map<std::string, double> ULogParams(const ULog& log) {
 }
 
 Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
-  const std::vector<StreamSource> sources = Sources(log);
+  // The candidates: the sources of the instance (and the stream) selected, the only ones whose
+  // samples are decoded (Select looks at no other).
+  std::vector<StreamSource> sources;
+  for (const StreamSource& src : Sources(log)) {
+    if (src.instance != selection.imu) continue;
+    if (!selection.stream.empty() && KindName(src.kind) != selection.stream) continue;
+    sources.push_back(src);
+  }
   std::vector<ImuStreamInfo> infos;
   std::vector<ImuSeries> all;
   std::vector<std::vector<std::string>> notes(sources.size());

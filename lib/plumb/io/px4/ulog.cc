@@ -22,7 +22,6 @@ constexpr std::size_t kMsgHeaderSize = 3;
 constexpr std::size_t kFlagBitsSize = 40;        // 8 + 8 + 3 * 8
 constexpr int kResyncChain = 4;  // consecutive valid headers that end a resync without D or S
 constexpr std::size_t kMinColumnBudget = 65536;  // columns allowed beyond one per input byte
-constexpr std::size_t kPreScanMinSize = std::size_t{1} << 16;  // inputs worth a counting pass
 
 template <typename T>
 T Load(const std::uint8_t* p) {
@@ -119,72 +118,125 @@ std::uint64_t TimestampOf(const ULogTopic& t, const std::uint8_t* body) {
   throw Error("ULog topic " + name + ": its message bodies were not kept (RecordFilter)");
 }
 
-/// The one-pass decoder state.
+/// The one-pass decoder state: fed the file's bytes in order, in one piece (ParseULog) or in
+/// chunks (ReadULog, through ReadForward); the position, the segment and the resync state
+/// carry over from one call to the next.
 class Parser {
  public:
-  /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
-  /// `filter`: the topics whose bodies are kept.
-  Parser(const std::uint8_t* data, std::size_t size, ULog* log, const LogFile* file,
-         const RecordFilter& filter)
-      : data_(data), size_(size), log_(log), file_(file), filter_(filter),
+  /// Bytes a decision at a position may look at: a resync's chain of kResyncChain messages of
+  /// at most 65535 bytes each, and the next header.
+  static constexpr std::size_t kLookahead =
+      kResyncChain * (kMsgHeaderSize + 65535) + kMsgHeaderSize;
+
+  /// `size`: the input's size in bytes (corrected by the call with at_end); `filter`: the
+  /// topics whose bodies are kept.
+  Parser(std::size_t size, ULog* log, const RecordFilter& filter)
+      : size_(size), end_(size), log_(log), filter_(filter),
         resolver_(log->formats, size + kMinColumnBudget) {}
 
-  void Run() {
-    if (size_ >= kPreScanMinSize) PreScan();
-    std::size_t pos = kFileHeaderSize;
-    std::size_t end = size_;
-    std::size_t next_segment = 0;  // index into log_->appended_offsets
-    bool resync = false;
+  /// Decodes the messages starting in the bytes [offset, offset + n) of the input held at
+  /// `data` and returns the offset to go on from: unless `at_end`, the first message not
+  /// whole in the bytes (or, resynchronising, the first position less than kLookahead bytes
+  /// before offset + n), or the start of the next appended segment (a jump forward). `at_end`:
+  /// the bytes end the input. The first call starts at offset 0 (the file header).
+  std::size_t Feed(const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    data_ = data;
+    base_ = offset;
+    avail_ = offset + n;
+    if (at_end && avail_ < size_) {  // a shorter input than announced: it ends here
+      size_ = avail_;
+      end_ = std::min(end_, size_);
+    }
+    if (pos_ == 0) {
+      ReadFileHeader(at_end);
+      pos_ = kFileHeaderSize;
+    }
+    Run(at_end);
+    return std::max(pos_, offset);
+  }
+
+  /// The messages from pos_ on, while the look-ahead is in the bytes held (or `at_end`).
+  void Run(bool at_end) {
     while (true) {
-      if (file_ != nullptr) file_->Release(pos);
-      if (pos >= end) {
-        if (next_segment < log_->appended_offsets.size()) {
-          pos = static_cast<std::size_t>(log_->appended_offsets[next_segment]);
-          ++next_segment;
-          end = next_segment < log_->appended_offsets.size()
-                    ? static_cast<std::size_t>(log_->appended_offsets[next_segment])
-                    : size_;
-          resync = false;
+      if (pos_ >= end_) {
+        if (next_segment_ < log_->appended_offsets.size()) {
+          pos_ = std::min(size_, static_cast<std::size_t>(log_->appended_offsets[next_segment_]));
+          ++next_segment_;
+          end_ = next_segment_ < log_->appended_offsets.size()
+                     ? static_cast<std::size_t>(log_->appended_offsets[next_segment_])
+                     : size_;
+          end_ = std::min(end_, size_);
+          resync_ = false;
           continue;
         }
+        pos_ = std::max(pos_, size_);
         return;
       }
-      if (resync) {
-        if (!ResyncPoint(pos, end)) {
-          Skip(pos);
-          ++pos;
+      if (!at_end && !Held(pos_)) return;
+      if (resync_) {
+        if (!ResyncPoint(pos_, end_)) {
+          Skip(pos_);
+          ++pos_;
           continue;
         }
-        resync = false;
+        resync_ = false;
       }
-      if (end - pos < kMsgHeaderSize) {
-        Truncated(end - pos);
-        pos = end;
+      if (end_ - pos_ < kMsgHeaderSize) {
+        Truncated(end_ - pos_);
+        pos_ = end_;
         continue;
       }
-      const std::size_t size = Load<std::uint16_t>(data_ + pos);
-      const std::uint8_t type = data_[pos + 2];
-      if (Corrupt(pos, end, size, type)) {
-        resync = true;
+      const std::size_t size = Load<std::uint16_t>(At(pos_));
+      const std::uint8_t type = At(pos_)[2];
+      if (Corrupt(pos_, end_, size, type)) {
+        resync_ = true;
         continue;
       }
-      if (size > end - pos - kMsgHeaderSize) {
-        Truncated(end - pos);
-        pos = end;
+      if (size > end_ - pos_ - kMsgHeaderSize) {
+        Truncated(end_ - pos_);
+        pos_ = end_;
         continue;
       }
-      const std::uint8_t* body = data_ + pos + kMsgHeaderSize;
-      const std::size_t at = pos;
-      pos += kMsgHeaderSize + size;
+      const std::uint8_t* body = At(pos_) + kMsgHeaderSize;
+      const std::size_t at = pos_;
+      pos_ += kMsgHeaderSize + size;
       if (type == 'D') {
         Data(body, size);
       } else {
-        Other(at, type, body, size, &end);
+        Other(at, type, body, size, &end_);
       }
     }
   }
 
  private:
+  /// True when the bytes held decide the message at `pos`: while resynchronising, kLookahead
+  /// bytes (a chain of messages); else its header and body.
+  bool Held(std::size_t pos) const {
+    if (resync_) return pos + kLookahead <= avail_;
+    return pos + kMsgHeaderSize <= avail_ &&
+           pos + kMsgHeaderSize + Load<std::uint16_t>(At(pos)) <= avail_;
+  }
+
+  /// The byte of the input at file offset `pos` (in the bytes held).
+  const std::uint8_t* At(std::size_t pos) const { return data_ + (pos - base_); }
+
+  /// The 16-byte file header: magic, version, start time.
+  void ReadFileHeader(bool at_end) {
+    if (avail_ < kFileHeaderSize) {
+      (void)at_end;  // a first chunk holds the header unless the input is shorter
+      throw InputError(log_->source, "byte 0",
+                       "expected a 16-byte ULog header, the input has " + std::to_string(avail_) +
+                           " bytes");
+    }
+    if (std::memcmp(data_, kULogMagic, sizeof(kULogMagic)) != 0) {
+      throw InputError(log_->source, "byte 0",
+                       "expected the ULog magic 'ULog' 01 12 35: not a PX4 ULog file");
+    }
+    log_->version = data_[7];
+    log_->warnings.unknown_version = log_->version > 1;
+    log_->start_timestamp_us = Load<std::uint64_t>(data_ + 8);
+  }
+
   bool Corrupt(std::size_t pos, std::size_t end, std::size_t size, std::uint8_t type) const {
     if (size == 0 || !IsLetter(type)) return true;
     const bool body_fits = size <= end - pos - kMsgHeaderSize;
@@ -192,7 +244,7 @@ class Parser {
       case 'D': {
         if (size < 2) return true;
         if (end - pos < kMsgHeaderSize + 2) return false;  // truncated: the caller decides
-        const int idx = Index(Load<std::uint16_t>(data_ + pos + kMsgHeaderSize));
+        const int idx = Index(Load<std::uint16_t>(At(pos) + kMsgHeaderSize));
         if (idx < 0) return false;
         const ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
         return size - 2 < t.body_size || size - 2 > t.full_size;
@@ -200,7 +252,7 @@ class Parser {
       case 'S':
         return size != sizeof(kSyncMagic) ||
                (body_fits &&
-                std::memcmp(data_ + pos + kMsgHeaderSize, kSyncMagic, sizeof(kSyncMagic)) != 0);
+                std::memcmp(At(pos) + kMsgHeaderSize, kSyncMagic, sizeof(kSyncMagic)) != 0);
       case 'O': case 'R': return size != 2;
       case 'A': return size < 4;
       case 'L': return size < 9;
@@ -214,10 +266,10 @@ class Parser {
   /// non-corrupt messages of known types (fewer when the segment ends right after them).
   bool ResyncPoint(std::size_t pos, std::size_t end) const {
     if (end - pos < kMsgHeaderSize) return false;
-    const std::size_t size = Load<std::uint16_t>(data_ + pos);
-    const std::uint8_t type = data_[pos + 2];
+    const std::size_t size = Load<std::uint16_t>(At(pos));
+    const std::uint8_t type = At(pos)[2];
     if (size > end - pos - kMsgHeaderSize) return false;
-    const std::uint8_t* body = data_ + pos + kMsgHeaderSize;
+    const std::uint8_t* body = At(pos) + kMsgHeaderSize;
     if (type == 'D' && size >= 2 && Index(Load<std::uint16_t>(body)) >= 0) {
       const ULogTopic& t = log_->topics[static_cast<std::size_t>(Index(Load<std::uint16_t>(body)))];
       return size - 2 >= t.body_size && size - 2 <= t.full_size;
@@ -229,8 +281,8 @@ class Parser {
     for (int k = 0; k < kResyncChain; ++k) {
       if (at == end) return true;
       if (end - at < kMsgHeaderSize) return false;
-      const std::size_t n = Load<std::uint16_t>(data_ + at);
-      const std::uint8_t ty = data_[at + 2];
+      const std::size_t n = Load<std::uint16_t>(At(at));
+      const std::uint8_t ty = At(at)[2];
       if (!IsKnownType(ty) || Corrupt(at, end, n, ty) || n > end - at - kMsgHeaderSize) {
         return false;
       }
@@ -249,7 +301,7 @@ class Parser {
     ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
     (void)size;  // checked by Corrupt(): body_size <= size - 2 <= full_size
     t.last_timestamp_us = TimestampOf(t, body + 2);
-    if (t.bodies_kept) t.bodies.insert(t.bodies.end(), body + 2, body + 2 + t.body_size);
+    if (t.bodies_kept) t.bodies.Append(body + 2);
     ++t.rows;
   }
 
@@ -286,33 +338,9 @@ class Parser {
 
   void Malformed() { ++log_->warnings.malformed_messages; }
 
-  /// Counts D messages per msg_id by hopping from header to header, so that each topic's
-  /// storage is reserved once (no reallocation copies). Stops at the first implausible header;
-  /// the counts are only a hint.
-  void PreScan() {
-    expected_rows_.assign(std::size_t{65536}, 0);
-    expected_bytes_.assign(std::size_t{65536}, 0);
-    std::size_t pos = kFileHeaderSize;
-    while (size_ - pos >= kMsgHeaderSize + 2) {
-      if (file_ != nullptr) file_->Release(pos);
-      const std::size_t size = Load<std::uint16_t>(data_ + pos);
-      if (size == 0 || size > size_ - pos - kMsgHeaderSize) break;
-      if (data_[pos + 2] == 'D' && size >= 2) {
-        const std::uint16_t id = Load<std::uint16_t>(data_ + pos + 3);
-        ++expected_rows_[id];
-        expected_bytes_[id] += size - 2;
-      }
-      pos += kMsgHeaderSize + size;
-    }
-  }
-
-  void Reserve(ULogTopic* t) {
+  void Keep(ULogTopic* t) {
     t->bodies_kept = filter_.Keeps(t->name);
-    if (expected_rows_.empty() || !t->bodies_kept) return;
-    // Never more than the D bytes seen for this id: the reservations add up to at most the
-    // input size.
-    t->bodies.reserve(std::min(std::size_t{expected_rows_[t->msg_id]} * t->body_size,
-                               expected_bytes_[t->msg_id]));
+    if (t->bodies_kept) t->bodies = RecordStore(t->body_size);
   }
 
   /// Index into log_->topics of a msg_id, -1 when it is not subscribed.
@@ -406,7 +434,7 @@ class Parser {
       ++log_->warnings.unresolved_subscriptions;
       return;
     }
-    Reserve(&t);
+    Keep(&t);
     if (index_.size() <= t.msg_id) index_.resize(std::size_t{t.msg_id} + 1, -1);
     index_[t.msg_id] = static_cast<int>(log_->topics.size());
     log_->topics.push_back(std::move(t));
@@ -434,14 +462,17 @@ class Parser {
     log_->warnings.truncated_bytes += bytes;
   }
 
-  const std::uint8_t* data_;
-  std::size_t size_;
+  const std::uint8_t* data_ = nullptr;  ///< the bytes held: file offsets [base_, avail_)
+  std::size_t base_ = 0;
+  std::size_t avail_ = 0;
+  std::size_t size_;           ///< input size, bytes
+  std::size_t pos_ = 0;        ///< next message's offset (0: the file header is next)
+  std::size_t end_;            ///< end of the current segment
+  std::size_t next_segment_ = 0;  ///< index into log_->appended_offsets
+  bool resync_ = false;        ///< skipping bytes after a corrupt header
   ULog* log_;
-  const LogFile* file_;
   const RecordFilter& filter_;
   std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
-  std::vector<std::uint32_t> expected_rows_;  // PreScan() counts per msg_id, or empty
-  std::vector<std::size_t> expected_bytes_;   // PreScan() D body bytes per msg_id, or empty
   detail::ULogFormatResolver resolver_;
   bool in_definitions_ = true;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
@@ -456,29 +487,11 @@ int ULogTopic::ColumnIndex(std::string_view column) const {
   return -1;
 }
 
-double ULogTopic::Value(std::size_t row, std::size_t col) const {
-  if (!bodies_kept) NotKept(name);
-  const ULogColumn& c = columns[col];
-  const std::uint8_t* p = bodies.data() + row * body_size + c.offset;
-  switch (c.type) {
-    case ULogType::kInt8: return Load<std::int8_t>(p);
-    case ULogType::kUInt8: case ULogType::kChar: return Load<std::uint8_t>(p);
-    case ULogType::kBool: return Load<std::uint8_t>(p) != 0 ? 1.0 : 0.0;
-    case ULogType::kInt16: return Load<std::int16_t>(p);
-    case ULogType::kUInt16: return Load<std::uint16_t>(p);
-    case ULogType::kInt32: return Load<std::int32_t>(p);
-    case ULogType::kUInt32: return Load<std::uint32_t>(p);
-    case ULogType::kInt64: return static_cast<double>(Load<std::int64_t>(p));
-    case ULogType::kUInt64: return static_cast<double>(Load<std::uint64_t>(p));
-    case ULogType::kFloat: return Load<float>(p);
-    case ULogType::kDouble: return Load<double>(p);
-  }
-  return 0.0;
-}
+void ULogTopic::ThrowNotKept() const { NotKept(name); }
 
 std::uint64_t ULogTopic::TimestampUs(std::size_t row) const {
   if (!bodies_kept) NotKept(name);
-  return TimestampOf(*this, bodies.data() + row * body_size);
+  return TimestampOf(*this, bodies.Row(row));
 }
 
 std::vector<double> ULogTopic::Column(std::string_view column) const {
@@ -547,39 +560,31 @@ std::vector<std::pair<std::string, std::size_t>> ULog::MessageCounts() const {
 
 namespace {
 
-/// ParseULog, telling `file` (nullptr: none) what the parser has read.
-ULog ParseULogFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
-                   const LogFile* file, const RecordFilter& filter) {
-  ULog log;
-  log.source = source;
-  log.size_bytes = size;
-  if (size < kFileHeaderSize) {
-    throw InputError(source, "byte 0",
-                     "expected a 16-byte ULog header, the input has " + std::to_string(size) +
-                         " bytes");
-  }
-  if (std::memcmp(data, kULogMagic, sizeof(kULogMagic)) != 0) {
-    throw InputError(source, "byte 0",
-                     "expected the ULog magic 'ULog' 01 12 35: not a PX4 ULog file");
-  }
-  log.version = data[7];
-  log.warnings.unknown_version = log.version > 1;
-  log.start_timestamp_us = Load<std::uint64_t>(data + 8);
-  Parser parser(data, size, &log, file, filter);
-  parser.Run();
-  return log;
-}
-
 }  // namespace
 
 ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source,
                const RecordFilter& filter) {
-  return ParseULogFrom(data, size, source, nullptr, filter);
+  ULog log;
+  log.source = source;
+  log.size_bytes = size;
+  Parser parser(size, &log, filter);
+  parser.Feed(data, size, 0, true);
+  return log;
 }
 
 ULog ReadULog(const std::string& path, const RecordFilter& filter) {
-  const LogFile file(path, "ULog file");
-  return ParseULogFrom(file.data(), file.size(), path, &file, filter);
+  ULog log;
+  log.source = path;
+  log.size_bytes = RegularFileSize(path);  // 0 for a pipe: read whole, in one call
+  std::optional<Parser> parser;  // made at the first call, when the size is known
+  // One pass, in chunks: every message is decoded from the read buffer as it goes by.
+  ReadForward(path, "ULog file", Parser::kLookahead,
+              [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+                if (at_end) log.size_bytes = offset + n;
+                if (!parser) parser.emplace(log.size_bytes, &log, filter);
+                return parser->Feed(data, n, offset, at_end);
+              });
+  return log;
 }
 
 }  // namespace plumb::io

@@ -17,7 +17,7 @@
 //     uint8 level, uint16 tag, uint64 time, text; S sync: 8 magic bytes 2F 73 13 20 25 0C BB
 //     12; O dropout: uint16 duration (ms).
 //
-// Decoding contract (one pass over the file held in memory):
+// Decoding contract (one pass over the file, read forward in chunks by ReadULog):
 //  * Parameters: P messages before the first A, L or C are the initial values (`params`);
 //    later ones are changes (`param_changes`).
 //  * A subscription's format is resolved when its A message arrives: nested formats are
@@ -46,14 +46,16 @@
 //    of an unknown letter type (a future ULog message, counted). A known message whose body
 //    does not parse (e.g. a key length past its end) is skipped (counted as malformed).
 //
-// Storage ("compact per-topic table", as the DataFlash reader): each subscription keeps the
-// bodies of its D messages contiguously (row-major, `body_size` bytes each, as in the file);
-// columns are decoded on access from their byte offsets. No allocation per data message.
+// Storage ("compact per-topic table", as the DataFlash reader): each kept subscription
+// (RecordFilter) keeps the bodies of its D messages (RecordStore: row-major blocks, `body_size`
+// bytes each, as in the file); columns are decoded on access from their byte offsets. No
+// allocation per data message, no counting pass.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <string>
 #include <string_view>
@@ -68,6 +70,29 @@ namespace plumb::io {
 enum class ULogType : std::uint8_t {
   kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kInt64, kUInt64, kFloat, kDouble, kBool, kChar
 };
+
+/// The value of a field of type `type` stored at `p` (little endian) as a double (bool 0/1,
+/// char its code).
+inline double DecodeULogValue(const std::uint8_t* p, ULogType type) {
+  const auto load = [p](auto v) {
+    std::memcpy(&v, p, sizeof v);  // little endian on every supported host
+    return v;
+  };
+  switch (type) {
+    case ULogType::kInt8: return load(std::int8_t{});
+    case ULogType::kUInt8: case ULogType::kChar: return load(std::uint8_t{});
+    case ULogType::kBool: return load(std::uint8_t{}) != 0 ? 1.0 : 0.0;
+    case ULogType::kInt16: return load(std::int16_t{});
+    case ULogType::kUInt16: return load(std::uint16_t{});
+    case ULogType::kInt32: return load(std::int32_t{});
+    case ULogType::kUInt32: return load(std::uint32_t{});
+    case ULogType::kInt64: return static_cast<double>(load(std::int64_t{}));
+    case ULogType::kUInt64: return static_cast<double>(load(std::uint64_t{}));
+    case ULogType::kFloat: return load(float{});
+    case ULogType::kDouble: return load(double{});
+  }
+  return 0.0;
+}
 
 /// One flattened field of a subscribed topic.
 struct ULogColumn {
@@ -86,7 +111,7 @@ struct ULogTopic {
   std::size_t full_size = 0;     ///< format size with trailing padding, bytes (>= body_size)
   int timestamp_col = -1;        ///< column of the top-level "timestamp" field, -1 if none
   std::size_t rows = 0;          ///< D messages stored
-  std::vector<std::uint8_t> bodies;  ///< rows * body_size bytes, in log order
+  RecordStore bodies;            ///< the kept D bodies in log order, body_size bytes each
   /// False when the reader's RecordFilter left this topic's bodies out (rows still counted):
   /// Value, TimestampUs and Column then throw plumb::Error.
   bool bodies_kept = true;
@@ -96,13 +121,21 @@ struct ULogTopic {
   /// Index of the column called `column`, or -1.
   int ColumnIndex(std::string_view column) const;
   /// Value of message `row`, column `col` as a double (bool 0/1, char its code). Precondition:
-  /// indices valid.
-  double Value(std::size_t row, std::size_t col) const;
+  /// indices valid. Inline: sessions call it for every sample.
+  double Value(std::size_t row, std::size_t col) const {
+    if (!bodies_kept) ThrowNotKept();
+    const ULogColumn& c = columns[col];
+    return DecodeULogValue(bodies.Row(row) + c.offset, c.type);
+  }
   /// The "timestamp" field of message `row`, microseconds (uint8 timestamps are milliseconds
   /// by the format and are scaled by 1000 here); 0 when the topic has none.
   std::uint64_t TimestampUs(std::size_t row) const;
   /// Every value of the column called `column` (see Value()). Throws plumb::Error if absent.
   std::vector<double> Column(std::string_view column) const;
+
+ private:
+  /// Throws the plumb::Error of a value asked of a topic whose bodies were not kept.
+  [[noreturn]] void ThrowNotKept() const;
 };
 
 /// One field of an F message, as written.

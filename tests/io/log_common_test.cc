@@ -1,0 +1,119 @@
+// Tests of the pieces every binary-log reader shares (plumb/io/common/log_common.h): the
+// forward chunked reading (ReadForward) and the blocked record storage (RecordStore).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "support/temp_dir.h"
+#include "plumb/core/error.h"
+#include "plumb/io/common/log_common.h"
+
+namespace plumb::io {
+namespace {
+
+std::vector<std::uint8_t> Pattern(std::size_t n) {
+  std::vector<std::uint8_t> out(n);
+  for (std::size_t k = 0; k < n; ++k) out[k] = static_cast<std::uint8_t>((k * 131 + k / 251) & 0xFF);
+  return out;
+}
+
+std::string WriteFile(const ::plumb::testing::TempDir& dir, const std::vector<std::uint8_t>& b) {
+  const std::string path = dir.File("log.bin");
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  return path;
+}
+
+TEST(LogCommon, RecordStoreKeepsRowsAcrossBlocksAndCopies) {
+  for (const std::size_t body : {std::size_t{0}, std::size_t{1}, std::size_t{37},
+                                  std::size_t{4096}, std::size_t{65533}}) {
+    RecordStore store(body);
+    const std::vector<std::uint8_t> bytes = Pattern(body * 3001 + 1);
+    const std::size_t rows = body == 0 ? 5000 : (body > 1000 ? 40 : 3001);
+    for (std::size_t r = 0; r < rows; ++r) store.Append(bytes.data() + r * (body > 1000 ? 0 : body));
+    ASSERT_EQ(store.rows(), rows);
+    EXPECT_EQ(store.size(), rows * body);
+    for (std::size_t r = 0; r < rows; ++r) {
+      ASSERT_EQ(std::memcmp(store.Row(r), bytes.data() + r * (body > 1000 ? 0 : body), body), 0)
+          << body << " " << r;
+    }
+    const RecordStore copy = store;  // NOLINT: the copy is what is tested
+    EXPECT_TRUE(copy == store);
+    RecordStore other(body);
+    for (std::size_t r = 0; r + 1 < rows; ++r) other.Append(store.Row(r));
+    EXPECT_FALSE(other == store);
+  }
+}
+
+TEST(LogCommon, ReadForwardHandsEveryByteOnceWithItsLookahead) {
+  ::plumb::testing::TempDir dir;
+  const std::vector<std::uint8_t> file = Pattern((std::size_t{5} << 20) + 777);
+  const std::string path = WriteFile(dir, file);
+  constexpr std::size_t kLookahead = 300000;
+  std::vector<std::uint8_t> seen;
+  std::size_t calls = 0;
+  bool ended = false;
+  ReadForward(path, "test log", kLookahead,
+              [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+                EXPECT_FALSE(ended);
+                EXPECT_EQ(offset, seen.size());  // the bytes kept come again first
+                EXPECT_EQ(std::memcmp(data, file.data() + offset, n), 0);
+                ++calls;
+                ended = at_end;
+                if (at_end) {
+                  seen.insert(seen.end(), data, data + n);
+                  return offset + n;
+                }
+                EXPECT_GT(n, kLookahead);
+                // Consume up to kLookahead bytes before the end, in steps of 7 (a parser).
+                const std::size_t take = (n - kLookahead) / 7 * 7;
+                seen.insert(seen.end(), data, data + take);
+                return offset + take;
+              });
+  EXPECT_TRUE(ended);
+  EXPECT_GT(calls, 4u);
+  EXPECT_TRUE(seen == file);
+}
+
+TEST(LogCommon, ReadForwardJumpsAndGrowsItsBuffer) {
+  ::plumb::testing::TempDir dir;
+  const std::vector<std::uint8_t> file = Pattern(std::size_t{6} << 20);
+  const std::string path = WriteFile(dir, file);
+  std::vector<std::size_t> offsets;
+  std::size_t largest = 0;
+  ReadForward(path, "test log", 16,
+              [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+                EXPECT_EQ(std::memcmp(data, file.data() + offset, n), 0);
+                offsets.push_back(offset);
+                largest = std::max(largest, n);
+                if (at_end) return offset + n;
+                if (offset == 0 && n < (std::size_t{3} << 20)) return offset;  // needs more
+                if (offset == 0) return std::size_t{5} << 20;  // a jump past the bytes held
+                return offset + n - 16;  // not reached: the jump's chunk ends the file
+              });
+  EXPECT_GE(largest, std::size_t{3} << 20);  // the buffer grew for the first position
+  ASSERT_GE(offsets.size(), 3u);
+  EXPECT_EQ(offsets.front(), 0u);
+  EXPECT_EQ(offsets[offsets.size() - 2], 0u);
+  EXPECT_EQ(offsets.back(), std::size_t{5} << 20);  // the bytes in between never handed over
+}
+
+TEST(LogCommon, ReadForwardNamesAMissingFile) {
+  try {
+    ReadForward("/nonexistent/plumb/log.bin", "test log", 1,
+                [](const std::uint8_t*, std::size_t n, std::size_t offset, bool) {
+                  return offset + n;
+                });
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/plumb/log.bin"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("cannot open the test log"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace plumb::io
