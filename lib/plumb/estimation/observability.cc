@@ -38,6 +38,96 @@ std::string FormatNumber(double v) {
   return buf;
 }
 
+/// Within each group of model parameters joined by null directions (rows of B, k x n_all, over
+/// names then the eliminated unknowns) that involve model parameters only, the combinations
+/// orthogonal to them (the ones the data determines), with value and sigma, into `out`.
+void AddDeterminedCombinations(const Eigen::MatrixXd& B, const std::vector<bool>& is_model,
+                               const ObservabilityInput& in, ObservabilityAnalysis& out) {
+  const Eigen::Index n = in.J.cols();
+  const auto n_all = static_cast<Eigen::Index>(is_model.size());
+  std::vector<int> group(static_cast<std::size_t>(n_all), -1);
+  std::vector<std::vector<int>> rows_of_group;
+  for (Eigen::Index r = 0; r < B.rows(); ++r) {
+    std::vector<int> support;
+    bool model_only = true;
+    for (int j = 0; j < n_all; ++j) {
+      if (B(r, j) != 0.0) {
+        support.push_back(j);
+        model_only = model_only && is_model[static_cast<std::size_t>(j)];
+      }
+    }
+    if (!model_only || support.size() < 2) continue;
+    // Merge with any existing group touching this support.
+    int g = -1;
+    for (int j : support) {
+      if (group[static_cast<std::size_t>(j)] >= 0) g = group[static_cast<std::size_t>(j)];
+    }
+    if (g < 0) {
+      g = static_cast<int>(rows_of_group.size());
+      rows_of_group.emplace_back();
+    }
+    for (int j : support) {
+      const int old = group[static_cast<std::size_t>(j)];
+      if (old >= 0 && old != g) {
+        for (int& gg : group) gg = gg == old ? g : gg;
+        rows_of_group[static_cast<std::size_t>(g)].insert(rows_of_group[static_cast<std::size_t>(g)].end(),
+            rows_of_group[static_cast<std::size_t>(old)].begin(), rows_of_group[static_cast<std::size_t>(old)].end());
+        rows_of_group[static_cast<std::size_t>(old)].clear();
+      }
+      group[static_cast<std::size_t>(j)] = g;
+    }
+    rows_of_group[static_cast<std::size_t>(g)].push_back(static_cast<int>(r));
+  }
+  std::vector<Eigen::VectorXd> determined_vectors;  // over all n unknowns
+  for (std::size_t g = 0; g < rows_of_group.size(); ++g) {
+    if (rows_of_group[g].empty()) continue;
+    std::vector<int> support;  // model parameters only: all among J's columns
+    for (int j = 0; j < n; ++j) {
+      if (group[static_cast<std::size_t>(j)] == static_cast<int>(g)) support.push_back(j);
+    }
+    Eigen::MatrixXd Ng(support.size(), rows_of_group[g].size());  // |S| x k_g
+    for (std::size_t a = 0; a < support.size(); ++a) {
+      for (std::size_t b = 0; b < rows_of_group[g].size(); ++b) {
+        Ng(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
+            B(rows_of_group[g][b], support[a]);
+      }
+    }
+    // Combinations c with c^T Ng = 0: the left null space of Ng.
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd_g(Ng.transpose(), Eigen::ComputeFullV);
+    const Eigen::Index kg = Ng.cols();
+    const Eigen::Index free_dim = static_cast<Eigen::Index>(support.size()) - kg;
+    if (free_dim <= 0) continue;
+    const Eigen::MatrixXd Cbasis = svd_g.matrixV().rightCols(free_dim);  // |S| x free
+    std::vector<int> rev(support.size());
+    std::iota(rev.rbegin(), rev.rend(), 0);  // pivots from the end: biases before matrices
+    const Eigen::MatrixXd Cr = Rref(Cbasis.transpose(), rev);
+    std::vector<std::string> group_names;
+    Eigen::VectorXd values(static_cast<Eigen::Index>(support.size()));
+    for (std::size_t a = 0; a < support.size(); ++a) {
+      group_names.push_back(in.names[static_cast<std::size_t>(support[a])]);
+      values[static_cast<Eigen::Index>(a)] = in.values[static_cast<std::size_t>(support[a])];
+    }
+    for (Eigen::Index r = 0; r < Cr.rows(); ++r) {
+      const Eigen::VectorXd c = Cr.row(r).transpose();
+      Eigen::VectorXd c_full = Eigen::VectorXd::Zero(n);
+      for (std::size_t a = 0; a < support.size(); ++a) c_full[support[a]] = c[static_cast<Eigen::Index>(a)];
+      Combination comb;
+      comb.text = FormatCombination(c, group_names, false);
+      comb.value = c.dot(values);
+      comb.sigma = std::sqrt(std::max(0.0, c_full.dot(out.covariance * c_full)));
+      comb.names = group_names;
+      comb.coefficients.assign(c.data(), c.data() + c.size());
+      out.summary.determined.push_back(comb);
+      determined_vectors.push_back(c_full);
+    }
+  }
+  Eigen::MatrixXd combos(n, static_cast<Eigen::Index>(determined_vectors.size()));
+  for (std::size_t j = 0; j < determined_vectors.size(); ++j) {
+    combos.col(static_cast<Eigen::Index>(j)) = determined_vectors[j];
+  }
+  out.summary.determined_covariance = combos.transpose() * out.covariance * combos;
+}
+
 }  // namespace
 
 std::string FormatCombination(const Eigen::VectorXd& c, const std::vector<std::string>& names,
@@ -140,88 +230,7 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
     out.summary.unobservable.push_back(FormatCombination(B.row(r).transpose(), names, true));
   }
 
-  // Groups of model parameters joined by null directions that involve model parameters only.
-  std::vector<int> group(static_cast<std::size_t>(n_all), -1);
-  std::vector<std::vector<int>> rows_of_group;
-  for (Eigen::Index r = 0; r < B.rows(); ++r) {
-    std::vector<int> support;
-    bool model_only = true;
-    for (int j = 0; j < n_all; ++j) {
-      if (B(r, j) != 0.0) {
-        support.push_back(j);
-        model_only = model_only && is_model[static_cast<std::size_t>(j)];
-      }
-    }
-    if (!model_only || support.size() < 2) continue;
-    // Merge with any existing group touching this support.
-    int g = -1;
-    for (int j : support) {
-      if (group[static_cast<std::size_t>(j)] >= 0) g = group[static_cast<std::size_t>(j)];
-    }
-    if (g < 0) {
-      g = static_cast<int>(rows_of_group.size());
-      rows_of_group.emplace_back();
-    }
-    for (int j : support) {
-      const int old = group[static_cast<std::size_t>(j)];
-      if (old >= 0 && old != g) {
-        for (int& gg : group) gg = gg == old ? g : gg;
-        rows_of_group[static_cast<std::size_t>(g)].insert(rows_of_group[static_cast<std::size_t>(g)].end(),
-            rows_of_group[static_cast<std::size_t>(old)].begin(), rows_of_group[static_cast<std::size_t>(old)].end());
-        rows_of_group[static_cast<std::size_t>(old)].clear();
-      }
-      group[static_cast<std::size_t>(j)] = g;
-    }
-    rows_of_group[static_cast<std::size_t>(g)].push_back(static_cast<int>(r));
-  }
-  std::vector<Eigen::VectorXd> determined_vectors;  // over all n unknowns
-  for (std::size_t g = 0; g < rows_of_group.size(); ++g) {
-    if (rows_of_group[g].empty()) continue;
-    std::vector<int> support;  // model parameters only: all among J's columns
-    for (int j = 0; j < n; ++j) {
-      if (group[static_cast<std::size_t>(j)] == static_cast<int>(g)) support.push_back(j);
-    }
-    Eigen::MatrixXd Ng(support.size(), rows_of_group[g].size());  // |S| x k_g
-    for (std::size_t a = 0; a < support.size(); ++a) {
-      for (std::size_t b = 0; b < rows_of_group[g].size(); ++b) {
-        Ng(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
-            B(rows_of_group[g][b], support[a]);
-      }
-    }
-    // Combinations c with c^T Ng = 0: the left null space of Ng.
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd_g(Ng.transpose(), Eigen::ComputeFullV);
-    const Eigen::Index kg = Ng.cols();
-    const Eigen::Index free_dim = static_cast<Eigen::Index>(support.size()) - kg;
-    if (free_dim <= 0) continue;
-    const Eigen::MatrixXd Cbasis = svd_g.matrixV().rightCols(free_dim);  // |S| x free
-    std::vector<int> rev(support.size());
-    std::iota(rev.rbegin(), rev.rend(), 0);  // pivots from the end: biases before matrices
-    const Eigen::MatrixXd Cr = Rref(Cbasis.transpose(), rev);
-    std::vector<std::string> group_names;
-    Eigen::VectorXd values(static_cast<Eigen::Index>(support.size()));
-    for (std::size_t a = 0; a < support.size(); ++a) {
-      group_names.push_back(in.names[static_cast<std::size_t>(support[a])]);
-      values[static_cast<Eigen::Index>(a)] = in.values[static_cast<std::size_t>(support[a])];
-    }
-    for (Eigen::Index r = 0; r < Cr.rows(); ++r) {
-      const Eigen::VectorXd c = Cr.row(r).transpose();
-      Eigen::VectorXd c_full = Eigen::VectorXd::Zero(n);
-      for (std::size_t a = 0; a < support.size(); ++a) c_full[support[a]] = c[static_cast<Eigen::Index>(a)];
-      Combination comb;
-      comb.text = FormatCombination(c, group_names, false);
-      comb.value = c.dot(values);
-      comb.sigma = std::sqrt(std::max(0.0, c_full.dot(out.covariance * c_full)));
-      comb.names = group_names;
-      comb.coefficients.assign(c.data(), c.data() + c.size());
-      out.summary.determined.push_back(comb);
-      determined_vectors.push_back(c_full);
-    }
-  }
-  Eigen::MatrixXd combos(n, static_cast<Eigen::Index>(determined_vectors.size()));
-  for (std::size_t j = 0; j < determined_vectors.size(); ++j) {
-    combos.col(static_cast<Eigen::Index>(j)) = determined_vectors[j];
-  }
-  out.summary.determined_covariance = combos.transpose() * out.covariance * combos;
+  AddDeterminedCombinations(B, is_model, in, out);
   return out;
 }
 
