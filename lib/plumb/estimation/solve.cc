@@ -118,16 +118,9 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
   } else {
     M = Eigen::MatrixXd(J);
   }
-  for (Eigen::Index c = 0; c < M.cols(); ++c) {
-    const double norm = M.col(c).norm();
-    if (norm > 0) M.col(c) /= norm;
-  }
-  const Eigen::BDCSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
-  const Eigen::VectorXd& sv = svd.singularValues();
-  Eigen::Index r = 0;
-  while (r < sv.size() && sv[r] > options.rank_tolerance * sv[0]) ++r;
+  const Eigen::MatrixXd U_r = RangeBasis(M, options.rank_tolerance);
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    h[static_cast<Eigen::Index>(i)] += svd.matrixU().row(rows[i]).head(r).squaredNorm();
+    h[static_cast<Eigen::Index>(i)] += U_r.row(rows[i]).squaredNorm();
   }
   return h;
 }

@@ -84,6 +84,21 @@ ceres::CostFunction* VelocityResidual::Create(const model::Model& model, SharedM
 
 namespace {
 
+/// What both evaluations read from the parameters: the attitude of segment k (q_k, its
+/// R_b_n), the model's outputs at zero input (F, E and the biases) and F^-1, E^-1.
+struct LinearStage {
+  LinearStage(const model::Model& model, double const* const* parameters)
+      : q_k(Quat(parameters[0][3], parameters[0][0], parameters[0][1], parameters[0][2]).normalized()),
+        R_b_n(q_k.toRotationMatrix().transpose()),
+        linear(model.Predict(parameters + 1, model::SensorInput<double>())),
+        F_inv(linear.F.inverse()),
+        E_inv(linear.E.inverse()) {}
+  Quat q_k;
+  Mat3 R_b_n;
+  model::SensorOutput<double> linear;
+  Mat3 F_inv, E_inv;
+};
+
 /// The sum over `count` processes of the (b_from, b_to) block pairs starting at `blocks`.
 std::pair<Vec3, Vec3> WanderEnds(double const* const* blocks, int count) {
   Vec3 from = Vec3::Zero(), to = Vec3::Zero();
@@ -97,12 +112,12 @@ std::pair<Vec3, Vec3> WanderEnds(double const* const* blocks, int count) {
 }  // namespace
 
 Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
-  const Quat q_k(parameters[0][3], parameters[0][0], parameters[0][1], parameters[0][2]);
-  const Mat3 R_b_n = q_k.normalized().toRotationMatrix().transpose();
+  const LinearStage stage(*model_, parameters);
+  const Mat3& R_b_n = stage.R_b_n;
   double const* const* theta = parameters + 1;
-  const model::SensorOutput<double> linear = model_->Predict(theta, model::SensorInput<double>());
-  const Mat3 F_inv = linear.F.inverse();
-  const Mat3 E_inv = linear.E.inverse();
+  const model::SensorOutput<double>& linear = stage.linear;
+  const Mat3& F_inv = stage.F_inv;
+  const Mat3& E_inv = stage.E_inv;
   const std::size_t n = s_.size();
   // Every effect other than the linear stage at zero (the base model, or diagnose's probes
   // away from the one being differentiated): the closed-form inverse.
@@ -168,13 +183,13 @@ bool VelocityResidual::LinearAt(double const* const* parameters) const {
 
 void VelocityResidual::EvaluateLinear(double const* const* parameters, double* residuals,
                                       double** jacobians) const {
-  const Quat q_k(parameters[0][3], parameters[0][0], parameters[0][1], parameters[0][2]);
-  const Mat3 R_b_n = q_k.normalized().toRotationMatrix().transpose();
+  const LinearStage stage(*model_, parameters);
+  const Quat& q_k = stage.q_k;
+  const Mat3& R_b_n = stage.R_b_n;
   double const* const* theta = parameters + 1;
-  const model::SensorOutput<double> linear = model_->Predict(theta, model::SensorInput<double>());
-  const Mat3 F_inv = linear.F.inverse();
-  const Mat3 E_inv = linear.E.inverse();
-  const Vec3 b_a = linear.acc, b_g = linear.gyr;
+  const Mat3& F_inv = stage.F_inv;
+  const Mat3& E_inv = stage.E_inv;
+  const Vec3 b_a = stage.linear.acc, b_g = stage.linear.gyr;
   const std::size_t n = s_.size();
   // Columns of the unknowns: the model's P parameters (block by block), the left perturbation
   // of R_k, then the wander's ends: accelerometer from, to, gyroscope from, to (every process
