@@ -45,9 +45,11 @@ MotionResidual::MotionResidual(const model::Model& model, SharedMotionSamples sa
                                const Vec3& omega_ie_n, int wander_processes)
     : model_(&model), samples_(std::move(samples)), s_(*samples_), omega_ie_n_(omega_ie_n),
       wander_(wander_processes) {
-  for (const auto& t : model.terms()) {
+  for (int t = 0; t < model.num_terms(); ++t) {
     block_offset_.push_back(num_model_parameters_);
-    num_model_parameters_ += t.effect->info().size();
+    const int size = model.terms()[static_cast<std::size_t>(t)].effect->info().size();
+    for (int j = 0; j < size; ++j) parameter_of_.emplace_back(t, j);
+    num_model_parameters_ += size;
   }
   const int g = model.BaseTerm(model::Sensor::kGyro);
   if (g >= 0) bias_offset_ = block_offset_[static_cast<std::size_t>(g)] + model::gyro_linear::kBias;
@@ -123,19 +125,19 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
   // theta as Jets: constants, or the chunk [chunk, chunk + kStride) of the P parameters.
   std::vector<std::vector<Jet>> blocks(static_cast<std::size_t>(model_->num_terms()));
   std::vector<const Jet*> ptr(blocks.size());
-  auto set_theta = [&](int chunk) {
+  // theta as Jets: constants, with parameters `seeded` (global indices, at most kStride)
+  // differentiated.
+  auto set_theta = [&](const std::vector<int>& seeded) {
     for (int t = 0; t < model_->num_terms(); ++t) {
       const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
       auto& b = blocks[static_cast<std::size_t>(t)];
       b.assign(static_cast<std::size_t>(size), Jet());
-      for (int j = 0; j < size; ++j) {
-        const int global = block_offset_[static_cast<std::size_t>(t)] + j;
-        b[static_cast<std::size_t>(j)] = Jet(theta[t][j]);
-        if (chunk >= 0 && global >= chunk && global < chunk + kStride) {
-          b[static_cast<std::size_t>(j)].v[global - chunk] = 1.0;
-        }
-      }
+      for (int j = 0; j < size; ++j) b[static_cast<std::size_t>(j)] = Jet(theta[t][j]);
       ptr[static_cast<std::size_t>(t)] = b.data();
+    }
+    for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
+      const auto [t, j] = parameter_of_[static_cast<std::size_t>(seeded[slot])];
+      blocks[static_cast<std::size_t>(t)][static_cast<std::size_t>(j)].v[slot] = 1.0;
     }
   };
   auto input = [&](std::size_t i, bool differentiate) {
@@ -155,7 +157,8 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
   };
   // -D_x^-1 per sample (without accelerometer terms f is the output itself: d f = 0).
   std::vector<Eigen::Matrix<double, 6, 6>> minus_inv_D_x(n);
-  set_theta(-1);
+  set_theta({});
+  bool coupled = false;  // some output depends on the other sensor's input
   for (std::size_t i = 0; i < n; ++i) {
     const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), input(i, true));
     Eigen::Matrix<double, 6, 6> D;
@@ -164,11 +167,23 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
       D.row(3 + r) = z.gyr[r].v.head<6>().transpose();
     }
     if (!accel) D.topRows<3>() << Mat3::Identity(), Mat3::Zero();
+    coupled = coupled || !D.block<3, 3>(3, 0).isZero(0.0) || !D.block<3, 3>(0, 3).isZero(0.0);
     minus_inv_D_x[i] = -D.partialPivLu().inverse();
   }
-  for (int chunk = 0; chunk < P; chunk += kStride) {
-    set_theta(chunk);
-    const int width = std::min(kStride, P - chunk);
+  // The parameters that can move the rates: with the sensors uncoupled at every sample, D_x is
+  // block diagonal and the accelerometer's terms (which write y_a alone) leave w alone: their
+  // columns stay zero without a Jet pass.
+  std::vector<int> moving;
+  for (int g = 0; g < P; ++g) {
+    const int t = parameter_of_[static_cast<std::size_t>(g)].first;
+    const auto sensor = model_->terms()[static_cast<std::size_t>(t)].effect->info().sensor;
+    if (coupled || sensor == model::Sensor::kGyro) moving.push_back(g);
+  }
+  for (std::size_t first = 0; first < moving.size(); first += kStride) {
+    const std::vector<int> seeded(moving.begin() + static_cast<std::ptrdiff_t>(first),
+                                  moving.begin() + static_cast<std::ptrdiff_t>(
+                                                       std::min(moving.size(), first + kStride)));
+    set_theta(seeded);
     for (std::size_t i = 0; i < n; ++i) {
       const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), input(i, false));
       Eigen::Matrix<double, 6, kStride> D_theta;
@@ -176,8 +191,10 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
         D_theta.row(r) = z.acc[r].v.transpose();  // zero without accelerometer terms
         D_theta.row(3 + r) = z.gyr[r].v.transpose();
       }
-      (*W)[i].middleCols(chunk, width) =
-          (minus_inv_D_x[i].bottomRows<3>() * D_theta).leftCols(width);
+      const Eigen::Matrix<double, 3, kStride> dw = minus_inv_D_x[i].bottomRows<3>() * D_theta;
+      for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
+        (*W)[i].col(seeded[slot]) = dw.col(static_cast<Eigen::Index>(slot));
+      }
     }
   }
 }

@@ -37,6 +37,8 @@
 #include <ceres/cost_function.h>
 
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "plumb/model/model.h"
 #include "plumb/residuals/measurements.h"
@@ -87,6 +89,7 @@ class MotionResidual final : public ceres::CostFunction {
   Vec3 omega_ie_n_;
   int num_model_parameters_ = 0;
   std::vector<int> block_offset_;  // offset of each model block in the P parameters
+  std::vector<std::pair<int, int>> parameter_of_;  // per parameter of the P: (term, index)
   int wander_ = 0;                 // wander processes; their block pairs follow the model's
   int bias_offset_ = -1;           // offset of b_g among the P parameters (-1: no gyroscope)
   std::vector<double> walk_weight_;  // per sample, with a walk: a_i, the weight of b_to
