@@ -9,6 +9,7 @@
 #include <string>
 
 #include "plumb/estimation/calibration_problem.h"
+#include "plumb/estimation/elimination.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/solve.h"
@@ -58,14 +59,8 @@ Analyses AnalyseBothWays(int poses, bool wander, std::uint64_t seed) {
   return out;
 }
 
-Eigen::Index ModelColumns(const UnknownColumns& columns) {
-  Eigen::Index n = 0;
-  while (n < static_cast<Eigen::Index>(columns.is_model.size()) && columns.is_model[static_cast<std::size_t>(n)]) ++n;
-  return n;
-}
-
 void ExpectSameAnalysis(const Analyses& a) {
-  const Eigen::Index n_m = ModelColumns(a.columns);
+  const Eigen::Index n_m = LeadingModelColumns(a.columns.is_model);
   const auto n_w = static_cast<int>(a.columns.names.size() - a.columns.first_wander);
   EXPECT_EQ(a.eliminated.summary.wander_states, n_w);
   EXPECT_EQ(a.eliminated.summary.rank + n_w, a.dense.summary.rank);

@@ -76,6 +76,11 @@ std::unique_ptr<Elimination> EliminatePoses(const Eigen::SparseMatrix<double>& J
   return out;
 }
 
+Eigen::Index LeadingModelColumns(const std::vector<bool>& is_model) {
+  return static_cast<Eigen::Index>(std::find(is_model.begin(), is_model.end(), false) -
+                                   is_model.begin());
+}
+
 Eigen::MatrixXd RangeBasis(const Eigen::MatrixXd& A, double tolerance) {
   if (A.cols() == 0 || A.rows() == 0) return Eigen::MatrixXd(A.rows(), 0);
   Eigen::MatrixXd scaled = A;
@@ -107,6 +112,16 @@ Eigen::MatrixXd JacobianRange::Residual(const Eigen::MatrixXd& Z) const {
   return R;
 }
 
+Eigen::VectorXd JacobianRange::Leverage(const std::vector<Eigen::Index>& rows) const {
+  Eigen::VectorXd h = elimination_ != nullptr
+                          ? elimination_->Leverage(rows)
+                          : Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    h[static_cast<Eigen::Index>(i)] += Q_.row(rows[i]).squaredNorm();
+  }
+  return h;
+}
+
 Eigen::VectorXd JacobianRange::Coefficients(const Eigen::VectorXd& z) const {
   if (elimination_ == nullptr) return M_.completeOrthogonalDecomposition().solve(z);
   const Eigen::Index k = elimination_->first();
@@ -120,10 +135,7 @@ Eigen::VectorXd JacobianRange::Coefficients(const Eigen::VectorXd& z) const {
 }
 
 std::unique_ptr<JacobianRange> ProbeRange(const ProbeJacobian& probes, double rank_tolerance) {
-  const auto& is_model = probes.unknown_is_model;
-  const auto model_columns =
-      static_cast<Eigen::Index>(std::find(is_model.begin(), is_model.end(), false) - is_model.begin());
-  return std::make_unique<JacobianRange>(probes.J, model_columns,
+  return std::make_unique<JacobianRange>(probes.J, LeadingModelColumns(probes.unknown_is_model),
                                          static_cast<Eigen::Index>(probes.first_wander),
                                          rank_tolerance);
 }

@@ -70,6 +70,10 @@ class Elimination {
 std::unique_ptr<Elimination> EliminatePoses(const Eigen::SparseMatrix<double>& J,
                                             Eigen::Index model_columns, Eigen::Index first_wander);
 
+/// The number of leading model-parameter columns of a calibration's Jacobian (its columns are
+/// the model's parameters, then the attitudes, then the wander states: UnknownColumns).
+Eigen::Index LeadingModelColumns(const std::vector<bool>& is_model);
+
 /// Orthonormal basis of the range of A, its columns scaled to unit norm first, from the thin
 /// SVD; singular values at or below `tolerance` times the largest (or zero) are dropped.
 Eigen::MatrixXd RangeBasis(const Eigen::MatrixXd& A, double tolerance);
@@ -94,6 +98,9 @@ class JacobianRange {
   Eigen::MatrixXd Residual(const Eigen::MatrixXd& Z) const;
   /// The least-squares coefficients c of J c ~ z, one per column of J.
   Eigen::VectorXd Coefficients(const Eigen::VectorXd& z) const;
+  /// The leverages h_ii = J_i (J^T J)^+ J_i^T of the rows `rows`: the diagonal of the
+  /// projector onto range(J), (P_e)_ii + |Q^T e_i|^2.
+  Eigen::VectorXd Leverage(const std::vector<Eigen::Index>& rows) const;
   /// |J_k|, the norm of column k.
   double ColumnNorm(Eigen::Index k) const { return J_.col(k).norm(); }
 

@@ -3,9 +3,6 @@
 #include "plumb/core/error.h"
 #include "plumb/estimation/elimination.h"
 
-#include <Eigen/SVD>
-#include <Eigen/SparseCholesky>
-#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -40,15 +37,6 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
   if (!summary.IsSolutionUsable()) throw Error("the solver failed: " + summary.BriefReport());
 }
 
-namespace {
-
-Eigen::Index ModelColumns(const UnknownColumns& columns) {
-  return static_cast<Eigen::Index>(
-      std::find(columns.is_model.begin(), columns.is_model.end(), false) - columns.is_model.begin());
-}
-
-}  // namespace
-
 ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
                                 const CalibrationOptions& options, UnknownColumns& columns,
                                 double* cost, std::vector<double>* residuals,
@@ -62,7 +50,7 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   in.rank_tolerance = options.rank_tolerance;
   const auto n = static_cast<Eigen::Index>(columns.names.size());
   const auto first_wander = static_cast<Eigen::Index>(columns.first_wander);
-  const Eigen::Index n_m = ModelColumns(columns);
+  const Eigen::Index n_m = LeadingModelColumns(columns.is_model);
   if (jacobian != nullptr || (n_m == n && sparse_jacobian == nullptr)) {
     in.J = calibration.Jacobian(problem, columns, cost, residuals);
     ObservabilityAnalysis out = AnalyseObservability(in);
@@ -85,10 +73,11 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   in.values.resize(static_cast<std::size_t>(kept));
   in.is_model.resize(static_cast<std::size_t>(kept));
   const Eigen::Index n_attitudes = first_wander - kept;
-  const Eigen::SparseMatrix<double> J_k = J.leftCols(kept);
   if (n_attitudes > 0) {
     in.eliminated_names.assign(columns.names.begin() + kept, columns.names.begin() + first_wander);
-    in.eliminated_response = [&](const Eigen::MatrixXd& directions) -> Eigen::MatrixXd {
+    in.eliminated_response = [&elimination, n_attitudes,
+                              J_k = Eigen::SparseMatrix<double>(J.leftCols(kept))](
+                                 const Eigen::MatrixXd& directions) -> Eigen::MatrixXd {
       // J_k x_k + J_e x_e = 0: x_e = -argmin |J_k x_k + J_e x_e|, its attitudes' rows.
       return -elimination->Solve(J_k * directions).topRows(n_attitudes);
     };
@@ -104,25 +93,14 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
                           std::vector<double>* residuals) {
   const UnknownColumns columns = calibration.Columns(problem);
   double cost = 0;
-  const Eigen::SparseMatrix<double> J = calibration.SparseJacobian(problem, columns, &cost, residuals);
-  // The projector onto range(J) is P_e (the eliminated columns' range) plus the projector
-  // U_r U_r^T onto the range of the reduced Jacobian M = (I - P_e) J_k, M's rank as the
-  // analysis decides it on unit-norm columns: h_ii = (P_e)_ii + |U_r^T e_i|^2.
-  Eigen::MatrixXd M;
-  Eigen::VectorXd h = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
-  const std::unique_ptr<Elimination> elimination =
-      EliminatePoses(J, ModelColumns(columns), static_cast<Eigen::Index>(columns.first_wander));
-  if (elimination != nullptr) {
-    M = elimination->Reduced();
-    h = elimination->Leverage(rows);
-  } else {
-    M = Eigen::MatrixXd(J);
-  }
-  const Eigen::MatrixXd U_r = RangeBasis(M, options.rank_tolerance);
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    h[static_cast<Eigen::Index>(i)] += U_r.row(rows[i]).squaredNorm();
-  }
-  return h;
+  // The projector onto range(J) is P_e (the per-pose columns' range) plus the projector onto
+  // the range of the reduced Jacobian M = (I - P_e) J_k, M's rank as the analysis decides it
+  // on unit-norm columns (JacobianRange).
+  const JacobianRange range(calibration.SparseJacobian(problem, columns, &cost, residuals),
+                            LeadingModelColumns(columns.is_model),
+                            static_cast<Eigen::Index>(columns.first_wander),
+                            options.rank_tolerance);
+  return range.Leverage(rows);
 }
 
 Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOptions& options,

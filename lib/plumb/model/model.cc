@@ -179,6 +179,17 @@ void Model::Fix(const std::string& full_name, bool fixed) {
   terms_[static_cast<std::size_t>(where->first)].fixed[static_cast<std::size_t>(where->second)] = fixed;
 }
 
+bool Model::AtLinearStage(const double* const* theta) const {
+  for (std::size_t t = 0; t < terms_.size(); ++t) {
+    const EffectInfo& info = terms_[t].effect->info();
+    if (info.linear_stage) continue;
+    for (int j = 0; j < info.size(); ++j) {
+      if (theta[t][j] != 0.0) return false;
+    }
+  }
+  return true;
+}
+
 template <typename T>
 SensorOutput<T> Model::Predict(const T* const* theta, const SensorInput<T>& in) const {
   SensorOutput<T> out;

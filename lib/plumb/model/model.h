@@ -77,6 +77,11 @@ class Model {
   /// F and E, 0 elsewhere) in the fit (throws if the name is unknown).
   void Fix(const std::string& full_name, bool fixed = true);
 
+  /// True when every term but the linear stage's (EffectInfo::linear_stage) is at zero in
+  /// `theta` (block i of term i): the model then acts as its linear stage, y = F f + b_a,
+  /// y_g = E omega + b_g, and its inverse and derivatives have closed forms.
+  bool AtLinearStage(const double* const* theta) const;
+
   /// Forward model: predicted outputs for the true inputs. `theta[i]` is block i.
   /// Defined for T = double and T = Jet.
   template <typename T>

@@ -67,13 +67,10 @@ MotionResidual::MotionResidual(const model::Model& model, SharedMotionSamples sa
 }
 
 bool MotionResidual::LinearAt(double const* const* theta, double** jacobians) const {
-  for (int t = 0; t < model_->num_terms(); ++t) {
+  if (!model_->AtLinearStage(theta)) return false;
+  for (int t = 0; jacobians != nullptr && t < model_->num_terms(); ++t) {
     const auto& info = model_->terms()[static_cast<std::size_t>(t)].effect->info();
-    if (info.linear_stage) continue;
-    if (jacobians != nullptr && jacobians[2 + t] != nullptr) return false;
-    for (int j = 0; j < info.size(); ++j) {
-      if (theta[t][j] != 0.0) return false;
-    }
+    if (!info.linear_stage && jacobians[2 + t] != nullptr) return false;
   }
   return true;
 }

@@ -43,7 +43,7 @@ class VelocityCost final : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     if (jacobians == nullptr) return (*functor_)(parameters, residuals);
-    if (!functor_->LinearAt(parameters)) {
+    if (!functor_->model().AtLinearStage(parameters + 1)) {
       return numeric_->Evaluate(parameters, residuals, jacobians);
     }
     // The other effects at zero: analytic columns for the rest, central differences for
@@ -121,12 +121,7 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
   const std::size_t n = s_.size();
   // Every effect other than the linear stage at zero (the base model, or diagnose's probes
   // away from the one being differentiated): the closed-form inverse.
-  bool closed_form = true;
-  for (int t = 0; t < model_->num_terms() && closed_form; ++t) {
-    const auto& info = model_->terms()[static_cast<std::size_t>(t)].effect->info();
-    if (info.linear_stage) continue;
-    for (int j = 0; j < info.size(); ++j) closed_form = closed_form && theta[t][j] == 0.0;
-  }
+  const bool closed_form = model_->AtLinearStage(theta);
   const Vec3 b_a = linear.acc, b_g = linear.gyr;  // the outputs at zero input: the biases
   if (n < 2) return Vec3::Zero();  // no step: no velocity change
   // The wander along its line over the motion (file comment), per sensor.
@@ -168,17 +163,6 @@ bool VelocityResidual::IsLinearBlock(std::size_t block) const {
   const auto t = static_cast<int>(block) - 1;  // q_k, then the model's terms, then the wander
   return t < 0 || t >= model_->num_terms() ||
          model_->terms()[static_cast<std::size_t>(t)].effect->info().linear_stage;
-}
-
-bool VelocityResidual::LinearAt(double const* const* parameters) const {
-  for (int t = 0; t < model_->num_terms(); ++t) {
-    const auto& info = model_->terms()[static_cast<std::size_t>(t)].effect->info();
-    if (info.linear_stage) continue;
-    for (int j = 0; j < info.size(); ++j) {
-      if (parameters[1 + t][j] != 0.0) return false;
-    }
-  }
-  return true;
 }
 
 void VelocityResidual::EvaluateLinear(double const* const* parameters, double* residuals,

@@ -81,14 +81,14 @@ class VelocityResidual {
   /// The velocity change sum (unwhitened, m/s, body frame of k).
   Vec3 VelocityChange(double const* const* parameters) const;
 
-  /// True when the model acts as its linear stage at `parameters`: every other effect is at
-  /// zero.
-  bool LinearAt(double const* const* parameters) const;
+  /// The model the residual corrects the samples with.
+  const model::Model& model() const { return *model_; }
   /// Whether parameter block `block` is q_k, a linear-stage term's or a wander block: the
   /// blocks EvaluateLinear differentiates.
   bool IsLinearBlock(std::size_t block) const;
   /// r and its analytic Jacobians (Ceres's layout: row-major, ambient for q_k; null blocks
-  /// skipped) where LinearAt holds (the other terms' blocks must be null).
+  /// skipped) where the model is at its linear stage (model::Model::AtLinearStage; the other
+  /// terms' blocks must be null).
   void EvaluateLinear(double const* const* parameters, double* residuals,
                       double** jacobians) const;
 

@@ -247,7 +247,8 @@ std::vector<std::pair<std::string, std::size_t>> DataflashLog::MessageCounts() c
 
 namespace {
 
-/// Checks that `log`, fed by `parser`, held an FMT record and completes it (units, params).
+/// Checks that the parsed `log` (`size` bytes) held an FMT record and completes it (units,
+/// params).
 void FinishParse(DataflashLog* log, std::size_t size) {
   if (log->types.front().rows == 0) {
     throw InputError(log->source, "byte 0",

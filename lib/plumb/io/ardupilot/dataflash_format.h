@@ -7,11 +7,11 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <string>
 
 #include "plumb/io/ardupilot/dataflash.h"
+#include "plumb/io/common/log_common.h"
 
 namespace plumb::io::detail {
 
@@ -68,22 +68,22 @@ const DataflashFormatChar& DataflashFormat(char c);
 /// readers of the IMU streams use it.
 inline double DecodeDataflashValue(const std::uint8_t* p, DataflashStorage storage,
                                    double scale) {
-  const auto load = [p](auto v) {
-    std::memcpy(&v, p, sizeof v);  // little endian on every supported host
-    return v;
-  };
   double v = 0.0;
   switch (storage) {
-    case DataflashStorage::kInt8: v = load(std::int8_t{}); break;
-    case DataflashStorage::kUInt8: v = load(std::uint8_t{}); break;
-    case DataflashStorage::kInt16: v = load(std::int16_t{}); break;
-    case DataflashStorage::kUInt16: v = load(std::uint16_t{}); break;
-    case DataflashStorage::kInt32: v = load(std::int32_t{}); break;
-    case DataflashStorage::kUInt32: v = load(std::uint32_t{}); break;
-    case DataflashStorage::kInt64: v = static_cast<double>(load(std::int64_t{})); break;
-    case DataflashStorage::kUInt64: v = static_cast<double>(load(std::uint64_t{})); break;
-    case DataflashStorage::kFloat: v = load(float{}); break;
-    case DataflashStorage::kDouble: v = load(double{}); break;
+    case DataflashStorage::kInt8: v = LoadLittleEndian<std::int8_t>(p); break;
+    case DataflashStorage::kUInt8: v = LoadLittleEndian<std::uint8_t>(p); break;
+    case DataflashStorage::kInt16: v = LoadLittleEndian<std::int16_t>(p); break;
+    case DataflashStorage::kUInt16: v = LoadLittleEndian<std::uint16_t>(p); break;
+    case DataflashStorage::kInt32: v = LoadLittleEndian<std::int32_t>(p); break;
+    case DataflashStorage::kUInt32: v = LoadLittleEndian<std::uint32_t>(p); break;
+    case DataflashStorage::kInt64:
+      v = static_cast<double>(LoadLittleEndian<std::int64_t>(p));
+      break;
+    case DataflashStorage::kUInt64:
+      v = static_cast<double>(LoadLittleEndian<std::uint64_t>(p));
+      break;
+    case DataflashStorage::kFloat: v = LoadLittleEndian<float>(p); break;
+    case DataflashStorage::kDouble: v = LoadLittleEndian<double>(p); break;
     case DataflashStorage::kText: case DataflashStorage::kArray: case DataflashStorage::kUnknown:
       return std::numeric_limits<double>::quiet_NaN();
   }

@@ -58,6 +58,15 @@ class LogFile {
   mutable std::size_t released_ = 0;    ///< bytes [0, released_) were last released
 };
 
+/// The value of type T stored at `p` little endian, as every log format plumb reads stores it
+/// (on every supported host, little endian too: a plain copy). The one load of the readers.
+template <typename T>
+T LoadLittleEndian(const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
 /// Reads the file at `path` forward in chunks with read(2) into one reusable buffer (never
 /// mapped, never held whole: the page cache is copied from as `cat` does, without the page
 /// faults and TLB misses of walking a mapping), for parsers that decide at each position from

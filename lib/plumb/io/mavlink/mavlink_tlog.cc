@@ -149,23 +149,18 @@ inline int CrcExtraOf(std::uint32_t msgid) {
   return row ? row->crc_extra : -1;
 }
 
-template <typename T>
-T Load(const std::uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));  // little endian on every supported host
-  return v;
-}
-
 std::uint64_t LoadBigEndian64(const std::uint8_t* p) {
-  return __builtin_bswap64(Load<std::uint64_t>(p));  // little-endian host
+  return __builtin_bswap64(LoadLittleEndian<std::uint64_t>(p));  // little-endian host
 }
 
 std::array<std::int16_t, 3> Int16Triad(const std::uint8_t* p) {
-  return {Load<std::int16_t>(p), Load<std::int16_t>(p + 2), Load<std::int16_t>(p + 4)};
+  return {LoadLittleEndian<std::int16_t>(p), LoadLittleEndian<std::int16_t>(p + 2),
+          LoadLittleEndian<std::int16_t>(p + 4)};
 }
 
 std::array<float, 3> FloatTriad(const std::uint8_t* p) {
-  return {Load<float>(p), Load<float>(p + 4), Load<float>(p + 8)};
+  return {LoadLittleEndian<float>(p), LoadLittleEndian<float>(p + 4),
+          LoadLittleEndian<float>(p + 8)};
 }
 
 /// A frame located in the input.
@@ -230,7 +225,7 @@ Verdict Examine(const std::uint8_t* data, std::size_t size, std::size_t pos, Fra
   if (crc_extra < 0) return Verdict::kUnchecked;
   const std::uint16_t crc = CrcByte(Crc(frame + 1, header - 1 + f->len, 0xFFFF),
                                     static_cast<std::uint8_t>(crc_extra));
-  const std::uint16_t sent = Load<std::uint16_t>(f->payload + f->len);
+  const std::uint16_t sent = LoadLittleEndian<std::uint16_t>(f->payload + f->len);
   return crc == sent ? Verdict::kChecked : Verdict::kCrcFailed;
 }
 
@@ -348,7 +343,7 @@ class Parser {
         h.log_time_s = log_time_s;
         h.system_id = f.system_id;
         h.component_id = f.component_id;
-        h.custom_mode = Load<std::uint32_t>(p);
+        h.custom_mode = LoadLittleEndian<std::uint32_t>(p);
         h.type = p[4];
         h.autopilot = p[5];
         h.base_mode = p[6];
@@ -361,9 +356,9 @@ class Parser {
         v.log_time_s = log_time_s;
         v.system_id = f.system_id;
         v.component_id = f.component_id;
-        v.value = Load<float>(p);
-        v.count = Load<std::uint16_t>(p + 4);
-        v.index = Load<std::uint16_t>(p + 6);
+        v.value = LoadLittleEndian<float>(p);
+        v.count = LoadLittleEndian<std::uint16_t>(p + 4);
+        v.index = LoadLittleEndian<std::uint16_t>(p + 6);
         std::memcpy(v.id.data(), p + 8, 16);
         v.type = p[24];
         break;
@@ -373,30 +368,30 @@ class Parser {
         g.log_time_s = log_time_s;
         g.system_id = f.system_id;
         g.component_id = f.component_id;
-        g.time_us = Load<std::uint64_t>(p);
-        g.lat_e7 = Load<std::int32_t>(p + 8);
-        g.lon_e7 = Load<std::int32_t>(p + 12);
-        g.alt_mm = Load<std::int32_t>(p + 16);
-        g.eph = Load<std::uint16_t>(p + 20);
-        g.epv = Load<std::uint16_t>(p + 22);
-        g.vel_cm_s = Load<std::uint16_t>(p + 24);
-        g.cog_cdeg = Load<std::uint16_t>(p + 26);
+        g.time_us = LoadLittleEndian<std::uint64_t>(p);
+        g.lat_e7 = LoadLittleEndian<std::int32_t>(p + 8);
+        g.lon_e7 = LoadLittleEndian<std::int32_t>(p + 12);
+        g.alt_mm = LoadLittleEndian<std::int32_t>(p + 16);
+        g.eph = LoadLittleEndian<std::uint16_t>(p + 20);
+        g.epv = LoadLittleEndian<std::uint16_t>(p + 22);
+        g.vel_cm_s = LoadLittleEndian<std::uint16_t>(p + 24);
+        g.cog_cdeg = LoadLittleEndian<std::uint16_t>(p + 26);
         g.fix_type = p[28];
         g.satellites_visible = p[29];
-        g.alt_ellipsoid_mm = Load<std::int32_t>(p + 30);
-        g.h_acc_mm = Load<std::uint32_t>(p + 34);
-        g.v_acc_mm = Load<std::uint32_t>(p + 38);
-        g.vel_acc_mm_s = Load<std::uint32_t>(p + 42);
-        g.hdg_acc_degE5 = Load<std::uint32_t>(p + 46);
-        g.yaw_cdeg = Load<std::uint16_t>(p + 50);
+        g.alt_ellipsoid_mm = LoadLittleEndian<std::int32_t>(p + 30);
+        g.h_acc_mm = LoadLittleEndian<std::uint32_t>(p + 34);
+        g.v_acc_mm = LoadLittleEndian<std::uint32_t>(p + 38);
+        g.vel_acc_mm_s = LoadLittleEndian<std::uint32_t>(p + 42);
+        g.hdg_acc_degE5 = LoadLittleEndian<std::uint32_t>(p + 46);
+        g.yaw_cdeg = LoadLittleEndian<std::uint16_t>(p + 50);
         break;
       }
       case kMavRawImu: {
         // time_usec u64, 9 x int16, extensions id u8 (26), temperature int16 (27).
         MavlinkInt16Imu& s = log_->raw_imu.emplace_back();
-        FillInt16Imu(f, log_time_s, Load<std::uint64_t>(p), p + 8, &s);
+        FillInt16Imu(f, log_time_s, LoadLittleEndian<std::uint64_t>(p), p + 8, &s);
         s.id = p[26];
-        s.temperature_cdegc = Load<std::int16_t>(p + 27);
+        s.temperature_cdegc = LoadLittleEndian<std::int16_t>(p + 27);
         break;
       }
       case kMavScaledImu:
@@ -407,8 +402,9 @@ class Parser {
                                             : f.msgid == kMavScaledImu2 ? log_->scaled_imu2
                                                                         : log_->scaled_imu3;
         MavlinkInt16Imu& s = out.emplace_back();
-        FillInt16Imu(f, log_time_s, std::uint64_t{Load<std::uint32_t>(p)} * 1000u, p + 4, &s);
-        s.temperature_cdegc = Load<std::int16_t>(p + 22);
+        FillInt16Imu(f, log_time_s, std::uint64_t{LoadLittleEndian<std::uint32_t>(p)} * 1000u,
+                     p + 4, &s);
+        s.temperature_cdegc = LoadLittleEndian<std::int16_t>(p + 22);
         break;
       }
       case kMavHighresImu: {
@@ -417,15 +413,15 @@ class Parser {
         h.log_time_s = log_time_s;
         h.system_id = f.system_id;
         h.component_id = f.component_id;
-        h.time_us = Load<std::uint64_t>(p);
+        h.time_us = LoadLittleEndian<std::uint64_t>(p);
         h.acc = FloatTriad(p + 8);
         h.gyr = FloatTriad(p + 20);
         h.mag = FloatTriad(p + 32);
-        h.abs_pressure_hpa = Load<float>(p + 44);
-        h.diff_pressure_hpa = Load<float>(p + 48);
-        h.pressure_alt = Load<float>(p + 52);
-        h.temperature_degc = Load<float>(p + 56);
-        h.fields_updated = Load<std::uint16_t>(p + 60);
+        h.abs_pressure_hpa = LoadLittleEndian<float>(p + 44);
+        h.diff_pressure_hpa = LoadLittleEndian<float>(p + 48);
+        h.pressure_alt = LoadLittleEndian<float>(p + 52);
+        h.temperature_degc = LoadLittleEndian<float>(p + 56);
+        h.fields_updated = LoadLittleEndian<std::uint16_t>(p + 60);
         h.id = p[62];
         break;
       }

@@ -23,13 +23,6 @@ constexpr std::size_t kFlagBitsSize = 40;        // 8 + 8 + 3 * 8
 constexpr int kResyncChain = 4;  // consecutive valid headers that end a resync without D or S
 constexpr std::size_t kMinColumnBudget = 65536;  // columns allowed beyond one per input byte
 
-template <typename T>
-T Load(const std::uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));  // little endian on every supported host
-  return v;
-}
-
 bool IsLetter(std::uint8_t c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); }
 
 /// The message types of ULog version 1.
@@ -63,8 +56,8 @@ std::optional<KeyValue> ParseKeyValue(const std::uint8_t* p, std::size_t n) {
 /// A parameter value (int32_t or float, 4 bytes); nullopt otherwise.
 std::optional<double> ParamValue(const KeyValue& kv) {
   if (kv.value_size != 4) return std::nullopt;
-  if (kv.type == "int32_t") return Load<std::int32_t>(kv.value);
-  if (kv.type == "float") return Load<float>(kv.value);
+  if (kv.type == "int32_t") return LoadLittleEndian<std::int32_t>(kv.value);
+  if (kv.type == "float") return LoadLittleEndian<float>(kv.value);
   return std::nullopt;
 }
 
@@ -76,17 +69,17 @@ std::string InfoText(const KeyValue& kv) {
   if (const auto basic = ULogBasicType(kv.type); basic && basic->second == kv.value_size) {
     const std::uint8_t* p = kv.value;
     switch (basic->first) {
-      case ULogType::kInt8: return std::to_string(Load<std::int8_t>(p));
+      case ULogType::kInt8: return std::to_string(LoadLittleEndian<std::int8_t>(p));
       case ULogType::kUInt8: case ULogType::kBool: case ULogType::kChar:
-        return std::to_string(Load<std::uint8_t>(p));
-      case ULogType::kInt16: return std::to_string(Load<std::int16_t>(p));
-      case ULogType::kUInt16: return std::to_string(Load<std::uint16_t>(p));
-      case ULogType::kInt32: return std::to_string(Load<std::int32_t>(p));
-      case ULogType::kUInt32: return std::to_string(Load<std::uint32_t>(p));
-      case ULogType::kInt64: return std::to_string(Load<std::int64_t>(p));
-      case ULogType::kUInt64: return std::to_string(Load<std::uint64_t>(p));
-      case ULogType::kFloat: return std::to_string(Load<float>(p));
-      case ULogType::kDouble: return std::to_string(Load<double>(p));
+        return std::to_string(LoadLittleEndian<std::uint8_t>(p));
+      case ULogType::kInt16: return std::to_string(LoadLittleEndian<std::int16_t>(p));
+      case ULogType::kUInt16: return std::to_string(LoadLittleEndian<std::uint16_t>(p));
+      case ULogType::kInt32: return std::to_string(LoadLittleEndian<std::int32_t>(p));
+      case ULogType::kUInt32: return std::to_string(LoadLittleEndian<std::uint32_t>(p));
+      case ULogType::kInt64: return std::to_string(LoadLittleEndian<std::int64_t>(p));
+      case ULogType::kUInt64: return std::to_string(LoadLittleEndian<std::uint64_t>(p));
+      case ULogType::kFloat: return std::to_string(LoadLittleEndian<float>(p));
+      case ULogType::kDouble: return std::to_string(LoadLittleEndian<double>(p));
     }
   }
   static const char kHex[] = "0123456789abcdef";
@@ -105,10 +98,10 @@ std::uint64_t TimestampOf(const ULogTopic& t, const std::uint8_t* body) {
   const ULogColumn& c = t.columns[static_cast<std::size_t>(t.timestamp_col)];
   const std::uint8_t* p = body + c.offset;
   switch (c.type) {
-    case ULogType::kUInt64: return Load<std::uint64_t>(p);
-    case ULogType::kUInt32: return Load<std::uint32_t>(p);
-    case ULogType::kUInt16: return Load<std::uint16_t>(p);
-    case ULogType::kUInt8: return std::uint64_t{Load<std::uint8_t>(p)} * 1000u;
+    case ULogType::kUInt64: return LoadLittleEndian<std::uint64_t>(p);
+    case ULogType::kUInt32: return LoadLittleEndian<std::uint32_t>(p);
+    case ULogType::kUInt16: return LoadLittleEndian<std::uint16_t>(p);
+    case ULogType::kUInt8: return std::uint64_t{LoadLittleEndian<std::uint8_t>(p)} * 1000u;
     default: return 0;
   }
 }
@@ -186,7 +179,7 @@ class Parser {
         pos_ = end_;
         continue;
       }
-      const std::size_t size = Load<std::uint16_t>(At(pos_));
+      const std::size_t size = LoadLittleEndian<std::uint16_t>(At(pos_));
       const std::uint8_t type = At(pos_)[2];
       if (Corrupt(pos_, end_, size, type)) {
         resync_ = true;
@@ -214,7 +207,7 @@ class Parser {
   bool Held(std::size_t pos) const {
     if (resync_) return pos + kLookahead <= avail_;
     return pos + kMsgHeaderSize <= avail_ &&
-           pos + kMsgHeaderSize + Load<std::uint16_t>(At(pos)) <= avail_;
+           pos + kMsgHeaderSize + LoadLittleEndian<std::uint16_t>(At(pos)) <= avail_;
   }
 
   /// The byte of the input at file offset `pos` (in the bytes held).
@@ -234,7 +227,7 @@ class Parser {
     }
     log_->version = data_[7];
     log_->warnings.unknown_version = log_->version > 1;
-    log_->start_timestamp_us = Load<std::uint64_t>(data_ + 8);
+    log_->start_timestamp_us = LoadLittleEndian<std::uint64_t>(data_ + 8);
   }
 
   bool Corrupt(std::size_t pos, std::size_t end, std::size_t size, std::uint8_t type) const {
@@ -244,7 +237,7 @@ class Parser {
       case 'D': {
         if (size < 2) return true;
         if (end - pos < kMsgHeaderSize + 2) return false;  // truncated: the caller decides
-        const int idx = Index(Load<std::uint16_t>(At(pos) + kMsgHeaderSize));
+        const int idx = Index(LoadLittleEndian<std::uint16_t>(At(pos) + kMsgHeaderSize));
         if (idx < 0) return false;
         const ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
         return size - 2 < t.body_size || size - 2 > t.full_size;
@@ -266,12 +259,13 @@ class Parser {
   /// non-corrupt messages of known types (fewer when the segment ends right after them).
   bool ResyncPoint(std::size_t pos, std::size_t end) const {
     if (end - pos < kMsgHeaderSize) return false;
-    const std::size_t size = Load<std::uint16_t>(At(pos));
+    const std::size_t size = LoadLittleEndian<std::uint16_t>(At(pos));
     const std::uint8_t type = At(pos)[2];
     if (size > end - pos - kMsgHeaderSize) return false;
     const std::uint8_t* body = At(pos) + kMsgHeaderSize;
-    if (type == 'D' && size >= 2 && Index(Load<std::uint16_t>(body)) >= 0) {
-      const ULogTopic& t = log_->topics[static_cast<std::size_t>(Index(Load<std::uint16_t>(body)))];
+    if (type == 'D' && size >= 2 && Index(LoadLittleEndian<std::uint16_t>(body)) >= 0) {
+      const auto topic = static_cast<std::size_t>(Index(LoadLittleEndian<std::uint16_t>(body)));
+      const ULogTopic& t = log_->topics[topic];
       return size - 2 >= t.body_size && size - 2 <= t.full_size;
     }
     if (type == 'S') {
@@ -281,7 +275,7 @@ class Parser {
     for (int k = 0; k < kResyncChain; ++k) {
       if (at == end) return true;
       if (end - at < kMsgHeaderSize) return false;
-      const std::size_t n = Load<std::uint16_t>(At(at));
+      const std::size_t n = LoadLittleEndian<std::uint16_t>(At(at));
       const std::uint8_t ty = At(at)[2];
       if (!IsKnownType(ty) || Corrupt(at, end, n, ty) || n > end - at - kMsgHeaderSize) {
         return false;
@@ -292,7 +286,7 @@ class Parser {
   }
 
   void Data(const std::uint8_t* body, std::size_t size) {
-    const std::uint16_t msg_id = Load<std::uint16_t>(body);
+    const std::uint16_t msg_id = LoadLittleEndian<std::uint16_t>(body);
     const int idx = Index(msg_id);
     if (idx < 0) {
       ++log_->warnings.unknown_msg_id_messages;
@@ -330,7 +324,7 @@ class Parser {
       case 'S': ++log_->sync_messages; break;
       case 'O':
         ++log_->dropouts;
-        log_->dropout_total_ms += Load<std::uint16_t>(body);
+        log_->dropout_total_ms += LoadLittleEndian<std::uint16_t>(body);
         break;
       default: ++log_->warnings.unknown_type_messages; break;
     }
@@ -361,7 +355,7 @@ class Parser {
     if ((log_->incompat_flags[0] & 1u) == 0) return;
     std::size_t last = at + kMsgHeaderSize + size;
     for (int k = 0; k < 3; ++k) {
-      const std::uint64_t off = Load<std::uint64_t>(body + 16 + 8 * k);
+      const std::uint64_t off = LoadLittleEndian<std::uint64_t>(body + 16 + 8 * k);
       if (off == 0) continue;
       if (off < last || off > size_) {
         ++log_->warnings.bad_appended_offsets;
@@ -427,7 +421,7 @@ class Parser {
     in_definitions_ = false;
     ULogTopic t;
     t.multi_id = body[0];
-    t.msg_id = Load<std::uint16_t>(body + 1);
+    t.msg_id = LoadLittleEndian<std::uint16_t>(body + 1);
     t.name.assign(reinterpret_cast<const char*>(body + 3), size - 3);
     if (Index(t.msg_id) >= 0) return Malformed();  // an id must not be reused
     if (!resolver_.Resolve(&t)) {
@@ -446,10 +440,10 @@ class Parser {
     t.level = body[0];
     std::size_t off = 1;
     if (tagged) {
-      t.tag = Load<std::uint16_t>(body + 1);
+      t.tag = LoadLittleEndian<std::uint16_t>(body + 1);
       off = 3;
     }
-    t.timestamp_us = Load<std::uint64_t>(body + off);
+    t.timestamp_us = LoadLittleEndian<std::uint64_t>(body + off);
     off += 8;
     t.text.assign(reinterpret_cast<const char*>(body + off), size - off);
     log_->texts.push_back(std::move(t));

@@ -55,7 +55,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <map>
 #include <string>
 #include <string_view>
@@ -74,22 +73,18 @@ enum class ULogType : std::uint8_t {
 /// The value of a field of type `type` stored at `p` (little endian) as a double (bool 0/1,
 /// char its code).
 inline double DecodeULogValue(const std::uint8_t* p, ULogType type) {
-  const auto load = [p](auto v) {
-    std::memcpy(&v, p, sizeof v);  // little endian on every supported host
-    return v;
-  };
   switch (type) {
-    case ULogType::kInt8: return load(std::int8_t{});
-    case ULogType::kUInt8: case ULogType::kChar: return load(std::uint8_t{});
-    case ULogType::kBool: return load(std::uint8_t{}) != 0 ? 1.0 : 0.0;
-    case ULogType::kInt16: return load(std::int16_t{});
-    case ULogType::kUInt16: return load(std::uint16_t{});
-    case ULogType::kInt32: return load(std::int32_t{});
-    case ULogType::kUInt32: return load(std::uint32_t{});
-    case ULogType::kInt64: return static_cast<double>(load(std::int64_t{}));
-    case ULogType::kUInt64: return static_cast<double>(load(std::uint64_t{}));
-    case ULogType::kFloat: return load(float{});
-    case ULogType::kDouble: return load(double{});
+    case ULogType::kInt8: return LoadLittleEndian<std::int8_t>(p);
+    case ULogType::kUInt8: case ULogType::kChar: return LoadLittleEndian<std::uint8_t>(p);
+    case ULogType::kBool: return LoadLittleEndian<std::uint8_t>(p) != 0 ? 1.0 : 0.0;
+    case ULogType::kInt16: return LoadLittleEndian<std::int16_t>(p);
+    case ULogType::kUInt16: return LoadLittleEndian<std::uint16_t>(p);
+    case ULogType::kInt32: return LoadLittleEndian<std::int32_t>(p);
+    case ULogType::kUInt32: return LoadLittleEndian<std::uint32_t>(p);
+    case ULogType::kInt64: return static_cast<double>(LoadLittleEndian<std::int64_t>(p));
+    case ULogType::kUInt64: return static_cast<double>(LoadLittleEndian<std::uint64_t>(p));
+    case ULogType::kFloat: return LoadLittleEndian<float>(p);
+    case ULogType::kDouble: return LoadLittleEndian<double>(p);
   }
   return 0.0;
 }

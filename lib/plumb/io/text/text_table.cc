@@ -152,16 +152,6 @@ class TableParser {
 
   Session Finish(const std::string& source) {
     session_.source = source;
-    // Reserve's estimate from the first row's length overshoots when later rows are longer:
-    // give the slack back (one column at a time, so the copy costs a column at most), as the
-    // series is held for the rest of the run.
-    auto& s = session_.series;
-    if (s.t_s.capacity() > s.t_s.size() + s.t_s.size() / 32) {
-      s.t_s.shrink_to_fit();
-      s.acc.shrink_to_fit();
-      s.gyr.shrink_to_fit();
-      s.temp_c.shrink_to_fit();
-    }
     if (skipped_ > 0) {
       session_.warnings.push_back(source + ": skipped " + std::to_string(skipped_) +
                                   " rows with NaN or infinite values (first at line " +
