@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "validators.h"
+#include "jobs.h"
 #include "progress.h"
 #include "commands.h"
 #include "fit_options.h"
@@ -39,6 +40,7 @@ struct DiagnoseArgs {
   std::string residuals_path;           ///< --residuals FILE: per-sample residuals, CSV
   double significance = 0.01;           ///< level of the score test, (0, 0.5)
   int confirm = 3;                      ///< refit the best N significant candidates, >= 0
+  int jobs = 0;                         ///< --jobs N: refits at once (0: every core)
   std::vector<std::string> candidates;  ///< --candidates: effect names (default: catalogue)
 };
 
@@ -72,6 +74,10 @@ class DiagnoseCommand : public Command {
                      "fall of chi2)")
         ->check(NonNegative)
         ->capture_default_str();
+    app_->add_option("--jobs", a.jobs,
+                     "Refits in parallel, each on one core (default: every core); the result "
+                     "is the same whatever N")
+        ->check(NonNegative);
     app_->add_option("--candidates", a.candidates,
                      "Test only these effects (NAME or NAME:OPTION, comma-separated); default: "
                      "every catalogue effect not in the model")
@@ -111,6 +117,7 @@ class DiagnoseCommand : public Command {
     options.calibration = fit.options;
     options.calibration.method = "generalized";
     options.on_stage = [](const std::string& stage) { Progress::Of().Stage(stage); };
+    options.run_jobs = ParallelJobs(a.jobs);
 
     PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose)

@@ -22,6 +22,7 @@
 
 #include "validators.h"
 #include "commands.h"
+#include "jobs.h"
 #include "progress.h"
 #include "fit_options.h"
 #include "input_options.h"
@@ -58,6 +59,7 @@ struct ReportArgs {
   bool diagnose = true;             ///< --diagnose / --no-diagnose
   double significance = 0.01;       ///< level of the score test, (0, 0.5)
   int confirm = 3;                  ///< refit the best N significant candidates, >= 0
+  int jobs = 0;                     ///< --jobs N: diagnose's refits at once (0: every core)
   bool no_figures = false;          ///< --no-figures: do not draw (nor write figure data)
   std::string gnuplot = "gnuplot";  ///< --gnuplot PROGRAM
   std::string study;                ///< --study DIR: the page of a plumb sweep folder instead
@@ -111,7 +113,7 @@ std::string CalibrateCommand(const std::vector<std::string>& replaced,
                              const std::vector<std::string>& extra) {
   // Report's own options, and whether each takes a value.
   const std::vector<std::pair<std::string, bool>> own = {
-      {"--out", true},         {"--significance", true}, {"--confirm", true},
+      {"--out", true},         {"--significance", true}, {"--confirm", true}, {"--jobs", true},
       {"--gnuplot", true},     {"--study", true},        {"--diagnose", false},
       {"--no-diagnose", false}, {"--no-figures", false}};
   const std::vector<std::string>& args = CommandLineArgs();
@@ -195,6 +197,10 @@ class ReportCommand : public Command {
                      "Refit the model with each of the best N significant effects")
         ->check(NonNegative)
         ->capture_default_str();
+    app_->add_option("--jobs", a.jobs,
+                     "Diagnose's refits in parallel, each on one core (default: every core); "
+                     "the page is the same whatever N")
+        ->check(NonNegative);
     AddFitOptions(app_, a.fit);
     app_->add_flag("--no-figures", a.no_figures, "Write the page without figures (no gnuplot)");
     app_->add_option("--gnuplot", a.gnuplot,
@@ -329,6 +335,7 @@ class ReportCommand : public Command {
     options.calibration = calibration;
     options.calibration.on_insufficient = estimation::InsufficientData::kReport;
     options.on_stage = [](const std::string& stage) { Progress::Of().Stage(stage); };
+    options.run_jobs = ParallelJobs(args_.jobs);
     try {
       diagnostics::Diagnosis d = diagnostics::Diagnose(series, segments, model, site, options);
       std::cout << report::DiagnosisText(d);

@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <iomanip>
 #include <sstream>
 
@@ -234,27 +235,49 @@ void Tell(const DiagnoseOptions& options, const std::string& stage) {
 
 /// Refits the model plus each of the best `options.confirm` significant candidates: the
 /// actual fall of chi^2 from its probe fit (`fit` or, with velocity residuals, `fit_motion`).
+/// The refits are independent: options.run_jobs may run them at once. A refit's error is
+/// thrown after all have ended (the first candidate's, in ranking order).
 void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segments,
                  const model::Model& model, const geo::Site& site, const DiagnoseOptions& options,
                  const estimation::CalibrationResult& fit,
                  const std::optional<estimation::CalibrationResult>& fit_motion,
                  std::vector<Candidate>& candidates) {
-  int confirmed = 0;
+  std::vector<Candidate*> chosen;
   for (auto& cand : candidates) {
-    if (confirmed >= options.confirm) break;
-    if (!cand.significant) continue;
-    model::Model with = model;
-    with.Add(cand.effect, cand.option);
-    Tell(options, "refit with " + with.spec() + " (" + std::to_string(confirmed + 1) + " of at most " +
-                      std::to_string(options.confirm) + ")");
-    estimation::CalibrationOptions refit_options = options.calibration;
-    refit_options.accel_in_motion = cand.with_velocity;
-    estimation::CalibrationResult refit =
-        estimation::Calibrate(series, segments, with, site, refit_options);
-    const double before = cand.with_velocity ? fit_motion->fit.chi2 : fit.fit.chi2;
-    cand.refit_drop = before - refit.fit.chi2;
-    cand.refit = std::move(refit);
-    ++confirmed;
+    if (static_cast<int>(chosen.size()) >= options.confirm) break;
+    if (cand.significant) chosen.push_back(&cand);
+  }
+  if (chosen.empty()) return;
+  std::string specs;
+  for (const Candidate* cand : chosen) {
+    specs += (specs.empty() ? "" : ", ") + SpecWith(model, cand->effect, cand->option);
+  }
+  Tell(options, "refit with " + specs);
+  std::vector<std::exception_ptr> errors(chosen.size());
+  const auto refit = [&](int k) {
+    Candidate& cand = *chosen[static_cast<std::size_t>(k)];
+    try {
+      model::Model with = model;
+      with.Add(cand.effect, cand.option);
+      estimation::CalibrationOptions refit_options = options.calibration;
+      refit_options.accel_in_motion = cand.with_velocity;
+      estimation::CalibrationResult result =
+          estimation::Calibrate(series, segments, with, site, refit_options);
+      const double before = cand.with_velocity ? fit_motion->fit.chi2 : fit.fit.chi2;
+      cand.refit_drop = before - result.fit.chi2;
+      cand.refit = std::move(result);
+    } catch (...) {
+      errors[static_cast<std::size_t>(k)] = std::current_exception();
+    }
+  };
+  const int count = static_cast<int>(chosen.size());
+  if (options.run_jobs) {
+    options.run_jobs(count, refit);
+  } else {
+    for (int k = 0; k < count; ++k) refit(k);
+  }
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);
   }
 }
 

@@ -131,12 +131,12 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   Solution& solution = fitted.solution;
   Calibration& cal = result.calibration;
   FitReport& fit = result.fit;
-  UnknownColumns columns;
-  double cost = 0;
-  std::vector<double> residual_values;
-  Eigen::SparseMatrix<double> J;  // at the solution, for the linearity check
-  const ObservabilityAnalysis analysis = AnalyseAt(problem, *solution.all_free.problem, options,
-                                                   columns, &cost, &residual_values, nullptr, &J);
+  if (!solution.analysed) {
+    solution.analysed = AnalyseSolution(problem, *solution.all_free.problem, options);
+  }
+  const AnalysedSolution& at = *solution.analysed;
+  const ObservabilityAnalysis& analysis = at.analysis;
+  const UnknownColumns& columns = at.columns;
   cal.observability = analysis.summary;
 
   // 6. Parameters and their covariance.
@@ -147,8 +147,8 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
                     fit.warnings);
 
   // 7. The fit: chi^2, degrees of freedom and the residuals.
-  fit.chi2 = 2.0 * cost;
-  fit.num_residuals = static_cast<int>(residual_values.size());
+  fit.chi2 = 2.0 * at.cost;
+  fit.num_residuals = static_cast<int>(at.residuals.size());
   fit.dof = fit.num_residuals - analysis.summary.rank - analysis.summary.wander_states;
   fit.still_segments = static_cast<int>(problem.still().poses.size());
   fit.motion_segments = static_cast<int>(problem.still().motions.size());
@@ -163,7 +163,7 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
     // The analysis's Jacobian is the fitted problem's when no parameter is held.
     const bool same = solution.held_parameters.empty();
     fit.linearity = CheckLinearity(problem, solution.fitted(), solution.held_parameters,
-                                   kLinearityStepSigmas, same ? &J : nullptr, cost);
+                                   kLinearityStepSigmas, same ? &at.jacobian : nullptr, at.cost);
   }
   fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
   if (!fitted.implausible_walk.empty()) {

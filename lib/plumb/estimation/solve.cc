@@ -103,31 +103,44 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
   return range.Leverage(rows);
 }
 
+AnalysedSolution AnalyseSolution(CalibrationProblem& calibration, ceres::Problem& problem,
+                                 const CalibrationOptions& options) {
+  AnalysedSolution out;
+  out.analysis = AnalyseAt(calibration, problem, options, out.columns, &out.cost, &out.residuals,
+                           nullptr, &out.jacobian);
+  return out;
+}
+
+// Solves with every unknown free (with motion: roughly, then again with the motion weights
+// of that solution) and analyses the solution. Where the analysis finds null directions, their
+// pivots are held and the fit is made again from the starting values (the fit's account then
+// has the first solve and this one).
 Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOptions& options,
                         FitReport& fit) {
   Solution out;
   calibration.SaveValues();
-  {
-    BuiltProblem first = calibration.Build({});
-    Solve(*first.problem, calibration.has_motion(), options, fit);
-    UnknownColumns columns;
-    double cost = 0;
-    const ObservabilityAnalysis analysis =
-        AnalyseAt(calibration, *first.problem, options, columns, &cost, nullptr);
-    for (int c : analysis.pivots) {
-      const ParameterIndex& index = columns.model_index[static_cast<std::size_t>(c)];
-      if (index.first >= 0) out.held_parameters.push_back(index);
-    }
-  }
-  if (calibration.has_motion()) calibration.SetMotionWeightsFromSolution();
-  if (!out.held_parameters.empty()) calibration.RestoreValues();
   out.all_free = calibration.Build({});
-  if (!out.held_parameters.empty()) out.held = calibration.Build(out.held_parameters);
-  if (!out.held_parameters.empty() || calibration.has_motion()) {
-    // From the first solution (new motion weights), or again from the starting values with
-    // the null directions' pivots held.
-    Solve(out.fitted(), false, options, fit, out.held_parameters.empty());
+  Solve(*out.all_free.problem, calibration.has_motion(), options, fit);
+  FitReport refined = fit;  // the fit's account, kept only when nothing is held
+  if (calibration.has_motion()) {
+    calibration.SetMotionWeightsFromSolution();
+    out.all_free = calibration.Build({});
+    Solve(*out.all_free.problem, false, options, refined, true);
   }
+  out.analysed = AnalyseSolution(calibration, *out.all_free.problem, options);
+  for (int c : out.analysed->analysis.pivots) {
+    const ParameterIndex& index = out.analysed->columns.model_index[static_cast<std::size_t>(c)];
+    if (index.first >= 0) out.held_parameters.push_back(index);
+  }
+  if (out.held_parameters.empty()) {
+    fit = std::move(refined);
+    return out;
+  }
+  out.analysed.reset();
+  calibration.RestoreValues();
+  out.all_free = calibration.Build({});
+  out.held = calibration.Build(out.held_parameters);
+  Solve(*out.held.problem, false, options, fit);
   return out;
 }
 

@@ -12,6 +12,7 @@
 
 #include <ceres/ceres.h>
 
+#include <optional>
 #include <vector>
 
 #include "plumb/estimation/calibration_problem.h"
@@ -67,11 +68,28 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
                           const CalibrationOptions& options, const std::vector<Eigen::Index>& rows,
                           std::vector<double>* residuals);
 
+/// The analysis (AnalyseAt) of a problem at its solution, with what the calibration reads of
+/// it besides: the unknowns' columns, the cost, the whitened residuals and Jacobian.
+struct AnalysedSolution {
+  ObservabilityAnalysis analysis;
+  UnknownColumns columns;
+  double cost = 0;
+  std::vector<double> residuals;
+  Eigen::SparseMatrix<double> jacobian;  ///< over `columns`, for the linearity check
+};
+
+/// AnalyseAt with every output kept.
+AnalysedSolution AnalyseSolution(CalibrationProblem& calibration, ceres::Problem& problem,
+                                 const CalibrationOptions& options);
+
 /// The solved problem.
 struct Solution {
   BuiltProblem all_free;  ///< every free unknown: for the analysis and the residuals
   BuiltProblem held;      ///< with the null directions' pivots held (empty when there are none)
   std::vector<ParameterIndex> held_parameters;  ///< those pivots
+  /// all_free analysed at the solution, when nothing is held (the analysis that found no null
+  /// direction to hold); empty otherwise.
+  std::optional<AnalysedSolution> analysed;
   /// The problem the fit and its covariance were made on.
   ceres::Problem& fitted() { return held_parameters.empty() ? *all_free.problem : *held.problem; }
 };

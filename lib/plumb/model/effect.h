@@ -121,6 +121,9 @@ class Effect {
 
   /// Adds this effect's term to `out`. `theta` points at this effect's parameter block
   /// (info().size() values). Linear-stage effects overwrite acc or gyr and F or E instead.
+  /// A catalogue term may read the linear stage's F and E; one that reads acc or gyr as the
+  /// terms before it left them makes the motion residual differentiate the whole model at
+  /// every pass (residuals/motion_residual.h), so the built-in ones do not.
   virtual void Apply(const double* theta, const SensorInput<double>& in,
                      SensorOutput<double>& out) const = 0;
   virtual void Apply(const Jet* theta, const SensorInput<Jet>& in,

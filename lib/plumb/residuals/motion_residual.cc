@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "plumb/core/so3.h"
+#include "plumb/model/effects/accel_linear.h"
 #include "plumb/model/effects/gyro_linear.h"
 
 namespace plumb::residuals {
@@ -25,6 +26,50 @@ bool HasAccelTerms(const model::Model& model) {
     if (t.effect->info().sensor == model::Sensor::kAccel) return true;
   }
   return false;
+}
+
+
+/// What a catalogue term reads of the output the terms before it wrote: the linear stage's F
+/// and E, or the outputs summed so far (effect.h: terms add to the outputs; the built-in ones
+/// read F or E at most). Found by applying the term on doubles at generic values, once with F,
+/// E and the outputs as the identity model leaves them and once changed: a term whose
+/// increment does not move (beyond rounding) does not read them, on the inputs this residual
+/// gives.
+struct TermReads {
+  bool linear_stage = false;  ///< the increment depends on F or E
+  bool outputs = false;       ///< the increment depends on acc or gyr as summed so far
+};
+
+TermReads ProbeTermReads(const model::Effect& effect) {
+  const int size = effect.info().size();
+  std::vector<double> theta(static_cast<std::size_t>(size));
+  for (int j = 0; j < size; ++j) theta[static_cast<std::size_t>(j)] = 1e-3 * (1.0 + 0.37 * j);
+  model::SensorInput<double> in;
+  in.f_b = Vec3(0.31, -0.42, 9.7);
+  in.omega_b = Vec3(0.23, -0.61, 0.47);
+  in.alpha_b = Vec3(1.3, -0.7, 0.9);
+  in.dt_s = 12.5;
+  in.dtemp_c = 3.25;
+  // R_b_n stays zero: the attitude is not known inside a motion interval, and this residual
+  // never gives it (earth_rate's term, E R_b_n omega_n, is then zero here whatever E).
+  auto increment = [&](const model::SensorOutput<double>& before) {
+    model::SensorOutput<double> out = before;
+    effect.Apply(theta.data(), in, out);
+    Eigen::Matrix<double, 6, 1> d;
+    d << out.acc - before.acc, out.gyr - before.gyr;
+    return d;
+  };
+  const model::SensorOutput<double> identity;
+  model::SensorOutput<double> stage = identity, summed = identity;
+  stage.F += 0.1 * so3::Skew(Vec3(0.7, -0.3, 0.5)) + 0.05 * Mat3::Identity();
+  stage.E += 0.1 * so3::Skew(Vec3(-0.4, 0.6, 0.2)) - 0.03 * Mat3::Identity();
+  summed.acc = Vec3(1.7, -2.3, 9.1);
+  summed.gyr = Vec3(-0.9, 0.4, 1.3);
+  const Eigen::Matrix<double, 6, 1> base = increment(identity);
+  auto moved = [&](const Eigen::Matrix<double, 6, 1>& d) {
+    return (d - base).cwiseAbs().maxCoeff() > 1e-12 * (1.0 + base.cwiseAbs().maxCoeff());
+  };
+  return TermReads{moved(increment(stage)), moved(increment(summed))};
 }
 
 }  // namespace
@@ -51,6 +96,19 @@ MotionResidual::MotionResidual(const model::Model& model, SharedMotionSamples sa
     for (int j = 0; j < size; ++j) parameter_of_.emplace_back(t, j);
     num_model_parameters_ += size;
   }
+  for (int t = 0; t < model.num_terms(); ++t) {
+    all_terms_.push_back(t);
+    const model::Effect& effect = *model.terms()[static_cast<std::size_t>(t)].effect;
+    if (effect.info().linear_stage) {
+      linear_terms_.push_back(t);
+      continue;
+    }
+    catalogue_terms_.push_back(t);
+    const TermReads reads = ProbeTermReads(effect);
+    if (reads.outputs) terms_split_ = false;
+    if (reads.linear_stage) stage_readers_.push_back(t);
+  }
+  if (!stage_readers_.empty()) stage_readers_.insert(stage_readers_.begin(), linear_terms_.begin(), linear_terms_.end());
   const int g = model.BaseTerm(model::Sensor::kGyro);
   if (g >= 0) bias_offset_ = block_offset_[static_cast<std::size_t>(g)] + model::gyro_linear::kBias;
   set_num_residuals(3);
@@ -77,11 +135,11 @@ bool MotionResidual::LinearAt(double const* const* theta, double** jacobians) co
 
 void MotionResidual::CorrectedRates(double const* const* theta, const std::vector<Vec3>& gyr,
                                     bool linear, std::vector<Vec3>* w,
-                                    std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const {
+                                    RateJacobians* W) const {
   const std::size_t n = s_.size();
   const int P = num_model_parameters_;
   w->resize(n);
-  if (W) W->assign(n, Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, P));
+  if (W) W->Reset(n, P);
   const model::SensorOutput<double> at_zero = model_->Predict(theta, model::SensorInput<double>());
   const Mat3 F_inv = at_zero.F.inverse();
   const Mat3 E_inv = at_zero.E.inverse();
@@ -114,34 +172,57 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
     std::tie(f[i], (*w)[i]) = model_->CorrectToFixedPoint(theta, s_.acc[i], gyr[i], in, F_inv,
                                                           E_inv, kNewtonSteps, kNewtonTolerance);
   }
-  if (!W) return;
+  if (W) ImplicitRateJacobians(theta, at_zero, f, *w, *W);
+}
+
+// The general model's d w_i / d theta by implicit differentiation (see CorrectedRates): with
+// D_x = d Predict / d x (6 x 6) and D_theta = d Predict / d theta at the fixed point,
+// d x / d theta = -D_x^-1 D_theta. The linear stage's share of both is closed-form (D_x gets F
+// and E; D_theta is e_r f_c, e_r w_c and I, the linear residuals' columns); the catalogue terms'
+// share comes from Jets, one pass per 8 parameters through the term that owns them alone, on
+// the linear stage's F and E (terms add to the outputs and read only those). Where a term reads
+// F or E, the linear stage's parameters go through Jets too (with the terms that read them);
+// where one reads more than that (terms_split_ false), every pass runs the whole model.
+void MotionResidual::ImplicitRateJacobians(double const* const* theta,
+                                           const model::SensorOutput<double>& at_zero,
+                                           const std::vector<Vec3>& f, const std::vector<Vec3>& w,
+                                           RateJacobians& W) const {
   using Jet = model::Jet;
   constexpr int kStride = model::kJetStride;
   static_assert(kStride >= 6, "one Jet pass differentiates the six inputs");
+  const std::size_t n = s_.size();
+  const int T = model_->num_terms();
   const bool accel = HasAccelTerms(*model_);
-  // theta as Jets: constants, or the chunk [chunk, chunk + kStride) of the P parameters.
-  std::vector<std::vector<Jet>> blocks(static_cast<std::size_t>(model_->num_terms()));
-  std::vector<const Jet*> ptr(blocks.size());
+  const int a_term = model_->BaseTerm(model::Sensor::kAccel);
+  const int g_term = model_->BaseTerm(model::Sensor::kGyro);
   // theta as Jets: constants, with parameters `seeded` (global indices, at most kStride)
   // differentiated.
+  std::vector<std::vector<Jet>> blocks(static_cast<std::size_t>(T));
+  std::vector<const Jet*> ptr(blocks.size());
+  for (int t = 0; t < T; ++t) {
+    auto& b = blocks[static_cast<std::size_t>(t)];
+    const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
+    b.resize(static_cast<std::size_t>(size));
+    ptr[static_cast<std::size_t>(t)] = b.data();
+  }
   auto set_theta = [&](const std::vector<int>& seeded) {
-    for (int t = 0; t < model_->num_terms(); ++t) {
-      const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
+    for (int t = 0; t < T; ++t) {
       auto& b = blocks[static_cast<std::size_t>(t)];
-      b.assign(static_cast<std::size_t>(size), Jet());
-      for (int j = 0; j < size; ++j) b[static_cast<std::size_t>(j)] = Jet(theta[t][j]);
-      ptr[static_cast<std::size_t>(t)] = b.data();
+      for (std::size_t j = 0; j < b.size(); ++j) b[j] = Jet(theta[t][j]);
     }
     for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
       const auto [t, j] = parameter_of_[static_cast<std::size_t>(seeded[slot])];
       blocks[static_cast<std::size_t>(t)][static_cast<std::size_t>(j)].v[slot] = 1.0;
     }
   };
-  auto input = [&](std::size_t i, bool differentiate) {
+  // The terms `terms` applied at sample i (inputs differentiated if asked), on the linear
+  // stage's F and E as constants when they leave the linear stage out.
+  const Mat3T<Jet> F_jet = at_zero.F.cast<Jet>(), E_jet = at_zero.E.cast<Jet>();
+  auto predict = [&](std::size_t i, bool differentiate, const std::vector<int>& terms) {
     model::SensorInput<Jet> in;
     for (int k = 0; k < 3; ++k) {
       in.f_b[k] = Jet(f[i][k]);
-      in.omega_b[k] = Jet((*w)[i][k]);
+      in.omega_b[k] = Jet(w[i][k]);
       in.alpha_b[k] = Jet(s_.alpha_b[i][k]);
       if (differentiate) {
         in.f_b[k].v[k] = 1.0;
@@ -150,48 +231,109 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
     }
     in.dt_s = Jet(s_.dt_s[i]);
     in.dtemp_c = Jet(s_.dtemp_c[i]);
-    return in;
+    model::SensorOutput<Jet> z;
+    if (terms_split_) {
+      z.F = F_jet;
+      z.E = E_jet;
+    }
+    for (int t : terms) {
+      model_->terms()[static_cast<std::size_t>(t)].effect->Apply(ptr[static_cast<std::size_t>(t)], in, z);
+    }
+    return z;
   };
-  // -D_x^-1 per sample (without accelerometer terms f is the output itself: d f = 0).
-  std::vector<Eigen::Matrix<double, 6, 6>> minus_inv_D_x(n);
+
+  // The rate rows of -D_x^-1 per sample, M = d w / d y (3 x 6; without accelerometer terms f
+  // is the output itself: d f = 0). With D_x = [A B; C D] (A = d y_a / d f ~ F, D ~ E) and
+  // S = D - C A^-1 B: M = [S^-1 C A^-1, -S^-1].
+  std::vector<Eigen::Matrix<double, 3, 6>> dw_dy(n);
   set_theta({});
   bool coupled = false;  // some output depends on the other sensor's input
+  const std::vector<int>& input_terms = terms_split_ ? catalogue_terms_ : all_terms_;
   for (std::size_t i = 0; i < n; ++i) {
-    const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), input(i, true));
-    Eigen::Matrix<double, 6, 6> D;
-    for (int r = 0; r < 3; ++r) {
-      D.row(r) = z.acc[r].v.head<6>().transpose();
-      D.row(3 + r) = z.gyr[r].v.head<6>().transpose();
+    Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Zero();
+    if (terms_split_) {
+      if (a_term >= 0) D.topLeftCorner<3, 3>() = at_zero.F;
+      if (g_term >= 0) D.bottomRightCorner<3, 3>() = at_zero.E;
+    }
+    if (!input_terms.empty()) {
+      const model::SensorOutput<Jet> z = predict(i, true, input_terms);
+      for (int r = 0; r < 3; ++r) {
+        D.row(r) += z.acc[r].v.head<6>().transpose();
+        D.row(3 + r) += z.gyr[r].v.head<6>().transpose();
+      }
     }
     if (!accel) D.topRows<3>() << Mat3::Identity(), Mat3::Zero();
     coupled = coupled || !D.block<3, 3>(3, 0).isZero(0.0) || !D.block<3, 3>(0, 3).isZero(0.0);
-    minus_inv_D_x[i] = -D.partialPivLu().inverse();
+    const Mat3 A_inv = D.topLeftCorner<3, 3>().inverse();
+    const Mat3 S_inv =
+        (D.bottomRightCorner<3, 3>() - D.bottomLeftCorner<3, 3>() * A_inv * D.topRightCorner<3, 3>())
+            .inverse();
+    dw_dy[i] << S_inv * D.bottomLeftCorner<3, 3>() * A_inv, -S_inv;
   }
   // The parameters that can move the rates: with the sensors uncoupled at every sample, D_x is
   // block diagonal and the accelerometer's terms (which write y_a alone) leave w alone: their
-  // columns stay zero without a Jet pass.
-  std::vector<int> moving;
-  for (int g = 0; g < P; ++g) {
-    const int t = parameter_of_[static_cast<std::size_t>(g)].first;
-    const auto sensor = model_->terms()[static_cast<std::size_t>(t)].effect->info().sensor;
-    if (coupled || sensor == model::Sensor::kGyro) moving.push_back(g);
+  // columns stay zero without a pass.
+  auto moves = [&](int t) {
+    return coupled ||
+           model_->terms()[static_cast<std::size_t>(t)].effect->info().sensor == model::Sensor::kGyro;
+  };
+  // Jet passes: (parameters seeded, terms applied).
+  std::vector<std::pair<std::vector<int>, std::vector<int>>> passes;
+  auto add_passes = [&](const std::vector<int>& params, const std::vector<int>& terms) {
+    for (std::size_t first = 0; first < params.size(); first += kStride) {
+      const auto last = std::min(params.size(), first + kStride);
+      passes.emplace_back(std::vector<int>(params.begin() + static_cast<std::ptrdiff_t>(first),
+                                           params.begin() + static_cast<std::ptrdiff_t>(last)),
+                          terms);
+    }
+  };
+  auto params_of = [&](const std::vector<int>& terms) {
+    std::vector<int> params;
+    for (int t : terms) {
+      if (!moves(t)) continue;
+      const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
+      for (int j = 0; j < size; ++j) params.push_back(block_offset_[static_cast<std::size_t>(t)] + j);
+    }
+    return params;
+  };
+  const bool linear_closed = terms_split_ && stage_readers_.empty();
+  if (!terms_split_) {
+    add_passes(params_of(all_terms_), all_terms_);
+  } else {
+    for (int t : catalogue_terms_) add_passes(params_of({t}), {t});
+    if (!linear_closed) add_passes(params_of(linear_terms_), stage_readers_);
   }
-  for (std::size_t first = 0; first < moving.size(); first += kStride) {
-    const std::vector<int> seeded(moving.begin() + static_cast<std::ptrdiff_t>(first),
-                                  moving.begin() + static_cast<std::ptrdiff_t>(
-                                                       std::min(moving.size(), first + kStride)));
+  for (const auto& [seeded, terms] : passes) {
     set_theta(seeded);
     for (std::size_t i = 0; i < n; ++i) {
-      const model::SensorOutput<Jet> z = model_->Predict(ptr.data(), input(i, false));
+      const model::SensorOutput<Jet> z = predict(i, false, terms);
       Eigen::Matrix<double, 6, kStride> D_theta;
       for (int r = 0; r < 3; ++r) {
         D_theta.row(r) = z.acc[r].v.transpose();  // zero without accelerometer terms
         D_theta.row(3 + r) = z.gyr[r].v.transpose();
       }
-      const Eigen::Matrix<double, 3, kStride> dw = minus_inv_D_x[i].bottomRows<3>() * D_theta;
+      const Eigen::Matrix<double, 3, kStride> dw = dw_dy[i] * D_theta;
       for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
-        (*W)[i].col(seeded[slot]) = dw.col(static_cast<Eigen::Index>(slot));
+        W[i].col(seeded[slot]) = dw.col(static_cast<Eigen::Index>(slot));
       }
+    }
+  }
+  if (!linear_closed) return;
+  // The linear stage in closed form: d y_a / d F_rc = e_r f_c, d y_a / d b_a = I (the
+  // accelerometer's columns, when the sensors are coupled), and the same for E and b_g, each
+  // taken through the rows of -D_x^-1 that give w (SubtractForceJacobian with K F^-1 = -M).
+  const int a_size = a_term >= 0 ? model_->terms()[static_cast<std::size_t>(a_term)].effect->info().size() : 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Matrix<double, 3, 6>& M = dw_dy[i];
+    if (a_term >= 0 && moves(a_term)) {
+      model::accel_linear::SubtractForceJacobian(
+          Mat3(-M.leftCols<3>()), f[i], a_size == model::accel_linear::kSizeFull,
+          W[i].middleCols(block_offset_[static_cast<std::size_t>(a_term)], a_size));
+    }
+    if (g_term >= 0) {
+      model::gyro_linear::SubtractRateJacobian(
+          Mat3(-M.rightCols<3>()), w[i],
+          W[i].middleCols(block_offset_[static_cast<std::size_t>(g_term)], model::gyro_linear::kSize));
     }
   }
 }
@@ -224,7 +366,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   const std::vector<Vec3>& gyr = walk ? walked : s_.gyr;
 
   std::vector<Vec3> w;
-  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> W;
+  RateJacobians W;
   // For the base model dw/dtheta has a closed form used on the fly (no per-sample storage):
   // w = E^-1 (y - b_g), dw/dE_rc = -E^-1 e_r w_c, dw/db_g = -E^-1. It also holds when every
   // other effect is at zero and its Jacobian is not asked for (e.g. diagnose's probes).
@@ -277,6 +419,10 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   //   A' = Exp(phi)^T A + J_r(phi) d phi
   //      = (Exp(phi)^T - J_r (C0 + C1) [e]x) A + J_r C0 W_i + J_r C1 W_i+1
   //        - [0 | J_r (C0 + C1) dR^T d omega_k].
+  //
+  // Without Earth rate A is carried in the frame of the interval's start instead,
+  // A~_i = dR_i A_i: then A~_i+1 = A~_i + dR_i+1 (J_r C0 W_i + J_r C1 W_i+1), with no product
+  // by Exp(phi)^T per step, and A = dR^T A~ at the end.
   Eigen::Matrix<double, 3, Eigen::Dynamic> A = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, U);
   Eigen::Matrix<double, 3, Eigen::Dynamic> A_next(3, U);
   const bool earth = omega_ie_n_.squaredNorm() > 0.0;  // without a site: e = 0, no att terms
@@ -287,6 +433,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
     const Vec3 phi = so3::ConingIncrement(u0, u1, h);
     const Mat3 Ex = so3::Exp(phi);
+    const Mat3 dR_next = dR * Ex;
     if (want_jacobians) {
       const Mat3 Jr = so3::RightJacobian(phi);
       const Mat3 K0 = Jr * (0.5 * h * Mat3::Identity() - (h * h / 12.0) * Skew(u1));
@@ -295,15 +442,17 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
         const Mat3 K = K0 + K1;
         A_next.noalias() = (Ex.transpose() - K * Skew(e)) * A;
         A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
+        add_rate_jacobian(K0, i, A_next);
+        add_rate_jacobian(K1, i + 1, A_next);
+        A.swap(A_next);
       } else {
-        A_next.noalias() = Ex.transpose() * A;
+        add_rate_jacobian(dR_next * K0, i, A);
+        add_rate_jacobian(dR_next * K1, i + 1, A);
       }
-      add_rate_jacobian(K0, i, A_next);
-      add_rate_jacobian(K1, i + 1, A_next);
-      A.swap(A_next);
     }
-    dR = dR * Ex;
+    dR = dR_next;
   }
+  if (want_jacobians && !earth) A = (dR.transpose() * A).eval();
   const Mat3 M = dR.transpose() * R_k.transpose();
   const Vec3 r = so3::Log(M * R_k1);
   for (int i = 0; i < 3; ++i) residuals[i] = s_.sqrt_info[i] * r[i];

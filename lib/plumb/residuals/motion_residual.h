@@ -16,8 +16,9 @@
 //
 // Jacobians are analytic, as in IMU preintegration: the right-perturbation sensitivity of
 // dR, A (3 x unknowns), follows A_i+1 = Exp(phi_i)^T A_i + J_r(phi_i) d(phi_i)/d(unknowns);
-// d(w_i)/d(theta) is closed-form for the base model and from Jets (one pass per 8 parameters)
-// when the model has other effects. The cost is one pass over the samples per evaluation.
+// d(w_i)/d(theta) is closed-form for the base model; with other effects it is implicit, the
+// linear stage's share closed-form and the other terms' from Jets (one pass per 8 parameters
+// through the term that owns them). The cost is one pass over the samples per evaluation.
 //
 // With a gyroscope bias random walk (residuals/bias_walk_residual.h), the output carries the
 // walk too: it is b_from at the first sample (the walk at the last sample of segment k) and
@@ -44,6 +45,23 @@
 #include "plumb/residuals/measurements.h"
 
 namespace plumb::residuals {
+
+/// d w_i / d theta of every sample of an interval, 3 x P each, side by side in one allocation.
+class RateJacobians {
+ public:
+  void Reset(std::size_t samples, int parameters) {
+    P_ = parameters;
+    columns_.setZero(3, static_cast<Eigen::Index>(samples) * P_);
+  }
+  auto operator[](std::size_t i) { return columns_.middleCols(static_cast<Eigen::Index>(i) * P_, P_); }
+  auto operator[](std::size_t i) const {
+    return columns_.middleCols(static_cast<Eigen::Index>(i) * P_, P_);
+  }
+
+ private:
+  Eigen::Index P_ = 0;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> columns_;
+};
 
 class MotionResidual final : public ceres::CostFunction {
  public:
@@ -80,8 +98,13 @@ class MotionResidual final : public ceres::CostFunction {
   /// d w_i / d theta (3 x P, P = all model parameters in block order); `linear` selects the
   /// closed form of LinearAt.
   void CorrectedRates(double const* const* theta, const std::vector<Vec3>& gyr, bool linear,
-                      std::vector<Vec3>* w,
-                      std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>>* W) const;
+                      std::vector<Vec3>* w, RateJacobians* W) const;
+  /// The general model's d w_i / d theta (3 x P) at the corrected inputs (f_i, w_i), given the
+  /// model's output at zero input (its F and E).
+  void ImplicitRateJacobians(double const* const* theta,
+                             const model::SensorOutput<double>& at_zero,
+                             const std::vector<Vec3>& f, const std::vector<Vec3>& w,
+                             RateJacobians& W) const;
 
   const model::Model* model_;
   SharedMotionSamples samples_;  // shared with the other problems built on the same samples
@@ -93,6 +116,11 @@ class MotionResidual final : public ceres::CostFunction {
   int wander_ = 0;                 // wander processes; their block pairs follow the model's
   int bias_offset_ = -1;           // offset of b_g among the P parameters (-1: no gyroscope)
   std::vector<double> walk_weight_;  // per sample, with a walk: a_i, the weight of b_to
+  // The model's terms: all, the linear stage's, the catalogue's; the linear stage's followed
+  // by the catalogue terms that read its F or E (empty when none does); false when some
+  // catalogue term reads the outputs summed before it (every Jet pass then runs every term).
+  std::vector<int> all_terms_, linear_terms_, catalogue_terms_, stage_readers_;
+  bool terms_split_ = true;
 };
 
 /// d(Exp(delta) (x) q)/d(delta) at delta = 0 for q in Eigen order (x y z w): 4 x 3.
