@@ -226,7 +226,7 @@ def run_study(client, study, out, tasks=None, plumb=None, jobs=1, log=print, wor
         raise
     finally:
         shutil.rmtree(staging, ignore_errors=True)
-    return merge.stdout.replace(str(merged), str(out))
+    return merge.stdout.strip().replace(str(merged), str(out))
 
 
 def _gather(futures, staging, tasks, version, digest, log):
@@ -252,7 +252,7 @@ def _gather(futures, staging, tasks, version, digest, log):
         workers.add(r["worker"])
         _write_shard(staging / f"shard-{r['shard']}", r["files"], r["shard"], r["worker"])
         points = sum(1 for rel in r["files"] if rel.startswith("points"))
-        log(f"{where}: {points} points")
+        log(f"{where}: {points} point{'' if points == 1 else 's'}")
     log(f"{tasks} shards done on {len(workers)} workers")
 
 
