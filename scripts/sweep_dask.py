@@ -176,20 +176,26 @@ def run_study(client, study, out, tasks=None, plumb=None, jobs=1, log=print, wor
     tasks: shards, one Dask task each (default: every thread of the cluster's workers); a shard
     with no point is allowed. plumb: the executable's path on the workers and here (default
     default_plumb()). jobs: `--jobs` of each task's plumb (runs in parallel inside a task).
-    log: called with each progress line. worker_timeout: seconds to wait for a first worker
-    when tasks is not given. Returns the `plumb sweep merge` output. Raises
+    log: called with each progress line. worker_timeout: seconds to wait for a first worker.
+    Returns the `plumb sweep merge` output. Raises
     SweepError naming the shard, the worker and plumb's error; `out` is then not created.
     """
     plumb = plumb or default_plumb()
+    if plumb and os.sep not in plumb:  # a name: this machine's PATH says which
+        plumb = shutil.which(plumb)
     if not plumb:
         raise SweepError("no plumb executable: build it (build/apps/plumb/plumb) or give --plumb",
                          exit_code=2)
+    plumb = os.path.abspath(plumb)  # the workers run it from other folders
     out = Path(out)
     if os.path.lexists(out):
         raise SweepError(f"{out}: exists; sweep-dask writes a new folder and never overwrites one")
     files, study_name = study_files(study)
-    if tasks is None:  # every thread of the workers, once one has joined
+    try:
         client.wait_for_workers(1, timeout=worker_timeout)
+    except (TimeoutError, OSError):
+        raise SweepError(f"no Dask worker joined the scheduler within {worker_timeout} s") from None
+    if tasks is None:  # every thread of the workers
         tasks = sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())
     if tasks < 1 or jobs < 1:
         raise SweepError(f"tasks ({tasks}) and jobs ({jobs}) must be at least 1", exit_code=2)

@@ -8,7 +8,9 @@ then
   1. scripts/sweep-dask STUDY --scheduler ADDRESS --tasks 4: the result's files equal those of
      `plumb sweep STUDY --out DIR --jobs 1`, and both workers ran shards;
   2. run_study(client, ...) imported from scripts/sweep_dask.py, one task per point (6): equal;
-  3. bad input: an existing --out (exit 1, left untouched), a study plumb refuses (exit 1, the
+  3. a study on a real session's template (mikoff's bundled imu0 calibrated), the template
+     shipped to the workers with the study: equal;
+  4. bad input: an existing --out (exit 1, left untouched), a study plumb refuses (exit 1, the
      message names the shard, its worker and plumb's error with the study file), usage (exit 2).
 The study is fixed (its seed, 6 points of 4 runs: about a second of work). Every process is
 started here and killed in a finally block (SIGTERM from a timeout included); every wait has
@@ -133,6 +135,7 @@ def main(plumb, repo):
                               f"a scheduler at {address} and two worker processes")
                 check_cli(checks, sweep_dask, plumb, address, study, tmp)
                 check_function(checks, client, plumb, repo, study, tmp)
+                check_template(checks, sweep_dask, plumb, repo, address, tmp)
                 check_errors(checks, sweep_dask, plumb, address, study, tmp)
         finally:
             stop(processes)
@@ -155,6 +158,7 @@ def check_cli(checks, sweep_dask, plumb, address, study, tmp):
 
 
 def check_function(checks, client, plumb, repo, study, tmp):
+    sys.dont_write_bytecode = True  # no __pycache__ in the source tree
     sys.path.insert(0, str(Path(repo) / "scripts"))
     from sweep_dask import run_study
     lines = []
@@ -162,6 +166,29 @@ def check_function(checks, client, plumb, repo, study, tmp):
                      log=lines.append)
     checks.expect("merged 6 points from 6 folders" in said, "run_study, one task per point", said)
     checks.same_files(tmp / "function", tmp / "single", "run_study's result against plumb sweep's")
+
+
+def check_template(checks, sweep_dask, plumb, repo, address, tmp):
+    """A study whose base is a real session (a calibrate --json file beside the study): the
+    workers, in folders of their own, get the template with the study."""
+    folder = tmp / "template"
+    folder.mkdir()
+    r = run([plumb, "calibrate", str(Path(repo) / "data" / "mikoff" / "imu0.log"), "--columns",
+             "ax,ay,az,gx,gy,gz", "--rate", "100", "--json", str(folder / "imu0.json")])
+    if not checks.expect(r.returncode == 0, "the bundled session calibrated", r.stderr):
+        return
+    (folder / "s.json").write_text(json.dumps({
+        "seed": 5, "runs": 2, "design": "grid",
+        "base": {"schedule": "session", "template": "imu0.json", "rate_hz": 100},
+        "factors": [{"name": "gyro_noise", "levels": [7e-5, 2e-4]}]}))
+    single = run([plumb, "sweep", str(folder / "s.json"), "--out", str(tmp / "tsingle"),
+                  "--jobs", "1"])
+    r = run(sweep_dask + [str(folder / "s.json"), "--out", str(tmp / "tdist"), "--scheduler",
+                          address, "--tasks", "2", "--plumb", plumb])
+    if checks.expect(single.returncode == 0 and r.returncode == 0,
+                     "a session-template study, in one process and on Dask",
+                     single.stderr + r.stdout + r.stderr):
+        checks.same_files(tmp / "tdist", tmp / "tsingle", "its result against plumb sweep's")
 
 
 def check_errors(checks, sweep_dask, plumb, address, study, tmp):
