@@ -73,6 +73,8 @@ def start(command, cwd, log):
 
 
 def stop(processes):
+    """The workers first, then the scheduler (the reverse of their start)."""
+    processes = processes[::-1]
     for p in processes:
         if p.poll() is None:
             os.killpg(p.pid, signal.SIGTERM)
