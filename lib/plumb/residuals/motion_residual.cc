@@ -139,7 +139,6 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
   const std::size_t n = s_.size();
   const int P = num_model_parameters_;
   w->resize(n);
-  if (W) W->Reset(n, P);
   const model::SensorOutput<double> at_zero = model_->Predict(theta, model::SensorInput<double>());
   const Mat3 F_inv = at_zero.F.inverse();
   const Mat3 E_inv = at_zero.E.inverse();
@@ -147,6 +146,7 @@ void MotionResidual::CorrectedRates(double const* const* theta, const std::vecto
 
   if (linear) {
     // w = E^-1 (y - b_g): dw/db_g = -E^-1, dw/dE_rc = -E^-1 e_r w_c.
+    if (W) W->Reset(n, 0, P);
     const int g = model_->BaseTerm(model::Sensor::kGyro);
     const int off = g >= 0 ? block_offset_[static_cast<std::size_t>(g)] : 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -297,6 +297,12 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
     return params;
   };
   const bool linear_closed = terms_split_ && stage_readers_.empty();
+  // Stored: the other terms' columns alone when the linear stage's are closed-form (they come
+  // first in block order), else every column.
+  const int first = linear_closed ? (catalogue_terms_.empty() ? num_model_parameters_
+                                                              : block_offset_[static_cast<std::size_t>(catalogue_terms_.front())])
+                                  : 0;
+  W.Reset(n, first, num_model_parameters_ - first);
   if (!terms_split_) {
     add_passes(params_of(all_terms_), all_terms_);
   } else {
@@ -314,28 +320,12 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
       }
       const Eigen::Matrix<double, 3, kStride> dw = dw_dy[i] * D_theta;
       for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
-        W[i].col(seeded[slot]) = dw.col(static_cast<Eigen::Index>(slot));
+        W[i].col(seeded[slot] - first) = dw.col(static_cast<Eigen::Index>(slot));
       }
     }
   }
-  if (!linear_closed) return;
-  // The linear stage in closed form: d y_a / d F_rc = e_r f_c, d y_a / d b_a = I (the
-  // accelerometer's columns, when the sensors are coupled), and the same for E and b_g, each
-  // taken through the rows of -D_x^-1 that give w (SubtractForceJacobian with K F^-1 = -M).
-  const int a_size = a_term >= 0 ? model_->terms()[static_cast<std::size_t>(a_term)].effect->info().size() : 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Matrix<double, 3, 6>& M = dw_dy[i];
-    if (a_term >= 0 && moves(a_term)) {
-      model::accel_linear::SubtractForceJacobian(
-          Mat3(-M.leftCols<3>()), f[i], a_size == model::accel_linear::kSizeFull,
-          W[i].middleCols(block_offset_[static_cast<std::size_t>(a_term)], a_size));
-    }
-    if (g_term >= 0) {
-      model::gyro_linear::SubtractRateJacobian(
-          Mat3(-M.rightCols<3>()), w[i],
-          W[i].middleCols(block_offset_[static_cast<std::size_t>(g_term)], model::gyro_linear::kSize));
-    }
-  }
+  // The linear stage in closed form (applied by Evaluate through d w / d y).
+  if (linear_closed) W.SetLinearStage(std::move(dw_dy), f, coupled);
 }
 
 bool MotionResidual::Evaluate(double const* const* parameters, double* residuals,
@@ -388,10 +378,35 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   const int att = rate_cols;
   const int from = rate_cols + 3;
   const int U = rate_cols + 3 + (walk ? 6 : 0);
+  const int a_term = model_->BaseTerm(model::Sensor::kAccel);
+  const int g_term = model_->BaseTerm(model::Sensor::kGyro);
+  const int a_size =
+      a_term >= 0 ? model_->terms()[static_cast<std::size_t>(a_term)].effect->info().size() : 0;
   // Adds K dw_i/dtheta to the first rate_cols columns of `out` and, with a walk, K dw_i/d
   // b_from and K dw_i/d b_to (d w_i / d b_g weighted by 1 - a_i and a_i) to the walk's columns.
   auto add_rate_jacobian = [&](const Mat3& K, std::size_t i,
                                Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
+    if (!closed_form && W.linear_stage_closed()) {
+      // The other terms' stored columns, then the linear stage's: with K_y = K d w / d y,
+      // d y_g / d E_rc = e_r w_c, d y_g / d b_g = I (SubtractRateJacobian with K E^-1 = -K_y)
+      // and the same for F, b_a and f when the sensors are coupled.
+      if (W.columns() > 0) out.middleCols(W.first(), W.columns()).noalias() += K * W[i];
+      const Mat3 K_g = K * W.dw_dy(i).rightCols<3>();
+      if (g_term >= 0) {
+        model::gyro_linear::SubtractRateJacobian(
+            Mat3(-K_g), w[i], out.middleCols(block_offset_[static_cast<std::size_t>(g_term)], model::gyro_linear::kSize));
+      }
+      if (a_term >= 0 && W.coupled()) {
+        model::accel_linear::SubtractForceJacobian(
+            Mat3(-(K * W.dw_dy(i).leftCols<3>())), W.f(i), a_size == model::accel_linear::kSizeFull,
+            out.middleCols(block_offset_[static_cast<std::size_t>(a_term)], a_size));
+      }
+      if (walk) {
+        out.middleCols<3>(from).noalias() += (1.0 - a[i]) * K_g;
+        out.middleCols<3>(from + 3).noalias() += a[i] * K_g;
+      }
+      return;
+    }
     if (!closed_form) {
       out.leftCols(P).noalias() += K * W[i];
       if (walk) {
