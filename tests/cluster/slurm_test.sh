@@ -51,12 +51,18 @@ check "one log per array element" test -f "$TMP/slurm.shards/logs/array-2.out"
 python3 -c 'import json, sys; s = json.load(open(sys.argv[1]))
 s["factors"] = [{"name": "pose", "levels": [3]}]; json.dump(s, open(sys.argv[2], "w"))' \
   "$TMP/study.json" "$TMP/bad.json"
-set +e
-timeout 120 "$REPO/scripts/sweep-slurm" "$TMP/bad.json" --out "$TMP/bad" --tasks 2 \
-  --plumb "$PLUMB" --wait --time=5 >"$TMP/bad.out" 2>&1
-status=$?
-set -e
-cat "$TMP/bad.out"
+# Runs sweep-slurm with a time limit, its output to $TMP/NAME.out and shown; its exit in $status.
+sweep_slurm() {
+  local name=$1 limit=$2
+  shift 2
+  set +e
+  timeout "$limit" "$REPO/scripts/sweep-slurm" "$@" --out "$TMP/$name" --tasks 2 --wait --time=5 \
+    >"$TMP/$name.out" 2>&1
+  status=$?
+  set -e
+  cat "$TMP/$name.out"
+}
+sweep_slurm bad 120 "$TMP/bad.json" --plumb "$PLUMB"
 check "a study plumb refuses: exit 1, nothing submitted" \
   test $status -eq 1 -a ! -e "$TMP/bad.shards" -a ! -e "$TMP/bad"
 check "  with plumb's error" grep -q "nothing submitted: plumb: error: .*unknown factor 'pose'" \
@@ -72,12 +78,7 @@ done
 exec "$PLUMB" "\$@"
 EOF
 chmod +x "$TMP/plumb-failing-shard-2"
-set +e
-timeout 180 "$REPO/scripts/sweep-slurm" "$TMP/study.json" --out "$TMP/failed" --tasks 2 \
-  --plumb "$TMP/plumb-failing-shard-2" --wait --time=5 >"$TMP/failed.out" 2>&1
-status=$?
-set -e
-cat "$TMP/failed.out"
+sweep_slurm failed 180 "$TMP/study.json" --plumb "$TMP/plumb-failing-shard-2"
 check "a shard failing on its node: exit 1, no result" test $status -eq 1 -a ! -e "$TMP/failed"
 check "  the failed element's log shown, the shard named" \
   grep -q "sweep-slurm: shard 2/2 failed: plumb exited 1" "$TMP/failed.out"
