@@ -29,16 +29,17 @@ const char* const kTableHint =
 /// malformed table flag is refused only when a table is read (see ReadInputs).
 std::string TableFlags(const InputArgs& a, bool two_files, io::InputOptions* o) {
   try {
-    o->delimiter = io::ParseDelimiter(a.delimiter);
+    const io::ColumnOptionNames names{"--columns", "--rate HZ"};
+    o->delimiter = io::ParseDelimiter(a.delimiter, "--delimiter");
     if (two_files) {
       o->two_table_columns =
-          io::ParseTwoTableColumns(a.columns.empty() ? "t,x,y,z" : a.columns, a.rate_hz);
+          io::ParseTwoTableColumns(a.columns.empty() ? "t,x,y,z" : a.columns, a.rate_hz, names);
     } else {
-      o->columns = io::ParseTableColumns(a.columns, a.rate_hz);
+      o->columns = io::ParseTableColumns(a.columns, a.rate_hz, names);
     }
     o->acc.scale = io::ParseScale(a.acc_scale, "--acc-scale");
     o->gyr.scale = io::ParseScale(a.gyr_scale, "--gyr-scale");
-    o->axis_map = io::ParseAxisMap(a.axis_map);
+    o->axis_map = io::ParseAxisMap(a.axis_map, "--axis-map");
   } catch (const Error& e) {
     return e.what();
   }

@@ -21,9 +21,7 @@ void AddSiteOptions(CLI::App* app, SiteArgs& args) {
 
 geo::Site ResolveSite(const SiteArgs& args, const std::optional<SiteInput>& from_log,
                       std::optional<double> gravity_m_s2) {
-  std::optional<SiteInput> given;
-  if (args.given()) given = SiteInput{args.lat_deg, args.lon_deg, args.height_m, "flags"};
-  return geo::ResolveSite(given, from_log, gravity_m_s2);
+  return geo::ResolveSite(args.given_site(), from_log, gravity_m_s2);
 }
 
 void AddGravityOption(CLI::App* app, SiteArgs& args) {

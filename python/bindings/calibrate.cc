@@ -7,9 +7,8 @@
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/uncertainty.h"
-#include "plumb/io/text/segments_file.h"
+#include "plumb/pipeline/datasheet_level.h"
 #include "plumb/report/json_report.h"
-#include "plumb/segmentation/given_segments.h"
 
 namespace plumb::python {
 namespace {
@@ -27,7 +26,8 @@ Keywords (the command's options, '-' as '_'):
   level_north (bool); temp_ref (degC, 25); max_iterations (200); strict (bool: raise when the
   data cannot determine the model or a gate fails); accel_rw (m/s^3/sqrt(Hz)), gyro_rw
   (rad/s^2/sqrt(Hz)), estimate_rw (bool), accel_bi (m/s^2), gyro_bi (rad/s), bi_time (s),
-  constant_bias (bool): the bias wander, SI numbers only.
+  constant_bias (bool): the bias wander, each level a number in SI or a text with a datasheet's
+  unit as the command takes it ('4 deg/h', '40 ug', '0.3 deg/h/sqrt(h)', '10 ug/sqrt(h)').
 Returns a Result. Raises plumb.Error (plumb.InsufficientDataError when the data cannot
 support the model).)doc";
 
@@ -39,26 +39,42 @@ struct PyResult {
   nlohmann::json document;  ///< report::CalibrationJson, made once
 };
 
-segmentation::SegmentationResult FindSegments(const ImuSeries& series, Keywords& k) {
-  const std::optional<std::string> path = k.Take<std::string>("segments");
-  segmentation::StillDetectorOptions d;
-  d.init_still_s = k.Take<double>("init_still", d.init_still_s);
-  d.window_s = k.Take<double>("window", d.window_s);
-  d.min_still_s = k.Take<double>("min_still", d.min_still_s);
-  d.false_alarm = k.Take<double>("false_alarm", d.false_alarm);
-  d.use_gyro = !k.Take<bool>("still_accel_only", false);
-  if (path) return segmentation::UseGivenSegments(series, io::ReadSegments(*path, series));
-  d.acc_unit = series.acc_unit;
-  d.gyr_unit = series.gyr_unit;
-  return segmentation::DetectStillSegments(series, d);
+pipeline::SegmentRequest Segments(Keywords& k) {
+  pipeline::SegmentRequest r;
+  r.segments_path = k.Take<std::string>("segments", "");
+  r.detector.init_still_s = k.Take<double>("init_still", r.detector.init_still_s);
+  r.detector.window_s = k.Take<double>("window", r.detector.window_s);
+  r.detector.min_still_s = k.Take<double>("min_still", r.detector.min_still_s);
+  r.detector.false_alarm = k.Take<double>("false_alarm", r.detector.false_alarm);
+  r.still_accel_only = k.Take<bool>("still_accel_only", false);
+  return r;
+}
+
+/// A bias wander level: a number (SI) or a datasheet's text ("4 deg/h"), both through the
+/// command's parser (plumb/pipeline/datasheet_level.h), so that the same checks apply.
+std::optional<double> Level(Keywords& k, const char* name, pipeline::WanderLevel level) {
+  const std::optional<py::object> value = k.Take<py::object>(name);
+  if (!value) return std::nullopt;
+  const std::string text = py::str(*value).cast<std::string>();
+  if (!py::isinstance<py::str>(*value) && !py::isinstance<py::float_>(*value) &&
+      !(py::isinstance<py::int_>(*value) && !py::isinstance<py::bool_>(*value))) {
+    throw Error(std::string("calibrate: ") + name + " must be a number or a text such as '4 deg/h', "
+                "got " + py::str(py::repr(*value)).cast<std::string>());
+  }
+  try {
+    return pipeline::ParseDatasheetLevel(text, level);
+  } catch (const Error& e) {
+    throw Error(std::string("calibrate: ") + name + ": " + e.what());
+  }
 }
 
 void WanderOptions(Keywords& k, estimation::CalibrationOptions& o) {
-  o.accel_walk_density = k.Take<double>("accel_rw");
-  o.gyro_walk_density = k.Take<double>("gyro_rw");
+  using pipeline::WanderLevel;
+  o.accel_walk_density = Level(k, "accel_rw", WanderLevel::kAccelWalk);
+  o.gyro_walk_density = Level(k, "gyro_rw", WanderLevel::kGyroWalk);
   o.estimate_walk = k.Take<bool>("estimate_rw", false);
-  o.accel_instability = k.Take<double>("accel_bi");
-  o.gyro_instability = k.Take<double>("gyro_bi");
+  o.accel_instability = Level(k, "accel_bi", WanderLevel::kAccelInstability);
+  o.gyro_instability = Level(k, "gyro_bi", WanderLevel::kGyroInstability);
   o.instability_time_s = k.Take<double>("bi_time", o.instability_time_s);
   o.constant_bias = k.Take<bool>("constant_bias", false);
   if (o.constant_bias && (o.accel_walk_density || o.gyro_walk_density || o.estimate_walk ||
@@ -96,18 +112,14 @@ std::shared_ptr<PyResult> Calibrate(const PySession& s, const std::string& model
   auto out = std::make_shared<PyResult>();
   {
     py::gil_scoped_release release;
-    out->result = estimation::Calibrate(s.session.series, fit.segments, fit.model, fit.site,
-                                        fit.options);
+    out->result = pipeline::CalibrateSession(s.session, fit.setup);
   }
   if (fit.strict && !out->result.fit.gates.empty()) {
-    std::string names;
-    for (const auto& g : out->result.fit.gates) names += (names.empty() ? "" : ", ") + g.name;
-    throw Error("the fit of " + s.session.source + " failed gates (" + names +
-                ") under strict=True");
+    throw Error(pipeline::GateFailure(out->result.fit, s.session.source) + " under strict=True");
   }
   out->segmentation = std::move(fit.segmentation);
   out->inputs = s.inputs;
-  out->input_warnings = fit.input_warnings;
+  out->input_warnings = fit.setup.input_warnings;
   out->document = report::CalibrationJson(out->result, out->segmentation, out->inputs,
                                           out->input_warnings);
   return out;
@@ -117,39 +129,35 @@ std::shared_ptr<PyResult> Calibrate(const PySession& s, const std::string& model
 
 FitInputs PrepareFit(const PySession& s, const std::string& model_spec, const py::object& site,
                      Keywords& k, bool fit_options) {
-  const ImuSeries& series = s.session.series;
   FitInputs out;
-  out.segmentation = FindSegments(series, k);
-  out.segments = out.segmentation.segments;
-  const std::optional<double> gravity = k.Take<double>("gravity");
-  out.site = geo::ResolveSite(SiteFromPython(site), s.session.site, gravity);
-  out.input_warnings = s.session.warnings;
-  if (gravity && out.site.known) {
-    out.input_warnings.push_back("gravity fixed at " + std::to_string(*gravity) +
-                                 " m/s^2 by --gravity instead of WGS84 normal gravity");
+  out.segmentation = pipeline::FindSegments(s.session.series, Segments(k));
+  pipeline::FitRequest request;
+  request.site = SiteFromPython(site);
+  request.gravity_m_s2 = k.Take<double>("gravity");
+  request.gravity_option = "gravity=";
+  request.model = model::Model::Parse(model_spec);
+  request.temp_ref_c = k.Take<double>("temp_ref", request.temp_ref_c);
+  estimation::CalibrationOptions& o = request.options;
+  o.first_heading_deg = k.Take<double>("heading");
+  if (fit_options) {
+    request.level_north = k.Take<bool>("level_north", false);
+    if (request.level_north && o.first_heading_deg) throw Error("level_north excludes heading");
+    out.strict = k.Take<bool>("strict", false);
+    if (out.strict) o.on_insufficient = estimation::InsufficientData::kError;
+    o.max_iterations = k.Take<int>("max_iterations", o.max_iterations);
+    if (o.max_iterations < 1) throw Error("max_iterations must be >= 1");
+    WanderOptions(k, o);
   }
-  out.model = model::Model::Parse(model_spec);
-  out.model.t_ref_s = series.t_s.front();
-  out.model.temp_ref_c = k.Take<double>("temp_ref", 25.0);
-  if (const auto heading = k.Take<double>("heading")) out.options.first_heading_deg = *heading;
-  if (!fit_options) return out;
-  if (k.Take<bool>("level_north", false)) {
-    if (out.options.first_heading_deg) throw Error("level_north excludes heading");
-    if (!out.segments.empty()) out.segments.front().known_R_n_b = Quat::Identity();
-  }
-  out.strict = k.Take<bool>("strict", false);
-  if (out.strict) out.options.on_insufficient = estimation::InsufficientData::kError;
-  out.options.max_iterations = k.Take<int>("max_iterations", out.options.max_iterations);
-  if (out.options.max_iterations < 1) throw Error("max_iterations must be >= 1");
-  WanderOptions(k, out.options);
+  out.setup = pipeline::PrepareFit(s.session, out.segmentation, std::move(request));
   return out;
 }
 
 void RegisterCalibrate(py::module_& m) {
-  py::class_<PyResult, std::shared_ptr<PyResult>>(
+  py::class_<PyResult, std::shared_ptr<PyResult>> result(
       m, "Result",
       "A calibration and how its fit went: what `plumb calibrate --json` writes, as Python "
-      "objects. SI units (sensor units for counts).")
+      "objects. SI units (sensor units for counts).");
+  DocumentMethods(result, "calibrate")
       .def_property_readonly("model", [](const PyResult& r) { return r.result.calibration.model.spec(); },
                              "The fitted model's spec.")
       .def_property_readonly("parameters", &Parameters,
@@ -191,10 +199,6 @@ void RegisterCalibrate(py::module_& m) {
                              "(m/s^2), source.")
       .def_property_readonly("warnings", [](const PyResult& r) { return ToPython(r.document["warnings"]); },
                              "What the user must know, in words.")
-      .def_property_readonly("document", [](const PyResult& r) { return ToPython(r.document); },
-                             "The whole calibrate --json document as a dict.")
-      .def("to_json", [](const PyResult& r) { return report::JsonText(r.document); },
-           "The calibrate --json document as text, byte for byte what the command writes.")
       .def("save", [](const PyResult& r, const std::string& path) { report::WriteJson(path, r.document); },
            py::arg("path"), "Write the calibrate --json document to path (atomically).")
       .def("__repr__", [](const PyResult& r) {

@@ -88,31 +88,43 @@ py::array View(const T* data, std::size_t rows, std::size_t cols, std::size_t ro
   return out;
 }
 
+/// Adds `document` (the whole `plumb COMMAND --json` document as a dict) and `to_json()` (its
+/// text, byte for byte what the command writes) to a class whose objects hold it as `document`.
+template <typename Class>
+Class& DocumentMethods(Class& c, const std::string& command);
+
 /// A JSON document as Python objects (dict, list, float, ...), through Python's json module
 /// so that numbers keep every bit.
 py::object ToPython(const nlohmann::json& doc);
+/// report::JsonText (the text of every JSON file plumb writes).
+std::string JsonText(const nlohmann::json& doc);
 /// A Python dict / list / number ... as JSON (through Python's json module).
 nlohmann::json FromPython(const py::handle& object);
 
+template <typename Class>
+Class& DocumentMethods(Class& c, const std::string& command) {
+  using T = typename Class::type;
+  c.def_property_readonly("document", [](const T& t) { return ToPython(t.document); },
+                          ("The whole " + command + " --json document as a dict.").c_str());
+  c.def("to_json", [](const T& t) { return JsonText(t.document); },
+        ("The " + command + " --json document as text, byte for byte what the command writes.")
+            .c_str());
+  return c;
+}
+
 }  // namespace plumb::python
 
-#include "plumb/estimation/options.h"
-#include "plumb/model/model.h"
-#include "plumb/segmentation/still_detector.h"
+#include "plumb/pipeline/fit_setup.h"
 
 namespace plumb::python {
 
 /// What a fit takes besides the samples, from the keywords calibrate() and diagnose() share
-/// (the command's --segments, still detection, site, --gravity, --heading, --level-north,
-/// --temp-ref, --max-iterations, --strict and the bias wander options), as the command's
-/// FindSegments and PrepareFit (apps/plumb/fit_options.h) make them.
+/// (the command's --segments, still detection, site, --gravity, --heading, --temp-ref and, with
+/// `fit_options`, --level-north, --max-iterations, --strict and the bias wander options), made
+/// by the library's pipeline as the command makes it (plumb/pipeline/fit_setup.h).
 struct FitInputs {
   segmentation::SegmentationResult segmentation;
-  std::vector<StillSegment> segments;
-  geo::Site site;
-  model::Model model;
-  estimation::CalibrationOptions options;
-  std::vector<std::string> input_warnings;  ///< the session's, plus the --gravity note
+  pipeline::FitSetup setup;
   bool strict = false;
 };
 FitInputs PrepareFit(const PySession& session, const std::string& model_spec,

@@ -39,12 +39,13 @@ std::shared_ptr<PyDiagnosis> Diagnose(const PySession& s, const std::string& mod
     throw Error("diagnose: significance must be in [1e-12, 0.5]");
   }
   if (options.confirm < 0) throw Error("diagnose: confirm must be >= 0");
-  options.calibration = fit.options;
+  options.calibration = fit.setup.options;
   options.calibration.method = "generalized";
   auto out = std::make_shared<PyDiagnosis>();
   py::gil_scoped_release release;
   const diagnostics::Diagnosis d =
-      diagnostics::Diagnose(s.session.series, fit.segments, fit.model, fit.site, options);
+      diagnostics::Diagnose(s.session.series, fit.setup.segments, fit.setup.model,
+                            fit.setup.site, options);
   diagnostics::ResidualAnalysisOptions ra_options;
   ra_options.significance = options.significance;
   const diagnostics::ResidualAnalysis ra =
@@ -56,19 +57,16 @@ std::shared_ptr<PyDiagnosis> Diagnose(const PySession& s, const std::string& mod
 }  // namespace
 
 void RegisterDiagnose(py::module_& m) {
-  py::class_<PyDiagnosis, std::shared_ptr<PyDiagnosis>>(
-      m, "Diagnosis", "What `plumb diagnose --json` writes, as Python objects.")
+  py::class_<PyDiagnosis, std::shared_ptr<PyDiagnosis>> diagnosis(
+      m, "Diagnosis", "What `plumb diagnose --json` writes, as Python objects.");
+  DocumentMethods(diagnosis, "diagnose")
       .def_property_readonly("candidates",
                              [](const PyDiagnosis& d) { return ToPython(d.document["candidates"]); },
                              "The effects tested, best evidence first: effect, lm (predicted "
                              "fall of chi2), dof, evidence, significant, predicted_drop, "
                              "refit_drop, identifiable ...")
       .def_property_readonly("fit", [](const PyDiagnosis& d) { return ToPython(d.document["fit"]); },
-                             "The diagnosed model's fit: chi2, dof, ...")
-      .def_property_readonly("document", [](const PyDiagnosis& d) { return ToPython(d.document); },
-                             "The whole diagnose --json document as a dict.")
-      .def("to_json", [](const PyDiagnosis& d) { return report::JsonText(d.document); },
-           "The diagnose --json document as text, byte for byte what the command writes.");
+                             "The diagnosed model's fit: chi2, dof, ...");
   m.def("diagnose", &Diagnose, py::arg("session"), py::arg("model") = "base",
         py::arg("site") = py::none(), kDiagnoseDoc);
 }

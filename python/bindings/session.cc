@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "common.h"
 #include "plumb/core/error.h"
@@ -68,20 +69,20 @@ io::InputOptions Options(Keywords& k) {
              : format == "native"         ? io::InputFormat::kNative
                                           : io::InputFormat::kAuto;
   o.rate_hz = k.Take<double>("rate", 0.0);
-  o.delimiter = io::ParseDelimiter(k.Take<std::string>("delimiter", ""));
+  o.delimiter = io::ParseDelimiter(k.Take<std::string>("delimiter", ""), "open: delimiter");
   o.skip_lines = k.Take<std::size_t>("skip_lines", 0);
   o.header_row = k.Take<bool>("header", false);
   o.comment_prefix = k.Take<std::string>("comment", "#");
   o.time_unit_s = k.Take<double>("time_scale", 1.0);
   if (!(o.time_unit_s > 0.0)) throw Error("open: time_scale must be > 0");
   o.drop_nan_rows = k.Take<bool>("drop_nan", false);
-  o.acc.unit = io::ParseAccUnit(k.Take<std::string>("acc_unit", "m/s^2"));
-  o.gyr.unit = io::ParseGyrUnit(k.Take<std::string>("gyr_unit", "rad/s"));
-  o.acc.scale = io::ParseScale(k.Take<std::string>("acc_scale", "1"), "acc_scale");
-  o.gyr.scale = io::ParseScale(k.Take<std::string>("gyr_scale", "1"), "gyr_scale");
+  o.acc.unit = io::ParseAccUnit(k.Take<std::string>("acc_unit", "m/s^2"), "open: acc_unit");
+  o.gyr.unit = io::ParseGyrUnit(k.Take<std::string>("gyr_unit", "rad/s"), "open: gyr_unit");
+  o.acc.scale = io::ParseScale(k.Take<std::string>("acc_scale", "1"), "open: acc_scale");
+  o.gyr.scale = io::ParseScale(k.Take<std::string>("gyr_scale", "1"), "open: gyr_scale");
   o.acc.offset = k.Take<double>("acc_offset", 0.0);
   o.gyr.offset = k.Take<double>("gyr_offset", 0.0);
-  o.axis_map = io::ParseAxisMap(k.Take<std::string>("axis_map", "1,2,3"));
+  o.axis_map = io::ParseAxisMap(k.Take<std::string>("axis_map", "1,2,3"), "open: axis_map");
   o.flight_log.imu = k.Take<int>("imu", 0);
   if (o.flight_log.imu < 0) throw Error("open: imu must be >= 0");
   o.flight_log.stream = k.Take<std::string>("stream", "");
@@ -94,15 +95,16 @@ io::InputOptions Options(Keywords& k) {
   // The column specs are parsed for the kind of input that uses them, and refused only when
   // such an input is read (as the command: a one-file spec does not describe two files).
   const double rate = o.rate_hz;
+  const io::ColumnOptionNames names{"open: columns", "rate=HZ"};
   const std::string spec = columns.value_or("");
   std::string one_error, two_error;
   try {
-    o.two_table_columns = io::ParseTwoTableColumns(spec.empty() ? "t,x,y,z" : spec, rate);
+    o.two_table_columns = io::ParseTwoTableColumns(spec.empty() ? "t,x,y,z" : spec, rate, names);
   } catch (const Error& e) {
     two_error = e.what();
   }
   try {
-    if (!spec.empty()) o.columns = io::ParseTableColumns(spec, rate);
+    if (!spec.empty()) o.columns = io::ParseTableColumns(spec, rate, names);
   } catch (const Error& e) {
     one_error = e.what();
   }
@@ -146,6 +148,21 @@ py::object SiteOf(const PySession& s) {
   return std::move(d);
 }
 
+/// The getter of a numpy view over one column of the session's series (`cols` 0: a vector
+/// of numbers; 3: rows of Vec3f), kept alive by the Python session.
+template <typename Column>
+auto SeriesView(Column ImuSeries::*column, std::size_t cols) {
+  return [column, cols](const py::object& self) {
+    const auto& v = self.cast<const PySession&>().session.series.*column;
+    using Item = typename Column::value_type;
+    if constexpr (std::is_same_v<Item, double>) {
+      return View(v.data(), v.size(), cols, sizeof(Item), self);
+    } else {
+      return View(v.empty() ? nullptr : v[0].data(), v.size(), cols, sizeof(Item), self);
+    }
+  };
+}
+
 }  // namespace
 
 void RegisterSession(py::module_& m) {
@@ -153,30 +170,14 @@ void RegisterSession(py::module_& m) {
       m, "Session",
       "A recorded session: the samples (numpy views over plumb's own storage, read-only, no "
       "copy) and what the reader said. Body frame FRD.")
-      .def_property_readonly(
-          "time",
-          [](const py::object& self) {
-            const ImuSeries& s = self.cast<const PySession&>().session.series;
-            return View(s.t_s.data(), s.size(), 0, sizeof(double), self);
-          },
-          "Sample times, s (float64, N), strictly increasing; any origin.")
-      .def_property_readonly(
-          "specific_force",
-          [](const py::object& self) {
-            const ImuSeries& s = self.cast<const PySession&>().session.series;
-            return View(s.acc.empty() ? nullptr : s.acc[0].data(), s.size(), 3, sizeof(Vec3f), self);
-          },
-          "Accelerometer output, m/s^2 (float32, N x 3; in acc_unit when the input was "
-          "counts), as stored by plumb.")
-      .def_property_readonly(
-          "rate",
-          [](const py::object& self) {
-            const ImuSeries& s = self.cast<const PySession&>().session.series;
-            return View(s.gyr.empty() ? nullptr : s.gyr[0].data(), s.gyr.size(), 3, sizeof(Vec3f),
-                        self);
-          },
-          "Gyroscope output, rad/s (float32, N x 3; 0 x 3 without a gyroscope; in gyr_unit "
-          "when the input was counts).")
+      .def_property_readonly("time", SeriesView(&ImuSeries::t_s, 0),
+                             "Sample times, s (float64, N), strictly increasing; any origin.")
+      .def_property_readonly("specific_force", SeriesView(&ImuSeries::acc, 3),
+                             "Accelerometer output, m/s^2 (float32, N x 3; in acc_unit when the "
+                             "input was counts), as stored by plumb.")
+      .def_property_readonly("rate", SeriesView(&ImuSeries::gyr, 3),
+                             "Gyroscope output, rad/s (float32, N x 3; 0 x 3 without a "
+                             "gyroscope; in gyr_unit when the input was counts).")
       .def_property_readonly("temperature", &Temperature,
                              "Sensor temperature, degC (float32, N); NaN when the input has "
                              "none (then a new array, not a view).")

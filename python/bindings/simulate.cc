@@ -51,24 +51,17 @@ sim::TemperatureProfile Temperature(const py::object& spec) {
 }
 
 sim::Schedule MakeSchedule(Keywords& k, std::uint64_t seed) {
-  const std::string schedule = k.Take<std::string>("schedule", "multipose");
-  const std::optional<int> poses = k.Take<int>("poses");
-  const std::optional<double> still = k.Take<double>("still_s");
-  const std::optional<double> turn = k.Take<double>("turn_s");
-  if (schedule != "multipose" && poses) throw Error("simulate: poses applies to multipose only");
-  if (schedule == "paper-static") {
-    if (turn) throw Error("simulate: turn_s does not apply to paper-static");
-    return still ? sim::PaperStatic(*still) : sim::PaperStatic();
+  sim::ScheduleRequest r;
+  r.kind = k.Take<std::string>("schedule", r.kind);
+  r.poses = k.Take<int>("poses");
+  r.still_s = k.Take<double>("still_s");
+  r.turn_s = k.Take<double>("turn_s");
+  r.seed = seed;
+  try {
+    return sim::NamedSchedule(r, {"schedule", "poses", "turn_s"});
+  } catch (const Error& e) {
+    throw Error(std::string("simulate: ") + e.what());
   }
-  if (schedule == "paper-benchmark") {
-    return sim::PaperBenchmark(still.value_or(20.0), turn.value_or(3.0));
-  }
-  if (schedule != "multipose") {
-    throw Error("simulate: schedule must be multipose, paper-static or paper-benchmark");
-  }
-  const int n = poses.value_or(12);
-  if (n < 1 || n > 10000) throw Error("simulate: poses must be in 1..10000");
-  return sim::MultiPose(n, still.value_or(5.0), turn.value_or(2.0), seed);
 }
 
 void Noise(Keywords& k, sim::SimulationOptions& o) {

@@ -9,6 +9,7 @@
 #include "common.h"
 #include "plumb/core/error.h"
 #include "plumb/io/text/json_file.h"
+#include "plumb/pipeline/study_template.h"
 #include "plumb/report/json_report.h"
 #include "plumb/study/run.h"
 #include "plumb/study/study.h"
@@ -35,12 +36,7 @@ study::Study LoadStudy(const py::object& source) {
     doc = io::ReadJsonFile(path);
   }
   study::Study s = study::ParseStudy(doc, path);
-  if (!s.base.template_path.empty()) {
-    fs::path t = s.base.template_path;
-    if (t.is_relative() && path != "<dict>") t = fs::path(path).parent_path() / t;
-    s.template_document = io::ReadJsonFile(t.string());
-    s.base.template_path = t.string();
-  }
+  pipeline::ReadSessionTemplate(s, path == "<dict>" ? "" : fs::path(path).parent_path().string());
   return s;
 }
 

@@ -45,16 +45,23 @@ class Errors(unittest.TestCase):
         self.assertIn("columns=", str(c.exception))
 
     def test_malformed_options_are_errors(self):
-        for kwargs, text in [({"columns": "ax,ay", "rate": 10}, "all three accelerometer"),
+        # The library's parsers name the keyword as Python spells it, never the command's flag.
+        for kwargs, text in [({"columns": "ax,ay", "rate": 10},
+                              "open: columns 'ax,ay' must name all three accelerometer"),
+                             ({"columns": "ax,ay,az"},
+                              "open: columns 'ax,ay,az' has no time column (t): give rate=HZ"),
                              ({"columns": "ax,ay,az,gx,gy,gz", "rate": 100, "axis_map": "1,2"},
-                              "axis-map"),
+                              "open: axis_map must be three signed axes such as 1,-2,-3 (got '1,2')"),
                              ({"columns": "ax,ay,az", "rate": 100, "acc_unit": "furlong"},
-                              "acc-unit"),
+                              "open: acc_unit must be m/s^2, g or counts (got 'furlong')"),
+                             ({"columns": "ax,ay,az", "rate": 100, "delimiter": "|"},
+                              "open: delimiter must be one of"),
                              ({"colums": "ax,ay,az"}, "unknown option(s) colums"),
                              ({"rate": "fast"}, "wrong type")]:
             with self.assertRaises(plumb.Error, msg=str(kwargs)) as c:
                 plumb.open(SESSION, **kwargs)
             self.assertIn(text, str(c.exception))
+            self.assertNotIn("--", str(c.exception))
 
     def test_bad_model_and_site(self):
         s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
@@ -64,6 +71,25 @@ class Errors(unittest.TestCase):
             plumb.calibrate(s, site=(95.0, 0.0))
         with self.assertRaises(plumb.Error):
             plumb.calibrate(s, site="Oxford")
+
+    def test_errors_name_the_keyword(self):
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        for kwargs, text in [({"accel_bi": "4 deg/h"},
+                              "calibrate: accel_bi: unit 'deg/h' not known here; use one of "
+                              "m/s^2, ug, mg"),
+                             ({"gyro_rw": -1.0}, "calibrate: gyro_rw: must be a finite number >= 0"),
+                             ({"gyro_bi": [1]}, "calibrate: gyro_bi must be a number or a text")]:
+            with self.assertRaises(plumb.Error, msg=str(kwargs)) as c:
+                plumb.calibrate(s, **kwargs)
+            self.assertIn(text, str(c.exception))
+        for kwargs, text in [({"schedule": "paper-static", "poses": 3},
+                              "simulate: poses applies to schedule multipose only"),
+                             ({"schedule": "paper-static", "turn_s": 1.0},
+                              "simulate: turn_s does not apply to schedule paper-static"),
+                             ({"schedule": "spin"}, "simulate: schedule must be multipose")]:
+            with self.assertRaises(plumb.Error, msg=str(kwargs)) as c:
+                plumb.simulate(**kwargs)
+            self.assertIn(text, str(c.exception))
 
     def test_bad_calibration_file_names_it(self):
         path = out("not_a_calibration.json")

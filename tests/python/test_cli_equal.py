@@ -68,6 +68,26 @@ class CliEqual(unittest.TestCase):
         with open(out("cal_site.json")) as f:
             self.assertEqual(result.to_json(), f.read())
 
+    def test_datasheet_units_are_the_commands(self):
+        # The bias wander levels in a datasheet's units, parsed by the command's parser.
+        levels = {"gyro_bi": "4 deg/h", "accel_rw": "10 ug/sqrt(h)"}
+        run("calibrate", SESSION, *TABLE, "--gyro-bi", levels["gyro_bi"], "--accel-rw",
+            levels["accel_rw"], "--json", out("cal_levels.json"))
+        result = plumb.calibrate(self.session, **levels)
+        with open(out("cal_levels.json")) as f:
+            self.assertEqual(result.to_json(), f.read())
+        # The same levels in SI, as numbers: the same fit (to the last bits of the conversion).
+        deg_per_hour = np.pi / 180 / 3600
+        si = plumb.calibrate(self.session, gyro_bi=4 * deg_per_hour,
+                             accel_rw=10e-6 * 9.80665 / 60)
+        for name, p in result.parameters.items():
+            self.assertAlmostEqual(si.parameters[name].value, p.value, delta=1e-9 * abs(p.value))
+            self.assertAlmostEqual(si.parameters[name].sigma, p.sigma, delta=1e-6 * p.sigma)
+        # ... and not the fit without them (the levels reach the fit).
+        default = plumb.calibrate(self.session)
+        self.assertNotEqual(default.parameters["accel.bias.x"].sigma,
+                            result.parameters["accel.bias.x"].sigma)
+
     def test_diagnose_document_is_the_commands(self):
         run("diagnose", SESSION, *TABLE, "--json", out("diagnosis.json"))
         with open(out("diagnosis.json")) as f:
