@@ -118,7 +118,7 @@ class CalibrateCommand : public Command {
     PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose) << "\n";
 
-    const estimation::CalibrationResult result = CalibrateSession(session, fit);
+    const estimation::CalibrationResult result = CalibrateWithProgress(session, fit);
     std::cout << report::CalibrationSummary(result, session.source);
     PrintWarnings(result.fit.warnings);
     std::optional<estimation::CalibrationResult> baseline;

@@ -15,6 +15,7 @@
 #include "plumb/estimation/result.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
+#include "plumb/pipeline/fit_setup.h"
 #include "plumb/segmentation/still_detector.h"
 #include "input_options.h"
 #include "site_options.h"
@@ -29,17 +30,13 @@ struct FitArgs {
   CLI::Option* heading = nullptr;  ///< set when --heading was given
   bool level_north = false;        ///< --level-north: first still pose level, x north (known)
   double temp_ref_c = 25.0;        ///< --temp-ref: reference of the temperature terms, degC
-  int max_iterations = 200;        ///< --max-iterations: the solver's limit per solve, >= 1
-  /// --accel-rw / --gyro-rw: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0.
-  std::optional<double> accel_walk_density;
-  std::optional<double> gyro_walk_density;
-  bool estimate_walk = false;  ///< --estimate-rw
-  bool constant_bias = false;  ///< --constant-bias
-  /// --accel-bi / --gyro-bi: bias instability (Gauss-Markov sigma), sensor units, >= 0;
-  /// --bi-time: its correlation time, s.
-  std::optional<double> accel_instability;
-  std::optional<double> gyro_instability;
-  double instability_time_s = typical_mems::kInstabilityTime_s;
+  /// The options the flags set directly, as the fit takes them: --max-iterations
+  /// (max_iterations, >= 1) and the bias wander: --accel-rw / --gyro-rw (accel_walk_density,
+  /// gyro_walk_density: bias random-walk densities, sensor units / s / sqrt(Hz), >= 0),
+  /// --estimate-rw (estimate_walk), --constant-bias (constant_bias), --accel-bi / --gyro-bi
+  /// (accel_instability, gyro_instability: Gauss-Markov sigma, sensor units, >= 0) and
+  /// --bi-time (instability_time_s, s).
+  estimation::CalibrationOptions options;
   /// --noise-from FILE: a still recording of the same sensor whose Allan deviation informs
   /// the wander levels not given (estimation/wander_levels.h).
   std::string noise_from;
@@ -60,17 +57,12 @@ model::Model ParseModelOption(const std::string& option, const std::string& spec
 /// --noise-from, --constant-bias) on `app`.
 void AddFitOptions(CLI::App* app, FitArgs& args);
 
-/// Everything Calibrate() takes besides the samples.
-struct FitSetup {
-  std::vector<StillSegment> segments;  ///< the detected or given segments, first one known
-                                       ///< level x north with --level-north
-  geo::Site site;                      ///< from the flags, else the log's GPS, else none
-  model::Model model;                  ///< parsed --model, time and temperature references set
-  estimation::CalibrationOptions options;  ///< heading and strictness from the flags
-};
+/// Everything Calibrate() takes besides the samples (plumb/pipeline/fit_setup.h).
+using pipeline::FitSetup;
 
-/// The fit's inputs for `session` and its segmentation; adds to session.warnings when
-/// --gravity overrides WGS84 gravity at a known site. With --noise-from, reads that still
+/// The flags as a pipeline::FitRequest, and the fit's inputs for `session` and its
+/// segmentation (pipeline::PrepareFit); adds to session.warnings when --gravity overrides
+/// WGS84 gravity at a known site. With --noise-from, reads that still
 /// recording with `input`'s options and analyses its noise (signal::AnalyseStillNoise);
 /// throws plumb::Error naming the file when it has no still stretch long enough.
 FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& segmentation,
@@ -87,13 +79,12 @@ void PrintWarnings(const std::vector<std::string>& warnings);
 void AddFitInputFiles(const InputArgs& input, const std::string& segments_path,
                       const FitArgs& fit, FileRoles& roles);
 
-/// estimation::Calibrate on the session with `fit`. When it throws, the error also lists the
-/// samples' gates (estimation::CheckSamples: samples out of range, a saturated axis), often
-/// the reason, naming the input.
-estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit);
+/// pipeline::CalibrateSession (its error also lists the samples' gates), after saying the
+/// stage on the progress line.
+estimation::CalibrationResult CalibrateWithProgress(const Session& session, const FitSetup& fit);
 
 /// "the fit of SOURCE failed N gates (names)": for errors and refusals.
-std::string GateFailure(const estimation::FitReport& fit, const std::string& source);
+using pipeline::GateFailure;
 
 /// With --strict and a failed gate: prints "plumb: error: ..." on stderr and returns
 /// kExitGateFailed (the caller returns it before writing anything); otherwise 0.

@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "plumb/core/error.h"
+#include "plumb/io/input/input_spec.h"
 #include "plumb/io/input/open_inputs.h"
 #include "validators.h"
 
@@ -22,138 +23,24 @@ const char* const kTableHint =
     "no 't' needs --rate HZ), with --skip-lines N, --header, --acc-unit g, --gyr-unit deg/s, "
     "--acc-scale, --acc-offset (see 'plumb calibrate --help')";
 
-std::vector<std::string> SplitList(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, sep)) {
-    const auto b = item.find_first_not_of(" \t");
-    const auto e = item.find_last_not_of(" \t");
-    out.push_back(b == std::string::npos ? "" : item.substr(b, e - b + 1));
-  }
-  return out;
-}
-
-bool ParseDouble(const std::string& text, double& value) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtod(text.c_str(), &end);
-  return errno == 0 && end == text.c_str() + text.size() && std::isfinite(value);
-}
-
-char Delimiter(const std::string& name) {
-  if (name.empty()) return 0;
-  if (name == "," || name == "comma") return ',';
-  if (name == ";" || name == "semicolon") return ';';
-  if (name == "tab" || name == "\\t" || name == "\t") return '\t';
-  if (name == "space" || name == " ") return ' ';
-  throw UsageError("--delimiter must be one of , ; tab space (got '" + name + "')");
-}
-
-std::array<int, 3> AxisMap(const std::string& text) {
-  const auto items = SplitList(text, ',');
-  std::array<int, 3> map{};
-  bool ok = items.size() == 3;
-  for (std::size_t i = 0; ok && i < 3; ++i) {
-    double v = 0;
-    ok = ParseDouble(items[i], v) && v == std::round(v) && std::abs(v) >= 1 && std::abs(v) <= 3;
-    map[i] = static_cast<int>(v);
-  }
-  if (!ok)
-    throw UsageError("--axis-map must be three signed axes such as 1,-2,-3 (got '" + text + "')");
-  return map;
-}
-
-/// Applies the --columns spec of a one-file table. Tokens: t, ax ay az, gx gy gz, temp, '-'
-/// (or empty) to skip.
-io::TableColumns TableColumns(const std::string& spec, double rate_hz) {
-  io::TableColumns c;
-  const auto tokens = SplitList(spec, ',');
-  for (std::size_t i = 0; i < tokens.size(); ++i) {
-    const std::string& tok = tokens[i];
-    const auto set_once = [&](int& column) {
-      if (column >= 0) throw UsageError("--columns names '" + tok + "' twice in '" + spec + "'");
-      column = static_cast<int>(i);
-    };
-    if (tok == "-" || tok.empty()) continue;
-    if (tok == "t" || tok == "time") {
-      set_once(c.time);
-    } else if (tok == "temp" || tok == "temp_c") {
-      set_once(c.temp);
-    } else if (tok.size() == 2 && (tok[0] == 'a' || tok[0] == 'g') && tok[1] >= 'x' &&
-               tok[1] <= 'z') {
-      auto& triad = tok[0] == 'a' ? c.acc : c.gyr;
-      set_once(triad[static_cast<std::size_t>(tok[1] - 'x')]);
-    } else {
-      throw UsageError("--columns: unknown column '" + tok + "' in '" + spec +
-                       "'; use t, ax, ay, az, gx, gy, gz, temp or - to skip a column");
-    }
-  }
-  const auto given = [](const std::array<int, 3>& t, bool all) {
-    return all ? t[0] >= 0 && t[1] >= 0 && t[2] >= 0 : t[0] >= 0 || t[1] >= 0 || t[2] >= 0;
-  };
-  if (!given(c.acc, true)) {
-    throw UsageError("--columns '" + spec + "' must name all three accelerometer columns (" +
-                     "ax,ay,az)");
-  }
-  if (given(c.gyr, false) && !given(c.gyr, true)) {
-    throw UsageError("--columns '" + spec + "' names only part of the gyroscope (gx,gy,gz)");
-  }
-  if (c.time < 0 && !(rate_hz > 0)) {
-    throw UsageError("--columns '" + spec + "' has no time column (t): give --rate HZ");
-  }
-  return c;
-}
-
-/// Applies the --columns spec of the two-file form: t, x, y, z, '-' (or empty) to skip.
-io::TwoTableColumns TwoTableColumns(const std::string& spec, double rate_hz) {
-  io::TwoTableColumns c;
-  c.time = -1;
-  c.xyz = {-1, -1, -1};
-  const auto tokens = SplitList(spec, ',');
-  for (std::size_t i = 0; i < tokens.size(); ++i) {
-    const std::string& tok = tokens[i];
-    const auto set_once = [&](int& column) {
-      if (column >= 0) throw UsageError("--columns names '" + tok + "' twice in '" + spec + "'");
-      column = static_cast<int>(i);
-    };
-    if (tok == "-" || tok.empty()) continue;
-    if (tok == "t" || tok == "time") {
-      set_once(c.time);
-    } else if (tok.size() == 1 && tok[0] >= 'x' && tok[0] <= 'z') {
-      set_once(c.xyz[static_cast<std::size_t>(tok[0] - 'x')]);
-    } else {
-      throw UsageError("--columns: unknown column '" + tok + "' in '" + spec +
-                       "'; use t, x, y, z or - to skip a column");
-    }
-  }
-  if (c.xyz[0] < 0 || c.xyz[1] < 0 || c.xyz[2] < 0) {
-    throw UsageError("--columns '" + spec + "' must name all three accelerometer columns (" +
-                     "x,y,z)");
-  }
-  if (c.time < 0 && !(rate_hz > 0)) {
-    throw UsageError("--columns '" + spec + "' has no time column (t): give --rate HZ");
-  }
-  return c;
-}
-
 /// Turns the flags that describe a table (one-file, or each file of the two-file form when
 /// `two_files`) into `o`: --delimiter, --columns, --acc-scale, --gyr-scale, --axis-map, in that
 /// order. Returns the message of the first malformed one, "" when all are well formed. A
 /// malformed table flag is refused only when a table is read (see ReadInputs).
 std::string TableFlags(const InputArgs& a, bool two_files, io::InputOptions* o) {
   try {
-    o->delimiter = Delimiter(a.delimiter);
+    const io::ColumnOptionNames names{"--columns", "--rate HZ"};
+    o->delimiter = io::ParseDelimiter(a.delimiter, "--delimiter");
     if (two_files) {
-      o->two_table_columns = TwoTableColumns(a.columns.empty() ? "t,x,y,z" : a.columns, a.rate_hz);
+      o->two_table_columns =
+          io::ParseTwoTableColumns(a.columns.empty() ? "t,x,y,z" : a.columns, a.rate_hz, names);
     } else {
-      o->columns = TableColumns(a.columns, a.rate_hz);
+      o->columns = io::ParseTableColumns(a.columns, a.rate_hz, names);
     }
-    o->acc.scale = ParseScale(a.acc_scale, "--acc-scale");
-    o->gyr.scale = ParseScale(a.gyr_scale, "--gyr-scale");
-    o->axis_map = AxisMap(a.axis_map);
-  } catch (const UsageError& e) {
+    o->acc.scale = io::ParseScale(a.acc_scale, "--acc-scale");
+    o->gyr.scale = io::ParseScale(a.gyr_scale, "--gyr-scale");
+    o->axis_map = io::ParseAxisMap(a.axis_map, "--axis-map");
+  } catch (const Error& e) {
     return e.what();
   }
   return "";
@@ -201,7 +88,7 @@ io::InputOptions MakeInputOptions(const InputArgs& a, const std::vector<std::str
   o.not_native_hint = kTableHint;
   o.before_read = [&a, &inputs, table_error, two_table_error](std::size_t i, io::InputKind kind) {
     const std::string& input = inputs[i];
-    const std::size_t parts = SplitList(input, ',').size();
+    const std::size_t parts = io::SplitList(input, ',').size();
     if (parts != 1 && parts != 2) {
       throw UsageError("input '" + input + "': give one file, or two as acc.txt,gyr.txt");
     }
@@ -233,20 +120,6 @@ io::InputOptions MakeInputOptions(const InputArgs& a, const std::vector<std::str
 }
 
 }  // namespace
-
-double ParseScale(const std::string& text, const std::string& option) {
-  const auto parts = SplitList(text, '/');
-  double num = 0, den = 1;
-  const bool ok = (parts.size() == 1 || parts.size() == 2) && ParseDouble(parts[0], num) &&
-                  (parts.size() == 1 || ParseDouble(parts[1], den)) && den != 0.0 && num != 0.0;
-  if (!ok) {
-    throw UsageError(option +
-                     " must be a non-zero number or a fraction such as 9.80665/16384 "
-                     "(got '" +
-                     text + "')");
-  }
-  return num / den;
-}
 
 void AddInputFiles(const InputArgs& args, FileRoles& roles) {
   for (const std::string& input : args.inputs) {
@@ -399,7 +272,7 @@ Session ReadInputs(const InputArgs& a) {
   std::vector<io::InputFile> files;
   std::vector<std::string> paths;
   for (const std::string& input : inputs) {
-    const auto parts = SplitList(input, ',');
+    const auto parts = io::SplitList(input, ',');
     files.push_back(parts.size() == 2 ? io::InputFile(parts[0], parts[1]) : io::InputFile(input));
     paths.insert(paths.end(), parts.begin(), parts.end());
   }

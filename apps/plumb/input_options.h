@@ -88,8 +88,4 @@ std::uint64_t CheckMemory(const std::vector<std::string>& files, std::uint64_t m
 /// `bytes` for people: "850 kB", "25.2 MB", "1.9 GB" (powers of 1000, 3 significant digits).
 std::string FormatBytes(std::uint64_t bytes);
 
-/// Parses a positive scale "x" or "a/b" (e.g. "9.80665/16384"); throws UsageError naming
-/// `option` otherwise.
-double ParseScale(const std::string& text, const std::string& option);
-
 }  // namespace plumb::cli

@@ -239,7 +239,7 @@ class ReportCommand : public Command {
     PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose);
 
-    const estimation::CalibrationResult result = CalibrateSession(session, fit);
+    const estimation::CalibrationResult result = CalibrateWithProgress(session, fit);
     std::cout << report::FitVerdict(result.fit) << "\n" << report::GateLines(result.fit, session.source);
     if (const int code = StrictGateExit(result.fit, session.source, a.fit.strict)) return code;
     std::optional<diagnostics::Diagnosis> diagnosis;

@@ -2,8 +2,6 @@
 #include "segment_options.h"
 #include "progress.h"
 
-#include "plumb/io/text/segments_file.h"
-#include "plumb/segmentation/given_segments.h"
 #include "validators.h"
 
 namespace plumb::cli {
@@ -37,15 +35,10 @@ void AddSegmentOptions(CLI::App* app, SegmentArgs& a) {
 }
 
 segmentation::SegmentationResult FindSegments(const ImuSeries& series, const SegmentArgs& a) {
-  if (!a.segments_path.empty()) {
-    return segmentation::UseGivenSegments(series, io::ReadSegments(a.segments_path, series));
+  if (a.segments_path.empty()) {
+    Progress::Of().Stage("finding still segments in " + std::to_string(series.size()) + " samples");
   }
-  Progress::Of().Stage("finding still segments in " + std::to_string(series.size()) + " samples");
-  segmentation::StillDetectorOptions detector = a.detector;
-  detector.use_gyro = !a.still_accel_only;
-  detector.acc_unit = series.acc_unit;
-  detector.gyr_unit = series.gyr_unit;
-  return segmentation::DetectStillSegments(series, detector);
+  return pipeline::FindSegments(series, a);
 }
 
 }  // namespace plumb::cli

@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "fit_options.h"
+#include "plumb/core/error.h"
 #include "plumb/io/common/atomic_file.h"
 #include "plumb/io/text/native_csv.h"
 #include "plumb/model/model.h"
@@ -27,7 +28,7 @@ namespace {
 struct SimulateArgs {
   std::string out_path;                ///< --out: native CSV written here
   std::string schedule = "multipose";  ///< multipose | paper-static | paper-benchmark
-  int poses = 12;                      ///< multipose: number of still poses, 1..10000
+  int poses = sim::kMultiPosePoses;    ///< multipose: number of still poses, 1..10000
   CLI::Option* poses_option = nullptr;
   double still_s = 0.0;  ///< length of each still hold, s, > 0
   CLI::Option* still_option = nullptr;
@@ -300,22 +301,20 @@ class SimulateCommand : public Command {
   }
 
  private:
+  /// The schedule the flags name (sim::NamedSchedule: its defaults for what is not given).
   sim::Schedule MakeSchedule() const {
     const SimulateArgs& a = args_;
-    const bool still_given = a.still_option->count() > 0;
-    const bool turn_given = a.turn_option->count() > 0;
-    if (a.schedule != "multipose" && a.poses_option->count() > 0) {
-      throw UsageError("--poses applies to --schedule multipose only");
+    sim::ScheduleRequest r;
+    r.kind = a.schedule;
+    if (a.poses_option->count() > 0) r.poses = a.poses;
+    if (a.still_option->count() > 0) r.still_s = a.still_s;
+    if (a.turn_option->count() > 0) r.turn_s = a.turn_s;
+    r.seed = a.seed;
+    try {
+      return sim::NamedSchedule(r, {"--schedule", "--poses", "--turn"});
+    } catch (const Error& e) {
+      throw UsageError(e.what());
     }
-    if (a.schedule == "paper-static") {
-      if (turn_given) throw UsageError("--turn does not apply to --schedule paper-static");
-      return sim::PaperStatic(still_given ? a.still_s : 60.0);
-    }
-    if (a.schedule == "paper-benchmark") {
-      return sim::PaperBenchmark(still_given ? a.still_s : 20.0, turn_given ? a.turn_s : 3.0);
-    }
-    return sim::MultiPose(a.poses, still_given ? a.still_s : 5.0, turn_given ? a.turn_s : 2.0,
-                          a.seed);
   }
 
   SimulateArgs args_;

@@ -21,16 +21,7 @@ void AddSiteOptions(CLI::App* app, SiteArgs& args) {
 
 geo::Site ResolveSite(const SiteArgs& args, const std::optional<SiteInput>& from_log,
                       std::optional<double> gravity_m_s2) {
-  geo::Site site;
-  if (args.given()) {
-    site = geo::Site::At(args.lat_deg, args.lon_deg, args.height_m, "flags");
-  } else if (from_log) {
-    site = geo::Site::At(*from_log);
-  } else {
-    return geo::Site::Unknown(gravity_m_s2.value_or(units::kStandardGravity));
-  }
-  if (gravity_m_s2) site.g_n = Vec3(0.0, 0.0, *gravity_m_s2);
-  return site;
+  return geo::ResolveSite(args.given_site(), from_log, gravity_m_s2);
 }
 
 void AddGravityOption(CLI::App* app, SiteArgs& args) {

@@ -21,6 +21,11 @@ struct SiteArgs {
   CLI::Option* gravity = nullptr;  ///< registered by AddGravityOption, if at all
 
   bool given() const { return lat != nullptr && lat->count() > 0; }
+  /// The site the flags give (source "flags"), when given.
+  std::optional<SiteInput> given_site() const {
+    if (!given()) return std::nullopt;
+    return SiteInput{lat_deg, lon_deg, height_m, "flags"};
+  }
   /// The --gravity value when given.
   std::optional<double> fixed_gravity() const {
     if (gravity == nullptr || gravity->count() == 0) return std::nullopt;

@@ -3,7 +3,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/atomic_file.h"
@@ -13,17 +12,6 @@
 namespace plumb::cli {
 
 namespace fs = std::filesystem;
-
-nlohmann::json ReadJsonFile(const std::string& path) {
-  if (fs::is_directory(path)) throw InputError(path, "", "is a folder, not a JSON file");
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "", "cannot be read");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
-  }
-}
 
 std::string PointPath(const std::string& dir, int index) {
   char name[32];

@@ -6,13 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "plumb/io/text/json_file.h"
 #include "plumb/study/study.h"
 #include "plumb/study/summary.h"
 
 namespace plumb::cli {
 
 /// A JSON file; plumb::InputError naming it (and the byte of a syntax error) otherwise.
-nlohmann::json ReadJsonFile(const std::string& path);
+using io::ReadJsonFile;
 
 /// DIR/points/point-NNNNN.json.
 std::string PointPath(const std::string& dir, int index);

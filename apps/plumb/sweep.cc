@@ -24,6 +24,7 @@
 #include "study_files.h"
 #include "plumb/core/error.h"
 #include "plumb/io/common/atomic_file.h"
+#include "plumb/pipeline/study_template.h"
 #include "plumb/report/json_report.h"
 #include "plumb/study/run.h"
 #include "plumb/study/summary.h"
@@ -178,13 +179,8 @@ class SweepCommand : public Command {
     }
     const auto [k, n] = ParseShard(a.shard);
     study::Study s = study::ParseStudy(ReadStudyFile(a.study_path), a.study_path);
-    if (!s.base.template_path.empty()) {
-      // A session template: relative to the study file's folder.
-      fs::path t = s.base.template_path;
-      if (t.is_relative()) t = fs::path(a.study_path).parent_path() / t;
-      s.template_document = ReadJsonFile(t.string());
-      s.base.template_path = t.string();
-    }
+    // A session template: relative to the study file's folder.
+    pipeline::ReadSessionTemplate(s, fs::path(a.study_path).parent_path().string());
     const std::vector<study::Point> points = study::DesignPoints(s);
     fs::create_directories(fs::path(a.out) / "points");
     report::WriteJson((fs::path(a.out) / "study.json").string(), s.source);

@@ -354,3 +354,48 @@ TEST(TemperatureProfile, RampAndUpDownValues) {
 
 }  // namespace
 }  // namespace plumb::sim
+
+namespace plumb::sim {
+namespace {
+
+const ScheduleOptionNames kNames{"KIND", "POSES", "TURN"};
+
+TEST(NamedSchedule, DefaultsAreTheFrontEndsDefaults) {
+  ScheduleRequest r;
+  r.seed = 7;
+  const Schedule multipose = NamedSchedule(r, kNames);
+  const Schedule expected = MultiPose(12, 5.0, 2.0, 7);
+  EXPECT_EQ(multipose.size(), expected.size());
+  EXPECT_DOUBLE_EQ(multipose.duration_s(), expected.duration_s());
+  EXPECT_DOUBLE_EQ(multipose.step_duration_s(0), 5.0);
+  r.kind = "paper-static";
+  EXPECT_DOUBLE_EQ(NamedSchedule(r, kNames).duration_s(), 60.0);
+  r.kind = "paper-benchmark";
+  EXPECT_DOUBLE_EQ(NamedSchedule(r, kNames).duration_s(), PaperBenchmark(20.0, 3.0).duration_s());
+  r.still_s = 4.0;
+  r.turn_s = 1.5;
+  EXPECT_DOUBLE_EQ(NamedSchedule(r, kNames).duration_s(), PaperBenchmark(4.0, 1.5).duration_s());
+}
+
+TEST(NamedSchedule, ErrorsNameTheOptionsAsTheFrontEndDoes) {
+  const auto message = [](const ScheduleRequest& r) -> std::string {
+    try {
+      NamedSchedule(r, kNames);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  ScheduleRequest r;
+  r.kind = "paper-static";
+  r.poses = 3;
+  EXPECT_EQ(message(r), "POSES applies to KIND multipose only");
+  r.poses.reset();
+  r.turn_s = 1.0;
+  EXPECT_EQ(message(r), "TURN does not apply to KIND paper-static");
+  r.kind = "spin";
+  EXPECT_EQ(message(r), "KIND must be multipose, paper-static or paper-benchmark (got 'spin')");
+}
+
+}  // namespace
+}  // namespace plumb::sim

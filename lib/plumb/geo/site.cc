@@ -57,4 +57,18 @@ Site Site::Unknown(double g) {
   return s;
 }
 
+Site ResolveSite(const std::optional<SiteInput>& given, const std::optional<SiteInput>& from_log,
+                 std::optional<double> gravity_m_s2) {
+  Site site;
+  if (given) {
+    site = Site::At(*given);
+  } else if (from_log) {
+    site = Site::At(*from_log);
+  } else {
+    return Site::Unknown(gravity_m_s2.value_or(units::kStandardGravity));
+  }
+  if (gravity_m_s2) site.g_n = Vec3(0.0, 0.0, *gravity_m_s2);
+  return site;
+}
+
 }  // namespace plumb::geo

@@ -6,6 +6,7 @@
 // ECEF-to-NED rotation (the paper's C_ecef^ned) from GeographicLib::Geocentric.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "plumb/core/session.h"
@@ -40,5 +41,11 @@ struct Site {
   /// No site: gravity `g` (default standard gravity 9.80665 m/s^2) straight down, no Earth rate.
   static Site Unknown(double g = units::kStandardGravity);
 };
+
+/// The site a fit uses: `given` (the user's, e.g. --lat/--lon, source "flags") when set, else
+/// `from_log` (the log's GPS), else Site::Unknown. `gravity_m_s2`, when set, replaces the
+/// gravity magnitude (still pointing down); without a site it is Site::Unknown's gravity.
+Site ResolveSite(const std::optional<SiteInput>& given, const std::optional<SiteInput>& from_log,
+                 std::optional<double> gravity_m_s2);
 
 }  // namespace plumb::geo

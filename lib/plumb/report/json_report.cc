@@ -399,8 +399,12 @@ json CalibrationJson(const estimation::CalibrationResult& result,
   return doc;
 }
 
+std::string JsonText(const json& document) {
+  return document.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+}
+
 void WriteJson(const std::string& path, const json& document) {
-  io::WriteFileAtomic(path, document.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
+  io::WriteFileAtomic(path, JsonText(document));
 }
 
 }  // namespace plumb::report

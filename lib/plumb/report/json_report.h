@@ -90,6 +90,10 @@ nlohmann::json CalibrationJson(const estimation::CalibrationResult& result,
                                const std::vector<std::string>& inputs,
                                const std::vector<std::string>& input_warnings);
 
+/// `document` as every JSON file plumb writes holds it: indented by 2, newline-terminated,
+/// invalid UTF-8 in strings replaced (the text WriteJson writes, the Python module's to_json).
+std::string JsonText(const nlohmann::json& document);
+
 /// Writes `document` (indented, newline-terminated, invalid UTF-8 in strings replaced) to
 /// `path` atomically: temporary file in the same folder, then rename. Throws plumb::Error
 /// naming `path` when it cannot be written.

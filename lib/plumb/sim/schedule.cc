@@ -230,4 +230,24 @@ Schedule PaperBenchmark(double still_s, double turn_s) {
   return schedule;
 }
 
+Schedule NamedSchedule(const ScheduleRequest& r, const ScheduleOptionNames& names) {
+  if (r.kind != "multipose" && r.kind != "paper-static" && r.kind != "paper-benchmark") {
+    throw Error(names.kind + " must be multipose, paper-static or paper-benchmark (got '" +
+                r.kind + "')");
+  }
+  if (r.kind != "multipose" && r.poses) {
+    throw Error(names.poses + " applies to " + names.kind + " multipose only");
+  }
+  if (r.kind == "paper-static") {
+    if (r.turn_s) throw Error(names.turn + " does not apply to " + names.kind + " paper-static");
+    return PaperStatic(r.still_s.value_or(kPaperStaticStill_s));
+  }
+  if (r.kind == "paper-benchmark") {
+    return PaperBenchmark(r.still_s.value_or(kPaperBenchmarkStill_s),
+                          r.turn_s.value_or(kPaperBenchmarkTurn_s));
+  }
+  return MultiPose(r.poses.value_or(kMultiPosePoses), r.still_s.value_or(kMultiPoseStill_s),
+                   r.turn_s.value_or(kMultiPoseTurn_s), r.seed);
+}
+
 }  // namespace plumb::sim

@@ -15,11 +15,13 @@
 //
 // Ready-made schedules: MultiPose (well-spread poses for the generalised calibration),
 // PaperStatic (the seed paper's one-minute level, x-north hold) and PaperBenchmark (the seed
-// paper's section 3.1 benchmark sequence).
+// paper's section 3.1 benchmark sequence); NamedSchedule picks one by name with the defaults
+// every front end (plumb simulate, the Python module's simulate) offers.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -103,6 +105,15 @@ class Schedule {
   std::vector<Quat> start_R_n_b_of_step_;  ///< size() + 1 entries
 };
 
+/// The ready-made schedules' defaults (NamedSchedule): holds and turns, s, and multipose's
+/// number of poses.
+inline constexpr int kMultiPosePoses = 12;
+inline constexpr double kMultiPoseStill_s = 5.0;
+inline constexpr double kMultiPoseTurn_s = 2.0;
+inline constexpr double kPaperStaticStill_s = 60.0;
+inline constexpr double kPaperBenchmarkStill_s = 20.0;
+inline constexpr double kPaperBenchmarkTurn_s = 3.0;
+
 /// Well-spread still poses for the generalised calibration, joined by single-axis turns.
 /// Pose 1 is level (z down, x north); poses 1-6 are the six faces (z, x, y down, then z, x, y
 /// up), poses 7.. are tilts in between chosen by farthest-point sampling of the down direction
@@ -114,7 +125,7 @@ Schedule MultiPose(int n_poses, double still_s, double turn_s, std::uint64_t see
 
 /// The seed paper's static test (section 3.2): one still hold, level with x north
 /// (R_n_b = identity), still_s seconds (the paper: about a minute).
-Schedule PaperStatic(double still_s = 60.0);
+Schedule PaperStatic(double still_s = kPaperStaticStill_s);
 
 /// The seed paper's benchmark sequence (section 3.1), starting level with x north:
 ///  1. accelerometer: each axis parallel (down) and antiparallel (up) to gravity, still_s each
@@ -126,6 +137,32 @@ Schedule PaperStatic(double still_s = 60.0);
 ///     ("x up 0 deg", "x up 90 deg", ..., "x up 360 deg");
 ///  4. z parallel and perpendicular again.
 /// Poses are joined by single-axis turns of turn_s seconds. 25 still holds in all.
-Schedule PaperBenchmark(double still_s = 20.0, double turn_s = 3.0);
+Schedule PaperBenchmark(double still_s = kPaperBenchmarkStill_s,
+                        double turn_s = kPaperBenchmarkTurn_s);
+
+/// A ready-made schedule by name, as a front end is asked for it.
+struct ScheduleRequest {
+  std::string kind = "multipose";  ///< multipose, paper-static or paper-benchmark
+  std::optional<int> poses;        ///< multipose only: the number of poses, 1..10000 (12)
+  /// Each still hold, s, > 0 (multipose 5, paper-static 60, paper-benchmark 20).
+  std::optional<double> still_s;
+  /// Each turn, s, > 0 (multipose 2, paper-benchmark 3); paper-static has none.
+  std::optional<double> turn_s;
+  std::uint64_t seed = 1;  ///< multipose: the seed of the tilts and headings
+};
+
+/// How a front end names the request's fields in its errors (e.g. "--schedule", "--poses",
+/// "--turn" on the command line).
+struct ScheduleOptionNames {
+  std::string kind;   ///< the option that names the schedule
+  std::string poses;  ///< ... the number of poses
+  std::string turn;   ///< ... the length of a turn
+};
+
+/// The schedule `request` names, with the defaults above for what it leaves out. Throws
+/// plumb::Error naming the options by `names` when the kind is unknown, poses is given for
+/// another kind than multipose, or a turn length for paper-static (and as MultiPose,
+/// PaperStatic and PaperBenchmark for bad numbers).
+Schedule NamedSchedule(const ScheduleRequest& request, const ScheduleOptionNames& names);
 
 }  // namespace plumb::sim

@@ -1,0 +1,212 @@
+// plumb.calibrate(session, model=..., site=..., **options) -> Result: the generalized fit, as
+// `plumb calibrate` makes it; Result.to_json() is the command's `calibrate --json` document,
+// made by the same writer (report/json_report.h).
+#include <pybind11/stl.h>
+
+#include "common.h"
+#include "plumb/core/error.h"
+#include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/uncertainty.h"
+#include "plumb/pipeline/datasheet_level.h"
+#include "plumb/report/json_report.h"
+
+namespace plumb::python {
+namespace {
+
+const char* const kCalibrateDoc = R"doc(Calibrate the accelerometer and gyroscope from a session
+of still poses joined by turns (the generalized least-squares fit of `plumb calibrate`).
+
+session: a Session (plumb.open, plumb.simulate(...).session).
+model: the error model spec: 'base', 'paper', or 'base+EFFECT[:OPTION]+...' (plumb effects).
+site: None (the log's GPS, else no site: standard gravity, no Earth rate), or
+      (lat_deg, lon_deg[, height_m]) / dict(lat_deg=, lon_deg=, height_m=) as --lat --lon --height.
+Keywords (the command's options, '-' as '_'):
+  segments (file of given still segments), init_still (s), window (s), min_still (s),
+  false_alarm, still_accel_only (bool); gravity (m/s^2, fixed magnitude); heading (deg);
+  level_north (bool); temp_ref (degC, 25); max_iterations (200); strict (bool: raise when the
+  data cannot determine the model or a gate fails); accel_rw (m/s^3/sqrt(Hz)), gyro_rw
+  (rad/s^2/sqrt(Hz)), estimate_rw (bool), accel_bi (m/s^2), gyro_bi (rad/s), bi_time (s),
+  constant_bias (bool): the bias wander, each level a number in SI or a text with a datasheet's
+  unit as the command takes it ('4 deg/h', '40 ug', '0.3 deg/h/sqrt(h)', '10 ug/sqrt(h)').
+Returns a Result. Raises plumb.Error (plumb.InsufficientDataError when the data cannot
+support the model).)doc";
+
+/// The fitted calibration and what the document says beside it.
+struct PyResult {
+  estimation::CalibrationResult result;
+  segmentation::SegmentationResult segmentation;
+  std::vector<std::string> inputs, input_warnings;
+  nlohmann::json document;  ///< report::CalibrationJson, made once
+};
+
+pipeline::SegmentRequest Segments(Keywords& k) {
+  pipeline::SegmentRequest r;
+  r.segments_path = k.Take<std::string>("segments", "");
+  r.detector.init_still_s = k.Take<double>("init_still", r.detector.init_still_s);
+  r.detector.window_s = k.Take<double>("window", r.detector.window_s);
+  r.detector.min_still_s = k.Take<double>("min_still", r.detector.min_still_s);
+  r.detector.false_alarm = k.Take<double>("false_alarm", r.detector.false_alarm);
+  r.still_accel_only = k.Take<bool>("still_accel_only", false);
+  return r;
+}
+
+/// A bias wander level: a number (SI) or a datasheet's text ("4 deg/h"), both through the
+/// command's parser (plumb/pipeline/datasheet_level.h), so that the same checks apply.
+std::optional<double> Level(Keywords& k, const char* name, pipeline::WanderLevel level) {
+  const std::optional<py::object> value = k.Take<py::object>(name);
+  if (!value) return std::nullopt;
+  const std::string text = py::str(*value).cast<std::string>();
+  if (!py::isinstance<py::str>(*value) && !py::isinstance<py::float_>(*value) &&
+      !(py::isinstance<py::int_>(*value) && !py::isinstance<py::bool_>(*value))) {
+    throw Error(std::string("calibrate: ") + name + " must be a number or a text such as '4 deg/h', "
+                "got " + py::str(py::repr(*value)).cast<std::string>());
+  }
+  try {
+    return pipeline::ParseDatasheetLevel(text, level);
+  } catch (const Error& e) {
+    throw Error(std::string("calibrate: ") + name + ": " + e.what());
+  }
+}
+
+void WanderOptions(Keywords& k, estimation::CalibrationOptions& o) {
+  using pipeline::WanderLevel;
+  o.accel_walk_density = Level(k, "accel_rw", WanderLevel::kAccelWalk);
+  o.gyro_walk_density = Level(k, "gyro_rw", WanderLevel::kGyroWalk);
+  o.estimate_walk = k.Take<bool>("estimate_rw", false);
+  o.accel_instability = Level(k, "accel_bi", WanderLevel::kAccelInstability);
+  o.gyro_instability = Level(k, "gyro_bi", WanderLevel::kGyroInstability);
+  o.instability_time_s = k.Take<double>("bi_time", o.instability_time_s);
+  o.constant_bias = k.Take<bool>("constant_bias", false);
+  if (o.constant_bias && (o.accel_walk_density || o.gyro_walk_density || o.estimate_walk ||
+                          o.accel_instability || o.gyro_instability)) {
+    throw Error("constant_bias excludes accel_rw, gyro_rw, estimate_rw, accel_bi, gyro_bi");
+  }
+}
+
+py::dict Parameters(const PyResult& r) {
+  py::module_ ns = py::module_::import("types");
+  const double scale = estimation::SigmaScale(r.result.fit);
+  py::dict out;
+  for (const auto& p : r.result.calibration.parameters) {
+    out[p.name.c_str()] = ns.attr("SimpleNamespace")(
+        py::arg("value") = p.value, py::arg("sigma") = p.sigma * scale,
+        py::arg("sigma_formal") = p.sigma, py::arg("unit") = p.unit,
+        py::arg("observable") = p.observable, py::arg("fixed") = p.fixed);
+  }
+  return out;
+}
+
+py::array_t<double> Matrix(const Eigen::MatrixXd& m) {
+  py::array_t<double> out({m.rows(), m.cols()});
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    for (Eigen::Index j = 0; j < m.cols(); ++j) out.mutable_at(i, j) = m(i, j);
+  }
+  return out;
+}
+
+std::shared_ptr<PyResult> Calibrate(const PySession& s, const std::string& model,
+                                    const py::object& site, const py::kwargs& kwargs) {
+  Keywords k("calibrate", kwargs);
+  FitInputs fit = PrepareFit(s, model, site, k, true);
+  k.Finish();
+  auto out = std::make_shared<PyResult>();
+  {
+    py::gil_scoped_release release;
+    out->result = pipeline::CalibrateSession(s.session, fit.setup);
+  }
+  if (fit.strict && !out->result.fit.gates.empty()) {
+    throw Error(pipeline::GateFailure(out->result.fit, s.session.source) + " under strict=True");
+  }
+  out->segmentation = std::move(fit.segmentation);
+  out->inputs = s.inputs;
+  out->input_warnings = fit.setup.input_warnings;
+  out->document = report::CalibrationJson(out->result, out->segmentation, out->inputs,
+                                          out->input_warnings);
+  return out;
+}
+
+}  // namespace
+
+FitInputs PrepareFit(const PySession& s, const std::string& model_spec, const py::object& site,
+                     Keywords& k, bool fit_options) {
+  FitInputs out;
+  out.segmentation = pipeline::FindSegments(s.session.series, Segments(k));
+  pipeline::FitRequest request;
+  request.site = SiteFromPython(site);
+  request.gravity_m_s2 = k.Take<double>("gravity");
+  request.gravity_option = "gravity=";
+  request.model = model::Model::Parse(model_spec);
+  request.temp_ref_c = k.Take<double>("temp_ref", request.temp_ref_c);
+  estimation::CalibrationOptions& o = request.options;
+  o.first_heading_deg = k.Take<double>("heading");
+  if (fit_options) {
+    request.level_north = k.Take<bool>("level_north", false);
+    if (request.level_north && o.first_heading_deg) throw Error("level_north excludes heading");
+    out.strict = k.Take<bool>("strict", false);
+    if (out.strict) o.on_insufficient = estimation::InsufficientData::kError;
+    o.max_iterations = k.Take<int>("max_iterations", o.max_iterations);
+    if (o.max_iterations < 1) throw Error("max_iterations must be >= 1");
+    WanderOptions(k, o);
+  }
+  out.setup = pipeline::PrepareFit(s.session, out.segmentation, std::move(request));
+  return out;
+}
+
+void RegisterCalibrate(py::module_& m) {
+  py::class_<PyResult, std::shared_ptr<PyResult>> result(
+      m, "Result",
+      "A calibration and how its fit went: what `plumb calibrate --json` writes, as Python "
+      "objects. SI units (sensor units for counts).");
+  DocumentMethods(result, "calibrate")
+      .def_property_readonly("model", [](const PyResult& r) { return r.result.calibration.model.spec(); },
+                             "The fitted model's spec.")
+      .def_property_readonly("parameters", &Parameters,
+                             "name -> (value, sigma, sigma_formal, unit, observable, fixed): "
+                             "the value in SI (unit); sigma one standard deviation as reported "
+                             "(scaled by sqrt(chi2/dof) when chi2/dof is above its band), "
+                             "sigma_formal unscaled; NaN where unobservable or fixed.")
+      .def_property_readonly(
+          "covariance",
+          [](const PyResult& r) {
+            const double scale = estimation::SigmaScale(r.result.fit);
+            return Matrix(scale * scale *
+                          estimation::ParameterCovariance(r.result.calibration).matrix);
+          },
+          "Covariance of the free, observable parameters (numpy, units of parameter_names "
+          "squared), as the JSON's covariance.matrix: scaled by chi2/dof when above its band.")
+      .def_property_readonly(
+          "parameter_names",
+          [](const PyResult& r) { return estimation::ParameterCovariance(r.result.calibration).names; },
+          "The rows and columns of covariance, in model order.")
+      .def_property_readonly(
+          "sigma_scale", [](const PyResult& r) { return estimation::SigmaScale(r.result.fit); },
+          "The factor on every reported sigma: sqrt(chi2/dof) above its band, else 1.")
+      .def_property_readonly("observability",
+                             [](const PyResult& r) { return ToPython(r.document["observability"]); },
+                             "rank, unobservable directions, determined combinations (value, "
+                             "sigma): the JSON's observability.")
+      .def_property_readonly(
+          "fit",
+          [](const PyResult& r) {
+            py::dict fit = ToPython(r.document["fit"]);
+            fit["gates"] = ToPython(r.document["gates"]);
+            return fit;
+          },
+          "chi2, dof, chi2_dof, RMS, convergence, verdict ... (the JSON's fit) and gates (the "
+          "checks failed: name, message).")
+      .def_property_readonly("site", [](const PyResult& r) { return ToPython(r.document["site"]); },
+                             "The site used: lat_deg, lon_deg (degrees), height_m (m), gravity "
+                             "(m/s^2), source.")
+      .def_property_readonly("warnings", [](const PyResult& r) { return ToPython(r.document["warnings"]); },
+                             "What the user must know, in words.")
+      .def("save", [](const PyResult& r, const std::string& path) { report::WriteJson(path, r.document); },
+           py::arg("path"), "Write the calibrate --json document to path (atomically).")
+      .def("__repr__", [](const PyResult& r) {
+        return "<plumb.Result " + r.result.calibration.model.spec() + ": chi2/dof " +
+               Number(r.result.fit.chi2_dof()) + ">";
+      });
+  m.def("calibrate", &Calibrate, py::arg("session"), py::arg("model") = "base",
+        py::arg("site") = py::none(), kCalibrateDoc);
+}
+
+}  // namespace plumb::python

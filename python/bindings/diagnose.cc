@@ -1,0 +1,74 @@
+// plumb.diagnose(session, model=..., **options) -> Diagnosis: which catalogue effects the model
+// misses, as `plumb diagnose` finds them; Diagnosis.to_json() is its --json document.
+#include <pybind11/stl.h>
+
+#include "common.h"
+#include "plumb/core/error.h"
+#include "plumb/diagnostics/diagnose.h"
+#include "plumb/diagnostics/residual_analysis.h"
+#include "plumb/report/diagnosis_json.h"
+#include "plumb/report/json_report.h"
+
+namespace plumb::python {
+namespace {
+
+const char* const kDiagnoseDoc = R"doc(Find which effects of the catalogue the model is missing:
+the score test of every effect not in the model, ranked by evidence, the best confirmed by
+refitting (`plumb diagnose`).
+
+session: a Session; model: the spec diagnosed ('base'); site: as in calibrate().
+Keywords: significance (0.01: the test's level), confirm (3: refit the best N significant
+candidates), candidates (list of effect names, default: the catalogue); segments, init_still,
+window, min_still, false_alarm, still_accel_only, gravity, heading (deg), temp_ref (degC).
+Returns a Diagnosis.)doc";
+
+struct PyDiagnosis {
+  nlohmann::json document;  ///< report::DiagnosisJson
+};
+
+std::shared_ptr<PyDiagnosis> Diagnose(const PySession& s, const std::string& model,
+                                      const py::object& site, const py::kwargs& kwargs) {
+  Keywords k("diagnose", kwargs);
+  FitInputs fit = PrepareFit(s, model, site, k, false);
+  diagnostics::DiagnoseOptions options;
+  options.significance = k.Take<double>("significance", options.significance);
+  options.confirm = k.Take<int>("confirm", options.confirm);
+  options.candidates = k.Take<std::vector<std::string>>("candidates", {});
+  k.Finish();
+  if (!(options.significance >= 1e-12 && options.significance <= 0.5)) {
+    throw Error("diagnose: significance must be in [1e-12, 0.5]");
+  }
+  if (options.confirm < 0) throw Error("diagnose: confirm must be >= 0");
+  options.calibration = fit.setup.options;
+  options.calibration.method = "generalized";
+  auto out = std::make_shared<PyDiagnosis>();
+  py::gil_scoped_release release;
+  const diagnostics::Diagnosis d =
+      diagnostics::Diagnose(s.session.series, fit.setup.segments, fit.setup.model,
+                            fit.setup.site, options);
+  diagnostics::ResidualAnalysisOptions ra_options;
+  ra_options.significance = options.significance;
+  const diagnostics::ResidualAnalysis ra =
+      diagnostics::AnalyseResiduals(s.session.series, d.fit, ra_options);
+  out->document = report::DiagnosisJson(d, ra);
+  return out;
+}
+
+}  // namespace
+
+void RegisterDiagnose(py::module_& m) {
+  py::class_<PyDiagnosis, std::shared_ptr<PyDiagnosis>> diagnosis(
+      m, "Diagnosis", "What `plumb diagnose --json` writes, as Python objects.");
+  DocumentMethods(diagnosis, "diagnose")
+      .def_property_readonly("candidates",
+                             [](const PyDiagnosis& d) { return ToPython(d.document["candidates"]); },
+                             "The effects tested, best evidence first: effect, lm (predicted "
+                             "fall of chi2), dof, evidence, significant, predicted_drop, "
+                             "refit_drop, identifiable ...")
+      .def_property_readonly("fit", [](const PyDiagnosis& d) { return ToPython(d.document["fit"]); },
+                             "The diagnosed model's fit: chi2, dof, ...");
+  m.def("diagnose", &Diagnose, py::arg("session"), py::arg("model") = "base",
+        py::arg("site") = py::none(), kDiagnoseDoc);
+}
+
+}  // namespace plumb::python

@@ -1,0 +1,73 @@
+// Keyword arguments, sites and JSON between Python and C++: see common.h.
+#include <pybind11/stl.h>
+
+#include "common.h"
+#include "plumb/core/error.h"
+#include "plumb/report/json_report.h"
+
+namespace plumb::python {
+
+Keywords::Keywords(std::string function, const py::kwargs& kwargs)
+    : function_(std::move(function)), kwargs_(kwargs) {}
+
+bool Keywords::Given(const std::string& name) const {
+  return kwargs_.contains(name.c_str()) && !kwargs_[name.c_str()].is_none();
+}
+
+void Keywords::Fail(const std::string& name, const py::object& value) const {
+  throw Error(function_ + ": " + name + "=" + py::str(py::repr(value)).cast<std::string>() +
+              " has the wrong type (" + py::str(py::type::of(value).attr("__name__")).cast<std::string>() +
+              ")");
+}
+
+void Keywords::Finish() const {
+  std::string unknown;
+  for (const auto& item : kwargs_) {
+    const std::string name = py::str(item.first).cast<std::string>();
+    if (known_.count(name) == 0) unknown += (unknown.empty() ? "" : ", ") + name;
+  }
+  if (unknown.empty()) return;
+  std::string names;
+  for (const std::string& k : known_) names += (names.empty() ? "" : ", ") + k;
+  throw Error(function_ + ": unknown option(s) " + unknown + "; the options are " + names);
+}
+
+std::optional<SiteInput> SiteFromPython(const py::object& site) {
+  if (site.is_none()) return std::nullopt;
+  SiteInput s;
+  s.source = "flags";
+  try {
+    if (py::isinstance<py::dict>(site)) {
+      const py::dict d = site;
+      s.lat_deg = d["lat_deg"].cast<double>();
+      s.lon_deg = d["lon_deg"].cast<double>();
+      if (d.contains("height_m")) s.height_m = d["height_m"].cast<double>();
+      return s;
+    }
+    const auto v = site.cast<std::vector<double>>();
+    if (v.size() == 2 || v.size() == 3) {
+      s.lat_deg = v[0];
+      s.lon_deg = v[1];
+      if (v.size() == 3) s.height_m = v[2];
+      return s;
+    }
+  } catch (const py::error_already_set&) {
+  } catch (const py::cast_error&) {
+  }
+  throw Error("site must be (lat_deg, lon_deg[, height_m]) or a dict with lat_deg, lon_deg[, "
+              "height_m], got " + py::str(py::repr(site)).cast<std::string>());
+}
+
+py::object ToPython(const nlohmann::json& doc) {
+  return py::module_::import("json").attr("loads")(doc.dump(-1, ' ', false,
+                                                            nlohmann::json::error_handler_t::replace));
+}
+
+std::string JsonText(const nlohmann::json& doc) { return report::JsonText(doc); }
+
+nlohmann::json FromPython(const py::handle& object) {
+  const std::string text = py::module_::import("json").attr("dumps")(object).cast<std::string>();
+  return nlohmann::json::parse(text);
+}
+
+}  // namespace plumb::python

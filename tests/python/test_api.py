@@ -1,0 +1,160 @@
+"""The Python module's contract apart from the command: errors are plumb.Error naming the file,
+never a crash; the session's arrays are views over its storage; apply takes arrays; keywords
+are checked."""
+import gc
+import os
+import unittest
+
+import numpy as np
+
+import plumb
+
+SOURCE = os.environ["PLUMB_SOURCE_DIR"]
+OUT = os.environ["PLUMB_TEST_OUT"]
+SESSION = os.path.join(SOURCE, "data/mikoff/imu0.log")
+
+
+def out(name):
+    os.makedirs(OUT, exist_ok=True)
+    return os.path.join(OUT, name)
+
+
+class Errors(unittest.TestCase):
+    def test_error_is_an_exception_class(self):
+        self.assertTrue(issubclass(plumb.Error, Exception))
+        self.assertTrue(issubclass(plumb.InputError, plumb.Error))
+        self.assertTrue(issubclass(plumb.InsufficientDataError, plumb.Error))
+
+    def test_missing_file_names_it(self):
+        with self.assertRaises(plumb.InputError) as c:
+            plumb.open(out("absent.csv"))
+        self.assertIn("absent.csv", str(c.exception))
+        self.assertEqual(c.exception.file, out("absent.csv"))
+
+    def test_bad_table_line_names_file_and_line(self):
+        path = out("bad.csv")
+        with open(path, "w") as f:
+            f.write("1,2,3\n4,x,6\n")
+        with self.assertRaises(plumb.Error) as c:
+            plumb.open(path, columns="ax,ay,az", rate=10)
+        self.assertIn("bad.csv:line 2", str(c.exception))
+
+    def test_not_native_says_how_to_describe_it(self):
+        with self.assertRaises(plumb.InputError) as c:
+            plumb.open(SESSION)
+        self.assertIn("columns=", str(c.exception))
+
+    def test_malformed_options_are_errors(self):
+        # The library's parsers name the keyword as Python spells it, never the command's flag.
+        for kwargs, text in [({"columns": "ax,ay", "rate": 10},
+                              "open: columns 'ax,ay' must name all three accelerometer"),
+                             ({"columns": "ax,ay,az"},
+                              "open: columns 'ax,ay,az' has no time column (t): give rate=HZ"),
+                             ({"columns": "ax,ay,az,gx,gy,gz", "rate": 100, "axis_map": "1,2"},
+                              "open: axis_map must be three signed axes such as 1,-2,-3 (got '1,2')"),
+                             ({"columns": "ax,ay,az", "rate": 100, "acc_unit": "furlong"},
+                              "open: acc_unit must be m/s^2, g or counts (got 'furlong')"),
+                             ({"columns": "ax,ay,az", "rate": 100, "delimiter": "|"},
+                              "open: delimiter must be one of"),
+                             ({"colums": "ax,ay,az"}, "unknown option(s) colums"),
+                             ({"rate": "fast"}, "wrong type")]:
+            with self.assertRaises(plumb.Error, msg=str(kwargs)) as c:
+                plumb.open(SESSION, **kwargs)
+            self.assertIn(text, str(c.exception))
+            self.assertNotIn("--", str(c.exception))
+
+    def test_bad_model_and_site(self):
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        with self.assertRaises(plumb.Error):
+            plumb.calibrate(s, model="base+no_such_effect")
+        with self.assertRaises(plumb.Error):
+            plumb.calibrate(s, site=(95.0, 0.0))
+        with self.assertRaises(plumb.Error):
+            plumb.calibrate(s, site="Oxford")
+
+    def test_errors_name_the_keyword(self):
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        for kwargs, text in [({"accel_bi": "4 deg/h"},
+                              "calibrate: accel_bi: unit 'deg/h' not known here; use one of "
+                              "m/s^2, ug, mg"),
+                             ({"gyro_rw": -1.0}, "calibrate: gyro_rw: must be a finite number >= 0"),
+                             ({"gyro_bi": [1]}, "calibrate: gyro_bi must be a number or a text")]:
+            with self.assertRaises(plumb.Error, msg=str(kwargs)) as c:
+                plumb.calibrate(s, **kwargs)
+            self.assertIn(text, str(c.exception))
+        for kwargs, text in [({"schedule": "paper-static", "poses": 3},
+                              "simulate: poses applies to schedule multipose only"),
+                             ({"schedule": "paper-static", "turn_s": 1.0},
+                              "simulate: turn_s does not apply to schedule paper-static"),
+                             ({"schedule": "spin"}, "simulate: schedule must be multipose")]:
+            with self.assertRaises(plumb.Error, msg=str(kwargs)) as c:
+                plumb.simulate(**kwargs)
+            self.assertIn(text, str(c.exception))
+
+    def test_bad_calibration_file_names_it(self):
+        path = out("not_a_calibration.json")
+        with open(path, "w") as f:
+            f.write('{"model": "base"')
+        with self.assertRaises(plumb.InputError) as c:
+            plumb.load_calibration(path)
+        self.assertIn("not_a_calibration.json", str(c.exception))
+
+    def test_bad_arrays_are_errors(self):
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        plumb.calibrate(s).save(out("cal.json"))
+        cal = plumb.load_calibration(out("cal.json"))
+        with self.assertRaises(plumb.Error):
+            cal.apply(np.zeros((5, 2)), np.zeros((5, 3)))
+        with self.assertRaises(plumb.Error):
+            cal.apply(np.zeros((5, 3)), np.zeros((4, 3)))
+        with self.assertRaises(plumb.Error):  # a gyroscope model without gyroscope samples
+            cal.apply(np.zeros((5, 3)))
+
+
+class Arrays(unittest.TestCase):
+    def test_session_arrays_are_views_of_one_storage(self):
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        a, b = s.specific_force, s.specific_force
+        self.assertTrue(np.shares_memory(a, b))
+        self.assertFalse(a.flags.owndata)
+        self.assertFalse(a.flags.writeable)
+        self.assertEqual(a.shape, (len(s), 3))
+        self.assertTrue(np.shares_memory(s.time, s.time))
+        self.assertTrue(np.shares_memory(s.rate, s.rate))
+
+    def test_a_view_keeps_its_session_alive(self):
+        f = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100).specific_force
+        first = f[0].copy()
+        gc.collect()
+        junk = [np.ones(1000) for _ in range(1000)]
+        del junk
+        np.testing.assert_array_equal(f[0], first)
+
+    def test_apply_to_the_session_equals_apply_to_its_arrays(self):
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        plumb.calibrate(s).save(out("cal_arrays.json"))
+        cal = plumb.load_calibration(out("cal_arrays.json"))
+        f, w = cal.apply(s)
+        f2, w2 = cal.apply(s.specific_force, s.rate, time=s.time)
+        np.testing.assert_array_equal(f, f2)
+        np.testing.assert_array_equal(w, w2)
+        self.assertEqual(f.shape, (len(s), 3))
+        # The base model has no time or angular-acceleration effect: times are not needed.
+        f3, _ = cal.apply(s.specific_force, s.rate)
+        np.testing.assert_array_equal(f, f3)
+
+
+class Docstrings(unittest.TestCase):
+    def test_every_function_and_property_has_one(self):
+        for name in plumb.__all__:
+            obj = getattr(plumb, name)
+            self.assertTrue(obj.__doc__ and obj.__doc__.strip(), name)
+            if isinstance(obj, type) and not issubclass(obj, BaseException):
+                for attr, value in vars(obj).items():
+                    if attr.startswith("_"):
+                        continue
+                    self.assertTrue(value.__doc__ and value.__doc__.strip(), f"{name}.{attr}")
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,148 @@
+"""The Python module's results equal the plumb command's on the same inputs, bit for bit: the
+calibrate --json document (the tutorial's bundled session), its parameters, sigmas and
+covariance, diagnose --json, apply's corrected samples, simulate's samples, and one point of a
+study as `plumb sweep` writes it."""
+import csv
+import json
+import os
+import subprocess
+import unittest
+
+import numpy as np
+
+import plumb
+
+PLUMB = os.environ["PLUMB"]
+SOURCE = os.environ["PLUMB_SOURCE_DIR"]
+OUT = os.environ["PLUMB_TEST_OUT"]
+# The session the tutorial and scripts/demo calibrate (docs/tutorial.md), as the command reads it.
+SESSION = "data/mikoff/imu0.log"
+TABLE = ["--columns", "ax,ay,az,gx,gy,gz", "--rate", "100"]
+
+
+def run(*args):
+    """The plumb command, from the repository root; its standard output."""
+    done = subprocess.run([PLUMB, *args], cwd=SOURCE, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise AssertionError(f"plumb {' '.join(args)} exited {done.returncode}: {done.stderr}")
+    return done.stdout
+
+
+def out(name):
+    os.makedirs(OUT, exist_ok=True)
+    return os.path.join(OUT, name)
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array([[float(x) for x in r] for r in rows[1:]])
+
+
+class CliEqual(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        os.chdir(SOURCE)
+        cls.session = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+
+    def test_calibrate_document_is_the_commands(self):
+        run("calibrate", SESSION, *TABLE, "--json", out("cal.json"))
+        with open(out("cal.json")) as f:
+            text = f.read()
+        result = plumb.calibrate(self.session, model="base")
+        self.assertEqual(result.to_json(), text)
+        doc = json.loads(text)
+        for p in doc["parameters"]:
+            mine = result.parameters[p["name"]]
+            self.assertEqual(mine.value, p["value"], p["name"])
+            self.assertEqual(mine.sigma, p["sigma"], p["name"])
+        self.assertEqual(result.parameter_names, doc["covariance"]["parameters"])
+        np.testing.assert_array_equal(result.covariance, np.array(doc["covariance"]["matrix"]))
+        self.assertEqual(result.observability, doc["observability"])
+
+    def test_calibrate_with_site_and_options_is_the_commands(self):
+        run("calibrate", SESSION, *TABLE, "--lat", "51.64", "--lon", "-1.2", "--height", "100",
+            "--model", "base+gyro_g_sensitivity", "--constant-bias", "--json", out("cal_site.json"))
+        result = plumb.calibrate(self.session, model="base+gyro_g_sensitivity",
+                                 site=(51.64, -1.2, 100), constant_bias=True)
+        with open(out("cal_site.json")) as f:
+            self.assertEqual(result.to_json(), f.read())
+
+    def test_datasheet_units_are_the_commands(self):
+        # The bias wander levels in a datasheet's units, parsed by the command's parser.
+        levels = {"gyro_bi": "4 deg/h", "accel_rw": "10 ug/sqrt(h)"}
+        run("calibrate", SESSION, *TABLE, "--gyro-bi", levels["gyro_bi"], "--accel-rw",
+            levels["accel_rw"], "--json", out("cal_levels.json"))
+        result = plumb.calibrate(self.session, **levels)
+        with open(out("cal_levels.json")) as f:
+            self.assertEqual(result.to_json(), f.read())
+        # The same levels in SI, as numbers: the same fit (to the last bits of the conversion).
+        deg_per_hour = np.pi / 180 / 3600
+        si = plumb.calibrate(self.session, gyro_bi=4 * deg_per_hour,
+                             accel_rw=10e-6 * 9.80665 / 60)
+        for name, p in result.parameters.items():
+            self.assertAlmostEqual(si.parameters[name].value, p.value, delta=1e-9 * abs(p.value))
+            self.assertAlmostEqual(si.parameters[name].sigma, p.sigma, delta=1e-6 * p.sigma)
+        # ... and not the fit without them (the levels reach the fit).
+        default = plumb.calibrate(self.session)
+        self.assertNotEqual(default.parameters["accel.bias.x"].sigma,
+                            result.parameters["accel.bias.x"].sigma)
+
+    def test_diagnose_document_is_the_commands(self):
+        run("diagnose", SESSION, *TABLE, "--json", out("diagnosis.json"))
+        with open(out("diagnosis.json")) as f:
+            self.assertEqual(plumb.diagnose(self.session, model="base").to_json(), f.read())
+
+    def test_apply_equals_plumb_apply(self):
+        run("calibrate", SESSION, *TABLE, "--json", out("cal_apply.json"))
+        run("apply", out("cal_apply.json"), SESSION, *TABLE, "--out", out("corrected.csv"),
+            "--sigma")
+        header, table = read_csv(out("corrected.csv"))
+        calibration = plumb.load_calibration(out("cal_apply.json"))
+        f, w, fs, ws = calibration.apply(self.session, sigma=True)
+        # plumb apply writes %.9g: round ours the same way to compare every printed digit.
+        def printed(a):
+            return np.array([[float(f"{x:.9g}") for x in row] for row in a])
+        np.testing.assert_array_equal(printed(f), table[:, 1:4])
+        np.testing.assert_array_equal(printed(w), table[:, 4:7])
+        np.testing.assert_array_equal(printed(fs), table[:, 7:10])
+        np.testing.assert_array_equal(printed(ws), table[:, 10:13])
+        # The same samples given as arrays (float64, the session's values) and times.
+        f2, w2 = calibration.apply(self.session.specific_force.astype(np.float64),
+                                   self.session.rate.astype(np.float64),
+                                   time=self.session.time)
+        np.testing.assert_array_equal(f2, f)
+        np.testing.assert_array_equal(w2, w)
+
+    def test_simulate_equals_plumb_simulate(self):
+        run("simulate", "--out", out("sim.csv"), "--random-truth", "1", "--poses", "6",
+            "--lat", "51.64", "--lon", "-1.2", "--height", "100", "--seed", "3")
+        sim = plumb.simulate(random_truth=1, poses=6, site=(51.64, -1.2, 100), seed=3)
+        written = plumb.open(out("sim.csv"))
+        np.testing.assert_array_equal(sim.session.time, written.time)
+        np.testing.assert_array_equal(sim.session.specific_force, written.specific_force)
+        np.testing.assert_array_equal(sim.session.rate, written.rate)
+        np.testing.assert_array_equal(sim.session.temperature, written.temperature)
+
+    def test_sweep_point_is_the_commands_point_file(self):
+        study = {"name": "python test", "seed": 5, "runs": 2, "design": "grid",
+                 "base": {"schedule": "multipose", "still_s": 3, "turn_s": 2, "rate_hz": 50,
+                          "sensor": "typical", "random_truth": 1},
+                 "fit": {"model": "base"},
+                 "factors": [{"name": "poses", "levels": [6, 8]}]}
+        path = out("study.json")
+        with open(path, "w") as f:
+            json.dump(study, f)
+        run("sweep", path, "--out", out("sweep"), "--jobs", "1")
+        self.assertEqual(plumb.sweep_points(path), 2)
+        for index in range(2):
+            with open(os.path.join(out("sweep"), "points", f"point-{index:05d}.json")) as f:
+                text = f.read()
+            self.assertEqual(plumb.sweep_point_json(path, index), text)
+            self.assertEqual(plumb.sweep_point(study, index), json.loads(text))
+        with open(os.path.join(out("sweep"), "study.json")) as f:
+            self.assertEqual(plumb.study_json(path), f.read())
+
+
+if __name__ == "__main__":
+    unittest.main()
