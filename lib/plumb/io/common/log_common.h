@@ -142,8 +142,14 @@ class RecordStore {
 struct RecordFilter {
   /// True for the names whose bodies are stored; empty: all.
   std::function<bool(std::string_view name)> keep;
+  /// True for the IMU messages whose samples the reader decodes inside its pass, while each
+  /// record is in the cache, keeping the decoded samples instead of the bodies (the format's
+  /// reader says which messages it can decode so, and what it keeps of them; a message it
+  /// cannot decode keeps its bodies when `keep` says so). Empty: none, bodies only.
+  std::function<bool(std::string_view name)> decode;
 
   bool Keeps(std::string_view name) const { return !keep || keep(name); }
+  bool Decodes(std::string_view name) const { return decode && decode(name); }
 };
 
 /// The message of a time window (--from/--to, log times) that holds fewer than 2 samples of a
