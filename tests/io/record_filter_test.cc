@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <string>
 
 #include "plumb/core/error.h"
 #include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/ardupilot/dataflash.h"
+#include "dataflash_builder.h"
 #include "plumb/io/px4/px4_session.h"
 #include "plumb/io/px4/ulog.h"
 
@@ -65,6 +67,102 @@ TEST(RecordFilter, DataflashBinaryKeepsWhatSessionsRead) {
     SCOPED_TRACE(name);
     CheckDataflash(ReadDataflash(path), ReadDataflash(path, ArdupilotSessionRecords()));
   }
+}
+
+/// The IMU samples decoded in the reader's pass (`kept`, ArdupilotSessionRecords) against the
+/// ones decoded from every stored body (`all`): the same instances, samples, errors, streams.
+void CheckDecodedImu(const DataflashLog& all, const DataflashLog& kept) {
+  const std::vector<DataflashImuInfo> a = DataflashImuInstances(all);
+  const std::vector<DataflashImuInfo> b = DataflashImuInstances(kept);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].instance, b[k].instance);
+    EXPECT_EQ(a[k].message, b[k].message);
+    EXPECT_EQ(a[k].samples, b[k].samples);
+    EXPECT_EQ(a[k].rate_hz, b[k].rate_hz);
+    EXPECT_EQ(a[k].has_temperature, b[k].has_temperature);
+  }
+  for (int instance : {0, 1, 2, 3, 255, 256}) {
+    SCOPED_TRACE(instance);
+    std::string error_all, error_kept;
+    ImuSeries sa, sb;
+    try {
+      sa = ImuFromDataflash(all, instance);
+    } catch (const InputError& e) {
+      error_all = e.what();
+    }
+    try {
+      sb = ImuFromDataflash(kept, instance);
+    } catch (const InputError& e) {
+      error_kept = e.what();
+    }
+    EXPECT_EQ(error_all, error_kept);
+    ExpectSameSeries(sa, sb);
+  }
+  const std::vector<ImuStreamInfo> sa = DataflashImuStreams(all);
+  const std::vector<ImuStreamInfo> sb = DataflashImuStreams(kept);
+  ASSERT_EQ(sa.size(), sb.size());
+  for (std::size_t k = 0; k < sa.size(); ++k) {
+    EXPECT_EQ(sa[k].name, sb[k].name);
+    EXPECT_EQ(sa[k].instance, sb[k].instance);
+    EXPECT_EQ(sa[k].samples, sb[k].samples);
+    EXPECT_EQ(sa[k].rate_hz, sb[k].rate_hz);
+    EXPECT_EQ(sa[k].t_start_s, sb[k].t_start_s);
+    EXPECT_EQ(sa[k].t_end_s, sb[k].t_end_s);
+    EXPECT_EQ(sa[k].has_temperature, sb[k].has_temperature);
+  }
+}
+
+TEST(RecordFilter, DataflashImuDecodedInThePassAsFromBodies) {
+  for (const char* name : {"copter36_chibios.bin", "copter364_fmuv5.bin", "plane408_centre_point.BIN",
+                           "plane408_pilot_pos.BIN", "plane382_pymavlink_test.BIN",
+                           "copter462_truncated_isbd.bin", "copter344_pixhawk1_oldformat.bin"}) {
+    const std::string path = SharedFile(std::string("ardupilot/") + name);
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+    SCOPED_TRACE(name);
+    const DataflashLog kept = ReadDataflash(path, ArdupilotSessionRecords());
+    std::size_t decoded = 0;
+    for (const DataflashType& t : kept.types) decoded += t.imu_decoded ? 1 : 0;
+    EXPECT_GT(decoded, 0u);
+    CheckDecodedImu(ReadDataflash(path), kept);
+  }
+}
+
+/// A log whose IMU has a float I column (whole, fractional, out-of-range and NaN instances),
+/// times that go back, a spike and repeats, and a truncated last record.
+TEST(RecordFilter, DataflashImuDecodedKeepsTheTimeRuleAndInstances) {
+  using testing::Append;
+  using testing::Bytes;
+  using testing::Put;
+  // TimeUS Q, I f, GyrX..Z fff, AccX..Z fff, T h: 3 + 8 + 4 + 24 + 2 = 41 bytes.
+  Bytes log = testing::FmtRecord(128, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+  Append(&log, testing::FmtRecord(20, 41, "IMU", "QfffffffH", "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ,T"));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float instances[] = {0.0f, 1.0f, 1.5f, 300.0f, -1.0f, nan, 2.0f};
+  const std::uint64_t times[] = {1000, 2000, 1500, 3000, 3000, 90000000, 4000, 5000, 6000, 7000};
+  std::size_t n = 0;
+  for (std::uint64_t t : times) {
+    for (float instance : instances) {
+      Bytes r = {0xA3, 0x95, 20};
+      Put(&r, t + static_cast<std::uint64_t>(n % 3));
+      Put(&r, instance);
+      for (int k = 0; k < 6; ++k) Put(&r, 0.25f * static_cast<float>(n + k));
+      Put(&r, static_cast<std::uint16_t>(n));
+      Append(&log, r);
+      ++n;
+    }
+  }
+  log.resize(log.size() - 7);  // the last record cut
+  const DataflashLog all = ParseDataflash(log.data(), log.size(), "decoded.bin");
+  const DataflashLog kept =
+      ParseDataflash(log.data(), log.size(), "decoded.bin", ArdupilotSessionRecords());
+  ASSERT_TRUE(kept.Find("IMU")->imu_decoded);
+  EXPECT_FALSE(kept.Find("IMU")->bodies_kept);
+  EXPECT_EQ(all.MessageCounts(), kept.MessageCounts());
+  EXPECT_EQ(all.warnings.Describe(), kept.warnings.Describe());
+  CheckDecodedImu(all, kept);
+  EXPECT_LT(ImuFromDataflash(kept, 0).size(), std::size(times));  // the rule dropped some
+  EXPECT_GT(ImuFromDataflash(kept, 0).size(), 3u);
 }
 
 TEST(RecordFilter, DataflashTextKeepsWhatSessionsRead) {
