@@ -169,11 +169,14 @@ class Parser {
       : log_(log), filter_(filter), size_hint_(size_hint) {
     index_.fill(-1);
     decoder_of_.fill(-1);
+    rows_.fill(0);
     AddType(detail::DataflashFmtType(&log_->warnings));
   }
 
-  /// After the last Feed: the decoded IMU messages' waiting records are decided.
+  /// After the last Feed: the record counts go to the types, and the decoded IMU messages'
+  /// waiting records are decided.
   void Finish() {
+    for (DataflashType& t : log_->types) t.rows = rows_[t.id];
     for (std::size_t id = 0; id < decoder_of_.size(); ++id) {
       if (decoder_of_[id] < 0) continue;
       decoders_[static_cast<std::size_t>(decoder_of_[id])].Finish(
@@ -186,28 +189,23 @@ class Parser {
   /// before offset + n, so that every record starting before it is whole). `at_end`: the bytes
   /// end the input (the truncated last record and trailing bytes are counted).
   std::size_t Feed(const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    // The loop reads one table per record (length and action by type byte) and touches a
+    // type only for the records it keeps or decodes: the walk from record to record is the
+    // chain of loads byte -> length -> next byte, nothing more.
+    const std::size_t room = at_end ? kHeaderSize : kMaxRecord;  // bytes a record may need
     std::size_t i = 0;
-    while (n - i >= kHeaderSize) {
-      if (!at_end && n - i < kMaxRecord) return offset + i;
-      if (data[i] == kHead1 && data[i + 1] == kHead2) {
-        const int idx = index_[data[i + 2]];
-        if (idx >= 0) {
-          DataflashType& t = log_->types[static_cast<std::size_t>(idx)];
-          if (t.length > n - i) {
-            Truncated(n - i);
-            return offset + n;
-          }
-          const std::uint8_t* body = data + i + kHeaderSize;
-          if (t.bodies_kept) {
-            t.bodies.Append(body);
-          } else if (t.imu_decoded) {
-            decoders_[static_cast<std::size_t>(decoder_of_[t.id])].Add(t, body);
-          }
-          ++t.rows;
-          i += t.length;
-          if (t.id == kFmtType) HandleFmt(body, t.body_size, offset + i);
-          continue;
+    while (n - i >= room) {
+      const std::uint8_t* p = data + i;
+      const Entry e = table_[p[2]];
+      if (p[0] == kHead1 && p[1] == kHead2 && e.length != 0) {
+        if (e.length > n - i) {
+          Truncated(n - i);
+          return offset + n;
         }
+        ++rows_[p[2]];
+        i += e.length;
+        if (e.action != Action::kCount) Act(e.action, p[2], p + kHeaderSize, offset + i);
+        continue;
       }
       Skip(offset + i);
       ++i;
@@ -225,6 +223,26 @@ class Parser {
   }
 
  private:
+  /// What the loop does with a record of a type besides counting it.
+  enum class Action : std::uint8_t { kCount, kKeep, kDecode, kFmt };
+  /// A type's entry in the loop's table, by type byte.
+  struct Entry {
+    std::uint8_t length = 0;  ///< record length with the header; 0: no type has this byte
+    Action action = Action::kCount;
+  };
+
+  /// Keeps (kKeep, kFmt) or decodes (kDecode) the record body `body` of type `id`; an FMT
+  /// (kFmt, its record ending at byte `end`) defines a type.
+  void Act(Action action, std::uint8_t id, const std::uint8_t* body, std::size_t end) {
+    DataflashType& t = log_->types[static_cast<std::size_t>(index_[id])];
+    if (action == Action::kDecode) {
+      decoders_[static_cast<std::size_t>(decoder_of_[id])].Add(t, body);
+      return;
+    }
+    t.bodies.Append(body);
+    if (action == Action::kFmt) HandleFmt(body, t.body_size, end);
+  }
+
   /// Adds a type from its FMT, found at byte `offset`.
   void AddType(DataflashType t, std::size_t offset = 0) {
     t.bodies_kept = t.id == kFmtType || filter_.Keeps(t.name);
@@ -237,6 +255,12 @@ class Parser {
         decoders_.push_back(*d);
       }
     }
+    Entry& e = table_[t.id];
+    e.length = static_cast<std::uint8_t>(t.length);  // 3..255 (AcceptFmt, one byte)
+    e.action = t.id == kFmtType ? Action::kFmt
+               : t.imu_decoded  ? Action::kDecode
+               : t.bodies_kept  ? Action::kKeep
+                                : Action::kCount;
     index_[t.id] = static_cast<int>(log_->types.size());
     log_->types.push_back(std::move(t));
   }
@@ -270,6 +294,8 @@ class Parser {
   std::size_t size_hint_ = 0;   ///< the input's size, bytes (0: unknown)
   std::array<int, 256> index_;
   std::array<int, 256> decoder_of_;  ///< index in decoders_ by type id, -1: not decoded
+  std::array<Entry, 256> table_{};    ///< the loop's table by type id
+  std::array<std::size_t, 256> rows_;  ///< records counted by type id
   std::vector<ImuDecoder> decoders_;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
