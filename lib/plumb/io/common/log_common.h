@@ -83,6 +83,13 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
                  const std::function<std::size_t(const std::uint8_t* data, std::size_t n,
                                                  std::size_t offset, bool at_end)>& consume);
 
+/// Asks the system to back the memory [p, p + bytes) of a large buffer that is about to be
+/// filled by transparent huge pages (madvise MADV_HUGEPAGE on the whole 2 MiB pages inside it;
+/// nothing when it holds none or the system has no such pages): one page fault per 2 MiB
+/// instead of per 4 KiB as the buffer is first written. Only a hint: the contents and the
+/// results never depend on it.
+void AdviseHugePages(const void* p, std::size_t bytes);
+
 /// The size of the file at `path` in bytes (0 when it is not a regular file or cannot be
 /// read).
 std::size_t RegularFileSize(const std::string& path);
