@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <new>
 
 #include "plumb/core/error.h"
 
@@ -190,7 +191,17 @@ bool RecordStore::operator==(const RecordStore& other) const {
 }
 
 void RecordStore::AddBlock() {
-  blocks_.emplace_back(new std::uint8_t[(mask_ + 1) * body_size_]);
+  // Whole huge pages: the rows' bytes rounded up to kBlockBytes (the tail is never written).
+  const std::size_t rows_bytes = std::max<std::size_t>((mask_ + 1) * body_size_, 1);
+  const std::size_t bytes = (rows_bytes + kBlockBytes - 1) / kBlockBytes * kBlockBytes;
+  auto* block = static_cast<std::uint8_t*>(
+      ::operator new(bytes, std::align_val_t{kBlockBytes}));
+  blocks_.emplace_back(block);
+  if (blocks_.size() > 1) AdviseHugePages(block, bytes);
+}
+
+void RecordStore::FreeBlock::operator()(std::uint8_t* p) const {
+  ::operator delete(p, std::align_val_t{kBlockBytes});
 }
 
 LogFile::~LogFile() {
