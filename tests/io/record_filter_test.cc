@@ -198,5 +198,41 @@ TEST(RecordFilter, ULogKeepsWhatSessionsRead) {
   }
 }
 
+/// Every stream of every shared .ulg: the samples sensor_combined's reader decoded in its pass
+/// (Px4SessionTopics) equal the ones decoded from its stored bodies, as listed and as sessions.
+TEST(RecordFilter, ULogSensorCombinedDecodedInThePassAsFromBodies) {
+  std::size_t decoded = 0;
+  for (const char* name : {"sample.ulg", "sample_log_small.ulg", "sample_appended_multiple.ulg",
+                           "sample_logging_tagged_and_default_params.ulg",
+                           "sample_px4_events.ulg"}) {
+    const std::string path = SharedFile(std::string("px4/") + name);
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+    SCOPED_TRACE(name);
+    const ULog all = ReadULog(path);
+    const ULog kept = ReadULog(path, Px4SessionTopics());
+    if (const ULogTopic* t = kept.Find("sensor_combined"); t != nullptr && t->imu_decoded) {
+      ++decoded;
+      EXPECT_FALSE(t->bodies_kept);
+      EXPECT_EQ(t->KeptBytes(), all.Find("sensor_combined")->bodies.size());
+    }
+    const std::vector<ImuStreamInfo> a = ULogImuStreams(all);
+    const std::vector<ImuStreamInfo> b = ULogImuStreams(kept);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].name, b[k].name);
+      EXPECT_EQ(a[k].instance, b[k].instance);
+      EXPECT_EQ(a[k].samples, b[k].samples);
+      EXPECT_EQ(a[k].t_start_s, b[k].t_start_s);
+      EXPECT_EQ(a[k].t_end_s, b[k].t_end_s);
+      EXPECT_EQ(a[k].rate_hz, b[k].rate_hz);
+      FlightLogSelection pick;
+      pick.imu = a[k].instance;
+      pick.stream = a[k].name;
+      ExpectSameSeries(ULogSession(all, pick).series, ULogSession(kept, pick).series);
+    }
+  }
+  EXPECT_GT(decoded, 0u);
+}
+
 }  // namespace
 }  // namespace plumb::io

@@ -456,28 +456,6 @@ DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter) 
 
 namespace {
 
-/// `v` copied into a buffer reserved first and backed by huge pages where it is large.
-template <typename T>
-std::vector<T> CopyVector(const std::vector<T>& v) {
-  std::vector<T> out;
-  out.reserve(v.size());
-  AdviseHugePages(out.data(), v.size() * sizeof(T));
-  out.assign(v.begin(), v.end());
-  return out;
-}
-
-/// A copy of the series `s` (see CopyVector).
-ImuSeries CopyOf(const ImuSeries& s) {
-  ImuSeries out;
-  out.t_s = CopyVector(s.t_s);
-  out.acc = CopyVector(s.acc);
-  out.gyr = CopyVector(s.gyr);
-  out.temp_c = CopyVector(s.temp_c);
-  out.acc_unit = s.acc_unit;
-  out.gyr_unit = s.gyr_unit;
-  return out;
-}
-
 /// The description of IMU `instance` of message `type`: `samples` records, the first and last
 /// with the (unscaled) times `first` and `last`.
 DataflashImuInfo ImuInfo(const DataflashType& type, int instance, std::size_t samples,
@@ -581,7 +559,7 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
       throw InputError(log.source, "", "no " + type->name + " rows with I == " +
                                            std::to_string(instance) + " for " + what);
     }
-    return CopyOf(type->imu[k].series);
+    return CopySeries(type->imu[k].series);
   }
   if (!type->bodies_kept) NotKept(type->name);
   using Reader = detail::DataflashColumnReader;

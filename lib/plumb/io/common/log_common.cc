@@ -113,6 +113,30 @@ void AdviseHugePages(const void* p, std::size_t bytes) {
 #endif
 }
 
+namespace {
+
+template <typename T>
+std::vector<T> CopyVector(const std::vector<T>& v) {
+  std::vector<T> out;
+  out.reserve(v.size());
+  AdviseHugePages(out.data(), v.size() * sizeof(T));
+  out.assign(v.begin(), v.end());
+  return out;
+}
+
+}  // namespace
+
+ImuSeries CopySeries(const ImuSeries& s) {
+  ImuSeries out;
+  out.t_s = CopyVector(s.t_s);
+  out.acc = CopyVector(s.acc);
+  out.gyr = CopyVector(s.gyr);
+  out.temp_c = CopyVector(s.temp_c);
+  out.acc_unit = s.acc_unit;
+  out.gyr_unit = s.gyr_unit;
+  return out;
+}
+
 std::size_t RegularFileSize(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return 0;

@@ -90,6 +90,10 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
 /// results never depend on it.
 void AdviseHugePages(const void* p, std::size_t bytes);
 
+/// A copy of `s` whose large buffers are reserved first and backed by huge pages
+/// (AdviseHugePages): samples a reader decoded in its pass, handed out by value.
+ImuSeries CopySeries(const ImuSeries& s);
+
 /// The size of the file at `path` in bytes (0 when it is not a regular file or cannot be
 /// read).
 std::size_t RegularFileSize(const std::string& path);

@@ -240,7 +240,7 @@ double KeptFraction(const std::string& path, FlightLogFormat format) {
         break;
       case FlightLogFormat::kPx4ULog:
         for (const ULogTopic& t : ParseULog(bytes, prefix.size(), path, Px4SessionTopics()).topics) {
-          kept += t.bodies.size();
+          kept += t.KeptBytes();
         }
         break;
       case FlightLogFormat::kMavlinkTlog:

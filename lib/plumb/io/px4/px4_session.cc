@@ -126,6 +126,7 @@ ImuSeries FromCombined(const ULogTopic& t) {
   auto gyr = ArrayColumns(t, "gyro_rad");
   if (!gyr) gyr = ArrayColumns(t, "gyro_rad_s");
   if (!acc || !gyr || t.timestamp_col < 0) return s;
+  if (t.imu_decoded) return CopySeries(t.imu);  // decoded by the reader, the same way
   const Cols a = ColsOf(t, *acc), w = ColsOf(t, *gyr);
   const Col time = ColOf(t, t.timestamp_col);
   Reserve(&s, t.rows, true, false);
@@ -409,7 +410,11 @@ ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries
 std::vector<ImuStreamInfo> ULogImuStreams(const ULog& log) {
   std::vector<ImuStreamInfo> out;
   for (const StreamSource& src : Sources(log)) {
-    out.push_back(Describe(log, src, Extract(src, nullptr)));
+    if (src.kind == StreamKind::kCombined && src.topic->imu_decoded) {
+      out.push_back(Describe(log, src, src.topic->imu));  // no copy of the reader's samples
+    } else {
+      out.push_back(Describe(log, src, Extract(src, nullptr)));
+    }
   }
   return out;
 }
@@ -565,6 +570,8 @@ bool LooksLikeULog(const std::string& path) {
 
 RecordFilter Px4SessionTopics() {
   RecordFilter filter;
+  // sensor_combined: decoded in the reader's pass (a session and `plumb info` read its samples).
+  filter.decode = [](std::string_view name) { return name == "sensor_combined"; };
   filter.keep = [](std::string_view name) {
     for (const char* topic : {"sensor_combined", "vehicle_imu", "vehicle_imu_status",
                               "sensor_accel", "sensor_gyro", "sensor_gps",
