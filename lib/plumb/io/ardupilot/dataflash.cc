@@ -79,6 +79,14 @@ class ImuDecoder {
     const int instance = t.name == "IMU" ? t.ColumnIndex("I") : -1;
     d.has_instance_ = instance >= 0;
     if (d.has_instance_) d.instance_ = Reader::Of(t, instance);
+    const auto plain_float = [](const Reader& r) {
+      return r.storage == detail::DataflashStorage::kFloat && r.scale == 1.0;
+    };
+    d.float_axes_ = plain_float(d.acc_[0]) && plain_float(d.acc_[1]) && plain_float(d.acc_[2]);
+    if (d.has_gyr_) {
+      d.float_axes_ = d.float_axes_ && plain_float(d.gyr_[0]) && plain_float(d.gyr_[1]) &&
+                      plain_float(d.gyr_[2]);
+    }
     d.rows_bound_ = std::min(rows_bound, kMaxReserve);
     return d;
   }
@@ -104,15 +112,22 @@ class ImuDecoder {
     if (d.pending) Decide(d, d.pending_t_s < t_s);
     d.pending = true;
     d.pending_t_s = t_s;
-    d.pending_acc = Vec3f(static_cast<float>(acc_[0].Read(body)),
-                          static_cast<float>(acc_[1].Read(body)),
-                          static_cast<float>(acc_[2].Read(body)));
-    if (has_gyr_) {
-      d.pending_gyr = Vec3f(static_cast<float>(gyr_[0].Read(body)),
-                            static_cast<float>(gyr_[1].Read(body)),
-                            static_cast<float>(gyr_[2].Read(body)));
-    }
+    d.pending_acc = Axes(body, acc_);
+    if (has_gyr_) d.pending_gyr = Axes(body, gyr_);
     if (has_temp_) d.pending_temp = static_cast<float>(temp_.Read(body));
+  }
+
+  /// The three columns `c` of `body` as floats: Read() cast to float, or (float_axes_, the
+  /// usual 'f' columns) the stored floats themselves, the same values without the decoding
+  /// switch.
+  Vec3f Axes(const std::uint8_t* body, const detail::DataflashColumnReader* c) const {
+    if (float_axes_) {
+      return Vec3f(LoadLittleEndian<float>(body + c[0].offset),
+                   LoadLittleEndian<float>(body + c[1].offset),
+                   LoadLittleEndian<float>(body + c[2].offset));
+    }
+    return Vec3f(static_cast<float>(c[0].Read(body)), static_cast<float>(c[1].Read(body)),
+                 static_cast<float>(c[2].Read(body)));
   }
 
   /// After the last record: decides every instance's waiting record.
@@ -157,6 +172,7 @@ class ImuDecoder {
   bool has_gyr_ = false;
   bool has_temp_ = false;
   bool has_instance_ = false;
+  bool float_axes_ = false;  ///< every Acc/Gyr column is a plain float ('f')
   std::size_t rows_bound_ = 0;
 };
 

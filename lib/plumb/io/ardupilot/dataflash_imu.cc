@@ -345,7 +345,20 @@ ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref, const ImuS
   return info;
 }
 
+/// The samples the reader decoded for IMU stream `ref` (DataflashType::imu), or nullptr when
+/// it did not (they are then read from bodies).
+const ImuSeries* DecodedImu(const DataflashLog& log, const StreamRef& ref) {
+  if (ref.kind != Kind::kImu) return nullptr;
+  int col = -1;
+  const DataflashType* t = DataflashInstanceMessage(log, "IMU", ref.instance, false, &col);
+  if (t == nullptr || !t->imu_decoded) return nullptr;
+  const std::size_t k = col >= 0 ? static_cast<std::size_t>(ref.instance) : 0;
+  if (k >= t->imu.size() || t->imu[k].records == 0) return nullptr;  // as ImuFromDataflash
+  return &t->imu[k].series;
+}
+
 ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
+  if (const ImuSeries* decoded = DecodedImu(log, ref)) return Describe(log, ref, *decoded);
   ImuSeries s;
   try {
     s = ReadStream(log, ref);
