@@ -318,8 +318,9 @@ BENCHMARK_CAPTURE(BM_Cat, sample, std::string("px4/sample.ulg"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// ArduPilot DataFlash .bin: decode the log as FlightLog does (the bodies a session reads)
-/// and every IMU instance's samples, of every copy.
+/// ArduPilot DataFlash .bin: decode the log as FlightLog does (the bodies a session reads;
+/// the IMU messages' samples decoded in the pass) and get every IMU instance's samples, of
+/// every copy, as ImuFromDataflash returns them (a copy of the decoded samples).
 void BM_ReadDataflash(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative, [](const std::string& path) {
     const plumb::io::DataflashLog decoded =
@@ -385,9 +386,9 @@ BENCHMARK_CAPTURE(BM_ReadTlog, plane385_disarmed, std::string("mavlink/plane385_
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// PX4 ULog: decode the log as FlightLog does (the bodies of the topics a session reads) and
-/// the samples of every IMU stream (sensor_combined, vehicle_imu, sensor_accel paired with
-/// sensor_gyro), of every copy.
+/// PX4 ULog: decode the log as FlightLog does (the bodies of the topics a session reads;
+/// sensor_combined's samples decoded in the pass) and list every IMU stream with its samples
+/// (sensor_combined, vehicle_imu, sensor_accel paired with sensor_gyro), of every copy.
 void BM_ReadULog(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative, [](const std::string& path) {
     const plumb::io::ULog decoded = plumb::io::ReadULog(path, plumb::io::Px4SessionTopics());

@@ -47,6 +47,15 @@ TEST(LogCommon, RecordStoreKeepsRowsAcrossBlocksAndCopies) {
     for (std::size_t r = 0; r + 1 < rows; ++r) other.Append(store.Row(r));
     EXPECT_FALSE(other == store);
   }
+  // Small rows across blocks (2 MiB each: 32768 rows of 37 bytes).
+  RecordStore store(37);
+  const std::vector<std::uint8_t> bytes = Pattern(37 * 100003);
+  for (std::size_t r = 0; r < 100003; ++r) store.Append(bytes.data() + r * 37);
+  ASSERT_EQ(store.rows(), 100003u);
+  for (std::size_t r = 0; r < 100003; ++r) {
+    ASSERT_EQ(std::memcmp(store.Row(r), bytes.data() + r * 37, 37), 0) << r;
+  }
+  EXPECT_TRUE(RecordStore(store) == store);
 }
 
 TEST(LogCommon, ReadForwardHandsEveryByteOnceWithItsLookahead) {

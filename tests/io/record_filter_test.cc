@@ -4,12 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
 
 #include "plumb/core/error.h"
 #include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/ardupilot/dataflash.h"
+#include "dataflash_builder.h"
 #include "plumb/io/px4/px4_session.h"
 #include "plumb/io/px4/ulog.h"
 
@@ -67,6 +73,190 @@ TEST(RecordFilter, DataflashBinaryKeepsWhatSessionsRead) {
   }
 }
 
+/// The IMU samples decoded in the reader's pass (`kept`, ArdupilotSessionRecords) against the
+/// ones decoded from every stored body (`all`): the same instances, samples, errors, streams.
+void CheckDecodedImu(const DataflashLog& all, const DataflashLog& kept) {
+  const std::vector<DataflashImuInfo> a = DataflashImuInstances(all);
+  const std::vector<DataflashImuInfo> b = DataflashImuInstances(kept);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].instance, b[k].instance);
+    EXPECT_EQ(a[k].message, b[k].message);
+    EXPECT_EQ(a[k].samples, b[k].samples);
+    EXPECT_EQ(a[k].rate_hz, b[k].rate_hz);
+    EXPECT_EQ(a[k].has_temperature, b[k].has_temperature);
+  }
+  for (int instance : {0, 1, 2, 3, 255, 256}) {
+    SCOPED_TRACE(instance);
+    std::string error_all, error_kept;
+    ImuSeries sa, sb;
+    try {
+      sa = ImuFromDataflash(all, instance);
+    } catch (const InputError& e) {
+      error_all = e.what();
+    }
+    try {
+      sb = ImuFromDataflash(kept, instance);
+    } catch (const InputError& e) {
+      error_kept = e.what();
+    }
+    EXPECT_EQ(error_all, error_kept);
+    ExpectSameSeries(sa, sb);
+  }
+  const std::vector<ImuStreamInfo> sa = DataflashImuStreams(all);
+  const std::vector<ImuStreamInfo> sb = DataflashImuStreams(kept);
+  ASSERT_EQ(sa.size(), sb.size());
+  for (std::size_t k = 0; k < sa.size(); ++k) {
+    EXPECT_EQ(sa[k].name, sb[k].name);
+    EXPECT_EQ(sa[k].instance, sb[k].instance);
+    EXPECT_EQ(sa[k].samples, sb[k].samples);
+    EXPECT_EQ(sa[k].rate_hz, sb[k].rate_hz);
+    EXPECT_EQ(sa[k].t_start_s, sb[k].t_start_s);
+    EXPECT_EQ(sa[k].t_end_s, sb[k].t_end_s);
+    EXPECT_EQ(sa[k].has_temperature, sb[k].has_temperature);
+  }
+}
+
+TEST(RecordFilter, DataflashImuDecodedInThePassAsFromBodies) {
+  for (const char* name : {"copter36_chibios.bin", "copter364_fmuv5.bin", "plane408_centre_point.BIN",
+                           "plane408_pilot_pos.BIN", "plane382_pymavlink_test.BIN",
+                           "copter462_truncated_isbd.bin", "copter344_pixhawk1_oldformat.bin"}) {
+    const std::string path = SharedFile(std::string("ardupilot/") + name);
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+    SCOPED_TRACE(name);
+    const DataflashLog kept = ReadDataflash(path, ArdupilotSessionRecords());
+    std::size_t decoded = 0;
+    for (const DataflashType& t : kept.types) decoded += t.imu_decoded ? 1 : 0;
+    EXPECT_GT(decoded, 0u);
+    CheckDecodedImu(ReadDataflash(path), kept);
+  }
+}
+
+/// A log whose IMU has a float I column (whole, fractional, out-of-range and NaN instances),
+/// times that go back, a spike and repeats, and a truncated last record.
+TEST(RecordFilter, DataflashImuDecodedKeepsTheTimeRuleAndInstances) {
+  using testing::Append;
+  using testing::Bytes;
+  using testing::Put;
+  // TimeUS Q, I f, GyrX..Z fff, AccX..Z fff, T h: 3 + 8 + 4 + 24 + 2 = 41 bytes.
+  Bytes log = testing::FmtRecord(128, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+  Append(&log, testing::FmtRecord(20, 41, "IMU", "QfffffffH", "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ,T"));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float instances[] = {0.0f, 1.0f, 1.5f, 300.0f, -1.0f, nan, 2.0f};
+  const std::uint64_t times[] = {1000, 2000, 1500, 3000, 3000, 90000000, 4000, 5000, 6000, 7000};
+  std::size_t n = 0;
+  for (std::uint64_t t : times) {
+    for (float instance : instances) {
+      Bytes r = {0xA3, 0x95, 20};
+      Put(&r, t + static_cast<std::uint64_t>(n % 3));
+      Put(&r, instance);
+      for (int k = 0; k < 6; ++k) Put(&r, 0.25f * static_cast<float>(n + k));
+      Put(&r, static_cast<std::uint16_t>(n));
+      Append(&log, r);
+      ++n;
+    }
+  }
+  log.resize(log.size() - 7);  // the last record cut
+  const DataflashLog all = ParseDataflash(log.data(), log.size(), "decoded.bin");
+  const DataflashLog kept =
+      ParseDataflash(log.data(), log.size(), "decoded.bin", ArdupilotSessionRecords());
+  ASSERT_TRUE(kept.Find("IMU")->imu_decoded);
+  EXPECT_FALSE(kept.Find("IMU")->bodies_kept);
+  EXPECT_EQ(all.MessageCounts(), kept.MessageCounts());
+  EXPECT_EQ(all.warnings.Describe(), kept.warnings.Describe());
+  CheckDecodedImu(all, kept);
+  EXPECT_LT(ImuFromDataflash(kept, 0).size(), std::size(times));  // the rule dropped some
+  EXPECT_GT(ImuFromDataflash(kept, 0).size(), 3u);
+}
+
+/// Everything the IMU side of a log gives (streams, every instance's samples and sessions, or
+/// the error each throws) as text, the sums of the samples in hexadecimal floating point.
+std::string SeriesText(const ImuSeries& s) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    sum += s.t_s[i] + s.acc[i].sum() + (s.has_gyro() ? s.gyr[i].sum() : 0.0f) +
+           (s.has_temperature() ? s.temp_c[i] : 0.0f);
+  }
+  char text[64];
+  std::snprintf(text, sizeof text, "%zu:%a", s.size(), sum);
+  return text;
+}
+
+template <typename Log, typename Streams, typename Select>
+std::string ImuText(const Log& log, Streams streams, Select select) {
+  std::ostringstream out;
+  try {
+    for (const ImuStreamInfo& info : streams(log)) {
+      out << info.name << "/" << info.instance << " " << info.samples << " " << info.rate_hz
+          << " " << info.t_start_s << " " << info.t_end_s << ": ";
+      FlightLogSelection pick;
+      pick.imu = info.instance;
+      pick.stream = info.name;
+      try {
+        out << SeriesText(select(log, pick).series) << "\n";
+      } catch (const Error& e) {
+        out << e.what() << "\n";
+      }
+    }
+  } catch (const Error& e) {
+    out << "streams: " << e.what();
+  }
+  return out.str();
+}
+
+std::vector<std::uint8_t> FileStart(const std::string& path, std::size_t bytes) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::uint8_t> out((std::istreambuf_iterator<char>(in)), {});
+  if (out.size() > bytes) out.resize(bytes);
+  return out;
+}
+
+/// The start of `bytes` damaged the `variant`-th way: bytes flipped at a fixed stride, and for
+/// odd variants the end cut (deterministic).
+std::vector<std::uint8_t> Damaged(std::vector<std::uint8_t> bytes, int variant) {
+  const std::size_t stride = 997 + 101 * static_cast<std::size_t>(variant);
+  for (std::size_t k = 13 * static_cast<std::size_t>(variant) + 20; k < bytes.size(); k += stride) {
+    bytes[k] = static_cast<std::uint8_t>(bytes[k] ^ (0x5A + variant));
+  }
+  if (variant % 2 == 1) bytes.resize(bytes.size() - 1000 * static_cast<std::size_t>(variant));
+  return bytes;
+}
+
+/// On damaged logs (flipped bytes, cut ends) the samples decoded in the pass still equal the
+/// ones decoded from bodies, stream by stream and session by session, errors included.
+TEST(RecordFilter, DecodedInThePassAsFromBodiesOnDamagedLogs) {
+  for (const char* name : {"ardupilot/copter36_chibios.bin", "ardupilot/plane408_centre_point.BIN",
+                           "ardupilot/copter364_fmuv5.bin", "px4/sample.ulg"}) {
+    const std::string path = SharedFile(name);
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+    const std::vector<std::uint8_t> start = FileStart(path, std::size_t{1} << 20);
+    for (int variant = 0; variant < 6; ++variant) {
+      SCOPED_TRACE(std::string(name) + " variant " + std::to_string(variant));
+      const std::vector<std::uint8_t> b = Damaged(start, variant);
+      if (std::string(name).rfind("px4/", 0) == 0) {
+        const ULog all = ParseULog(b.data(), b.size(), "damaged");
+        const ULog kept = ParseULog(b.data(), b.size(), "damaged", Px4SessionTopics());
+        EXPECT_EQ(all.MessageCounts(), kept.MessageCounts());
+        EXPECT_EQ(all.warnings.Describe(), kept.warnings.Describe());
+        EXPECT_EQ(ImuText(all, ULogImuStreams, ULogSession),
+                  ImuText(kept, ULogImuStreams, ULogSession));
+      } else {
+        const DataflashLog all = ParseDataflash(b.data(), b.size(), "damaged");
+        const DataflashLog kept =
+            ParseDataflash(b.data(), b.size(), "damaged", ArdupilotSessionRecords());
+        EXPECT_EQ(all.MessageCounts(), kept.MessageCounts());
+        EXPECT_EQ(all.warnings.Describe(), kept.warnings.Describe());
+        const auto session = [](const DataflashLog& log, const FlightLogSelection& pick) {
+          return ArdupilotSession(log, pick);
+        };
+        const std::string text = ImuText(all, DataflashImuStreams, session);
+        EXPECT_EQ(text, ImuText(kept, DataflashImuStreams, session));
+        EXPECT_NE(text.find("IMU"), std::string::npos);
+      }
+    }
+  }
+}
+
 TEST(RecordFilter, DataflashTextKeepsWhatSessionsRead) {
   const std::string path = SharedFile("ardupilot/copter311_nan.log");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
@@ -98,6 +288,42 @@ TEST(RecordFilter, ULogKeepsWhatSessionsRead) {
     ExpectSameSeries(a.series, b.series);
     EXPECT_EQ(a.warnings, b.warnings);
   }
+}
+
+/// Every stream of every shared .ulg: the samples sensor_combined's reader decoded in its pass
+/// (Px4SessionTopics) equal the ones decoded from its stored bodies, as listed and as sessions.
+TEST(RecordFilter, ULogSensorCombinedDecodedInThePassAsFromBodies) {
+  std::size_t decoded = 0;
+  for (const char* name : {"sample.ulg", "sample_log_small.ulg", "sample_appended_multiple.ulg",
+                           "sample_logging_tagged_and_default_params.ulg",
+                           "sample_px4_events.ulg"}) {
+    const std::string path = SharedFile(std::string("px4/") + name);
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+    SCOPED_TRACE(name);
+    const ULog all = ReadULog(path);
+    const ULog kept = ReadULog(path, Px4SessionTopics());
+    if (const ULogTopic* t = kept.Find("sensor_combined"); t != nullptr && t->imu_decoded) {
+      ++decoded;
+      EXPECT_FALSE(t->bodies_kept);
+      EXPECT_EQ(t->KeptBytes(), all.Find("sensor_combined")->bodies.size());
+    }
+    const std::vector<ImuStreamInfo> a = ULogImuStreams(all);
+    const std::vector<ImuStreamInfo> b = ULogImuStreams(kept);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].name, b[k].name);
+      EXPECT_EQ(a[k].instance, b[k].instance);
+      EXPECT_EQ(a[k].samples, b[k].samples);
+      EXPECT_EQ(a[k].t_start_s, b[k].t_start_s);
+      EXPECT_EQ(a[k].t_end_s, b[k].t_end_s);
+      EXPECT_EQ(a[k].rate_hz, b[k].rate_hz);
+      FlightLogSelection pick;
+      pick.imu = a[k].instance;
+      pick.stream = a[k].name;
+      ExpectSameSeries(ULogSession(all, pick).series, ULogSession(kept, pick).series);
+    }
+  }
+  EXPECT_GT(decoded, 0u);
 }
 
 }  // namespace

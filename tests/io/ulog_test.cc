@@ -506,6 +506,43 @@ TEST(ULogBuilt, BadHeadersAndUnknownIncompatibleBitsThrow) {
   EXPECT_TRUE(Parse(newer).warnings.unknown_version);
 }
 
+/// sensor_combined decoded in the reader's pass (Px4SessionTopics) against decoded from kept
+/// bodies: times going back, repeated, NaN-free but huge values (saturated to float), a
+/// corrupt message and a cut last one give the same samples.
+TEST(ULogBuilt, SensorCombinedDecodedInThePassAsFromBodies) {
+  Writer w(1);
+  w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
+           "double[3] accelerometer_m_s2;uint8_t[4] _padding0;");
+  w.Add(0, 3, "sensor_combined");
+  const std::uint64_t times[] = {1000, 2000, 1500, 3000, 3000, 4000, 90000000, 5000, 6000};
+  for (std::size_t k = 0; k < std::size(times); ++k) {
+    const double big = k == 4 ? 1e300 : 9.8 + static_cast<double>(k);
+    w.Data(3, Cat({Le(times[k]), Le(0.1f * static_cast<float>(k)), Le(-0.2f), Le(0.3f),
+                   Le<std::uint32_t>(4000), Le(big), Le(-big), Le(0.5)}));
+    if (k == 5) w.bytes().insert(w.bytes().end(), {0x07, 0x00, 0x44});  // a corrupt header
+  }
+  w.bytes().resize(w.bytes().size() - 5);  // the last message cut
+  const Bytes& b = w.bytes();
+  const ULog all = ParseULog(b.data(), b.size(), "built");
+  const ULog kept = ParseULog(b.data(), b.size(), "built", Px4SessionTopics());
+  const ULogTopic* t = kept.Find("sensor_combined");
+  ASSERT_NE(t, nullptr);
+  EXPECT_TRUE(t->imu_decoded);
+  EXPECT_EQ(t->rows, all.Find("sensor_combined")->rows);
+  EXPECT_EQ(kept.warnings.Describe(), all.warnings.Describe());
+  const std::vector<ImuStreamInfo> a = ULogImuStreams(all);
+  const std::vector<ImuStreamInfo> k = ULogImuStreams(kept);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(k.size(), 1u);
+  EXPECT_EQ(a[0].samples, k[0].samples);
+  EXPECT_LT(a[0].samples, std::size(times) - 2);  // the rule dropped some
+  const Session sa = ULogSession(all, FlightLogSelection{});
+  const Session sk = ULogSession(kept, FlightLogSelection{});
+  EXPECT_EQ(sa.series.t_s, sk.series.t_s);
+  EXPECT_EQ(sa.series.acc, sk.series.acc);
+  EXPECT_EQ(sa.series.gyr, sk.series.gyr);
+}
+
 // --- sessions ---------------------------------------------------------------------------------
 
 double MeanNorm(const std::vector<Vec3f>& v) {

@@ -134,6 +134,13 @@ RecordFilter ArdupilotSessionRecords() {
     }
     return false;
   };
+  // IMU, IMU2, IMU3: decoded in the reader's pass (what a session and `plumb info` read of
+  // them is their samples).
+  filter.decode = [](std::string_view name) {
+    if (name.substr(0, 3) != "IMU") return false;
+    const std::string_view rest = name.substr(3);
+    return std::all_of(rest.begin(), rest.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
   return filter;
 }
 

@@ -53,6 +53,8 @@ bool LooksLikeDataflash(const std::string& path);
 /// The DataFlash types a session and `plumb info` read the values of (the format tables FMT,
 /// FMTU, UNIT, MULT; PARM; GPS; the IMU messages IMU*, ACC*, GYR*, ISBH, ISBD): the filter
 /// FlightLog reads .bin and .log files with, so a big log keeps only these bodies in memory.
+/// Its `decode` names IMU, IMU2, IMU3, ...: the binary reader decodes their samples in its pass
+/// and keeps those instead of the bodies (DataflashType::imu; the text reader keeps bodies).
 RecordFilter ArdupilotSessionRecords();
 
 }  // namespace plumb::io

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <optional>
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
@@ -32,6 +33,149 @@ std::string FixedText(const std::uint8_t* p, std::size_t n) {
   return std::string(c, strnlen(c, n));
 }
 
+/// Time of record `row` in seconds from TimeUS or TimeMS (`scale` 1e-6 or 1e-3).
+struct TimeColumn {
+  int col = -1;
+  double scale = 0.0;
+};
+
+TimeColumn FindTime(const DataflashType& t) {
+  if (const int c = t.ColumnIndex("TimeUS"); c >= 0) return {c, 1e-6};
+  if (const int c = t.ColumnIndex("TimeMS"); c >= 0) return {c, 1e-3};
+  return {};
+}
+
+int TemperatureColumn(const DataflashType& t) {
+  const int c = t.ColumnIndex("T");
+  return c >= 0 ? c : t.ColumnIndex("Temp");
+}
+
+/// Decodes the IMU samples of one message inside the reader's pass (RecordFilter::decode):
+/// the columns ImuFromDataflash reads, and its rule for times applied record by record.
+class ImuDecoder {
+ public:
+  /// The decoder of `t`, or nullopt when `t` lacks a time or AccX/Y/Z column (its bodies are
+  /// then kept, and ImuFromDataflash says what is missing). `rows_bound`: at most this many
+  /// records are coming (0: unknown), to reserve each instance's samples once.
+  static std::optional<ImuDecoder> For(const DataflashType& t, std::size_t rows_bound) {
+    using Reader = detail::DataflashColumnReader;
+    const TimeColumn time = FindTime(t);
+    const int acc[3] = {t.ColumnIndex("AccX"), t.ColumnIndex("AccY"), t.ColumnIndex("AccZ")};
+    if (time.col < 0 || acc[0] < 0 || acc[1] < 0 || acc[2] < 0) return std::nullopt;
+    const int gyr[3] = {t.ColumnIndex("GyrX"), t.ColumnIndex("GyrY"), t.ColumnIndex("GyrZ")};
+    ImuDecoder d;
+    d.time_ = Reader::Of(t, time.col);
+    d.time_scale_ = time.scale;
+    for (int k = 0; k < 3; ++k) d.acc_[k] = Reader::Of(t, acc[k]);
+    d.has_gyr_ = gyr[0] >= 0 && gyr[1] >= 0 && gyr[2] >= 0;
+    if (d.has_gyr_) {
+      for (int k = 0; k < 3; ++k) d.gyr_[k] = Reader::Of(t, gyr[k]);
+    }
+    const int temp = TemperatureColumn(t);
+    d.has_temp_ = temp >= 0;
+    if (d.has_temp_) d.temp_ = Reader::Of(t, temp);
+    // As ImuFromDataflash finds its instances (DataflashInstanceMessage): the I column of
+    // "IMU"; any other message (IMU2, ...) is one instance.
+    const int instance = t.name == "IMU" ? t.ColumnIndex("I") : -1;
+    d.has_instance_ = instance >= 0;
+    if (d.has_instance_) d.instance_ = Reader::Of(t, instance);
+    const auto plain_float = [](const Reader& r) {
+      return r.storage == detail::DataflashStorage::kFloat && r.scale == 1.0;
+    };
+    d.float_axes_ = plain_float(d.acc_[0]) && plain_float(d.acc_[1]) && plain_float(d.acc_[2]);
+    if (d.has_gyr_) {
+      d.float_axes_ = d.float_axes_ && plain_float(d.gyr_[0]) && plain_float(d.gyr_[1]) &&
+                      plain_float(d.gyr_[2]);
+    }
+    d.rows_bound_ = std::min(rows_bound, kMaxReserve);
+    return d;
+  }
+
+  /// Decodes the record body `body` of `t` (the type this decoder was made for).
+  void Add(DataflashType& t, const std::uint8_t* body) const {
+    std::size_t k = 0;
+    if (has_instance_) {
+      const double v = instance_.Read(body);
+      if (!(v >= 0 && v < 256 && v == std::floor(v))) return;  // no instance's record
+      k = static_cast<std::size_t>(v);
+    }
+    if (k >= t.imu.size()) t.imu.resize(k + 1);
+    DataflashImuDecoded& d = t.imu[k];
+    const double raw_t = time_.Read(body);
+    const double t_s = raw_t * time_scale_;
+    if (d.records == 0) {
+      d.first_time = raw_t;
+      Reserve(d.series);
+    }
+    d.last_time = raw_t;
+    ++d.records;
+    if (d.pending) Decide(d, d.pending_t_s < t_s);
+    d.pending = true;
+    d.pending_t_s = t_s;
+    d.pending_acc = Axes(body, acc_);
+    if (has_gyr_) d.pending_gyr = Axes(body, gyr_);
+    if (has_temp_) d.pending_temp = static_cast<float>(temp_.Read(body));
+  }
+
+  /// The three columns `c` of `body` as floats: Read() cast to float, or (float_axes_, the
+  /// usual 'f' columns) the stored floats themselves, the same values without the decoding
+  /// switch.
+  Vec3f Axes(const std::uint8_t* body, const detail::DataflashColumnReader* c) const {
+    if (float_axes_) {
+      return Vec3f(LoadLittleEndian<float>(body + c[0].offset),
+                   LoadLittleEndian<float>(body + c[1].offset),
+                   LoadLittleEndian<float>(body + c[2].offset));
+    }
+    return Vec3f(static_cast<float>(c[0].Read(body)), static_cast<float>(c[1].Read(body)),
+                 static_cast<float>(c[2].Read(body)));
+  }
+
+  /// After the last record: decides every instance's waiting record.
+  void Finish(DataflashType& t) const {
+    for (DataflashImuDecoded& d : t.imu) {
+      if (d.pending) Decide(d, true);
+      d.pending = false;
+    }
+  }
+
+ private:
+  /// Reserved samples per instance at most (beyond, the series grow by doubling).
+  static constexpr std::size_t kMaxReserve = std::size_t{1} << 24;
+
+  void Reserve(ImuSeries& s) const {
+    if (rows_bound_ == 0) return;
+    s.t_s.reserve(rows_bound_);
+    s.acc.reserve(rows_bound_);
+    if (has_gyr_) s.gyr.reserve(rows_bound_);
+    if (has_temp_) s.temp_c.reserve(rows_bound_);
+    AdviseHugePages(s.t_s.data(), rows_bound_ * sizeof(double));
+    AdviseHugePages(s.acc.data(), rows_bound_ * sizeof(Vec3f));
+    if (has_gyr_) AdviseHugePages(s.gyr.data(), rows_bound_ * sizeof(Vec3f));
+    if (has_temp_) AdviseHugePages(s.temp_c.data(), rows_bound_ * sizeof(float));
+  }
+
+  /// ImuFromDataflash's rule for the waiting record: kept when its time is finite, above the
+  /// last kept sample's and (`below_next`) below the next record's.
+  void Decide(DataflashImuDecoded& d, bool below_next) const {
+    ImuSeries& s = d.series;
+    if (!std::isfinite(d.pending_t_s)) return;
+    if (!s.t_s.empty() && !(d.pending_t_s > s.t_s.back())) return;
+    if (!below_next) return;
+    s.t_s.push_back(d.pending_t_s);
+    s.acc.push_back(d.pending_acc);
+    if (has_gyr_) s.gyr.push_back(d.pending_gyr);
+    if (has_temp_) s.temp_c.push_back(d.pending_temp);
+  }
+
+  detail::DataflashColumnReader time_, acc_[3], gyr_[3], temp_, instance_;
+  double time_scale_ = 0.0;
+  bool has_gyr_ = false;
+  bool has_temp_ = false;
+  bool has_instance_ = false;
+  bool float_axes_ = false;  ///< every Acc/Gyr column is a plain float ('f')
+  std::size_t rows_bound_ = 0;
+};
+
 /// The one-pass decoder state: fed the file's bytes in order, in one piece (ParseDataflash) or
 /// in chunks (ReadDataflash, through ReadForward).
 class Parser {
@@ -39,10 +183,25 @@ class Parser {
   /// The longest record: its length is one byte, header included.
   static constexpr std::size_t kMaxRecord = 255;
 
-  /// `filter`: the types whose bodies are kept.
-  Parser(DataflashLog* log, const RecordFilter& filter) : log_(log), filter_(filter) {
+  /// `filter`: the types whose bodies are kept or samples decoded; `size_hint`: the input's
+  /// size in bytes (0: unknown), to reserve decoded samples once.
+  Parser(DataflashLog* log, const RecordFilter& filter, std::size_t size_hint)
+      : log_(log), filter_(filter), size_hint_(size_hint) {
     index_.fill(-1);
+    decoder_of_.fill(-1);
+    rows_.fill(0);
     AddType(detail::DataflashFmtType(&log_->warnings));
+  }
+
+  /// After the last Feed: the record counts go to the types, and the decoded IMU messages'
+  /// waiting records are decided.
+  void Finish() {
+    for (DataflashType& t : log_->types) t.rows = rows_[t.id];
+    for (std::size_t id = 0; id < decoder_of_.size(); ++id) {
+      if (decoder_of_[id] < 0) continue;
+      decoders_[static_cast<std::size_t>(decoder_of_[id])].Finish(
+          log_->types[static_cast<std::size_t>(index_[id])]);
+    }
   }
 
   /// Decodes the records starting in the bytes [offset, offset + n) of the input held at
@@ -50,24 +209,23 @@ class Parser {
   /// before offset + n, so that every record starting before it is whole). `at_end`: the bytes
   /// end the input (the truncated last record and trailing bytes are counted).
   std::size_t Feed(const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    // The loop reads one table per record (length and action by type byte) and touches a
+    // type only for the records it keeps or decodes: the walk from record to record is the
+    // chain of loads byte -> length -> next byte, nothing more.
+    const std::size_t room = at_end ? kHeaderSize : kMaxRecord;  // bytes a record may need
     std::size_t i = 0;
-    while (n - i >= kHeaderSize) {
-      if (!at_end && n - i < kMaxRecord) return offset + i;
-      if (data[i] == kHead1 && data[i + 1] == kHead2) {
-        const int idx = index_[data[i + 2]];
-        if (idx >= 0) {
-          DataflashType& t = log_->types[static_cast<std::size_t>(idx)];
-          if (t.length > n - i) {
-            Truncated(n - i);
-            return offset + n;
-          }
-          const std::uint8_t* body = data + i + kHeaderSize;
-          if (t.bodies_kept) t.bodies.Append(body);
-          ++t.rows;
-          i += t.length;
-          if (t.id == kFmtType) HandleFmt(body, t.body_size);
-          continue;
+    while (n - i >= room) {
+      const std::uint8_t* p = data + i;
+      const Entry e = table_[p[2]];
+      if (p[0] == kHead1 && p[1] == kHead2 && e.length != 0) {
+        if (e.length > n - i) {
+          Truncated(n - i);
+          return offset + n;
         }
+        ++rows_[p[2]];
+        i += e.length;
+        if (e.action != Action::kCount) Act(e.action, p[2], p + kHeaderSize, offset + i);
+        continue;
       }
       Skip(offset + i);
       ++i;
@@ -85,8 +243,44 @@ class Parser {
   }
 
  private:
-  void AddType(DataflashType t) {
+  /// What the loop does with a record of a type besides counting it.
+  enum class Action : std::uint8_t { kCount, kKeep, kDecode, kFmt };
+  /// A type's entry in the loop's table, by type byte.
+  struct Entry {
+    std::uint8_t length = 0;  ///< record length with the header; 0: no type has this byte
+    Action action = Action::kCount;
+  };
+
+  /// Keeps (kKeep, kFmt) or decodes (kDecode) the record body `body` of type `id`; an FMT
+  /// (kFmt, its record ending at byte `end`) defines a type.
+  void Act(Action action, std::uint8_t id, const std::uint8_t* body, std::size_t end) {
+    DataflashType& t = log_->types[static_cast<std::size_t>(index_[id])];
+    if (action == Action::kDecode) {
+      decoders_[static_cast<std::size_t>(decoder_of_[id])].Add(t, body);
+      return;
+    }
+    t.bodies.Append(body);
+    if (action == Action::kFmt) HandleFmt(body, t.body_size, end);
+  }
+
+  /// Adds a type from its FMT, found at byte `offset`.
+  void AddType(DataflashType t, std::size_t offset = 0) {
     t.bodies_kept = t.id == kFmtType || filter_.Keeps(t.name);
+    if (t.id != kFmtType && filter_.Decodes(t.name) && t.length > 0) {
+      const std::size_t rest = size_hint_ > offset ? size_hint_ - offset : 0;
+      if (std::optional<ImuDecoder> d = ImuDecoder::For(t, rest / t.length + 1)) {
+        t.imu_decoded = true;
+        t.bodies_kept = false;
+        decoder_of_[t.id] = static_cast<int>(decoders_.size());
+        decoders_.push_back(*d);
+      }
+    }
+    Entry& e = table_[t.id];
+    e.length = static_cast<std::uint8_t>(t.length);  // 3..255 (AcceptFmt, one byte)
+    e.action = t.id == kFmtType ? Action::kFmt
+               : t.imu_decoded  ? Action::kDecode
+               : t.bodies_kept  ? Action::kKeep
+                                : Action::kCount;
     index_[t.id] = static_cast<int>(log_->types.size());
     log_->types.push_back(std::move(t));
   }
@@ -99,7 +293,7 @@ class Parser {
   }
 
   // FMT body: Type (B), Length (B), Name (n), Format (N), Columns (Z) = 86 bytes.
-  void HandleFmt(const std::uint8_t* body, std::size_t body_size) {
+  void HandleFmt(const std::uint8_t* body, std::size_t body_size, std::size_t offset) {
     if (body_size < detail::kFmtBodySize) return;  // cannot happen with the built-in FMT
     const std::uint8_t id = body[detail::kFmtTypeOffset];
     const std::size_t length = body[detail::kFmtLengthOffset];
@@ -111,35 +305,24 @@ class Parser {
     const DataflashType* known =
         existing >= 0 ? &log_->types[static_cast<std::size_t>(existing)] : nullptr;
     if (!detail::AcceptFmt(known, length, name, format, &log_->warnings)) return;
-    AddType(detail::MakeDataflashType(id, length, name, format, columns, &log_->warnings));
+    AddType(detail::MakeDataflashType(id, length, name, format, columns, &log_->warnings),
+            offset);
   }
 
   DataflashLog* log_;
   const RecordFilter& filter_;
+  std::size_t size_hint_ = 0;   ///< the input's size, bytes (0: unknown)
   std::array<int, 256> index_;
+  std::array<int, 256> decoder_of_;  ///< index in decoders_ by type id, -1: not decoded
+  std::array<Entry, 256> table_{};    ///< the loop's table by type id
+  std::array<std::size_t, 256> rows_;  ///< records counted by type id
+  std::vector<ImuDecoder> decoders_;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
 };
 
 /// The message holding IMU `instance` and the column of its instance field (-1 if none).
 const DataflashType* ImuType(const DataflashLog& log, int instance, int* instance_col) {
   return detail::DataflashInstanceMessage(log, "IMU", instance, false, instance_col);
-}
-
-/// Time of record `row` in seconds from TimeUS or TimeMS (`scale` 1e-6 or 1e-3).
-struct TimeColumn {
-  int col = -1;
-  double scale = 0.0;
-};
-
-TimeColumn FindTime(const DataflashType& t) {
-  if (const int c = t.ColumnIndex("TimeUS"); c >= 0) return {c, 1e-6};
-  if (const int c = t.ColumnIndex("TimeMS"); c >= 0) return {c, 1e-3};
-  return {};
-}
-
-int TemperatureColumn(const DataflashType& t) {
-  const int c = t.ColumnIndex("T");
-  return c >= 0 ? c : t.ColumnIndex("Temp");
 }
 
 }  // namespace
@@ -265,8 +448,9 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
   DataflashLog log;
   log.source = source;
   log.size_bytes = size;
-  Parser parser(&log, filter);
+  Parser parser(&log, filter, size);
   parser.Feed(data, size, 0, true);
+  parser.Finish();
   FinishParse(&log, size);
   return log;
 }
@@ -274,16 +458,38 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
 DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter) {
   DataflashLog log;
   log.source = path;
-  Parser parser(&log, filter);
+  Parser parser(&log, filter, RegularFileSize(path));
   // One pass, in chunks: every record is decoded from the read buffer as it goes by.
   ReadForward(path, "DataFlash log", Parser::kMaxRecord,
               [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
                 if (at_end) log.size_bytes = offset + n;
                 return parser.Feed(data, n, offset, at_end);
               });
+  parser.Finish();
   FinishParse(&log, log.size_bytes);
   return log;
 }
+
+namespace {
+
+/// The description of IMU `instance` of message `type`: `samples` records, the first and last
+/// with the (unscaled) times `first` and `last`.
+DataflashImuInfo ImuInfo(const DataflashType& type, int instance, std::size_t samples,
+                         double first, double last) {
+  DataflashImuInfo info;
+  info.instance = instance;
+  info.message = type.name;
+  info.samples = samples;
+  info.has_temperature = TemperatureColumn(type) >= 0;
+  const TimeColumn time = FindTime(type);
+  if (time.col >= 0 && samples >= 2) {
+    const double span = (last - first) * time.scale;
+    if (span > 0.0) info.rate_hz = static_cast<double>(samples - 1) / span;
+  }
+  return info;
+}
+
+}  // namespace
 
 std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {
   using Reader = detail::DataflashColumnReader;
@@ -291,7 +497,11 @@ std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {
   std::vector<int> instances;
   int probe_col = -1;
   const DataflashType* probe = ImuType(log, 0, &probe_col);
-  if (probe != nullptr && probe_col >= 0) {
+  if (probe != nullptr && probe_col >= 0 && probe->imu_decoded) {
+    for (std::size_t k = 0; k < probe->imu.size(); ++k) {
+      if (probe->imu[k].records > 0) instances.push_back(static_cast<int>(k));
+    }
+  } else if (probe != nullptr && probe_col >= 0) {
     if (!probe->bodies_kept) NotKept(probe->name);
     const Reader inst = Reader::Of(*probe, probe_col);
     std::array<bool, 256> seen{};
@@ -310,6 +520,14 @@ std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {
     int instance_col = -1;
     const DataflashType* type = ImuType(log, instance, &instance_col);
     if (type == nullptr || type->rows == 0) continue;
+    if (type->imu_decoded) {
+      const std::size_t k = instance_col >= 0 ? static_cast<std::size_t>(instance) : 0;
+      if (k < type->imu.size() && type->imu[k].records > 0) {
+        out.push_back(ImuInfo(*type, instance, type->imu[k].records, type->imu[k].first_time,
+                              type->imu[k].last_time));
+      }
+      continue;
+    }
     if (!type->bodies_kept) NotKept(type->name);
     const Reader inst = instance_col >= 0 ? Reader::Of(*type, instance_col) : Reader{};
     const TimeColumn time = FindTime(*type);
@@ -323,16 +541,7 @@ std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {
       ++samples;
     }
     if (samples == 0) continue;
-    DataflashImuInfo info;
-    info.instance = instance;
-    info.message = type->name;
-    info.samples = samples;
-    info.has_temperature = TemperatureColumn(*type) >= 0;
-    if (time.col >= 0 && samples >= 2) {
-      const double span = (last - first) * time.scale;
-      if (span > 0.0) info.rate_hz = static_cast<double>(samples - 1) / span;
-    }
-    out.push_back(info);
+    out.push_back(ImuInfo(*type, instance, samples, first, last));
   }
   return out;
 }
@@ -359,6 +568,14 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
     throw InputError(log.source, "",
                      "the log defines " + type->name + " (FMT) but holds no " + type->name +
                          " rows: no IMU samples were logged (LOG_BITMASK without IMU?)");
+  }
+  if (type->imu_decoded) {  // decoded by the reader, with the rule below
+    const std::size_t k = instance_col >= 0 ? static_cast<std::size_t>(instance) : 0;
+    if (k >= type->imu.size() || type->imu[k].records == 0) {
+      throw InputError(log.source, "", "no " + type->name + " rows with I == " +
+                                           std::to_string(instance) + " for " + what);
+    }
+    return CopySeries(type->imu[k].series);
   }
   if (!type->bodies_kept) NotKept(type->name);
   using Reader = detail::DataflashColumnReader;

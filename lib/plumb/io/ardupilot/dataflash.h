@@ -26,7 +26,10 @@
 // records (RecordStore: row-major blocks, body_size bytes per record, exactly as in the file),
 // and columns are decoded on access with their byte offsets. Memory is about the kept bodies;
 // reading is a bounds-checked copy per kept record, with no per-record allocation and no
-// counting pass.
+// counting pass. An IMU message the filter asks to decode (RecordFilter::decode; a session
+// reads IMU, IMU2, ... so) keeps no bodies: the binary reader decodes its time, AccX/Y/Z,
+// GyrX/Y/Z and T/Temp into per-instance samples as each record goes by, while it is in the
+// cache (DataflashType::imu), with ImuFromDataflash's rule for times applied as it goes.
 #pragma once
 
 #include <array>
@@ -58,6 +61,23 @@ struct DataflashColumn {
   double multiplier = 0.0;
 };
 
+/// The samples of one instance of an IMU message, decoded by the binary reader as it met the
+/// records (RecordFilter::decode; see DataflashType::imu).
+struct DataflashImuDecoded {
+  std::size_t records = 0;    ///< records of this instance, kept as samples or not
+  double first_time = 0.0;    ///< time column (TimeUS or TimeMS, unscaled) of its first record
+  double last_time = 0.0;     ///< the same of its last record
+  /// The samples ImuFromDataflash gives for this instance (its rule for times applied), in
+  /// the log's units; read by ImuFromDataflash and DataflashImuInstances.
+  ImuSeries series;
+  // The reader's state: the last record, whose fate waits for the next record's time.
+  bool pending = false;       ///< a record is waiting
+  double pending_t_s = 0.0;   ///< its time, s
+  Vec3f pending_acc = Vec3f::Zero();  ///< its AccX/Y/Z
+  Vec3f pending_gyr = Vec3f::Zero();  ///< its GyrX/Y/Z (when the message has them)
+  float pending_temp = 0.0f;  ///< its T or Temp (when the message has one)
+};
+
 /// All records of one message type.
 struct DataflashType {
   std::uint8_t id = 0;          ///< message-type byte, 0..255
@@ -71,7 +91,18 @@ struct DataflashType {
   /// False when the reader's RecordFilter left this type's bodies out (rows still counted):
   /// Value, Text, Array and Column then throw plumb::Error.
   bool bodies_kept = true;
+  /// True when the binary reader decoded this IMU message's samples in its pass instead of
+  /// keeping its bodies (RecordFilter::decode, for a message with a TimeUS/TimeMS and AccX/Y/Z
+  /// column): bodies_kept is then false, and `imu` holds the samples.
+  bool imu_decoded = false;
+  /// With imu_decoded: the samples by instance, the I value (0..255) of the records of "IMU"
+  /// with an I column, else 0 for all records (IMU2 is one instance); records whose I is not
+  /// a whole number in 0..255 belong to no instance (ImuFromDataflash never selects them).
+  std::vector<DataflashImuDecoded> imu;
 
+  /// Bytes this type holds of the log: its bodies, or with imu_decoded its records counted at
+  /// body size (the decoded samples take a little less).
+  std::size_t KeptBytes() const { return imu_decoded ? rows * body_size : bodies.size(); }
   /// Index of the column called `column`, or -1.
   int ColumnIndex(std::string_view column) const;
   /// Numeric value of record `row`, column `col`, with the format-character scale applied

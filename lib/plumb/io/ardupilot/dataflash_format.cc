@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <string>
+#include <unordered_set>
 #include <vector>
 
 namespace plumb::io::detail {
@@ -94,13 +96,30 @@ void ApplyUnits(DataflashLog* log) {
   if (type_col < 0) return;
   std::array<DataflashType*, 256> by_id{};  // the first type of each id (as a search finds)
   for (auto t = log->types.rbegin(); t != log->types.rend(); ++t) by_id[t->id] = &*t;
-  for (std::size_t r = 0; r < fmtu->rows; ++r) {
+  // A row applied twice changes nothing and a later row wins where two set a column, so only
+  // the last of identical rows is applied, in log order (a log repeats its FMTU rows).
+  struct Row {
+    DataflashType* type;
+    std::string unit_ids, mult_ids;
+  };
+  std::vector<Row> last_rows;
+  std::unordered_set<std::string> seen;
+  for (std::size_t r = fmtu->rows; r-- > 0;) {
     const double type_id = fmtu->Value(r, type_col);
     if (!(type_id >= 0 && type_id < 256) || type_id != std::floor(type_id)) continue;
     DataflashType* const it = by_id[static_cast<std::size_t>(type_id)];
     if (it == nullptr) continue;
-    const std::string unit_ids = unit_col >= 0 ? fmtu->Text(r, unit_col) : "";
-    const std::string mult_ids = mult_col >= 0 ? fmtu->Text(r, mult_col) : "";
+    std::string unit_ids = unit_col >= 0 ? fmtu->Text(r, unit_col) : "";
+    std::string mult_ids = mult_col >= 0 ? fmtu->Text(r, mult_col) : "";
+    // Texts end at their first NUL, so NUL separates the parts of the key.
+    std::string key = std::to_string(it->id) + '\0' + unit_ids + '\0' + mult_ids;
+    if (!seen.insert(std::move(key)).second) continue;
+    last_rows.push_back({it, std::move(unit_ids), std::move(mult_ids)});
+  }
+  for (auto row = last_rows.rbegin(); row != last_rows.rend(); ++row) {
+    DataflashType* const it = row->type;
+    const std::string& unit_ids = row->unit_ids;
+    const std::string& mult_ids = row->mult_ids;
     for (std::size_t c = 0; c < it->columns.size(); ++c) {
       if (c < unit_ids.size() && units.count(unit_ids[c])) it->columns[c].unit = units[unit_ids[c]];
       if (c < mult_ids.size() && mults.count(mult_ids[c])) {
@@ -116,8 +135,13 @@ void CollectParams(DataflashLog* log) {
   const int name = parm->ColumnIndex("Name");
   const int value = parm->ColumnIndex("Value");
   if (name < 0 || value < 0) return;
-  for (std::size_t r = 0; r < parm->rows; ++r) {
-    log->params[parm->Text(r, name)] = parm->Value(r, value);
+  // The last value of each name wins: from the last row back, the first one met is kept.
+  std::unordered_set<std::string> seen;
+  for (std::size_t r = parm->rows; r-- > 0;) {
+    std::string key = parm->Text(r, name);
+    if (seen.count(key) != 0) continue;
+    log->params.emplace(key, parm->Value(r, value));
+    seen.insert(std::move(key));
   }
 }
 

@@ -55,6 +55,13 @@ double ValueAt(const DataflashType& t, std::size_t row, int col) {
 /// {0} / {} when it has no I column (defined / not defined).
 std::vector<int> InstancesOf(const DataflashType& t, int instance_col) {
   std::array<bool, 256> seen{};
+  if (t.imu_decoded) {  // the reader's instances: the same whole I values in 0..255
+    std::vector<int> out;
+    for (std::size_t k = 0; k < t.imu.size(); ++k) {
+      if (t.imu[k].records > 0) out.push_back(static_cast<int>(k));
+    }
+    return out;
+  }
   if (t.rows > 0 && !t.bodies_kept) ValueAt(t, 0, instance_col);  // throws: not kept
   const auto column = detail::DataflashColumnReader::Of(t, instance_col);
   for (std::size_t r = 0; r < t.rows; ++r) {
@@ -338,7 +345,20 @@ ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref, const ImuS
   return info;
 }
 
+/// The samples the reader decoded for IMU stream `ref` (DataflashType::imu), or nullptr when
+/// it did not (they are then read from bodies).
+const ImuSeries* DecodedImu(const DataflashLog& log, const StreamRef& ref) {
+  if (ref.kind != Kind::kImu) return nullptr;
+  int col = -1;
+  const DataflashType* t = DataflashInstanceMessage(log, "IMU", ref.instance, false, &col);
+  if (t == nullptr || !t->imu_decoded) return nullptr;
+  const std::size_t k = col >= 0 ? static_cast<std::size_t>(ref.instance) : 0;
+  if (k >= t->imu.size() || t->imu[k].records == 0) return nullptr;  // as ImuFromDataflash
+  return &t->imu[k].series;
+}
+
 ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {
+  if (const ImuSeries* decoded = DecodedImu(log, ref)) return Describe(log, ref, *decoded);
   ImuSeries s;
   try {
     s = ReadStream(log, ref);

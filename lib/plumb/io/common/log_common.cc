@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <new>
 
 #include "plumb/core/error.h"
 
@@ -97,6 +98,45 @@ struct FdCloser {
 
 }  // namespace
 
+void AdviseHugePages(const void* p, std::size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
+  const auto begin = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t first = (begin + kHuge - 1) / kHuge * kHuge;
+  const std::uintptr_t last = (begin + bytes) / kHuge * kHuge;
+  if (last > first) {
+    ::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);  // a hint: errors ignored
+  }
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+namespace {
+
+template <typename T>
+std::vector<T> CopyVector(const std::vector<T>& v) {
+  std::vector<T> out;
+  out.reserve(v.size());
+  AdviseHugePages(out.data(), v.size() * sizeof(T));
+  out.assign(v.begin(), v.end());
+  return out;
+}
+
+}  // namespace
+
+ImuSeries CopySeries(const ImuSeries& s) {
+  ImuSeries out;
+  out.t_s = CopyVector(s.t_s);
+  out.acc = CopyVector(s.acc);
+  out.gyr = CopyVector(s.gyr);
+  out.temp_c = CopyVector(s.temp_c);
+  out.acc_unit = s.acc_unit;
+  out.gyr_unit = s.gyr_unit;
+  return out;
+}
+
 std::size_t RegularFileSize(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return 0;
@@ -175,7 +215,17 @@ bool RecordStore::operator==(const RecordStore& other) const {
 }
 
 void RecordStore::AddBlock() {
-  blocks_.emplace_back(new std::uint8_t[(mask_ + 1) * body_size_]);
+  // Whole huge pages: the rows' bytes rounded up to kBlockBytes (the tail is never written).
+  const std::size_t rows_bytes = std::max<std::size_t>((mask_ + 1) * body_size_, 1);
+  const std::size_t bytes = (rows_bytes + kBlockBytes - 1) / kBlockBytes * kBlockBytes;
+  auto* block = static_cast<std::uint8_t*>(
+      ::operator new(bytes, std::align_val_t{kBlockBytes}));
+  blocks_.emplace_back(block);
+  if (blocks_.size() > 1) AdviseHugePages(block, bytes);
+}
+
+void RecordStore::FreeBlock::operator()(std::uint8_t* p) const {
+  ::operator delete(p, std::align_val_t{kBlockBytes});
 }
 
 LogFile::~LogFile() {

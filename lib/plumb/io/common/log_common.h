@@ -83,6 +83,17 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
                  const std::function<std::size_t(const std::uint8_t* data, std::size_t n,
                                                  std::size_t offset, bool at_end)>& consume);
 
+/// Asks the system to back the memory [p, p + bytes) of a large buffer that is about to be
+/// filled by transparent huge pages (madvise MADV_HUGEPAGE on the whole 2 MiB pages inside it;
+/// nothing when it holds none or the system has no such pages): one page fault per 2 MiB
+/// instead of per 4 KiB as the buffer is first written. Only a hint: the contents and the
+/// results never depend on it.
+void AdviseHugePages(const void* p, std::size_t bytes);
+
+/// A copy of `s` whose large buffers are reserved first and backed by huge pages
+/// (AdviseHugePages): samples a reader decoded in its pass, handed out by value.
+ImuSeries CopySeries(const ImuSeries& s);
+
 /// The size of the file at `path` in bytes (0 when it is not a regular file or cannot be
 /// read).
 std::size_t RegularFileSize(const std::string& path);
@@ -91,11 +102,13 @@ std::size_t RegularFileSize(const std::string& path);
 /// `body_size` bytes each, exactly as in the file, in blocks of a power-of-two number of rows
 /// (about kBlockBytes each), so that appending never moves the rows already stored (no
 /// counting pass to size the storage, no reallocation copy; the last block's unused rows are
-/// never written, so they cost address space, not resident memory).
+/// never written, so they cost address space, not resident memory). Blocks are aligned on
+/// kBlockBytes; from the second block of a store on (a message with many records), they are
+/// backed by huge pages (AdviseHugePages: one page fault per block instead of one per 4 KiB).
 class RecordStore {
  public:
-  /// Bytes per block, about (a block holds at least one row).
-  static constexpr std::size_t kBlockBytes = std::size_t{256} << 10;
+  /// Bytes per block, about (a block holds at least one row): 2 MiB, a huge page.
+  static constexpr std::size_t kBlockBytes = std::size_t{2} << 20;
 
   RecordStore() = default;
   explicit RecordStore(std::size_t body_size);
@@ -127,11 +140,16 @@ class RecordStore {
   }
   void AddBlock();
 
+  /// Frees a block (allocated aligned on kBlockBytes).
+  struct FreeBlock {
+    void operator()(std::uint8_t* p) const;
+  };
+
   std::size_t body_size_ = 0;
   std::size_t rows_ = 0;
   unsigned shift_ = 0;      ///< rows per block = 1 << shift_
   std::size_t mask_ = 0;    ///< (1 << shift_) - 1
-  std::vector<std::unique_ptr<std::uint8_t[]>> blocks_;
+  std::vector<std::unique_ptr<std::uint8_t[], FreeBlock>> blocks_;
 };
 
 /// Which messages (DataFlash types, ULog topics) a binary-log reader keeps the record bodies
@@ -142,8 +160,14 @@ class RecordStore {
 struct RecordFilter {
   /// True for the names whose bodies are stored; empty: all.
   std::function<bool(std::string_view name)> keep;
+  /// True for the IMU messages whose samples the reader decodes inside its pass, while each
+  /// record is in the cache, keeping the decoded samples instead of the bodies (the format's
+  /// reader says which messages it can decode so, and what it keeps of them; a message it
+  /// cannot decode keeps its bodies when `keep` says so). Empty: none, bodies only.
+  std::function<bool(std::string_view name)> decode;
 
   bool Keeps(std::string_view name) const { return !keep || keep(name); }
+  bool Decodes(std::string_view name) const { return decode && decode(name); }
 };
 
 /// The message of a time window (--from/--to, log times) that holds fewer than 2 samples of a

@@ -229,18 +229,18 @@ double KeptFraction(const std::string& path, FlightLogFormat format) {
       case FlightLogFormat::kDataflashBinary:
         for (const DataflashType& t :
              ParseDataflash(bytes, prefix.size(), path, ArdupilotSessionRecords()).types) {
-          kept += t.bodies.size();
+          kept += t.KeptBytes();
         }
         break;
       case FlightLogFormat::kDataflashText:
         for (const DataflashType& t : ParseDataflashText(prefix.data(), prefix.size(), path,
                                                          ArdupilotSessionRecords()).types) {
-          kept += t.bodies.size();
+          kept += t.KeptBytes();
         }
         break;
       case FlightLogFormat::kPx4ULog:
         for (const ULogTopic& t : ParseULog(bytes, prefix.size(), path, Px4SessionTopics()).topics) {
-          kept += t.bodies.size();
+          kept += t.KeptBytes();
         }
         break;
       case FlightLogFormat::kMavlinkTlog:

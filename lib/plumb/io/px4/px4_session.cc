@@ -60,18 +60,54 @@ int TimeColumn(const ULogTopic& t) {
   return sample >= 0 ? sample : t.timestamp_col;
 }
 
-Vec3 Row3d(const ULogTopic& t, std::size_t row, const Triad& c) {
-  return Vec3(t.Value(row, static_cast<std::size_t>(c[0])),
-              t.Value(row, static_cast<std::size_t>(c[1])),
-              t.Value(row, static_cast<std::size_t>(c[2])));
-}
+/// One column of a topic read straight from its message bodies: ULogTopic::Value without the
+/// look-ups per value (the decoding loops below read every row).
+struct Col {
+  std::size_t offset = 0;
+  ULogType type = ULogType::kUInt8;
 
-Vec3f Row3(const ULogTopic& t, std::size_t row, const Triad& c) {
-  return SaturatedFloat(Row3d(t, row, c));
+  double Read(const std::uint8_t* body) const { return DecodeULogValue(body + offset, type); }
+};
+
+/// The reader of column `c` (>= 0) of `t`; throws as ULogTopic::Value when `t` has rows whose
+/// bodies were not kept.
+Col ColOf(const ULogTopic& t, int c) {
+  if (t.rows > 0 && !t.bodies_kept) (void)t.Value(0, static_cast<std::size_t>(c));  // throws
+  const ULogColumn& column = t.columns[static_cast<std::size_t>(c)];
+  return {column.offset, column.type};
 }
 
 double TimeS(const ULogTopic& t, std::size_t row, int col) {
   return t.Value(row, static_cast<std::size_t>(col)) * kUsToS;
+}
+
+using Cols = std::array<Col, 3>;
+
+Cols ColsOf(const ULogTopic& t, const Triad& c) {
+  return {ColOf(t, c[0]), ColOf(t, c[1]), ColOf(t, c[2])};
+}
+
+Vec3 Read3d(const std::uint8_t* body, const Cols& c) {
+  return Vec3(c[0].Read(body), c[1].Read(body), c[2].Read(body));
+}
+
+Vec3f Read3(const std::uint8_t* body, const Cols& c) { return SaturatedFloat(Read3d(body, c)); }
+
+/// Reserves `n` samples of `s` (gyr with `gyr`, temp_c with `temp`), large buffers backed by
+/// huge pages (AdviseHugePages: fewer page faults as they are filled).
+void Reserve(ImuSeries* s, std::size_t n, bool gyr, bool temp) {
+  s->t_s.reserve(n);
+  s->acc.reserve(n);
+  AdviseHugePages(s->t_s.data(), n * sizeof(double));
+  AdviseHugePages(s->acc.data(), n * sizeof(Vec3f));
+  if (gyr) {
+    s->gyr.reserve(n);
+    AdviseHugePages(s->gyr.data(), n * sizeof(Vec3f));
+  }
+  if (temp) {
+    s->temp_c.reserve(n);
+    AdviseHugePages(s->temp_c.data(), n * sizeof(float));
+  }
 }
 
 /// Appends a sample when its time increases; returns whether it was kept.
@@ -90,10 +126,14 @@ ImuSeries FromCombined(const ULogTopic& t) {
   auto gyr = ArrayColumns(t, "gyro_rad");
   if (!gyr) gyr = ArrayColumns(t, "gyro_rad_s");
   if (!acc || !gyr || t.timestamp_col < 0) return s;
-  s.reserve(t.rows);
+  if (t.imu_decoded) return CopySeries(t.imu);  // decoded by the reader, the same way
+  const Cols a = ColsOf(t, *acc), w = ColsOf(t, *gyr);
+  const Col time = ColOf(t, t.timestamp_col);
+  Reserve(&s, t.rows, true, false);
   for (std::size_t r = 0; r < t.rows; ++r) {
-    const Vec3f g = Row3(t, r, *gyr);
-    Push(&s, TimeS(t, r, t.timestamp_col), Row3(t, r, *acc), &g, nullptr);
+    const std::uint8_t* body = t.bodies.Row(r);
+    const Vec3f g = Read3(body, w);
+    Push(&s, time.Read(body) * kUsToS, Read3(body, a), &g, nullptr);
   }
   return s;
 }
@@ -106,14 +146,17 @@ ImuSeries FromVehicleImu(const ULogTopic& t) {
   const int da_dt = t.ColumnIndex("delta_angle_dt");
   const int time = TimeColumn(t);
   if (!dv || !da || dv_dt < 0 || da_dt < 0 || time < 0) return s;
-  s.reserve(t.rows);
+  const Cols v = ColsOf(t, *dv), a = ColsOf(t, *da);
+  const Col v_dt = ColOf(t, dv_dt), a_dt = ColOf(t, da_dt), time_col = ColOf(t, time);
+  Reserve(&s, t.rows, true, false);
   for (std::size_t r = 0; r < t.rows; ++r) {
-    const double v_dt_s = t.Value(r, static_cast<std::size_t>(dv_dt)) * kUsToS;
-    const double a_dt_s = t.Value(r, static_cast<std::size_t>(da_dt)) * kUsToS;
+    const std::uint8_t* body = t.bodies.Row(r);
+    const double v_dt_s = v_dt.Read(body) * kUsToS;
+    const double a_dt_s = a_dt.Read(body) * kUsToS;
     if (!(v_dt_s > 0.0) || !(a_dt_s > 0.0)) continue;
-    const Vec3f acc = SaturatedFloat(Row3d(t, r, *dv) / v_dt_s);
-    const Vec3f g = SaturatedFloat(Row3d(t, r, *da) / a_dt_s);
-    Push(&s, TimeS(t, r, time), acc, &g, nullptr);
+    const Vec3f acc = SaturatedFloat(Read3d(body, v) / v_dt_s);
+    const Vec3f g = SaturatedFloat(Read3d(body, a) / a_dt_s);
+    Push(&s, time_col.Read(body) * kUsToS, acc, &g, nullptr);
   }
   return s;
 }
@@ -136,8 +179,12 @@ ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topi
   const int time = TimeColumn(acc_topic);
   const int temp = acc_topic.ColumnIndex("temperature");
   if (!acc || time < 0) return s;
+  const Cols a = ColsOf(acc_topic, *acc);
+  const Col time_col = ColOf(acc_topic, time);
   std::vector<double> t_acc(acc_topic.rows);
-  for (std::size_t r = 0; r < acc_topic.rows; ++r) t_acc[r] = TimeS(acc_topic, r, time);
+  for (std::size_t r = 0; r < acc_topic.rows; ++r) {
+    t_acc[r] = time_col.Read(acc_topic.bodies.Row(r)) * kUsToS;
+  }
 
   // Pairing with sensor_gyro: nearest gyro time within half the median accel interval.
   std::vector<long> match(acc_topic.rows, -1);
@@ -148,14 +195,17 @@ ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topi
     const int gtime = TimeColumn(*gyro_topic);
     const double tolerance_s = 0.5 * MedianStep(t_acc);
     if (gyr && gtime >= 0 && tolerance_s > 0.0) {
+      const Col g_time = ColOf(*gyro_topic, gtime);
+      const auto time_s = [&](std::size_t g) {
+        return g_time.Read(gyro_topic->bodies.Row(g)) * kUsToS;
+      };
       std::size_t g = 0;
       for (std::size_t r = 0; r < acc_topic.rows; ++r) {
         while (g + 1 < gyro_topic->rows &&
-               std::abs(TimeS(*gyro_topic, g + 1, gtime) - t_acc[r]) <=
-                   std::abs(TimeS(*gyro_topic, g, gtime) - t_acc[r])) {
+               std::abs(time_s(g + 1) - t_acc[r]) <= std::abs(time_s(g) - t_acc[r])) {
           ++g;
         }
-        if (g < gyro_topic->rows && std::abs(TimeS(*gyro_topic, g, gtime) - t_acc[r]) <= tolerance_s) {
+        if (g < gyro_topic->rows && std::abs(time_s(g) - t_acc[r]) <= tolerance_s) {
           match[r] = static_cast<long>(g);
           ++matched;
         }
@@ -170,15 +220,17 @@ ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topi
                      " accel samples have a gyro sample within half an interval: "
                      "accelerometer only");
   }
-  s.reserve(acc_topic.rows);
+  const Col temp_col = temp >= 0 ? ColOf(acc_topic, temp) : Col{};
+  const Cols w = paired ? ColsOf(*gyro_topic, *gyr) : Cols{};
+  Reserve(&s, acc_topic.rows, paired, temp >= 0);
   for (std::size_t r = 0; r < acc_topic.rows; ++r) {
     if (paired && match[r] < 0) continue;
-    const float tc =
-        temp >= 0 ? SaturatedFloat(acc_topic.Value(r, static_cast<std::size_t>(temp))) : 0.0f;
+    const std::uint8_t* body = acc_topic.bodies.Row(r);
+    const float tc = temp >= 0 ? SaturatedFloat(temp_col.Read(body)) : 0.0f;
     Vec3f g;
-    if (paired) g = Row3(*gyro_topic, static_cast<std::size_t>(match[r]), *gyr);
+    if (paired) g = Read3(gyro_topic->bodies.Row(static_cast<std::size_t>(match[r])), w);
     // Temperature and gyro columns must stay aligned with t_s: Push keeps or drops all.
-    Push(&s, t_acc[r], Row3(acc_topic, r, *acc), paired ? &g : nullptr, temp >= 0 ? &tc : nullptr);
+    Push(&s, t_acc[r], Read3(body, a), paired ? &g : nullptr, temp >= 0 ? &tc : nullptr);
   }
   return s;
 }
@@ -358,7 +410,11 @@ ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries
 std::vector<ImuStreamInfo> ULogImuStreams(const ULog& log) {
   std::vector<ImuStreamInfo> out;
   for (const StreamSource& src : Sources(log)) {
-    out.push_back(Describe(log, src, Extract(src, nullptr)));
+    if (src.kind == StreamKind::kCombined && src.topic->imu_decoded) {
+      out.push_back(Describe(log, src, src.topic->imu));  // no copy of the reader's samples
+    } else {
+      out.push_back(Describe(log, src, Extract(src, nullptr)));
+    }
   }
   return out;
 }
@@ -514,6 +570,8 @@ bool LooksLikeULog(const std::string& path) {
 
 RecordFilter Px4SessionTopics() {
   RecordFilter filter;
+  // sensor_combined: decoded in the reader's pass (a session and `plumb info` read its samples).
+  filter.decode = [](std::string_view name) { return name == "sensor_combined"; };
   filter.keep = [](std::string_view name) {
     for (const char* topic : {"sensor_combined", "vehicle_imu", "vehicle_imu_status",
                               "sensor_accel", "sensor_gyro", "sensor_gps",

@@ -75,7 +75,8 @@ bool LooksLikeULog(const std::string& path);
 /// The ULog topics a session and `plumb info` read the values of (sensor_combined,
 /// vehicle_imu, vehicle_imu_status, sensor_accel, sensor_gyro, sensor_gps,
 /// vehicle_gps_position): the filter FlightLog reads .ulg files with, so a big log keeps only
-/// these bodies in memory.
+/// these bodies in memory. Its `decode` names sensor_combined: the reader decodes its samples
+/// in its pass and keeps those instead of the bodies (ULogTopic::imu).
 RecordFilter Px4SessionTopics();
 
 }  // namespace plumb::io

@@ -2,6 +2,7 @@
 #include "plumb/io/px4/ulog.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <optional>
@@ -110,6 +111,63 @@ std::uint64_t TimestampOf(const ULogTopic& t, const std::uint8_t* body) {
 [[noreturn]] void NotKept(const std::string& name) {
   throw Error("ULog topic " + name + ": its message bodies were not kept (RecordFilter)");
 }
+
+/// Decodes sensor_combined's IMU samples inside the reader's pass (RecordFilter::decode), as
+/// the PX4 session reads them from bodies (px4_session.cc, FromCombined): t_s = timestamp *
+/// 1e-6, accelerometer_m_s2[0..2] and gyro_rad[0..2] (or gyro_rad_s) saturated to float, a
+/// sample kept when its time is finite and above the last kept one.
+class CombinedDecoder {
+ public:
+  /// The decoder of `t`, or nullopt when `t` is not sensor_combined or lacks a column.
+  static std::optional<CombinedDecoder> For(const ULogTopic& t) {
+    if (t.name != "sensor_combined" || t.timestamp_col < 0) return std::nullopt;
+    CombinedDecoder d;
+    d.time_ = t.columns[static_cast<std::size_t>(t.timestamp_col)];
+    if (!Triad(t, "accelerometer_m_s2", d.acc_) ||
+        (!Triad(t, "gyro_rad", d.gyr_) && !Triad(t, "gyro_rad_s", d.gyr_))) {
+      return std::nullopt;
+    }
+    return d;
+  }
+
+  /// Decodes the message body `body` (after the msg_id) into `s`.
+  void Add(ImuSeries& s, const std::uint8_t* body) const {
+    const Vec3f gyr = Read3(body, gyr_);
+    const double t_s = DecodeULogValue(body + time_.offset, time_.type) * 1e-6;
+    if (!std::isfinite(t_s) || (!s.t_s.empty() && !(t_s > s.t_s.back()))) return;
+    s.t_s.push_back(t_s);
+    s.acc.push_back(Read3(body, acc_));
+    s.gyr.push_back(gyr);
+  }
+
+  /// Reserves `rows` samples of `s`, backed by huge pages where large.
+  static void Reserve(ImuSeries& s, std::size_t rows) {
+    s.t_s.reserve(rows);
+    s.acc.reserve(rows);
+    s.gyr.reserve(rows);
+    AdviseHugePages(s.t_s.data(), rows * sizeof(double));
+    AdviseHugePages(s.acc.data(), rows * sizeof(Vec3f));
+    AdviseHugePages(s.gyr.data(), rows * sizeof(Vec3f));
+  }
+
+ private:
+  static bool Triad(const ULogTopic& t, const std::string& base, ULogColumn* out) {
+    for (int i = 0; i < 3; ++i) {
+      const int c = t.ColumnIndex(base + "[" + std::to_string(i) + "]");
+      if (c < 0) return false;
+      out[i] = t.columns[static_cast<std::size_t>(c)];
+    }
+    return true;
+  }
+
+  static Vec3f Read3(const std::uint8_t* body, const ULogColumn* c) {
+    return SaturatedFloat(Vec3(DecodeULogValue(body + c[0].offset, c[0].type),
+                               DecodeULogValue(body + c[1].offset, c[1].type),
+                               DecodeULogValue(body + c[2].offset, c[2].type)));
+  }
+
+  ULogColumn time_, acc_[3], gyr_[3];
+};
 
 /// The one-pass decoder state: fed the file's bytes in order, in one piece (ParseULog) or in
 /// chunks (ReadULog, through ReadForward); the position, the segment and the resync state
@@ -295,7 +353,16 @@ class Parser {
     ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
     (void)size;  // checked by Corrupt(): body_size <= size - 2 <= full_size
     t.last_timestamp_us = TimestampOf(t, body + 2);
-    if (t.bodies_kept) t.bodies.Append(body + 2);
+    if (t.bodies_kept) {
+      t.bodies.Append(body + 2);
+    } else if (t.imu_decoded) {
+      const CombinedDecoder& d = decoders_[static_cast<std::size_t>(idx)];
+      if (t.rows == 0 && t.body_size > 0) {  // at most one sample per remaining message
+        const std::size_t rest = size_ > pos_ ? size_ - pos_ : 0;
+        CombinedDecoder::Reserve(t.imu, std::min(rest / (t.body_size + 5) + 1, kMaxReserve));
+      }
+      d.Add(t.imu, body + 2);
+    }
     ++t.rows;
   }
 
@@ -332,8 +399,17 @@ class Parser {
 
   void Malformed() { ++log_->warnings.malformed_messages; }
 
-  void Keep(ULogTopic* t) {
+  /// Decides whether `t` (topic index `index`) keeps its bodies or has its samples decoded.
+  void Keep(ULogTopic* t, std::size_t index) {
     t->bodies_kept = filter_.Keeps(t->name);
+    if (decoders_.size() <= index) decoders_.resize(index + 1);
+    if (filter_.Decodes(t->name)) {
+      if (const std::optional<CombinedDecoder> d = CombinedDecoder::For(*t)) {
+        t->imu_decoded = true;
+        t->bodies_kept = false;
+        decoders_[index] = *d;
+      }
+    }
     if (t->bodies_kept) t->bodies = RecordStore(t->body_size);
   }
 
@@ -428,7 +504,7 @@ class Parser {
       ++log_->warnings.unresolved_subscriptions;
       return;
     }
-    Keep(&t);
+    Keep(&t, log_->topics.size());
     if (index_.size() <= t.msg_id) index_.resize(std::size_t{t.msg_id} + 1, -1);
     index_[t.msg_id] = static_cast<int>(log_->topics.size());
     log_->topics.push_back(std::move(t));
@@ -456,6 +532,10 @@ class Parser {
     log_->warnings.truncated_bytes += bytes;
   }
 
+  /// Reserved samples of a decoded topic at most (beyond, they grow by doubling).
+  static constexpr std::size_t kMaxReserve = std::size_t{1} << 24;
+
+  std::vector<CombinedDecoder> decoders_;  ///< by topic index, for the topics decoded
   const std::uint8_t* data_ = nullptr;  ///< the bytes held: file offsets [base_, avail_)
   std::size_t base_ = 0;
   std::size_t avail_ = 0;

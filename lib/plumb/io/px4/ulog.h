@@ -49,7 +49,9 @@
 // Storage ("compact per-topic table", as the DataFlash reader): each kept subscription
 // (RecordFilter) keeps the bodies of its D messages (RecordStore: row-major blocks, `body_size`
 // bytes each, as in the file); columns are decoded on access from their byte offsets. No
-// allocation per data message, no counting pass.
+// allocation per data message, no counting pass. A topic the filter asks to decode
+// (RecordFilter::decode; a session reads sensor_combined so) keeps no bodies: its IMU samples
+// are decoded as each message goes by, while it is in the cache (ULogTopic::imu).
 #pragma once
 
 #include <array>
@@ -61,6 +63,7 @@
 #include <utility>
 #include <vector>
 
+#include "plumb/core/imu_series.h"
 #include "plumb/io/common/log_common.h"
 
 namespace plumb::io {
@@ -112,6 +115,18 @@ struct ULogTopic {
   bool bodies_kept = true;
   /// The "timestamp" of the last message, us (as TimestampUs), kept or not; 0 before any.
   std::uint64_t last_timestamp_us = 0;
+  /// True when the reader decoded this topic's IMU samples in its pass instead of keeping its
+  /// bodies (RecordFilter::decode; sensor_combined with a timestamp, accelerometer_m_s2[3]
+  /// and gyro_rad[3] or gyro_rad_s[3]): bodies_kept is then false and `imu` holds them.
+  bool imu_decoded = false;
+  /// With imu_decoded: the samples, t_s = timestamp * 1e-6, acc and gyr saturated to float,
+  /// those whose time is not finite or does not increase dropped (as the PX4 session reads
+  /// sensor_combined from bodies).
+  ImuSeries imu;
+
+  /// Bytes this topic holds of the log: its bodies, or with imu_decoded its messages counted
+  /// at body size (the decoded samples take a little less).
+  std::size_t KeptBytes() const { return imu_decoded ? rows * body_size : bodies.size(); }
 
   /// Index of the column called `column`, or -1.
   int ColumnIndex(std::string_view column) const;
