@@ -14,17 +14,21 @@
 #include "select_every_stream.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  try {
-    const plumb::io::ULog log = plumb::io::ParseULog(data, size, "fuzz");
-    (void)log.warnings.Describe();
-    (void)plumb::io::SiteFromULog(log);
-    (void)plumb::io::ULogParams(log);
-    plumb::fuzz::SelectEveryStream(
-        plumb::io::ULogImuStreams(log),
-        [&](const plumb::io::FlightLogSelection& selection) {
-          (void)plumb::io::ULogSession(log, selection);
-        });
-  } catch (const plumb::Error&) {
+  // Every topic kept, then the session's filter (sensor_combined decoded in the read pass).
+  for (const bool session_filter : {false, true}) {
+    try {
+      const plumb::io::ULog log = plumb::io::ParseULog(
+          data, size, "fuzz", session_filter ? plumb::io::Px4SessionTopics() : plumb::io::RecordFilter{});
+      (void)log.warnings.Describe();
+      (void)plumb::io::SiteFromULog(log);
+      (void)plumb::io::ULogParams(log);
+      plumb::fuzz::SelectEveryStream(
+          plumb::io::ULogImuStreams(log),
+          [&](const plumb::io::FlightLogSelection& selection) {
+            (void)plumb::io::ULogSession(log, selection);
+          });
+    } catch (const plumb::Error&) {
+    }
   }
   return 0;
 }
