@@ -473,6 +473,18 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   for (int i = 0; i < 3; ++i) residuals[i] = s_.sqrt_info[i] * r[i];
   if (!want_jacobians) return true;
 
+  WriteJacobians(r, M, A, closed_form ? std::max(gyro_offset, 0) : 0, rate_cols, q_k, q_k1,
+                 jacobians);
+  return true;
+}
+
+void MotionResidual::WriteJacobians(const Vec3& r, const Mat3& M,
+                                    const Eigen::Matrix<double, 3, Eigen::Dynamic>& A,
+                                    int rate_first, int rate_cols, const Quat& q_k,
+                                    const Quat& q_k1, double** jacobians) const {
+  const int P = num_model_parameters_;
+  const int att = rate_cols;
+  const int from = rate_cols + 3;
   const Mat3 Jli = so3::LeftJacobianInverse(r);
   const Eigen::DiagonalMatrix<double, 3> Wsi(s_.sqrt_info);
   // Tangent Jacobians (left perturbations in NED for the attitudes), then ambient ones
@@ -487,7 +499,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   if (jacobians[0]) ambient(J_k, q_k, jacobians[0]);
   if (jacobians[1]) ambient(J_k1, q_k1, jacobians[1]);
   Eigen::Matrix<double, 3, Eigen::Dynamic> J_theta = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, P);
-  J_theta.middleCols(closed_form ? std::max(gyro_offset, 0) : 0, rate_cols) =
+  J_theta.middleCols(rate_first, rate_cols) =
       Wsi * (-Jli * A.leftCols(rate_cols));
   for (int t = 0; t < model_->num_terms(); ++t) {
     double* out = jacobians[t + 2];
@@ -502,7 +514,6 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> J_out(out);
     J_out = Wsi * (-Jli * A.middleCols<3>(from + 3 * (b % 2)));
   }
-  return true;
 }
 
 Quat MotionResidual::Integrate(const double* q_k, const model::ParameterBlocks& theta) const {

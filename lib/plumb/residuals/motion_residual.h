@@ -125,6 +125,12 @@ class MotionResidual final : public ceres::CostFunction {
   /// closed form of LinearAt.
   void CorrectedRates(double const* const* theta, const std::vector<Vec3>& gyr, bool linear,
                       std::vector<Vec3>* w, RateJacobians* W) const;
+  /// Ceres's Jacobians of the residual r = W Log(M R_k+1), M = dR^T R_k^T, from the propagated
+  /// sensitivities A of dR (columns: `rate_cols` model parameters from `rate_first`, the
+  /// attitude R_k, then each walk's b_from and b_to).
+  void WriteJacobians(const Vec3& r, const Mat3& M, const Eigen::Matrix<double, 3, Eigen::Dynamic>& A,
+                      int rate_first, int rate_cols, const Quat& q_k, const Quat& q_k1,
+                      double** jacobians) const;
   /// The general model's d w_i / d theta (3 x P) at the corrected inputs (f_i, w_i), given the
   /// model's output at zero input (its F and E).
   void ImplicitRateJacobians(double const* const* theta,
