@@ -14,6 +14,7 @@
 
 #include "plumb/core/session.h"
 #include "plumb/geo/site.h"
+#include "plumb/report/json_report.h"
 
 namespace plumb::python {
 
@@ -96,8 +97,6 @@ Class& DocumentMethods(Class& c, const std::string& command);
 /// A JSON document as Python objects (dict, list, float, ...), through Python's json module
 /// so that numbers keep every bit.
 py::object ToPython(const nlohmann::json& doc);
-/// report::JsonText (the text of every JSON file plumb writes).
-std::string JsonText(const nlohmann::json& doc);
 /// A Python dict / list / number ... as JSON (through Python's json module).
 nlohmann::json FromPython(const py::handle& object);
 
@@ -106,7 +105,7 @@ Class& DocumentMethods(Class& c, const std::string& command) {
   using T = typename Class::type;
   c.def_property_readonly("document", [](const T& t) { return ToPython(t.document); },
                           ("The whole " + command + " --json document as a dict.").c_str());
-  c.def("to_json", [](const T& t) { return JsonText(t.document); },
+  c.def("to_json", [](const T& t) { return report::JsonText(t.document); },
         ("The " + command + " --json document as text, byte for byte what the command writes.")
             .c_str());
   return c;

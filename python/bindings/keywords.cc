@@ -3,7 +3,6 @@
 
 #include "common.h"
 #include "plumb/core/error.h"
-#include "plumb/report/json_report.h"
 
 namespace plumb::python {
 
@@ -62,8 +61,6 @@ py::object ToPython(const nlohmann::json& doc) {
   return py::module_::import("json").attr("loads")(doc.dump(-1, ' ', false,
                                                             nlohmann::json::error_handler_t::replace));
 }
-
-std::string JsonText(const nlohmann::json& doc) { return report::JsonText(doc); }
 
 nlohmann::json FromPython(const py::handle& object) {
   const std::string text = py::module_::import("json").attr("dumps")(object).cast<std::string>();

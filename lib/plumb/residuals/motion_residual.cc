@@ -242,10 +242,11 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
     return z;
   };
 
-  // The rate rows of -D_x^-1 per sample, M = d w / d y (3 x 6; without accelerometer terms f
-  // is the output itself: d f = 0). With D_x = [A B; C D] (A = d y_a / d f ~ F, D ~ E) and
-  // S = D - C A^-1 B: M = [S^-1 C A^-1, -S^-1].
-  std::vector<Eigen::Matrix<double, 3, 6>> dw_dy(n);
+  // The rate rows of -D_x^-1 per sample, M = d w / d p, how w moves when p is added to the
+  // predicted outputs (3 x 6; without accelerometer terms f is the output itself: d f = 0).
+  // With D_x = [A B; C D] (A = d y_a / d f ~ F, D ~ E) and S = D - C A^-1 B:
+  // M = [S^-1 C A^-1, -S^-1].
+  std::vector<Eigen::Matrix<double, 3, 6>> dw_dp(n);
   set_theta({});
   bool coupled = false;  // some output depends on the other sensor's input
   const std::vector<int>& input_terms = terms_split_ ? catalogue_terms_ : all_terms_;
@@ -268,7 +269,7 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
     const Mat3 S_inv =
         (D.bottomRightCorner<3, 3>() - D.bottomLeftCorner<3, 3>() * A_inv * D.topRightCorner<3, 3>())
             .inverse();
-    dw_dy[i] << S_inv * D.bottomLeftCorner<3, 3>() * A_inv, -S_inv;
+    dw_dp[i] << S_inv * D.bottomLeftCorner<3, 3>() * A_inv, -S_inv;
   }
   // The parameters that can move the rates: with the sensors uncoupled at every sample, D_x is
   // block diagonal and the accelerometer's terms (which write y_a alone) leave w alone: their
@@ -318,14 +319,14 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
         D_theta.row(r) = z.acc[r].v.transpose();  // zero without accelerometer terms
         D_theta.row(3 + r) = z.gyr[r].v.transpose();
       }
-      const Eigen::Matrix<double, 3, kStride> dw = dw_dy[i] * D_theta;
+      const Eigen::Matrix<double, 3, kStride> dw = dw_dp[i] * D_theta;
       for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
         W[i].col(seeded[slot] - first) = dw.col(static_cast<Eigen::Index>(slot));
       }
     }
   }
-  // The linear stage in closed form (applied by Evaluate through d w / d y).
-  if (linear_closed) W.SetLinearStage(std::move(dw_dy), f, coupled);
+  // The linear stage in closed form (applied by Evaluate through d w / d p).
+  if (linear_closed) W.SetLinearStage(std::move(dw_dp), f, coupled);
 }
 
 bool MotionResidual::Evaluate(double const* const* parameters, double* residuals,
@@ -382,46 +383,46 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   const int g_term = model_->BaseTerm(model::Sensor::kGyro);
   const int a_size =
       a_term >= 0 ? model_->terms()[static_cast<std::size_t>(a_term)].effect->info().size() : 0;
+  // The linear gyroscope stage's share of K dw_i/dtheta, given KE = -K d w_i / d p_g (K E^-1
+  // for the base model, w = E^-1 (y_g - b_g)): the 12 columns of E and b_g from `g_col` and,
+  // with a walk, those of b_from and b_to (d w_i / d b_g weighted by 1 - a_i and a_i).
+  auto add_gyro_stage = [&](const Mat3& KE, std::size_t i, int g_col,
+                            Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
+    model::gyro_linear::SubtractRateJacobian(KE, w[i], out.middleCols(g_col, model::gyro_linear::kSize));
+    if (walk) {
+      out.middleCols<3>(from).noalias() -= (1.0 - a[i]) * KE;
+      out.middleCols<3>(from + 3).noalias() -= a[i] * KE;
+    }
+  };
   // Adds K dw_i/dtheta to the first rate_cols columns of `out` and, with a walk, K dw_i/d
-  // b_from and K dw_i/d b_to (d w_i / d b_g weighted by 1 - a_i and a_i) to the walk's columns.
+  // b_from and K dw_i/d b_to to the walk's columns.
   auto add_rate_jacobian = [&](const Mat3& K, std::size_t i,
                                Eigen::Matrix<double, 3, Eigen::Dynamic>& out) {
-    if (!closed_form && W.linear_stage_closed()) {
-      // The other terms' stored columns, then the linear stage's: with K_y = K d w / d y,
-      // d y_g / d E_rc = e_r w_c, d y_g / d b_g = I (SubtractRateJacobian with K E^-1 = -K_y)
-      // and the same for F, b_a and f when the sensors are coupled.
+    if (closed_form) {
+      if (gyro_offset >= 0) add_gyro_stage(K * E_inv, i, 0, out);
+      return;
+    }
+    if (W.linear_stage_closed()) {
+      // The other terms' stored columns, then the linear stage's through d w / d p: d p_g /
+      // d E_rc = e_r w_c, d p_g / d b_g = I, and the same for F, b_a and f when the sensors are
+      // coupled (the linear residuals' column functions, with K F^-1 = -K d w / d p_a).
       if (W.columns() > 0) out.middleCols(W.first(), W.columns()).noalias() += K * W[i];
-      const Mat3 K_g = K * W.dw_dy(i).rightCols<3>();
       if (g_term >= 0) {
-        model::gyro_linear::SubtractRateJacobian(
-            Mat3(-K_g), w[i], out.middleCols(block_offset_[static_cast<std::size_t>(g_term)], model::gyro_linear::kSize));
+        add_gyro_stage(Mat3(-K * W.dw_dp(i).rightCols<3>()), i,
+                       block_offset_[static_cast<std::size_t>(g_term)], out);
       }
       if (a_term >= 0 && W.coupled()) {
         model::accel_linear::SubtractForceJacobian(
-            Mat3(-(K * W.dw_dy(i).leftCols<3>())), W.f(i), a_size == model::accel_linear::kSizeFull,
+            Mat3(-(K * W.dw_dp(i).leftCols<3>())), W.f(i), a_size == model::accel_linear::kSizeFull,
             out.middleCols(block_offset_[static_cast<std::size_t>(a_term)], a_size));
       }
-      if (walk) {
-        out.middleCols<3>(from).noalias() += (1.0 - a[i]) * K_g;
-        out.middleCols<3>(from + 3).noalias() += a[i] * K_g;
-      }
       return;
     }
-    if (!closed_form) {
-      out.leftCols(P).noalias() += K * W[i];
-      if (walk) {
-        const Mat3 K_dw_db = K * W[i].middleCols<3>(bias_offset_);
-        out.middleCols<3>(from).noalias() += (1.0 - a[i]) * K_dw_db;
-        out.middleCols<3>(from + 3).noalias() += a[i] * K_dw_db;
-      }
-      return;
-    }
-    if (gyro_offset < 0) return;
-    const Mat3 KE_inv = K * E_inv;
-    model::gyro_linear::SubtractRateJacobian(KE_inv, w[i], out.leftCols(model::gyro_linear::kSize));
+    out.leftCols(P).noalias() += K * W[i];
     if (walk) {
-      out.middleCols<3>(from).noalias() -= (1.0 - a[i]) * KE_inv;
-      out.middleCols<3>(from + 3).noalias() -= a[i] * KE_inv;
+      const Mat3 K_dw_db = K * W[i].middleCols<3>(bias_offset_);
+      out.middleCols<3>(from).noalias() += (1.0 - a[i]) * K_dw_db;
+      out.middleCols<3>(from + 3).noalias() += a[i] * K_dw_db;
     }
   };
 

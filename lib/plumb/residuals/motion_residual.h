@@ -48,17 +48,18 @@ namespace plumb::residuals {
 
 /// d w_i / d theta of every sample of an interval, 3 x P each. Stored either whole (columns
 /// [0, P), side by side in one allocation) or, when the linear stage's share has its closed
-/// form, as the columns [first, P) of the other terms plus, per sample, d w / d y (3 x 6, the
-/// rate rows of -D_x^-1) and the corrected force f: the linear stage's columns are then
-/// d w / d y_a (e_r f_c, I) and d w / d y_g (e_r w_c, I), applied by the caller with the
-/// linear residuals' own column functions.
+/// form, as the columns [first, P) of the other terms plus, per sample, d w / d p (3 x 6, the
+/// rate rows of -D_x^-1: how w moves when p is added to the predicted outputs y_a, y_g at a
+/// fixed measurement, -d w / d y) and the corrected force f: the linear stage's columns are
+/// then d w / d p times d p / d theta (e_r f_c and I for F and b_a, e_r w_c and I for E and
+/// b_g), applied by the caller with the linear residuals' own column functions.
 class RateJacobians {
  public:
   void Reset(std::size_t samples, int first, int columns) {
     first_ = first;
     P_ = columns;
     columns_.setZero(3, static_cast<Eigen::Index>(samples) * P_);
-    dw_dy_.clear();
+    dw_dp_.clear();
     f_.clear();
   }
   /// The stored columns of sample i (those from first()).
@@ -68,15 +69,15 @@ class RateJacobians {
   }
   int first() const { return static_cast<int>(first_); }
   int columns() const { return static_cast<int>(P_); }
-  /// Gives the linear stage's share by d w / d y per sample (see above).
-  void SetLinearStage(std::vector<Eigen::Matrix<double, 3, 6>> dw_dy, std::vector<Vec3> f,
+  /// Gives the linear stage's share by d w / d p per sample (see above).
+  void SetLinearStage(std::vector<Eigen::Matrix<double, 3, 6>> dw_dp, std::vector<Vec3> f,
                       bool coupled) {
-    dw_dy_ = std::move(dw_dy);
+    dw_dp_ = std::move(dw_dp);
     f_ = std::move(f);
     coupled_ = coupled;
   }
-  bool linear_stage_closed() const { return !dw_dy_.empty(); }
-  const Eigen::Matrix<double, 3, 6>& dw_dy(std::size_t i) const { return dw_dy_[i]; }
+  bool linear_stage_closed() const { return !dw_dp_.empty(); }
+  const Eigen::Matrix<double, 3, 6>& dw_dp(std::size_t i) const { return dw_dp_[i]; }
   const Vec3& f(std::size_t i) const { return f_[i]; }
   /// Some rate depends on the accelerometer's input (its columns are then not zero).
   bool coupled() const { return coupled_; }
@@ -84,7 +85,7 @@ class RateJacobians {
  private:
   Eigen::Index first_ = 0, P_ = 0;
   Eigen::Matrix<double, 3, Eigen::Dynamic> columns_;
-  std::vector<Eigen::Matrix<double, 3, 6>> dw_dy_;
+  std::vector<Eigen::Matrix<double, 3, 6>> dw_dp_;
   std::vector<Vec3> f_;
   bool coupled_ = false;
 };
