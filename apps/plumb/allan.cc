@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "validators.h"
+#include "jobs.h"
 #include "commands.h"
 #include "fit_options.h"
 #include "input_options.h"
@@ -129,7 +130,7 @@ class AllanCommand : public Command {
                                                   a.segments.verbose));
     signal::StillNoise noise;
     try {
-      noise = signal::AnalyseStillNoise(series, still, a.noise);
+      noise = signal::AnalyseStillNoise(series, still, a.noise, ParallelJobs(0));
     } catch (const InsufficientDataError& e) {
       throw InsufficientDataError(session.source + ": " + e.what());
     }

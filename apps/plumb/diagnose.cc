@@ -104,7 +104,7 @@ class DiagnoseCommand : public Command {
   int Run() override {
     const DiagnoseArgs& a = args_;
     const TextAsideForJson text_aside(a.json_path);
-    Session session = ReadInputs(a.input);
+    Session session = ReadInputs(a.input, a.jobs);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
     const FitSetup fit = PrepareFit(session, seg, a.site, a.fit, a.input);
@@ -118,6 +118,7 @@ class DiagnoseCommand : public Command {
     options.calibration.method = "generalized";
     options.on_stage = [](const std::string& stage) { Progress::Of().Stage(stage); };
     options.run_jobs = ParallelJobs(a.jobs);
+    options.calibration.run_jobs = options.run_jobs;  // the probe fit's motion residuals
 
     PrintSession(session);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose)

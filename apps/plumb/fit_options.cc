@@ -1,6 +1,7 @@
 // See fit_options.h.
 #include "fit_options.h"
 #include "commands.h"
+#include "jobs.h"
 #include "progress.h"
 
 #include <cstdio>
@@ -135,7 +136,8 @@ signal::StillNoise StillNoiseFrom(const std::string& path, const InputArgs& inpu
   const segmentation::SegmentationResult seg = FindSegments(still.series, SegmentArgs{});
   try {
     return signal::AnalyseStillNoise(still.series, seg.segments,
-                                     estimation::WanderNoiseOptions(instability_time_s));
+                                     estimation::WanderNoiseOptions(instability_time_s),
+                                     ParallelJobs(0));
   } catch (const InsufficientDataError& e) {
     throw InsufficientDataError("--noise-from " + path + ": " + e.what());
   }

@@ -1,4 +1,5 @@
 #include "input_options.h"
+#include "jobs.h"
 #include "progress.h"
 
 #include <array>
@@ -255,7 +256,7 @@ std::uint64_t CheckMemory(const std::vector<std::string>& files, std::uint64_t m
               (max_memory > 0 ? "--max-memory" : "MemAvailable in /proc/meminfo") + ")");
 }
 
-Session ReadInputs(const InputArgs& a) {
+Session ReadInputs(const InputArgs& a, int jobs) {
   std::vector<std::string> inputs = a.inputs;
   if (!a.acc_file.empty() || !a.gyr_file.empty()) {
     if (a.acc_file.empty() || a.gyr_file.empty()) {
@@ -278,7 +279,9 @@ Session ReadInputs(const InputArgs& a) {
   }
   CheckMemory(paths, a.max_memory);
   Progress::Of().Stage("reading " + names);
-  return io::OpenInputs(files, MakeInputOptions(a, inputs));
+  io::InputOptions options = MakeInputOptions(a, inputs);
+  options.run_jobs = ParallelJobs(jobs);
+  return io::OpenInputs(files, options);
 }
 
 }  // namespace plumb::cli

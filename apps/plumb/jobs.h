@@ -1,14 +1,16 @@
 // apps/plumb/jobs.h — independent jobs run at once on OpenMP threads, for the library's
-// run_jobs hooks (diagnostics::DiagnoseOptions::run_jobs). The library starts no thread.
+// run_jobs hooks (core/jobs.h: estimation::CalibrationOptions::run_jobs,
+// diagnostics::DiagnoseOptions::run_jobs). The library starts no thread.
 #pragma once
 
-#include <functional>
+#include "plumb/core/jobs.h"
 
 namespace plumb::cli {
 
 /// Runs job(0), ..., job(count - 1) on at most `jobs` threads (0: every core), each job on
-/// one thread, taken in order as threads come free. The jobs must not throw.
-using JobRunner = std::function<void(int count, const std::function<void(int)>& job)>;
+/// one thread, taken in order as threads come free. The jobs must not throw. Inside another
+/// runner's job (diagnose's refits, each fitting with its own runner) the jobs run on the
+/// job's thread: OpenMP keeps nested regions to one thread.
 JobRunner ParallelJobs(int jobs);
 
 }  // namespace plumb::cli

@@ -228,7 +228,7 @@ class ReportCommand : public Command {
     const ReportArgs& a = args_;
     if (!a.study.empty()) return RunStudy();
     CheckReplaceable(a.out_dir);
-    Session session = ReadInputs(a.input);
+    Session session = ReadInputs(a.input, a.jobs);
     const ImuSeries& series = session.series;
     const segmentation::SegmentationResult seg = FindSegments(series, a.segments);
     const FitSetup fit = PrepareFit(session, seg, a.site, a.fit, a.input);
@@ -270,7 +270,7 @@ class ReportCommand : public Command {
     extras.segments_source = a.segments.segments_path;
     // The sensor's noise as `plumb allan` measures it on the same still segments.
     try {
-      extras.still_noise = signal::AnalyseStillNoise(series, segments);
+      extras.still_noise = signal::AnalyseStillNoise(series, segments, {}, ParallelJobs(a.jobs));
       report::WriteJson((dir / "allan.json").string(),
                         report::StillNoiseJson(*extras.still_noise, series));
       files.push_back("allan.json");
@@ -336,6 +336,7 @@ class ReportCommand : public Command {
     options.calibration.on_insufficient = estimation::InsufficientData::kReport;
     options.on_stage = [](const std::string& stage) { Progress::Of().Stage(stage); };
     options.run_jobs = ParallelJobs(args_.jobs);
+    options.calibration.run_jobs = options.run_jobs;  // the probe fit's motion residuals
     try {
       diagnostics::Diagnosis d = diagnostics::Diagnose(series, segments, model, site, options);
       std::cout << report::DiagnosisText(d);

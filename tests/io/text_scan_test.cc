@@ -3,10 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <string>
 
 namespace plumb::io::detail {
 namespace {
@@ -50,6 +52,31 @@ TEST(ParseNumber, AgreesWithFromCharsOnRandomDecimals) {
         break;
     }
     ExpectSameAsReference(text);
+  }
+}
+
+// Numbers inside a longer text, as a file's rows give them: the digit runs are then read 8
+// bytes at a time (TakeDigits), whatever their length and whatever follows them.
+TEST(ScanNumber, AgreesWithFromCharsInsideText) {
+  std::mt19937_64 rng(7654321);
+  std::uniform_int_distribution<int> digit(0, 9), run(0, 21), exponent(-25, 25), pick(0, 5);
+  const char* const after[] = {"", " ", "\t7", ",12345678", "e", "   3.3108000e+04\n"};
+  for (int i = 0; i < 100000; ++i) {
+    std::string number = (i % 4 == 0) ? "-" : "";
+    const int before = run(rng), fraction = run(rng);
+    for (int k = 0; k < before; ++k) number += static_cast<char>('0' + digit(rng));
+    if (i % 5 != 0) number += '.';
+    for (int k = 0; k < fraction; ++k) number += static_cast<char>('0' + digit(rng));
+    if (i % 3 == 0) number += "e" + std::to_string(exponent(rng));
+    const std::string text = number + after[pick(rng)];
+    double expected = 0.0, got = 0.0;
+    const auto result = std::from_chars(text.data(), text.data() + text.size(), expected);
+    const char* p = text.data();
+    const bool ok = ScanNumber(p, text.data() + text.size(), got);
+    ASSERT_EQ(ok, result.ec == std::errc()) << "'" << text << "'";
+    if (!ok) continue;
+    ASSERT_EQ(p, result.ptr) << "'" << text << "'";
+    ASSERT_EQ(std::memcmp(&got, &expected, sizeof got), 0) << "'" << text << "' " << got;
   }
 }
 

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/jobs.h"
 #include "plumb/core/segment.h"
 #include "plumb/diagnostics/score_test.h"
 #include "plumb/estimation/options.h"
@@ -53,7 +54,7 @@ struct DiagnoseOptions {
   /// result, so the diagnosis is the same bit for bit whatever the order. Empty: one after
   /// another. A command may run them at once (plumb's does, on OpenMP); the library starts
   /// no thread itself. The jobs throw nothing (Diagnose keeps their errors).
-  std::function<void(int count, const std::function<void(int)>& job)> run_jobs;
+  JobRunner run_jobs;
 };
 
 /// One candidate effect.

@@ -315,10 +315,12 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built) {
     for (std::size_t p : gyr_wander) {
       blocks.insert(blocks.end(), {wander(mo.from, p, true), wander(mo.from + 1, p, false)});
     }
-    built.motion.push_back(problem->AddResidualBlock(
-        residuals::MotionResidual::Create(model_, motion_samples_[k], site_.omega_ie_n,
-                                          static_cast<int>(gyr_wander.size())),
-        nullptr, blocks));
+    auto* motion = new residuals::MotionResidual(model_, motion_samples_[k], site_.omega_ie_n,
+                                                 static_cast<int>(gyr_wander.size()));
+    built.motion.push_back(problem->AddResidualBlock(motion, nullptr, blocks));
+    if (built.evaluation) {
+      built.evaluation->Add(motion, blocks, static_cast<double>(motion_samples_[k]->size()));
+    }
     if (velocity_on_) {
       std::vector<double*> vblocks = {q(mo.from)};
       vblocks.insert(vblocks.end(), all_terms.begin(), all_terms.end());
@@ -376,7 +378,12 @@ BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
   BuiltProblem built;
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  if (!still_.motions.empty()) {
+    built.evaluation = std::make_unique<ParallelEvaluation>(options_.run_jobs);
+    problem_options.evaluation_callback = built.evaluation.get();
+  }
   built.problem = std::make_unique<ceres::Problem>(problem_options);
+  if (built.evaluation) built.evaluation->SetProblem(built.problem.get());
   AddParameterBlocks(built, held, free_probes);
   AddResiduals(built);
   for (std::size_t p = 0; p < wander_.size(); ++p) AddWanderFactors(built, p);
@@ -512,6 +519,18 @@ ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
 
 void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& fit) const {
   const ceres::Problem& problem = *built.problem;
+  // The parameters stay as they are: only the first block's evaluation lets the evaluation
+  // callback prepare (all motion residuals at once, parallel_evaluation.h); asking it again
+  // per block would compare every block's values per block.
+  bool prepared = false;
+  auto evaluate = [&](ceres::ResidualBlockId id, double* w) {
+    if (prepared) {
+      problem.EvaluateResidualBlockAssumingParametersUnchanged(id, false, nullptr, w, nullptr);
+    } else {
+      problem.EvaluateResidualBlock(id, false, nullptr, w, nullptr);
+      prepared = true;
+    }
+  };
   Vec3 ss_acc = Vec3::Zero(), ss_gyr = Vec3::Zero(), ss_mot = Vec3::Zero(), ss_vel = Vec3::Zero();
   for (std::size_t k = 0; k < still_.poses.size(); ++k) {
     const StillPose& s = still_.poses[k];
@@ -533,13 +552,13 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
     double w[3];
     if (built.acc[k]) {
-      problem.EvaluateResidualBlock(built.acc[k], false, nullptr, w, nullptr);
+      evaluate(built.acc[k], w);
       f.acc_whitened = Vec3(w[0], w[1], w[2]);
       f.acc_residual = f.acc_whitened.cwiseQuotient(s.acc_measurement.sqrt_info);
       ss_acc += f.acc_residual.cwiseAbs2();
     }
     if (built.gyr[k]) {
-      problem.EvaluateResidualBlock(built.gyr[k], false, nullptr, w, nullptr);
+      evaluate(built.gyr[k], w);
       f.gyr_whitened = Vec3(w[0], w[1], w[2]);
       f.gyr_residual = f.gyr_whitened.cwiseQuotient(s.gyr_measurement.sqrt_info);
       ss_gyr += f.gyr_residual.cwiseAbs2();
@@ -554,12 +573,12 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     f.to = mo.from + 1;
     f.duration_s = series_.t_s[mo.last] - series_.t_s[mo.first];
     double w[3];
-    problem.EvaluateResidualBlock(built.motion[k], false, nullptr, w, nullptr);
+    evaluate(built.motion[k], w);
     f.whitened = Vec3(w[0], w[1], w[2]);
     f.rotation_residual = f.whitened.cwiseQuotient(motion_samples_[k]->sqrt_info);
     ss_mot += f.rotation_residual.cwiseAbs2();
     if (k < built.velocity.size()) {
-      problem.EvaluateResidualBlock(built.velocity[k], false, nullptr, w, nullptr);
+      evaluate(built.velocity[k], w);
       f.has_velocity = true;
       f.velocity_whitened = Vec3(w[0], w[1], w[2]);
       f.velocity_residual = f.velocity_whitened.cwiseQuotient(velocity_info_[k]);

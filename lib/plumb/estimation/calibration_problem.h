@@ -38,6 +38,7 @@
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/options.h"
+#include "plumb/estimation/parallel_evaluation.h"
 #include "plumb/estimation/still_set.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
@@ -49,6 +50,9 @@ namespace plumb::estimation {
 /// and motion interval (null where absent) and the manifolds it uses.
 struct BuiltProblem {
   std::vector<std::unique_ptr<ceres::Manifold>> manifolds;  // outlives `problem` (declared first)
+  /// The motion residuals evaluated before each pass, at once when options.run_jobs is given
+  /// (null without motion); outlives `problem`, which points to it.
+  std::unique_ptr<ParallelEvaluation> evaluation;
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ceres::ResidualBlockId> acc, gyr;  ///< per still pose
   std::vector<ceres::ResidualBlockId> motion;    ///< per motion interval

@@ -87,7 +87,7 @@ FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment
     // 2b. the walk estimated over the fit (opt-in).
     std::vector<const signal::StillNoise*> measured;
     const std::optional<signal::StillNoise> own =
-        MeasureStillNoise(series, still, options.instability_time_s, fit.notes);
+        MeasureStillNoise(series, still, options.instability_time_s, fit.notes, options.run_jobs);
     if (own) measured.push_back(&*own);
     for (const signal::StillNoise& other : options.other_still_noise) measured.push_back(&other);
     WanderLevels levels = AssignWanderLevels(out.noise, measured, out.start, cal.has_gyro,

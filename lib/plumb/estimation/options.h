@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/jobs.h"
 #include "plumb/core/typical_mems.h"
 #include "plumb/signal/noise_terms.h"
 
@@ -19,6 +20,10 @@ enum class InsufficientData {
 struct CalibrationOptions {
   /// Label of the method in outputs ("generalized", or a paper method run on the backend).
   std::string method = "generalized";
+  /// Runs independent jobs at once (core/jobs.h): here the motion residuals of each of
+  /// Ceres's evaluation passes (parallel_evaluation.h). Empty: one after another. The fit is
+  /// the same bit for bit either way.
+  JobRunner run_jobs;
   /// Integrate the gyroscope between consecutive still segments (motion residuals).
   bool use_motion = true;
   /// Motion intervals longer than this are not integrated, s (> 0): the attitude before and

@@ -225,10 +225,11 @@ signal::StillNoiseOptions WanderNoiseOptions(double instability_time_s) {
 
 std::optional<signal::StillNoise> MeasureStillNoise(const ImuSeries& series, const StillSet& set,
                                                     double instability_time_s,
-                                                    std::vector<std::string>& notes) {
+                                                    std::vector<std::string>& notes,
+                                                    const JobRunner& run_jobs) {
   try {
     return signal::AnalyseStillNoise(series, set.AtRestSegments(),
-                                      WanderNoiseOptions(instability_time_s));
+                                      WanderNoiseOptions(instability_time_s), run_jobs);
   } catch (const InsufficientDataError& e) {
     notes.push_back(std::string("the still data are too short for an Allan deviation (") +
                     e.what() + ")");

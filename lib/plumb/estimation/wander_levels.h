@@ -65,9 +65,10 @@ signal::StillNoiseOptions WanderNoiseOptions(double instability_time_s);
 
 /// The noise terms of the session's segments at rest (signal::AnalyseStillNoise with
 /// WanderNoiseOptions), or nullopt when they are too short for an Allan deviation (the reason
-/// appended to `notes`).
+/// appended to `notes`). The axes are analysed at once through `run_jobs` when it is given.
 std::optional<signal::StillNoise> MeasureStillNoise(const ImuSeries& series, const StillSet& set,
                                                     double instability_time_s,
-                                                    std::vector<std::string>& notes);
+                                                    std::vector<std::string>& notes,
+                                                    const JobRunner& run_jobs = {});
 
 }  // namespace plumb::estimation

@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <tuple>
 
@@ -71,6 +72,31 @@ TermReads ProbeTermReads(const model::Effect& effect) {
   };
   return TermReads{moved(increment(stage)), moved(increment(summed))};
 }
+
+/// The closed form's share of the propagated sensitivities without Earth rate: the sums over
+/// samples of G_i w_i,c, G_i and a_i G_i, multiplied by E^-1 once at the end (E^-1 is the
+/// same for every sample).
+struct GyroStageSums {
+  std::array<Mat3, 3> by_rate = {Mat3::Zero(), Mat3::Zero(), Mat3::Zero()};
+  Mat3 total = Mat3::Zero();  ///< sum_i G_i
+  Mat3 to = Mat3::Zero();     ///< sum_i a_i G_i (the walk's b_to weight)
+
+  void Add(const Mat3& G, const Vec3& w, double a) {
+    for (int c = 0; c < 3; ++c) by_rate[static_cast<std::size_t>(c)] += w[c] * G;
+    total += G;
+    to += a * G;
+  }
+  /// Subtracts the sums times E^-1 from the gyroscope's 12 leading columns of A and, when
+  /// `walk_from` >= 0, from the walk's b_from and b_to columns there.
+  void SubtractFrom(const Mat3& E_inv, int walk_from,
+                    Eigen::Matrix<double, 3, Eigen::Dynamic>& A) const {
+    model::gyro_linear::SubtractSummedRateJacobian(E_inv, by_rate, total,
+                                                   A.leftCols(model::gyro_linear::kSize));
+    if (walk_from < 0) return;
+    A.middleCols<3>(walk_from).noalias() -= (total - to) * E_inv;
+    A.middleCols<3>(walk_from + 3).noalias() -= to * E_inv;
+  }
+};
 
 }  // namespace
 
@@ -329,8 +355,8 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
   if (linear_closed) W.SetLinearStage(std::move(dw_dp), f, coupled);
 }
 
-bool MotionResidual::Evaluate(double const* const* parameters, double* residuals,
-                              double** jacobians) const {
+bool MotionResidual::EvaluateUncached(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
   const Quat q_k(parameters[0][3], parameters[0][0], parameters[0][1], parameters[0][2]);
   const Quat q_k1(parameters[1][3], parameters[1][0], parameters[1][1], parameters[1][2]);
   const Mat3 R_k = q_k.normalized().toRotationMatrix();
@@ -343,17 +369,7 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   // The outputs with the bias walk taken off (the samples themselves without a walk).
   std::vector<Vec3> walked;
   const std::vector<double>& a = walk_weight_;
-  if (walk) {
-    Vec3 b_from = Vec3::Zero(), b_to = Vec3::Zero();
-    for (int p = 0; p < wander_; ++p) {
-      b_from += Eigen::Map<const Vec3>(parameters[2 + model_->num_terms() + 2 * p]);
-      b_to += Eigen::Map<const Vec3>(parameters[3 + model_->num_terms() + 2 * p]);
-    }
-    walked.resize(s_.size());
-    for (std::size_t i = 0; i < s_.size(); ++i) {
-      walked[i] = s_.gyr[i] - ((1.0 - a[i]) * b_from + a[i] * b_to);
-    }
-  }
+  if (walk) walked = WalkedOutputs(parameters);
   const std::vector<Vec3>& gyr = walk ? walked : s_.gyr;
 
   std::vector<Vec3> w;
@@ -364,14 +380,8 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   const bool closed_form = LinearAt(theta, jacobians);
   CorrectedRates(theta, gyr, closed_form, &w, want_jacobians && !closed_form ? &W : nullptr);
   Mat3 E_inv = Mat3::Identity();
-  int gyro_offset = -1;
-  if (closed_form && want_jacobians) {
-    const int g = model_->BaseTerm(model::Sensor::kGyro);
-    if (g >= 0) {
-      gyro_offset = block_offset_[static_cast<std::size_t>(g)];
-      E_inv = model_->Predict(theta, model::SensorInput<double>()).E.inverse();
-    }
-  }
+  int gyro_offset = -1;  // the gyroscope's linear block among the P (closed form, Jacobians)
+  if (closed_form && want_jacobians) std::tie(E_inv, gyro_offset) = ClosedFormGyro(theta);
   // Columns of the propagated sensitivities: the model parameters that move the rates (all P
   // in general; in closed form the gyroscope's linear block only, the others' columns being
   // zero), the left perturbation of R_k, then (wander) b_from and b_to.
@@ -426,22 +436,28 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     }
   };
 
+  const bool earth = omega_ie_n_.squaredNorm() > 0.0;  // without a site: e = 0, no att terms
+  if (!want_jacobians && !earth) {
+    const Vec3 r = so3::Log(IntegratedRotation(w).transpose() * R_k.transpose() * R_k1);
+    for (int i = 0; i < 3; ++i) residuals[i] = s_.sqrt_info[i] * r[i];
+    return true;
+  }
   const Vec3 omega_k = R_k.transpose() * omega_ie_n_;  // Earth rate in b_k
   const Mat3 d_omega_k = R_k.transpose() * Skew(omega_ie_n_);  // d omega_k / d delta_k
   Mat3 dR = Mat3::Identity();
-  // A = d(right perturbation of dR)/d(unknowns), propagated step by step. With
-  // C0 = h/2 I - h^2/12 [u1]x and C1 = h/2 I + h^2/12 [u0]x,
-  //   d phi = C0 dU0 + C1 dU1,  dU = W - d e,  d e = [e]x A + [0 | dR^T d omega_k],
-  //   A' = Exp(phi)^T A + J_r(phi) d phi
-  //      = (Exp(phi)^T - J_r (C0 + C1) [e]x) A + J_r C0 W_i + J_r C1 W_i+1
-  //        - [0 | J_r (C0 + C1) dR^T d omega_k].
-  //
-  // Without Earth rate A is carried in the frame of the interval's start instead,
-  // A~_i = dR_i A_i: then A~_i+1 = A~_i + dR_i+1 (J_r C0 W_i + J_r C1 W_i+1), with no product
-  // by Exp(phi)^T per step, and A = dR^T A~ at the end.
+  // A = d(right perturbation of dR)/d(unknowns), propagated step by step (the header's
+  // "Propagation": with Earth rate in the body frame, without it in the start frame).
   Eigen::Matrix<double, 3, Eigen::Dynamic> A = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, U);
   Eigen::Matrix<double, 3, Eigen::Dynamic> A_next(3, U);
-  const bool earth = omega_ie_n_.squaredNorm() > 0.0;  // without a site: e = 0, no att terms
+  GyroStageSums sums;
+  auto add_sample = [&](const Mat3& G, std::size_t i) {
+    if (closed_form) {
+      sums.Add(G, w[i], walk ? a[i] : 0.0);
+    } else {
+      add_rate_jacobian(G, i, A);
+    }
+  };
+  Mat3 G_next = Mat3::Zero();  // the share of W_i+1 from step i
   for (std::size_t i = 0; i + 1 < s_.size(); ++i) {
     const double h = s_.dt_s[i + 1] - s_.dt_s[i];
     // Earth rate at the start of the step, held over the step.
@@ -452,9 +468,10 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
     const Mat3 dR_next = dR * Ex;
     if (want_jacobians) {
       const Mat3 Jr = so3::RightJacobian(phi);
-      const Mat3 K0 = Jr * (0.5 * h * Mat3::Identity() - (h * h / 12.0) * Skew(u1));
-      const Mat3 K1 = Jr * (0.5 * h * Mat3::Identity() + (h * h / 12.0) * Skew(u0));
+      const Mat3 C0 = 0.5 * h * Mat3::Identity() - (h * h / 12.0) * Skew(u1);
+      const Mat3 C1 = 0.5 * h * Mat3::Identity() + (h * h / 12.0) * Skew(u0);
       if (earth) {
+        const Mat3 K0 = Jr * C0, K1 = Jr * C1;
         const Mat3 K = K0 + K1;
         A_next.noalias() = (Ex.transpose() - K * Skew(e)) * A;
         A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
@@ -462,13 +479,18 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
         add_rate_jacobian(K1, i + 1, A_next);
         A.swap(A_next);
       } else {
-        add_rate_jacobian(dR_next * K0, i, A);
-        add_rate_jacobian(dR_next * K1, i + 1, A);
+        const Mat3 dR_next_Jr = dR_next * Jr;
+        add_sample(G_next + dR_next_Jr * C0, i);
+        G_next.noalias() = dR_next_Jr * C1;
       }
     }
     dR = dR_next;
   }
-  if (want_jacobians && !earth) A = (dR.transpose() * A).eval();
+  if (want_jacobians && !earth) {
+    if (s_.size() >= 2) add_sample(G_next, s_.size() - 1);
+    if (closed_form && gyro_offset >= 0) sums.SubtractFrom(E_inv, walk ? from : -1, A);
+    A = (dR.transpose() * A).eval();
+  }
   const Mat3 M = dR.transpose() * R_k.transpose();
   const Vec3 r = so3::Log(M * R_k1);
   for (int i = 0; i < 3; ++i) residuals[i] = s_.sqrt_info[i] * r[i];
@@ -477,6 +499,35 @@ bool MotionResidual::Evaluate(double const* const* parameters, double* residuals
   WriteJacobians(r, M, A, closed_form ? std::max(gyro_offset, 0) : 0, rate_cols, q_k, q_k1,
                  jacobians);
   return true;
+}
+
+std::pair<Mat3, int> MotionResidual::ClosedFormGyro(double const* const* theta) const {
+  const int g = model_->BaseTerm(model::Sensor::kGyro);
+  if (g < 0) return {Mat3::Identity(), -1};
+  return {model_->Predict(theta, model::SensorInput<double>()).E.inverse(),
+          block_offset_[static_cast<std::size_t>(g)]};
+}
+
+std::vector<Vec3> MotionResidual::WalkedOutputs(double const* const* parameters) const {
+  Vec3 b_from = Vec3::Zero(), b_to = Vec3::Zero();
+  for (int p = 0; p < wander_; ++p) {
+    b_from += Eigen::Map<const Vec3>(parameters[2 + model_->num_terms() + 2 * p]);
+    b_to += Eigen::Map<const Vec3>(parameters[3 + model_->num_terms() + 2 * p]);
+  }
+  std::vector<Vec3> walked(s_.size());
+  for (std::size_t i = 0; i < s_.size(); ++i) {
+    const double a = walk_weight_[i];
+    walked[i] = s_.gyr[i] - ((1.0 - a) * b_from + a * b_to);
+  }
+  return walked;
+}
+
+Mat3 MotionResidual::IntegratedRotation(const std::vector<Vec3>& w) const {
+  Quat dR = Quat::Identity();
+  for (std::size_t i = 0; i + 1 < s_.size(); ++i) {
+    dR *= so3::ExpQuat(so3::ConingIncrement(w[i], w[i + 1], s_.dt_s[i + 1] - s_.dt_s[i]));
+  }
+  return dR.normalized().toRotationMatrix();
 }
 
 void MotionResidual::WriteJacobians(const Vec3& r, const Mat3& M,

@@ -14,8 +14,19 @@
 // and the residual is r = W Log(dR^T R_k^T R_k+1) (3 values, rad), whitened by
 // W = diag(sqrt_info), the propagated white gyroscope noise of the interval.
 //
-// Jacobians are analytic, as in IMU preintegration: the right-perturbation sensitivity of
-// dR, A (3 x unknowns), follows A_i+1 = Exp(phi_i)^T A_i + J_r(phi_i) d(phi_i)/d(unknowns);
+// Propagation. Jacobians are analytic, as in IMU preintegration: the right-perturbation
+// sensitivity of dR, A (3 x unknowns), follows A_i+1 = Exp(phi_i)^T A_i + J_r(phi_i)
+// d(phi_i)/d(unknowns). With C0 = h/2 I - h^2/12 [u1]x, C1 = h/2 I + h^2/12 [u0]x and W_i =
+// d w_i / d(unknowns):
+//   d phi = C0 dU0 + C1 dU1,  dU = W - d e,  d e = [e]x A + [0 | dR^T d omega_k],
+//   A' = (Exp(phi)^T - J_r (C0 + C1) [e]x) A + J_r C0 W_i + J_r C1 W_i+1
+//        - [0 | J_r (C0 + C1) dR^T d omega_k].
+// Without Earth rate A is carried in the interval's start frame, A~_i = dR_i A_i:
+// A~_i+1 = A~_i + dR_i+1 (J_r C0 W_i + J_r C1 W_i+1), A = dR^T A~ at the end; each W_i then
+// enters once, with G_i = dR_i+1 J_r C0 (step i) + dR_i J_r C1 (step i-1), and in closed form
+// only the sums of gyro_linear::SubtractSummedRateJacobian are kept (their product with E^-1
+// taken once). A value alone without Earth rate is integrated on unit quaternions.
+//
 // d(w_i)/d(theta) is closed-form for the base model; with other effects it is implicit, the
 // linear stage's share closed-form and the other terms' from Jets (one pass per 8 parameters
 // through the term that owns them). The cost is one pass over the samples per evaluation.
@@ -35,13 +46,12 @@
 // (3) in sensor units.
 #pragma once
 
-#include <ceres/cost_function.h>
-
 #include <memory>
 #include <utility>
 #include <vector>
 
 #include "plumb/model/model.h"
+#include "plumb/residuals/cached_cost_function.h"
 #include "plumb/residuals/measurements.h"
 
 namespace plumb::residuals {
@@ -90,7 +100,7 @@ class RateJacobians {
   bool coupled_ = false;
 };
 
-class MotionResidual final : public ceres::CostFunction {
+class MotionResidual final : public CachedCostFunction {
  public:
   /// `omega_ie_n`: Earth rate in NED, rad/s (zero without a site). The model must outlive
   /// the cost function.
@@ -110,8 +120,10 @@ class MotionResidual final : public ceres::CostFunction {
     return new MotionResidual(model, std::move(samples), omega_ie_n, wander_processes);
   }
 
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override;
+  /// ceres::CostFunction::Evaluate's contract (CachedCostFunction::Evaluate hands out a
+  /// precomputed one when it can).
+  bool EvaluateUncached(double const* const* parameters, double* residuals,
+                        double** jacobians) const override;
 
   /// The integrated rotation dR = R_k^T R(t_end) (body frame) at given values (with a walk:
   /// the walk at zero).
@@ -126,6 +138,16 @@ class MotionResidual final : public ceres::CostFunction {
   /// closed form of LinearAt.
   void CorrectedRates(double const* const* theta, const std::vector<Vec3>& gyr, bool linear,
                       std::vector<Vec3>* w, RateJacobians* W) const;
+  /// E^-1 at `theta` and the offset of the gyroscope's linear block among the P parameters
+  /// (identity and -1 without a gyroscope term).
+  std::pair<Mat3, int> ClosedFormGyro(double const* const* theta) const;
+  /// The gyroscope's outputs with the bias walk taken off: y_g,i - ((1 - a_i) b_from + a_i b_to),
+  /// the walk's blocks summed over its processes.
+  std::vector<Vec3> WalkedOutputs(double const* const* parameters) const;
+  /// dR without Earth rate, from the corrected rates `w`: the same product of exponentials
+  /// on unit quaternions (a value alone needs no 3 x 3 matrix per step; the same rotation to
+  /// rounding).
+  Mat3 IntegratedRotation(const std::vector<Vec3>& w) const;
   /// Ceres's Jacobians of the residual r = W Log(M R_k+1), M = dR^T R_k^T, from the propagated
   /// sensitivities A of dR (columns: `rate_cols` model parameters from `rate_first`, the
   /// attitude R_k, then each walk's b_from and b_to).

@@ -11,27 +11,36 @@
 namespace plumb::signal {
 namespace {
 
-/// Samples of every usable chunk centred on the chunk's mean, stored back to back.
-struct CentredChunks {
-  std::vector<double> values;
-  std::vector<std::size_t> offsets;  ///< chunk c is values[offsets[c], offsets[c + 1])
-  std::size_t longest = 0;
+/// The usable chunks (at least 3 samples with a detrend, else 2), each centred on its own
+/// mean (and line) when asked for: one chunk at a time, in a buffer that stays in cache,
+/// rather than every centred sample stored at once (hours of data are tens of MB per axis).
+class CentredChunks {
+ public:
+  CentredChunks(const std::vector<AxisView>& chunks, bool detrend)
+      : chunks_(chunks), detrend_(detrend) {
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+      const auto n = static_cast<std::size_t>(chunks[c].size());
+      if (n < (detrend ? 3u : 2u)) continue;
+      usable_.push_back(c);
+      samples_ += n;
+      longest_ = std::max(longest_, n);
+    }
+  }
+  std::size_t count() const { return usable_.size(); }
+  std::size_t samples() const { return samples_; }
+  std::size_t longest() const { return longest_; }
+  std::size_t length(std::size_t c) const {
+    return static_cast<std::size_t>(chunks_[usable_[c]].size());
+  }
 
-  std::size_t count() const { return offsets.size() - 1; }
-  std::size_t length(std::size_t c) const { return offsets[c + 1] - offsets[c]; }
-};
-
-CentredChunks Centre(const std::vector<AxisView>& chunks, bool detrend) {
-  CentredChunks out;
-  out.offsets.push_back(0);
-  for (const AxisView& chunk : chunks) {
+  /// Usable chunk c about its mean (and least-squares line against the sample index).
+  const std::vector<double>& Centred(std::size_t c) const {
+    const AxisView& chunk = chunks_[usable_[c]];
     const auto n = static_cast<std::size_t>(chunk.size());
-    if (n < (detrend ? 3u : 2u)) continue;
     const double mean = chunk.cast<double>().mean();
-    // The least-squares slope against the sample index about its middle (0 without detrend).
     const double mid = 0.5 * static_cast<double>(n - 1);
     double slope = 0.0;
-    if (detrend) {
+    if (detrend_) {
       double sxy = 0.0, sxx = 0.0;
       for (Eigen::Index i = 0; i < chunk.size(); ++i) {
         const double x = static_cast<double>(i) - mid;
@@ -40,15 +49,21 @@ CentredChunks Centre(const std::vector<AxisView>& chunks, bool detrend) {
       }
       slope = sxy / sxx;
     }
+    buffer_.resize(n);
     for (Eigen::Index i = 0; i < chunk.size(); ++i) {
-      out.values.push_back(static_cast<double>(chunk[i]) - mean -
-                           slope * (static_cast<double>(i) - mid));
+      buffer_[static_cast<std::size_t>(i)] =
+          static_cast<double>(chunk[i]) - mean - slope * (static_cast<double>(i) - mid);
     }
-    out.offsets.push_back(out.values.size());
-    out.longest = std::max(out.longest, n);
+    return buffer_;
   }
-  return out;
-}
+
+ private:
+  const std::vector<AxisView>& chunks_;
+  bool detrend_;
+  std::vector<std::size_t> usable_;
+  std::size_t samples_ = 0, longest_ = 0;
+  mutable std::vector<double> buffer_;
+};
 
 /// Lags computed per pass over the data: the window usually stops within a few lags, and
 /// one pass for several keeps the samples in cache once instead of streaming them per lag.
@@ -56,15 +71,22 @@ constexpr std::size_t kLagsPerPass = 8;
 
 /// Autocovariances at lags first .. first + count - 1 pooled over chunks (each divided by its
 /// number of pairs), NaN for a lag no chunk is longer than. One pass over each chunk; each
-/// lag's sum is accumulated in the same order as a pass of its own would.
+/// lag's sum is accumulated in the same order as a pass of its own would. With `sum_sq`, the
+/// squares of every centred sample are added to it too, in order.
 std::array<double, kLagsPerPass> PooledAutocovariances(const CentredChunks& data,
-                                                       std::size_t first, std::size_t count) {
+                                                       std::size_t first, std::size_t count,
+                                                       double* sum_sq = nullptr) {
   std::array<double, kLagsPerPass> sum{}, out{};
   std::array<std::size_t, kLagsPerPass> pairs{};
   for (std::size_t c = 0; c < data.count(); ++c) {
     const std::size_t n = data.length(c);
+    if (n <= first && sum_sq == nullptr) continue;
+    const std::vector<double>& centred = data.Centred(c);
+    const double* y = centred.data();
+    if (sum_sq != nullptr) {
+      for (double v : centred) *sum_sq += v * v;
+    }
     if (n <= first) continue;
-    const double* y = data.values.data() + data.offsets[c];
     std::array<double, kLagsPerPass> chunk_sum{};
     const std::size_t lags = std::min(count, n - first);  // lags this chunk has pairs for
     for (std::size_t i = 0; i + first < n; ++i) {
@@ -96,7 +118,7 @@ void CheckOptions(const CorrelationTimeOptions& options) {
 CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
                                         const CorrelationTimeOptions& options) {
   CheckOptions(options);
-  const CentredChunks data = Centre(chunks, options.detrend);
+  const CentredChunks data(chunks, options.detrend);
   if (data.count() == 0) {
     throw Error(std::string("correlation time: no chunk has at least ") +
                 (options.detrend ? "3" : "2") + " samples (" +
@@ -104,9 +126,12 @@ CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
   }
   CorrelationTime out;
   out.chunks = data.count();
-  out.samples = data.values.size();
+  out.samples = data.samples();
+  // The first pass gives the variance and the first lags' covariances together.
+  const std::size_t last_lag = std::min(options.max_lag, data.longest() / 2);
   double sum_sq = 0.0;
-  for (double y : data.values) sum_sq += y * y;
+  std::array<double, kLagsPerPass> covariances =
+      PooledAutocovariances(data, 1, std::min(kLagsPerPass, last_lag), &sum_sq);
   const std::size_t fitted = (options.detrend ? 2 : 1) * out.chunks;  // means (and slopes)
   out.variance = sum_sq / static_cast<double>(out.samples - fitted);
   const double c0 = sum_sq / static_cast<double>(out.samples);
@@ -115,13 +140,11 @@ CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
                 Number(out.variance) + ")");
   }
 
-  const std::size_t last_lag = std::min(options.max_lag, data.longest / 2);
   double tau = 1.0;
   double tau_sq = 1.0;
-  std::array<double, kLagsPerPass> covariances{};
   for (std::size_t k = 1; k <= last_lag; ++k) {
     const std::size_t slot = (k - 1) % kLagsPerPass;
-    if (slot == 0) {
+    if (slot == 0 && k > 1) {
       covariances = PooledAutocovariances(data, k, std::min(kLagsPerPass, last_lag + 1 - k));
     }
     const double rho = covariances[slot] / c0;

@@ -3,6 +3,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <string>
 
@@ -387,7 +388,7 @@ const AxisNoise* StillNoise::Find(Sensor sensor, int axis) const {
 }
 
 StillNoise AnalyseStillNoise(const ImuSeries& series, const std::vector<StillSegment>& segments,
-                             const StillNoiseOptions& options) {
+                             const StillNoiseOptions& options, const JobRunner& run_jobs) {
   StillNoise out;
   out.options = options;
   out.dt_s = series.median_dt_s();
@@ -419,21 +420,30 @@ StillNoise AnalyseStillNoise(const ImuSeries& series, const std::vector<StillSeg
   }
   out.still_s = static_cast<double>(out.samples) * out.dt_s;
   out.longest_s = static_cast<double>(longest) * out.dt_s;
-  for (Sensor sensor : {Sensor::kAccel, Sensor::kGyro}) {
-    if (sensor == Sensor::kGyro && !series.has_gyro()) continue;
-    for (int axis = 0; axis < 3; ++axis) {
+  // One job per axis of each sensor, each writing its own entry; the first error in axis
+  // order is the one thrown.
+  const int sensors = series.has_gyro() ? 2 : 1;
+  out.axes.resize(static_cast<std::size_t>(3 * sensors));
+  std::vector<std::exception_ptr> errors(out.axes.size());
+  RunJobs(run_jobs, static_cast<int>(out.axes.size()), [&](int job) {
+    const auto k = static_cast<std::size_t>(job);
+    try {
+      AxisNoise& a = out.axes[k];
+      a.sensor = job < 3 ? Sensor::kAccel : Sensor::kGyro;
+      a.axis = job % 3;
       std::vector<AxisView> records;
       for (const StillSegment& s : out.segments) {
-        records.push_back(ViewAxis(series, sensor, axis, s.begin, s.end));
+        records.push_back(ViewAxis(series, a.sensor, a.axis, s.begin, s.end));
       }
-      AxisNoise a;
-      a.sensor = sensor;
-      a.axis = axis;
       a.adev = PooledAllanDeviation(records, out.dt_s, options.allan);
       a.fit = FitNoiseTerms(a.adev, options.terms);
       SetAllanIntervals(a.adev, a.fit.noise, options.allan.confidence);
-      out.axes.push_back(std::move(a));
+    } catch (...) {
+      errors[k] = std::current_exception();
     }
+  });
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
   }
   return out;
 }

@@ -65,6 +65,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/jobs.h"
 #include "plumb/core/segment.h"
 #include "plumb/signal/allan.h"
 #include "plumb/signal/axis_view.h"
@@ -199,8 +200,10 @@ struct StillNoise {
 /// Allan deviation with intervals and the fitted terms. Segments that turn at a stated rate or
 /// have fewer than 2 samples are left out (noted). Throws InsufficientDataError when the
 /// longest remaining segment has fewer than 8 samples, plumb::Error for a series without a
-/// sample interval or options out of range.
+/// sample interval or options out of range. The axes are analysed at once through `run_jobs`
+/// when it is given (core/jobs.h); the result is the same either way.
 StillNoise AnalyseStillNoise(const ImuSeries& series, const std::vector<StillSegment>& segments,
-                             const StillNoiseOptions& options = {});
+                             const StillNoiseOptions& options = {},
+                             const JobRunner& run_jobs = {});
 
 }  // namespace plumb::signal

@@ -94,30 +94,37 @@ class FieldCursor {
   std::size_t pos_ = 0;
 };
 
-/// Appends the 8 digits at `q` to `mantissa` in one step (SWAR) when there are 8 digits and
-/// room for them among 19; little-endian only (elsewhere the caller's digit loop does it).
-inline bool TakeEightDigits(const char*& q, const char* end, std::uint64_t& mantissa, int& digits) {
+/// Appends the run of digits at `q`, up to 8 of them, to `mantissa` in one step (SWAR) and
+/// returns how many it took; 0 (nothing taken) when `q` is not a digit, when fewer than 8
+/// bytes remain before `end` or when the digits would pass 19 (the caller's digit loop then
+/// goes on). Little-endian only (elsewhere it takes nothing).
+inline int TakeDigits(const char*& q, const char* end, std::uint64_t& mantissa, int& digits) {
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-  if (end - q < 8 || digits > 11) return false;
+  static constexpr std::uint64_t kPow10[] = {1,      10,      100,      1000,     10000,
+                                             100000, 1000000, 10000000, 100000000};
+  if (end - q < 8) return 0;
   std::uint64_t chunk;
   std::memcpy(&chunk, q, sizeof chunk);
-  const bool all_digits =
-      ((chunk & 0xF0F0F0F0F0F0F0F0u) |
-       (((chunk + 0x0606060606060606u) & 0xF0F0F0F0F0F0F0F0u) >> 4)) == 0x3333333333333333u;
-  if (!all_digits) return false;
-  chunk -= 0x3030303030303030u;
-  chunk = chunk * 10 + (chunk >> 8);  // pairs of digits
+  // Each byte's value less '0': a digit's is below 10. A byte's high bit in
+  // (x + 0x76) | x says it is not a digit; carries only run from a byte that is not one, so
+  // the bytes before the first of those read right.
+  const std::uint64_t x = chunk ^ 0x3030303030303030u;
+  const std::uint64_t not_digit = ((x + 0x7676767676767676u) | x) & 0x8080808080808080u;
+  const int k = not_digit == 0 ? 8 : __builtin_ctzll(not_digit) / 8;
+  if (k == 0 || digits + k > 19) return 0;
+  // The k digits to the top bytes, zeros (leading zeros) below them, then pairs, quads and
+  // the eight at once.
+  std::uint64_t v = x << (8 * (8 - k));
+  v = v * 10 + (v >> 8);
   constexpr std::uint64_t kMask = 0x000000FF000000FFu;
-  chunk =
-      (((chunk & kMask) * 0x000F424000000064u) + (((chunk >> 16) & kMask) * 0x0000271000000001u)) >>
-      32;
-  mantissa = mantissa * 100000000u + chunk;
-  q += 8;
-  digits += 8;
-  return true;
+  v = (((v & kMask) * 0x000F424000000064u) + (((v >> 16) & kMask) * 0x0000271000000001u)) >> 32;
+  mantissa = mantissa * kPow10[k] + v;
+  q += k;
+  digits += k;
+  return k;
 #else
   (void)q, (void)end, (void)mantissa, (void)digits;
-  return false;
+  return 0;
 #endif
 }
 
@@ -135,14 +142,14 @@ inline bool ScanSimpleDecimal(const char*& p, const char* end, double& value) {
   if (negative) ++q;
   std::uint64_t mantissa = 0;
   int digits = 0, exponent = 0;
-  while (TakeEightDigits(q, end, mantissa, digits)) continue;
+  while (TakeDigits(q, end, mantissa, digits) == 8) continue;
   for (; q != end && is_digit(*q) && digits < 20; ++q, ++digits) {
     mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
   }
   if (q != end && *q == '.') {
     const int before_point = digits;
     ++q;
-    while (TakeEightDigits(q, end, mantissa, digits)) continue;
+    while (TakeDigits(q, end, mantissa, digits) == 8) continue;
     for (; q != end && is_digit(*q) && digits < 20; ++q, ++digits) {
       mantissa = mantissa * 10 + static_cast<unsigned>(*q - '0');
     }

@@ -152,7 +152,7 @@ Session Read(const InputFile& input, InputKind kind, const InputOptions& o) {
         throw Error(input.path + "," + input.gyr_path +
                     ": the two-file form is a table, not native CSV");
       }
-      return ReadSplitTables(input.path, input.gyr_path, TableOptions(o, true));
+      return ReadSplitTables(input.path, input.gyr_path, TableOptions(o, true), o.run_jobs);
     case InputKind::kFlightLog:
       return FlightLog::Open(input.path).Select(o.flight_log);
     case InputKind::kTextTable:

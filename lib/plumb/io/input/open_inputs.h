@@ -51,6 +51,7 @@
 #include <utility>
 #include <vector>
 
+#include "plumb/core/jobs.h"
 #include "plumb/core/session.h"
 #include "plumb/io/common/flight_log.h"
 
@@ -167,6 +168,11 @@ struct InputOptions {
   /// 0-based index; it may throw to refuse the input (the command line refuses options that do
   /// not fit that kind of input this way). Empty: nothing is called.
   std::function<void(std::size_t input, InputKind kind)> before_read;
+
+  // ---- Work ----
+  /// Runs independent jobs at once (core/jobs.h): the two files of the two-file form are read
+  /// at once. Empty: one after another. The session is the same either way.
+  JobRunner run_jobs;
 };
 
 /// Reads every input (see the file comment) and joins them into one session. Throws

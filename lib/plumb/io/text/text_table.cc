@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <vector>
 
 #include "plumb/core/error.h"
@@ -407,7 +408,7 @@ Session ParseTextTable(std::string_view text, const std::string& name,
 }
 
 Session ReadSplitTables(const std::string& acc_path, const std::string& gyr_path,
-                        const TextTableOptions& options) {
+                        const TextTableOptions& options, const JobRunner& run_jobs) {
   CheckAccelerometer(options);
   if (!options.gyr.given()) {
     throw Error("TextTableOptions: ReadSplitTables needs the gyroscope columns (gyr.axes)");
@@ -418,11 +419,27 @@ Session ReadSplitTables(const std::string& acc_path, const std::string& gyr_path
   gyr_options.acc = TriadColumns{};
   gyr_options.temp = ScalarColumn{};
 
+  // The two files are read by two jobs (at once through `run_jobs`); the accelerometer
+  // file's error, if any, is the one thrown, as when they are read in turn.
   std::vector<std::size_t> acc_lines, gyr_lines;
-  LineSource acc_src = LineSource::FromFile(acc_path);
-  Session session = CheckHasAccelerometer(ParseSource(acc_src, acc_options, &acc_lines));
-  LineSource gyr_src = LineSource::FromFile(gyr_path);
-  Session gyr = ParseSource(gyr_src, gyr_options, &gyr_lines);
+  Session session, gyr;
+  std::exception_ptr errors[2];
+  RunJobs(run_jobs, 2, [&](int job) {
+    try {
+      if (job == 0) {
+        LineSource acc_src = LineSource::FromFile(acc_path);
+        session = CheckHasAccelerometer(ParseSource(acc_src, acc_options, &acc_lines));
+      } else {
+        LineSource gyr_src = LineSource::FromFile(gyr_path);
+        gyr = ParseSource(gyr_src, gyr_options, &gyr_lines);
+      }
+    } catch (...) {
+      errors[job] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
 
   const auto& t_acc = session.series.t_s;
   const auto& t_gyr = gyr.series.t_s;

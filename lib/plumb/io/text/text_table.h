@@ -24,6 +24,7 @@
 #include <string_view>
 #include <utility>
 
+#include "plumb/core/jobs.h"
 #include "plumb/core/session.h"
 
 namespace plumb::io {
@@ -112,8 +113,9 @@ Session ParseTextTable(std::string_view text, const std::string& name,
 /// two-file layout `t x y z`). `options.acc` locates the triad in `acc_path`, `options.gyr`
 /// in `gyr_path`; time, delimiter, header and comment options apply to both; temperature is
 /// read from the accelerometer file. The files must have the same number of rows and times
-/// equal within 1 us; otherwise an InputError names the first row (line) that differs.
+/// equal within 1 us; otherwise an InputError names the first row (line) that differs. The
+/// two files are read at once through `run_jobs` when it is given (core/jobs.h).
 Session ReadSplitTables(const std::string& acc_path, const std::string& gyr_path,
-                        const TextTableOptions& options);
+                        const TextTableOptions& options, const JobRunner& run_jobs = {});
 
 }  // namespace plumb::io

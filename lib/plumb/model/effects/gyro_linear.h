@@ -10,6 +10,7 @@
 // Option "triangular" (the paper's E) holds matrix.yx, matrix.zx, matrix.zy at zero.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "plumb/core/types.h"
@@ -56,6 +57,19 @@ void SubtractRateJacobian(const Mat3& KE_inv, const Vec3& omega, Columns&& cols)
     for (int c = 0; c < 3; ++c) cols.col(MatrixIndex(r, c)) -= KE_inv.col(r) * omega[c];
   }
   cols.template middleCols<3>(kBias) -= KE_inv;
+}
+
+/// The sum over samples i of SubtractRateJacobian(K_i E^-1, omega_i, cols), given the sums
+/// K_by_rate[c] = sum_i K_i omega_i,c and K_sum = sum_i K_i: E^-1 being the same for every
+/// sample, the product with it is taken once, on the sums.
+template <class Columns>
+void SubtractSummedRateJacobian(const Mat3& E_inv, const std::array<Mat3, 3>& K_by_rate,
+                                const Mat3& K_sum, Columns&& cols) {
+  for (int c = 0; c < 3; ++c) {
+    const Mat3 KE_inv = K_by_rate[static_cast<std::size_t>(c)] * E_inv;
+    for (int r = 0; r < 3; ++r) cols.col(MatrixIndex(r, c)) -= KE_inv.col(r);
+  }
+  cols.template middleCols<3>(kBias) -= K_sum * E_inv;
 }
 
 }  // namespace plumb::model::gyro_linear
