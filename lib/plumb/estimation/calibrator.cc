@@ -163,7 +163,8 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
     // The analysis's Jacobian is the fitted problem's when no parameter is held.
     const bool same = solution.held_parameters.empty();
     fit.linearity = CheckLinearity(problem, solution.fitted(), solution.held_parameters,
-                                   kLinearityStepSigmas, same ? &at.jacobian : nullptr, at.cost);
+                                   kLinearityStepSigmas, same ? &at.jacobian : nullptr, at.cost,
+                                   same ? at.eliminated.get() : nullptr, options.run_jobs);
   }
   fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
   if (!fitted.implausible_walk.empty()) {

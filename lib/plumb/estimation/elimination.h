@@ -64,6 +64,16 @@ class Elimination {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
 };
 
+/// A sparse Jacobian with its per-pose columns eliminated, kept together (the elimination
+/// refers to J; held by a pointer so that it stays where it is): the analysis's, reused by
+/// the linearity check (linearity.h) for the Schur complement on the model's parameters and
+/// the other unknowns' response.
+struct EliminatedJacobian {
+  Eigen::SparseMatrix<double> J;
+  std::unique_ptr<Elimination> elimination;  ///< from column elimination->first()
+  Eigen::MatrixXd M;                         ///< elimination->Reduced()
+};
+
 /// The per-pose columns of `J` eliminated: attitudes and wander together (from column
 /// `model_columns`) when the data determine the attitudes clearly, else the wander alone (from
 /// `first_wander`; throws plumb::Error when even they are not determined), else none (null).

@@ -22,6 +22,7 @@
 #include <ceres/ceres.h>
 
 #include "plumb/estimation/calibration_problem.h"
+#include "plumb/estimation/elimination.h"
 #include "plumb/estimation/fit_report.h"
 
 namespace plumb::estimation {
@@ -41,16 +42,21 @@ inline constexpr double kLinearityStepSigmas = 2.0;
 inline constexpr int kLinearityDirections = 6;
 
 /// The check of the file comment on `problem` (built by `calibration` with `held` held, at
-/// its solution: Solution::fitted() and held_parameters), with steps of `step_sigmas` sigma. The values are left as they were. Not checked
+/// its solution: Solution::fitted() and held_parameters), with steps of `step_sigmas` sigma; the
+/// problem's values are not touched. Not checked
 /// (LinearityReport::checked false) without free model parameters or when the reduced normal
 /// matrix is not positive definite (the observability analysis then says why).
 /// `jacobian` (optional): the whitened Jacobian of `problem` at its solution over
 /// calibration.Columns(problem, held), and `cost` its cost there, when the caller has them
-/// (the analysis's, FinishCalibration), so as not to evaluate them again.
+/// (the analysis's, FinishCalibration), so as not to evaluate them again; `eliminated`
+/// (optional, with `jacobian`): the analysis's elimination of every column after the model's
+/// (AnalysedSolution::eliminated), so as not to factorise again. The points of the check are
+/// evaluated at once through `run_jobs` (core/jobs.h); the report is the same either way.
 LinearityReport CheckLinearity(CalibrationProblem& calibration, ceres::Problem& problem,
                                const std::vector<ParameterIndex>& held,
                                double step_sigmas = kLinearityStepSigmas,
                                const Eigen::SparseMatrix<double>* jacobian = nullptr,
-                               double cost = 0.0);
+                               double cost = 0.0, const EliminatedJacobian* eliminated = nullptr,
+                               const JobRunner& run_jobs = {});
 
 }  // namespace plumb::estimation

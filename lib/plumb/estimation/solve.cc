@@ -41,7 +41,8 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
                                 const CalibrationOptions& options, UnknownColumns& columns,
                                 double* cost, std::vector<double>* residuals,
                                 Eigen::MatrixXd* jacobian,
-                                Eigen::SparseMatrix<double>* sparse_jacobian) {
+                                Eigen::SparseMatrix<double>* sparse_jacobian,
+                                std::shared_ptr<const EliminatedJacobian>* eliminated) {
   columns = calibration.Columns(problem);
   ObservabilityInput in;
   in.names = columns.names;
@@ -61,21 +62,30 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   Eigen::SparseMatrix<double>& J = sparse_jacobian != nullptr ? *sparse_jacobian : J_local;
   J = calibration.SparseJacobian(problem, columns, cost, residuals);
   // The attitudes and wander states eliminated together when the data determine the attitudes
-  // clearly (the cost is then linear in the poses), else the wander states alone.
-  const std::unique_ptr<Elimination> elimination = EliminatePoses(J, n_m, first_wander);
+  // clearly (the cost is then linear in the poses), else the wander states alone; kept for
+  // the caller (`eliminated`) in the first case.
+  auto kept_elimination = std::make_shared<EliminatedJacobian>();
+  if (eliminated != nullptr) kept_elimination->J = J;
+  const Eigen::SparseMatrix<double>& J_e = eliminated != nullptr ? kept_elimination->J : J;
+  kept_elimination->elimination = EliminatePoses(J_e, n_m, first_wander);
+  const Elimination* elimination = kept_elimination->elimination.get();
   if (elimination == nullptr) {
     in.J = Eigen::MatrixXd(J);
     return AnalyseObservability(in);
   }
   const Eigen::Index kept = elimination->first();
   in.J = elimination->Reduced();
+  if (eliminated != nullptr && kept == n_m) {
+    kept_elimination->M = in.J;
+    *eliminated = kept_elimination;
+  }
   in.names.resize(static_cast<std::size_t>(kept));
   in.values.resize(static_cast<std::size_t>(kept));
   in.is_model.resize(static_cast<std::size_t>(kept));
   const Eigen::Index n_attitudes = first_wander - kept;
   if (n_attitudes > 0) {
     in.eliminated_names.assign(columns.names.begin() + kept, columns.names.begin() + first_wander);
-    in.eliminated_response = [&elimination, n_attitudes,
+    in.eliminated_response = [elimination, n_attitudes,
                               J_k = Eigen::SparseMatrix<double>(J.leftCols(kept))](
                                  const Eigen::MatrixXd& directions) -> Eigen::MatrixXd {
       // J_k x_k + J_e x_e = 0: x_e = -argmin |J_k x_k + J_e x_e|, its attitudes' rows.
@@ -107,7 +117,7 @@ AnalysedSolution AnalyseSolution(CalibrationProblem& calibration, ceres::Problem
                                  const CalibrationOptions& options) {
   AnalysedSolution out;
   out.analysis = AnalyseAt(calibration, problem, options, out.columns, &out.cost, &out.residuals,
-                           nullptr, &out.jacobian);
+                           nullptr, &out.jacobian, &out.eliminated);
   return out;
 }
 

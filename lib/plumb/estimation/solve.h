@@ -12,10 +12,12 @@
 
 #include <ceres/ceres.h>
 
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "plumb/estimation/calibration_problem.h"
+#include "plumb/estimation/elimination.h"
 #include "plumb/estimation/fit_report.h"
 #include "plumb/estimation/observability.h"
 #include "plumb/estimation/options.h"
@@ -54,12 +56,15 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
 /// `jacobian`, bias-wander states are eliminated first (a sparse QR): the analysis and its
 /// covariance are then over the columns before columns.first_wander, the wander marginalised;
 /// with it, over every column (dense, O(unknowns^3)). `sparse_jacobian` (optional, without
-/// `jacobian`) receives the whitened Jacobian over `columns` for other checks at the same point.
+/// `jacobian`) receives the whitened Jacobian over `columns` for other checks at the same point,
+/// and `eliminated` (optional, with it) the elimination of every column after the model's
+/// when the analysis made one (else it is left alone).
 ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
                                 const CalibrationOptions& options, UnknownColumns& columns,
                                 double* cost, std::vector<double>* residuals,
                                 Eigen::MatrixXd* jacobian = nullptr,
-                                Eigen::SparseMatrix<double>* sparse_jacobian = nullptr);
+                                Eigen::SparseMatrix<double>* sparse_jacobian = nullptr,
+                                std::shared_ptr<const EliminatedJacobian>* eliminated = nullptr);
 
 /// The leverages h_ii = J_i (J^T J)^+ J_i^T of the whitened residual rows `rows` of `problem`
 /// (every free unknown, the wander states eliminated by a sparse QR first), and its whitened
@@ -76,6 +81,9 @@ struct AnalysedSolution {
   double cost = 0;
   std::vector<double> residuals;
   Eigen::SparseMatrix<double> jacobian;  ///< over `columns`, for the linearity check
+  /// The analysis's elimination when it took every column after the model's (attitudes and
+  /// wander together; else null), for the linearity check.
+  std::shared_ptr<const EliminatedJacobian> eliminated;
 };
 
 /// AnalyseAt with every output kept.
