@@ -82,6 +82,37 @@ inline Mat3 RightJacobian(const Vec3& phi) {
   return Mat3::Identity() - (1 - std::cos(a)) / a2 * S + (a - std::sin(a)) / (a2 * a) * S * S;
 }
 
+/// Exp(phi) and J_r(phi) together (one set of coefficients and one S^2 for both).
+inline void ExpAndRightJacobian(const Vec3& phi, Mat3* Ex, Mat3* Jr) {
+  const double a2 = phi.squaredNorm();
+  double A, B, C;
+  if (a2 < 0.05 * 0.05) {
+    // sin(a)/a, (1 - cos a)/a^2 and (a - sin a)/a^3 by series (error < 1e-17).
+    A = 1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0));
+    B = 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0));
+    C = 1.0 / 6.0 - a2 / 120.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0));
+  } else {
+    const double a = std::sqrt(a2);
+    A = std::sin(a) / a;
+    B = (1.0 - std::cos(a)) / a2;
+    C = (a - std::sin(a)) / (a2 * a);
+  }
+  const Mat3 S = Skew(phi);
+  Mat3 S2 = phi * phi.transpose();  // S^2 = phi phi^T - |phi|^2 I
+  S2.diagonal().array() -= a2;
+  *Ex = Mat3::Identity() + A * S + B * S2;
+  *Jr = Mat3::Identity() - B * S + C * S2;
+}
+
+/// D [u]x, by columns (no 3 x 3 product).
+inline Mat3 TimesSkew(const Mat3& D, const Vec3& u) {
+  Mat3 out;
+  out.col(0) = u.z() * D.col(1) - u.y() * D.col(2);
+  out.col(1) = u.x() * D.col(2) - u.z() * D.col(0);
+  out.col(2) = u.y() * D.col(0) - u.x() * D.col(1);
+  return out;
+}
+
 /// Rotation vector of one integration step of a rate varying linearly from u0 to u1 over h
 /// seconds, with the coning correction (third order in h, like RK4 on SO(3)):
 /// phi = (h/2) (u0 + u1) + (h^2/12) u0 x u1. u in rad/s, phi in rad.

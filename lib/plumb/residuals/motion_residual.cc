@@ -464,25 +464,27 @@ bool MotionResidual::EvaluateUncached(double const* const* parameters, double* r
     const Vec3 e = earth ? Vec3(dR.transpose() * omega_k) : Vec3::Zero();
     const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
     const Vec3 phi = so3::ConingIncrement(u0, u1, h);
-    const Mat3 Ex = so3::Exp(phi);
+    Mat3 Ex, Jr;
+    if (!want_jacobians) {  // a value with Earth rate
+      dR = dR * so3::Exp(phi);
+      continue;
+    }
+    so3::ExpAndRightJacobian(phi, &Ex, &Jr);
     const Mat3 dR_next = dR * Ex;
-    if (want_jacobians) {
-      const Mat3 Jr = so3::RightJacobian(phi);
-      const Mat3 C0 = 0.5 * h * Mat3::Identity() - (h * h / 12.0) * Skew(u1);
-      const Mat3 C1 = 0.5 * h * Mat3::Identity() + (h * h / 12.0) * Skew(u0);
-      if (earth) {
-        const Mat3 K0 = Jr * C0, K1 = Jr * C1;
-        const Mat3 K = K0 + K1;
-        A_next.noalias() = (Ex.transpose() - K * Skew(e)) * A;
-        A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
-        add_rate_jacobian(K0, i, A_next);
-        add_rate_jacobian(K1, i + 1, A_next);
-        A.swap(A_next);
-      } else {
-        const Mat3 dR_next_Jr = dR_next * Jr;
-        add_sample(G_next + dR_next_Jr * C0, i);
-        G_next.noalias() = dR_next_Jr * C1;
-      }
+    const double c0 = 0.5 * h, c1 = h * h / 12.0;  // C0 = c0 I - c1 [u1]x, C1 = c0 I + c1 [u0]x
+    if (earth) {
+      const Mat3 K0 = c0 * Jr - c1 * so3::TimesSkew(Jr, u1);
+      const Mat3 K1 = c0 * Jr + c1 * so3::TimesSkew(Jr, u0);
+      const Mat3 K = K0 + K1;
+      A_next.noalias() = (Ex.transpose() - K * Skew(e)) * A;
+      A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
+      add_rate_jacobian(K0, i, A_next);
+      add_rate_jacobian(K1, i + 1, A_next);
+      A.swap(A_next);
+    } else {
+      const Mat3 D = dR_next * Jr;
+      add_sample(G_next + c0 * D - c1 * so3::TimesSkew(D, u1), i);
+      G_next = c0 * D + c1 * so3::TimesSkew(D, u0);
     }
     dR = dR_next;
   }
