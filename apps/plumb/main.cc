@@ -9,6 +9,7 @@
 #include <exception>
 #include <iostream>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "commands.h"
@@ -55,32 +56,31 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer("Run 'plumb COMMAND --help' for the options of a command.");
 
+  // The commands, in the order `plumb --help` lists them. A run of one command builds only
+  // that one's options (building every command's costs about 0.8 ms of each run).
+  using Factory = std::unique_ptr<plumb::cli::Command> (*)(CLI::App&);
+  const std::pair<const char*, Factory> kCommands[] = {
+      {"calibrate", plumb::cli::MakeCalibrateCommand}, {"diagnose", plumb::cli::MakeDiagnoseCommand},
+      {"simulate", plumb::cli::MakeSimulateCommand},   {"effects", plumb::cli::MakeEffectsCommand},
+      {"compare", plumb::cli::MakeCompareCommand},     {"paper", plumb::cli::MakePaperCommand},
+      {"info", plumb::cli::MakeInfoCommand},           {"report", plumb::cli::MakeReportCommand},
+      {"allan", plumb::cli::MakeAllanCommand},         {"sweep", plumb::cli::MakeSweepCommand},
+      {"apply", plumb::cli::MakeApplyCommand}};
   std::vector<std::unique_ptr<plumb::cli::Command>> commands;
-  commands.push_back(plumb::cli::MakeCalibrateCommand(app));
-  commands.push_back(plumb::cli::MakeDiagnoseCommand(app));
-  commands.push_back(plumb::cli::MakeSimulateCommand(app));
-  commands.push_back(plumb::cli::MakeEffectsCommand(app));
-  commands.push_back(plumb::cli::MakeCompareCommand(app));
-  commands.push_back(plumb::cli::MakePaperCommand(app));
-  commands.push_back(plumb::cli::MakeInfoCommand(app));
-  commands.push_back(plumb::cli::MakeReportCommand(app));
-  commands.push_back(plumb::cli::MakeAllanCommand(app));
-  commands.push_back(plumb::cli::MakeSweepCommand(app));
-  commands.push_back(plumb::cli::MakeApplyCommand(app));
-
   if (argc > 1 && argv[1][0] != '-') {
     const std::string name = argv[1];
-    bool known = false;
     std::string names;
-    for (const auto& command : commands) {
-      known = known || command->app()->get_name() == name;
-      names += (names.empty() ? "" : ", ") + command->app()->get_name();
+    for (const auto& [command_name, make] : kCommands) {
+      if (command_name == name) commands.push_back(make(app));
+      names += (names.empty() ? "" : ", ") + std::string(command_name);
     }
-    if (!known) {
+    if (commands.empty()) {
       std::cerr << "plumb: error: unknown command '" << name << "'; the commands are " << names
                 << "\nRun 'plumb --help' for an overview.\n";
       return 2;
     }
+  } else {
+    for (const auto& entry : kCommands) commands.push_back(entry.second(app));
   }
   try {
     app.parse(argc, argv);

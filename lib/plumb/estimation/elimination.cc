@@ -42,8 +42,19 @@ Eigen::MatrixXd Elimination::Project(const Eigen::MatrixXd& A) const {
   return A - J_e_ * ScaledSolve(A);
 }
 
-Eigen::MatrixXd Elimination::Reduced() const {
-  return Project(Eigen::MatrixXd(J_.leftCols(first_)));
+Eigen::MatrixXd Elimination::Reduced(const JobRunner& run_jobs) const {
+  const Eigen::MatrixXd J_k = Eigen::MatrixXd(J_.leftCols(first_));
+  if (!run_jobs || first_ < 2 * kReducedColumnsPerJob) return Project(J_k);
+  // Column blocks at once: each column's products and solves are the same arithmetic
+  // whatever the block it is in, so the result is the same bits.
+  Eigen::MatrixXd M(J_k.rows(), J_k.cols());
+  const Eigen::Index jobs = (first_ + kReducedColumnsPerJob - 1) / kReducedColumnsPerJob;
+  RunJobs(run_jobs, static_cast<int>(jobs), [&](int job) {
+    const Eigen::Index begin = job * kReducedColumnsPerJob;
+    const Eigen::Index count = std::min(kReducedColumnsPerJob, first_ - begin);
+    M.middleCols(begin, count) = Project(J_k.middleCols(begin, count));
+  });
+  return M;
 }
 
 Eigen::VectorXd Elimination::Leverage(const std::vector<Eigen::Index>& rows) const {

@@ -22,6 +22,7 @@
 #include <memory>
 #include <vector>
 
+#include "plumb/core/jobs.h"
 #include "plumb/estimation/fit_report.h"
 
 namespace plumb::estimation {
@@ -32,6 +33,9 @@ namespace plumb::estimation {
 /// attitude the data barely determine) the analysis keeps those columns and decides their
 /// rank itself.
 inline constexpr double kEliminationPivot = 1e-10;
+
+/// Columns of M per job in Elimination::Reduced.
+inline constexpr Eigen::Index kReducedColumnsPerJob = 6;
 
 /// Columns [first, n) of a whitened Jacobian J = [J_k J_e], eliminated: the projection P_e onto
 /// range(J_e) through the sparse LDL^T factor of D J_e^T J_e D (D scales J_e's columns to unit
@@ -47,8 +51,9 @@ class Elimination {
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& A) const;
   /// (I - P_e) A for a dense A with J's rows.
   Eigen::MatrixXd Project(const Eigen::MatrixXd& A) const;
-  /// M = (I - P_e) J_k: rows x first.
-  Eigen::MatrixXd Reduced() const;
+  /// M = (I - P_e) J_k: rows x first; blocks of columns at once through `run_jobs` when given
+  /// (core/jobs.h; the same bits either way).
+  Eigen::MatrixXd Reduced(const JobRunner& run_jobs = {}) const;
   /// The diagonal of P_e at `rows`.
   Eigen::VectorXd Leverage(const std::vector<Eigen::Index>& rows) const;
   Eigen::Index first() const { return first_; }

@@ -74,7 +74,7 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
     return AnalyseObservability(in);
   }
   const Eigen::Index kept = elimination->first();
-  in.J = elimination->Reduced();
+  in.J = elimination->Reduced(options.run_jobs);
   if (eliminated != nullptr && kept == n_m) {
     kept_elimination->M = in.J;
     *eliminated = kept_elimination;
