@@ -5,6 +5,7 @@ study as `plumb sweep` writes it."""
 import csv
 import json
 import os
+import shutil
 import subprocess
 import unittest
 
@@ -133,6 +134,7 @@ class CliEqual(unittest.TestCase):
         path = out("study.json")
         with open(path, "w") as f:
             json.dump(study, f)
+        shutil.rmtree(out("sweep"), ignore_errors=True)  # a rerun would resume an older run's
         run("sweep", path, "--out", out("sweep"), "--jobs", "1")
         self.assertEqual(plumb.sweep_points(path), 2)
         for index in range(2):
