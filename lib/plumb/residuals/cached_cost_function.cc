@@ -16,20 +16,25 @@ std::vector<bool> Wanted(const std::vector<bool>& wanted, std::size_t blocks) {
 
 }  // namespace
 
-bool CachedCostFunction::NeedsPrecompute(double const* const* parameters,
-                                         const std::vector<bool>& wanted) const {
+bool CachedCostFunction::KeptAt(double const* const* parameters) const {
+  if (!kept_.valid) return false;
   const std::vector<int>& sizes = parameter_block_sizes();
-  if (!kept_.valid) return true;
-  for (std::size_t j = 0; j < sizes.size(); ++j) {
-    if (kept_.wanted[j] != (j < wanted.size() && wanted[j])) return true;
-  }
   std::size_t at = 0;
   for (std::size_t j = 0; j < sizes.size(); ++j) {
     const auto bytes = static_cast<std::size_t>(sizes[j]) * sizeof(double);
-    if (std::memcmp(kept_.values.data() + at, parameters[j], bytes) != 0) return true;
+    if (std::memcmp(kept_.values.data() + at, parameters[j], bytes) != 0) return false;
     at += static_cast<std::size_t>(sizes[j]);
   }
-  return false;
+  return true;
+}
+
+bool CachedCostFunction::NeedsPrecompute(double const* const* parameters,
+                                         const std::vector<bool>& wanted) const {
+  if (!kept_.valid) return true;
+  for (std::size_t j = 0; j < kept_.wanted.size(); ++j) {
+    if (kept_.wanted[j] != (j < wanted.size() && wanted[j])) return true;
+  }
+  return !KeptAt(parameters);
 }
 
 void CachedCostFunction::Precompute(double const* const* parameters,
@@ -69,16 +74,11 @@ void CachedCostFunction::Precompute(double const* const* parameters,
 
 bool CachedCostFunction::Matches(double const* const* parameters, double** jacobians) const {
   if (!kept_.valid) return false;
-  const std::vector<int>& sizes = parameter_block_sizes();
-  std::size_t at = 0;
-  for (std::size_t j = 0; j < sizes.size(); ++j) {
+  for (std::size_t j = 0; j < kept_.wanted.size(); ++j) {
     const bool asked = jacobians != nullptr && jacobians[j] != nullptr;
     if (asked != kept_.wanted[j]) return false;
-    const auto bytes = static_cast<std::size_t>(sizes[j]) * sizeof(double);
-    if (std::memcmp(kept_.values.data() + at, parameters[j], bytes) != 0) return false;
-    at += static_cast<std::size_t>(sizes[j]);
   }
-  return true;
+  return KeptAt(parameters);
 }
 
 bool CachedCostFunction::Evaluate(double const* const* parameters, double* residuals,

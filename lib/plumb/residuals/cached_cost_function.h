@@ -44,6 +44,9 @@ class CachedCostFunction : public ceres::CostFunction {
                                 double** jacobians) const = 0;
 
  private:
+  /// The kept evaluation was made at exactly these values.
+  bool KeptAt(double const* const* parameters) const;
+  /// ... and with exactly the Jacobian blocks `jacobians` asks for.
   bool Matches(double const* const* parameters, double** jacobians) const;
 
   struct Kept {
