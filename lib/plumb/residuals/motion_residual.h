@@ -100,6 +100,9 @@ class RateJacobians {
   bool coupled_ = false;
 };
 
+/// The residual of the file comment. A CachedCostFunction: its evaluations may be made ahead
+/// of Ceres's call, all intervals at once (estimation/parallel_evaluation.h); it keeps no
+/// other state, so distinct objects may be evaluated on distinct threads.
 class MotionResidual final : public CachedCostFunction {
  public:
   /// `omega_ie_n`: Earth rate in NED, rad/s (zero without a site). The model must outlive
