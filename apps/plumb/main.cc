@@ -44,9 +44,9 @@ std::vector<std::string>& CommandLineArgs() {
 int main(int argc, char** argv) {
   // A fit allocates and frees large blocks many times (Jacobians, each pass's work arrays).
   // glibc hands blocks over 128 KiB to mmap and returns freed memory to the kernel, so each
-  // such block costs fresh page faults; kept in the heap instead, they are reused (the whole
-  // `calibrate`: imu_tk's session about 3% less wall time, 600 poses about 14%, the peak
-  // memory within 2%; docs/performance.md).
+  // such block costs fresh page faults; kept in the heap instead, they are reused (compare
+  // `/usr/bin/time -v` of a `calibrate` with and without these, e.g. on the 600-pose session
+  // of docs/performance.md: less wall time, about the same peak memory).
   ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
   ::mallopt(M_TRIM_THRESHOLD, 128 << 20);
   ::mallopt(M_TOP_PAD, 16 << 20);
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
   app.footer("Run 'plumb COMMAND --help' for the options of a command.");
 
   // The commands, in the order `plumb --help` lists them. A run of one command builds only
-  // that one's options (building every command's costs about 0.8 ms of each run).
+  // that one's options (building every command's is a noticeable part of a short run).
   using Factory = std::unique_ptr<plumb::cli::Command> (*)(CLI::App&);
   const std::pair<const char*, Factory> kCommands[] = {
       {"calibrate", plumb::cli::MakeCalibrateCommand}, {"diagnose", plumb::cli::MakeDiagnoseCommand},

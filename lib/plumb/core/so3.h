@@ -17,16 +17,19 @@ inline Mat3 Skew(const Vec3& v) {
   return S;
 }
 
-/// sin(a)/a and (1 - cos a)/a^2 from a2 = a^2, by series below 0.05 rad (error < 1e-17; no
-/// square root) to avoid sincos on the many small steps of an integration.
-inline void ExpCoefficients(double a2, double* A, double* B) {
+/// sin(a)/a, (1 - cos a)/a^2 and, if `C` is given, (a - sin a)/a^3 from a2 = a^2, by series
+/// below 0.05 rad (error < 1e-17; no square root) to avoid sincos on the many small steps of
+/// an integration. Exp(phi) = I + A S + B S^2 and J_r(phi) = I - B S + C S^2, S = [phi]x.
+inline void ExpCoefficients(double a2, double* A, double* B, double* C = nullptr) {
   if (a2 < 0.05 * 0.05) {
     *A = 1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0));
     *B = 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0));
+    if (C) *C = 1.0 / 6.0 - a2 / 120.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0));
   } else {
     const double a = std::sqrt(a2);
     *A = std::sin(a) / a;
     *B = (1.0 - std::cos(a)) / a2;
+    if (C) *C = (a - std::sin(a)) / (a2 * a);
   }
 }
 
@@ -70,33 +73,17 @@ inline Vec3 Log(const Mat3& R) {
 
 /// Right Jacobian J_r(phi).
 inline Mat3 RightJacobian(const Vec3& phi) {
-  const double a2 = phi.squaredNorm();
+  double A, B, C;
+  ExpCoefficients(phi.squaredNorm(), &A, &B, &C);
   const Mat3 S = Skew(phi);
-  if (a2 < 0.05 * 0.05) {
-    // (1 - cos a)/a^2 and (a - sin a)/a^3 by series (error < 1e-17).
-    const double B = 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0));
-    const double C = 1.0 / 6.0 - a2 / 120.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0));
-    return Mat3::Identity() - B * S + C * S * S;
-  }
-  const double a = std::sqrt(a2);
-  return Mat3::Identity() - (1 - std::cos(a)) / a2 * S + (a - std::sin(a)) / (a2 * a) * S * S;
+  return Mat3::Identity() - B * S + C * S * S;
 }
 
 /// Exp(phi) and J_r(phi) together (one set of coefficients and one S^2 for both).
 inline void ExpAndRightJacobian(const Vec3& phi, Mat3* Ex, Mat3* Jr) {
   const double a2 = phi.squaredNorm();
   double A, B, C;
-  if (a2 < 0.05 * 0.05) {
-    // sin(a)/a, (1 - cos a)/a^2 and (a - sin a)/a^3 by series (error < 1e-17).
-    A = 1.0 - a2 / 6.0 * (1.0 - a2 / 20.0 * (1.0 - a2 / 42.0));
-    B = 0.5 - a2 / 24.0 * (1.0 - a2 / 30.0 * (1.0 - a2 / 56.0));
-    C = 1.0 / 6.0 - a2 / 120.0 * (1.0 - a2 / 42.0 * (1.0 - a2 / 72.0));
-  } else {
-    const double a = std::sqrt(a2);
-    A = std::sin(a) / a;
-    B = (1.0 - std::cos(a)) / a2;
-    C = (a - std::sin(a)) / (a2 * a);
-  }
+  ExpCoefficients(a2, &A, &B, &C);
   const Mat3 S = Skew(phi);
   Mat3 S2 = phi * phi.transpose();  // S^2 = phi phi^T - |phi|^2 I
   S2.diagonal().array() -= a2;

@@ -84,7 +84,7 @@ struct GyroStageSums {
   void Add(const Mat3& G, const Vec3& w, double a) {
     for (int c = 0; c < 3; ++c) by_rate[static_cast<std::size_t>(c)] += w[c] * G;
     total += G;
-    to += a * G;
+    if (a != 0.0) to += a * G;  // without a walk (a = 0) nothing to add
   }
   /// Subtracts the sums times E^-1 from the gyroscope's 12 leading columns of A and, when
   /// `walk_from` >= 0, from the walk's b_from and b_to columns there.
@@ -464,11 +464,11 @@ bool MotionResidual::EvaluateUncached(double const* const* parameters, double* r
     const Vec3 e = earth ? Vec3(dR.transpose() * omega_k) : Vec3::Zero();
     const Vec3 u0 = w[i] - e, u1 = w[i + 1] - e;
     const Vec3 phi = so3::ConingIncrement(u0, u1, h);
-    Mat3 Ex, Jr;
     if (!want_jacobians) {  // a value with Earth rate
       dR = dR * so3::Exp(phi);
       continue;
     }
+    Mat3 Ex, Jr;
     so3::ExpAndRightJacobian(phi, &Ex, &Jr);
     const Mat3 dR_next = dR * Ex;
     const double c0 = 0.5 * h, c1 = h * h / 12.0;  // C0 = c0 I - c1 [u1]x, C1 = c0 I + c1 [u0]x
