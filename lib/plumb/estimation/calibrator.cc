@@ -80,7 +80,7 @@ FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment
   out.noise = EstimateNoise(series, still, cal.has_gyro, options);
   model::ParameterBlocks theta = cal.model.ZeroParameters();
   out.start = Initialize(series, cal.model, site.gravity(), cal.has_gyro,
-                         options.first_heading_deg, still, theta);
+                         options.first_heading_deg, still, theta, options.run_jobs);
   AssignHeadingGauge(still, cal.has_gyro);
   if (options.ModelsWander()) {
     // 2a. The wander's levels: given, from the still data's Allan deviation, or typical;

@@ -78,14 +78,56 @@ Quat CorrectTilt(const Quat& R_n_b, const Vec3& down_b) {
   return (Quat::FromTwoVectors(down_n, Vec3::UnitZ()) * R_n_b).normalized();
 }
 
+namespace {
+
+/// The rate sum of one trapezoidal step of IntegrateRaw, (y_i - b) + (y_i+1 - b), sensor units.
+Vec3 RateSum(const ImuSeries& series, std::size_t i, const Vec3& bias) {
+  return (series.gyr[i].cast<double>() - bias) + (series.gyr[i + 1].cast<double>() - bias);
+}
+
+/// One trapezoidal step: q Exp(0.5 s u h), `u` the step's RateSum.
+Quat Step(const Quat& q, const Vec3& u, double h, double scale) {
+  const Vec3 w = 0.5 * scale * u;
+  return q * so3::ExpQuat(w * h);
+}
+
+/// The steps of every motion interval, kept for the scale search, which integrates them
+/// again at each scale it tries: the same arithmetic as IntegrateRaw, without reading the
+/// samples each time.
+class TurnSteps {
+ public:
+  TurnSteps(const ImuSeries& series,
+            const std::vector<std::pair<std::size_t, std::size_t>>& intervals, const Vec3& bias) {
+    for (const auto& [first, last] : intervals) {
+      begin_.push_back(u_.size());
+      for (std::size_t i = first; i < last; ++i) {
+        u_.push_back(RateSum(series, i, bias));
+        h_.push_back(series.t_s[i + 1] - series.t_s[i]);
+      }
+    }
+    begin_.push_back(u_.size());
+  }
+
+  /// IntegrateRaw of interval k at `scale`.
+  Quat Integrate(std::size_t k, double scale) const {
+    Quat q = Quat::Identity();
+    for (std::size_t i = begin_[k]; i < begin_[k + 1]; ++i) q = Step(q, u_[i], h_[i], scale);
+    return q.normalized();
+  }
+
+ private:
+  std::vector<Vec3> u_;
+  std::vector<double> h_;
+  std::vector<std::size_t> begin_;
+};
+
+}  // namespace
+
 Quat IntegrateRaw(const ImuSeries& series, std::size_t first, std::size_t last,
                   const Vec3& bias, double scale) {
   Quat q = Quat::Identity();
   for (std::size_t i = first; i < last; ++i) {
-    const double h = series.t_s[i + 1] - series.t_s[i];
-    const Vec3 w = 0.5 * scale *
-                   ((series.gyr[i].cast<double>() - bias) + (series.gyr[i + 1].cast<double>() - bias));
-    q = q * so3::ExpQuat(w * h);
+    q = Step(q, RateSum(series, i, bias), series.t_s[i + 1] - series.t_s[i], scale);
   }
   return q.normalized();
 }
@@ -93,16 +135,21 @@ Quat IntegrateRaw(const ImuSeries& series, std::size_t first, std::size_t last,
 double GuessGyroScale(const ImuSeries& series,
                       const std::vector<std::pair<std::size_t, std::size_t>>& intervals,
                       const std::vector<Vec3>& down_before, const std::vector<Vec3>& down_after,
-                      const Vec3& bias) {
+                      const Vec3& bias, const JobRunner& run_jobs) {
   if (intervals.empty()) return 1.0;
-  // down_after = dR^T down_before, dR = R_k^T R_k+1.
+  // down_after = dR^T down_before, dR = R_k^T R_k+1. The intervals are integrated as jobs,
+  // their terms summed in order.
+  const TurnSteps steps(series, intervals, bias);
+  std::vector<double> terms(intervals.size());
   auto cost = [&](double log10_s) {
     const double s = std::pow(10.0, log10_s);
+    RunJobs(run_jobs, static_cast<int>(intervals.size()), [&](int job) {
+      const auto k = static_cast<std::size_t>(job);
+      const Quat dR = steps.Integrate(k, s);
+      terms[k] = (dR.conjugate() * down_before[k] - down_after[k]).squaredNorm();
+    });
     double c = 0;
-    for (std::size_t k = 0; k < intervals.size(); ++k) {
-      const Quat dR = IntegrateRaw(series, intervals[k].first, intervals[k].second, bias, s);
-      c += (dR.conjugate() * down_before[k] - down_after[k]).squaredNorm();
-    }
+    for (const double term : terms) c += term;
     return c;
   };
   // A first estimate: the angle between the down directions over the integrated raw angle,
@@ -155,7 +202,8 @@ namespace {
 
 /// The gyroscope's starting bias (mean still output) and scalar scale (GuessGyroScale over
 /// the motion intervals).
-void GuessGyro(const ImuSeries& series, const StillSet& set, StartingValues& start) {
+void GuessGyro(const ImuSeries& series, const StillSet& set, const JobRunner& run_jobs,
+               StartingValues& start) {
   const auto at_rest = set.AtRestMeans(true);
   for (const auto& m : at_rest) start.gyro_bias += m / static_cast<double>(at_rest.size());
   std::vector<std::pair<std::size_t, std::size_t>> intervals;
@@ -165,7 +213,8 @@ void GuessGyro(const ImuSeries& series, const StillSet& set, StartingValues& sta
     before.push_back(start.Down(set.poses[m.from]));
     after.push_back(start.Down(set.poses[m.from + 1]));
   }
-  start.gyro_rad_per_unit = GuessGyroScale(series, intervals, before, after, start.gyro_bias);
+  start.gyro_rad_per_unit =
+      GuessGyroScale(series, intervals, before, after, start.gyro_bias, run_jobs);
 }
 
 /// Starting attitudes: tilt from gravity, heading carried along each chain.
@@ -195,13 +244,13 @@ void InitialAttitudes(const ImuSeries& series, const StartingValues& start,
 
 StartingValues Initialize(const ImuSeries& series, const model::Model& model, double g,
                           bool has_gyro, std::optional<double> first_heading_deg, StillSet& set,
-                          model::ParameterBlocks& theta) {
+                          model::ParameterBlocks& theta, const JobRunner& run_jobs) {
   StartingValues start;
   start.accel = GuessAccel(set.AtRestMeans(false), g);
   model::accel_linear::SetIsotropic(theta[static_cast<std::size_t>(model.BaseTerm(model::Sensor::kAccel))],
                                     start.accel.scale, start.accel.bias);
   if (has_gyro) {
-    GuessGyro(series, set, start);
+    GuessGyro(series, set, run_jobs, start);
     model::gyro_linear::SetIsotropic(
         theta[static_cast<std::size_t>(model.BaseTerm(model::Sensor::kGyro))],
         start.gyro_rad_per_unit, start.gyro_bias);

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/jobs.h"
 #include "plumb/core/types.h"
 #include "plumb/estimation/still_set.h"
 #include "plumb/model/model.h"
@@ -49,10 +50,12 @@ Quat IntegrateRaw(const ImuSeries& series, std::size_t first, std::size_t last,
 /// each still segment to the next through the motion between them.
 /// `intervals`: (last sample of segment k, first sample of segment k+1);
 /// `down_before`, `down_after`: unit down directions in the body frame at both ends.
+/// Each value of the search integrates the intervals as jobs through `run_jobs` (the same
+/// result without it).
 double GuessGyroScale(const ImuSeries& series,
                       const std::vector<std::pair<std::size_t, std::size_t>>& intervals,
                       const std::vector<Vec3>& down_before, const std::vector<Vec3>& down_after,
-                      const Vec3& bias);
+                      const Vec3& bias, const JobRunner& run_jobs = {});
 
 /// The starting values of stage 3 (file comment).
 struct StartingValues {
@@ -68,9 +71,10 @@ struct StartingValues {
 /// on entry) from the closed forms, holds every fixed parameter at its nominal value, and sets
 /// each pose's attitude: known ones as given, the others tilted from gravity with the heading
 /// carried along each motion-joined chain by the integrated gyroscope (a chain's first pose:
-/// `first_heading_deg` for the first pose when stated, else 0).
+/// `first_heading_deg` for the first pose when stated, else 0). The gyroscope scale's search
+/// runs its jobs through `run_jobs`.
 StartingValues Initialize(const ImuSeries& series, const model::Model& model, double g,
                           bool has_gyro, std::optional<double> first_heading_deg, StillSet& set,
-                          model::ParameterBlocks& theta);
+                          model::ParameterBlocks& theta, const JobRunner& run_jobs = {});
 
 }  // namespace plumb::estimation

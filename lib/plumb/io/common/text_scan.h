@@ -132,7 +132,8 @@ inline int TakeDigits(const char*& q, const char* end, std::uint64_t& mantissa, 
 /// most 19 digits, a mantissa up to 2^53 and a power of ten within 1e+-22 take one correctly
 /// rounded multiplication or division. On success advances `p` past the number; returns false
 /// (and leaves `p`) for anything else, which std::from_chars then decides.
-inline bool ScanSimpleDecimal(const char*& p, const char* end, double& value) {
+[[gnu::always_inline]] inline bool ScanSimpleDecimal(const char*& p, const char* end,
+                                                   double& value) {
   static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                       1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                       1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};

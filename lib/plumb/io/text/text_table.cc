@@ -68,6 +68,14 @@ bool IsComment(std::string_view line, const std::string& prefix) {
   return line.compare(i, prefix.size(), prefix) == 0;
 }
 
+// Neither blank nor a comment (IsBlankLine and IsComment in one pass over the leading blanks).
+bool IsDataRow(std::string_view line, const std::string& prefix) {
+  std::size_t i = 0;
+  while (i < line.size() && detail::IsBlank(line[i])) ++i;
+  if (i == line.size()) return false;
+  return prefix.empty() || line.compare(i, prefix.size(), prefix) != 0;
+}
+
 // ',' or ';' when the row has one; '\t' for tabs without spaces; else runs of blanks.
 char DetectDelimiter(std::string_view row) {
   for (char c : {',', ';'}) {
@@ -374,7 +382,7 @@ Session ParseSource(LineSource& src, const TextTableOptions& o,
   }
   parser.Row(line, src.line_number(), line_numbers);
   while (src.Next(line)) {
-    if (detail::IsBlankLine(line) || IsComment(line, o.comment_prefix)) continue;
+    if (!IsDataRow(line, o.comment_prefix)) continue;
     parser.Row(line, src.line_number(), line_numbers);
   }
   return parser.Finish(src.name());
