@@ -1,7 +1,8 @@
 // The jobs hook (core/jobs.h) changes how the work is run, never the result: a calibration
 // with CalibrationOptions::run_jobs (its motion residuals precomputed before each of Ceres's
-// passes, parallel_evaluation.h, and the still noise analysed per axis) is the same bit for
-// bit as one without, whatever order the jobs run in.
+// passes, parallel_evaluation.h; the noise's correlation times and the still noise analysed
+// per axis; the gyroscope scale's search integrating the turns per interval) is the same bit
+// for bit as one without, whatever order the jobs run in.
 #include <gtest/gtest.h>
 
 #include <cstring>

@@ -1,6 +1,10 @@
 #include "plumb/signal/correlation_time.h"
 
 #include <cmath>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -113,6 +117,71 @@ TEST(CorrelationTime, TriadsOverStillSegments) {
   EXPECT_NEAR(ct[1].tau_int, 1.0, 0.1);
   EXPECT_EQ(ct[2].samples, 28000U);
   EXPECT_THROW(EstimateCorrelationTime(s, {StillSegment{0, 10}}, Sensor::kGyro), Error);
+}
+
+/// Runs the jobs last to first, half of them on a second thread.
+void ReverseOnTwoThreads(int count, const std::function<void(int)>& job) {
+  std::thread other([&] {
+    for (int k = count - 1; k >= 0; k -= 2) job(k);
+  });
+  for (int k = count - 2; k >= 0; k -= 2) job(k);
+  other.join();
+}
+
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(CorrelationTime, EverySensorsAxesAsJobsInTheirOrder) {
+  ImuSeries s;
+  const std::vector<float> a = testing::Ar1Noise(7, 20000, 0.5, 0.01, 9.8);
+  const std::vector<float> b = testing::Ar1Noise(8, 20000, 0.0, 0.001);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    s.t_s.push_back(0.01 * static_cast<double>(i));
+    s.acc.emplace_back(a[i], b[i], a[i] - b[i]);
+    s.gyr.emplace_back(b[i], 2.0F * a[i], a[i] + b[i]);
+  }
+  const std::vector<StillSegment> still{StillSegment{0, 8000}, StillSegment{9000, 20000}};
+  const std::vector<Sensor> both{Sensor::kAccel, Sensor::kGyro};
+  const std::vector<CorrelationTime> jobs =
+      EstimateCorrelationTimes(s, still, both, {}, ReverseOnTwoThreads);
+  ASSERT_EQ(jobs.size(), 6U);
+  for (int k = 0; k < 6; ++k) {
+    const CorrelationTime one = EstimateCorrelationTime(s, still, both[k / 3], k % 3);
+    EXPECT_TRUE(SameBits(jobs[k].tau_int, one.tau_int)) << "axis " << k;
+    EXPECT_TRUE(SameBits(jobs[k].variance, one.variance)) << "axis " << k;
+    EXPECT_EQ(jobs[k].window, one.window) << "axis " << k;
+  }
+  // An axis's error is thrown after the others have run: the first in axis order (the
+  // accelerometer's y, constant here: zero variance; the gyroscope's x, not a number, fails
+  // too, with another message).
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.acc[i].y() = 1.0F;
+    s.gyr[i].x() = std::nanf("");
+  }
+  try {
+    EstimateCorrelationTimes(s, still, both, {}, ReverseOnTwoThreads);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string accel_error = [&] {
+      try {
+        EstimateCorrelationTime(s, still, Sensor::kAccel, 1);
+      } catch (const Error& first) {
+        return std::string(first.what());
+      }
+      return std::string();
+    }();
+    const std::string gyro_error = [&] {
+      try {
+        EstimateCorrelationTime(s, still, Sensor::kGyro, 0);
+      } catch (const Error& other) {
+        return std::string(other.what());
+      }
+      return std::string();
+    }();
+    EXPECT_FALSE(accel_error.empty());
+    EXPECT_FALSE(gyro_error.empty());
+    EXPECT_NE(accel_error, gyro_error);
+    EXPECT_EQ(std::string(e.what()), accel_error);
+  }
 }
 
 TEST(CorrelationTime, RejectsUnusableInput) {

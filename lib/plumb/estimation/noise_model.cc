@@ -91,19 +91,19 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
   // wander) is not white noise; the wander processes carry it (file comment).
   signal::CorrelationTimeOptions correlation;
   correlation.detrend = true;
-  const auto acc = signal::EstimateCorrelationTime(series, used, signal::Sensor::kAccel, correlation);
-  std::array<signal::CorrelationTime, 3> gyr{};
-  if (has_gyro) {
-    gyr = signal::EstimateCorrelationTime(series, used, signal::Sensor::kGyro, correlation);
-  }
+  std::vector<signal::Sensor> sensors{signal::Sensor::kAccel};
+  if (has_gyro) sensors.push_back(signal::Sensor::kGyro);
+  const std::vector<signal::CorrelationTime> axes =
+      signal::EstimateCorrelationTimes(series, used, sensors, correlation, options.run_jobs);
   NoiseModel noise;
   for (int i = 0; i < 3; ++i) {
-    const auto axis = static_cast<std::size_t>(i);
-    noise.sigma_acc[i] = std::max(std::sqrt(acc[axis].variance), options.min_sigma_acc);
-    noise.tau_acc[i] = std::max(1.0, acc[axis].tau_int);
+    const auto acc = static_cast<std::size_t>(i);
+    noise.sigma_acc[i] = std::max(std::sqrt(axes[acc].variance), options.min_sigma_acc);
+    noise.tau_acc[i] = std::max(1.0, axes[acc].tau_int);
     if (has_gyro) {
-      noise.sigma_gyr[i] = std::max(std::sqrt(gyr[axis].variance), options.min_sigma_gyr);
-      noise.tau_gyr[i] = std::max(1.0, gyr[axis].tau_int);
+      const std::size_t gyr = 3 + acc;
+      noise.sigma_gyr[i] = std::max(std::sqrt(axes[gyr].variance), options.min_sigma_gyr);
+      noise.tau_gyr[i] = std::max(1.0, axes[gyr].tau_int);
     }
   }
   for (const auto& density : {options.accel_walk_density, options.gyro_walk_density}) {

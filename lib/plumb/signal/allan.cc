@@ -151,8 +151,8 @@ std::pair<double, double> AllanInterval(double adev, double edf, double confiden
   return {adev * std::sqrt(edf / upper_q), adev * std::sqrt(edf / lower_q)};
 }
 
-AllanDeviation PooledAllanDeviation(const std::vector<AxisView>& records, double dt_s,
-                                    const AllanOptions& options) {
+AllanDeviation PooledAllanPoints(const std::vector<AxisView>& records, double dt_s,
+                                 const AllanOptions& options) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) {
     throw Error("Allan deviation: sample interval " + Number(dt_s) +
                 " s must be positive and finite");
@@ -198,6 +198,12 @@ AllanDeviation PooledAllanDeviation(const std::vector<AxisView>& records, double
     out.adev.push_back(std::sqrt(avar));
     out.terms.push_back(terms);
   }
+  return out;
+}
+
+AllanDeviation PooledAllanDeviation(const std::vector<AxisView>& records, double dt_s,
+                                    const AllanOptions& options) {
+  AllanDeviation out = PooledAllanPoints(records, dt_s, options);
   SetAllanIntervals(out, std::vector<PowerLawNoise>(out.adev.size(), options.noise),
                     options.confidence);
   return out;

@@ -122,6 +122,12 @@ AllanDeviation OverlappingAllanDeviation(const AxisView& x, double dt_s,
 AllanDeviation PooledAllanDeviation(const std::vector<AxisView>& records, double dt_s,
                                     const AllanOptions& options = {});
 
+/// PooledAllanDeviation without the intervals (edf, noise, adev_lower, adev_upper empty and
+/// confidence 0), for a caller that sets them with SetAllanIntervals once it knows each
+/// point's noise type (AnalyseStillNoise). Throws as PooledAllanDeviation does.
+AllanDeviation PooledAllanPoints(const std::vector<AxisView>& records, double dt_s,
+                                 const AllanOptions& options = {});
+
 /// Recomputes edf, noise and the intervals of `adev` for the noise type of each point
 /// (`noise`, one per point) at `confidence`. Throws plumb::Error when the sizes differ or the
 /// confidence is not in (0, 1).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <string>
 
@@ -161,18 +162,47 @@ CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
   return out;
 }
 
+CorrelationTime EstimateCorrelationTime(const ImuSeries& series,
+                                        const std::vector<StillSegment>& segments, Sensor sensor,
+                                        int axis, const CorrelationTimeOptions& options) {
+  std::vector<AxisView> chunks;
+  chunks.reserve(segments.size());
+  for (const StillSegment& segment : segments) {
+    chunks.push_back(ViewAxis(series, sensor, axis, segment.begin, segment.end));
+  }
+  return EstimateCorrelationTime(chunks, options);
+}
+
+std::vector<CorrelationTime> EstimateCorrelationTimes(const ImuSeries& series,
+                                                      const std::vector<StillSegment>& segments,
+                                                      const std::vector<Sensor>& sensors,
+                                                      const CorrelationTimeOptions& options,
+                                                      const JobRunner& run_jobs) {
+  const int count = 3 * static_cast<int>(sensors.size());
+  std::vector<CorrelationTime> out(static_cast<std::size_t>(count));
+  std::vector<std::exception_ptr> errors(out.size());
+  RunJobs(run_jobs, count, [&](int job) {
+    const auto k = static_cast<std::size_t>(job);
+    try {
+      out[k] = EstimateCorrelationTime(series, segments, sensors[k / 3], job % 3, options);
+    } catch (...) {
+      errors[k] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+  return out;
+}
+
 std::array<CorrelationTime, 3> EstimateCorrelationTime(const ImuSeries& series,
                                                        const std::vector<StillSegment>& segments,
                                                        Sensor sensor,
                                                        const CorrelationTimeOptions& options) {
   std::array<CorrelationTime, 3> out;
   for (int axis = 0; axis < 3; ++axis) {
-    std::vector<AxisView> chunks;
-    chunks.reserve(segments.size());
-    for (const StillSegment& segment : segments) {
-      chunks.push_back(ViewAxis(series, sensor, axis, segment.begin, segment.end));
-    }
-    out[static_cast<std::size_t>(axis)] = EstimateCorrelationTime(chunks, options);
+    out[static_cast<std::size_t>(axis)] =
+        EstimateCorrelationTime(series, segments, sensor, axis, options);
   }
   return out;
 }

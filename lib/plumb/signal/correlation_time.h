@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/jobs.h"
 #include "plumb/core/segment.h"
 #include "plumb/signal/axis_view.h"
 
@@ -63,11 +64,25 @@ struct CorrelationTime {
 CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
                                         const CorrelationTimeOptions& options = {});
 
-/// The same for the three axes of the accelerometer or gyroscope over still segments of a
+/// The same for one axis (0-2) of the accelerometer or gyroscope over still segments of a
 /// series (their [begin, end) ranges; attitude and labels are ignored).
+CorrelationTime EstimateCorrelationTime(const ImuSeries& series,
+                                        const std::vector<StillSegment>& segments, Sensor sensor,
+                                        int axis, const CorrelationTimeOptions& options = {});
+
+/// The same for the three axes of the accelerometer or gyroscope.
 std::array<CorrelationTime, 3> EstimateCorrelationTime(
     const ImuSeries& series, const std::vector<StillSegment>& segments, Sensor sensor,
     const CorrelationTimeOptions& options = {});
+
+/// The three axes of each of `sensors`, in that order (x, y, z of the first, then of the
+/// next), each axis a job run through `run_jobs` (the same results without it); an axis's
+/// error is thrown after all have run, the first in that order.
+std::vector<CorrelationTime> EstimateCorrelationTimes(const ImuSeries& series,
+                                                      const std::vector<StillSegment>& segments,
+                                                      const std::vector<Sensor>& sensors,
+                                                      const CorrelationTimeOptions& options,
+                                                      const JobRunner& run_jobs);
 
 /// Variance of the mean of `count` correlated samples: variance * tau_int / count, units^2.
 /// Valid for count much larger than tau_int. Returns +inf for count == 0.

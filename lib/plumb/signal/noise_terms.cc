@@ -435,7 +435,7 @@ StillNoise AnalyseStillNoise(const ImuSeries& series, const std::vector<StillSeg
       for (const StillSegment& s : out.segments) {
         records.push_back(ViewAxis(series, a.sensor, a.axis, s.begin, s.end));
       }
-      a.adev = PooledAllanDeviation(records, out.dt_s, options.allan);
+      a.adev = PooledAllanPoints(records, out.dt_s, options.allan);  // intervals below
       a.fit = FitNoiseTerms(a.adev, options.terms);
       SetAllanIntervals(a.adev, a.fit.noise, options.allan.confidence);
     } catch (...) {
