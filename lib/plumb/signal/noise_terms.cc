@@ -6,6 +6,8 @@
 #include <exception>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
@@ -59,21 +61,63 @@ double TermShape(int k, double tau, double gm) {
   return NoiseTermShape(Kind(k), tau);
 }
 
-struct WeightedProblem {
-  std::vector<double> tau, target, weight;  // per fitted point
-  double gm = 0.0;                          // the instability's shape (TermShape)
+/// The fitted points and what every pass of the fit and every term's refit reads of them,
+/// computed once per FitNoiseTerms: each point's tau, AVAR and term shapes (TermShape), and its
+/// pooled EDF for each noise type, computed when first asked for.
+class FitData {
+ public:
+  FitData(const AllanDeviation& a, std::vector<std::size_t> points, double gm)
+      : a_(a), points_(std::move(points)), gm_(gm) {
+    for (std::size_t j : points_) {
+      tau_.push_back(a.tau_s[j]);
+      avar_.push_back(a.adev[j] * a.adev[j]);
+      Coefficients shape{};
+      for (int k = 0; k < kNoiseTermCount; ++k) shape[k] = TermShape(k, a.tau_s[j], gm);
+      shape_.push_back(shape);
+    }
+    edf_.assign(points_.size() * kNoiseTypes, kUnset);
+  }
+
+  std::size_t size() const { return points_.size(); }
+  const std::vector<std::size_t>& points() const { return points_; }
+  const std::vector<double>& tau() const { return tau_; }
+  const std::vector<double>& avar() const { return avar_; }
+  const Coefficients& shape(std::size_t i) const { return shape_[i]; }
+  double gm() const { return gm_; }
+
+  /// PooledAllanEdf of point i for `noise`.
+  double Edf(std::size_t i, PowerLawNoise noise) {
+    double& edf = edf_[i * kNoiseTypes + static_cast<std::size_t>(noise)];
+    if (edf == kUnset) edf = PooledAllanEdf(a_.record_sizes, a_.cluster_size[points_[i]], noise);
+    return edf;
+  }
+
+ private:
+  static constexpr std::size_t kNoiseTypes = 5;  // PowerLawNoise's values
+  static constexpr double kUnset = -1.0;         // an EDF is at least 1
+  const AllanDeviation& a_;
+  std::vector<std::size_t> points_;
+  double gm_;
+  std::vector<double> tau_, avar_;
+  std::vector<Coefficients> shape_;
+  std::vector<double> edf_;
 };
 
-double Model(const Coefficients& c, double tau, double gm) {
+struct WeightedProblem {
+  std::vector<double> target, weight;  // per fitted point
+};
+
+/// The model's AVAR at a point, from its term shapes.
+double Model(const Coefficients& c, const Coefficients& shape) {
   double sum = 0.0;
-  for (int k = 0; k < kNoiseTermCount; ++k) sum += c[k] * TermShape(k, tau, gm);
+  for (int k = 0; k < kNoiseTermCount; ++k) sum += c[k] * shape[k];
   return sum;
 }
 
-double LinearCost(const WeightedProblem& p, const Coefficients& c) {
+double LinearCost(const FitData& d, const WeightedProblem& p, const Coefficients& c) {
   double cost = 0.0;
-  for (std::size_t j = 0; j < p.tau.size(); ++j) {
-    const double r = p.target[j] - Model(c, p.tau[j], p.gm);
+  for (std::size_t j = 0; j < d.size(); ++j) {
+    const double r = p.target[j] - Model(c, d.shape(j));
     cost += p.weight[j] * r * r;
   }
   return cost;
@@ -82,11 +126,11 @@ double LinearCost(const WeightedProblem& p, const Coefficients& c) {
 /// Non-negative weighted least squares of `target` by enumerating the subsets of the enabled
 /// terms (each solved by column-pivoted QR on unit-norm columns; the cheapest one with no
 /// negative coefficient wins).
-Coefficients SolveNonNegative(const WeightedProblem& p,
+Coefficients SolveNonNegative(const FitData& d, const WeightedProblem& p,
                               const std::array<bool, kNoiseTermCount>& enabled) {
-  const auto rows = static_cast<Eigen::Index>(p.tau.size());
+  const auto rows = static_cast<Eigen::Index>(d.size());
   Coefficients best{};
-  double best_cost = LinearCost(p, best);  // all zero
+  double best_cost = LinearCost(d, p, best);  // all zero
   for (int subset = 1; subset < (1 << kNoiseTermCount); ++subset) {
     std::vector<int> cols;
     for (int k = 0; k < kNoiseTermCount; ++k) {
@@ -97,10 +141,11 @@ Coefficients SolveNonNegative(const WeightedProblem& p,
     Eigen::MatrixXd design(rows, static_cast<Eigen::Index>(cols.size()));
     Eigen::VectorXd y(rows);
     for (Eigen::Index j = 0; j < rows; ++j) {
-      const double s = std::sqrt(p.weight[j]);
-      y[j] = s * p.target[j];
+      const auto point = static_cast<std::size_t>(j);
+      const double s = std::sqrt(p.weight[point]);
+      y[j] = s * p.target[point];
       for (std::size_t i = 0; i < cols.size(); ++i) {
-        design(j, static_cast<Eigen::Index>(i)) = s * TermShape(cols[i], p.tau[j], p.gm);
+        design(j, static_cast<Eigen::Index>(i)) = s * d.shape(point)[cols[i]];
       }
     }
     const Eigen::VectorXd norms = design.colwise().norm();
@@ -116,7 +161,7 @@ Coefficients SolveNonNegative(const WeightedProblem& p,
       feasible = feasible && c[cols[i]] >= 0.0 && std::isfinite(c[cols[i]]);
     }
     if (!feasible) continue;
-    const double cost = LinearCost(p, c);
+    const double cost = LinearCost(d, p, c);
     if (cost < best_cost) {
       best_cost = cost;
       best = c;
@@ -125,12 +170,13 @@ Coefficients SolveNonNegative(const WeightedProblem& p,
   return best;
 }
 
-/// The term with the largest AVAR at tau (the white noise when every coefficient is 0).
-int Dominant(const Coefficients& c, double tau, double gm) {
+/// The term with the largest AVAR at a point of term shapes `shape` (the white noise when
+/// every coefficient is 0).
+int Dominant(const Coefficients& c, const Coefficients& shape) {
   int best = static_cast<int>(NoiseTermKind::kWhite);
   double largest = 0.0;
   for (int k = 0; k < kNoiseTermCount; ++k) {
-    const double v = c[k] * TermShape(k, tau, gm);
+    const double v = c[k] * shape[k];
     if (v > largest) {
       largest = v;
       best = k;
@@ -149,13 +195,12 @@ struct FitState {
 };
 
 /// sum_j edf_j / 2 (ln AVAR_j - ln model_j)^2; infinite where the model is not positive.
-double LogCost(const std::vector<double>& tau, const std::vector<double>& avar,
-               const std::vector<double>& edf, const Coefficients& c, double gm) {
+double LogCost(const FitData& d, const std::vector<double>& edf, const Coefficients& c) {
   double cost = 0.0;
-  for (std::size_t j = 0; j < tau.size(); ++j) {
-    const double m = Model(c, tau[j], gm);
+  for (std::size_t j = 0; j < d.size(); ++j) {
+    const double m = Model(c, d.shape(j));
     if (!(m > 0.0)) return std::numeric_limits<double>::infinity();
-    const double r = std::log(avar[j] / m);
+    const double r = std::log(d.avar()[j] / m);
     cost += 0.5 * edf[j] * r * r;
   }
   return cost;
@@ -165,44 +210,37 @@ double LogCost(const std::vector<double>& tau, const std::vector<double>& avar,
 /// fits model_j (1 + ln(AVAR_j / model_j)) with weights edf_j / (2 model_j^2) (the first pass,
 /// model = AVAR, is the relative-error fit), halves the step while the log cost rises, and
 /// updates the noise types and EDF from the dominant terms.
-FitState FitInLogs(const AllanDeviation& a, const std::vector<std::size_t>& points,
-                   const std::array<bool, kNoiseTermCount>& enabled, int max_iterations,
-                   double gm) {
+FitState FitInLogs(FitData& d, const std::array<bool, kNoiseTermCount>& enabled,
+                   int max_iterations) {
+  const std::size_t points = d.size();
+  const std::vector<double>& avar = d.avar();
   FitState s;
-  s.noise.assign(points.size(), PowerLawNoise::kWhiteFrequency);
-  s.edf.assign(points.size(), 0.0);
+  s.noise.assign(points, PowerLawNoise::kWhiteFrequency);
+  s.edf.assign(points, 0.0);
   WeightedProblem p;
-  p.gm = gm;
-  std::vector<double> avar;
-  for (std::size_t j : points) {
-    p.tau.push_back(a.tau_s[j]);
-    avar.push_back(a.adev[j] * a.adev[j]);
-  }
   std::vector<double> model = avar;
-  p.target.assign(points.size(), 0.0);
-  p.weight.assign(points.size(), 0.0);
+  p.target.assign(points, 0.0);
+  p.weight.assign(points, 0.0);
   const auto update_edf = [&] {
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      s.edf[i] = PooledAllanEdf(a.record_sizes, a.cluster_size[points[i]], s.noise[i]);
-    }
+    for (std::size_t i = 0; i < points; ++i) s.edf[i] = d.Edf(i, s.noise[i]);
   };
   for (int it = 1; it <= max_iterations; ++it) {
     update_edf();
-    for (std::size_t i = 0; i < points.size(); ++i) {
+    for (std::size_t i = 0; i < points; ++i) {
       p.weight[i] = 0.5 * s.edf[i] / (model[i] * model[i]);
       p.target[i] = model[i] * (1.0 + std::log(avar[i] / model[i]));
     }
-    Coefficients c = SolveNonNegative(p, enabled);
+    Coefficients c = SolveNonNegative(d, p, enabled);
     if (it > 1) {  // step control: never a higher log cost than the last solution's
       const Coefficients from = s.c;
-      const double before = LogCost(p.tau, avar, s.edf, from, gm);
+      const double before = LogCost(d, s.edf, from);
       double step = 1.0;
       Coefficients trial = c;
-      while (LogCost(p.tau, avar, s.edf, trial, gm) > before && step > 1.0 / 64) {
+      while (LogCost(d, s.edf, trial) > before && step > 1.0 / 64) {
         step *= 0.5;
         for (int k = 0; k < kNoiseTermCount; ++k) trial[k] = from[k] + step * (c[k] - from[k]);
       }
-      c = LogCost(p.tau, avar, s.edf, trial, gm) <= before ? trial : from;
+      c = LogCost(d, s.edf, trial) <= before ? trial : from;
     }
     s.iterations = it;
     bool same = it > 1;
@@ -212,17 +250,17 @@ FitState FitInLogs(const AllanDeviation& a, const std::vector<std::size_t>& poin
       same = same && std::abs(c[k] - s.c[k]) <= kSettled * largest;
     }
     s.c = c;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const double m = Model(c, p.tau[i], gm);
+    for (std::size_t i = 0; i < points; ++i) {
+      const double m = Model(c, d.shape(i));
       model[i] = m > 0.0 ? m : avar[i];
-      const PowerLawNoise noise = NoiseTermNoise(Kind(Dominant(c, p.tau[i], gm)));
+      const PowerLawNoise noise = NoiseTermNoise(Kind(Dominant(c, d.shape(i))));
       same = same && noise == s.noise[i];
       s.noise[i] = noise;
     }
     if (same) break;
   }
   update_edf();
-  s.chi2 = LogCost(p.tau, avar, s.edf, s.c, gm);
+  s.chi2 = LogCost(d, s.edf, s.c);
   return s;
 }
 
@@ -230,9 +268,28 @@ std::array<bool, kNoiseTermCount> Enabled(const NoiseTermsOptions& o) {
   return {o.quantisation, true, true, true, o.rate_ramp};
 }
 
+/// What Judge reads of the fit for every term: each fitted point's one-sided upper limit of
+/// AVAR (Bonferroni over the points: each leaves out (1 - c) / P), and the chi^2 rise that
+/// resolves a term.
+struct Limits {
+  std::vector<double> upper_avar;  // per fitted point
+  double resolving_rise = 0.0;
+};
+
+Limits MakeLimits(const FitData& d, const FitState& s, const NoiseTermsOptions& o) {
+  Limits limits;
+  const double tail = (1.0 - o.term_confidence) / static_cast<double>(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    limits.upper_avar.push_back(d.avar()[i] * s.edf[i] / ChiSquareQuantileExact(tail, s.edf[i]));
+  }
+  limits.resolving_rise = ChiSquareQuantileExact(o.term_confidence, 1.0);
+  return limits;
+}
+
 /// Resolved test and upper bound of term k (see the header).
-NoiseTerm Judge(int k, const AllanDeviation& a, const std::vector<std::size_t>& points,
-                const FitState& s, const NoiseTermsOptions& o) {
+NoiseTerm Judge(int k, FitData& d, const FitState& s, const Limits& limits,
+                const NoiseTermsOptions& o) {
+  const std::size_t points = d.size();
   NoiseTerm t;
   t.kind = Kind(k);
   t.in_model = k == static_cast<int>(NoiseTermKind::kQuantisation) ? o.quantisation
@@ -240,21 +297,17 @@ NoiseTerm Judge(int k, const AllanDeviation& a, const std::vector<std::size_t>& 
                                                                     : true;
   t.fitted = std::sqrt(s.c[k]);
   t.upper_bound = kNaN;
-  // Bonferroni over the fitted points: each point's one-sided limit leaves out (1 - c) / P.
   t.chi2_rise = kNaN;
-  const double tail = (1.0 - o.term_confidence) / static_cast<double>(points.size());
   double bound = std::numeric_limits<double>::infinity();
   std::size_t run_begin = 0, run_length = 0, best_begin = 0, best_length = 0;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const double tau = a.tau_s[points[i]];
-    const double avar = a.adev[points[i]] * a.adev[points[i]];
-    const double upper = avar * s.edf[i] / ChiSquareQuantileExact(tail, s.edf[i]);
-    const double b = upper / TermShape(k, tau, o.gauss_markov_time_s);
+  for (std::size_t i = 0; i < points; ++i) {
+    const double tau = d.tau()[i];
+    const double b = limits.upper_avar[i] / d.shape(i)[k];
     if (b < bound) {
       bound = b;
       t.bound_tau_s = tau;
     }
-    const bool dominant = s.c[k] > 0.0 && Dominant(s.c, tau, o.gauss_markov_time_s) == k;
+    const bool dominant = s.c[k] > 0.0 && Dominant(s.c, d.shape(i)) == k;
     run_length = dominant ? run_length + 1 : 0;
     if (run_length == 1) run_begin = i;
     if (run_length > best_length) {
@@ -268,22 +321,16 @@ NoiseTerm Judge(int k, const AllanDeviation& a, const std::vector<std::size_t>& 
     // as one observation.
     std::array<bool, kNoiseTermCount> without = Enabled(o);
     without[k] = false;
-    const Coefficients c =
-        FitInLogs(a, points, without, o.max_iterations, o.gauss_markov_time_s).c;
-    std::vector<double> tau, avar;
-    for (std::size_t j : points) {
-      tau.push_back(a.tau_s[j]);
-      avar.push_back(a.adev[j] * a.adev[j]);
-    }
-    const double decades = std::log10(tau.back() / tau.front());
+    const Coefficients c = FitInLogs(d, without, o.max_iterations).c;
+    const double decades = std::log10(d.tau().back() / d.tau().front());
     const double per_decade =
-        decades > 0.0 ? std::max(1.0, static_cast<double>(points.size() - 1) / decades) : 1.0;
-    t.chi2_rise = (LogCost(tau, avar, s.edf, c, o.gauss_markov_time_s) - s.chi2) / per_decade;
-    t.resolved = t.chi2_rise > ChiSquareQuantileExact(o.term_confidence, 1.0);
+        decades > 0.0 ? std::max(1.0, static_cast<double>(points - 1) / decades) : 1.0;
+    t.chi2_rise = (LogCost(d, s.edf, c) - s.chi2) / per_decade;
+    t.resolved = t.chi2_rise > limits.resolving_rise;
   }
   if (t.resolved) {
-    t.tau_min_s = a.tau_s[points[best_begin]];
-    t.tau_max_s = a.tau_s[points[best_begin + best_length - 1]];
+    t.tau_min_s = d.tau()[best_begin];
+    t.tau_max_s = d.tau()[best_begin + best_length - 1];
   } else {
     t.tau_min_s = t.tau_max_s = t.bound_tau_s;
   }
@@ -349,10 +396,12 @@ NoiseFit FitNoiseTerms(const AllanDeviation& a, const NoiseTermsOptions& o) {
         "noise terms: " + std::to_string(points.size()) +
         " Allan deviation point(s) in the fitted range; record a longer still period");
   }
-  const FitState s = FitInLogs(a, points, Enabled(o), o.max_iterations, o.gauss_markov_time_s);
+  FitData data(a, points, o.gauss_markov_time_s);
+  const FitState s = FitInLogs(data, Enabled(o), o.max_iterations);
+  const Limits limits = MakeLimits(data, s, o);
   NoiseFit fit;
   fit.gauss_markov_time_s = o.gauss_markov_time_s;
-  for (int k = 0; k < kNoiseTermCount; ++k) fit.terms[k] = Judge(k, a, points, s, o);
+  for (int k = 0; k < kNoiseTermCount; ++k) fit.terms[k] = Judge(k, data, s, limits, o);
   fit.first = points.front();
   fit.last = points.back();
   fit.chi2 = s.chi2;
