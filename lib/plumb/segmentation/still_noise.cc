@@ -35,14 +35,17 @@ struct Pooled {
   Vec3 scatter = Vec3::Zero();  ///< sum over runs of squared deviations from the run's mean
 };
 
-/// The output's resolution on `axis`: the smallest nonzero step between consecutive samples
-/// of the whole series, 0 when the axis never changes.
-double QuantisationStep(const ImuSeries& series, signal::Sensor sensor, int axis) {
-  const signal::AxisView v = signal::ViewAxis(series, sensor, axis, 0, series.size());
-  double step = 0.0;
-  for (Eigen::Index i = 1; i < v.size(); ++i) {
-    const double d = std::abs(static_cast<double>(v[i]) - static_cast<double>(v[i - 1]));
-    if (d > 0.0 && (step == 0.0 || d < step)) step = d;
+/// The output's resolution on each axis of `sensor`: the smallest nonzero step between
+/// consecutive samples of the whole series, 0 where the axis never changes (one pass over the
+/// triads).
+Vec3 QuantisationSteps(const ImuSeries& series, signal::Sensor sensor) {
+  const std::vector<Vec3f>& x = sensor == signal::Sensor::kAccel ? series.acc : series.gyr;
+  Vec3 step = Vec3::Zero();
+  for (std::size_t i = 1; i < x.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      const double d = std::abs(static_cast<double>(x[i][a]) - static_cast<double>(x[i - 1][a]));
+      if (d > 0.0 && (step[a] == 0.0 || d < step[a])) step[a] = d;
+    }
   }
   return step;
 }
@@ -59,8 +62,9 @@ void FinishTriad(const ImuSeries& series, const std::vector<StillSegment>& spans
   mean = reference + pooled.sum / samples;
   const double floor = 4.0 * kFloatEps * mean.cwiseAbs().maxCoeff();
   sigma = (pooled.scatter / dof).cwiseSqrt().cwiseMax(floor);
+  const Vec3 steps = QuantisationSteps(series, sensor);
   for (int a = 0; a < 3; ++a) {
-    sigma[a] = std::max(sigma[a], QuantisationStep(series, sensor, a) / std::sqrt(12.0));
+    sigma[a] = std::max(sigma[a], steps[a] / std::sqrt(12.0));
     std::vector<signal::AxisView> chunks;
     for (const StillSegment& span : spans) {
       chunks.push_back(signal::ViewAxis(series, sensor, a, span.begin, span.end));
