@@ -11,6 +11,15 @@ namespace plumb::cli {
 /// one thread, taken in order as threads come free. The jobs must not throw. Inside another
 /// runner's job (diagnose's refits, each fitting with its own runner) the jobs run on the
 /// job's thread: OpenMP keeps nested regions to one thread.
+///
+/// The first runner with more than one thread starts OpenMP's threads and binds each to its
+/// own CPU of those the process may use, the calling thread to the one it is on (jobs.cc says
+/// why), unless OMP_PROC_BIND, OMP_PLACES or GOMP_CPU_AFFINITY is set: OpenMP then places
+/// them as those say.
 JobRunner ParallelJobs(int jobs);
+
+/// The CPUs this process may use (counted once, before any thread is bound to one): what
+/// `--jobs 0` means.
+int Cores();
 
 }  // namespace plumb::cli

@@ -21,6 +21,7 @@
 #include "validators.h"
 #include "progress.h"
 #include "commands.h"
+#include "jobs.h"
 #include "study_files.h"
 #include "plumb/core/error.h"
 #include "plumb/io/common/atomic_file.h"
@@ -220,7 +221,7 @@ class SweepCommand : public Command {
     std::vector<std::vector<study::RunOutcome>> outcomes(todo.size(),
                                                          std::vector<study::RunOutcome>(runs));
     std::vector<std::atomic<std::size_t>> done(todo.size());
-    const int jobs = args_.jobs > 0 ? args_.jobs : omp_get_num_procs();
+    const int jobs = args_.jobs > 0 ? args_.jobs : Cores();
     std::size_t written = 0;
     Progress::Of().Stage("0 of " + std::to_string(todo.size()) + " points");
     std::string error;

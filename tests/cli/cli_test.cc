@@ -159,6 +159,32 @@ TEST(Cli, CalibrateJsonIsBitForBitWhateverTheHeapLayout) {
   EXPECT_EQ(testing::ReadAll(dir.File("a.json")), testing::ReadAll(dir.File("b.json")));
 }
 
+TEST(Cli, CalibrateJsonIsBitForBitWhereverTheThreadsRun) {
+  // The command binds its OpenMP threads to CPUs unless OMP_PROC_BIND (or OMP_PLACES,
+  // GOMP_CPU_AFFINITY) is set (apps/plumb/jobs.cc); on one thread, on bound threads and on
+  // threads the kernel places, every job writes only its own result.
+  TempDir dir;
+  const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
+  const std::vector<std::string> args = {"calibrate", imu0, "--columns", "ax,ay,az,gx,gy,gz",
+                                         "--rate", "100", "--json"};
+  const auto run = [&](const std::string& name, const std::vector<std::string>& more) {
+    std::vector<std::string> a = args;
+    a.push_back(dir.File(name));
+    a.insert(a.end(), more.begin(), more.end());
+    const ToolRun r = Plumb(a, dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return testing::ReadAll(dir.File(name));
+  };
+  const std::string bound = run("bound.json", {"--jobs", "2"});
+  const std::string one = run("one.json", {"--jobs", "1"});
+  ::setenv("OMP_PROC_BIND", "false", 1);
+  const std::string placed_by_kernel = run("kernel.json", {"--jobs", "2"});
+  ::unsetenv("OMP_PROC_BIND");
+  EXPECT_FALSE(bound.empty());
+  EXPECT_EQ(bound, one);
+  EXPECT_EQ(bound, placed_by_kernel);
+}
+
 TEST(Cli, BiasWanderLevelsMustBeFiniteAndNonNegative) {
   TempDir dir;
   const std::string imu0 = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.log";
