@@ -10,8 +10,8 @@ find_package(Boost 1.71 REQUIRED)
 if(NOT TARGET GeographicLib::GeographicLib)
   list(APPEND CMAKE_MODULE_PATH /usr/share/cmake/geographiclib)
   find_package(GeographicLib 1.49 REQUIRED)
-  add_library(GeographicLib::GeographicLib UNKNOWN IMPORTED)
+  add_library(GeographicLib::GeographicLib INTERFACE IMPORTED)
   set_target_properties(GeographicLib::GeographicLib PROPERTIES
-    IMPORTED_LOCATION "${GeographicLib_LIBRARIES}"
+    INTERFACE_LINK_LIBRARIES "${GeographicLib_LIBRARIES}"
     INTERFACE_INCLUDE_DIRECTORIES "${GeographicLib_INCLUDE_DIRS}")
 endif()
