@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "plumb/estimation/calibrator.h"
@@ -210,6 +211,46 @@ INSTANTIATE_TEST_SUITE_P(
                       // turns), which diagnose adds for them:
                       OneEffect{"accel_size_effect", 108}, OneEffect{"time_offset", 109}),
     EffectName);
+
+/// Runs the jobs last to first, half of them on a second thread: another order than the
+/// serial one, and at once.
+void ReverseOnTwoThreads(int count, const std::function<void(int)>& job) {
+  std::thread other([&] {
+    for (int k = count - 1; k >= 0; k -= 2) job(k);
+  });
+  for (int k = count - 2; k >= 0; k -= 2) job(k);
+  other.join();
+}
+
+TEST(Diagnose, TheSameBitForBitWhetherItsFitsRunInTurnOrAtOnce) {
+  // DiagnoseOptions::run_jobs runs the two probe fits (its own residuals, and with velocity
+  // residuals for accel_size_effect) and the refits: each writes only its own result.
+  SessionSpec spec;
+  spec.hidden = {{"accel_size_effect", 3.0}};
+  spec.seed = 108;
+  Session s = Simulate(spec);
+  s.options.confirm = 3;
+  const Diagnosis in_turn = DiagnoseSession(s, s.base);
+  s.options.run_jobs = ReverseOnTwoThreads;
+  const Diagnosis at_once = DiagnoseSession(s, s.base);
+  ASSERT_TRUE(in_turn.fit_with_velocity.has_value());
+  ASSERT_TRUE(at_once.fit_with_velocity.has_value());
+  EXPECT_EQ(in_turn.fit.fit.chi2, at_once.fit.fit.chi2);
+  EXPECT_EQ(in_turn.fit_with_velocity->fit.chi2, at_once.fit_with_velocity->fit.chi2);
+  ASSERT_EQ(in_turn.candidates.size(), at_once.candidates.size());
+  int refits = 0;
+  for (std::size_t i = 0; i < in_turn.candidates.size(); ++i) {
+    const Candidate& a = in_turn.candidates[i];
+    const Candidate& b = at_once.candidates[i];
+    EXPECT_EQ(a.effect, b.effect);
+    EXPECT_EQ(a.lm, b.lm) << a.effect;
+    EXPECT_EQ(a.evidence, b.evidence) << a.effect;
+    EXPECT_EQ(a.refit_drop, b.refit_drop) << a.effect;
+    EXPECT_EQ(a.refit.has_value(), b.refit.has_value()) << a.effect;
+    if (a.refit) ++refits;
+  }
+  EXPECT_GE(refits, 1);
+}
 
 // --- 2. nothing hidden ---------------------------------------------------------------------
 

@@ -308,21 +308,38 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   // residuals and, for the candidates that need them, once with velocity residuals.
   const std::vector<CandidateSpec> wanted = WantedCandidates(options);
   const ProbePlan plan = PlanProbes(wanted, series, site, model, d.skipped);
+  // The two are independent: run at once through options.run_jobs (each fit then on one
+  // thread). The second is kept only when the first has motion intervals.
   estimation::CalibrationOptions own = options.calibration;
   if (!own.accel_in_motion) own.accel_in_motion = false;
-  Tell(options, "probe fit of " + plan.probed.spec());
-  const estimation::CalibrationResult fit =
-      estimation::Calibrate(series, segments, plan.probed, site, own);
-  d.fit = StripProbes(fit, model);
+  estimation::CalibrationOptions with = options.calibration;
+  with.accel_in_motion = true;
+  with.check_linearity = false;  // its columns score candidates; its covariance is not shown
+  const bool try_motion = plan.probed_motion.has_probes();
+  Tell(options, "probe fit of " + plan.probed.spec() +
+                    (try_motion ? " and with velocity residuals" : ""));
+  estimation::CalibrationResult fit;
   std::optional<estimation::CalibrationResult> fit_motion;
-  if (plan.probed_motion.has_probes() && d.fit.fit.motion_segments > 0) {
-    Tell(options, "probe fit with velocity residuals");
-    estimation::CalibrationOptions with = options.calibration;
-    with.accel_in_motion = true;
-    with.check_linearity = false;  // its columns score candidates; its covariance is not shown
-    fit_motion = estimation::Calibrate(series, segments, plan.probed_motion, site, with);
-    d.fit_with_velocity = StripProbes(*fit_motion, model);
+  std::exception_ptr errors[2];
+  RunJobs(try_motion ? options.run_jobs : JobRunner{}, try_motion ? 2 : 1, [&](int job) {
+    try {
+      if (job == 0) {
+        fit = estimation::Calibrate(series, segments, plan.probed, site, own);
+      } else {
+        fit_motion = estimation::Calibrate(series, segments, plan.probed_motion, site, with);
+      }
+    } catch (...) {
+      errors[job] = std::current_exception();
+    }
+  });
+  if (errors[0]) std::rethrow_exception(errors[0]);
+  d.fit = StripProbes(fit, model);
+  if (d.fit.fit.motion_segments == 0) {
+    fit_motion.reset();
+  } else if (errors[1]) {
+    std::rethrow_exception(errors[1]);
   }
+  if (fit_motion) d.fit_with_velocity = StripProbes(*fit_motion, model);
   if (!fit.fit.probes && !fit_motion) return d;
   d.num_residuals = fit.fit.probes
                         ? static_cast<int>(std::count_if(

@@ -50,7 +50,8 @@ struct DiagnoseOptions {
   /// Told what Diagnose starts next ("probe fit", "refit with base+EFFECT (1 of 3)"), for a
   /// command's progress display; empty: nobody is told. The library itself never prints.
   std::function<void(const std::string& stage)> on_stage;
-  /// Runs job(0), ..., job(count - 1): independent fits (the refits), each writing only its own
+  /// Runs job(0), ..., job(count - 1): independent fits (the two probe fits, own residuals and
+  /// with velocity residuals, then the refits), each writing only its own
   /// result, so the diagnosis is the same bit for bit whatever the order. Empty: one after
   /// another. A command may run them at once (plumb's does, on OpenMP); the library starts
   /// no thread itself. The jobs throw nothing (Diagnose keeps their errors).
