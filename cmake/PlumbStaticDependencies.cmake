@@ -4,7 +4,7 @@
 #
 # Why: much of a short command's time is the process's start. Every shared object is found,
 # mapped and relocated, and its symbols looked up, before main: `plumb --version` took 6.4-8.9
-# ms linked against 28 shared objects and 3.5-3.7 ms linked so, against 6 (libc, libm,
+# ms linked against 27 shared libraries and 3.5-3.7 ms linked so, against 6 (libc, libm,
 # libgomp, METIS, libunwind and liblzma, which Debian ships without archives or which are C
 # and stay shared); docs/performance.md, "Threads and start-up", has the command.
 #
