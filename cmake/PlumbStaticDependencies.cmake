@@ -6,7 +6,7 @@
 # mapped and relocated, and its symbols looked up, before main: `plumb --version` took 6.4-8.9
 # ms linked against 27 shared libraries and 3.5-3.7 ms linked so, against 6 (libc, libm,
 # libgomp, METIS, libunwind and liblzma, which Debian ships without archives or which are C
-# and stay shared); docs/performance.md, "Threads and start-up", has the command.
+# and stay shared); docs/performance.md, "Threads (`--jobs`) and start-up", has the command.
 #
 # Only the target named gets this (the `plumb` command): the tests, the benchmarks, the Python
 # module and an installed plumb's consumers (plumbConfig.cmake does not include this file) link
@@ -95,9 +95,10 @@ function(_plumb_static_entry out entry)
   endif()
 endfunction()
 
-# Rewrites `target`'s link interface: each entry that has an archive becomes
-# $<IF:static,archive...,entry> on the consuming target's PLUMB_STATIC_LINK, plus `extra`
-# (libraries the archives need that the shared objects brought themselves) for static links.
+# Rewrites `target`'s link interface: the entries with no archive stay; the others become
+# $<IF:static,$<LINK_GROUP:RESCAN,their archives...,extra...>,the entries> on the consuming
+# target's PLUMB_STATIC_LINK, `extra` being what the archives need that the shared objects
+# brought along themselves.
 function(_plumb_static_interface target extra)
   if(NOT TARGET ${target})
     return()

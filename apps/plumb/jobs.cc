@@ -42,8 +42,8 @@ std::vector<int> AllowedCpus() {
 /// Why: Linux starts a new thread on its creator's CPU, and libgomp's master waits for the
 /// threads of its first team by spinning on that CPU, so the new thread runs only once the
 /// scheduler's tick moves one of them; a thread woken later can again be queued behind a
-/// spinning one. On a 2-core machine the first parallel region of `plumb calibrate` took 2-6
-/// ms longer than the others for this reason (docs/performance.md, "Threads and start-up").
+/// spinning one. On a 2-core machine the first parallel region of `plumb calibrate` waited
+/// milliseconds for its threads (docs/performance.md, "Threads (`--jobs`) and start-up").
 /// Bound threads never share a CPU, so a region starts in microseconds. The start itself asks
 /// for one thread more than it binds: when that is more than the CPUs (as with every core),
 /// libgomp waits for them by sleeping, not spinning, so the new threads run at once; the extra

@@ -31,7 +31,6 @@
 #include <cstdint>
 #include <iostream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "plumb/estimation/calibrator.h"
@@ -42,6 +41,7 @@
 #include "plumb/signal/chi_square.h"
 #include "plumb/report/calibration_text.h"
 #include "plumb/report/diagnosis_text.h"
+#include "support/reverse_jobs.h"
 
 namespace plumb::diagnostics {
 namespace {
@@ -212,15 +212,7 @@ INSTANTIATE_TEST_SUITE_P(
                       OneEffect{"accel_size_effect", 108}, OneEffect{"time_offset", 109}),
     EffectName);
 
-/// Runs the jobs last to first, half of them on a second thread: another order than the
-/// serial one, and at once.
-void ReverseOnTwoThreads(int count, const std::function<void(int)>& job) {
-  std::thread other([&] {
-    for (int k = count - 1; k >= 0; k -= 2) job(k);
-  });
-  for (int k = count - 2; k >= 0; k -= 2) job(k);
-  other.join();
-}
+using ::plumb::testing::ReverseOnTwoThreads;
 
 TEST(Diagnose, TheSameBitForBitWhetherItsFitsRunInTurnOrAtOnce) {
   // DiagnoseOptions::run_jobs runs the two probe fits (its own residuals, and with velocity

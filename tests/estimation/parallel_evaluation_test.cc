@@ -6,26 +6,18 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
-#include <thread>
 #include <vector>
 
 #include "plumb/estimation/calibrator.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
 #include "plumb/sim/truth.h"
+#include "support/reverse_jobs.h"
 
 namespace plumb::estimation {
 namespace {
 
-/// Runs the jobs last to first, half of them on a second thread: another order than the
-/// serial one, and at once.
-void ReverseOnTwoThreads(int count, const std::function<void(int)>& job) {
-  std::thread other([&] {
-    for (int k = count - 1; k >= 0; k -= 2) job(k);
-  });
-  for (int k = count - 2; k >= 0; k -= 2) job(k);
-  other.join();
-}
+using ::plumb::testing::ReverseOnTwoThreads;
 
 CalibrationResult CalibrateSession(const sim::Simulation& sim, const JobRunner& run_jobs) {
   CalibrationOptions options;  // the default: the bias wanders, levels from the still data

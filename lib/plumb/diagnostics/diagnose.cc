@@ -270,12 +270,7 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
       errors[static_cast<std::size_t>(k)] = std::current_exception();
     }
   };
-  const int count = static_cast<int>(chosen.size());
-  if (options.run_jobs) {
-    options.run_jobs(count, refit);
-  } else {
-    for (int k = 0; k < count; ++k) refit(k);
-  }
+  RunJobs(options.run_jobs, static_cast<int>(chosen.size()), refit);
   for (const std::exception_ptr& error : errors) {
     if (error) std::rethrow_exception(error);
   }
@@ -309,7 +304,8 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   const std::vector<CandidateSpec> wanted = WantedCandidates(options);
   const ProbePlan plan = PlanProbes(wanted, series, site, model, d.skipped);
   // The two are independent: run at once through options.run_jobs (each fit then on one
-  // thread). The second is kept only when the first has motion intervals.
+  // thread). The second is kept only when the first has motion intervals. A lone fit is run
+  // directly, so that its own work may still use options.calibration.run_jobs.
   estimation::CalibrationOptions own = options.calibration;
   if (!own.accel_in_motion) own.accel_in_motion = false;
   estimation::CalibrationOptions with = options.calibration;
