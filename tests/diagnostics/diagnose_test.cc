@@ -216,12 +216,14 @@ using ::plumb::testing::ReverseOnTwoThreads;
 
 TEST(Diagnose, TheSameBitForBitWhetherItsFitsRunInTurnOrAtOnce) {
   // DiagnoseOptions::run_jobs runs the two probe fits (its own residuals, and with velocity
-  // residuals for accel_size_effect) and the refits: each writes only its own result.
+  // residuals for accel_size_effect) and the refits: each writes only its own result. At once,
+  // the first probe fit refits its best candidates (gyro_g_sensitivity) while the second runs;
+  // the refits of both fits' candidates are the same as in turn.
   SessionSpec spec;
-  spec.hidden = {{"accel_size_effect", 3.0}};
+  spec.hidden = {{"accel_size_effect", 3.0}, {"gyro_g_sensitivity", 3.0}};
   spec.seed = 108;
   Session s = Simulate(spec);
-  s.options.confirm = 3;
+  s.options.confirm = 10;  // every significant candidate, of both probe fits
   const Diagnosis in_turn = DiagnoseSession(s, s.base);
   s.options.run_jobs = ReverseOnTwoThreads;
   const Diagnosis at_once = DiagnoseSession(s, s.base);
@@ -230,7 +232,7 @@ TEST(Diagnose, TheSameBitForBitWhetherItsFitsRunInTurnOrAtOnce) {
   EXPECT_EQ(in_turn.fit.fit.chi2, at_once.fit.fit.chi2);
   EXPECT_EQ(in_turn.fit_with_velocity->fit.chi2, at_once.fit_with_velocity->fit.chi2);
   ASSERT_EQ(in_turn.candidates.size(), at_once.candidates.size());
-  int refits = 0;
+  int refits = 0, with_velocity = 0;
   for (std::size_t i = 0; i < in_turn.candidates.size(); ++i) {
     const Candidate& a = in_turn.candidates[i];
     const Candidate& b = at_once.candidates[i];
@@ -238,10 +240,16 @@ TEST(Diagnose, TheSameBitForBitWhetherItsFitsRunInTurnOrAtOnce) {
     EXPECT_EQ(a.lm, b.lm) << a.effect;
     EXPECT_EQ(a.evidence, b.evidence) << a.effect;
     EXPECT_EQ(a.refit_drop, b.refit_drop) << a.effect;
-    EXPECT_EQ(a.refit.has_value(), b.refit.has_value()) << a.effect;
-    if (a.refit) ++refits;
+    ASSERT_EQ(a.refit.has_value(), b.refit.has_value()) << a.effect;
+    if (!a.refit) continue;
+    ++refits;
+    if (a.with_velocity) ++with_velocity;
+    EXPECT_EQ(a.refit->fit.chi2, b.refit->fit.chi2) << a.effect;
+    EXPECT_EQ(a.refit->calibration.covariance, b.refit->calibration.covariance) << a.effect;
   }
-  EXPECT_GE(refits, 1);
+  EXPECT_GE(refits, 2);
+  EXPECT_GE(with_velocity, 1);
+  EXPECT_LT(with_velocity, refits);
 }
 
 // --- 2. nothing hidden ---------------------------------------------------------------------

@@ -3,9 +3,11 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
 #include <iomanip>
+#include <memory>
 #include <sstream>
 
 #include "plumb/core/error.h"
@@ -113,13 +115,16 @@ ProbePlan PlanProbes(const std::vector<CandidateSpec>& wanted, const ImuSeries& 
   return plan;
 }
 
-// The two functions below append a candidate and its basis (the residual directions it
-// explains; empty when it was not tested) to `candidates` and `bases`, in the same order.
+/// A scored candidate and its basis (the residual directions it explains; empty when it was
+/// not tested).
+struct Scored {
+  Candidate candidate;
+  Eigen::MatrixXd basis;
+};
 
 /// A candidate its probe fit could not test (no motion between the poses: nothing excites
 /// it): not identifiable, every parameter unexcited.
-void AddUnexcited(const CandidateSpec& c, std::vector<Candidate>& candidates,
-                  std::vector<Eigen::MatrixXd>& bases) {
+Scored Unexcited(const CandidateSpec& c) {
   Candidate cand;
   cand.effect = c.name;
   cand.option = c.option;
@@ -134,8 +139,7 @@ void AddUnexcited(const CandidateSpec& c, std::vector<Candidate>& candidates,
     n.unit = effect->info().parameters[static_cast<std::size_t>(i)].unit;
     cand.not_identifiable.push_back(n);
   }
-  candidates.push_back(std::move(cand));
-  bases.emplace_back();
+  return {std::move(cand), Eigen::MatrixXd()};
 }
 
 /// The velocity residuals' chi^2 per residual in a probe fit when above 1, else 1.
@@ -153,10 +157,9 @@ double VelocityDispersion(const estimation::ProbeJacobian& p) {
 /// The score test of one candidate in its probe fit `source`: its columns of the probe
 /// Jacobian Z with their typical sizes (in the fit's units), LM (divided by the velocity
 /// residuals' dispersion when tested with them), evidence and significance.
-void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& source,
-               const estimation::JacobianRange& range, bool with_velocity,
-               const ImuSeries& series, const DiagnoseOptions& options,
-               std::vector<Candidate>& candidates, std::vector<Eigen::MatrixXd>& bases) {
+Scored Score(const CandidateSpec& c, const estimation::CalibrationResult& source,
+             const estimation::JacobianRange& range, bool with_velocity, const ImuSeries& series,
+             const DiagnoseOptions& options) {
   const estimation::ProbeJacobian& p = *source.fit.probes;
   // N counts the observations: the bias-wander factors are priors, not measurements.
   const auto observations = std::count_if(p.row_kind.begin(), p.row_kind.end(), [](auto kind) {
@@ -198,8 +201,24 @@ void AddScored(const CandidateSpec& c, const estimation::CalibrationResult& sour
   cand.threshold = s.dof > 0 ? signal::ChiSquareQuantileExact(1.0 - options.significance, s.dof) : 0.0;
   cand.significant = s.identifiable && s.dof > 0 && cand.lm > cand.threshold;
   cand.with_velocity = with_velocity;
-  candidates.push_back(std::move(cand));
-  bases.push_back(s.basis);
+  return {std::move(cand), s.basis};
+}
+
+/// Scores the candidates of `plan` tested in one probe fit (`motion`: the one with velocity
+/// residuals), `source`, into their slots of `scored` (plan order); all unexcited when
+/// `source` is null or has no probe columns. Its Jacobian is factorised once for all of them.
+void ScoreInFit(const ProbePlan& plan, bool motion, const estimation::CalibrationResult* source,
+                const ImuSeries& series, const DiagnoseOptions& options,
+                std::vector<Scored>& scored) {
+  std::unique_ptr<estimation::JacobianRange> range;
+  if (source != nullptr && source->fit.probes) {
+    range = estimation::ProbeRange(*source->fit.probes, options.score.rank_tolerance);
+  }
+  for (std::size_t ci = 0; ci < plan.tested.size(); ++ci) {
+    if (plan.needs_motion[ci] != motion) continue;
+    scored[ci] = range ? Score(plan.tested[ci], *source, *range, motion, series, options)
+                       : Unexcited(plan.tested[ci]);
+  }
 }
 
 /// Candidates whose explained directions lie within another's: the smallest cosine of the
@@ -219,13 +238,15 @@ void MarkIndistinguishable(const std::vector<Eigen::MatrixXd>& bases,
   }
 }
 
-/// Best evidence first; the ones not identifiable last.
+/// The ranking's order: identifiable before not, then best evidence first.
+bool RanksBefore(const Candidate& a, const Candidate& b) {
+  if (a.identifiable != b.identifiable) return a.identifiable;
+  return a.evidence > b.evidence;
+}
+
+/// Best evidence first; the ones not identifiable last (a stable sort: ties keep their order).
 void Rank(std::vector<Candidate>& candidates) {
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) {
-                     if (a.identifiable != b.identifiable) return a.identifiable;
-                     return a.evidence > b.evidence;
-                   });
+  std::stable_sort(candidates.begin(), candidates.end(), RanksBefore);
 }
 
 /// Tells options.on_stage, when set, that `stage` begins.
@@ -233,12 +254,54 @@ void Tell(const DiagnoseOptions& options, const std::string& stage) {
   if (options.on_stage) options.on_stage(stage);
 }
 
+/// A refit of the model plus one candidate: its result, or the error it threw.
+struct Refit {
+  std::optional<estimation::CalibrationResult> result;
+  std::exception_ptr error;
+};
+
+Refit RefitWith(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                const model::Model& model, const geo::Site& site, const DiagnoseOptions& options,
+                const Candidate& cand) {
+  Refit out;
+  try {
+    model::Model with = model;
+    with.Add(cand.effect, cand.option);
+    estimation::CalibrationOptions refit_options = options.calibration;
+    refit_options.accel_in_motion = cand.with_velocity;
+    out.result = estimation::Calibrate(series, segments, with, site, refit_options);
+  } catch (...) {
+    out.error = std::current_exception();
+  }
+  return out;
+}
+
+/// The candidates of one probe fit (`motion`: the one with velocity residuals) that the
+/// ranking of all candidates may choose to refit, in plan slots: its significant ones in
+/// ranking order, at most options.confirm. Whatever the other fit's candidates, those of this
+/// one that are chosen are the start of this list (the ranking keeps their order).
+std::vector<std::size_t> RefitOrder(const ProbePlan& plan, bool motion,
+                                    const std::vector<Scored>& scored, int confirm) {
+  std::vector<std::size_t> order;
+  for (std::size_t ci = 0; ci < plan.tested.size(); ++ci) {
+    if (plan.needs_motion[ci] == motion && scored[ci].candidate.significant) order.push_back(ci);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return RanksBefore(scored[a].candidate, scored[b].candidate);
+  });
+  if (static_cast<int>(order.size()) > confirm) order.resize(static_cast<std::size_t>(confirm));
+  return order;
+}
+
 /// Refits the model plus each of the best `options.confirm` significant candidates: the
 /// actual fall of chi^2 from its probe fit (`fit` or, with velocity residuals, `fit_motion`).
-/// The refits are independent: options.run_jobs may run them at once. A refit's error is
-/// thrown after all have ended (the first candidate's, in ranking order).
+/// `early` holds, per plan slot, the refits already made while the probe fits ran (kept only
+/// for the candidates chosen here). The others are independent: options.run_jobs may run them
+/// at once. A refit's error is thrown after all have ended (the first candidate's, in ranking
+/// order).
 void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segments,
                  const model::Model& model, const geo::Site& site, const DiagnoseOptions& options,
+                 const ProbePlan& plan, std::vector<std::optional<Refit>>& early,
                  const estimation::CalibrationResult& fit,
                  const std::optional<estimation::CalibrationResult>& fit_motion,
                  std::vector<Candidate>& candidates) {
@@ -248,32 +311,112 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
     if (cand.significant) chosen.push_back(&cand);
   }
   if (chosen.empty()) return;
+  std::vector<Refit> refits(chosen.size());
+  std::vector<std::size_t> pending;  // chosen ones not refitted yet
   std::string specs;
-  for (const Candidate* cand : chosen) {
-    specs += (specs.empty() ? "" : ", ") + SpecWith(model, cand->effect, cand->option);
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    const Candidate& cand = *chosen[k];
+    const auto slot = static_cast<std::size_t>(
+        std::find_if(plan.tested.begin(), plan.tested.end(),
+                     [&](const CandidateSpec& c) {
+                       return c.name == cand.effect && c.option == cand.option;
+                     }) -
+        plan.tested.begin());
+    if (slot < early.size() && early[slot]) {
+      refits[k] = std::move(*early[slot]);
+      continue;
+    }
+    pending.push_back(k);
+    specs += (specs.empty() ? "" : ", ") + SpecWith(model, cand.effect, cand.option);
   }
-  Tell(options, "refit with " + specs);
-  std::vector<std::exception_ptr> errors(chosen.size());
-  const auto refit = [&](int k) {
-    Candidate& cand = *chosen[static_cast<std::size_t>(k)];
-    try {
-      model::Model with = model;
-      with.Add(cand.effect, cand.option);
-      estimation::CalibrationOptions refit_options = options.calibration;
-      refit_options.accel_in_motion = cand.with_velocity;
-      estimation::CalibrationResult result =
-          estimation::Calibrate(series, segments, with, site, refit_options);
-      const double before = cand.with_velocity ? fit_motion->fit.chi2 : fit.fit.chi2;
-      cand.refit_drop = before - result.fit.chi2;
-      cand.refit = std::move(result);
-    } catch (...) {
-      errors[static_cast<std::size_t>(k)] = std::current_exception();
+  const auto refit = [&](int job) {
+    const std::size_t k = pending[static_cast<std::size_t>(job)];
+    refits[k] = RefitWith(series, segments, model, site, options, *chosen[k]);
+  };
+  if (!pending.empty()) Tell(options, "refit with " + specs);
+  // A lone refit is run directly, so that its own work may still use the threads.
+  if (pending.size() == 1) {
+    refit(0);
+  } else {
+    RunJobs(options.run_jobs, static_cast<int>(pending.size()), refit);
+  }
+  for (const Refit& r : refits) {
+    if (r.error) std::rethrow_exception(r.error);
+  }
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    Candidate& cand = *chosen[k];
+    const double before = cand.with_velocity ? fit_motion->fit.chi2 : fit.fit.chi2;
+    cand.refit_drop = before - refits[k].result->fit.chi2;
+    cand.refit = std::move(refits[k].result);
+  }
+}
+
+/// The probe fits and, while the one with velocity residuals runs, refits of the other's best
+/// candidates (see Diagnose).
+struct ProbeFits {
+  estimation::CalibrationResult fit;                      ///< own residuals
+  std::optional<estimation::CalibrationResult> fit_motion;  ///< with velocity residuals
+  std::vector<Scored> scored;                             ///< per plan slot
+  std::vector<std::optional<Refit>> early;                ///< per plan slot
+};
+
+/// Fits the model with the probes of `plan`, once with its own residuals (job 0) and, when
+/// some candidate needs them, once with velocity residuals (job 1); the two are independent
+/// and run through options.run_jobs (each fit then on one thread). Job 0 then scores its
+/// candidates and, while job 1 is still running on another thread, refits its best ones one
+/// at a time (RefitOrder): the core would otherwise wait. Which of them it refits depends on
+/// timing, the diagnosis does not (ConfirmBest refits what is missing and drops the rest). A
+/// lone fit is run directly, so that its own work may still use options.calibration.run_jobs.
+/// The second fit is kept only when the first has motion intervals; the first's error first.
+ProbeFits FitProbes(const ImuSeries& series, const std::vector<StillSegment>& segments,
+                    const model::Model& model, const geo::Site& site, const ProbePlan& plan,
+                    const DiagnoseOptions& options) {
+  estimation::CalibrationOptions own = options.calibration;
+  // Without velocity residuals unless asked for (its probes would otherwise turn them on).
+  if (!own.accel_in_motion) own.accel_in_motion = false;
+  estimation::CalibrationOptions with = options.calibration;
+  with.accel_in_motion = true;
+  with.check_linearity = false;  // its columns score candidates; its covariance is not shown
+  const bool try_motion = plan.probed_motion.has_probes();
+  Tell(options, "probe fit of " + plan.probed.spec() +
+                    (try_motion ? " and with velocity residuals" : ""));
+  ProbeFits out;
+  out.scored.resize(plan.tested.size());
+  out.early.resize(plan.tested.size());
+  enum MotionFit { kNotStarted, kRunning, kDone };
+  std::atomic<int> motion_fit{kNotStarted};
+  std::exception_ptr errors[2];
+  const auto own_fit = [&] {
+    out.fit = estimation::Calibrate(series, segments, plan.probed, site, own);
+    ScoreInFit(plan, false, &out.fit, series, options, out.scored);
+    for (std::size_t ci : RefitOrder(plan, false, out.scored, options.confirm)) {
+      if (motion_fit.load() != kRunning) break;
+      const Candidate& cand = out.scored[ci].candidate;
+      Tell(options, "refit with " + SpecWith(model, cand.effect, cand.option) +
+                        " and the probe fit with velocity residuals");
+      out.early[ci] = RefitWith(series, segments, model, site, options, cand);
     }
   };
-  RunJobs(options.run_jobs, static_cast<int>(chosen.size()), refit);
-  for (const std::exception_ptr& error : errors) {
-    if (error) std::rethrow_exception(error);
+  RunJobs(try_motion ? options.run_jobs : JobRunner{}, try_motion ? 2 : 1, [&](int job) {
+    try {
+      if (job == 0) {
+        own_fit();
+      } else {
+        motion_fit.store(kRunning);
+        out.fit_motion = estimation::Calibrate(series, segments, plan.probed_motion, site, with);
+      }
+    } catch (...) {
+      errors[job] = std::current_exception();
+    }
+    if (job == 1) motion_fit.store(kDone);
+  });
+  if (errors[0]) std::rethrow_exception(errors[0]);
+  if (out.fit.fit.motion_segments == 0) {
+    out.fit_motion.reset();
+  } else if (errors[1]) {
+    std::rethrow_exception(errors[1]);
   }
+  return out;
 }
 
 }  // namespace
@@ -300,41 +443,14 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   d.significance = options.significance;
 
   // 1. Probe fits: the model with the candidates as probes (held at zero), once with its own
-  // residuals and, for the candidates that need them, once with velocity residuals.
+  // residuals and, for the candidates that need them, once with velocity residuals; the first
+  // fit's candidates scored (and some refitted) while the second runs.
   const std::vector<CandidateSpec> wanted = WantedCandidates(options);
   const ProbePlan plan = PlanProbes(wanted, series, site, model, d.skipped);
-  // The two are independent: run at once through options.run_jobs (each fit then on one
-  // thread). The second is kept only when the first has motion intervals. A lone fit is run
-  // directly, so that its own work may still use options.calibration.run_jobs.
-  estimation::CalibrationOptions own = options.calibration;
-  if (!own.accel_in_motion) own.accel_in_motion = false;
-  estimation::CalibrationOptions with = options.calibration;
-  with.accel_in_motion = true;
-  with.check_linearity = false;  // its columns score candidates; its covariance is not shown
-  const bool try_motion = plan.probed_motion.has_probes();
-  Tell(options, "probe fit of " + plan.probed.spec() +
-                    (try_motion ? " and with velocity residuals" : ""));
-  estimation::CalibrationResult fit;
-  std::optional<estimation::CalibrationResult> fit_motion;
-  std::exception_ptr errors[2];
-  RunJobs(try_motion ? options.run_jobs : JobRunner{}, try_motion ? 2 : 1, [&](int job) {
-    try {
-      if (job == 0) {
-        fit = estimation::Calibrate(series, segments, plan.probed, site, own);
-      } else {
-        fit_motion = estimation::Calibrate(series, segments, plan.probed_motion, site, with);
-      }
-    } catch (...) {
-      errors[job] = std::current_exception();
-    }
-  });
-  if (errors[0]) std::rethrow_exception(errors[0]);
+  ProbeFits probes = FitProbes(series, segments, model, site, plan, options);
+  const estimation::CalibrationResult& fit = probes.fit;
+  const std::optional<estimation::CalibrationResult>& fit_motion = probes.fit_motion;
   d.fit = StripProbes(fit, model);
-  if (d.fit.fit.motion_segments == 0) {
-    fit_motion.reset();
-  } else if (errors[1]) {
-    std::rethrow_exception(errors[1]);
-  }
   if (fit_motion) d.fit_with_velocity = StripProbes(*fit_motion, model);
   if (!fit.fit.probes && !fit_motion) return d;
   d.num_residuals = fit.fit.probes
@@ -345,26 +461,12 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
                               }))
                         : 0;
 
-  // 2. Score each candidate in its probe fit, whose Jacobian is factorised once.
-  const auto range_of = [&](const estimation::CalibrationResult* source) {
-    if (source == nullptr || !source->fit.probes) return std::unique_ptr<estimation::JacobianRange>();
-    return estimation::ProbeRange(*source->fit.probes, options.score.rank_tolerance);
-  };
-  const std::unique_ptr<estimation::JacobianRange> range = range_of(&fit);
-  const std::unique_ptr<estimation::JacobianRange> range_motion =
-      range_of(fit_motion ? &*fit_motion : nullptr);
+  // 2. Score the other candidates in the fit with velocity residuals.
+  ScoreInFit(plan, true, fit_motion ? &*fit_motion : nullptr, series, options, probes.scored);
   std::vector<Eigen::MatrixXd> bases;
-  for (std::size_t ci = 0; ci < plan.tested.size(); ++ci) {
-    const bool motion = plan.needs_motion[ci];
-    const estimation::CalibrationResult* source =
-        motion ? (fit_motion ? &*fit_motion : nullptr) : &fit;
-    const estimation::JacobianRange* source_range = motion ? range_motion.get() : range.get();
-    if (source_range == nullptr) {
-      AddUnexcited(plan.tested[ci], d.candidates, bases);
-    } else {
-      AddScored(plan.tested[ci], *source, *source_range, motion, series, options, d.candidates,
-                bases);
-    }
+  for (Scored& s : probes.scored) {
+    d.candidates.push_back(std::move(s.candidate));
+    bases.push_back(std::move(s.basis));
   }
 
   // 3. Rank: which candidates this data cannot tell apart, then by evidence.
@@ -372,7 +474,8 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   Rank(d.candidates);
 
   // 4. Confirm the best significant candidates by refitting.
-  ConfirmBest(series, segments, model, site, options, d.fit, fit_motion, d.candidates);
+  ConfirmBest(series, segments, model, site, options, plan, probes.early, d.fit, fit_motion,
+              d.candidates);
   return d;
 }
 

@@ -49,12 +49,16 @@ struct DiagnoseOptions {
   ScoreTestOptions score;
   /// Told what Diagnose starts next ("probe fit", "refit with base+EFFECT (1 of 3)"), for a
   /// command's progress display; empty: nobody is told. The library itself never prints.
+  /// Called from the thread of the job that starts the stage.
   std::function<void(const std::string& stage)> on_stage;
   /// Runs job(0), ..., job(count - 1): independent fits (the two probe fits, own residuals and
   /// with velocity residuals, then the refits), each writing only its own
   /// result, so the diagnosis is the same bit for bit whatever the order. Empty: one after
   /// another. A command may run them at once (plumb's does, on OpenMP); the library starts
-  /// no thread itself. The jobs throw nothing (Diagnose keeps their errors).
+  /// no thread itself. The jobs throw nothing (Diagnose keeps their errors). When the two
+  /// probe fits run at once, the first, once done, refits its own best candidates while the
+  /// second still runs (those the ranking may choose; how many depends on timing, the
+  /// diagnosis does not).
   JobRunner run_jobs;
 };
 

@@ -242,10 +242,19 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
     }
   };
   // The terms `terms` applied at sample i (inputs differentiated if asked), on the linear
-  // stage's F and E as constants when they leave the linear stage out.
+  // stage's F and E as constants when they leave the linear stage out. `in` and `z` are a
+  // pass's own, kept from sample to sample (a 3 x 3 matrix of Jets is 81 values to set):
+  // every input is set anew; when the terms are split, F and E are set once (catalogue terms
+  // only read them; the linear stage's terms, first in stage_readers_, overwrite them) and
+  // the outputs zeroed; otherwise z starts afresh.
   const Mat3T<Jet> F_jet = at_zero.F.cast<Jet>(), E_jet = at_zero.E.cast<Jet>();
-  auto predict = [&](std::size_t i, bool differentiate, const std::vector<int>& terms) {
-    model::SensorInput<Jet> in;
+  auto start_pass = [&](model::SensorOutput<Jet>& z) {
+    if (!terms_split_) return;
+    z.F = F_jet;
+    z.E = E_jet;
+  };
+  auto predict = [&](std::size_t i, bool differentiate, const std::vector<int>& terms,
+                     model::SensorInput<Jet>& in, model::SensorOutput<Jet>& z) {
     for (int k = 0; k < 3; ++k) {
       in.f_b[k] = Jet(f[i][k]);
       in.omega_b[k] = Jet(w[i][k]);
@@ -257,15 +266,15 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
     }
     in.dt_s = Jet(s_.dt_s[i]);
     in.dtemp_c = Jet(s_.dtemp_c[i]);
-    model::SensorOutput<Jet> z;
     if (terms_split_) {
-      z.F = F_jet;
-      z.E = E_jet;
+      z.acc.setZero();
+      z.gyr.setZero();
+    } else {
+      z = model::SensorOutput<Jet>();
     }
     for (int t : terms) {
       model_->terms()[static_cast<std::size_t>(t)].effect->Apply(ptr[static_cast<std::size_t>(t)], in, z);
     }
-    return z;
   };
 
   // The rate rows of -D_x^-1 per sample, M = d w / d p, how w moves when p is added to the
@@ -276,6 +285,9 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
   set_theta({});
   bool coupled = false;  // some output depends on the other sensor's input
   const std::vector<int>& input_terms = terms_split_ ? catalogue_terms_ : all_terms_;
+  model::SensorInput<Jet> in;
+  model::SensorOutput<Jet> z;
+  start_pass(z);
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Zero();
     if (terms_split_) {
@@ -283,7 +295,7 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
       if (g_term >= 0) D.bottomRightCorner<3, 3>() = at_zero.E;
     }
     if (!input_terms.empty()) {
-      const model::SensorOutput<Jet> z = predict(i, true, input_terms);
+      predict(i, true, input_terms, in, z);
       for (int r = 0; r < 3; ++r) {
         D.row(r) += z.acc[r].v.head<6>().transpose();
         D.row(3 + r) += z.gyr[r].v.head<6>().transpose();
@@ -338,8 +350,9 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
   }
   for (const auto& [seeded, terms] : passes) {
     set_theta(seeded);
+    start_pass(z);
     for (std::size_t i = 0; i < n; ++i) {
-      const model::SensorOutput<Jet> z = predict(i, false, terms);
+      predict(i, false, terms, in, z);
       Eigen::Matrix<double, 6, kStride> D_theta;
       for (int r = 0; r < 3; ++r) {
         D_theta.row(r) = z.acc[r].v.transpose();  // zero without accelerometer terms

@@ -212,8 +212,9 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
     out.middleCols<3>(gyr_from).noalias() -= (1.0 - x.u) * KE_inv;
     out.middleCols<3>(gyr_to).noalias() -= x.u * KE_inv;
   };
-  auto force_jacobian = [&](const Sample& x) {
-    Cols out = Cols::Zero(3, U);
+  // Writes K d f / dx of sample `x` to `out` (3 x U, preallocated: no allocation per sample).
+  auto force_jacobian = [&](const Sample& x, Cols& out) {
+    out.setZero();
     if (a_term >= 0) {
       const int size = model_->terms()[static_cast<std::size_t>(a_term)].effect->info().size();
       model::accel_linear::SubtractForceJacobian(
@@ -222,7 +223,6 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
     }
     out.middleCols<3>(acc_from) -= (1.0 - x.u) * F_inv;
     out.middleCols<3>(acc_to) -= x.u * F_inv;
-    return out;
   };
 
   const Vec3 omega_k = R_b_n * omega_ie_n_;
@@ -232,7 +232,8 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
   // A: d(right perturbation of dR_i)/dx; D: d(dR_i f_i)/dx; B: d(dv)/dx (file comment).
   Cols A = Cols::Zero(3, U), A_next(3, U), B = Cols::Zero(3, U);
   Sample x0 = n > 0 ? correct(0) : Sample{Vec3::Zero(), Vec3::Zero(), 0.0};
-  Cols D0 = n > 0 ? force_jacobian(x0) : Cols::Zero(3, U);
+  Cols D0 = Cols::Zero(3, U), D1(3, U), dR_D1(3, U);
+  if (n > 0) force_jacobian(x0, D0);
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const double h = s_.dt_s[i + 1] - s_.dt_s[i];
     const Sample x1 = correct(i + 1);
@@ -250,11 +251,11 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
     add_rate(K0, x0, A_next);
     add_rate(K1, x1, A_next);
     A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
-    Cols D1 = force_jacobian(x1);
+    force_jacobian(x1, D1);
     D1.noalias() -= so3::Skew(x1.f) * A_next;
-    D1 = dR_next * D1;
-    B += 0.5 * h * (D0 + D1);
-    D0.swap(D1);
+    dR_D1.noalias() = dR_next * D1;
+    B += 0.5 * h * (D0 + dR_D1);
+    D0.swap(dR_D1);
     A.swap(A_next);
     dR = dR_next;
     x0 = x1;
