@@ -76,7 +76,8 @@ class DiagnoseCommand : public Command {
         ->capture_default_str();
     app_->add_option("--jobs", a.jobs,
                      "The two probe fits, then the refits, in parallel, each on one core "
-                     "(default: every core); the result is the same whatever N")
+                     "(the first refits while the second probe fit runs; default: every "
+                     "core); the result is the same whatever N")
         ->check(NonNegative);
     app_->add_option("--candidates", a.candidates,
                      "Test only these effects (NAME or NAME:OPTION, comma-separated); default: "
