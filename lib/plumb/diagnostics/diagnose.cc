@@ -254,11 +254,21 @@ void Tell(const DiagnoseOptions& options, const std::string& stage) {
   if (options.on_stage) options.on_stage(stage);
 }
 
-/// A refit of the model plus one candidate: its result, or the error it threw.
+/// A refit of the model plus one candidate: its result, or the error it threw; neither when
+/// it was not made.
 struct Refit {
   std::optional<estimation::CalibrationResult> result;
   std::exception_ptr error;
+  bool made() const { return result.has_value() || error != nullptr; }
 };
+
+/// The plan slot of a tested candidate.
+std::size_t SlotOf(const ProbePlan& plan, const Candidate& cand) {
+  const auto at = std::find_if(plan.tested.begin(), plan.tested.end(), [&](const CandidateSpec& c) {
+    return c.name == cand.effect && c.option == cand.option;
+  });
+  return static_cast<std::size_t>(at - plan.tested.begin());
+}
 
 Refit RefitWith(const ImuSeries& series, const std::vector<StillSegment>& segments,
                 const model::Model& model, const geo::Site& site, const DiagnoseOptions& options,
@@ -301,7 +311,7 @@ std::vector<std::size_t> RefitOrder(const ProbePlan& plan, bool motion,
 /// order).
 void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segments,
                  const model::Model& model, const geo::Site& site, const DiagnoseOptions& options,
-                 const ProbePlan& plan, std::vector<std::optional<Refit>>& early,
+                 const ProbePlan& plan, std::vector<Refit>& early,
                  const estimation::CalibrationResult& fit,
                  const std::optional<estimation::CalibrationResult>& fit_motion,
                  std::vector<Candidate>& candidates) {
@@ -316,14 +326,9 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
   std::string specs;
   for (std::size_t k = 0; k < chosen.size(); ++k) {
     const Candidate& cand = *chosen[k];
-    const auto slot = static_cast<std::size_t>(
-        std::find_if(plan.tested.begin(), plan.tested.end(),
-                     [&](const CandidateSpec& c) {
-                       return c.name == cand.effect && c.option == cand.option;
-                     }) -
-        plan.tested.begin());
-    if (slot < early.size() && early[slot]) {
-      refits[k] = std::move(*early[slot]);
+    Refit& made_early = early[SlotOf(plan, cand)];
+    if (made_early.made()) {
+      refits[k] = std::move(made_early);
       continue;
     }
     pending.push_back(k);
@@ -357,7 +362,7 @@ struct ProbeFits {
   estimation::CalibrationResult fit;                      ///< own residuals
   std::optional<estimation::CalibrationResult> fit_motion;  ///< with velocity residuals
   std::vector<Scored> scored;                             ///< per plan slot
-  std::vector<std::optional<Refit>> early;                ///< per plan slot
+  std::vector<Refit> early;                               ///< per plan slot
 };
 
 /// Fits the model with the probes of `plan`, once with its own residuals (job 0) and, when

@@ -98,6 +98,128 @@ struct GyroStageSums {
   }
 };
 
+using Jet = model::Jet;
+
+/// The model's terms on Jets at the samples of one interval, for the implicit derivative of the
+/// corrected rates (MotionResidual::ImplicitRateJacobians): theta as Jets, constants with up to
+/// kJetStride parameters seeded, and the inputs at sample i (the corrected f_i and w_i,
+/// differentiated if asked). The input and the output are kept from sample to sample (a 3 x 3
+/// matrix of Jets is 81 values to set): every input is set anew; when the terms are split
+/// (catalogue terms only read F and E), F and E are the linear stage's, set once per pass (the
+/// linear stage's terms, first in stage_readers_, overwrite them) and the outputs are zeroed;
+/// otherwise the output starts afresh.
+class TermJets {
+ public:
+  /// `parameter_of`: per parameter of the P, its (term, index); `at_zero`: the model's output
+  /// at zero input (its F and E). Every argument must outlive the object.
+  TermJets(const model::Model& model, double const* const* theta,
+           const std::vector<std::pair<int, int>>& parameter_of, bool terms_split,
+           const model::SensorOutput<double>& at_zero, const MotionSamples& samples,
+           const std::vector<Vec3>& f, const std::vector<Vec3>& w)
+      : model_(model), theta_(theta), parameter_of_(parameter_of), terms_split_(terms_split),
+        F_(at_zero.F.cast<Jet>()), E_(at_zero.E.cast<Jet>()), s_(samples), f_(f), w_(w),
+        blocks_(static_cast<std::size_t>(model.num_terms())), ptr_(blocks_.size()) {
+    for (std::size_t t = 0; t < blocks_.size(); ++t) {
+      blocks_[t].resize(static_cast<std::size_t>(model.terms()[t].effect->info().size()));
+      ptr_[t] = blocks_[t].data();
+    }
+  }
+
+  /// Starts a pass with the parameters `seeded` (indices among the P) differentiated.
+  void Start(const std::vector<int>& seeded) {
+    for (std::size_t t = 0; t < blocks_.size(); ++t) {
+      for (std::size_t j = 0; j < blocks_[t].size(); ++j) blocks_[t][j] = Jet(theta_[t][j]);
+    }
+    for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
+      const auto [t, j] = parameter_of_[static_cast<std::size_t>(seeded[slot])];
+      blocks_[static_cast<std::size_t>(t)][static_cast<std::size_t>(j)].v[slot] = 1.0;
+    }
+    if (terms_split_) {
+      z_.F = F_;
+      z_.E = E_;
+    }
+  }
+
+  /// The terms `terms` applied at sample i, the inputs f_i and w_i differentiated (the first
+  /// six slots) when `differentiate`.
+  const model::SensorOutput<Jet>& Predict(std::size_t i, bool differentiate,
+                                          const std::vector<int>& terms) {
+    for (int k = 0; k < 3; ++k) {
+      in_.f_b[k] = Jet(f_[i][k]);
+      in_.omega_b[k] = Jet(w_[i][k]);
+      in_.alpha_b[k] = Jet(s_.alpha_b[i][k]);
+      if (differentiate) {
+        in_.f_b[k].v[k] = 1.0;
+        in_.omega_b[k].v[3 + k] = 1.0;
+      }
+    }
+    in_.dt_s = Jet(s_.dt_s[i]);
+    in_.dtemp_c = Jet(s_.dtemp_c[i]);
+    if (terms_split_) {
+      z_.acc.setZero();
+      z_.gyr.setZero();
+    } else {
+      z_ = model::SensorOutput<Jet>();
+    }
+    for (int t : terms) {
+      model_.terms()[static_cast<std::size_t>(t)].effect->Apply(ptr_[static_cast<std::size_t>(t)], in_, z_);
+    }
+    return z_;
+  }
+
+ private:
+  const model::Model& model_;
+  double const* const* theta_;
+  const std::vector<std::pair<int, int>>& parameter_of_;
+  bool terms_split_;
+  Mat3T<Jet> F_, E_;
+  const MotionSamples& s_;
+  const std::vector<Vec3>& f_;
+  const std::vector<Vec3>& w_;
+  std::vector<std::vector<Jet>> blocks_;
+  std::vector<const Jet*> ptr_;
+  model::SensorInput<Jet> in_;
+  model::SensorOutput<Jet> z_;
+};
+
+/// The rate rows of -D_x^-1 per sample, M = d w / d p: how w moves when p is added to the
+/// predicted outputs (3 x 6; without accelerometer terms f is the output itself: d f = 0). With
+/// D_x = [A B; C D] (A = d y_a / d f ~ F, D ~ E) and S = D - C A^-1 B: M = [S^-1 C A^-1, -S^-1].
+/// D_x is the linear stage's F and E (when the terms are split) plus the Jets of `input_terms`.
+/// `coupled`: set when some output depends on the other sensor's input at some sample.
+std::vector<Eigen::Matrix<double, 3, 6>> RateRowsOfInverse(
+    const model::Model& model, bool terms_split, const std::vector<int>& input_terms,
+    const model::SensorOutput<double>& at_zero, std::size_t n, TermJets& jets, bool* coupled) {
+  const bool accel = HasAccelTerms(model);
+  const int a_term = model.BaseTerm(model::Sensor::kAccel);
+  const int g_term = model.BaseTerm(model::Sensor::kGyro);
+  std::vector<Eigen::Matrix<double, 3, 6>> dw_dp(n);
+  jets.Start({});
+  *coupled = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Zero();
+    if (terms_split) {
+      if (a_term >= 0) D.topLeftCorner<3, 3>() = at_zero.F;
+      if (g_term >= 0) D.bottomRightCorner<3, 3>() = at_zero.E;
+    }
+    if (!input_terms.empty()) {
+      const model::SensorOutput<Jet>& z = jets.Predict(i, true, input_terms);
+      for (int r = 0; r < 3; ++r) {
+        D.row(r) += z.acc[r].v.head<6>().transpose();
+        D.row(3 + r) += z.gyr[r].v.head<6>().transpose();
+      }
+    }
+    if (!accel) D.topRows<3>() << Mat3::Identity(), Mat3::Zero();
+    *coupled = *coupled || !D.block<3, 3>(3, 0).isZero(0.0) || !D.block<3, 3>(0, 3).isZero(0.0);
+    const Mat3 A_inv = D.topLeftCorner<3, 3>().inverse();
+    const Mat3 S_inv =
+        (D.bottomRightCorner<3, 3>() - D.bottomLeftCorner<3, 3>() * A_inv * D.topRightCorner<3, 3>())
+            .inverse();
+    dw_dp[i] << S_inv * D.bottomLeftCorner<3, 3>() * A_inv, -S_inv;
+  }
+  return dw_dp;
+}
+
 }  // namespace
 
 Eigen::Matrix<double, 4, 3> LeftPlusJacobian(const Quat& q) {
@@ -213,102 +335,43 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
                                            const model::SensorOutput<double>& at_zero,
                                            const std::vector<Vec3>& f, const std::vector<Vec3>& w,
                                            RateJacobians& W) const {
-  using Jet = model::Jet;
   constexpr int kStride = model::kJetStride;
   static_assert(kStride >= 6, "one Jet pass differentiates the six inputs");
   const std::size_t n = s_.size();
-  const int T = model_->num_terms();
-  const bool accel = HasAccelTerms(*model_);
-  const int a_term = model_->BaseTerm(model::Sensor::kAccel);
-  const int g_term = model_->BaseTerm(model::Sensor::kGyro);
-  // theta as Jets: constants, with parameters `seeded` (global indices, at most kStride)
-  // differentiated.
-  std::vector<std::vector<Jet>> blocks(static_cast<std::size_t>(T));
-  std::vector<const Jet*> ptr(blocks.size());
-  for (int t = 0; t < T; ++t) {
-    auto& b = blocks[static_cast<std::size_t>(t)];
-    const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
-    b.resize(static_cast<std::size_t>(size));
-    ptr[static_cast<std::size_t>(t)] = b.data();
-  }
-  auto set_theta = [&](const std::vector<int>& seeded) {
-    for (int t = 0; t < T; ++t) {
-      auto& b = blocks[static_cast<std::size_t>(t)];
-      for (std::size_t j = 0; j < b.size(); ++j) b[j] = Jet(theta[t][j]);
-    }
-    for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
-      const auto [t, j] = parameter_of_[static_cast<std::size_t>(seeded[slot])];
-      blocks[static_cast<std::size_t>(t)][static_cast<std::size_t>(j)].v[slot] = 1.0;
-    }
-  };
-  // The terms `terms` applied at sample i (inputs differentiated if asked), on the linear
-  // stage's F and E as constants when they leave the linear stage out. `in` and `z` are a
-  // pass's own, kept from sample to sample (a 3 x 3 matrix of Jets is 81 values to set):
-  // every input is set anew; when the terms are split, F and E are set once (catalogue terms
-  // only read them; the linear stage's terms, first in stage_readers_, overwrite them) and
-  // the outputs zeroed; otherwise z starts afresh.
-  const Mat3T<Jet> F_jet = at_zero.F.cast<Jet>(), E_jet = at_zero.E.cast<Jet>();
-  auto start_pass = [&](model::SensorOutput<Jet>& z) {
-    if (!terms_split_) return;
-    z.F = F_jet;
-    z.E = E_jet;
-  };
-  auto predict = [&](std::size_t i, bool differentiate, const std::vector<int>& terms,
-                     model::SensorInput<Jet>& in, model::SensorOutput<Jet>& z) {
-    for (int k = 0; k < 3; ++k) {
-      in.f_b[k] = Jet(f[i][k]);
-      in.omega_b[k] = Jet(w[i][k]);
-      in.alpha_b[k] = Jet(s_.alpha_b[i][k]);
-      if (differentiate) {
-        in.f_b[k].v[k] = 1.0;
-        in.omega_b[k].v[3 + k] = 1.0;
-      }
-    }
-    in.dt_s = Jet(s_.dt_s[i]);
-    in.dtemp_c = Jet(s_.dtemp_c[i]);
-    if (terms_split_) {
-      z.acc.setZero();
-      z.gyr.setZero();
-    } else {
-      z = model::SensorOutput<Jet>();
-    }
-    for (int t : terms) {
-      model_->terms()[static_cast<std::size_t>(t)].effect->Apply(ptr[static_cast<std::size_t>(t)], in, z);
-    }
-  };
-
-  // The rate rows of -D_x^-1 per sample, M = d w / d p, how w moves when p is added to the
-  // predicted outputs (3 x 6; without accelerometer terms f is the output itself: d f = 0).
-  // With D_x = [A B; C D] (A = d y_a / d f ~ F, D ~ E) and S = D - C A^-1 B:
-  // M = [S^-1 C A^-1, -S^-1].
-  std::vector<Eigen::Matrix<double, 3, 6>> dw_dp(n);
-  set_theta({});
-  bool coupled = false;  // some output depends on the other sensor's input
-  const std::vector<int>& input_terms = terms_split_ ? catalogue_terms_ : all_terms_;
-  model::SensorInput<Jet> in;
-  model::SensorOutput<Jet> z;
-  start_pass(z);
-  for (std::size_t i = 0; i < n; ++i) {
-    Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Zero();
-    if (terms_split_) {
-      if (a_term >= 0) D.topLeftCorner<3, 3>() = at_zero.F;
-      if (g_term >= 0) D.bottomRightCorner<3, 3>() = at_zero.E;
-    }
-    if (!input_terms.empty()) {
-      predict(i, true, input_terms, in, z);
+  TermJets jets(*model_, theta, parameter_of_, terms_split_, at_zero, s_, f, w);
+  bool coupled = false;
+  std::vector<Eigen::Matrix<double, 3, 6>> dw_dp = RateRowsOfInverse(
+      *model_, terms_split_, terms_split_ ? catalogue_terms_ : all_terms_, at_zero, n, jets,
+      &coupled);
+  const bool linear_closed = terms_split_ && stage_readers_.empty();
+  // Stored: the other terms' columns alone when the linear stage's are closed-form (they come
+  // first in block order), else every column.
+  const int first = linear_closed ? (catalogue_terms_.empty() ? num_model_parameters_
+                                                              : block_offset_[static_cast<std::size_t>(catalogue_terms_.front())])
+                                  : 0;
+  W.Reset(n, first, num_model_parameters_ - first);
+  for (const auto& [seeded, terms] : JetPasses(coupled, linear_closed)) {
+    jets.Start(seeded);
+    for (std::size_t i = 0; i < n; ++i) {
+      const model::SensorOutput<Jet>& z = jets.Predict(i, false, terms);
+      Eigen::Matrix<double, 6, kStride> D_theta;
       for (int r = 0; r < 3; ++r) {
-        D.row(r) += z.acc[r].v.head<6>().transpose();
-        D.row(3 + r) += z.gyr[r].v.head<6>().transpose();
+        D_theta.row(r) = z.acc[r].v.transpose();  // zero without accelerometer terms
+        D_theta.row(3 + r) = z.gyr[r].v.transpose();
+      }
+      const Eigen::Matrix<double, 3, kStride> dw = dw_dp[i] * D_theta;
+      for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
+        W[i].col(seeded[slot] - first) = dw.col(static_cast<Eigen::Index>(slot));
       }
     }
-    if (!accel) D.topRows<3>() << Mat3::Identity(), Mat3::Zero();
-    coupled = coupled || !D.block<3, 3>(3, 0).isZero(0.0) || !D.block<3, 3>(0, 3).isZero(0.0);
-    const Mat3 A_inv = D.topLeftCorner<3, 3>().inverse();
-    const Mat3 S_inv =
-        (D.bottomRightCorner<3, 3>() - D.bottomLeftCorner<3, 3>() * A_inv * D.topRightCorner<3, 3>())
-            .inverse();
-    dw_dp[i] << S_inv * D.bottomLeftCorner<3, 3>() * A_inv, -S_inv;
   }
+  // The linear stage in closed form (applied by Evaluate through d w / d p).
+  if (linear_closed) W.SetLinearStage(std::move(dw_dp), f, coupled);
+}
+
+std::vector<std::pair<std::vector<int>, std::vector<int>>> MotionResidual::JetPasses(
+    bool coupled, bool linear_closed) const {
+  constexpr std::size_t kStride = model::kJetStride;
   // The parameters that can move the rates: with the sensors uncoupled at every sample, D_x is
   // block diagonal and the accelerometer's terms (which write y_a alone) leave w alone: their
   // columns stay zero without a pass.
@@ -316,7 +379,6 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
     return coupled ||
            model_->terms()[static_cast<std::size_t>(t)].effect->info().sensor == model::Sensor::kGyro;
   };
-  // Jet passes: (parameters seeded, terms applied).
   std::vector<std::pair<std::vector<int>, std::vector<int>>> passes;
   auto add_passes = [&](const std::vector<int>& params, const std::vector<int>& terms) {
     for (std::size_t first = 0; first < params.size(); first += kStride) {
@@ -335,37 +397,13 @@ void MotionResidual::ImplicitRateJacobians(double const* const* theta,
     }
     return params;
   };
-  const bool linear_closed = terms_split_ && stage_readers_.empty();
-  // Stored: the other terms' columns alone when the linear stage's are closed-form (they come
-  // first in block order), else every column.
-  const int first = linear_closed ? (catalogue_terms_.empty() ? num_model_parameters_
-                                                              : block_offset_[static_cast<std::size_t>(catalogue_terms_.front())])
-                                  : 0;
-  W.Reset(n, first, num_model_parameters_ - first);
   if (!terms_split_) {
     add_passes(params_of(all_terms_), all_terms_);
   } else {
     for (int t : catalogue_terms_) add_passes(params_of({t}), {t});
     if (!linear_closed) add_passes(params_of(linear_terms_), stage_readers_);
   }
-  for (const auto& [seeded, terms] : passes) {
-    set_theta(seeded);
-    start_pass(z);
-    for (std::size_t i = 0; i < n; ++i) {
-      predict(i, false, terms, in, z);
-      Eigen::Matrix<double, 6, kStride> D_theta;
-      for (int r = 0; r < 3; ++r) {
-        D_theta.row(r) = z.acc[r].v.transpose();  // zero without accelerometer terms
-        D_theta.row(3 + r) = z.gyr[r].v.transpose();
-      }
-      const Eigen::Matrix<double, 3, kStride> dw = dw_dp[i] * D_theta;
-      for (std::size_t slot = 0; slot < seeded.size(); ++slot) {
-        W[i].col(seeded[slot] - first) = dw.col(static_cast<Eigen::Index>(slot));
-      }
-    }
-  }
-  // The linear stage in closed form (applied by Evaluate through d w / d p).
-  if (linear_closed) W.SetLinearStage(std::move(dw_dp), f, coupled);
+  return passes;
 }
 
 bool MotionResidual::EvaluateUncached(double const* const* parameters, double* residuals,

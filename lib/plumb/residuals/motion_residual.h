@@ -163,6 +163,13 @@ class MotionResidual final : public CachedCostFunction {
                              const model::SensorOutput<double>& at_zero,
                              const std::vector<Vec3>& f, const std::vector<Vec3>& w,
                              RateJacobians& W) const;
+  /// The Jet passes of ImplicitRateJacobians: (parameters seeded, at most model::kJetStride of
+  /// the P; the terms applied), one per kJetStride parameters of a term that can move the
+  /// rates (`coupled`: the sensors' inputs are coupled somewhere, so accelerometer terms can),
+  /// through that term alone when the terms are split, and the linear stage's with the terms
+  /// that read it unless it is closed-form (`linear_closed`).
+  std::vector<std::pair<std::vector<int>, std::vector<int>>> JetPasses(bool coupled,
+                                                                       bool linear_closed) const;
 
   const model::Model* model_;
   SharedMotionSamples samples_;  // shared with the other problems built on the same samples
