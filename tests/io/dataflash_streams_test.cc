@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "dataflash_builder.h"
@@ -81,6 +83,32 @@ TEST(DataflashStreams, AccAndGyrArePairedOnlyWhenTheirTimesMatch) {
   one.stream = "GYR";
   testing::ExpectInputError([&] { DataflashStream(log, one); }, "raw.bin", "",
                             {"gyroscope samples only", "select IMU"});
+}
+
+// PARM: the last value of each name wins, a name filling its 16 characters (no NUL) included;
+// a reader told not to keep PARM collects no parameters (and does not fail).
+TEST(DataflashStreams, ParametersTakeTheLastValueOfEachName) {
+  Bytes log = FmtRecord(129, 3 + 16 + 4, "PARM", "Nf", "Name,Value");
+  const auto parm = [&](const std::string& name, float value) {
+    Bytes r = {0xA3, 0x95, 129};
+    PutFixed(&r, name, 16);
+    Put<float>(&r, value);
+    Append(&log, r);
+  };
+  parm("INS_ACCOFFS_X", 0.5f);
+  parm("SIXTEEN_CHARS_AB", 1.0f);
+  parm("INS_ACCOFFS_X", 0.25f);
+  parm("SIXTEEN_CHARS_AB", 2.0f);
+  parm("INS_ACCOFFS_Y", -1.0f);
+  const DataflashLog d = ParseDataflash(log.data(), log.size(), "parm.bin");
+  const std::map<std::string, double> expected = {
+      {"INS_ACCOFFS_X", 0.25}, {"INS_ACCOFFS_Y", -1.0}, {"SIXTEEN_CHARS_AB", 2.0}};
+  EXPECT_EQ(d.params, expected);
+  RecordFilter no_parm;
+  no_parm.keep = [](std::string_view name) { return name != "PARM"; };
+  const DataflashLog without = ParseDataflash(log.data(), log.size(), "parm.bin", no_parm);
+  EXPECT_TRUE(without.params.empty());
+  EXPECT_EQ(without.Find("PARM")->rows, 5u);
 }
 
 TEST(DataflashStreams, StreamsSayWhatArduPilotAppliedAndWhetherItCanBeUndone) {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -109,6 +110,31 @@ TEST(LogCommon, ReadForwardJumpsAndGrowsItsBuffer) {
   EXPECT_EQ(offsets.front(), 0u);
   EXPECT_EQ(offsets[offsets.size() - 2], 0u);
   EXPECT_EQ(offsets.back(), std::size_t{5} << 20);  // the bytes in between never handed over
+}
+
+// A log cut short while it is read (copied over, or a card failing) is a read error naming
+// the file and the byte, not a SIGBUS from touching a mapped page past the new end.
+TEST(LogCommon, ReadForwardReportsAFileCutShortWhileItIsRead) {
+  ::plumb::testing::TempDir dir;
+  const std::vector<std::uint8_t> file = Pattern(std::size_t{6} << 20);
+  const std::string path = WriteFile(dir, file);
+  constexpr std::size_t kCut = std::size_t{1} << 20;
+  std::size_t handed = 0;  // bytes handed over, all of them before the cut
+  try {
+    ReadForward(path, "test log", 16,
+                [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+                  if (offset == 0) std::filesystem::resize_file(path, kCut);
+                  EXPECT_EQ(std::memcmp(data, file.data() + offset, n), 0);
+                  handed = offset + n;
+                  return at_end ? offset + n : offset + n - 16;
+                });
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find("read failed before the end of the file"), std::string::npos) << what;
+    EXPECT_LE(handed, std::size_t{6} << 20);
+  }
 }
 
 TEST(LogCommon, ReadForwardNamesAMissingFile) {

@@ -109,12 +109,16 @@ class ImuDecoder {
     }
     d.last_time = raw_t;
     ++d.records;
-    if (d.pending) Decide(d, d.pending_t_s < t_s);
-    d.pending = true;
-    d.pending_t_s = t_s;
-    d.pending_acc = Axes(body, acc_);
-    if (has_gyr_) d.pending_gyr = Axes(body, gyr_);
-    if (has_temp_) d.pending_temp = static_cast<float>(temp_.Read(body));
+    ImuSeries& s = d.series;
+    if (d.last_on_trial && !(s.t_s.back() < t_s)) PopBack(s);  // it was a spike
+    // Kept for now when its time is finite and above the last kept sample's; its fate is
+    // sealed by the next record's time (ImuFromDataflash's rule).
+    d.last_on_trial = std::isfinite(t_s) && (s.t_s.empty() || t_s > s.t_s.back());
+    if (!d.last_on_trial) return;
+    s.t_s.push_back(t_s);
+    s.acc.push_back(Axes(body, acc_));
+    if (has_gyr_) s.gyr.push_back(Axes(body, gyr_));
+    if (has_temp_) s.temp_c.push_back(static_cast<float>(temp_.Read(body)));
   }
 
   /// The three columns `c` of `body` as floats: Read() cast to float, or (float_axes_, the
@@ -130,12 +134,9 @@ class ImuDecoder {
                  static_cast<float>(c[2].Read(body)));
   }
 
-  /// After the last record: decides every instance's waiting record.
+  /// After the last record: every instance's last sample stays (no record follows it).
   void Finish(DataflashType& t) const {
-    for (DataflashImuDecoded& d : t.imu) {
-      if (d.pending) Decide(d, true);
-      d.pending = false;
-    }
+    for (DataflashImuDecoded& d : t.imu) d.last_on_trial = false;
   }
 
  private:
@@ -154,17 +155,12 @@ class ImuDecoder {
     if (has_temp_) AdviseHugePages(s.temp_c.data(), rows_bound_ * sizeof(float));
   }
 
-  /// ImuFromDataflash's rule for the waiting record: kept when its time is finite, above the
-  /// last kept sample's and (`below_next`) below the next record's.
-  void Decide(DataflashImuDecoded& d, bool below_next) const {
-    ImuSeries& s = d.series;
-    if (!std::isfinite(d.pending_t_s)) return;
-    if (!s.t_s.empty() && !(d.pending_t_s > s.t_s.back())) return;
-    if (!below_next) return;
-    s.t_s.push_back(d.pending_t_s);
-    s.acc.push_back(d.pending_acc);
-    if (has_gyr_) s.gyr.push_back(d.pending_gyr);
-    if (has_temp_) s.temp_c.push_back(d.pending_temp);
+  /// Takes the last sample out of `s`.
+  void PopBack(ImuSeries& s) const {
+    s.t_s.pop_back();
+    s.acc.pop_back();
+    if (has_gyr_) s.gyr.pop_back();
+    if (has_temp_) s.temp_c.pop_back();
   }
 
   detail::DataflashColumnReader time_, acc_[3], gyr_[3], temp_, instance_;
@@ -546,6 +542,15 @@ std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log) {
   return out;
 }
 
+const ImuSeries* DecodedDataflashImu(const DataflashLog& log, int instance) {
+  int col = -1;
+  const DataflashType* t = instance >= 0 ? ImuType(log, instance, &col) : nullptr;
+  if (t == nullptr || !t->imu_decoded) return nullptr;
+  const std::size_t k = col >= 0 ? static_cast<std::size_t>(instance) : 0;
+  if (k >= t->imu.size() || t->imu[k].records == 0) return nullptr;
+  return &t->imu[k].series;
+}
+
 ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
   int instance_col = -1;
   const DataflashType* type = instance >= 0 ? ImuType(log, instance, &instance_col) : nullptr;
@@ -570,12 +575,9 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
                          " rows: no IMU samples were logged (LOG_BITMASK without IMU?)");
   }
   if (type->imu_decoded) {  // decoded by the reader, with the rule below
-    const std::size_t k = instance_col >= 0 ? static_cast<std::size_t>(instance) : 0;
-    if (k >= type->imu.size() || type->imu[k].records == 0) {
-      throw InputError(log.source, "", "no " + type->name + " rows with I == " +
-                                           std::to_string(instance) + " for " + what);
-    }
-    return CopySeries(type->imu[k].series);
+    if (const ImuSeries* decoded = DecodedDataflashImu(log, instance)) return CopySeries(*decoded);
+    throw InputError(log.source, "", "no " + type->name + " rows with I == " +
+                                         std::to_string(instance) + " for " + what);
   }
   if (!type->bodies_kept) NotKept(type->name);
   using Reader = detail::DataflashColumnReader;

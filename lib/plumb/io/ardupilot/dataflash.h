@@ -70,12 +70,10 @@ struct DataflashImuDecoded {
   /// The samples ImuFromDataflash gives for this instance (its rule for times applied), in
   /// the log's units; read by ImuFromDataflash and DataflashImuInstances.
   ImuSeries series;
-  // The reader's state: the last record, whose fate waits for the next record's time.
-  bool pending = false;       ///< a record is waiting
-  double pending_t_s = 0.0;   ///< its time, s
-  Vec3f pending_acc = Vec3f::Zero();  ///< its AccX/Y/Z
-  Vec3f pending_gyr = Vec3f::Zero();  ///< its GyrX/Y/Z (when the message has them)
-  float pending_temp = 0.0f;  ///< its T or Temp (when the message has one)
+  /// The reader's state: the last sample of `series` is this instance's last record, kept
+  /// only if the next record's time is above its own (else taken out again); false after the
+  /// last record.
+  bool last_on_trial = false;
 };
 
 /// All records of one message type.
@@ -216,6 +214,12 @@ std::vector<DataflashImuInfo> DataflashImuInstances(const DataflashLog& log);
 /// plumb::InputError naming the log when the instance has no samples or the message lacks a
 /// time or Acc column.
 ImuSeries ImuFromDataflash(const DataflashLog& log, int instance);
+
+/// The samples of IMU instance `instance` as the binary reader decoded them in its pass
+/// (RecordFilter::decode; DataflashType::imu), by reference: the samples ImuFromDataflash
+/// returns a copy of. nullptr when the reader kept that message's bodies instead (a text log,
+/// a filter without decode) or the instance has no records.
+const ImuSeries* DecodedDataflashImu(const DataflashLog& log, int instance);
 
 /// Every IMU stream of a DataFlash log (binary or text), in this order per instance:
 ///  * "IMU" (rows with I == k) or "IMU", "IMU2", "IMU3" (k = 0, 1, 2): accelerometer and

@@ -4,8 +4,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <map>
+#include <set>
 #include <string>
+#include <string_view>
+#include <tuple>
 #include <unordered_set>
 #include <vector>
 
@@ -61,6 +65,15 @@ std::vector<std::string> SplitColumns(const std::string& text) {
 
 /// Fills column units and multipliers from FMTU (FmtType, UnitIds, MultIds), UNIT (Id, Label)
 /// and MULT (Id, Mult), when the log has them.
+/// The text of n/N/Z column `col` of record `row` of `t` up to its first NUL, viewed where the
+/// body is stored (as DataflashType::Text, without a copy); empty for other columns.
+std::string_view TextView(const DataflashType& t, std::size_t row, int col) {
+  const DataflashColumn& c = t.columns[static_cast<std::size_t>(col)];
+  if (DataflashFormat(c.format).storage != DataflashStorage::kText) return {};
+  const auto* p = reinterpret_cast<const char*>(t.bodies.Row(row) + c.offset);
+  return {p, strnlen(p, c.size)};
+}
+
 void ApplyUnits(DataflashLog* log) {
   const DataflashType* fmtu = log->Find("FMTU");
   if (fmtu == nullptr) return;
@@ -98,28 +111,23 @@ void ApplyUnits(DataflashLog* log) {
   for (auto t = log->types.rbegin(); t != log->types.rend(); ++t) by_id[t->id] = &*t;
   // A row applied twice changes nothing and a later row wins where two set a column, so only
   // the last of identical rows is applied, in log order (a log repeats its FMTU rows).
-  struct Row {
-    DataflashType* type;
-    std::string unit_ids, mult_ids;
-  };
-  std::vector<Row> last_rows;
-  std::unordered_set<std::string> seen;
+  if (!fmtu->bodies_kept) return;
+  using Row = std::tuple<std::uint8_t, std::string_view, std::string_view>;  // id, units, mults
+  std::vector<std::pair<DataflashType*, Row>> last_rows;
+  std::set<Row> seen;
   for (std::size_t r = fmtu->rows; r-- > 0;) {
     const double type_id = fmtu->Value(r, type_col);
     if (!(type_id >= 0 && type_id < 256) || type_id != std::floor(type_id)) continue;
     DataflashType* const it = by_id[static_cast<std::size_t>(type_id)];
     if (it == nullptr) continue;
-    std::string unit_ids = unit_col >= 0 ? fmtu->Text(r, unit_col) : "";
-    std::string mult_ids = mult_col >= 0 ? fmtu->Text(r, mult_col) : "";
-    // Texts end at their first NUL, so NUL separates the parts of the key.
-    std::string key = std::to_string(it->id) + '\0' + unit_ids + '\0' + mult_ids;
-    if (!seen.insert(std::move(key)).second) continue;
-    last_rows.push_back({it, std::move(unit_ids), std::move(mult_ids)});
+    const Row row{it->id, unit_col >= 0 ? TextView(*fmtu, r, unit_col) : std::string_view(),
+                  mult_col >= 0 ? TextView(*fmtu, r, mult_col) : std::string_view()};
+    if (seen.insert(row).second) last_rows.push_back({it, row});
   }
   for (auto row = last_rows.rbegin(); row != last_rows.rend(); ++row) {
-    DataflashType* const it = row->type;
-    const std::string& unit_ids = row->unit_ids;
-    const std::string& mult_ids = row->mult_ids;
+    DataflashType* const it = row->first;
+    const std::string_view unit_ids = std::get<1>(row->second);
+    const std::string_view mult_ids = std::get<2>(row->second);
     for (std::size_t c = 0; c < it->columns.size(); ++c) {
       if (c < unit_ids.size() && units.count(unit_ids[c])) it->columns[c].unit = units[unit_ids[c]];
       if (c < mult_ids.size() && mults.count(mult_ids[c])) {
@@ -135,13 +143,13 @@ void CollectParams(DataflashLog* log) {
   const int name = parm->ColumnIndex("Name");
   const int value = parm->ColumnIndex("Value");
   if (name < 0 || value < 0) return;
+  if (!parm->bodies_kept) return;  // the reader's RecordFilter left them out
   // The last value of each name wins: from the last row back, the first one met is kept.
-  std::unordered_set<std::string> seen;
+  std::unordered_set<std::string_view> seen;
   for (std::size_t r = parm->rows; r-- > 0;) {
-    std::string key = parm->Text(r, name);
-    if (seen.count(key) != 0) continue;
-    log->params.emplace(key, parm->Value(r, value));
-    seen.insert(std::move(key));
+    const std::string_view key = TextView(*parm, r, name);
+    if (!seen.insert(key).second) continue;
+    log->params.emplace(std::string(key), parm->Value(r, value));
   }
 }
 

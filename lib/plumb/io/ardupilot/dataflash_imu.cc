@@ -348,13 +348,7 @@ ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref, const ImuS
 /// The samples the reader decoded for IMU stream `ref` (DataflashType::imu), or nullptr when
 /// it did not (they are then read from bodies).
 const ImuSeries* DecodedImu(const DataflashLog& log, const StreamRef& ref) {
-  if (ref.kind != Kind::kImu) return nullptr;
-  int col = -1;
-  const DataflashType* t = DataflashInstanceMessage(log, "IMU", ref.instance, false, &col);
-  if (t == nullptr || !t->imu_decoded) return nullptr;
-  const std::size_t k = col >= 0 ? static_cast<std::size_t>(ref.instance) : 0;
-  if (k >= t->imu.size() || t->imu[k].records == 0) return nullptr;  // as ImuFromDataflash
-  return &t->imu[k].series;
+  return ref.kind == Kind::kImu ? DecodedDataflashImu(log, ref.instance) : nullptr;
 }
 
 ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref) {

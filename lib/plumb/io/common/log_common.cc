@@ -96,6 +96,101 @@ struct FdCloser {
   ~FdCloser() { ::close(fd); }
 };
 
+/// Bytes behind the parser after which a mapped file's pages are dropped from this process's
+/// memory (MADV_DONTNEED): 2 MiB, so that a few MiB of it are resident at a time.
+constexpr std::size_t kDropStep = std::size_t{2} << 20;
+
+/// A whole regular file mapped read-only. Before the parser gets a span, the file's size is
+/// checked and the span's new pages read in with MADV_POPULATE_READ, which reports a read
+/// error (a failing card) as an error: touching a page that cannot be read, or one past the
+/// end of a file cut short meanwhile, would raise SIGBUS instead.
+class ForwardMapping {
+ public:
+  ForwardMapping(int fd, std::size_t size) : fd_(fd), size_(size) {
+    if (size == 0) return;
+    void* m = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (m == MAP_FAILED) return;
+    base_ = static_cast<std::uint8_t*>(m);
+    ::madvise(base_, size, MADV_SEQUENTIAL);  // a hint: errors ignored
+  }
+  ~ForwardMapping() {
+    if (base_ != nullptr) ::munmap(base_, size_);
+  }
+  ForwardMapping(const ForwardMapping&) = delete;
+  ForwardMapping& operator=(const ForwardMapping&) = delete;
+
+  const std::uint8_t* data() const { return base_; }
+
+  /// Makes the bytes [0, to) safe to touch: the file still holds them (fstat; a file cut
+  /// short meanwhile would raise SIGBUS there) and the pages not read in yet are read in
+  /// (MADV_POPULATE_READ). Returns 0, or errno: EINVAL when this kernel cannot populate
+  /// (before Linux 5.14), EFAULT when the file is now shorter than `to`, else the read error.
+  int Prepare(std::size_t to) {
+    if (base_ == nullptr) return EINVAL;
+#ifdef MADV_POPULATE_READ
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) return errno;
+    if (static_cast<std::size_t>(st.st_size) < to) return EFAULT;
+    if (to <= populated_) return 0;
+    const std::size_t begin = populated_ / Page() * Page();
+    if (::madvise(base_ + begin, to - begin, MADV_POPULATE_READ) != 0) return errno;
+    populated_ = to;
+    return 0;
+#else
+    (void)to;
+    return EINVAL;
+#endif
+  }
+
+  /// Drops the whole pages before byte `up_to` from this process's memory, every kDropStep
+  /// bytes (the page cache keeps them; the parser never goes back).
+  void DropBefore(std::size_t up_to) {
+    if (up_to < dropped_ + kDropStep) return;
+    const std::size_t end = up_to / Page() * Page();
+    ::madvise(base_ + dropped_, end - dropped_, MADV_DONTNEED);  // errors ignored: memory only
+    dropped_ = end;
+  }
+
+ private:
+  static std::size_t Page() { return static_cast<std::size_t>(::sysconf(_SC_PAGESIZE)); }
+
+  int fd_ = -1;                ///< the file, open while this lives
+  std::uint8_t* base_ = nullptr;
+  std::size_t size_ = 0;
+  std::size_t populated_ = 0;  ///< bytes [0, populated_) were read in
+  std::size_t dropped_ = 0;    ///< pages before this byte were dropped
+};
+
+using ForwardConsumer =
+    std::function<std::size_t(const std::uint8_t*, std::size_t, std::size_t, bool)>;
+
+/// ReadForward over a mapped file (see ForwardMapping): each call gets `span` bytes of the
+/// mapping from the offset the last one returned, as the read(2) loop would hand them.
+void ConsumeMapped(ForwardMapping& map, std::size_t size, std::size_t span,
+                   const std::string& path, const ForwardConsumer& consume) {
+  std::size_t at = 0;  // file offset of the next call's first byte
+  while (true) {
+    const std::size_t n = std::min(span, size - at);
+    if (const int error = map.Prepare(at + n); error != 0) {
+      throw InputError(path, "byte " + std::to_string(at),
+                       std::string("read failed before the end of the file: ") +
+                           (error == EFAULT ? "the file is shorter than when it was opened "
+                                              "(cut or replaced while it was read)"
+                                            : std::strerror(error)));
+    }
+    const bool at_end = at + n >= size;
+    const std::size_t next = consume(map.data() + at, n, at, at_end);
+    if (at_end) return;
+    if (next < at) throw Error("ReadForward: the parser of " + path + " went backwards");
+    if (next == at) {  // nothing consumed from a full span: hand over more
+      span *= 2;
+      continue;
+    }
+    at = std::min(next, size);  // at the end: one more call, with no bytes and at_end
+    map.DropBefore(at);
+  }
+}
+
 }  // namespace
 
 void AdviseHugePages(const void* p, std::size_t bytes) {
@@ -162,6 +257,11 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
   ::posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);
   const auto size = static_cast<std::size_t>(st.st_size);
   std::size_t capacity = lookahead + kReadChunk;
+  if (ForwardMapping map(fd, size); map.Prepare(std::min(size, capacity)) == 0) {
+    ConsumeMapped(map, size, capacity, path, consume);
+    return;
+  }
+  // Not mappable, or no MADV_POPULATE_READ to read a mapping safely: read(2) into a buffer.
   std::vector<std::uint8_t> buffer(capacity);
   std::size_t base = 0;  // file offset of buffer[0]
   std::size_t have = 0;  // bytes of the file in buffer

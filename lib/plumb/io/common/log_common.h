@@ -67,10 +67,14 @@ T LoadLittleEndian(const std::uint8_t* p) {
   return v;
 }
 
-/// Reads the file at `path` forward in chunks with read(2) into one reusable buffer (never
-/// mapped, never held whole: the page cache is copied from as `cat` does, without the page
-/// faults and TLB misses of walking a mapping), for parsers that decide at each position from
-/// a bounded look-ahead. `consume(data, n, offset, at_end)` gets the bytes [offset, offset + n)
+/// Reads the file at `path` forward, span by span, for parsers that decide at each position
+/// from a bounded look-ahead. A regular file is mapped read-only and each span's pages are
+/// read in (madvise MADV_POPULATE_READ) just before the parser gets them, so that a read
+/// error or a file cut short meanwhile is an InputError, never a SIGBUS; the pages the parser
+/// has passed are dropped from this process's memory every 2 MiB (never held whole, no copy
+/// of the page cache). Without MADV_POPULATE_READ (Linux before 5.14), or when the file
+/// cannot be mapped, it is read with read(2) into one reusable buffer the same way.
+/// `consume(data, n, offset, at_end)` gets the bytes [offset, offset + n)
 /// of the file (`at_end`: they reach its end) and returns the file offset it needs the bytes
 /// from next, in [offset, offset + n] or beyond (a forward jump: the bytes in between are not
 /// read). The bytes from that offset to offset + n are passed again at the start of the next

@@ -92,19 +92,23 @@ std::string InfoText(const KeyValue& kv) {
   return out;
 }
 
-/// The "timestamp" field of the message body `body` of `t`, us (uint8 timestamps are
-/// milliseconds by the format); 0 when the topic has none.
-std::uint64_t TimestampOf(const ULogTopic& t, const std::uint8_t* body) {
-  if (t.timestamp_col < 0) return 0;
-  const ULogColumn& c = t.columns[static_cast<std::size_t>(t.timestamp_col)];
-  const std::uint8_t* p = body + c.offset;
-  switch (c.type) {
+/// A "timestamp" field of type `type` stored at `p`, us (uint8 timestamps are milliseconds by
+/// the format; other types: 0).
+std::uint64_t TimestampAt(const std::uint8_t* p, ULogType type) {
+  switch (type) {
     case ULogType::kUInt64: return LoadLittleEndian<std::uint64_t>(p);
     case ULogType::kUInt32: return LoadLittleEndian<std::uint32_t>(p);
     case ULogType::kUInt16: return LoadLittleEndian<std::uint16_t>(p);
     case ULogType::kUInt8: return std::uint64_t{LoadLittleEndian<std::uint8_t>(p)} * 1000u;
     default: return 0;
   }
+}
+
+/// The "timestamp" field of the message body `body` of `t`, us; 0 when the topic has none.
+std::uint64_t TimestampOf(const ULogTopic& t, const std::uint8_t* body) {
+  if (t.timestamp_col < 0) return 0;
+  const ULogColumn& c = t.columns[static_cast<std::size_t>(t.timestamp_col)];
+  return TimestampAt(body + c.offset, c.type);
 }
 
 /// A value asked of a topic whose bodies the reader's RecordFilter left out: a caller's bug.
@@ -223,6 +227,7 @@ class Parser {
         pos_ = std::max(pos_, size_);
         return;
       }
+      if (!resync_ && DataMessage()) continue;
       if (!at_end && !Held(pos_)) return;
       if (resync_) {
         if (!ResyncPoint(pos_, end_)) {
@@ -297,8 +302,8 @@ class Parser {
         if (end - pos < kMsgHeaderSize + 2) return false;  // truncated: the caller decides
         const int idx = Index(LoadLittleEndian<std::uint16_t>(At(pos) + kMsgHeaderSize));
         if (idx < 0) return false;
-        const ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
-        return size - 2 < t.body_size || size - 2 > t.full_size;
+        const DataEntry& e = data_entries_[static_cast<std::size_t>(idx)];
+        return size - 2 < e.body_size || size - 2 > e.full_size;
       }
       case 'S':
         return size != sizeof(kSyncMagic) ||
@@ -343,6 +348,25 @@ class Parser {
     return true;
   }
 
+  /// The common case, taken before the general checks of Run: a D message of a subscribed
+  /// topic with a fitting size, whole in the bytes held and in the segment (what Run would
+  /// find it to be after Held, Corrupt and the size check). True when it was one, and read.
+  bool DataMessage() {
+    if (pos_ + kMsgHeaderSize + 2 > std::min(avail_, end_)) return false;
+    const std::uint8_t* p = At(pos_);
+    const std::size_t size = LoadLittleEndian<std::uint16_t>(p);
+    if (p[2] != 'D' || size < 2 || size > std::min(avail_, end_) - pos_ - kMsgHeaderSize) {
+      return false;
+    }
+    const int idx = Index(LoadLittleEndian<std::uint16_t>(p + kMsgHeaderSize));
+    if (idx < 0) return false;
+    const DataEntry& e = data_entries_[static_cast<std::size_t>(idx)];
+    if (size - 2 < e.body_size || size - 2 > e.full_size) return false;
+    pos_ += kMsgHeaderSize + size;
+    Data(static_cast<std::size_t>(idx), p + kMsgHeaderSize + 2);
+    return true;
+  }
+
   void Data(const std::uint8_t* body, std::size_t size) {
     const std::uint16_t msg_id = LoadLittleEndian<std::uint16_t>(body);
     const int idx = Index(msg_id);
@@ -350,18 +374,23 @@ class Parser {
       ++log_->warnings.unknown_msg_id_messages;
       return;
     }
-    ULogTopic& t = log_->topics[static_cast<std::size_t>(idx)];
     (void)size;  // checked by Corrupt(): body_size <= size - 2 <= full_size
-    t.last_timestamp_us = TimestampOf(t, body + 2);
+    Data(static_cast<std::size_t>(idx), body + 2);
+  }
+
+  /// A D message of topic `idx` whose fields start at `fields`.
+  void Data(std::size_t idx, const std::uint8_t* fields) {
+    ULogTopic& t = log_->topics[idx];
+    t.last_timestamp_us = data_entries_[idx].Timestamp(fields);
     if (t.bodies_kept) {
-      t.bodies.Append(body + 2);
+      t.bodies.Append(fields);
     } else if (t.imu_decoded) {
       const CombinedDecoder& d = decoders_[static_cast<std::size_t>(idx)];
       if (t.rows == 0 && t.body_size > 0) {  // at most one sample per remaining message
         const std::size_t rest = size_ > pos_ ? size_ - pos_ : 0;
         CombinedDecoder::Reserve(t.imu, std::min(rest / (t.body_size + 5) + 1, kMaxReserve));
       }
-      d.Add(t.imu, body + 2);
+      d.Add(t.imu, fields);
     }
     ++t.rows;
   }
@@ -505,6 +534,7 @@ class Parser {
       return;
     }
     Keep(&t, log_->topics.size());
+    data_entries_.push_back(DataEntry::Of(t));
     if (index_.size() <= t.msg_id) index_.resize(std::size_t{t.msg_id} + 1, -1);
     index_[t.msg_id] = static_cast<int>(log_->topics.size());
     log_->topics.push_back(std::move(t));
@@ -547,6 +577,33 @@ class Parser {
   ULog* log_;
   const RecordFilter& filter_;
   std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
+  /// What the loop reads of each topic for its D messages, by topic index: a small entry
+  /// instead of the topic and its column list.
+  struct DataEntry {
+    std::size_t body_size = 0;  ///< ULogTopic::body_size
+    std::size_t full_size = 0;  ///< ULogTopic::full_size
+    bool has_timestamp = false;  ///< the topic has a top-level "timestamp" column
+    ULogType timestamp_type = ULogType::kUInt64;  ///< its type
+    std::size_t timestamp_offset = 0;  ///< its offset in the body
+
+    static DataEntry Of(const ULogTopic& t) {
+      DataEntry e;
+      e.body_size = t.body_size;
+      e.full_size = t.full_size;
+      if (t.timestamp_col >= 0) {
+        const ULogColumn& c = t.columns[static_cast<std::size_t>(t.timestamp_col)];
+        e.has_timestamp = true;
+        e.timestamp_type = c.type;
+        e.timestamp_offset = c.offset;
+      }
+      return e;
+    }
+    /// TimestampOf(the topic, body).
+    std::uint64_t Timestamp(const std::uint8_t* body) const {
+      return has_timestamp ? TimestampAt(body + timestamp_offset, timestamp_type) : 0;
+    }
+  };
+  std::vector<DataEntry> data_entries_;
   detail::ULogFormatResolver resolver_;
   bool in_definitions_ = true;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
