@@ -131,17 +131,21 @@ class CombinedDecoder {
         (!Triad(t, "gyro_rad", d.gyr_) && !Triad(t, "gyro_rad_s", d.gyr_))) {
       return std::nullopt;
     }
+    const auto is_float = [](const ULogColumn* c) {
+      return c[0].type == ULogType::kFloat && c[1].type == ULogType::kFloat &&
+             c[2].type == ULogType::kFloat;
+    };
+    d.float_triads_ = is_float(d.acc_) && is_float(d.gyr_);
     return d;
   }
 
   /// Decodes the message body `body` (after the msg_id) into `s`.
   void Add(ImuSeries& s, const std::uint8_t* body) const {
-    const Vec3f gyr = Read3(body, gyr_);
     const double t_s = DecodeULogValue(body + time_.offset, time_.type) * 1e-6;
     if (!std::isfinite(t_s) || (!s.t_s.empty() && !(t_s > s.t_s.back()))) return;
     s.t_s.push_back(t_s);
-    s.acc.push_back(Read3(body, acc_));
-    s.gyr.push_back(gyr);
+    s.acc.push_back(Triad3(body, acc_));
+    s.gyr.push_back(Triad3(body, gyr_));
   }
 
   /// Reserves `rows` samples of `s`, backed by huge pages where large.
@@ -170,7 +174,17 @@ class CombinedDecoder {
                                DecodeULogValue(body + c[2].offset, c[2].type)));
   }
 
+  /// Read3, or (float_triads_, the usual float[3] fields) the stored floats themselves: the
+  /// same values without the decoding switch and the round trip through double.
+  Vec3f Triad3(const std::uint8_t* body, const ULogColumn* c) const {
+    if (!float_triads_) return Read3(body, c);
+    return Vec3f(LoadLittleEndian<float>(body + c[0].offset),
+                 LoadLittleEndian<float>(body + c[1].offset),
+                 LoadLittleEndian<float>(body + c[2].offset));
+  }
+
   ULogColumn time_, acc_[3], gyr_[3];
+  bool float_triads_ = false;  ///< every accelerometer and gyroscope field is a float
 };
 
 /// The one-pass decoder state: fed the file's bytes in order, in one piece (ParseULog) or in
@@ -348,6 +362,39 @@ class Parser {
     return true;
   }
 
+  /// What the loop reads and counts of each topic for its D messages, by topic index: a
+  /// small entry instead of the topic and its column list (Finish copies the counts over).
+  struct DataEntry {
+    /// What the loop does with a message besides counting it.
+    enum class Action : std::uint8_t { kCount, kKeep, kDecode };
+    std::size_t body_size = 0;  ///< ULogTopic::body_size
+    std::size_t full_size = 0;  ///< ULogTopic::full_size
+    bool has_timestamp = false;  ///< the topic has a top-level "timestamp" column
+    ULogType timestamp_type = ULogType::kUInt64;  ///< its type
+    Action action = Action::kCount;
+    std::size_t timestamp_offset = 0;  ///< its offset in the body
+    std::size_t rows = 0;              ///< messages so far (ULogTopic::rows)
+    std::uint64_t last_timestamp_us = 0;  ///< the last one's (ULogTopic::last_timestamp_us)
+
+    static DataEntry Of(const ULogTopic& t) {
+      DataEntry e;
+      e.body_size = t.body_size;
+      e.full_size = t.full_size;
+      if (t.timestamp_col >= 0) {
+        const ULogColumn& c = t.columns[static_cast<std::size_t>(t.timestamp_col)];
+        e.has_timestamp = true;
+        e.timestamp_type = c.type;
+        e.timestamp_offset = c.offset;
+      }
+      e.action = t.bodies_kept ? Action::kKeep : t.imu_decoded ? Action::kDecode : Action::kCount;
+      return e;
+    }
+    /// TimestampOf(the topic, body).
+    std::uint64_t Timestamp(const std::uint8_t* body) const {
+      return has_timestamp ? TimestampAt(body + timestamp_offset, timestamp_type) : 0;
+    }
+  };
+
   /// The common case, taken before the general checks of Run: a D message of a subscribed
   /// topic with a fitting size, whole in the bytes held and in the segment (what Run would
   /// find it to be after Held, Corrupt and the size check). True when it was one, and read.
@@ -378,28 +425,45 @@ class Parser {
     Data(static_cast<std::size_t>(idx), body + 2);
   }
 
-  /// A D message of topic `idx` whose fields start at `fields`.
+  /// A D message of topic `idx` whose fields start at `fields`: counted and its timestamp
+  /// noted in the topic's entry; kept or decoded when the filter says so.
   void Data(std::size_t idx, const std::uint8_t* fields) {
-    ULogTopic& t = log_->topics[idx];
-    t.last_timestamp_us = data_entries_[idx].Timestamp(fields);
-    if (t.bodies_kept) {
-      t.bodies.Append(fields);
-    } else if (t.imu_decoded) {
-      const CombinedDecoder& d = decoders_[static_cast<std::size_t>(idx)];
-      if (t.rows == 0 && t.body_size > 0) {  // at most one sample per remaining message
-        const std::size_t rest = size_ > pos_ ? size_ - pos_ : 0;
-        CombinedDecoder::Reserve(t.imu, std::min(rest / (t.body_size + 5) + 1, kMaxReserve));
-      }
-      d.Add(t.imu, fields);
-    }
-    ++t.rows;
+    DataEntry& e = data_entries_[idx];
+    e.last_timestamp_us = e.Timestamp(fields);
+    if (e.action != DataEntry::Action::kCount) Store(idx, e, fields);
+    ++e.rows;
   }
 
+  /// Keeps the fields of a D message of topic `idx` (entry `e`), or decodes its samples. Out of
+  /// line, so that Data, which every message goes through, stays small enough to inline.
+  [[gnu::noinline]] void Store(std::size_t idx, const DataEntry& e, const std::uint8_t* fields) {
+    ULogTopic& t = log_->topics[idx];
+    if (e.action == DataEntry::Action::kKeep) {
+      t.bodies.Append(fields);
+      return;
+    }
+    if (e.rows == 0 && t.body_size > 0) {  // at most one sample per remaining message
+      const std::size_t rest = size_ > pos_ ? size_ - pos_ : 0;
+      CombinedDecoder::Reserve(t.imu, std::min(rest / (t.body_size + 5) + 1, kMaxReserve));
+    }
+    decoders_[idx].Add(t.imu, fields);
+  }
+
+ public:
+  /// After the last Feed: the topics get their message counts and last timestamps.
+  void Finish() {
+    for (std::size_t k = 0; k < data_entries_.size(); ++k) {
+      log_->topics[k].rows = data_entries_[k].rows;
+      log_->topics[k].last_timestamp_us = data_entries_[k].last_timestamp_us;
+    }
+  }
+
+ private:
   /// The newest timestamp among the last message of every topic, us (for parameter changes).
   std::uint64_t NewestTimestampUs() const {
     std::uint64_t newest = 0;
-    for (const ULogTopic& t : log_->topics) {
-      if (t.rows > 0) newest = std::max(newest, t.last_timestamp_us);
+    for (const DataEntry& e : data_entries_) {
+      if (e.rows > 0) newest = std::max(newest, e.last_timestamp_us);
     }
     return newest;
   }
@@ -577,32 +641,6 @@ class Parser {
   ULog* log_;
   const RecordFilter& filter_;
   std::vector<int> index_;  // msg_id -> topics index, -1 when not subscribed; grows with A
-  /// What the loop reads of each topic for its D messages, by topic index: a small entry
-  /// instead of the topic and its column list.
-  struct DataEntry {
-    std::size_t body_size = 0;  ///< ULogTopic::body_size
-    std::size_t full_size = 0;  ///< ULogTopic::full_size
-    bool has_timestamp = false;  ///< the topic has a top-level "timestamp" column
-    ULogType timestamp_type = ULogType::kUInt64;  ///< its type
-    std::size_t timestamp_offset = 0;  ///< its offset in the body
-
-    static DataEntry Of(const ULogTopic& t) {
-      DataEntry e;
-      e.body_size = t.body_size;
-      e.full_size = t.full_size;
-      if (t.timestamp_col >= 0) {
-        const ULogColumn& c = t.columns[static_cast<std::size_t>(t.timestamp_col)];
-        e.has_timestamp = true;
-        e.timestamp_type = c.type;
-        e.timestamp_offset = c.offset;
-      }
-      return e;
-    }
-    /// TimestampOf(the topic, body).
-    std::uint64_t Timestamp(const std::uint8_t* body) const {
-      return has_timestamp ? TimestampAt(body + timestamp_offset, timestamp_type) : 0;
-    }
-  };
   std::vector<DataEntry> data_entries_;
   detail::ULogFormatResolver resolver_;
   bool in_definitions_ = true;
@@ -700,6 +738,7 @@ ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& so
   log.size_bytes = size;
   Parser parser(size, &log, filter);
   parser.Feed(data, size, 0, true);
+  parser.Finish();
   return log;
 }
 
@@ -715,6 +754,7 @@ ULog ReadULog(const std::string& path, const RecordFilter& filter) {
                 if (!parser) parser.emplace(log.size_bytes, &log, filter);
                 return parser->Feed(data, n, offset, at_end);
               });
+  if (parser) parser->Finish();
   return log;
 }
 
