@@ -133,7 +133,7 @@ TEST(LogCommon, ReadForwardReportsAFileCutShortWhileItIsRead) {
     const std::string what = e.what();
     EXPECT_NE(what.find(path), std::string::npos) << what;
     EXPECT_NE(what.find("read failed before the end of the file"), std::string::npos) << what;
-    EXPECT_LE(handed, std::size_t{6} << 20);
+    EXPECT_LE(handed, kCut);
   }
 }
 

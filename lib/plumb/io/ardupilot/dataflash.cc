@@ -338,10 +338,15 @@ double DataflashType::Value(std::size_t row, std::size_t col) const {
 }
 
 std::string DataflashType::Text(std::size_t row, std::size_t col) const {
+  return std::string(TextView(row, col));
+}
+
+std::string_view DataflashType::TextView(std::size_t row, std::size_t col) const {
   if (!bodies_kept) NotKept(name);
   const DataflashColumn& c = columns[col];
   if (DataflashFormat(c.format).storage != DataflashStorage::kText) return {};
-  return FixedText(bodies.Row(row) + c.offset, c.size);
+  const auto* p = reinterpret_cast<const char*>(bodies.Row(row) + c.offset);
+  return {p, strnlen(p, c.size)};
 }
 
 std::array<std::int16_t, 32> DataflashType::Array(std::size_t row, std::size_t col) const {

@@ -108,6 +108,8 @@ struct DataflashType {
   double Value(std::size_t row, std::size_t col) const;
   /// Text of an n/N/Z column up to its first NUL; empty for other columns.
   std::string Text(std::size_t row, std::size_t col) const;
+  /// Text() without a copy: a view of the stored body, valid while this type lives.
+  std::string_view TextView(std::size_t row, std::size_t col) const;
   /// The 32 int16 values of an 'a' column; zeros for other columns.
   std::array<std::int16_t, 32> Array(std::size_t row, std::size_t col) const;
   /// Every value of the column called `column` (see Value()). Throws plumb::Error if absent.

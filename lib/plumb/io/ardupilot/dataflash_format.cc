@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <map>
 #include <set>
 #include <string>
@@ -64,19 +63,10 @@ std::vector<std::string> SplitColumns(const std::string& text) {
 }
 
 /// Fills column units and multipliers from FMTU (FmtType, UnitIds, MultIds), UNIT (Id, Label)
-/// and MULT (Id, Mult), when the log has them.
-/// The text of n/N/Z column `col` of record `row` of `t` up to its first NUL, viewed where the
-/// body is stored (as DataflashType::Text, without a copy); empty for other columns.
-std::string_view TextView(const DataflashType& t, std::size_t row, int col) {
-  const DataflashColumn& c = t.columns[static_cast<std::size_t>(col)];
-  if (DataflashFormat(c.format).storage != DataflashStorage::kText) return {};
-  const auto* p = reinterpret_cast<const char*>(t.bodies.Row(row) + c.offset);
-  return {p, strnlen(p, c.size)};
-}
-
+/// and MULT (Id, Mult), when the log has them (and the reader kept FMTU's bodies).
 void ApplyUnits(DataflashLog* log) {
   const DataflashType* fmtu = log->Find("FMTU");
-  if (fmtu == nullptr) return;
+  if (fmtu == nullptr || !fmtu->bodies_kept) return;
   std::map<char, std::string> units;
   std::map<char, double> mults;
   if (const DataflashType* u = log->Find("UNIT")) {
@@ -111,7 +101,6 @@ void ApplyUnits(DataflashLog* log) {
   for (auto t = log->types.rbegin(); t != log->types.rend(); ++t) by_id[t->id] = &*t;
   // A row applied twice changes nothing and a later row wins where two set a column, so only
   // the last of identical rows is applied, in log order (a log repeats its FMTU rows).
-  if (!fmtu->bodies_kept) return;
   using Row = std::tuple<std::uint8_t, std::string_view, std::string_view>;  // id, units, mults
   std::vector<std::pair<DataflashType*, Row>> last_rows;
   std::set<Row> seen;
@@ -120,8 +109,10 @@ void ApplyUnits(DataflashLog* log) {
     if (!(type_id >= 0 && type_id < 256) || type_id != std::floor(type_id)) continue;
     DataflashType* const it = by_id[static_cast<std::size_t>(type_id)];
     if (it == nullptr) continue;
-    const Row row{it->id, unit_col >= 0 ? TextView(*fmtu, r, unit_col) : std::string_view(),
-                  mult_col >= 0 ? TextView(*fmtu, r, mult_col) : std::string_view()};
+    const auto text = [&](int col) {
+      return col >= 0 ? fmtu->TextView(r, static_cast<std::size_t>(col)) : std::string_view();
+    };
+    const Row row{it->id, text(unit_col), text(mult_col)};
     if (seen.insert(row).second) last_rows.push_back({it, row});
   }
   for (auto row = last_rows.rbegin(); row != last_rows.rend(); ++row) {
@@ -142,12 +133,11 @@ void CollectParams(DataflashLog* log) {
   if (parm == nullptr) return;
   const int name = parm->ColumnIndex("Name");
   const int value = parm->ColumnIndex("Value");
-  if (name < 0 || value < 0) return;
-  if (!parm->bodies_kept) return;  // the reader's RecordFilter left them out
+  if (name < 0 || value < 0 || !parm->bodies_kept) return;  // bodies: the filter may leave them out
   // The last value of each name wins: from the last row back, the first one met is kept.
   std::unordered_set<std::string_view> seen;
   for (std::size_t r = parm->rows; r-- > 0;) {
-    const std::string_view key = TextView(*parm, r, name);
+    const std::string_view key = parm->TextView(r, static_cast<std::size_t>(name));
     if (!seen.insert(key).second) continue;
     log->params.emplace(std::string(key), parm->Value(r, value));
   }

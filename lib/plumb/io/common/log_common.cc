@@ -68,8 +68,9 @@ void LogFile::DropPages(std::size_t up_to) const {
 
 namespace {
 
-/// Bytes read per call into the ReadForward buffer (beyond the consumer's look-ahead): 256 KiB,
-/// about what stays in the L2 cache while the parser goes over it (cat reads 128 KiB).
+/// Bytes ReadForward hands over per call beyond the consumer's look-ahead (read into its buffer,
+/// or of the mapped file): 256 KiB, about what stays in the L2 cache while the parser goes over
+/// it (cat reads 128 KiB).
 constexpr std::size_t kReadChunk = std::size_t{1} << 18;
 
 /// Reads up to `n` bytes at file offset `at` into `out`: fewer only at the end of the file.
