@@ -61,7 +61,7 @@ TEST(LogCommon, RecordStoreKeepsRowsAcrossBlocksAndCopies) {
 
 TEST(LogCommon, ReadForwardHandsEveryByteOnceWithItsLookahead) {
   ::plumb::testing::TempDir dir;
-  const std::vector<std::uint8_t> file = Pattern((std::size_t{5} << 20) + 777);
+  const std::vector<std::uint8_t> file = Pattern((std::size_t{21} << 20) + 777);
   const std::string path = WriteFile(dir, file);
   constexpr std::size_t kLookahead = 300000;
   std::vector<std::uint8_t> seen;
@@ -91,7 +91,7 @@ TEST(LogCommon, ReadForwardHandsEveryByteOnceWithItsLookahead) {
 
 TEST(LogCommon, ReadForwardJumpsAndGrowsItsBuffer) {
   ::plumb::testing::TempDir dir;
-  const std::vector<std::uint8_t> file = Pattern(std::size_t{6} << 20);
+  const std::vector<std::uint8_t> file = Pattern(std::size_t{12} << 20);
   const std::string path = WriteFile(dir, file);
   std::vector<std::size_t> offsets;
   std::size_t largest = 0;
@@ -101,30 +101,32 @@ TEST(LogCommon, ReadForwardJumpsAndGrowsItsBuffer) {
                 offsets.push_back(offset);
                 largest = std::max(largest, n);
                 if (at_end) return offset + n;
-                if (offset == 0 && n < (std::size_t{3} << 20)) return offset;  // needs more
-                if (offset == 0) return std::size_t{5} << 20;  // a jump past the bytes held
+                // More than one span (of either way of reading) holds, before it goes on.
+                if (offset == 0 && n < (std::size_t{5} << 20)) return offset;  // needs more
+                if (offset == 0) return std::size_t{10} << 20;  // a jump past the bytes held
                 return offset + n - 16;  // not reached: the jump's chunk ends the file
               });
-  EXPECT_GE(largest, std::size_t{3} << 20);  // the buffer grew for the first position
+  EXPECT_GE(largest, std::size_t{5} << 20);  // the span grew for the first position
   ASSERT_GE(offsets.size(), 3u);
   EXPECT_EQ(offsets.front(), 0u);
   EXPECT_EQ(offsets[offsets.size() - 2], 0u);
-  EXPECT_EQ(offsets.back(), std::size_t{5} << 20);  // the bytes in between never handed over
+  EXPECT_EQ(offsets.back(), std::size_t{10} << 20);  // the bytes in between never handed over
 }
 
 // A log cut short while it is read (copied over, or a card failing) is a read error naming
 // the file and the byte, not a SIGBUS from touching a mapped page past the new end.
 TEST(LogCommon, ReadForwardReportsAFileCutShortWhileItIsRead) {
   ::plumb::testing::TempDir dir;
-  const std::vector<std::uint8_t> file = Pattern(std::size_t{6} << 20);
+  // Cut past the first span (4 MiB mapped, 256 KiB read), while that span is parsed.
+  const std::vector<std::uint8_t> file = Pattern(std::size_t{12} << 20);
   const std::string path = WriteFile(dir, file);
-  constexpr std::size_t kCut = std::size_t{1} << 20;
+  constexpr std::size_t kCut = std::size_t{6} << 20;
   std::size_t handed = 0;  // bytes handed over, all of them before the cut
   try {
     ReadForward(path, "test log", 16,
                 [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
-                  if (offset == 0) std::filesystem::resize_file(path, kCut);
                   EXPECT_EQ(std::memcmp(data, file.data() + offset, n), 0);
+                  if (offset == 0) std::filesystem::resize_file(path, kCut);
                   handed = offset + n;
                   return at_end ? offset + n : offset + n - 16;
                 });
@@ -135,6 +137,28 @@ TEST(LogCommon, ReadForwardReportsAFileCutShortWhileItIsRead) {
     EXPECT_NE(what.find("read failed before the end of the file"), std::string::npos) << what;
     EXPECT_LE(handed, kCut);
   }
+}
+
+// A large decoded buffer is reserved to fill whole 2 MiB pages with its allocator's header,
+// so that it can start on a huge page; a small one is reserved as asked.
+TEST(LogCommon, HugePageCapacityFillsWholeHugePages) {
+  constexpr std::size_t kHuge = std::size_t{2} << 20;
+  EXPECT_EQ(HugePageCapacity(1000, sizeof(double)), 1000u);
+  EXPECT_EQ(HugePageCapacity(kHuge / 8 - 1, 8), kHuge / 8 - 1);
+  for (const std::size_t element : {std::size_t{4}, std::size_t{8}, std::size_t{12}}) {
+    for (const std::size_t n : {kHuge / element + 1, std::size_t{3000000}, std::size_t{5555555}}) {
+      const std::size_t capacity = HugePageCapacity(n, element);
+      EXPECT_GE(capacity, n);
+      const std::size_t bytes = capacity * element + 64;  // with the allocator's bookkeeping
+      const std::size_t whole = (bytes + kHuge - 1) / kHuge * kHuge;
+      EXPECT_LT(whole - bytes, element) << n << " of " << element;  // short of no element
+      EXPECT_LE(capacity * element, n * element + kHuge);  // never a whole huge page more
+    }
+  }
+  std::vector<float> v{1.0F, 2.0F};
+  ReserveHugePages(v, 3000000);
+  EXPECT_GE(v.capacity(), 3000000u);
+  EXPECT_EQ(v, (std::vector<float>{1.0F, 2.0F}));  // the contents stay
 }
 
 TEST(LogCommon, ReadForwardNamesAMissingFile) {

@@ -145,14 +145,10 @@ class ImuDecoder {
 
   void Reserve(ImuSeries& s) const {
     if (rows_bound_ == 0) return;
-    s.t_s.reserve(rows_bound_);
-    s.acc.reserve(rows_bound_);
-    if (has_gyr_) s.gyr.reserve(rows_bound_);
-    if (has_temp_) s.temp_c.reserve(rows_bound_);
-    AdviseHugePages(s.t_s.data(), rows_bound_ * sizeof(double));
-    AdviseHugePages(s.acc.data(), rows_bound_ * sizeof(Vec3f));
-    if (has_gyr_) AdviseHugePages(s.gyr.data(), rows_bound_ * sizeof(Vec3f));
-    if (has_temp_) AdviseHugePages(s.temp_c.data(), rows_bound_ * sizeof(float));
+    ReserveHugePages(s.t_s, rows_bound_);
+    ReserveHugePages(s.acc, rows_bound_);
+    if (has_gyr_) ReserveHugePages(s.gyr, rows_bound_);
+    if (has_temp_) ReserveHugePages(s.temp_c, rows_bound_);
   }
 
   /// Takes the last sample out of `s`.

@@ -69,10 +69,11 @@ T LoadLittleEndian(const std::uint8_t* p) {
 
 /// Reads the file at `path` forward, span by span, for parsers that decide at each position
 /// from a bounded look-ahead. A regular file is mapped read-only and each span's pages are
-/// read in (madvise MADV_POPULATE_READ) just before the parser gets them, so that a read
-/// error or a file cut short meanwhile is an InputError, never a SIGBUS; the pages the parser
-/// has passed are dropped from this process's memory every 2 MiB (never held whole, no copy
-/// of the page cache). Without MADV_POPULATE_READ (Linux before 5.14), or when the file
+/// read in (madvise MADV_POPULATE_READ) just before the parser gets them (4 MiB at a time),
+/// so that a read error, or a file found cut short before a span, is an InputError rather
+/// than the SIGBUS touching such a page raises (a cut while the parser is inside a span can
+/// still raise one); the pages the parser has passed are dropped from this process's memory
+/// every 2 MiB (never held whole, no copy of the page cache). Without MADV_POPULATE_READ (Linux before 5.14), or when the file
 /// cannot be mapped, it is read with read(2) into one reusable buffer the same way.
 /// `consume(data, n, offset, at_end)` gets the bytes [offset, offset + n)
 /// of the file (`at_end`: they reach its end) and returns the file offset it needs the bytes
@@ -93,6 +94,20 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
 /// instead of per 4 KiB as the buffer is first written. Only a hint: the contents and the
 /// results never depend on it.
 void AdviseHugePages(const void* p, std::size_t bytes);
+
+/// Capacity for `n` elements of size `element_size`, rounded up so that a buffer of 2 MiB or
+/// more, with its allocator's bookkeeping (64 bytes at most), fills whole 2 MiB pages: Linux
+/// then places such a mapping on a 2 MiB boundary, and every page of the buffer, its first
+/// included, can be a huge page (AdviseHugePages).
+std::size_t HugePageCapacity(std::size_t n, std::size_t element_size);
+
+/// Reserves at least `n` elements of `v` (HugePageCapacity) and asks for huge pages on them
+/// (AdviseHugePages): a buffer about to be filled, with one page fault per 2 MiB.
+template <typename T>
+void ReserveHugePages(std::vector<T>& v, std::size_t n) {
+  v.reserve(HugePageCapacity(n, sizeof(T)));
+  AdviseHugePages(v.data(), v.capacity() * sizeof(T));
+}
 
 /// A copy of `s` whose large buffers are reserved first and backed by huge pages
 /// (AdviseHugePages): samples a reader decoded in its pass, handed out by value.

@@ -96,18 +96,10 @@ Vec3f Read3(const std::uint8_t* body, const Cols& c) { return SaturatedFloat(Rea
 /// Reserves `n` samples of `s` (gyr with `gyr`, temp_c with `temp`), large buffers backed by
 /// huge pages (AdviseHugePages: fewer page faults as they are filled).
 void Reserve(ImuSeries* s, std::size_t n, bool gyr, bool temp) {
-  s->t_s.reserve(n);
-  s->acc.reserve(n);
-  AdviseHugePages(s->t_s.data(), n * sizeof(double));
-  AdviseHugePages(s->acc.data(), n * sizeof(Vec3f));
-  if (gyr) {
-    s->gyr.reserve(n);
-    AdviseHugePages(s->gyr.data(), n * sizeof(Vec3f));
-  }
-  if (temp) {
-    s->temp_c.reserve(n);
-    AdviseHugePages(s->temp_c.data(), n * sizeof(float));
-  }
+  ReserveHugePages(s->t_s, n);
+  ReserveHugePages(s->acc, n);
+  if (gyr) ReserveHugePages(s->gyr, n);
+  if (temp) ReserveHugePages(s->temp_c, n);
 }
 
 /// Appends a sample when its time increases; returns whether it was kept.

@@ -150,12 +150,9 @@ class CombinedDecoder {
 
   /// Reserves `rows` samples of `s`, backed by huge pages where large.
   static void Reserve(ImuSeries& s, std::size_t rows) {
-    s.t_s.reserve(rows);
-    s.acc.reserve(rows);
-    s.gyr.reserve(rows);
-    AdviseHugePages(s.t_s.data(), rows * sizeof(double));
-    AdviseHugePages(s.acc.data(), rows * sizeof(Vec3f));
-    AdviseHugePages(s.gyr.data(), rows * sizeof(Vec3f));
+    ReserveHugePages(s.t_s, rows);
+    ReserveHugePages(s.acc, rows);
+    ReserveHugePages(s.gyr, rows);
   }
 
  private:
