@@ -100,7 +100,7 @@ struct FdCloser {
 
 /// Bytes ReadForward hands over per call beyond the consumer's look-ahead from a mapped file:
 /// 4 MiB. Nothing is copied, so the span need not fit a cache, and each span costs an fstat
-/// and an madvise (ForwardMapping::Prepare): with 256 KiB spans the .bin reader took 10-25%
+/// and an madvise (ForwardMapping::Prepare): with 256 KiB spans the .bin reader took 12-20 %
 /// longer (docs/performance.md).
 constexpr std::size_t kMapSpan = std::size_t{4} << 20;
 

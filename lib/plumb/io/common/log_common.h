@@ -89,10 +89,11 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
                                                  std::size_t offset, bool at_end)>& consume);
 
 /// Asks the system to back the memory [p, p + bytes) of a large buffer that is about to be
-/// filled by transparent huge pages (madvise MADV_HUGEPAGE on the whole 2 MiB pages inside it;
-/// nothing when it holds none or the system has no such pages): one page fault per 2 MiB
-/// instead of per 4 KiB as the buffer is first written. Only a hint: the contents and the
-/// results never depend on it.
+/// filled by transparent huge pages (madvise MADV_HUGEPAGE on the whole 2 MiB pages inside it,
+/// and on those it fills but for 64 bytes of its allocator's bookkeeping, the first of which is
+/// made a huge page at once with MADV_COLLAPSE; nothing when it spans none or the system has no
+/// such pages): one page fault per 2 MiB instead of per 4 KiB as the buffer is first written.
+/// Only a hint: the contents and the results never depend on it.
 void AdviseHugePages(const void* p, std::size_t bytes);
 
 /// Capacity for `n` elements of size `element_size`, rounded up so that a buffer of 2 MiB or
