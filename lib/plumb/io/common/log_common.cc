@@ -214,6 +214,24 @@ std::size_t HugePageCapacity(std::size_t n, std::size_t element_size) {
   return std::max(n, (whole - kAllocatorSlack) / element_size);
 }
 
+namespace {
+
+/// Whether this system gives processes transparent huge pages when they ask (the mode in
+/// /sys/kernel/mm/transparent_hugepage/enabled is "always" or "madvise"; read once). When an
+/// administrator chose "never", no page is collapsed into one either (MADV_COLLAPSE would).
+bool HugePagesAllowed() {
+  static const bool allowed = [] {
+    std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+    std::string modes;
+    std::getline(in, modes);
+    return modes.find("[always]") != std::string::npos ||
+           modes.find("[madvise]") != std::string::npos;
+  }();
+  return allowed;
+}
+
+}  // namespace
+
 void AdviseHugePages(const void* p, std::size_t bytes) {
 #ifdef MADV_HUGEPAGE
   constexpr std::uintptr_t kHuge = kHugePage;
@@ -228,7 +246,9 @@ void AdviseHugePages(const void* p, std::size_t bytes) {
 #ifdef MADV_COLLAPSE
   // The allocator wrote its header into the first page already, so that page's 2 MiB would
   // fill by 4 KiB faults: made one huge page now (Linux 6.1 on; errors ignored).
-  if (first < begin) ::madvise(reinterpret_cast<void*>(first), kHuge, MADV_COLLAPSE);
+  if (first < begin && HugePagesAllowed()) {
+    ::madvise(reinterpret_cast<void*>(first), kHuge, MADV_COLLAPSE);
+  }
 #endif
 #else
   (void)p;

@@ -91,8 +91,9 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
 /// Asks the system to back the memory [p, p + bytes) of a large buffer that is about to be
 /// filled by transparent huge pages (madvise MADV_HUGEPAGE on the whole 2 MiB pages inside it,
 /// and on those it fills but for 64 bytes of its allocator's bookkeeping, the first of which is
-/// made a huge page at once with MADV_COLLAPSE; nothing when it spans none or the system has no
-/// such pages): one page fault per 2 MiB instead of per 4 KiB as the buffer is first written.
+/// made a huge page at once with MADV_COLLAPSE unless the system's mode is "never"; nothing when
+/// it spans none or the system has no such pages): one page fault per 2 MiB instead of per
+/// 4 KiB as the buffer is first written.
 /// Only a hint: the contents and the results never depend on it.
 void AdviseHugePages(const void* p, std::size_t bytes);
 
