@@ -175,6 +175,31 @@ TEST(MavlinkTlog, CrcMatchesKnownValues) {
   EXPECT_EQ(MavlinkCrcExtra(1u << 20), -1);
 }
 
+// The sliced CRC (8-byte steps, then slices of 4, 2 and 1) against the bit-by-bit definition
+// (reflected polynomial 0x8408), for every length up to 40 and every start state tried.
+TEST(MavlinkTlog, CrcEqualsTheBitwiseDefinitionAtEveryLength) {
+  const auto bitwise = [](const std::uint8_t* data, std::size_t size, std::uint16_t crc) {
+    for (std::size_t k = 0; k < size; ++k) {
+      crc = static_cast<std::uint16_t>(crc ^ data[k]);
+      for (int bit = 0; bit < 8; ++bit) {
+        crc = static_cast<std::uint16_t>((crc & 1u) ? (crc >> 1) ^ 0x8408u : crc >> 1);
+      }
+    }
+    return crc;
+  };
+  Bytes data(40);
+  for (std::size_t k = 0; k < data.size(); ++k) {
+    data[k] = static_cast<std::uint8_t>(k * 37 + 11);
+  }
+  for (const std::uint16_t start : {std::uint16_t{0xFFFF}, std::uint16_t{0x1234},
+                                    std::uint16_t{0}}) {
+    for (std::size_t size = 0; size <= data.size(); ++size) {
+      EXPECT_EQ(MavlinkCrc(data.data(), size, start), bitwise(data.data(), size, start))
+          << size << " bytes from " << start;
+    }
+  }
+}
+
 // The generated table (scripts/gen-mavlink-dialect computes every CRC_EXTRA from the fields
 // and checks it against the package) against values the MAVLink project's generated C headers
 // state (MAVLINK_MSG_ID_<NAME>_CRC, _MIN_LEN, _LEN), typed here, and the dialect file of the

@@ -113,7 +113,9 @@ inline std::uint16_t CrcByte(std::uint16_t crc, std::uint8_t byte) {
   return static_cast<std::uint16_t>((crc >> 8) ^ kCrcTable.t[0][(crc ^ byte) & 0xFFu]);
 }
 
-/// X.25 CRC of `size` bytes from state `crc`, sliced by 8 (see CrcTable).
+/// X.25 CRC of `size` bytes from state `crc`, sliced by 8 (see CrcTable). Each step is one
+/// link of a chain of dependent lookups, so the last 0-7 bytes go in at most three (slices of
+/// 4, 2 and 1 bytes) instead of one per byte: frames are short (a RAW_IMU's CRC covers 31).
 inline std::uint16_t Crc(const std::uint8_t* data, std::size_t size, std::uint16_t crc) {
   const auto& t = kCrcTable.t;
   std::size_t k = 0;
@@ -123,7 +125,19 @@ inline std::uint16_t Crc(const std::uint8_t* data, std::size_t size, std::uint16
         t[7][(crc ^ b[0]) & 0xFFu] ^ t[6][((crc >> 8) ^ b[1]) & 0xFFu] ^ t[5][b[2]] ^
         t[4][b[3]] ^ t[3][b[4]] ^ t[2][b[5]] ^ t[1][b[6]] ^ t[0][b[7]]);
   }
-  for (; k < size; ++k) crc = CrcByte(crc, data[k]);
+  if (size - k >= 4) {
+    const std::uint8_t* b = data + k;
+    crc = static_cast<std::uint16_t>(t[3][(crc ^ b[0]) & 0xFFu] ^
+                                     t[2][((crc >> 8) ^ b[1]) & 0xFFu] ^ t[1][b[2]] ^ t[0][b[3]]);
+    k += 4;
+  }
+  if (size - k >= 2) {
+    const std::uint8_t* b = data + k;
+    crc = static_cast<std::uint16_t>(t[1][(crc ^ b[0]) & 0xFFu] ^
+                                     t[0][((crc >> 8) ^ b[1]) & 0xFFu]);
+    k += 2;
+  }
+  if (k < size) crc = CrcByte(crc, data[k]);
   return crc;
 }
 
