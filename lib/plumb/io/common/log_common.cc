@@ -110,6 +110,20 @@ constexpr std::size_t kHugePage = std::size_t{2} << 20;
 /// 16-byte header before it, up to 16 bytes of rounding after it).
 constexpr std::size_t kAllocatorSlack = 64;
 
+/// Whether this system gives processes transparent huge pages when they ask (the mode in
+/// /sys/kernel/mm/transparent_hugepage/enabled is "always" or "madvise"; read once). When an
+/// administrator chose "never", no page is collapsed into one either (MADV_COLLAPSE would).
+bool HugePagesAllowed() {
+  static const bool allowed = [] {
+    std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+    std::string modes;
+    std::getline(in, modes);
+    return modes.find("[always]") != std::string::npos ||
+           modes.find("[madvise]") != std::string::npos;
+  }();
+  return allowed;
+}
+
 /// Bytes behind the parser after which a mapped file's pages are dropped from this process's
 /// memory (MADV_DONTNEED): 2 MiB, so that a few MiB of it are resident at a time.
 constexpr std::size_t kDropStep = std::size_t{2} << 20;
@@ -214,27 +228,9 @@ std::size_t HugePageCapacity(std::size_t n, std::size_t element_size) {
   return std::max(n, (whole - kAllocatorSlack) / element_size);
 }
 
-namespace {
-
-/// Whether this system gives processes transparent huge pages when they ask (the mode in
-/// /sys/kernel/mm/transparent_hugepage/enabled is "always" or "madvise"; read once). When an
-/// administrator chose "never", no page is collapsed into one either (MADV_COLLAPSE would).
-bool HugePagesAllowed() {
-  static const bool allowed = [] {
-    std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
-    std::string modes;
-    std::getline(in, modes);
-    return modes.find("[always]") != std::string::npos ||
-           modes.find("[madvise]") != std::string::npos;
-  }();
-  return allowed;
-}
-
-}  // namespace
-
 void AdviseHugePages(const void* p, std::size_t bytes) {
 #ifdef MADV_HUGEPAGE
-  constexpr std::uintptr_t kHuge = kHugePage;
+  constexpr std::uintptr_t kHuge = kHugePage;  // as an address step
   const auto begin = reinterpret_cast<std::uintptr_t>(p);
   // The 2 MiB pages inside the buffer, and those it fills but for its allocator's bookkeeping
   // (kAllocatorSlack bytes at either end: a buffer reserved by ReserveHugePages).

@@ -73,8 +73,9 @@ T LoadLittleEndian(const std::uint8_t* p) {
 /// so that a read error, or a file found cut short before a span, is an InputError rather
 /// than the SIGBUS touching such a page raises (a cut while the parser is inside a span can
 /// still raise one); the pages the parser has passed are dropped from this process's memory
-/// every 2 MiB (never held whole, no copy of the page cache). Without MADV_POPULATE_READ (Linux before 5.14), or when the file
-/// cannot be mapped, it is read with read(2) into one reusable buffer the same way.
+/// every 2 MiB (never held whole, no copy of the page cache). Without MADV_POPULATE_READ
+/// (Linux before 5.14), or when the file cannot be mapped, it is read with read(2) into one
+/// reusable buffer the same way (256 KiB at a time).
 /// `consume(data, n, offset, at_end)` gets the bytes [offset, offset + n)
 /// of the file (`at_end`: they reach its end) and returns the file offset it needs the bytes
 /// from next, in [offset, offset + n] or beyond (a forward jump: the bytes in between are not
@@ -93,8 +94,8 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
 /// and on those it fills but for 64 bytes of its allocator's bookkeeping, the first of which is
 /// made a huge page at once with MADV_COLLAPSE unless the system's mode is "never"; nothing when
 /// it spans none or the system has no such pages): one page fault per 2 MiB instead of per
-/// 4 KiB as the buffer is first written.
-/// Only a hint: the contents and the results never depend on it.
+/// 4 KiB as the buffer is first written. Only a hint: the contents and the results never
+/// depend on it.
 void AdviseHugePages(const void* p, std::size_t bytes);
 
 /// Capacity for `n` elements of size `element_size`, rounded up so that a buffer of 2 MiB or

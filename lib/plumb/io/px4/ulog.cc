@@ -200,6 +200,14 @@ class Parser {
       : size_(size), end_(size), log_(log), filter_(filter),
         resolver_(log->formats, size + kMinColumnBudget) {}
 
+  /// After the last Feed: the topics get their message counts and last timestamps.
+  void Finish() {
+    for (std::size_t k = 0; k < data_entries_.size(); ++k) {
+      log_->topics[k].rows = data_entries_[k].rows;
+      log_->topics[k].last_timestamp_us = data_entries_[k].last_timestamp_us;
+    }
+  }
+
   /// Decodes the messages starting in the bytes [offset, offset + n) of the input held at
   /// `data` and returns the offset to go on from: unless `at_end`, the first message not
   /// whole in the bytes (or, resynchronising, the first position less than kLookahead bytes
@@ -446,16 +454,6 @@ class Parser {
     decoders_[idx].Add(t.imu, fields);
   }
 
- public:
-  /// After the last Feed: the topics get their message counts and last timestamps.
-  void Finish() {
-    for (std::size_t k = 0; k < data_entries_.size(); ++k) {
-      log_->topics[k].rows = data_entries_[k].rows;
-      log_->topics[k].last_timestamp_us = data_entries_[k].last_timestamp_us;
-    }
-  }
-
- private:
   /// The newest timestamp among the last message of every topic, us (for parameter changes).
   std::uint64_t NewestTimestampUs() const {
     std::uint64_t newest = 0;
