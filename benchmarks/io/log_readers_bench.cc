@@ -77,9 +77,10 @@ void ForEachRecord(std::vector<char>& bytes, const std::array<std::size_t, 256>&
   }
 }
 
-/// `copies` copies of the DataFlash log `bytes`, copy k's clock shifted by k times (the log's
-/// last time + 1 s), so that times keep increasing across copies.
-std::vector<char> ContinuingDataflash(std::vector<char> bytes, std::size_t copies) {
+/// Writes `copies` copies of the DataFlash log `bytes` to `out`, copy k's clock shifted by k
+/// times (the log's last time + 1 s), so that times keep increasing across copies. Each copy
+/// is written as it is made: the whole file is never held in memory.
+void WriteContinuingDataflash(std::vector<char> bytes, std::size_t copies, std::ostream& out) {
   const plumb::io::DataflashLog log = plumb::io::ParseDataflash(
       reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "benchmark");
   std::array<std::size_t, 256> length{};
@@ -108,10 +109,9 @@ std::vector<char> ContinuingDataflash(std::vector<char> bytes, std::size_t copie
     }
   });
   const std::uint64_t shift_us = last_us + 1000000u;
-  std::vector<char> out;
-  out.reserve(bytes.size() * copies);
+  std::vector<char> copy;
   for (std::size_t k = 0; k < copies; ++k) {
-    std::vector<char> copy = bytes;
+    copy = bytes;
     ForEachRecord(copy, length, [&](std::size_t pos, std::uint8_t id) {
       const TimeField& f = time[id];
       if (f.format == 'Q') {
@@ -126,15 +126,15 @@ std::vector<char> ContinuingDataflash(std::vector<char> bytes, std::size_t copie
         std::memcpy(&copy[pos + f.offset], &v, sizeof v);
       }
     });
-    out.insert(out.end(), copy.begin(), copy.end());
+    out.write(copy.data(), static_cast<std::streamsize>(copy.size()));
   }
-  return out;
 }
 
-/// `copies` copies of the ULog `bytes` with a continuing clock: the file once, then its D
-/// messages `copies - 1` more times, copy k's top-level uint64 "timestamp" and
-/// "timestamp_sample" fields shifted by k times (the log's last timestamp + 1 s).
-std::vector<char> ContinuingULog(const std::vector<char>& bytes, std::size_t copies) {
+/// Writes `copies` copies of the ULog `bytes` with a continuing clock to `out`: the file once,
+/// then its D messages `copies - 1` more times, copy k's top-level uint64 "timestamp" and
+/// "timestamp_sample" fields shifted by k times (the log's last timestamp + 1 s); each copy
+/// written as it is made.
+void WriteContinuingULog(const std::vector<char>& bytes, std::size_t copies, std::ostream& out) {
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
   const plumb::io::ULog log = plumb::io::ParseULog(data, bytes.size(), "benchmark");
   std::map<std::uint16_t, std::vector<std::size_t>> clocks;  // msg_id -> field offsets
@@ -149,30 +149,31 @@ std::vector<char> ContinuingULog(const std::vector<char>& bytes, std::size_t cop
     if (t.rows > 0) last_us = std::max(last_us, t.TimestampUs(t.rows - 1));
   }
   const std::uint64_t shift_us = last_us + 1000000u;
-  std::vector<char> out(bytes);
-  out.reserve(bytes.size() * copies);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  std::vector<char> copy;
   for (std::size_t k = 1; k < copies; ++k) {
+    copy.clear();
     for (std::size_t pos = 16; pos + 5 <= bytes.size();) {  // after the 16-byte file header
       std::uint16_t size, msg_id;
       std::memcpy(&size, data + pos, 2);
       if (size == 0 || pos + 3 + size > bytes.size()) break;
       std::memcpy(&msg_id, data + pos + 3, 2);
       if (data[pos + 2] == 'D' && size >= 2) {
-        const std::size_t at = out.size();
-        out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(pos),
-                   bytes.begin() + static_cast<std::ptrdiff_t>(pos + 3 + size));
+        const std::size_t at = copy.size();
+        copy.insert(copy.end(), bytes.begin() + static_cast<std::ptrdiff_t>(pos),
+                    bytes.begin() + static_cast<std::ptrdiff_t>(pos + 3 + size));
         for (std::size_t offset : clocks[msg_id]) {
           if (5 + offset + 8 > 3u + size) continue;
           std::uint64_t v;
-          std::memcpy(&v, &out[at + 5 + offset], 8);
+          std::memcpy(&v, &copy[at + 5 + offset], 8);
           v += k * shift_us;
-          std::memcpy(&out[at + 5 + offset], &v, 8);
+          std::memcpy(&copy[at + 5 + offset], &v, 8);
         }
       }
       pos += 3 + size;
     }
+    out.write(copy.data(), static_cast<std::streamsize>(copy.size()));
   }
-  return out;
 }
 
 class RepeatedLog {
@@ -194,11 +195,12 @@ class RepeatedLog {
     std::ofstream out(path_, std::ios::binary);
     if (bytes.empty()) return;
     const std::size_t copies = (kTargetBytes + bytes.size() - 1) / bytes.size();
-    if (clock != Clock::kRepeated) {
-      const std::vector<char> all = clock == Clock::kDataflash
-                                        ? ContinuingDataflash(std::move(bytes), copies)
-                                        : ContinuingULog(bytes, copies);
-      out.write(all.data(), static_cast<std::streamsize>(all.size()));
+    if (clock == Clock::kDataflash) {
+      WriteContinuingDataflash(std::move(bytes), copies, out);
+      return;
+    }
+    if (clock == Clock::kULog) {
+      WriteContinuingULog(bytes, copies, out);
       return;
     }
     for (std::size_t k = 0; k < copies; ++k) {
