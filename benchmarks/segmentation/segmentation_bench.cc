@@ -2,6 +2,7 @@
 //   BM_Detect/OneHour1kHz*: a simulated one-hour 1 kHz session (3.6 M samples), built
 //   deterministically: 60 poses of 55 s still, 5 s smooth 90 degree turns between them.
 //   BM_Detect/MikoffImu0: the real 160 s, 100 Hz log when ../shared/data is present.
+//   BM_CorrelationTime_Drifting: the noise's correlation-time estimate on a drifting axis.
 // items_per_second is samples per second. The `segments` counter of the one-hour runs reads
 // 60 plus the splits that false_alarm (1e-3 per window length, Bonferroni-bounded) allows in
 // about 3240 s of stillness: 63 with the gyroscope tests, 60 without.
@@ -9,10 +10,12 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
 #include "plumb/segmentation/still_detector.h"
+#include "plumb/signal/correlation_time.h"
 #include "plumb/signal/segment_stats.h"
 
 namespace {
@@ -147,6 +150,42 @@ void BM_SegmentStats_OneHour1kHz(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * series.size()));
 }
 BENCHMARK(BM_SegmentStats_OneHour1kHz)->Unit(benchmark::kMillisecond);
+
+/// The still detector's correlation-time estimate at its sample budget (131072 samples of the
+/// still periods) on an axis that drifts: 18 chunks of AR(1) noise with phi = 0.9995, slow
+/// against chunks of 7281 samples, so that the window runs to thousands of lags, as on the
+/// accelerometer axes of the PX4 sample log (`plumb info`: 1242 and 5000 lags). Counters: the
+/// lags summed (`window`) and the samples read.
+void BM_CorrelationTime_Drifting(benchmark::State& state) {
+  static const std::vector<std::vector<float>> chunks = [] {
+    std::vector<std::vector<float>> out;
+    std::mt19937_64 rng(20261128);
+    std::normal_distribution<double> e(0.0, 1e-3);
+    for (int c = 0; c < 18; ++c) {
+      std::vector<float> x(131072 / 18);
+      double v = 0.0;
+      for (float& sample : x) {
+        v = 0.9995 * v + e(rng);
+        sample = static_cast<float>(9.81 + v);
+      }
+      out.push_back(std::move(x));
+    }
+    return out;
+  }();
+  std::vector<plumb::signal::AxisView> views;
+  for (const std::vector<float>& x : chunks) {
+    views.push_back(plumb::signal::ViewContiguous(x.data(), x.size()));
+  }
+  plumb::signal::CorrelationTime ct;
+  for (auto _ : state) {
+    ct = plumb::signal::EstimateCorrelationTime(views);
+    benchmark::DoNotOptimize(ct.tau_int);
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * ct.samples));
+  state.counters["window"] = static_cast<double>(ct.window);
+  state.counters["samples"] = static_cast<double>(ct.samples);
+}
+BENCHMARK(BM_CorrelationTime_Drifting)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -1,5 +1,6 @@
 #include "plumb/signal/correlation_time.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -202,6 +203,74 @@ TEST(CorrelationTime, MarksTheWindowNotReached) {
                                                      short_lags);
   EXPECT_FALSE(ct.converged);
   EXPECT_EQ(ct.window, 10U);
+}
+
+/// The estimator by its definition (correlation_time.h), one lag at a time: each chunk
+/// centred on its mean, C_k = sum over chunks of sum_i y_i y_{i+k} / (pairs at lag k), rho_k =
+/// C_k / C_0 with C_0 = sum y^2 / N, summed until M >= c tau_int(M) or the last lag.
+CorrelationTime ByDefinition(const std::vector<std::vector<float>>& chunks, double sokal_c,
+                             std::size_t max_lag) {
+  std::vector<std::vector<double>> centred;
+  std::size_t samples = 0, longest = 0;
+  double sum_sq = 0.0;
+  for (const std::vector<float>& chunk : chunks) {
+    double mean = 0.0;
+    for (float v : chunk) mean += v;
+    mean /= static_cast<double>(chunk.size());
+    std::vector<double> y;
+    for (float v : chunk) y.push_back(v - mean);
+    for (double v : y) sum_sq += v * v;
+    samples += y.size();
+    longest = std::max(longest, y.size());
+    centred.push_back(y);
+  }
+  const double c0 = sum_sq / static_cast<double>(samples);
+  CorrelationTime out;
+  double tau = 1.0, tau_sq = 1.0;
+  for (std::size_t k = 1; k <= std::min(max_lag, longest / 2); ++k) {
+    double sum = 0.0;
+    std::size_t pairs = 0;
+    for (const std::vector<double>& y : centred) {
+      for (std::size_t i = 0; i + k < y.size(); ++i) sum += y[i] * y[i + k];
+      pairs += y.size() > k ? y.size() - k : 0;
+    }
+    const double rho = sum / static_cast<double>(pairs) / c0;
+    tau += 2.0 * rho;
+    tau_sq += 2.0 * rho * rho;
+    out.window = k;
+    if (static_cast<double>(k) >= sokal_c * tau) {
+      out.converged = true;
+      break;
+    }
+  }
+  out.tau_int = tau;
+  out.tau_sq = tau_sq;
+  return out;
+}
+
+// A window of about a thousand lags: the lags past the first ones come from the chunks'
+// spectra (correlation_time.cc); they must give what the definition gives, lag by lag, to
+// rounding, whether the window closes or runs to max_lag.
+TEST(CorrelationTime, LongWindowsEqualTheDefinition) {
+  std::vector<std::vector<float>> data;
+  for (int c = 0; c < 4; ++c) {
+    data.push_back(testing::Ar1Noise(200 + static_cast<std::uint64_t>(c),
+                                     5000 + 700 * static_cast<std::size_t>(c), 0.99, 0.01,
+                                     0.2 * c));
+  }
+  std::vector<AxisView> views;
+  for (const auto& d : data) views.push_back(ViewContiguous(d.data(), d.size()));
+  for (std::size_t max_lag : {std::size_t{5000}, std::size_t{300}}) {
+    CorrelationTimeOptions options;
+    options.max_lag = max_lag;
+    const CorrelationTime ct = EstimateCorrelationTime(views, options);
+    const CorrelationTime expected = ByDefinition(data, options.sokal_c, max_lag);
+    EXPECT_GT(ct.window, 64U) << "max_lag " << max_lag;  // past the direct lags
+    EXPECT_EQ(ct.window, expected.window) << "max_lag " << max_lag;
+    EXPECT_EQ(ct.converged, expected.converged) << "max_lag " << max_lag;
+    EXPECT_NEAR(ct.tau_int / expected.tau_int, 1.0, 1e-9) << "max_lag " << max_lag;
+    EXPECT_NEAR(ct.tau_sq / expected.tau_sq, 1.0, 1e-9) << "max_lag " << max_lag;
+  }
 }
 
 }  // namespace
