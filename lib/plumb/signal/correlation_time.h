@@ -12,8 +12,10 @@
 // mean (or its own line, with `detrend`) (C_k = sum over chunks of sum_i y_i y_{i+k}, divided by the number of such pairs), and
 // the sum over lags stops at Sokal's automatic window: the first M with M >= c tau_int(M)
 // (A. Sokal, "Monte Carlo methods in statistical mechanics", 1997; c = 5 by default). The cost
-// is O(N M) for N samples; M is about c tau_int, small for IMU noise. Centring on each chunk's
-// mean biases tau_int low by about tau_int / n for chunks of n samples.
+// is O(N M) for N samples and the first 64 lags (M is about c tau_int, small for IMU noise);
+// a window that runs past them (a drifting axis) takes the further lags from each chunk's
+// power spectrum at once, O(N log N). Centring on each chunk's mean biases tau_int low by about
+// tau_int / n for chunks of n samples.
 #pragma once
 
 #include <array>
