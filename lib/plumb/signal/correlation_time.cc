@@ -7,6 +7,7 @@
 #include <exception>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include <unsupported/Eigen/FFT>
 
@@ -73,6 +74,17 @@ class CentredChunks {
 /// one pass for several keeps the samples in cache once instead of streaming them per lag.
 constexpr std::size_t kLagsPerPass = 8;
 
+/// Each lag's pooled sum of products divided by its number of pairs (the first `count` of
+/// them), NaN for a lag without pairs (no chunk is longer than it).
+template <typename Sums, typename Pairs>
+Sums PerPair(Sums sum, const Pairs& pairs, std::size_t count) {
+  for (std::size_t j = 0; j < count; ++j) {
+    sum[j] = pairs[j] == 0 ? std::numeric_limits<double>::quiet_NaN()
+                           : sum[j] / static_cast<double>(pairs[j]);
+  }
+  return sum;
+}
+
 /// Autocovariances at lags first .. first + count - 1 pooled over chunks (each divided by its
 /// number of pairs), NaN for a lag no chunk is longer than. One pass over each chunk; each
 /// lag's sum is accumulated in the same order as a pass of its own would. With `sum_sq`, the
@@ -80,7 +92,7 @@ constexpr std::size_t kLagsPerPass = 8;
 std::array<double, kLagsPerPass> PooledAutocovariances(const CentredChunks& data,
                                                        std::size_t first, std::size_t count,
                                                        double* sum_sq = nullptr) {
-  std::array<double, kLagsPerPass> sum{}, out{};
+  std::array<double, kLagsPerPass> sum{};
   std::array<std::size_t, kLagsPerPass> pairs{};
   for (std::size_t c = 0; c < data.count(); ++c) {
     const std::size_t n = data.length(c);
@@ -102,18 +114,15 @@ std::array<double, kLagsPerPass> PooledAutocovariances(const CentredChunks& data
       pairs[j] += n - first - j;
     }
   }
-  for (std::size_t j = 0; j < count; ++j) {
-    out[j] = pairs[j] == 0 ? std::numeric_limits<double>::quiet_NaN()
-                           : sum[j] / static_cast<double>(pairs[j]);
-  }
-  return out;
+  return PerPair(sum, pairs, count);
 }
 
 /// Lags summed from direct passes (PooledAutocovariances); a window that runs past them takes
 /// every further lag from the chunks' spectra at once (PooledAutocovariancesFft): O(N M) for
-/// M lags against O(N log N), which matters when the window runs to thousands of lags (a
-/// drifting axis that never meets the window condition).
+/// M lags against O(N log N), which matters when the window runs to thousands of lags (an
+/// axis that drifts within its still periods).
 constexpr std::size_t kDirectLags = 64;
+static_assert(kDirectLags % kLagsPerPass == 0, "the direct passes end at the last direct lag");
 
 /// Autocovariances at lags first .. last pooled over chunks as PooledAutocovariances gives
 /// them (each lag's sum of products over every chunk, divided by its number of pairs; NaN for
@@ -124,7 +133,7 @@ constexpr std::size_t kDirectLags = 64;
 std::vector<double> PooledAutocovariancesFft(const CentredChunks& data, std::size_t first,
                                              std::size_t last) {
   const std::size_t count = last + 1 - first;
-  std::vector<double> sum(count, 0.0), out(count);
+  std::vector<double> sum(count, 0.0);
   std::vector<std::size_t> pairs(count, 0);
   Eigen::FFT<double> fft;
   std::vector<double> padded, products;
@@ -146,11 +155,7 @@ std::vector<double> PooledAutocovariancesFft(const CentredChunks& data, std::siz
       pairs[k - first] += n - k;
     }
   }
-  for (std::size_t j = 0; j < count; ++j) {
-    out[j] = pairs[j] == 0 ? std::numeric_limits<double>::quiet_NaN()
-                           : sum[j] / static_cast<double>(pairs[j]);
-  }
-  return out;
+  return PerPair(std::move(sum), pairs, count);
 }
 
 void CheckOptions(const CorrelationTimeOptions& options) {
