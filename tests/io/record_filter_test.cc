@@ -169,6 +169,58 @@ TEST(RecordFilter, DataflashImuDecodedKeepsTheTimeRuleAndInstances) {
   EXPECT_GT(ImuFromDataflash(kept, 0).size(), 3u);
 }
 
+/// The layout ArduPilot writes (TimeUS Q, I B, the axes and T f: the decoder's UsualColumns),
+/// with times that go back, a spike, repeats and an instance no other record has, decoded in
+/// the pass as from the bodies; and as the same bytes declared with other format characters of
+/// the same values (q, b: the decoder's AnyColumns).
+TEST(RecordFilter, DataflashImuDecodedInArduPilotsLayoutAsInAnyOther) {
+  using testing::Append;
+  using testing::Bytes;
+  using testing::Put;
+  const std::string columns = "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ,EG,EA,T,GH,AH,GHz,AHz";
+  const auto build = [&](const std::string& format) {
+    // 3 + 8 + 1 + 24 + 4 + 4 + 4 + 1 + 1 + 2 + 2 = 54 bytes.
+    Bytes log = testing::FmtRecord(128, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+    Append(&log, testing::FmtRecord(21, 54, "IMU", format, columns));
+    const std::uint8_t instances[] = {0, 1, 2, 100, 1};  // below 128: the same as int8 (b)
+    const std::uint64_t times[] = {1000, 2000, 1500, 3000, 3000, 90000000, 4000, 5000, 6000};
+    std::size_t n = 0;
+    for (std::uint64_t t : times) {
+      for (std::uint8_t instance : instances) {
+        Bytes r = {0xA3, 0x95, 21};
+        Put(&r, t + static_cast<std::uint64_t>(n % 3));
+        Put(&r, instance);
+        for (int k = 0; k < 6; ++k) Put(&r, 0.25f * static_cast<float>(n + k) - 3.0f);
+        Put(&r, std::uint32_t{0});
+        Put(&r, std::uint32_t{0});
+        Put(&r, 20.0f + 0.125f * static_cast<float>(n));
+        for (int k = 0; k < 6; ++k) r.push_back(0);
+        Append(&log, r);
+        ++n;
+      }
+    }
+    return log;
+  };
+  const Bytes usual = build("QBffffffIIfBBHH");
+  const Bytes other = build("qbffffffIIfBBHH");
+  ASSERT_EQ(usual.size(), other.size());
+  const DataflashLog all = ParseDataflash(usual.data(), usual.size(), "usual.bin");
+  const DataflashLog kept =
+      ParseDataflash(usual.data(), usual.size(), "usual.bin", ArdupilotSessionRecords());
+  const DataflashLog kept_other =
+      ParseDataflash(other.data(), other.size(), "usual.bin", ArdupilotSessionRecords());
+  ASSERT_TRUE(kept.Find("IMU")->imu_decoded);
+  ASSERT_TRUE(kept_other.Find("IMU")->imu_decoded);
+  EXPECT_EQ(all.MessageCounts(), kept.MessageCounts());
+  CheckDecodedImu(all, kept);
+  CheckDecodedImu(all, kept_other);
+  const ImuSeries s = ImuFromDataflash(kept, 1);
+  EXPECT_LT(s.size(), 2 * 9u);  // the rule dropped some
+  EXPECT_GT(s.size(), 3u);
+  EXPECT_TRUE(s.has_temperature());
+  EXPECT_EQ(ImuFromDataflash(kept, 100).size(), ImuFromDataflash(kept_other, 100).size());
+}
+
 /// Everything the IMU side of a log gives (streams, every instance's samples and sessions, or
 /// the error each throws) as text, the sums of the samples in hexadecimal floating point.
 std::string SeriesText(const ImuSeries& s) {

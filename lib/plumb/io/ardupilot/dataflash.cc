@@ -82,26 +82,85 @@ class ImuDecoder {
     const auto plain_float = [](const Reader& r) {
       return r.storage == detail::DataflashStorage::kFloat && r.scale == 1.0;
     };
-    d.float_axes_ = plain_float(d.acc_[0]) && plain_float(d.acc_[1]) && plain_float(d.acc_[2]);
-    if (d.has_gyr_) {
-      d.float_axes_ = d.float_axes_ && plain_float(d.gyr_[0]) && plain_float(d.gyr_[1]) &&
-                      plain_float(d.gyr_[2]);
+    bool usual = d.time_.storage == detail::DataflashStorage::kUInt64 && d.time_.scale == 1.0;
+    usual = usual && (!d.has_instance_ || d.instance_.storage == detail::DataflashStorage::kUInt8);
+    usual = usual && (!d.has_temp_ || plain_float(d.temp_));
+    for (int k = 0; k < 3; ++k) {
+      usual = usual && plain_float(d.acc_[k]) && (!d.has_gyr_ || plain_float(d.gyr_[k]));
     }
+    d.usual_layout_ = usual;
     d.rows_bound_ = std::min(rows_bound, kMaxReserve);
     return d;
   }
 
   /// Decodes the record body `body` of `t` (the type this decoder was made for).
   void Add(DataflashType& t, const std::uint8_t* body) const {
+    if (usual_layout_) {
+      AddWith(t, body, UsualColumns{*this});
+    } else {
+      AddWith(t, body, AnyColumns{*this});
+    }
+  }
+
+  /// After the last record: every instance's last sample stays (no record follows it).
+  void Finish(DataflashType& t) const {
+    for (DataflashImuDecoded& d : t.imu) d.last_on_trial = false;
+  }
+
+ private:
+  /// Reserved samples per instance at most (beyond, the series grow by doubling).
+  static constexpr std::size_t kMaxReserve = std::size_t{1} << 24;
+
+  /// The columns read through their readers (DataflashColumnReader::Read, any format
+  /// character), the values cast to the series' types.
+  struct AnyColumns {
+    const ImuDecoder& d;
+    /// The record's instance 0..255, or -1 when its I value names none.
+    int Instance(const std::uint8_t* body) const {
+      const double v = d.instance_.Read(body);
+      return v >= 0 && v < 256 && v == std::floor(v) ? static_cast<int>(v) : -1;
+    }
+    double RawTime(const std::uint8_t* body) const { return d.time_.Read(body); }
+    Vec3f Axes(const std::uint8_t* body, const detail::DataflashColumnReader* c) const {
+      return Vec3f(static_cast<float>(c[0].Read(body)), static_cast<float>(c[1].Read(body)),
+                   static_cast<float>(c[2].Read(body)));
+    }
+    float Temperature(const std::uint8_t* body) const {
+      return static_cast<float>(d.temp_.Read(body));
+    }
+  };
+
+  /// The columns of the layout ArduPilot writes (usual_layout_: TimeUS 'Q', I 'B', the axes
+  /// and T 'f'): the stored values loaded as they are, which are AnyColumns' values without
+  /// its switch on the format character.
+  struct UsualColumns {
+    const ImuDecoder& d;
+    int Instance(const std::uint8_t* body) const { return body[d.instance_.offset]; }
+    double RawTime(const std::uint8_t* body) const {
+      return static_cast<double>(LoadLittleEndian<std::uint64_t>(body + d.time_.offset));
+    }
+    Vec3f Axes(const std::uint8_t* body, const detail::DataflashColumnReader* c) const {
+      return Vec3f(LoadLittleEndian<float>(body + c[0].offset),
+                   LoadLittleEndian<float>(body + c[1].offset),
+                   LoadLittleEndian<float>(body + c[2].offset));
+    }
+    float Temperature(const std::uint8_t* body) const {
+      return LoadLittleEndian<float>(body + d.temp_.offset);
+    }
+  };
+
+  /// Add with the columns read by `columns` (AnyColumns or UsualColumns).
+  template <typename Columns>
+  void AddWith(DataflashType& t, const std::uint8_t* body, const Columns& columns) const {
     std::size_t k = 0;
     if (has_instance_) {
-      const double v = instance_.Read(body);
-      if (!(v >= 0 && v < 256 && v == std::floor(v))) return;  // no instance's record
-      k = static_cast<std::size_t>(v);
+      const int instance = columns.Instance(body);
+      if (instance < 0) return;  // no instance's record
+      k = static_cast<std::size_t>(instance);
     }
     if (k >= t.imu.size()) t.imu.resize(k + 1);
     DataflashImuDecoded& d = t.imu[k];
-    const double raw_t = time_.Read(body);
+    const double raw_t = columns.RawTime(body);
     const double t_s = raw_t * time_scale_;
     if (d.records == 0) {
       d.first_time = raw_t;
@@ -116,32 +175,10 @@ class ImuDecoder {
     d.last_on_trial = std::isfinite(t_s) && (s.t_s.empty() || t_s > s.t_s.back());
     if (!d.last_on_trial) return;
     s.t_s.push_back(t_s);
-    s.acc.push_back(Axes(body, acc_));
-    if (has_gyr_) s.gyr.push_back(Axes(body, gyr_));
-    if (has_temp_) s.temp_c.push_back(static_cast<float>(temp_.Read(body)));
+    s.acc.push_back(columns.Axes(body, acc_));
+    if (has_gyr_) s.gyr.push_back(columns.Axes(body, gyr_));
+    if (has_temp_) s.temp_c.push_back(columns.Temperature(body));
   }
-
-  /// The three columns `c` of `body` as floats: Read() cast to float, or (float_axes_, the
-  /// usual 'f' columns) the stored floats themselves, the same values without the decoding
-  /// switch.
-  Vec3f Axes(const std::uint8_t* body, const detail::DataflashColumnReader* c) const {
-    if (float_axes_) {
-      return Vec3f(LoadLittleEndian<float>(body + c[0].offset),
-                   LoadLittleEndian<float>(body + c[1].offset),
-                   LoadLittleEndian<float>(body + c[2].offset));
-    }
-    return Vec3f(static_cast<float>(c[0].Read(body)), static_cast<float>(c[1].Read(body)),
-                 static_cast<float>(c[2].Read(body)));
-  }
-
-  /// After the last record: every instance's last sample stays (no record follows it).
-  void Finish(DataflashType& t) const {
-    for (DataflashImuDecoded& d : t.imu) d.last_on_trial = false;
-  }
-
- private:
-  /// Reserved samples per instance at most (beyond, the series grow by doubling).
-  static constexpr std::size_t kMaxReserve = std::size_t{1} << 24;
 
   void Reserve(ImuSeries& s) const {
     if (rows_bound_ == 0) return;
@@ -164,7 +201,9 @@ class ImuDecoder {
   bool has_gyr_ = false;
   bool has_temp_ = false;
   bool has_instance_ = false;
-  bool float_axes_ = false;  ///< every Acc/Gyr column is a plain float ('f')
+  /// The time column is 'Q', the instance column 'B', the axes and temperature 'f' (scale 1):
+  /// Add reads them with UsualColumns.
+  bool usual_layout_ = false;
   std::size_t rows_bound_ = 0;
 };
 
