@@ -671,6 +671,23 @@ TEST(MavlinkSession, NonArdupilotRawImuIsCountsAndPx4IntParamsAreBitCast) {
   EXPECT_EQ(TlogImuStreams(log)[0].applied, "");
 }
 
+TEST(MavlinkSession, ParametersTakeTheLastValueOfEachNameFromTheVehicle) {
+  Bytes t = SmallArdupilotLog(5);
+  Append(&t, Record({kMavParamValue, ParamValue("INS_ACCOFFS_X", 0.5f, 9), 1, 1}));
+  Append(&t, Record({kMavParamValue, ParamValue("INS_ACCOFFS_Y", 0.25f, 9), 1, 1}));
+  Append(&t, Record({kMavParamValue, ParamValue("INS_ACCOFFS_X", 0.75f, 9), 1, 1}));
+  Append(&t, Record({kMavParamValue, ParamValue("INS_ACCOFFS_X", 9.0f, 9), 9, 1}));  // other system
+  Append(&t, Record({kMavParamValue, ParamValue("", 1.0f, 9), 1, 1}));  // no name: ignored
+  Append(&t, Record({kMavParamValue, ParamValue("INS_ACCOFFS_Y_LONGER16", 2.0f, 9), 1, 1}));
+  const MavlinkLog log = Parse(t);
+  const std::map<std::string, double> params = TlogParams(log);
+  EXPECT_EQ(params.at("INS_ACCOFFS_X"), 0.75);
+  EXPECT_EQ(params.at("INS_ACCOFFS_Y"), 0.25);
+  EXPECT_EQ(params.count(""), 0u);
+  EXPECT_EQ(params.at("INS_ACCOFFS_Y_LO"), 2.0);  // param_id holds 16 characters
+  EXPECT_EQ(params.size(), 11u);  // SmallArdupilotLog sends ten
+}
+
 TEST(MavlinkSession, SiteIsTheMedianOf3dFixes) {
   Bytes t = SmallArdupilotLog(5);
   Append(&t, Record({kMavGpsRawInt, GpsRawInt(0, 0, 0, 1), 1, 1}));  // no fix: ignored

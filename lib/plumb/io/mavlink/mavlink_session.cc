@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <string_view>
+#include <unordered_set>
 
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
@@ -303,10 +306,12 @@ ImuSeries WindowedSeries(const StreamData& d, const FlightLogSelection& selectio
 std::optional<MavlinkVehicle> TlogVehicle(const MavlinkLog& log) {
   // (system, component) -> frames, first log time.
   std::map<std::pair<int, int>, std::pair<std::size_t, double>> sources;
+  auto last = sources.end();  // the source of the record before: most often this one's
   const auto add = [&](std::uint8_t sys, std::uint8_t comp, double t) {
-    auto [it, inserted] = sources.try_emplace({sys, comp}, 0, t);
-    ++it->second.first;
-    it->second.second = std::min(it->second.second, t);
+    const std::pair<int, int> key{sys, comp};
+    if (last == sources.end() || last->first != key) last = sources.try_emplace(key, 0, t).first;
+    ++last->second.first;
+    last->second.second = std::min(last->second.second, t);
   };
   for (Kind k : kKinds) {
     if (k == Kind::kHighres) {
@@ -376,16 +381,19 @@ std::optional<SiteInput> SiteFromTlog(const MavlinkLog& log) {
 std::map<std::string, double> TlogParams(const MavlinkLog& log) {
   const std::optional<MavlinkVehicle> v = TlogVehicle(log);
   const bool bytewise = v && v->autopilot == kMavAutopilotPx4;
+  // The last value of each name wins: from the last message back, the first one met is kept
+  // (a log may hold the whole list many times over, and names are compared once each here).
   std::map<std::string, double> params;
-  for (const MavlinkParamValue& p : log.param_value) {
-    if (v && p.system_id != v->system_id) continue;
-    const std::string name = p.Name();
-    if (name.empty()) continue;
-    double value = p.value;
-    if (bytewise && p.type >= 1 && p.type <= 6) {
+  std::unordered_set<std::string_view> seen;
+  for (auto p = log.param_value.rbegin(); p != log.param_value.rend(); ++p) {
+    if (v && p->system_id != v->system_id) continue;
+    const std::string_view name(p->id.data(), strnlen(p->id.data(), p->id.size()));
+    if (name.empty() || !seen.insert(name).second) continue;
+    double value = p->value;
+    if (bytewise && p->type >= 1 && p->type <= 6) {
       std::uint32_t bits = 0;
-      std::memcpy(&bits, &p.value, sizeof(bits));
-      switch (p.type) {
+      std::memcpy(&bits, &p->value, sizeof(bits));
+      switch (p->type) {
         case 1: value = static_cast<std::uint8_t>(bits & 0xFFu); break;
         case 2: value = static_cast<std::int8_t>(bits & 0xFFu); break;
         case 3: value = static_cast<std::uint16_t>(bits & 0xFFFFu); break;
@@ -394,7 +402,7 @@ std::map<std::string, double> TlogParams(const MavlinkLog& log) {
         default: value = static_cast<std::int32_t>(bits); break;
       }
     }
-    params[name] = value;
+    params.emplace(std::string(name), value);
   }
   return params;
 }
