@@ -342,7 +342,7 @@ std::optional<MavlinkVehicle> TlogVehicle(const MavlinkLog& log) {
   if (v.autopilot < 0) {
     // No HEARTBEAT (a cut log): ArduPilot is recognised by its INS_ parameters.
     for (const MavlinkParamValue& p : log.param_value) {
-      if (p.system_id == v.system_id && p.Name() == "INS_ACCOFFS_X") {
+      if (p.system_id == v.system_id && p.NameView() == "INS_ACCOFFS_X") {
         v.autopilot = kMavAutopilotArdupilotMega;
         break;
       }
@@ -387,7 +387,7 @@ std::map<std::string, double> TlogParams(const MavlinkLog& log) {
   std::unordered_set<std::string_view> seen;
   for (auto p = log.param_value.rbegin(); p != log.param_value.rend(); ++p) {
     if (v && p->system_id != v->system_id) continue;
-    const std::string_view name(p->id.data(), strnlen(p->id.data(), p->id.size()));
+    const std::string_view name = p->NameView();
     if (name.empty() || !seen.insert(name).second) continue;
     double value = p->value;
     if (bytewise && p->type >= 1 && p->type <= 6) {

@@ -509,8 +509,8 @@ std::string MavlinkMessageName(std::uint32_t msgid) {
 
 int MavlinkCrcExtra(std::uint32_t msgid) { return CrcExtraOf(msgid); }
 
-std::string MavlinkParamValue::Name() const {
-  return std::string(id.data(), strnlen(id.data(), id.size()));
+std::string_view MavlinkParamValue::NameView() const {
+  return {id.data(), strnlen(id.data(), id.size())};
 }
 
 std::vector<std::string> MavlinkWarnings::Describe(

@@ -53,6 +53,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -148,7 +149,9 @@ struct MavlinkParamValue {
   std::uint8_t component_id = 0;  ///< sender's component id
 
   /// param_id as text (up to the first NUL, at most 16 characters).
-  std::string Name() const;
+  std::string Name() const { return std::string(NameView()); }
+  /// Name() as a view into `id` (valid while this message lives).
+  std::string_view NameView() const;
 };
 
 /// What the reader skipped or repaired. Counts, never fatal.
