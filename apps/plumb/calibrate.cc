@@ -70,8 +70,9 @@ class CalibrateCommand : public Command {
     AddSegmentOptions(app_, a.segments);
     AddExportOptions(app_, a.exports);
     app_->add_option("--jobs", a.jobs,
-                     "Threads for the motion residuals' integration (default 0: every core); "
-                     "the result is the same bit for bit")
+                     "Threads for reading (a .bin of 32 MiB or more in two parts) and the motion "
+                     "residuals' integration (default 0: every core); the result is the same "
+                     "bit for bit")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
   }

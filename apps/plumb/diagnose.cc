@@ -77,7 +77,8 @@ class DiagnoseCommand : public Command {
     app_->add_option("--jobs", a.jobs,
                      "The two probe fits, then the refits, in parallel, each on one core "
                      "(the first refits while the second probe fit runs; default: every "
-                     "core); the result is the same whatever N")
+                     "core), and a .bin of 32 MiB or more read in two parts; the result is the "
+                     "same whatever N")
         ->check(NonNegative);
     app_->add_option("--candidates", a.candidates,
                      "Test only these effects (NAME or NAME:OPTION, comma-separated); default: "

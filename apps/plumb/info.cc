@@ -15,6 +15,7 @@
 #include "plumb/report/json_report.h"
 #include "plumb/segmentation/still_detector.h"
 #include "input_options.h"
+#include "jobs.h"
 #include "plumb/io/input/open_inputs.h"
 #include "segment_options.h"
 #include "json_output.h"
@@ -84,7 +85,7 @@ class InfoCommand : public Command {
     const TextAsideForJson text_aside(a.json_path);
     // The estimate reads the log's first 8 MiB; then the log is read once, whole.
     const std::uint64_t estimate = CheckMemory({a.log_path}, a.max_memory);
-    const io::FlightLog log = io::FlightLog::Open(a.log_path);
+    const io::FlightLog log = io::FlightLog::Open(a.log_path, ParallelJobs(0));
     const io::FlightLogSummary summary = log.Summary();
     nlohmann::json doc;
     doc["log"] = a.log_path;

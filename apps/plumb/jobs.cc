@@ -78,6 +78,7 @@ int Cores() {
 
 JobRunner ParallelJobs(int jobs) {
   const int cores = Cores();
+  if ((jobs > 0 ? jobs : cores) < 2) return {};  // one thread: one job after another
   return [jobs, cores](int count, const std::function<void(int)>& job) {
     const int threads = std::max(1, std::min(count, jobs > 0 ? jobs : cores));
     if (threads > 1 && omp_get_level() == 0) {

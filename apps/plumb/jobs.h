@@ -8,7 +8,8 @@
 namespace plumb::cli {
 
 /// Runs job(0), ..., job(count - 1) on at most `jobs` threads (0: every core), each job on
-/// one thread, taken in order as threads come free. The jobs must not throw. Inside another
+/// one thread, taken in order as threads come free; empty (one job after another, and the
+/// library's choices for one thread: e.g. a .bin read in one part) when that is one thread. The jobs must not throw. Inside another
 /// runner's job (diagnose's refits, each fitting with its own runner) the jobs run on the
 /// job's thread: OpenMP keeps nested regions to one thread.
 ///

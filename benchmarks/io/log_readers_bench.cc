@@ -34,6 +34,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -321,12 +322,15 @@ BENCHMARK_CAPTURE(BM_Cat, sample, std::string("px4/sample.ulg"))
     ->UseRealTime();
 
 /// Reads the DataFlash log at `path` as FlightLog does (the bodies a session reads; the IMU
-/// messages' samples decoded in the pass) and returns the number of IMU samples of every
-/// instance: counted where the reader put them, or with `copy_out` copied out as
-/// ImuFromDataflash returns them.
-std::size_t ReadDataflashSamples(const std::string& path, bool copy_out) {
+/// messages' samples decoded in the pass; in two parts at once with `run_jobs`) and returns
+/// the number of IMU samples of every instance: counted where the reader put them, or with
+/// `copy_out` copied out as ImuFromDataflash returns them.
+std::size_t ReadDataflashSamples(const std::string& path, bool copy_out,
+                                 const plumb::JobRunner& run_jobs = {}) {
+  plumb::io::DataflashReadOptions options;
+  options.run_jobs = run_jobs;
   const plumb::io::DataflashLog decoded =
-      plumb::io::ReadDataflash(path, plumb::io::ArdupilotSessionRecords());
+      plumb::io::ReadDataflash(path, plumb::io::ArdupilotSessionRecords(), options);
   std::size_t samples = 0;
   for (const auto& imu : plumb::io::DataflashImuInstances(decoded)) {
     if (copy_out) {
@@ -353,6 +357,31 @@ BENCHMARK_CAPTURE(BM_ReadDataflash, copter36_chibios, std::string("ardupilot/cop
 BENCHMARK_CAPTURE(BM_ReadDataflash, plane408_centre_point,
                   std::string("ardupilot/plane408_centre_point.BIN"))
     ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// The jobs at once on two OpenMP threads, as `plumb` runs them on a machine of two cores or
+/// more (apps/plumb/jobs.cc, ParallelJobs).
+void TwoThreads(int count, const std::function<void(int)>& job) {
+#pragma omp parallel for schedule(dynamic) num_threads(2)
+  for (int k = 0; k < count; ++k) job(k);
+}
+
+/// BM_ReadDataflash in two parts at once on two threads, as `plumb` reads a .bin of 32 MiB or
+/// more on a machine of two cores or more (DataflashReadOptions): the same samples. Its CPU
+/// time is the process's (both threads).
+void BM_ReadDataflashInTwoParts(benchmark::State& state, const std::string& relative) {
+  ReadRepeated(state, relative,
+               [](const std::string& path) { return ReadDataflashSamples(path, false, TwoThreads); });
+}
+BENCHMARK_CAPTURE(BM_ReadDataflashInTwoParts, copter36_chibios,
+                  std::string("ardupilot/copter36_chibios.bin"))
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadDataflashInTwoParts, plane408_centre_point,
+                  std::string("ardupilot/plane408_centre_point.BIN"))
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
     ->UseRealTime();
 
 /// BM_ReadDataflash, then every IMU instance's samples copied out as ImuFromDataflash returns

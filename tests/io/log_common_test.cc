@@ -113,6 +113,64 @@ TEST(LogCommon, ReadForwardJumpsAndGrowsItsBuffer) {
   EXPECT_EQ(offsets.back(), std::size_t{10} << 20);  // the bytes in between never handed over
 }
 
+// Part of a file: from an offset (the bytes before it never handed over) to where the consumer
+// says stop (no call after it), as the two-part .bin read reads its parts.
+TEST(LogCommon, ReadForwardFromAnOffsetUntilTheConsumerStops) {
+  ::plumb::testing::TempDir dir;
+  const std::vector<std::uint8_t> file = Pattern((std::size_t{9} << 20) + 12345);
+  const std::string path = WriteFile(dir, file);
+  const std::size_t from = (std::size_t{3} << 20) + 4097;  // not on a page boundary
+  const std::size_t stop = (std::size_t{7} << 20) + 5;
+  std::vector<std::uint8_t> seen;
+  std::size_t calls_after_stop = 0;
+  bool stopped = false;
+  ReadForward(
+      path, "test log", 255,
+      [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+        if (stopped) ++calls_after_stop;
+        EXPECT_EQ(offset, from + seen.size());
+        EXPECT_EQ(std::memcmp(data, file.data() + offset, n), 0);
+        EXPECT_FALSE(at_end);
+        if (offset + n >= stop) {
+          seen.insert(seen.end(), data, data + (stop - offset));
+          stopped = true;
+          return kStopReading;
+        }
+        seen.insert(seen.end(), data, data + (n - 255));
+        return offset + n - 255;
+      },
+      from);
+  EXPECT_TRUE(stopped);
+  EXPECT_EQ(calls_after_stop, 0u);
+  EXPECT_TRUE(seen == std::vector<std::uint8_t>(file.begin() + from, file.begin() + stop));
+  // From the end: one call, no bytes, at the end.
+  std::size_t calls = 0;
+  ReadForward(
+      path, "test log", 255,
+      [&](const std::uint8_t*, std::size_t n, std::size_t offset, bool at_end) {
+        ++calls;
+        EXPECT_EQ(n, 0u);
+        EXPECT_EQ(offset, file.size());
+        EXPECT_TRUE(at_end);
+        return offset;
+      },
+      file.size());
+  EXPECT_EQ(calls, 1u);
+}
+
+TEST(LogCommon, RecordStoreAppendsAnotherStore) {
+  const std::vector<std::uint8_t> bytes = Pattern(37 * 70001);
+  RecordStore whole(37), first(37), second(37);
+  for (std::size_t r = 0; r < 70001; ++r) {
+    whole.Append(bytes.data() + r * 37);
+    (r < 40000 ? first : second).Append(bytes.data() + r * 37);
+  }
+  first.Append(second);
+  EXPECT_TRUE(first == whole);
+  first.Append(RecordStore(37));  // nothing
+  EXPECT_TRUE(first == whole);
+}
+
 // A log cut short while it is read (copied over, or a card failing) is a read error naming
 // the file and the byte, not a SIGBUS from touching a mapped page past the new end.
 TEST(LogCommon, ReadForwardReportsAFileCutShortWhileItIsRead) {

@@ -4,352 +4,32 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <optional>
+#include <vector>
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/dataflash_format.h"
+#include "plumb/io/ardupilot/dataflash_parser.h"
 
 namespace plumb::io {
 namespace {
 
 using detail::DataflashFormat;
+using detail::DataflashParser;
 using detail::DataflashStorage;
-constexpr std::uint8_t kHead1 = detail::kDataflashHead1;
-constexpr std::uint8_t kHead2 = detail::kDataflashHead2;
-constexpr std::uint8_t kFmtType = detail::kDataflashFmtType;
-constexpr std::size_t kHeaderSize = detail::kDataflashHeaderSize;
+using TimeColumn = detail::DataflashTimeColumn;
+constexpr auto FindTime = detail::FindDataflashTime;
+constexpr auto TemperatureColumn = detail::DataflashTemperatureColumn;
 
 /// A value asked of a type whose bodies the reader's RecordFilter left out: a caller's bug.
 [[noreturn]] void NotKept(const std::string& name) {
   throw Error("DataFlash type " + name + ": its record bodies were not kept (RecordFilter)");
 }
-
-/// Text of a fixed-width char field up to its first NUL.
-std::string FixedText(const std::uint8_t* p, std::size_t n) {
-  const auto* c = reinterpret_cast<const char*>(p);
-  return std::string(c, strnlen(c, n));
-}
-
-/// Time of record `row` in seconds from TimeUS or TimeMS (`scale` 1e-6 or 1e-3).
-struct TimeColumn {
-  int col = -1;
-  double scale = 0.0;
-};
-
-TimeColumn FindTime(const DataflashType& t) {
-  if (const int c = t.ColumnIndex("TimeUS"); c >= 0) return {c, 1e-6};
-  if (const int c = t.ColumnIndex("TimeMS"); c >= 0) return {c, 1e-3};
-  return {};
-}
-
-int TemperatureColumn(const DataflashType& t) {
-  const int c = t.ColumnIndex("T");
-  return c >= 0 ? c : t.ColumnIndex("Temp");
-}
-
-/// Decodes the IMU samples of one message inside the reader's pass (RecordFilter::decode):
-/// the columns ImuFromDataflash reads, and its rule for times applied record by record.
-class ImuDecoder {
- public:
-  /// The decoder of `t`, or nullopt when `t` lacks a time or AccX/Y/Z column (its bodies are
-  /// then kept, and ImuFromDataflash says what is missing). `rows_bound`: at most this many
-  /// records are coming (0: unknown), to reserve each instance's samples once.
-  static std::optional<ImuDecoder> For(const DataflashType& t, std::size_t rows_bound) {
-    using Reader = detail::DataflashColumnReader;
-    const TimeColumn time = FindTime(t);
-    const int acc[3] = {t.ColumnIndex("AccX"), t.ColumnIndex("AccY"), t.ColumnIndex("AccZ")};
-    if (time.col < 0 || acc[0] < 0 || acc[1] < 0 || acc[2] < 0) return std::nullopt;
-    const int gyr[3] = {t.ColumnIndex("GyrX"), t.ColumnIndex("GyrY"), t.ColumnIndex("GyrZ")};
-    ImuDecoder d;
-    d.time_ = Reader::Of(t, time.col);
-    d.time_scale_ = time.scale;
-    for (int k = 0; k < 3; ++k) d.acc_[k] = Reader::Of(t, acc[k]);
-    d.has_gyr_ = gyr[0] >= 0 && gyr[1] >= 0 && gyr[2] >= 0;
-    if (d.has_gyr_) {
-      for (int k = 0; k < 3; ++k) d.gyr_[k] = Reader::Of(t, gyr[k]);
-    }
-    const int temp = TemperatureColumn(t);
-    d.has_temp_ = temp >= 0;
-    if (d.has_temp_) d.temp_ = Reader::Of(t, temp);
-    // As ImuFromDataflash finds its instances (DataflashInstanceMessage): the I column of
-    // "IMU"; any other message (IMU2, ...) is one instance.
-    const int instance = t.name == "IMU" ? t.ColumnIndex("I") : -1;
-    d.has_instance_ = instance >= 0;
-    if (d.has_instance_) d.instance_ = Reader::Of(t, instance);
-    const auto plain_float = [](const Reader& r) {
-      return r.storage == detail::DataflashStorage::kFloat && r.scale == 1.0;
-    };
-    bool usual = d.time_.storage == detail::DataflashStorage::kUInt64 && d.time_.scale == 1.0;
-    usual = usual && (!d.has_instance_ || d.instance_.storage == detail::DataflashStorage::kUInt8);
-    usual = usual && (!d.has_temp_ || plain_float(d.temp_));
-    for (int k = 0; k < 3; ++k) {
-      usual = usual && plain_float(d.acc_[k]) && (!d.has_gyr_ || plain_float(d.gyr_[k]));
-    }
-    d.usual_layout_ = usual;
-    d.rows_bound_ = std::min(rows_bound, kMaxReserve);
-    return d;
-  }
-
-  /// Decodes the record body `body` of `t` (the type this decoder was made for).
-  void Add(DataflashType& t, const std::uint8_t* body) const {
-    if (usual_layout_) {
-      AddWith(t, body, UsualColumns{*this});
-    } else {
-      AddWith(t, body, AnyColumns{*this});
-    }
-  }
-
-  /// After the last record: every instance's last sample stays (no record follows it).
-  void Finish(DataflashType& t) const {
-    for (DataflashImuDecoded& d : t.imu) d.last_on_trial = false;
-  }
-
- private:
-  /// Reserved samples per instance at most (beyond, the series grow by doubling).
-  static constexpr std::size_t kMaxReserve = std::size_t{1} << 24;
-
-  /// The columns read through their readers (DataflashColumnReader::Read, any format
-  /// character), the values cast to the series' types.
-  struct AnyColumns {
-    const ImuDecoder& d;
-    /// The record's instance 0..255, or -1 when its I value names none.
-    int Instance(const std::uint8_t* body) const {
-      const double v = d.instance_.Read(body);
-      return v >= 0 && v < 256 && v == std::floor(v) ? static_cast<int>(v) : -1;
-    }
-    double RawTime(const std::uint8_t* body) const { return d.time_.Read(body); }
-    Vec3f Axes(const std::uint8_t* body, const detail::DataflashColumnReader* c) const {
-      return Vec3f(static_cast<float>(c[0].Read(body)), static_cast<float>(c[1].Read(body)),
-                   static_cast<float>(c[2].Read(body)));
-    }
-    float Temperature(const std::uint8_t* body) const {
-      return static_cast<float>(d.temp_.Read(body));
-    }
-  };
-
-  /// The columns of the layout ArduPilot writes (usual_layout_: TimeUS 'Q', I 'B', the axes
-  /// and T 'f'): the stored values loaded as they are, which are AnyColumns' values without
-  /// its switch on the format character.
-  struct UsualColumns {
-    const ImuDecoder& d;
-    int Instance(const std::uint8_t* body) const { return body[d.instance_.offset]; }
-    double RawTime(const std::uint8_t* body) const {
-      return static_cast<double>(LoadLittleEndian<std::uint64_t>(body + d.time_.offset));
-    }
-    Vec3f Axes(const std::uint8_t* body, const detail::DataflashColumnReader* c) const {
-      return Vec3f(LoadLittleEndian<float>(body + c[0].offset),
-                   LoadLittleEndian<float>(body + c[1].offset),
-                   LoadLittleEndian<float>(body + c[2].offset));
-    }
-    float Temperature(const std::uint8_t* body) const {
-      return LoadLittleEndian<float>(body + d.temp_.offset);
-    }
-  };
-
-  /// Add with the columns read by `columns` (AnyColumns or UsualColumns).
-  template <typename Columns>
-  void AddWith(DataflashType& t, const std::uint8_t* body, const Columns& columns) const {
-    std::size_t k = 0;
-    if (has_instance_) {
-      const int instance = columns.Instance(body);
-      if (instance < 0) return;  // no instance's record
-      k = static_cast<std::size_t>(instance);
-    }
-    if (k >= t.imu.size()) t.imu.resize(k + 1);
-    DataflashImuDecoded& d = t.imu[k];
-    const double raw_t = columns.RawTime(body);
-    const double t_s = raw_t * time_scale_;
-    if (d.records == 0) {
-      d.first_time = raw_t;
-      Reserve(d.series);
-    }
-    d.last_time = raw_t;
-    ++d.records;
-    ImuSeries& s = d.series;
-    if (d.last_on_trial && !(s.t_s.back() < t_s)) PopBack(s);  // it was a spike
-    // Kept for now when its time is finite and above the last kept sample's; its fate is
-    // sealed by the next record's time (ImuFromDataflash's rule).
-    d.last_on_trial = std::isfinite(t_s) && (s.t_s.empty() || t_s > s.t_s.back());
-    if (!d.last_on_trial) return;
-    s.t_s.push_back(t_s);
-    s.acc.push_back(columns.Axes(body, acc_));
-    if (has_gyr_) s.gyr.push_back(columns.Axes(body, gyr_));
-    if (has_temp_) s.temp_c.push_back(columns.Temperature(body));
-  }
-
-  void Reserve(ImuSeries& s) const {
-    if (rows_bound_ == 0) return;
-    ReserveHugePages(s.t_s, rows_bound_);
-    ReserveHugePages(s.acc, rows_bound_);
-    if (has_gyr_) ReserveHugePages(s.gyr, rows_bound_);
-    if (has_temp_) ReserveHugePages(s.temp_c, rows_bound_);
-  }
-
-  /// Takes the last sample out of `s`.
-  void PopBack(ImuSeries& s) const {
-    s.t_s.pop_back();
-    s.acc.pop_back();
-    if (has_gyr_) s.gyr.pop_back();
-    if (has_temp_) s.temp_c.pop_back();
-  }
-
-  detail::DataflashColumnReader time_, acc_[3], gyr_[3], temp_, instance_;
-  double time_scale_ = 0.0;
-  bool has_gyr_ = false;
-  bool has_temp_ = false;
-  bool has_instance_ = false;
-  /// The time column is 'Q', the instance column 'B', the axes and temperature 'f' (scale 1):
-  /// Add reads them with UsualColumns.
-  bool usual_layout_ = false;
-  std::size_t rows_bound_ = 0;
-};
-
-/// The one-pass decoder state: fed the file's bytes in order, in one piece (ParseDataflash) or
-/// in chunks (ReadDataflash, through ReadForward).
-class Parser {
- public:
-  /// The longest record: its length is one byte, header included.
-  static constexpr std::size_t kMaxRecord = 255;
-
-  /// `filter`: the types whose bodies are kept or samples decoded; `size_hint`: the input's
-  /// size in bytes (0: unknown), to reserve decoded samples once.
-  Parser(DataflashLog* log, const RecordFilter& filter, std::size_t size_hint)
-      : log_(log), filter_(filter), size_hint_(size_hint) {
-    index_.fill(-1);
-    decoder_of_.fill(-1);
-    rows_.fill(0);
-    AddType(detail::DataflashFmtType(&log_->warnings));
-  }
-
-  /// After the last Feed: the record counts go to the types, and the decoded IMU messages'
-  /// waiting records are decided.
-  void Finish() {
-    for (DataflashType& t : log_->types) t.rows = rows_[t.id];
-    for (std::size_t id = 0; id < decoder_of_.size(); ++id) {
-      if (decoder_of_[id] < 0) continue;
-      decoders_[static_cast<std::size_t>(decoder_of_[id])].Finish(
-          log_->types[static_cast<std::size_t>(index_[id])]);
-    }
-  }
-
-  /// Decodes the records starting in the bytes [offset, offset + n) of the input held at
-  /// `data`; returns the offset to go on from (unless `at_end`, at least kMaxRecord bytes
-  /// before offset + n, so that every record starting before it is whole). `at_end`: the bytes
-  /// end the input (the truncated last record and trailing bytes are counted).
-  std::size_t Feed(const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
-    // The loop reads one table per record (length and action by type byte) and touches a
-    // type only for the records it keeps or decodes: the walk from record to record is the
-    // chain of loads byte -> length -> next byte, nothing more.
-    const std::size_t room = at_end ? kHeaderSize : kMaxRecord;  // bytes a record may need
-    std::size_t i = 0;
-    while (n - i >= room) {
-      const std::uint8_t* p = data + i;
-      const Entry e = table_[p[2]];
-      if (p[0] == kHead1 && p[1] == kHead2 && e.length != 0) {
-        if (e.length > n - i) {
-          Truncated(n - i);
-          return offset + n;
-        }
-        ++rows_[p[2]];
-        i += e.length;
-        if (e.action != Action::kCount) Act(e.action, p[2], p + kHeaderSize, offset + i);
-        continue;
-      }
-      Skip(offset + i);
-      ++i;
-    }
-    if (!at_end) return offset + i;
-    const std::size_t tail = n - i;
-    if (tail == 0) return offset + n;
-    const bool header_prefix = data[i] == kHead1 && (tail == 1 || data[i + 1] == kHead2);
-    if (header_prefix) {
-      Truncated(tail);
-    } else {
-      for (std::size_t k = 0; k < tail; ++k) Skip(offset + i + k);
-    }
-    return offset + n;
-  }
-
- private:
-  /// What the loop does with a record of a type besides counting it.
-  enum class Action : std::uint8_t { kCount, kKeep, kDecode, kFmt };
-  /// A type's entry in the loop's table, by type byte.
-  struct Entry {
-    std::uint8_t length = 0;  ///< record length with the header; 0: no type has this byte
-    Action action = Action::kCount;
-  };
-
-  /// Keeps (kKeep, kFmt) or decodes (kDecode) the record body `body` of type `id`; an FMT
-  /// (kFmt, its record ending at byte `end`) defines a type.
-  void Act(Action action, std::uint8_t id, const std::uint8_t* body, std::size_t end) {
-    DataflashType& t = log_->types[static_cast<std::size_t>(index_[id])];
-    if (action == Action::kDecode) {
-      decoders_[static_cast<std::size_t>(decoder_of_[id])].Add(t, body);
-      return;
-    }
-    t.bodies.Append(body);
-    if (action == Action::kFmt) HandleFmt(body, t.body_size, end);
-  }
-
-  /// Adds a type from its FMT, found at byte `offset`.
-  void AddType(DataflashType t, std::size_t offset = 0) {
-    t.bodies_kept = t.id == kFmtType || filter_.Keeps(t.name);
-    if (t.id != kFmtType && filter_.Decodes(t.name) && t.length > 0) {
-      const std::size_t rest = size_hint_ > offset ? size_hint_ - offset : 0;
-      if (std::optional<ImuDecoder> d = ImuDecoder::For(t, rest / t.length + 1)) {
-        t.imu_decoded = true;
-        t.bodies_kept = false;
-        decoder_of_[t.id] = static_cast<int>(decoders_.size());
-        decoders_.push_back(*d);
-      }
-    }
-    Entry& e = table_[t.id];
-    e.length = static_cast<std::uint8_t>(t.length);  // 3..255 (AcceptFmt, one byte)
-    e.action = t.id == kFmtType ? Action::kFmt
-               : t.imu_decoded  ? Action::kDecode
-               : t.bodies_kept  ? Action::kKeep
-                                : Action::kCount;
-    index_[t.id] = static_cast<int>(log_->types.size());
-    log_->types.push_back(std::move(t));
-  }
-
-  void Skip(std::size_t pos) { CountSkipped(log_->warnings, pos, pos + 1, skip_end_); }
-
-  void Truncated(std::size_t bytes) {
-    ++log_->warnings.truncated_records;
-    log_->warnings.truncated_bytes += bytes;
-  }
-
-  // FMT body: Type (B), Length (B), Name (n), Format (N), Columns (Z) = 86 bytes.
-  void HandleFmt(const std::uint8_t* body, std::size_t body_size, std::size_t offset) {
-    if (body_size < detail::kFmtBodySize) return;  // cannot happen with the built-in FMT
-    const std::uint8_t id = body[detail::kFmtTypeOffset];
-    const std::size_t length = body[detail::kFmtLengthOffset];
-    const std::string name = FixedText(body + detail::kFmtNameOffset, detail::kFmtNameSize);
-    const std::string format = FixedText(body + detail::kFmtFormatOffset, detail::kFmtFormatSize);
-    const std::string columns =
-        FixedText(body + detail::kFmtColumnsOffset, detail::kFmtColumnsSize);
-    const int existing = index_[id];
-    const DataflashType* known =
-        existing >= 0 ? &log_->types[static_cast<std::size_t>(existing)] : nullptr;
-    if (!detail::AcceptFmt(known, length, name, format, &log_->warnings)) return;
-    AddType(detail::MakeDataflashType(id, length, name, format, columns, &log_->warnings),
-            offset);
-  }
-
-  DataflashLog* log_;
-  const RecordFilter& filter_;
-  std::size_t size_hint_ = 0;   ///< the input's size, bytes (0: unknown)
-  std::array<int, 256> index_;
-  std::array<int, 256> decoder_of_;  ///< index in decoders_ by type id, -1: not decoded
-  std::array<Entry, 256> table_{};    ///< the loop's table by type id
-  std::array<std::size_t, 256> rows_;  ///< records counted by type id
-  std::vector<ImuDecoder> decoders_;
-  std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
-};
 
 /// The message holding IMU `instance` and the column of its instance field (-1 if none).
 const DataflashType* ImuType(const DataflashLog& log, int instance, int* instance_col) {
@@ -479,31 +159,142 @@ void FinishParse(DataflashLog* log, std::size_t size) {
 
 }  // namespace
 
-DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
-                            const std::string& source, const RecordFilter& filter) {
-  DataflashLog log;
-  log.source = source;
-  log.size_bytes = size;
-  Parser parser(&log, filter, size);
-  parser.Feed(data, size, 0, true);
-  parser.Finish();
-  FinishParse(&log, size);
-  return log;
+namespace {
+
+/// What consumes the input's bytes, as ReadForward hands them over.
+using ByteConsumer =
+    std::function<std::size_t(const std::uint8_t* data, std::size_t n, std::size_t offset,
+                              bool at_end)>;
+/// Hands the input's bytes from offset `from` on to `consume` as ReadForward does: a file span
+/// by span, bytes in memory in one call that ends them.
+using ByteSource = std::function<void(std::size_t from, const ByteConsumer& consume)>;
+
+/// Bytes looked at from the second part's nominal start for a record boundary (FindRecordChain).
+constexpr std::size_t kBoundaryWindow = std::size_t{64} << 10;
+/// Records in a row that make a guessed record boundary.
+constexpr int kBoundaryRecords = 16;
+
+/// Decodes the records of `source` starting in [from, until) into `parser`; returns the offset
+/// of the first record, or skipped byte, at or after `until` (or where the last whole record
+/// before the input's last kMaxRecord bytes ends).
+std::size_t DecodeUntil(const ByteSource& source, DataflashParser& parser, std::size_t from,
+                        std::size_t until) {
+  std::size_t reached = from;
+  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    // With `limit` bytes, Feed decodes exactly the records starting before `until`.
+    const std::size_t limit = until - offset + DataflashParser::kMaxRecord - 1;
+    if (n < limit && !at_end) return parser.Feed(data, n, offset, false);
+    reached = parser.Feed(data, std::min(n, limit), offset, false);
+    return kStopReading;
+  });
+  return reached;
 }
 
-DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter) {
+/// Decodes the records of `source` from `from` on into `ahead` (DataflashParser::Ahead) until
+/// it stops; returns the offset it reached.
+std::size_t DecodeAhead(const ByteSource& source, DataflashParser& ahead, std::size_t from) {
+  std::size_t reached = from;
+  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    reached = ahead.FeedAhead(data, n, offset);
+    return ahead.stopped() || at_end ? kStopReading : reached;
+  });
+  return reached;
+}
+
+/// A record boundary at byte `from` or after in `source`, as `parser`'s types make one
+/// (FindRecordChain over kBoundaryWindow bytes); nullopt when none is found.
+std::optional<std::size_t> RecordBoundary(const ByteSource& source, const DataflashParser& parser,
+                                          std::size_t from) {
+  std::optional<std::size_t> found;
+  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool) {
+    const std::size_t window = std::min(n, kBoundaryWindow);
+    const std::size_t at = parser.FindRecordChain(data, window, kBoundaryRecords);
+    if (at < window) found = offset + at;
+    return kStopReading;
+  });
+  return found;
+}
+
+/// Decodes `source` (`size` bytes) into `parser` in two parts at once through options.run_jobs
+/// (see DataflashReadOptions). Returns the offset from which the input is still to be decoded:
+/// where the second part stopped, or, when it does not count, where the first did.
+std::size_t DecodeInTwo(const ByteSource& source, std::size_t size, DataflashParser& parser,
+                        const DataflashReadOptions& options) {
+  const std::size_t lead = DecodeUntil(source, parser, 0, std::min(options.lead_bytes, size));
+  const double at = std::clamp(options.second_part_at, 0.0, 1.0);
+  const auto nominal = lead + static_cast<std::size_t>(at * static_cast<double>(size - lead));
+  const std::optional<std::size_t> start = RecordBoundary(source, parser, nominal);
+  if (!start || *start <= lead) return lead;
+  DataflashLog ahead_log;
+  DataflashParser ahead = parser.Ahead(&ahead_log);
+  std::size_t reached = lead;
+  std::size_t stop = *start;
+  std::exception_ptr first_failed;
+  bool ahead_failed = false;
+  RunJobs(options.run_jobs, 2, [&](int job) {
+    try {
+      if (job == 0) {
+        reached = DecodeUntil(source, parser, lead, *start);
+      } else {
+        stop = DecodeAhead(source, ahead, *start);
+      }
+    } catch (...) {  // the jobs throw nothing (core/jobs.h)
+      if (job == 0) {
+        first_failed = std::current_exception();
+      } else {
+        ahead_failed = true;
+      }
+    }
+  });
+  if (first_failed) std::rethrow_exception(first_failed);
+  // The second part counts when the first ended exactly on its start (the guess was a record
+  // boundary) and its samples join; else the first part goes on alone from where it is (and
+  // meets the second part's read error, if there was one, itself).
+  if (ahead_failed || reached != *start || !parser.Absorb(ahead, ahead_log, options.run_jobs)) {
+    return reached;
+  }
+  return stop;
+}
+
+/// The log of `source` (`size` bytes; 0: unknown), named `name`, decoded in one part or two
+/// (options).
+DataflashLog Decode(const ByteSource& source, std::size_t size, const std::string& name,
+                    const RecordFilter& filter, const DataflashReadOptions& options) {
   DataflashLog log;
-  log.source = path;
-  Parser parser(&log, filter, RegularFileSize(path));
-  // One pass, in chunks: every record is decoded from the read buffer as it goes by.
-  ReadForward(path, "DataFlash log", Parser::kMaxRecord,
-              [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
-                if (at_end) log.size_bytes = offset + n;
-                return parser.Feed(data, n, offset, at_end);
-              });
+  log.source = name;
+  DataflashParser parser(&log, filter, size);
+  const std::size_t from = options.run_jobs && size > 0 && size >= options.two_part_bytes
+                               ? DecodeInTwo(source, size, parser, options)
+                               : 0;
+  // One pass (the rest of it), in chunks: every record is decoded from the read buffer as it
+  // goes by.
+  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    if (at_end) log.size_bytes = offset + n;
+    return parser.Feed(data, n, offset, at_end);
+  });
   parser.Finish();
   FinishParse(&log, log.size_bytes);
   return log;
+}
+
+}  // namespace
+
+DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
+                            const std::string& source, const RecordFilter& filter,
+                            const DataflashReadOptions& options) {
+  const ByteSource memory = [&](std::size_t from, const ByteConsumer& consume) {
+    from = std::min(from, size);
+    consume(data + from, size - from, from, true);
+  };
+  return Decode(memory, size, source, filter, options);
+}
+
+DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter,
+                           const DataflashReadOptions& options) {
+  const ByteSource file = [&](std::size_t from, const ByteConsumer& consume) {
+    ReadForward(path, "DataFlash log", DataflashParser::kMaxRecord, consume, from);
+  };
+  return Decode(file, RegularFileSize(path), path, filter, options);
 }
 
 namespace {

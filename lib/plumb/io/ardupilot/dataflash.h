@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/jobs.h"
 #include "plumb/io/common/flight_log.h"
 #include "plumb/io/common/log_common.h"
 
@@ -153,14 +154,40 @@ struct DataflashLog {
   std::vector<std::pair<std::string, std::size_t>> MessageCounts() const;
 };
 
+/// How ReadDataflash reads a file: in one part, or in two at once.
+struct DataflashReadOptions {
+  /// Runs independent jobs at once (core/jobs.h). When given, a regular file of
+  /// `two_part_bytes` or more is read in two parts at once: the first from the file's start,
+  /// the second from a record boundary guessed near `second_part_at` of the way through. The
+  /// second part counts only when the first ends exactly on its start; it stops, leaving the
+  /// rest to the first, at any byte it cannot decide alone (one that starts no record of a
+  /// type defined in the file's first `lead_bytes`, or an FMT defining a new type); and its IMU
+  /// samples are joined to the first part's under the rule for times as if read in one pass.
+  /// So the log is the same, to the byte, as read in one part. Empty: one part.
+  JobRunner run_jobs;
+  /// Files from this size on are read in two parts when run_jobs is given (32 MiB: below, a
+  /// part takes a few milliseconds, what starting and joining it costs).
+  std::size_t two_part_bytes = std::size_t{32} << 20;
+  /// Bytes read alone before the second part starts: the types it knows are those defined in
+  /// them (ArduPilot writes the FMTs of the types it logs first; the FMT of a type first
+  /// logged later stops the second part there). 1 MiB.
+  std::size_t lead_bytes = std::size_t{1} << 20;
+  /// Where the second part's start is looked for, as a fraction of the bytes after the lead
+  /// (0.5: the middle, which gives both parts the same bytes).
+  double second_part_at = 0.5;
+};
+
 /// Reads and decodes a .bin log. Throws plumb::InputError(path, "byte N", what) when the file
 /// cannot be read or holds no FMT record at all.
 /// `filter`: the types whose record bodies are kept (RecordFilter; default all).
-DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter = {});
+/// `options`: in one part or two at once (DataflashReadOptions; default one).
+DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter = {},
+                           const DataflashReadOptions& options = {});
 
 /// Decodes a log held in memory; `source` names it in errors. Same contract as ReadDataflash.
 DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
-                            const std::string& source, const RecordFilter& filter = {});
+                            const std::string& source, const RecordFilter& filter = {},
+                            const DataflashReadOptions& options = {});
 
 /// Reads and decodes an ArduPilot TEXT log (.log, as Mission Planner writes it) into the same
 /// DataflashLog a .bin gives; see ParseDataflashText. Throws plumb::InputError(path, "", what)

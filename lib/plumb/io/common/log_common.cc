@@ -134,7 +134,9 @@ constexpr std::size_t kDropStep = std::size_t{2} << 20;
 /// end of a file cut short meanwhile, would raise SIGBUS instead.
 class ForwardMapping {
  public:
-  ForwardMapping(int fd, std::size_t size) : fd_(fd), size_(size) {
+  /// The file `fd` of `size` bytes, to be read from byte `from` on.
+  ForwardMapping(int fd, std::size_t size, std::size_t from)
+      : fd_(fd), size_(size), populated_(from / Page() * Page()), dropped_(populated_) {
     if (size == 0) return;
     void* m = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
     if (m == MAP_FAILED) return;
@@ -185,7 +187,7 @@ class ForwardMapping {
   int fd_ = -1;                ///< the file, open while this lives
   std::uint8_t* base_ = nullptr;
   std::size_t size_ = 0;
-  std::size_t populated_ = 0;  ///< bytes [0, populated_) were read in
+  std::size_t populated_ = 0;  ///< bytes up to this one, from the first read, were read in
   std::size_t dropped_ = 0;    ///< pages before this byte were dropped
 };
 
@@ -193,10 +195,11 @@ using ForwardConsumer =
     std::function<std::size_t(const std::uint8_t*, std::size_t, std::size_t, bool)>;
 
 /// ReadForward over a mapped file (see ForwardMapping): each call gets `span` bytes of the
-/// mapping from the offset the last one returned, as the read(2) loop would hand them.
-void ConsumeMapped(ForwardMapping& map, std::size_t size, std::size_t span,
+/// mapping from the offset the last one returned (the first from `from`), as the read(2) loop
+/// would hand them.
+void ConsumeMapped(ForwardMapping& map, std::size_t size, std::size_t span, std::size_t from,
                    const std::string& path, const ForwardConsumer& consume) {
-  std::size_t at = 0;  // file offset of the next call's first byte
+  std::size_t at = from;  // file offset of the next call's first byte
   while (true) {
     const std::size_t n = std::min(span, size - at);
     if (const int error = map.Prepare(at + n); error != 0) {
@@ -208,7 +211,7 @@ void ConsumeMapped(ForwardMapping& map, std::size_t size, std::size_t span,
     }
     const bool at_end = at + n >= size;
     const std::size_t next = consume(map.data() + at, n, at, at_end);
-    if (at_end) return;
+    if (at_end || next == kStopReading) return;
     if (next < at) throw Error("ReadForward: the parser of " + path + " went backwards");
     if (next == at) {  // nothing consumed from a full span: hand over more
       span *= 2;
@@ -283,7 +286,8 @@ std::size_t RegularFileSize(const std::string& path) {
 
 void ReadForward(const std::string& path, const std::string& what, std::size_t lookahead,
                  const std::function<std::size_t(const std::uint8_t*, std::size_t, std::size_t,
-                                                 bool)>& consume) {
+                                                 bool)>& consume,
+                 std::size_t from) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     throw InputError(path, "byte 0",
@@ -299,14 +303,16 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
   }
   ::posix_fadvise(fd, 0, 0, POSIX_FADV_SEQUENTIAL);
   const auto size = static_cast<std::size_t>(st.st_size);
-  if (ForwardMapping map(fd, size); map.Prepare(std::min(size, lookahead + kMapSpan)) == 0) {
-    ConsumeMapped(map, size, lookahead + kMapSpan, path, consume);
+  from = std::min(from, size);
+  if (ForwardMapping map(fd, size, from);
+      map.Prepare(std::min(size, from + lookahead + kMapSpan)) == 0) {
+    ConsumeMapped(map, size, lookahead + kMapSpan, from, path, consume);
     return;
   }
   std::size_t capacity = lookahead + kReadChunk;
   // Not mappable, or no MADV_POPULATE_READ to read a mapping safely: read(2) into a buffer.
   std::vector<std::uint8_t> buffer(capacity);
-  std::size_t base = 0;  // file offset of buffer[0]
+  std::size_t base = from;  // file offset of buffer[0]
   std::size_t have = 0;  // bytes of the file in buffer
   while (true) {
     const std::size_t want = std::min(capacity - have, size - std::min(size, base + have));
@@ -314,7 +320,7 @@ void ReadForward(const std::string& path, const std::string& what, std::size_t l
     have += got;
     const bool at_end = got < want || base + have >= size;
     const std::size_t next = consume(buffer.data(), have, base, at_end);
-    if (at_end) return;
+    if (at_end || next == kStopReading) return;
     if (next < base) throw Error("ReadForward: the parser of " + path + " went backwards");
     if (next == base && have == capacity) {  // nothing consumed from a full buffer: grow it
       capacity *= 2;

@@ -82,12 +82,19 @@ T LoadLittleEndian(const std::uint8_t* p) {
 /// read). The bytes from that offset to offset + n are passed again at the start of the next
 /// call, followed by the next chunk; a parser returns a position `lookahead` bytes or more
 /// before the end of its data unless `at_end`. Reading stops after the call with `at_end` (or
-/// when the returned offset is the file size or beyond). `what` names the format in errors:
-/// throws plumb::InputError(path, "byte N", ...) when the file cannot be opened or read. A
-/// file that is not a regular file (a pipe) is read whole first.
+/// when the returned offset is the file size or beyond); a call returning kStopReading ends
+/// the reading at once (a parser that reads part of a file). `what` names the format in
+/// errors: throws plumb::InputError(path, "byte N", ...) when the file cannot be opened or
+/// read. A file that is not a regular file (a pipe) is read whole first. `from`: the file
+/// offset of the first call's first byte (0: from the start); the bytes before it are not read
+/// (a regular file only: a pipe is read whole and handed over from its start).
 void ReadForward(const std::string& path, const std::string& what, std::size_t lookahead,
                  const std::function<std::size_t(const std::uint8_t* data, std::size_t n,
-                                                 std::size_t offset, bool at_end)>& consume);
+                                                 std::size_t offset, bool at_end)>& consume,
+                 std::size_t from = 0);
+
+/// What a ReadForward consumer returns to stop the reading there.
+inline constexpr std::size_t kStopReading = std::numeric_limits<std::size_t>::max();
 
 /// Asks the system to back the memory [p, p + bytes) of a large buffer that is about to be
 /// filled by transparent huge pages (madvise MADV_HUGEPAGE on the whole 2 MiB pages inside it,
@@ -144,6 +151,10 @@ class RecordStore {
     if ((rows_ & mask_) == 0 && (rows_ >> shift_) == blocks_.size()) AddBlock();
     std::memcpy(MutableRow(rows_), body, body_size_);
     ++rows_;
+  }
+  /// Appends every row of `other` (the same body_size()), in order.
+  void Append(const RecordStore& other) {
+    for (std::size_t r = 0; r < other.rows(); ++r) Append(other.Row(r));
   }
   /// The bytes of row `r` (< rows()).
   const std::uint8_t* Row(std::size_t r) const {

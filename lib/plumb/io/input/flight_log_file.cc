@@ -67,7 +67,7 @@ const char* FlightLogFormatName(FlightLogFormat format) {
   return "none";
 }
 
-FlightLog FlightLog::Open(const std::string& path) {
+FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
   {  // a missing, unreadable or folder path says so (not "not a flight log")
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a folder, not a file");
@@ -78,9 +78,12 @@ FlightLog FlightLog::Open(const std::string& path) {
   out.source_ = path;
   out.format_ = SniffFlightLog(path);
   switch (out.format_) {
-    case FlightLogFormat::kDataflashBinary:
-      out.log_ = ReadDataflash(path, ArdupilotSessionRecords());
+    case FlightLogFormat::kDataflashBinary: {
+      DataflashReadOptions options;
+      options.run_jobs = run_jobs;
+      out.log_ = ReadDataflash(path, ArdupilotSessionRecords(), options);
       break;
+    }
     case FlightLogFormat::kDataflashText:
       out.log_ = ReadDataflashText(path, ArdupilotSessionRecords());
       break;

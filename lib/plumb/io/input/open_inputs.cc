@@ -154,7 +154,7 @@ Session Read(const InputFile& input, InputKind kind, const InputOptions& o) {
       }
       return ReadSplitTables(input.path, input.gyr_path, TableOptions(o, true), o.run_jobs);
     case InputKind::kFlightLog:
-      return FlightLog::Open(input.path).Select(o.flight_log);
+      return FlightLog::Open(input.path, o.run_jobs).Select(o.flight_log);
     case InputKind::kTextTable:
       return ReadTextTable(input.path, TableOptions(o, false));
     case InputKind::kNativeCsv:

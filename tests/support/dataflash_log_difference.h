@@ -1,0 +1,98 @@
+// tests/support/dataflash_log_difference.h — the first difference between two decoded DataFlash
+// logs, or none: every type's definition, record count, kept bodies and decoded IMU samples
+// (with the reader's state), the parameters, the warnings. For tests and the differential fuzz
+// target of the two-part read (tests/fuzz/dataflash_two_part_fuzz.cc), which must find the log
+// read in two parts the same as read in one.
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include "plumb/io/ardupilot/dataflash.h"
+
+namespace plumb::testing {
+
+/// `a` and `b` the same value (NaN only where NaN).
+inline bool SameFloats(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+inline bool SameDoubles(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+inline std::string ImuSeriesDifference(const ImuSeries& a, const ImuSeries& b) {
+  if (a.size() != b.size()) {
+    return "samples " + std::to_string(a.size()) + " != " + std::to_string(b.size());
+  }
+  if (a.gyr.size() != b.gyr.size()) return "gyroscope samples";
+  if (a.temp_c.size() != b.temp_c.size()) return "temperature samples";
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a.t_s[i] != b.t_s[i]) return "time of sample " + std::to_string(i);
+    for (int k = 0; k < 3; ++k) {
+      if (!SameFloats(a.acc[i][k], b.acc[i][k])) return "accelerometer sample " + std::to_string(i);
+      if (!a.gyr.empty() && !SameFloats(a.gyr[i][k], b.gyr[i][k])) {
+        return "gyroscope sample " + std::to_string(i);
+      }
+    }
+    if (!a.temp_c.empty() && !SameFloats(a.temp_c[i], b.temp_c[i])) {
+      return "temperature sample " + std::to_string(i);
+    }
+  }
+  return "";
+}
+
+inline std::string DataflashWarningsDifference(const io::DataflashWarnings& a,
+                                               const io::DataflashWarnings& b) {
+  if (a.Describe() != b.Describe()) return "warnings' text";
+  if (a.bytes_skipped != b.bytes_skipped || a.skip_runs != b.skip_runs ||
+      a.first_skip_offset != b.first_skip_offset) {
+    return "skipped bytes";
+  }
+  if (a.truncated_records != b.truncated_records || a.truncated_bytes != b.truncated_bytes) {
+    return "truncated record";
+  }
+  if (a.fmt_conflicts != b.fmt_conflicts || a.fmt_invalid != b.fmt_invalid ||
+      a.fmt_length_mismatches != b.fmt_length_mismatches ||
+      a.fmt_unknown_chars != b.fmt_unknown_chars) {
+    return "FMT warnings";
+  }
+  return "";
+}
+
+/// "" when `a` and `b` are the same log; else what differs first.
+inline std::string DataflashLogDifference(const io::DataflashLog& a, const io::DataflashLog& b) {
+  if (a.size_bytes != b.size_bytes) return "size";
+  if (a.types.size() != b.types.size()) return "number of types";
+  for (std::size_t k = 0; k < a.types.size(); ++k) {
+    const io::DataflashType& s = a.types[k];
+    const io::DataflashType& t = b.types[k];
+    const std::string where = "type " + s.name + ": ";
+    if (s.id != t.id || s.name != t.name || s.length != t.length || s.format != t.format) {
+      return where + "definition";
+    }
+    if (s.rows != t.rows) {
+      return where + "rows " + std::to_string(s.rows) + " != " + std::to_string(t.rows);
+    }
+    if (!(s.bodies == t.bodies)) return where + "bodies";
+    if (s.bodies_kept != t.bodies_kept || s.imu_decoded != t.imu_decoded) return where + "kept";
+    if (s.imu.size() != t.imu.size()) return where + "IMU instances";
+    for (std::size_t i = 0; i < s.imu.size(); ++i) {
+      const io::DataflashImuDecoded& x = s.imu[i];
+      const io::DataflashImuDecoded& y = t.imu[i];
+      const std::string instance = where + "instance " + std::to_string(i) + ": ";
+      if (x.records != y.records) return instance + "records";
+      if (!SameDoubles(x.first_time, y.first_time) || !SameDoubles(x.last_time, y.last_time)) {
+        return instance + "first or last time";
+      }
+      if (x.last_on_trial != y.last_on_trial) return instance + "last sample's state";
+      if (const std::string d = ImuSeriesDifference(x.series, y.series); !d.empty()) {
+        return instance + d;
+      }
+    }
+  }
+  if (a.params.size() != b.params.size()) return "number of parameters";
+  for (const auto& [name, value] : a.params) {
+    const auto other = b.params.find(name);
+    if (other == b.params.end()) return "parameter " + name;
+    if (!SameDoubles(value, other->second)) return "value of parameter " + name;
+  }
+  return DataflashWarningsDifference(a.warnings, b.warnings);
+}
+
+}  // namespace plumb::testing
