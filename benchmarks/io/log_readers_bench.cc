@@ -16,7 +16,9 @@
 // its MB/s over the MB/s of the BM_Cat of the same file measured last in the same process (run
 // both in one invocation: --benchmark_filter='BM_(Cat|Read)').
 // BM_WalkDataflash/<log> walks the records of the same file (ReadForward, headers and FMT
-// lengths only): the floor under the DataFlash reader's record loop.
+// lengths only): the floor under the DataFlash reader's record loop (one thread).
+// BM_ReadDataflashInTwoParts/<log> is BM_ReadDataflash in two parts at once on two threads, as
+// `plumb` reads a .bin of 32 MiB or more (DataflashReadOptions); its CPU time is the process's.
 // Skipped with the reason when the shared data is absent. With PLUMB_BENCH_LOG_DIR=DIR set, the
 // repeated logs are written to DIR/big_<name> and kept (to time `plumb info` on them).
 #include <benchmark/benchmark.h>
