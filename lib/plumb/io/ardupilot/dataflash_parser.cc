@@ -223,17 +223,11 @@ DataflashParser DataflashParser::Ahead(DataflashLog* out) const {
   out->source = log_->source;
   out->types.clear();
   out->types.reserve(log_->types.size());
-  for (const DataflashType& t : log_->types) {  // the definitions, no records
-    DataflashType d;
-    d.id = t.id;
-    d.name = t.name;
-    d.length = t.length;
-    d.format = t.format;
-    d.columns = t.columns;
-    d.body_size = t.body_size;
+  for (const DataflashType& t : log_->types) {  // the definitions, without their records
+    DataflashType d = t;
+    d.rows = 0;
     d.bodies = RecordStore(t.body_size);
-    d.bodies_kept = t.bodies_kept;
-    d.imu_decoded = t.imu_decoded;
+    d.imu.clear();
     out->types.push_back(std::move(d));
   }
   return ahead;
