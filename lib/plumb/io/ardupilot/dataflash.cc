@@ -161,13 +161,9 @@ void FinishParse(DataflashLog* log, std::size_t size) {
 
 namespace {
 
-/// What consumes the input's bytes, as ReadForward hands them over.
-using ByteConsumer =
-    std::function<std::size_t(const std::uint8_t* data, std::size_t n, std::size_t offset,
-                              bool at_end)>;
 /// Hands the input's bytes from offset `from` on to `consume` as ReadForward does: a file span
 /// by span, bytes in memory in one call that ends them.
-using ByteSource = std::function<void(std::size_t from, const ByteConsumer& consume)>;
+using ByteSource = std::function<void(std::size_t from, const ForwardConsumer& consume)>;
 
 /// Bytes looked at from the second part's nominal start for a record boundary (FindRecordChain).
 constexpr std::size_t kBoundaryWindow = std::size_t{64} << 10;
@@ -282,7 +278,7 @@ DataflashLog Decode(const ByteSource& source, std::size_t size, const std::strin
 DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
                             const std::string& source, const RecordFilter& filter,
                             const DataflashReadOptions& options) {
-  const ByteSource memory = [&](std::size_t from, const ByteConsumer& consume) {
+  const ByteSource memory = [&](std::size_t from, const ForwardConsumer& consume) {
     from = std::min(from, size);
     consume(data + from, size - from, from, true);
   };
@@ -291,7 +287,7 @@ DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
 
 DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter,
                            const DataflashReadOptions& options) {
-  const ByteSource file = [&](std::size_t from, const ByteConsumer& consume) {
+  const ByteSource file = [&](std::size_t from, const ForwardConsumer& consume) {
     ReadForward(path, "DataFlash log", DataflashParser::kMaxRecord, consume, from);
   };
   return Decode(file, RegularFileSize(path), path, filter, options);

@@ -311,7 +311,9 @@ class DataflashParser {
         }
         ++rows_[p[2]];
         i += e.length;
-        if (e.action != Action::kCount) Act(e.action, p[2], p + kDataflashHeaderSize, offset + i);
+        if (e.action != Action::kCount) {
+          Act<kAhead>(e.action, p[2], p + kDataflashHeaderSize, offset + i);
+        }
         continue;
       }
       if constexpr (kAhead) {
@@ -335,13 +337,15 @@ class DataflashParser {
                        std::size_t i);
 
   /// Keeps (kKeep, kFmt) or decodes (kDecode) the record body `body` of type `id`; an FMT
-  /// (kFmt, its record ending at byte `end`) defines a type.
+  /// (kFmt, its record ending at byte `end`) defines a type. `kAhead`: a parser made by Ahead,
+  /// which keeps each instance's first records (heads_).
+  template <bool kAhead>
   [[gnu::always_inline]] void Act(Action action, std::uint8_t id, const std::uint8_t* body,
                                   std::size_t end) {
     DataflashType& t = log_->types[static_cast<std::size_t>(index_[id])];
     if (action == Action::kDecode) {
       const auto decoder = static_cast<std::size_t>(decoder_of_[id]);
-      decoders_[decoder].Add(t, body, heads_.empty() ? nullptr : &heads_[decoder]);
+      decoders_[decoder].Add(t, body, kAhead ? &heads_[decoder] : nullptr);
       return;
     }
     t.bodies.Append(body);

@@ -191,9 +191,6 @@ class ForwardMapping {
   std::size_t dropped_ = 0;    ///< pages before this byte were dropped
 };
 
-using ForwardConsumer =
-    std::function<std::size_t(const std::uint8_t*, std::size_t, std::size_t, bool)>;
-
 /// ReadForward over a mapped file (see ForwardMapping): each call gets `span` bytes of the
 /// mapping from the offset the last one returned (the first from `from`), as the read(2) loop
 /// would hand them.
@@ -285,9 +282,7 @@ std::size_t RegularFileSize(const std::string& path) {
 }
 
 void ReadForward(const std::string& path, const std::string& what, std::size_t lookahead,
-                 const std::function<std::size_t(const std::uint8_t*, std::size_t, std::size_t,
-                                                 bool)>& consume,
-                 std::size_t from) {
+                 const ForwardConsumer& consume, std::size_t from) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     throw InputError(path, "byte 0",

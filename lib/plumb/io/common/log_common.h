@@ -67,6 +67,11 @@ T LoadLittleEndian(const std::uint8_t* p) {
   return v;
 }
 
+/// What ReadForward hands the bytes to: consume(data, n, offset, at_end), returning the offset
+/// it needs the bytes from next (see ReadForward).
+using ForwardConsumer = std::function<std::size_t(const std::uint8_t* data, std::size_t n,
+                                                 std::size_t offset, bool at_end)>;
+
 /// Reads the file at `path` forward, span by span, for parsers that decide at each position
 /// from a bounded look-ahead. A regular file is mapped read-only and each span's pages are
 /// read in (madvise MADV_POPULATE_READ) just before the parser gets them (4 MiB at a time),
@@ -89,9 +94,7 @@ T LoadLittleEndian(const std::uint8_t* p) {
 /// offset of the first call's first byte (0: from the start); the bytes before it are not read
 /// (a regular file only: a pipe is read whole and handed over from its start).
 void ReadForward(const std::string& path, const std::string& what, std::size_t lookahead,
-                 const std::function<std::size_t(const std::uint8_t* data, std::size_t n,
-                                                 std::size_t offset, bool at_end)>& consume,
-                 std::size_t from = 0);
+                 const ForwardConsumer& consume, std::size_t from = 0);
 
 /// What a ReadForward consumer returns to stop the reading there.
 inline constexpr std::size_t kStopReading = std::numeric_limits<std::size_t>::max();
