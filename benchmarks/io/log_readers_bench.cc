@@ -17,8 +17,9 @@
 // both in one invocation: --benchmark_filter='BM_(Cat|Read)').
 // BM_WalkDataflash/<log> walks the records of the same file (ReadForward, headers and FMT
 // lengths only): the floor under the DataFlash reader's record loop (one thread).
-// BM_ReadDataflashInTwoParts/<log> is BM_ReadDataflash in two parts at once on two threads, as
-// `plumb` reads a .bin of 32 MiB or more (DataflashReadOptions); its CPU time is the process's.
+// BM_ReadDataflashInTwoParts/<log> and BM_ReadULogInTwoParts/<log> are BM_ReadDataflash and
+// BM_ReadULog in two parts at once on two threads, as `plumb` reads a .bin or .ulg of 32 MiB or
+// more (TwoPartReadOptions); their CPU time is the process's.
 // Skipped with the reason when the shared data is absent. With PLUMB_BENCH_LOG_DIR=DIR set, the
 // repeated logs are written to DIR/big_<name> and kept (to time `plumb info` on them).
 #include <benchmark/benchmark.h>
@@ -441,22 +442,41 @@ BENCHMARK_CAPTURE(BM_ReadTlog, plane385_disarmed, std::string("mavlink/plane385_
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// PX4 ULog: decode the log as FlightLog does (the bodies of the topics a session reads;
-/// sensor_combined's samples decoded in the pass) and list every IMU stream with its samples
-/// (sensor_combined, vehicle_imu, sensor_accel paired with sensor_gyro), of every copy.
+/// Reads the ULog at `path` as FlightLog does (the bodies of the topics a session reads;
+/// sensor_combined's samples decoded in the pass; in two parts at once with `run_jobs`) and
+/// returns the samples of every IMU stream (sensor_combined, vehicle_imu, sensor_accel paired
+/// with sensor_gyro), of every copy.
+std::size_t ReadULogSamples(const std::string& path, const plumb::JobRunner& run_jobs = {}) {
+  plumb::io::ULogReadOptions options;
+  options.run_jobs = run_jobs;
+  const plumb::io::ULog decoded =
+      plumb::io::ReadULog(path, plumb::io::Px4SessionTopics(), options);
+  std::size_t samples = 0;
+  for (const plumb::io::ImuStreamInfo& s : plumb::io::ULogImuStreams(decoded)) {
+    samples += s.samples;
+  }
+  benchmark::DoNotOptimize(decoded.topics.data());
+  return samples;
+}
+
+/// PX4 ULog, in one part (one thread).
 void BM_ReadULog(benchmark::State& state, const std::string& relative) {
-  ReadRepeated(state, relative, [](const std::string& path) {
-    const plumb::io::ULog decoded = plumb::io::ReadULog(path, plumb::io::Px4SessionTopics());
-    std::size_t samples = 0;
-    for (const plumb::io::ImuStreamInfo& s : plumb::io::ULogImuStreams(decoded)) {
-      samples += s.samples;
-    }
-    benchmark::DoNotOptimize(decoded.topics.data());
-    return samples;
-  });
+  ReadRepeated(state, relative, [](const std::string& path) { return ReadULogSamples(path); });
 }
 BENCHMARK_CAPTURE(BM_ReadULog, sample, std::string("px4/sample.ulg"))
     ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// BM_ReadULog in two parts at once on two threads, as `plumb` reads a .ulg of 32 MiB or more
+/// on a machine of two cores or more (ULogReadOptions): the same samples. Its CPU time is the
+/// process's (both threads).
+void BM_ReadULogInTwoParts(benchmark::State& state, const std::string& relative) {
+  ReadRepeated(state, relative,
+               [](const std::string& path) { return ReadULogSamples(path, TwoThreads); });
+}
+BENCHMARK_CAPTURE(BM_ReadULogInTwoParts, sample, std::string("px4/sample.ulg"))
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
     ->UseRealTime();
 
 }  // namespace

@@ -4,9 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <fstream>
-#include <functional>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -15,6 +13,7 @@
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/dataflash_format.h"
 #include "plumb/io/ardupilot/dataflash_parser.h"
+#include "plumb/io/common/two_part_read.h"
 
 namespace plumb::io {
 namespace {
@@ -157,101 +156,6 @@ void FinishParse(DataflashLog* log, std::size_t size) {
   detail::FinishDataflashLog(log);
 }
 
-}  // namespace
-
-namespace {
-
-/// Hands the input's bytes from offset `from` on to `consume` as ReadForward does: a file span
-/// by span, bytes in memory in one call that ends them.
-using ByteSource = std::function<void(std::size_t from, const ForwardConsumer& consume)>;
-
-/// Bytes looked at from the second part's nominal start for a record boundary (FindRecordChain).
-constexpr std::size_t kBoundaryWindow = std::size_t{64} << 10;
-/// Records in a row that make a guessed record boundary.
-constexpr int kBoundaryRecords = 16;
-
-/// Decodes the records of `source` starting in [from, until) into `parser`; returns the offset
-/// of the first record, or skipped byte, at or after `until` (or where the last whole record
-/// before the input's last kMaxRecord bytes ends).
-std::size_t DecodeUntil(const ByteSource& source, DataflashParser& parser, std::size_t from,
-                        std::size_t until) {
-  std::size_t reached = from;
-  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
-    // With `limit` bytes, Feed decodes exactly the records starting before `until`.
-    const std::size_t limit = until - offset + DataflashParser::kMaxRecord - 1;
-    if (n < limit && !at_end) return parser.Feed(data, n, offset, false);
-    reached = parser.Feed(data, std::min(n, limit), offset, false);
-    return kStopReading;
-  });
-  return reached;
-}
-
-/// Decodes the records of `source` from `from` on into `ahead` (DataflashParser::Ahead) until
-/// it stops; returns the offset it reached.
-std::size_t DecodeAhead(const ByteSource& source, DataflashParser& ahead, std::size_t from) {
-  std::size_t reached = from;
-  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
-    reached = ahead.FeedAhead(data, n, offset);
-    return ahead.stopped() || at_end ? kStopReading : reached;
-  });
-  return reached;
-}
-
-/// A record boundary at byte `from` or after in `source`, as `parser`'s types make one
-/// (FindRecordChain over kBoundaryWindow bytes); nullopt when none is found.
-std::optional<std::size_t> RecordBoundary(const ByteSource& source, const DataflashParser& parser,
-                                          std::size_t from) {
-  std::optional<std::size_t> found;
-  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool) {
-    const std::size_t window = std::min(n, kBoundaryWindow);
-    const std::size_t at = parser.FindRecordChain(data, window, kBoundaryRecords);
-    if (at < window) found = offset + at;
-    return kStopReading;
-  });
-  return found;
-}
-
-/// Decodes `source` (`size` bytes) into `parser` in two parts at once through options.run_jobs
-/// (see DataflashReadOptions). Returns the offset from which the input is still to be decoded:
-/// where the second part stopped, or, when it does not count, where the first did.
-std::size_t DecodeInTwo(const ByteSource& source, std::size_t size, DataflashParser& parser,
-                        const DataflashReadOptions& options) {
-  const std::size_t lead = DecodeUntil(source, parser, 0, std::min(options.lead_bytes, size));
-  const double at = std::clamp(options.second_part_at, 0.0, 1.0);
-  const auto nominal = lead + static_cast<std::size_t>(at * static_cast<double>(size - lead));
-  const std::optional<std::size_t> start = RecordBoundary(source, parser, nominal);
-  if (!start || *start <= lead) return lead;
-  DataflashLog ahead_log;
-  DataflashParser ahead = parser.Ahead(&ahead_log);
-  std::size_t reached = lead;
-  std::size_t stop = *start;
-  std::exception_ptr first_failed;
-  bool ahead_failed = false;
-  RunJobs(options.run_jobs, 2, [&](int job) {
-    try {
-      if (job == 0) {
-        reached = DecodeUntil(source, parser, lead, *start);
-      } else {
-        stop = DecodeAhead(source, ahead, *start);
-      }
-    } catch (...) {  // the jobs throw nothing (core/jobs.h)
-      if (job == 0) {
-        first_failed = std::current_exception();
-      } else {
-        ahead_failed = true;
-      }
-    }
-  });
-  if (first_failed) std::rethrow_exception(first_failed);
-  // The second part counts when the first ended exactly on its start (the guess was a record
-  // boundary) and its samples join; else the first part goes on alone from where it is (and
-  // meets the second part's read error, if there was one, itself).
-  if (ahead_failed || reached != *start || !parser.Absorb(ahead, ahead_log, options.run_jobs)) {
-    return reached;
-  }
-  return stop;
-}
-
 /// The log of `source` (`size` bytes; 0: unknown), named `name`, decoded in one part or two
 /// (options).
 DataflashLog Decode(const ByteSource& source, std::size_t size, const std::string& name,
@@ -259,9 +163,7 @@ DataflashLog Decode(const ByteSource& source, std::size_t size, const std::strin
   DataflashLog log;
   log.source = name;
   DataflashParser parser(&log, filter, size);
-  const std::size_t from = options.run_jobs && size > 0 && size >= options.two_part_bytes
-                               ? DecodeInTwo(source, size, parser, options)
-                               : 0;
+  const std::size_t from = detail::DecodeStart<DataflashLog>(source, size, parser, options);
   // One pass (the rest of it), in chunks: every record is decoded from the read buffer as it
   // goes by.
   source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
@@ -278,19 +180,13 @@ DataflashLog Decode(const ByteSource& source, std::size_t size, const std::strin
 DataflashLog ParseDataflash(const std::uint8_t* data, std::size_t size,
                             const std::string& source, const RecordFilter& filter,
                             const DataflashReadOptions& options) {
-  const ByteSource memory = [&](std::size_t from, const ForwardConsumer& consume) {
-    from = std::min(from, size);
-    consume(data + from, size - from, from, true);
-  };
-  return Decode(memory, size, source, filter, options);
+  return Decode(MemoryBytes(data, size), size, source, filter, options);
 }
 
 DataflashLog ReadDataflash(const std::string& path, const RecordFilter& filter,
                            const DataflashReadOptions& options) {
-  const ByteSource file = [&](std::size_t from, const ForwardConsumer& consume) {
-    ReadForward(path, "DataFlash log", DataflashParser::kMaxRecord, consume, from);
-  };
-  return Decode(file, RegularFileSize(path), path, filter, options);
+  return Decode(FileBytes(path, "DataFlash log", DataflashParser::kMaxRecord),
+                RegularFileSize(path), path, filter, options);
 }
 
 namespace {

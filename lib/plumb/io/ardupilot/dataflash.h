@@ -46,6 +46,7 @@
 #include "plumb/core/jobs.h"
 #include "plumb/io/common/flight_log.h"
 #include "plumb/io/common/log_common.h"
+#include "plumb/io/common/two_part_read.h"
 
 namespace plumb::io {
 
@@ -154,28 +155,12 @@ struct DataflashLog {
   std::vector<std::pair<std::string, std::size_t>> MessageCounts() const;
 };
 
-/// How ReadDataflash reads a file: in one part, or in two at once.
-struct DataflashReadOptions {
-  /// Runs independent jobs at once (core/jobs.h). When given, a regular file of
-  /// `two_part_bytes` or more is read in two parts at once: the first from the file's start,
-  /// the second from a record boundary guessed near `second_part_at` of the way through. The
-  /// second part counts only when the first ends exactly on its start; it stops, leaving the
-  /// rest to the first, at any byte it cannot decide alone (one that starts no record of a
-  /// type defined in the file's first `lead_bytes`, or an FMT defining a new type); and its IMU
-  /// samples are joined to the first part's under the rule for times as if read in one pass.
-  /// So the log is the same, to the byte, as read in one part. Empty: one part.
-  JobRunner run_jobs;
-  /// Files from this size on are read in two parts when run_jobs is given (32 MiB: below, a
-  /// part takes a few milliseconds, what starting and joining it costs).
-  std::size_t two_part_bytes = std::size_t{32} << 20;
-  /// Bytes read alone before the second part starts: the types it knows are those defined in
-  /// them (ArduPilot writes the FMTs of the types it logs first; the FMT of a type first
-  /// logged later stops the second part there). 1 MiB.
-  std::size_t lead_bytes = std::size_t{1} << 20;
-  /// Where the second part's start is looked for, as a fraction of the bytes after the lead
-  /// (0.5: the middle, which gives both parts the same bytes).
-  double second_part_at = 0.5;
-};
+/// How ReadDataflash reads a file: in one part, or in two at once (TwoPartReadOptions). A .bin's
+/// second part starts at a record boundary (16 records of known types in a row); it stops at a
+/// record header of a type not defined in the lead (ArduPilot writes the FMTs of the types it
+/// logs first) or an FMT defining a new type; its IMU samples are joined to the first part's
+/// under the rule for times as if read in one pass (DataflashParser::Absorb).
+using DataflashReadOptions = TwoPartReadOptions;
 
 /// Reads and decodes a .bin log. Throws plumb::InputError(path, "byte N", what) when the file
 /// cannot be read or holds no FMT record at all.

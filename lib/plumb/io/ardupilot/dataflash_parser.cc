@@ -6,6 +6,8 @@
 #include <string>
 #include <utility>
 
+#include "plumb/io/common/two_part_read.h"
+
 namespace plumb::io::detail {
 namespace {
 
@@ -50,13 +52,6 @@ struct ReplayKept {
 bool SameState(const ReplayKept& s, bool s_on_trial, const ReplayKept& r, bool r_on_trial) {
   return s_on_trial == r_on_trial && s.TimeFromBack(0) == r.TimeFromBack(0) &&
          (!s_on_trial || s.TimeFromBack(1) == r.TimeFromBack(1));
-}
-
-/// Appends the elements [from, end) of `in` to `out`.
-template <typename T>
-void AppendFrom(std::vector<T>& out, const std::vector<T>& in, std::size_t from) {
-  out.insert(out.end(), in.begin() + static_cast<std::ptrdiff_t>(std::min(from, in.size())),
-             in.end());
 }
 
 }  // namespace
@@ -167,13 +162,7 @@ void DataflashImuDecoder::Join(const DataflashImuSeam& seam, DataflashImuDecoded
     if (has_gyr_) s.gyr.push_back(r.gyr);
     if (has_temp_) s.temp_c.push_back(r.temp_c);
   }
-  const ImuSeries& more = b.series;
-  RunJobs(run_jobs, 4, [&](int column) {  // each job appends its own column
-    if (column == 0) AppendFrom(s.t_s, more.t_s, seam.from_b);
-    if (column == 1) AppendFrom(s.acc, more.acc, seam.from_b);
-    if (column == 2 && has_gyr_) AppendFrom(s.gyr, more.gyr, seam.from_b);
-    if (column == 3 && has_temp_) AppendFrom(s.temp_c, more.temp_c, seam.from_b);
-  });
+  AppendSamples(s, b.series, seam.from_b, run_jobs);  // b lacks the columns a lacks
   a.records += b.records;
   a.last_time = b.last_time;
   a.last_on_trial = seam.on_trial;

@@ -234,6 +234,9 @@ class DataflashParser {
  public:
   /// The longest record: its length is one byte, header included.
   static constexpr std::size_t kMaxRecord = 255;
+  /// Bytes past a position Feed must be given to decode every record starting before it (and
+  /// none after): its look-ahead less one (two_part_read.h).
+  static constexpr std::size_t kUntilSlack = kMaxRecord - 1;
 
   /// `filter`: the types whose bodies are kept or samples decoded; `size_hint`: the input's
   /// size in bytes (0: unknown), to reserve decoded samples once.

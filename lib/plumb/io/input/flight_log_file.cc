@@ -67,6 +67,17 @@ const char* FlightLogFormatName(FlightLogFormat format) {
   return "none";
 }
 
+namespace {
+
+/// Two parts at once through `run_jobs` for a large log (the defaults of TwoPartReadOptions).
+TwoPartReadOptions TwoParts(const JobRunner& run_jobs) {
+  TwoPartReadOptions options;
+  options.run_jobs = run_jobs;
+  return options;
+}
+
+}  // namespace
+
 FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
   {  // a missing, unreadable or folder path says so (not "not a flight log")
     std::error_code ec;
@@ -78,12 +89,9 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
   out.source_ = path;
   out.format_ = SniffFlightLog(path);
   switch (out.format_) {
-    case FlightLogFormat::kDataflashBinary: {
-      DataflashReadOptions options;
-      options.run_jobs = run_jobs;
-      out.log_ = ReadDataflash(path, ArdupilotSessionRecords(), options);
+    case FlightLogFormat::kDataflashBinary:
+      out.log_ = ReadDataflash(path, ArdupilotSessionRecords(), TwoParts(run_jobs));
       break;
-    }
     case FlightLogFormat::kDataflashText:
       out.log_ = ReadDataflashText(path, ArdupilotSessionRecords());
       break;
@@ -91,7 +99,7 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
       out.log_ = ReadTlog(path);
       break;
     case FlightLogFormat::kPx4ULog:
-      out.log_ = ReadULog(path, Px4SessionTopics());
+      out.log_ = ReadULog(path, Px4SessionTopics(), TwoParts(run_jobs));
       break;
     case FlightLogFormat::kNone:
       throw InputError(path, "byte 0",

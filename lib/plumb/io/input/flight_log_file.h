@@ -40,8 +40,8 @@ class FlightLog {
  public:
   /// Reads and decodes the log at `path`. Throws plumb::InputError naming the file when it is
   /// not a flight log plumb reads, and as the format's reader does. `run_jobs` (core/jobs.h):
-  /// a large .bin is read in two parts at once (DataflashReadOptions; the same log either
-  /// way). Empty: one part.
+  /// a large .bin or .ulg is read in two parts at once (TwoPartReadOptions; the same log
+  /// either way). Empty: one part.
   static FlightLog Open(const std::string& path, const JobRunner& run_jobs = {});
 
   FlightLogFormat format() const { return format_; }

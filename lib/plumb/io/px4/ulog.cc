@@ -9,6 +9,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
+#include "plumb/io/common/two_part_read.h"
 #include "plumb/io/px4/ulog_format.h"
 
 namespace plumb::io {
@@ -222,11 +223,109 @@ class Parser {
       end_ = std::min(end_, size_);
     }
     if (pos_ == 0) {
+      if (avail_ < kFileHeaderSize && !at_end) return offset;  // a part ending before it
       ReadFileHeader(at_end);
       pos_ = kFileHeaderSize;
     }
     Run(at_end);
     return std::max(pos_, offset);
+  }
+
+  /// Bytes past a position Feed must be given to decode no message starting at or after it
+  /// (and every one ending by it): none, Feed decodes only whole messages (two_part_read.h).
+  static constexpr std::size_t kUntilSlack = 0;
+
+  /// A parser for the messages from a later byte of the same input on, to run beside this one
+  /// (the two-part read, two_part_read.h): it knows the subscriptions this one knows now,
+  /// decodes into `out` (which gets their topics, without messages) and is fed with FeedAhead.
+  Parser Ahead(ULog* out) const {
+    Parser ahead(size_, out, filter_);
+    ahead.ahead_ = true;
+    ahead.pos_ = kNotStarted;
+    ahead.index_ = index_;
+    ahead.decoders_ = decoders_;
+    ahead.data_entries_ = data_entries_;
+    for (DataEntry& e : ahead.data_entries_) e.rows = 0, e.last_timestamp_us = 0;
+    out->topics.reserve(log_->topics.size());
+    for (const ULogTopic& t : log_->topics) out->topics.push_back(WithoutMessages(t));
+    return ahead;
+  }
+
+  /// Feed for a parser made by Ahead: decodes the messages from `offset` (at the first call) on
+  /// that it can decide as its maker would there (D messages of a subscribed topic with a
+  /// fitting size, S, O, L, C and R messages), and stops (stopped()) at the first whole message
+  /// it cannot: a definition, subscription, parameter, info, a D of an id not subscribed (yet),
+  /// an unknown type, a corrupt header. It never decodes a message cut by the input's end.
+  /// Returns the offset it reached.
+  std::size_t FeedAhead(const std::uint8_t* data, std::size_t n, std::size_t offset) {
+    if (pos_ == kNotStarted) pos_ = offset;
+    data_ = data;
+    base_ = offset;
+    avail_ = offset + n;
+    Run(false);
+    return std::max(pos_, offset);
+  }
+  /// True once FeedAhead stopped.
+  bool stopped() const { return stopped_; }
+
+  /// The first position in [0, n) of `data` from which `records` messages that a parser made
+  /// by Ahead decodes (D messages of subscribed topics with fitting sizes, AheadOther) follow
+  /// one another inside the n bytes; n when there is none, and always in a log with appended
+  /// data (its segments are read by one parser). A guess at a message boundary in the middle
+  /// of a log.
+  std::size_t FindRecordChain(const std::uint8_t* data, std::size_t n, int records) const {
+    if (log_->incompat_flags[0] != 0) return n;  // data appended (or its bit set): one part
+    for (std::size_t i = 0; i < n; ++i) {
+      std::size_t at = i;
+      int k = 0;
+      for (; k < records; ++k) {
+        std::size_t size = 0;
+        if (FittingData(data + at, n - at, &size) < 0) size = AheadOther(data + at, n - at);
+        if (size == 0) break;
+        at += kMsgHeaderSize + size;
+      }
+      if (k == records) return i;
+    }
+    return n;
+  }
+
+  /// Adds what `ahead` (made by this parser's Ahead, decoding into `ahead_log`) decoded to
+  /// this parser's log, as if this parser had gone on through the same messages from where it
+  /// is now (the byte `ahead` started at), and goes on from where `ahead` stopped: messages
+  /// counted, bodies kept, texts, sync and dropout counts added; a decoded topic's samples
+  /// joined under its rule (a sample is kept when its time is above the last kept one: of
+  /// `ahead`'s kept samples, those above this part's last). False, with nothing changed, when
+  /// this parser is resynchronising (not at a message boundary) or the log has data appended.
+  /// The samples' copies are jobs run through `run_jobs`.
+  bool Absorb(const Parser& ahead, ULog& ahead_log, const JobRunner& run_jobs) {
+    // Resynchronising, not at a message boundary; data appended (flags read after the lead):
+    // its segments' ends are not `ahead`'s.
+    if (resync_ || log_->incompat_flags[0] != 0) return false;
+    if (ahead_log.warnings.any()) return false;  // never: `ahead` stops before any warning
+    // `ahead` knows the topics subscribed in the lead; this parser may know more since (their
+    // D messages stopped `ahead`), with the same indices for those it knows.
+    for (std::size_t k = 0; k < ahead.data_entries_.size(); ++k) {
+      const DataEntry& a = ahead.data_entries_[k];
+      if (a.rows == 0) continue;
+      DataEntry& e = data_entries_[k];
+      ULogTopic& t = log_->topics[k];
+      ULogTopic& more = ahead_log.topics[k];
+      if (t.imu_decoded) {
+        JoinSamples(t.imu, more.imu, run_jobs);
+      } else if (t.bodies_kept) {
+        t.bodies.Append(more.bodies);
+      }
+      e.rows += a.rows;
+      e.last_timestamp_us = a.last_timestamp_us;
+    }
+    log_->texts.insert(log_->texts.end(), std::make_move_iterator(ahead_log.texts.begin()),
+                       std::make_move_iterator(ahead_log.texts.end()));
+    log_->sync_messages += ahead_log.sync_messages;
+    log_->dropouts += ahead_log.dropouts;
+    log_->dropout_total_ms += ahead_log.dropout_total_ms;
+    in_definitions_ = in_definitions_ && ahead.in_definitions_;
+    pos_ = ahead.pos_;
+    return true;
   }
 
   /// The messages from pos_ on, while the look-ahead is in the bytes held (or `at_end`).
@@ -248,6 +347,13 @@ class Parser {
       }
       if (!resync_ && DataMessage()) continue;
       if (!at_end && !Held(pos_)) return;
+      if (ahead_) {
+        if (!AheadMessage()) {
+          stopped_ = true;
+          return;
+        }
+        continue;
+      }
       if (resync_) {
         if (!ResyncPoint(pos_, end_)) {
           Skip(pos_);
@@ -294,6 +400,86 @@ class Parser {
 
   /// The byte of the input at file offset `pos` (in the bytes held).
   const std::uint8_t* At(std::size_t pos) const { return data_ + (pos - base_); }
+
+  /// pos_ of a parser made by Ahead before its first FeedAhead.
+  static constexpr std::size_t kNotStarted = static_cast<std::size_t>(-1);
+
+  /// `t` without its messages: its definition, and empty bodies or samples.
+  static ULogTopic WithoutMessages(const ULogTopic& t) {
+    ULogTopic out;
+    out.name = t.name;
+    out.multi_id = t.multi_id;
+    out.msg_id = t.msg_id;
+    out.columns = t.columns;
+    out.body_size = t.body_size;
+    out.full_size = t.full_size;
+    out.timestamp_col = t.timestamp_col;
+    out.bodies = RecordStore(t.body_size);
+    out.bodies_kept = t.bodies_kept;
+    out.imu_decoded = t.imu_decoded;
+    return out;
+  }
+
+  /// Appends the samples of `more` (decoded from the messages after those of `s`, starting
+  /// with no sample kept) to `s` as one decoder would have kept them: a sample is kept when its
+  /// time is above the last kept one, so `more`'s kept times (increasing) from the first above
+  /// `s`'s last on.
+  static void JoinSamples(ImuSeries& s, ImuSeries& more, const JobRunner& run_jobs) {
+    if (s.empty()) {
+      s = std::move(more);
+      return;
+    }
+    const auto first = std::upper_bound(more.t_s.begin(), more.t_s.end(), s.t_s.back());
+    AppendSamples(s, more, static_cast<std::size_t>(first - more.t_s.begin()), run_jobs);
+  }
+
+  /// For a parser made by Ahead, at a whole message that DataMessage did not take: true when it
+  /// is one this parser decides as its maker would here (AheadOther), and read; false (a stop)
+  /// otherwise.
+  bool AheadMessage() {
+    const std::uint8_t* p = At(pos_);
+    const std::size_t size = AheadOther(p, end_ - pos_);
+    if (size == 0) return false;
+    const std::size_t at = pos_;
+    pos_ += kMsgHeaderSize + size;
+    Other(at, p[2], p + kMsgHeaderSize, size, &end_);
+    return true;
+  }
+
+  /// The size of the message at `p` (n bytes held) when it is whole in them and one besides D
+  /// that a parser made by Ahead decides as its maker would (its effect does not depend on
+  /// what came before): an S with the sync magic, an O or R of 2 bytes, an L of 9 bytes or
+  /// more, a C of 11 or more; 0 otherwise.
+  static std::size_t AheadOther(const std::uint8_t* p, std::size_t n) {
+    if (n < kMsgHeaderSize) return 0;
+    const std::size_t size = LoadLittleEndian<std::uint16_t>(p);
+    if (size > n - kMsgHeaderSize) return 0;
+    bool sound = false;
+    switch (p[2]) {
+      case 'S':
+        sound = size == sizeof(kSyncMagic) &&
+                std::memcmp(p + kMsgHeaderSize, kSyncMagic, sizeof(kSyncMagic)) == 0;
+        break;
+      case 'O': case 'R': sound = size == 2; break;
+      case 'L': sound = size >= 9; break;
+      case 'C': sound = size >= 11; break;
+      default: break;
+    }
+    return sound ? size : 0;
+  }
+
+  /// The topic index of the D message at `p` (n bytes held) when it is whole in them, of a
+  /// subscribed topic and of a fitting size (`size` its size); -1 otherwise.
+  [[gnu::always_inline]] int FittingData(const std::uint8_t* p, std::size_t n,
+                                         std::size_t* size) const {
+    if (n < kMsgHeaderSize + 2 || p[2] != 'D') return -1;
+    *size = LoadLittleEndian<std::uint16_t>(p);
+    if (*size < 2 || *size > n - kMsgHeaderSize) return -1;
+    const int idx = Index(LoadLittleEndian<std::uint16_t>(p + kMsgHeaderSize));
+    if (idx < 0) return -1;
+    const DataEntry& e = data_entries_[static_cast<std::size_t>(idx)];
+    return *size - 2 < e.body_size || *size - 2 > e.full_size ? -1 : idx;
+  }
 
   /// The 16-byte file header: magic, version, start time.
   void ReadFileHeader(bool at_end) {
@@ -404,16 +590,12 @@ class Parser {
   /// topic with a fitting size, whole in the bytes held and in the segment (what Run would
   /// find it to be after Held, Corrupt and the size check). True when it was one, and read.
   bool DataMessage() {
-    if (pos_ + kMsgHeaderSize + 2 > std::min(avail_, end_)) return false;
+    const std::size_t held = std::min(avail_, end_);
+    if (pos_ >= held) return false;
     const std::uint8_t* p = At(pos_);
-    const std::size_t size = LoadLittleEndian<std::uint16_t>(p);
-    if (p[2] != 'D' || size < 2 || size > std::min(avail_, end_) - pos_ - kMsgHeaderSize) {
-      return false;
-    }
-    const int idx = Index(LoadLittleEndian<std::uint16_t>(p + kMsgHeaderSize));
+    std::size_t size = 0;
+    const int idx = FittingData(p, held - pos_, &size);
     if (idx < 0) return false;
-    const DataEntry& e = data_entries_[static_cast<std::size_t>(idx)];
-    if (size - 2 < e.body_size || size - 2 > e.full_size) return false;
     pos_ += kMsgHeaderSize + size;
     Data(static_cast<std::size_t>(idx), p + kMsgHeaderSize + 2);
     return true;
@@ -640,6 +822,8 @@ class Parser {
   detail::ULogFormatResolver resolver_;
   bool in_definitions_ = true;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
+  bool ahead_ = false;        ///< made by Ahead: Run stops where AheadMessage says
+  bool stopped_ = false;      ///< FeedAhead stopped
 };
 
 }  // namespace
@@ -724,33 +908,38 @@ std::vector<std::pair<std::string, std::size_t>> ULog::MessageCounts() const {
 
 namespace {
 
-}  // namespace
-
-ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source,
-               const RecordFilter& filter) {
+/// The log of `source` (`size` bytes; 0: unknown, a pipe), named `name`, decoded in one part
+/// or two (options).
+ULog Decode(const ByteSource& source, std::size_t size, const std::string& name,
+            const RecordFilter& filter, const ULogReadOptions& options) {
   ULog log;
-  log.source = source;
+  log.source = name;
   log.size_bytes = size;
-  Parser parser(size, &log, filter);
-  parser.Feed(data, size, 0, true);
-  parser.Finish();
+  std::optional<Parser> parser;  // made at the first call when the size is not known before
+  if (size > 0) parser.emplace(size, &log, filter);
+  const std::size_t from = parser ? detail::DecodeStart<ULog>(source, size, *parser, options) : 0;
+  // One pass (the rest of it), in chunks: every message is decoded from the read buffer as it
+  // goes by.
+  source(from, [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+    if (at_end) log.size_bytes = offset + n;
+    if (!parser) parser.emplace(log.size_bytes, &log, filter);
+    return parser->Feed(data, n, offset, at_end);
+  });
+  if (parser) parser->Finish();
   return log;
 }
 
-ULog ReadULog(const std::string& path, const RecordFilter& filter) {
-  ULog log;
-  log.source = path;
-  log.size_bytes = RegularFileSize(path);  // 0 for a pipe: read whole, in one call
-  std::optional<Parser> parser;  // made at the first call, when the size is known
-  // One pass, in chunks: every message is decoded from the read buffer as it goes by.
-  ReadForward(path, "ULog file", Parser::kLookahead,
-              [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
-                if (at_end) log.size_bytes = offset + n;
-                if (!parser) parser.emplace(log.size_bytes, &log, filter);
-                return parser->Feed(data, n, offset, at_end);
-              });
-  if (parser) parser->Finish();
-  return log;
+}  // namespace
+
+ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source,
+               const RecordFilter& filter, const ULogReadOptions& options) {
+  return Decode(MemoryBytes(data, size), size, source, filter, options);
+}
+
+ULog ReadULog(const std::string& path, const RecordFilter& filter,
+              const ULogReadOptions& options) {
+  return Decode(FileBytes(path, "ULog file", Parser::kLookahead), RegularFileSize(path), path,
+                filter, options);
 }
 
 }  // namespace plumb::io

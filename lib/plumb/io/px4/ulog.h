@@ -65,6 +65,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/io/common/log_common.h"
+#include "plumb/io/common/two_part_read.h"
 
 namespace plumb::io {
 
@@ -226,14 +227,25 @@ struct ULog {
   std::vector<std::pair<std::string, std::size_t>> MessageCounts() const;
 };
 
+/// How ReadULog reads a file: in one part, or in two at once (TwoPartReadOptions). A ULog's
+/// second part starts at a message boundary (16 messages it decodes in a row); it decodes D messages of the topics subscribed in the lead, S, O, L, C and
+/// R messages, and stops, leaving the rest to the first part, at any other message (a
+/// definition, subscription, parameter change, info, a D of an id not subscribed in the lead,
+/// an unknown type), a corrupt header or a message cut by the end. A decoded topic's samples
+/// are joined under its rule (ULogTopic::imu), every other count, body and text added after
+/// the first part's. A log with appended data is read in one part.
+using ULogReadOptions = TwoPartReadOptions;
+
 /// Reads and decodes a .ulg file. Throws plumb::InputError(path, "byte N", what) when the file
 /// cannot be read, is shorter than the 16-byte header, lacks the magic, or sets an
 /// incompatible flag bit this reader does not know.
 /// `filter`: the topics whose message bodies are kept (RecordFilter; default all).
-ULog ReadULog(const std::string& path, const RecordFilter& filter = {});
+/// `options`: in one part or two at once (ULogReadOptions; default one). The same log either way.
+ULog ReadULog(const std::string& path, const RecordFilter& filter = {},
+              const ULogReadOptions& options = {});
 
 /// Decodes a log held in memory; `source` names it in errors. Same contract as ReadULog.
 ULog ParseULog(const std::uint8_t* data, std::size_t size, const std::string& source,
-               const RecordFilter& filter = {});
+               const RecordFilter& filter = {}, const ULogReadOptions& options = {});
 
 }  // namespace plumb::io
