@@ -2,10 +2,12 @@
 // reader gives in one part, to the byte (formats, subscriptions, counts, last timestamps, kept
 // bodies, decoded sensor_combined samples, info, parameters and their changes, texts, sync and
 // dropout counts, warnings), wherever the second part's start is looked for: before and after
-// the message types it stops at (a parameter change, a late subscription and its data, info,
-// a D of an id never subscribed, an unknown type, corrupt bytes, a cut last message), in the
-// middle of a blob whose bytes look like messages (not joined: the first part goes on), times
-// that spike, go back and repeat on either side; a log with appended data (one part); every
+// the messages it reads besides data (parameter changes, whose timestamps come from both parts,
+// default parameters, info, continued info, late subscriptions and their data, a format
+// defined late) and those it stops at (a subscription whose id is taken or whose format is
+// unknown, an info continuing nothing, a D of an id never subscribed, an unknown type, corrupt
+// bytes, a cut last message), in the middle of a blob whose bytes look like messages (not
+// joined: the first part goes on), times that spike, go back and repeat on either side; a log with appended data (one part); every
 // shared .ulg through ReadULog, jobs run in either order or at once.
 #include <gtest/gtest.h>
 
@@ -110,6 +112,14 @@ Bytes SeamLog(std::size_t* definitions_end) {
     if (n == 300) w.KeyValue('P', "float CAL_ACC0_XOFF", Le(0.5f));
     if (n == 800) w.Add(0, 3, "late_topic");
     if (n > 800 && n % 4 == 0) w.Data(3, Cat({Le(time), Le(0.5f)}));
+    if (n == 820) w.Add(1, 3, "late_topic");                       // msg_id taken
+    if (n == 830) w.Add(0, 7, "no_such_format");                   // not resolved
+    if (n == 840) w.Format("late_two:uint64_t timestamp;double w;");
+    if (n == 845) w.Add(0, 8, "late_two");
+    if (n > 845 && n % 3 == 0) w.Data(8, Cat({Le(time), Le(0.25)}));
+    if (n == 870 || n == 100 || n == 600) w.KeyValue('P', "int32_t COM_X", Le<std::int32_t>(n));
+    if (n == 460) w.KeyValue('M', "char[2] perf", Bytes{'e', 'f'}, 1);  // continues 450's
+    if (n == 470) w.KeyValue('M', "char[2] other", Bytes{'g', 'h'}, 1);  // continues nothing
     if (n == 400) w.KeyValue('I', "char[3] ver", Bytes{'1', '.', '2'});
     if (n == 450) w.KeyValue('M', "char[2] perf", Bytes{'a', 'b'}, 0);
     if (n == 500) w.Data(9, Le(time));                             // never subscribed
@@ -117,13 +127,14 @@ Bytes SeamLog(std::size_t* definitions_end) {
     if (n == 650) w.Message('Z', Bytes{1, 2, 3});                  // an unknown type
     if (n == 700) w.Message('R', Le<std::uint16_t>(2));
     if (n == 750) w.KeyValue('Q', "float CAL_ACC0_XOFF", Le(0.0f), 1);
-    if (n % 90 == 45) {  // a blob whose bytes are 16 D messages of vehicle_status
+    if (n % 90 == 45) {  // a blob whose bytes are 16 D messages of vehicle_status, its time
+                         // ahead of the others' (the newest of a parameter change's topics)
       Bytes fake;
       for (int k = 0; k < 16; ++k) {
         fake = Cat({fake, Le<std::uint16_t>(11), Bytes{'D'}, Le<std::uint16_t>(2), Le(time),
                     Bytes{1}});
       }
-      w.Data(4, Cat({Le(time), fake}));
+      w.Data(4, Cat({Le(time + 50000000), fake}));
     }
     t += 1000;
   }
@@ -142,7 +153,10 @@ TEST(ULogTwoParts, SameLogWhereverTheSecondPartStarts) {
     ASSERT_GT(one.warnings.bytes_skipped, 0u);
     ASSERT_EQ(one.warnings.unknown_msg_id_messages, 1u);
     ASSERT_EQ(one.warnings.unknown_type_messages, 1u);
-    ASSERT_EQ(one.param_changes.size(), 1u);
+    ASSERT_EQ(one.param_changes.size(), 4u);
+    ASSERT_EQ(one.warnings.malformed_messages, 1u);
+    ASSERT_EQ(one.warnings.unresolved_subscriptions, 1u);
+    ASSERT_NE(one.Find("late_two"), nullptr);
     ASSERT_GT(one.texts.size(), 200u);
     ASSERT_EQ(one.Find("sensor_combined")->imu_decoded, filter.decode != nullptr);
     if (filter.decode) ASSERT_GT(one.Find("sensor_combined")->imu.size(), 800u);
@@ -192,6 +206,62 @@ TEST(ULogTwoParts, ClockSetBackAtTheSeamJoinsAsInOnePart) {
   }
 }
 
+/// sensor_combined's format and subscription as msg_id 0 (the lead), then `more` as the log goes
+/// on: the start of a made-up log for the cases at the edge of what the second part decides.
+Writer CombinedLog() {
+  Writer w;
+  w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
+           "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
+           "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;"
+           "uint8_t[3] _padding0;");
+  w.Format("sensor_accel:uint64_t timestamp;float x;float y;float z;");
+  w.Format("vehicle_status:uint64_t timestamp;uint8_t nav_state;");
+  w.Add(0, 0, "sensor_combined");
+  return w;
+}
+
+/// The first part subscribes a topic after the lead, the second part another under the same
+/// msg_id (in one pass an id taken: malformed): the second part's subscription must not join.
+TEST(ULogTwoParts, SubscriptionsOnBothSidesOfTheSeam) {
+  Writer w = CombinedLog();
+  const std::size_t lead = w.bytes().size();
+  w.Add(0, 5, "sensor_accel");
+  for (int n = 0; n < 40; ++n) w.Data(0, Combined(1000u * n, n, true));
+  w.Add(1, 5, "vehicle_status");  // msg_id 5 taken
+  for (int n = 40; n < 80; ++n) w.Data(0, Combined(1000u * n, n, true));
+  w.Data(5, Cat({Le<std::uint64_t>(5), Le(1.0f), Le(2.0f), Le(3.0f)}));
+  const Bytes& log = w.bytes();
+  const ULog one = ParseULog(log.data(), log.size(), "seam.ulg");
+  ASSERT_EQ(one.warnings.malformed_messages, 1u);
+  for (int k = 1; k < 40; ++k) {
+    SCOPED_TRACE(k);
+    ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", {},
+                                 TwoParts(lead, k / 100.0, kInOrder)));
+  }
+}
+
+/// Parameters after a run of sync messages and before any subscription or text are initial
+/// values in one pass: a second part started in the run must not take them for changes.
+TEST(ULogTwoParts, ParametersBeforeAnySubscriptionAreInitialValues) {
+  Writer w = CombinedLog();
+  w.bytes().resize(w.bytes().size() - (3 + 3 + 15));  // without the subscription
+  w.KeyValue('P', "float A", Le(1.0f));
+  const std::size_t lead = w.bytes().size();
+  for (int n = 0; n < 60; ++n) w.Message('S', Bytes{0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, 0xBB, 0x12});
+  w.KeyValue('P', "float B", Le(2.0f));
+  w.Add(0, 0, "sensor_combined");
+  w.KeyValue('P', "float C", Le(3.0f));
+  const Bytes& log = w.bytes();
+  const ULog one = ParseULog(log.data(), log.size(), "seam.ulg");
+  ASSERT_EQ(one.params.size(), 2u);
+  ASSERT_EQ(one.param_changes.size(), 1u);
+  for (int k = 1; k < 60; ++k) {
+    SCOPED_TRACE(k);
+    ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", {},
+                                 TwoParts(lead, k / 100.0, kInOrder)));
+  }
+}
+
 /// Appended data: its segments are read by one parser (no second part), the same log.
 TEST(ULogTwoParts, AppendedDataIsReadInOnePart) {
   Writer w;
@@ -233,7 +303,7 @@ TEST(ULogTwoParts, EverySharedUlgReadInTwoPartsAsInOne) {
         SCOPED_TRACE(at);
         const JobRunner run_jobs =
             at == 0.5 ? JobRunner(plumb::testing::ReverseOnTwoThreads) : kInOrder;
-        ExpectSameLog(one, ReadULog(path, filter, TwoParts(32 << 10, at, run_jobs)));
+        ExpectSameLog(one, ReadULog(path, filter, TwoParts(256 << 10, at, run_jobs)));
         if (::testing::Test::HasFailure()) return;
       }
     }

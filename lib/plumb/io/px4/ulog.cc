@@ -236,8 +236,9 @@ class Parser {
   static constexpr std::size_t kUntilSlack = 0;
 
   /// A parser for the messages from a later byte of the same input on, to run beside this one
-  /// (the two-part read, two_part_read.h): it knows the subscriptions this one knows now,
-  /// decodes into `out` (which gets their topics, without messages) and is fed with FeedAhead.
+  /// (the two-part read, two_part_read.h): it knows the formats, subscriptions and column
+  /// budget this one knows now, decodes into `out` (which gets their formats and topics,
+  /// without messages) and is fed with FeedAhead.
   Parser Ahead(ULog* out) const {
     Parser ahead(size_, out, filter_);
     ahead.ahead_ = true;
@@ -246,17 +247,24 @@ class Parser {
     ahead.decoders_ = decoders_;
     ahead.data_entries_ = data_entries_;
     for (DataEntry& e : ahead.data_entries_) e.rows = 0, e.last_timestamp_us = 0;
+    ahead.in_definitions_ = in_definitions_;
+    ahead.maker_topics_ = log_->topics.size();
+    ahead.maker_formats_seen_ = formats_seen_;
+    out->formats = log_->formats;
+    ahead.resolver_.set_budget_left(resolver_.budget_left());
     out->topics.reserve(log_->topics.size());
     for (const ULogTopic& t : log_->topics) out->topics.push_back(WithoutMessages(t));
     return ahead;
   }
 
   /// Feed for a parser made by Ahead: decodes the messages from `offset` (at the first call) on
-  /// that it can decide as its maker would there (D messages of a subscribed topic with a
-  /// fitting size, S, O, L, C and R messages), and stops (stopped()) at the first whole message
-  /// it cannot: a definition, subscription, parameter, info, a D of an id not subscribed (yet),
-  /// an unknown type, a corrupt header. It never decodes a message cut by the input's end.
-  /// Returns the offset it reached.
+  /// that it can decide as its maker would there: D messages of a subscribed topic with a
+  /// fitting size; S, O, L, C and R messages; P (once past the definitions), Q, I and M
+  /// messages that parse (an M continuing a key only when it has that key's first part); an A
+  /// whose msg_id is free and whose format it resolves. It stops (stopped()) at the first whole
+  /// message it cannot: an F or B, any other A, a message that does not parse, a D of an id not
+  /// subscribed, an unknown type, a corrupt header. It never decodes a message cut by the
+  /// input's end. Returns the offset it reached.
   std::size_t FeedAhead(const std::uint8_t* data, std::size_t n, std::size_t offset) {
     if (pos_ == kNotStarted) pos_ = offset;
     data_ = data;
@@ -303,8 +311,17 @@ class Parser {
     if (resync_ || log_->incompat_flags[0] != 0) return false;
     if (ahead_log.warnings.any()) return false;  // never: `ahead` stops before any warning
     // `ahead` knows the topics subscribed in the lead; this parser may know more since (their
-    // D messages stopped `ahead`), with the same indices for those it knows.
-    for (std::size_t k = 0; k < ahead.data_entries_.size(); ++k) {
+    // D messages stopped `ahead`), with the same indices for those it knows. Topics `ahead`
+    // subscribed take the next indices, the column budget and the formats as this parser's
+    // were at the lead: they join only when this parser subscribed none and defined no format
+    // since.
+    const bool ahead_subscribed = ahead_log.topics.size() > ahead.maker_topics_;
+    if (ahead_subscribed && (log_->topics.size() != ahead.maker_topics_ ||
+                             formats_seen_ != ahead.maker_formats_seen_)) {
+      return false;
+    }
+    AbsorbParamChanges(ahead, ahead_log);  // before the counts change: they read this part's
+    for (std::size_t k = 0; k < ahead.maker_topics_; ++k) {
       const DataEntry& a = ahead.data_entries_[k];
       if (a.rows == 0) continue;
       DataEntry& e = data_entries_[k];
@@ -318,11 +335,11 @@ class Parser {
       e.rows += a.rows;
       e.last_timestamp_us = a.last_timestamp_us;
     }
-    log_->texts.insert(log_->texts.end(), std::make_move_iterator(ahead_log.texts.begin()),
-                       std::make_move_iterator(ahead_log.texts.end()));
-    log_->sync_messages += ahead_log.sync_messages;
-    log_->dropouts += ahead_log.dropouts;
-    log_->dropout_total_ms += ahead_log.dropout_total_ms;
+    for (std::size_t k = ahead.maker_topics_; k < ahead_log.topics.size(); ++k) {
+      Subscribe(std::move(ahead_log.topics[k]), ahead.decoders_[k], ahead.data_entries_[k]);
+    }
+    if (ahead_subscribed) resolver_.set_budget_left(ahead.resolver_.budget_left());
+    AbsorbMessages(ahead_log);
     in_definitions_ = in_definitions_ && ahead.in_definitions_;
     pos_ = ahead.pos_;
     return true;
@@ -433,17 +450,95 @@ class Parser {
     AppendSamples(s, more, static_cast<std::size_t>(first - more.t_s.begin()), run_jobs);
   }
 
+  /// The parameter changes `ahead` logged, added after this part's with their timestamps as
+  /// one parser would have them: the newest among every topic's last message, taken from this
+  /// part for the topics `ahead` had no message of yet (PendingChange).
+  void AbsorbParamChanges(const Parser& ahead, ULog& ahead_log) {
+    for (const PendingChange& c : ahead.pending_changes_) {
+      std::uint64_t& newest = ahead_log.param_changes[c.change].timestamp_us;
+      for (const std::uint32_t k : c.topics_without_rows) {
+        const DataEntry& e = data_entries_[k];
+        if (e.rows > 0) newest = std::max(newest, e.last_timestamp_us);
+      }
+    }
+    log_->param_changes.insert(log_->param_changes.end(), ahead_log.param_changes.begin(),
+                               ahead_log.param_changes.end());
+  }
+
+  /// The messages other than D of `ahead_log` (made by a parser made by Ahead) added after this
+  /// part's: texts, default parameters, info (a later value replaces an earlier one; lists
+  /// continue), sync and dropout counts.
+  void AbsorbMessages(ULog& ahead_log) {
+    log_->texts.insert(log_->texts.end(), std::make_move_iterator(ahead_log.texts.begin()),
+                       std::make_move_iterator(ahead_log.texts.end()));
+    log_->default_params.insert(log_->default_params.end(), ahead_log.default_params.begin(),
+                                ahead_log.default_params.end());
+    for (auto& [key, value] : ahead_log.info) log_->info[key] = std::move(value);
+    for (auto& [key, list] : ahead_log.info_multiple) {
+      std::vector<std::string>& to = log_->info_multiple[key];
+      to.insert(to.end(), std::make_move_iterator(list.begin()),
+                std::make_move_iterator(list.end()));
+    }
+    log_->sync_messages += ahead_log.sync_messages;
+    log_->dropouts += ahead_log.dropouts;
+    log_->dropout_total_ms += ahead_log.dropout_total_ms;
+  }
+
   /// For a parser made by Ahead, at a whole message that DataMessage did not take: true when it
-  /// is one this parser decides as its maker would here (AheadOther), and read; false (a stop)
-  /// otherwise.
+  /// is one this parser decides as its maker would here (AheadOther, AheadDefinition), and
+  /// read; false (a stop, nothing changed) otherwise.
   bool AheadMessage() {
     const std::uint8_t* p = At(pos_);
-    const std::size_t size = AheadOther(p, end_ - pos_);
-    if (size == 0) return false;
     const std::size_t at = pos_;
+    if (const std::size_t size = AheadOther(p, end_ - pos_); size > 0) {
+      pos_ += kMsgHeaderSize + size;
+      Other(at, p[2], p + kMsgHeaderSize, size, &end_);
+      return true;
+    }
+    if (end_ - pos_ < kMsgHeaderSize) return false;
+    const std::size_t size = LoadLittleEndian<std::uint16_t>(p);
+    if (size > end_ - pos_ - kMsgHeaderSize || Corrupt(pos_, end_, size, p[2]) ||
+        !AheadDefinition(p[2], p + kMsgHeaderSize, size)) {
+      return false;
+    }
     pos_ += kMsgHeaderSize + size;
-    Other(at, p[2], p + kMsgHeaderSize, size, &end_);
     return true;
+  }
+
+  /// For a parser made by Ahead: reads a P, Q, I, M or A message (body `body`, `size` bytes,
+  /// sizes checked by Corrupt) and returns true when it decides it as its maker would here: a
+  /// P once past the definitions (a change, PendingChange), a P, Q, I or M that parses, an M
+  /// continuing a key only when this parser has that key's first part, an A whose msg_id is
+  /// free and whose format it resolves (AddLoggedAhead). False (nothing read) otherwise.
+  bool AheadDefinition(std::uint8_t type, const std::uint8_t* body, std::size_t size) {
+    const auto parses = [](const std::uint8_t* b, std::size_t n, bool param) {
+      const auto kv = ParseKeyValue(b, n);
+      return kv && (!param || ParamValue(*kv));
+    };
+    switch (type) {
+      case 'P':
+        if (in_definitions_ || !parses(body, size, true)) return false;
+        Param(body, size);
+        pending_changes_.push_back(PendingChange::Of(log_->param_changes.size() - 1,
+                                                     data_entries_, maker_topics_));
+        return true;
+      case 'Q':
+        if (size < 1 || !parses(body + 1, size - 1, true)) return false;
+        DefaultParam(body, size);
+        return true;
+      case 'I':
+        if (!parses(body, size, false)) return false;
+        Info(body, size);
+        return true;
+      case 'M': {
+        const auto kv = size >= 1 ? ParseKeyValue(body + 1, size - 1) : std::nullopt;
+        if (!kv || (body[0] != 0 && log_->info_multiple.count(kv->name) == 0)) return false;
+        InfoMultiple(body, size);
+        return true;
+      }
+      case 'A': return AddLoggedAhead(body, size);
+      default: return false;
+    }
   }
 
   /// The size of the message at `p` (n bytes held) when it is whole in them and one besides D
@@ -717,6 +812,7 @@ class Parser {
   }
 
   void Format(const std::uint8_t* body, std::size_t size) {
+    ++formats_seen_;
     std::string name;
     std::vector<ULogFormatField> fields;
     if (!detail::ParseULogFormat(std::string_view(reinterpret_cast<const char*>(body), size), &name,
@@ -763,21 +859,54 @@ class Parser {
     log_->default_params.push_back({kv->name, *value, body[0]});
   }
 
-  void AddLogged(const std::uint8_t* body, std::size_t size) {
-    in_definitions_ = false;
+  /// The topic an A message subscribes (multi_id, msg_id, name; not resolved).
+  static ULogTopic Subscription(const std::uint8_t* body, std::size_t size) {
     ULogTopic t;
     t.multi_id = body[0];
     t.msg_id = LoadLittleEndian<std::uint16_t>(body + 1);
     t.name.assign(reinterpret_cast<const char*>(body + 3), size - 3);
+    return t;
+  }
+
+  void AddLogged(const std::uint8_t* body, std::size_t size) {
+    in_definitions_ = false;
+    ULogTopic t = Subscription(body, size);
     if (Index(t.msg_id) >= 0) return Malformed();  // an id must not be reused
     if (!resolver_.Resolve(&t)) {
       ++log_->warnings.unresolved_subscriptions;
       return;
     }
-    Keep(&t, log_->topics.size());
-    data_entries_.push_back(DataEntry::Of(t));
+    Subscribe(std::move(t));
+  }
+
+  /// AddLogged for a parser made by Ahead: false, with nothing changed, where AddLogged would
+  /// count a warning (the ahead parser stops there instead).
+  bool AddLoggedAhead(const std::uint8_t* body, std::size_t size) {
+    ULogTopic t = Subscription(body, size);
+    if (Index(t.msg_id) >= 0 || !resolver_.Resolve(&t)) return false;  // no budget taken then
+    in_definitions_ = false;
+    Subscribe(std::move(t));
+    return true;
+  }
+
+  /// Adds the resolved topic `t` as the next one: kept or decoded as the filter says.
+  void Subscribe(ULogTopic t) {
+    const std::size_t k = log_->topics.size();
+    Keep(&t, k);
+    const DataEntry entry = DataEntry::Of(t);
+    const CombinedDecoder decoder = decoders_[k];
+    Subscribe(std::move(t), decoder, entry);
+  }
+
+  /// Adds the topic `t` as the next one, with its decoder and entry (those of the parser that
+  /// read its subscription and messages: the two-part read's join).
+  void Subscribe(ULogTopic t, const CombinedDecoder& decoder, const DataEntry& entry) {
+    const std::size_t k = log_->topics.size();
+    if (decoders_.size() <= k) decoders_.resize(k + 1);
+    decoders_[k] = decoder;
+    data_entries_.push_back(entry);
     if (index_.size() <= t.msg_id) index_.resize(std::size_t{t.msg_id} + 1, -1);
-    index_[t.msg_id] = static_cast<int>(log_->topics.size());
+    index_[t.msg_id] = static_cast<int>(k);
     log_->topics.push_back(std::move(t));
   }
 
@@ -824,6 +953,29 @@ class Parser {
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
   bool ahead_ = false;        ///< made by Ahead: Run stops where AheadMessage says
   bool stopped_ = false;      ///< FeedAhead stopped
+  std::size_t formats_seen_ = 0;  ///< F messages read (well formed or not)
+  /// Made by Ahead: its maker's topic count and formats_seen_ then.
+  std::size_t maker_topics_ = 0;
+  std::size_t maker_formats_seen_ = 0;
+
+  /// A parameter change read by a parser made by Ahead, whose timestamp (the newest among
+  /// every topic's last message) is completed by the join: the topics it had no message of
+  /// then, whose last message is the first part's.
+  struct PendingChange {
+    std::size_t change = 0;  ///< index into its log's param_changes
+    std::vector<std::uint32_t> topics_without_rows;  ///< of its maker's topics
+
+    static PendingChange Of(std::size_t change, const std::vector<DataEntry>& entries,
+                            std::size_t maker_topics) {
+      PendingChange c;
+      c.change = change;
+      for (std::size_t k = 0; k < maker_topics; ++k) {
+        if (entries[k].rows == 0) c.topics_without_rows.push_back(static_cast<std::uint32_t>(k));
+      }
+      return c;
+    }
+  };
+  std::vector<PendingChange> pending_changes_;  ///< made by Ahead: its parameter changes
 };
 
 }  // namespace

@@ -228,12 +228,16 @@ struct ULog {
 };
 
 /// How ReadULog reads a file: in one part, or in two at once (TwoPartReadOptions). A ULog's
-/// second part starts at a message boundary (16 messages it decodes in a row); it decodes D messages of the topics subscribed in the lead, S, O, L, C and
-/// R messages, and stops, leaving the rest to the first part, at any other message (a
-/// definition, subscription, parameter change, info, a D of an id not subscribed in the lead,
-/// an unknown type), a corrupt header or a message cut by the end. A decoded topic's samples
-/// are joined under its rule (ULogTopic::imu), every other count, body and text added after
-/// the first part's. A log with appended data is read in one part.
+/// second part starts at a message boundary (16 messages it decodes in a row) and knows the
+/// formats, subscriptions and column budget of the lead. It decodes D messages of subscribed
+/// topics; S, O, L, C and R messages; parameter changes (their timestamps completed from the
+/// first part's topics in the join), default parameters, info and continued info; and
+/// subscriptions whose id is free and whose format it resolves. It stops, leaving the rest to
+/// the first part, at a format, a subscription it cannot take, a message that does not parse,
+/// a D of an id not subscribed, an unknown type, a corrupt header or a message cut by the end.
+/// What it read joins after the first part's (a decoded topic's samples under its rule,
+/// ULogTopic::imu); its subscriptions only when the first part subscribed none and defined no
+/// format after the lead. A log with appended data is read in one part.
 using ULogReadOptions = TwoPartReadOptions;
 
 /// Reads and decodes a .ulg file. Throws plumb::InputError(path, "byte N", what) when the file

@@ -48,6 +48,11 @@ class ULogFormatResolver {
   /// Forgets cached layouts (call when a format is redefined).
   void Invalidate() { cache_.clear(); }
 
+  /// Columns the topics resolved from now on may still take (the budget left).
+  std::size_t budget_left() const { return column_budget_; }
+  /// Sets the budget left: a parser taking over another's resolutions (the two-part read).
+  void set_budget_left(std::size_t columns) { column_budget_ = columns; }
+
   /// Fills columns, body_size, full_size and timestamp_col of `topic`; false if unresolvable
   /// or over the column budget.
   bool Resolve(ULogTopic* topic);
