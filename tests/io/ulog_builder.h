@@ -68,4 +68,12 @@ inline Bytes Cat(std::initializer_list<Bytes> parts) {
   return out;
 }
 
+/// The body of a B message (flag bits) with incompat bit 0 set (data appended) and every
+/// offset 0; the first offset lies at file byte 16 + 3 + 16 when the message follows the header.
+inline Bytes AppendedDataFlagBits() {
+  Bytes flags(40, 0);
+  flags[8] = 1;
+  return flags;
+}
+
 }  // namespace plumb::io::testing

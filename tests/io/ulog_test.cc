@@ -383,9 +383,7 @@ TEST(ULogBuilt, TruncatedLastMessageIsCountedAndDropped) {
 
 TEST(ULogBuilt, AppendedSegmentsFollowTheFlagBitsOffsets) {
   Writer w;
-  Bytes flags(40, 0);
-  flags[8] = 1;  // incompat bit 0: data appended
-  w.Message('B', flags);
+  w.Message('B', testing::AppendedDataFlagBits());
   w.Format("t:uint64_t timestamp;float v;");
   w.Add(0, 0, "t");
   w.Data(0, Cat({Le<std::uint64_t>(1), Le(1.0f)}));
@@ -735,9 +733,7 @@ void FillTwoTopics(Writer* w, std::size_t until, std::uint64_t* t_us) {
 // ends) decodes exactly what the in-memory parser does.
 TEST(ULogBuilt, ReadingInChunksDecodesWhatTheWholeInputDoes) {
   Writer w;
-  Bytes flags(40, 0);
-  flags[8] = 1;  // incompat bit 0: data appended
-  w.Message('B', flags);
+  w.Message('B', testing::AppendedDataFlagBits());
   w.Format("t:uint64_t timestamp;float v;uint8_t[3] _padding0;");
   w.Format("big:uint64_t timestamp;uint8_t[3000] blob;");
   w.Add(0, 0, "t");

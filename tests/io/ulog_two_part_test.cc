@@ -74,17 +74,32 @@ Bytes Combined(std::uint64_t t_us, int n, bool padded) {
   return b;
 }
 
-/// A log with what the join must get right near any of its bytes (see the file comment).
-/// `definitions_end`: the offset where its data section starts.
-Bytes SeamLog(std::size_t* definitions_end) {
-  Writer w;
-  w.Message('B', Bytes(40, 0));
+/// Writes the formats of sensor_combined (PX4's layout), sensor_accel and vehicle_status.
+void CombinedFormats(Writer& w) {
   w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
            "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
            "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;"
            "uint8_t[3] _padding0;");
   w.Format("sensor_accel:uint64_t timestamp;float x;float y;float z;");
   w.Format("vehicle_status:uint64_t timestamp;uint8_t nav_state;");
+}
+
+/// The formats of sensor_combined (PX4's layout), sensor_accel and vehicle_status, and
+/// sensor_combined subscribed as msg_id 0: the start of a made-up log for the cases at the
+/// edge of what the second part decides.
+Writer CombinedLog() {
+  Writer w;
+  CombinedFormats(w);
+  w.Add(0, 0, "sensor_combined");
+  return w;
+}
+
+/// A log with what the join must get right near any of its bytes (see the file comment).
+/// `definitions_end`: the offset where its data section starts.
+Bytes SeamLog(std::size_t* definitions_end) {
+  Writer w;
+  w.Message('B', Bytes(40, 0));
+  CombinedFormats(w);
   w.Format("late_topic:uint64_t timestamp;float v;");
   w.Format("blob:uint64_t timestamp;uint8_t[224] bytes;");
   w.KeyValue('I', "char[3] sys_name", Bytes{'P', 'X', '4'});
@@ -180,12 +195,7 @@ TEST(ULogTwoParts, SameLogWhereverTheSecondPartStarts) {
 /// The clock set back at the seam by less than the first part's last sample: the second
 /// part's first kept samples are dropped in the join, as one part drops them.
 TEST(ULogTwoParts, ClockSetBackAtTheSeamJoinsAsInOnePart) {
-  Writer w;
-  w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
-           "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
-           "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;"
-           "uint8_t[3] _padding0;");
-  w.Add(0, 0, "sensor_combined");
+  Writer w = CombinedLog();
   const std::size_t lead = w.bytes().size();
   for (int n = 0; n < 2000; ++n) {
     const std::uint64_t time = n < 1000 ? 1000000 + 1000 * n : 1500000 + 1000 * (n - 1000);
@@ -206,19 +216,6 @@ TEST(ULogTwoParts, ClockSetBackAtTheSeamJoinsAsInOnePart) {
   }
 }
 
-/// sensor_combined's format and subscription as msg_id 0 (the lead), then `more` as the log goes
-/// on: the start of a made-up log for the cases at the edge of what the second part decides.
-Writer CombinedLog() {
-  Writer w;
-  w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
-           "int32_t accelerometer_timestamp_relative;float[3] accelerometer_m_s2;"
-           "uint32_t accelerometer_integral_dt;uint8_t accelerometer_clipping;"
-           "uint8_t[3] _padding0;");
-  w.Format("sensor_accel:uint64_t timestamp;float x;float y;float z;");
-  w.Format("vehicle_status:uint64_t timestamp;uint8_t nav_state;");
-  w.Add(0, 0, "sensor_combined");
-  return w;
-}
 
 /// The first part subscribes a topic after the lead, the second part another under the same
 /// msg_id (in one pass an id taken: malformed): the second part's subscription must not join.
@@ -265,9 +262,7 @@ TEST(ULogTwoParts, ParametersBeforeAnySubscriptionAreInitialValues) {
 /// Appended data: its segments are read by one parser (no second part), the same log.
 TEST(ULogTwoParts, AppendedDataIsReadInOnePart) {
   Writer w;
-  Bytes flags(40, 0);
-  flags[8] = 1;  // incompat bit 0: data appended
-  w.Message('B', flags);
+  w.Message('B', testing::AppendedDataFlagBits());
   w.Format("sensor_accel:uint64_t timestamp;float x;float y;float z;");
   w.Add(0, 1, "sensor_accel");
   const std::size_t flags_offsets = 16 + 3 + 16;

@@ -421,7 +421,8 @@ class Parser {
   /// pos_ of a parser made by Ahead before its first FeedAhead.
   static constexpr std::size_t kNotStarted = static_cast<std::size_t>(-1);
 
-  /// `t` without its messages: its definition, and empty bodies or samples.
+  /// `t` without its messages: its definition, and empty bodies or samples (field by field:
+  /// a copy would copy the blocks of its bodies).
   static ULogTopic WithoutMessages(const ULogTopic& t) {
     ULogTopic out;
     out.name = t.name;
