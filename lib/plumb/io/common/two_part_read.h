@@ -11,8 +11,10 @@
 //
 // The parser concept (DataflashParser, the ULog parser):
 //   Feed(data, n, offset, at_end) -> offset     the one-pass decoder (see ReadForward)
-//   kUntilSlack                                 bytes past `until` Feed must be given so that it
-//                                               decodes exactly the records starting before it
+//   kUntilSlack                                 bytes past `until` Feed may be given: with them
+//                                               it decodes no record starting at `until` or
+//                                               after, and reaches `until` exactly when a
+//                                               record ends there
 //   Ahead(Log* out) const -> Parser             the second part's parser, decoding into `out`
 //   FeedAhead(data, n, offset) -> offset        its Feed: stops (stopped()) where it cannot go on
 //   stopped() -> bool
