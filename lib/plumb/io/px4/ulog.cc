@@ -547,21 +547,25 @@ class Parser {
   /// what came before): an S with the sync magic, an O or R of 2 bytes, an L of 9 bytes or
   /// more, a C of 11 or more; 0 otherwise.
   static std::size_t AheadOther(const std::uint8_t* p, std::size_t n) {
-    if (n < kMsgHeaderSize) return 0;
+    if (n < kMsgHeaderSize || std::memchr("SORLC", p[2], 5) == nullptr) return 0;
     const std::size_t size = LoadLittleEndian<std::uint16_t>(p);
-    if (size > n - kMsgHeaderSize) return 0;
-    bool sound = false;
-    switch (p[2]) {
+    if (size > n - kMsgHeaderSize || FixedRuleBroken(p[2], size, p + kMsgHeaderSize)) return 0;
+    return size;
+  }
+
+  /// True when a message of type S, O, R, L or C of `size` bytes breaks its type's rule (an S
+  /// of 8 bytes with the sync magic, checked when its body `body` is whole: else nullptr; an O
+  /// or R of 2 bytes; an L of 9 bytes or more, a C of 11 or more). False for other types.
+  static bool FixedRuleBroken(std::uint8_t type, std::size_t size, const std::uint8_t* body) {
+    switch (type) {
       case 'S':
-        sound = size == sizeof(kSyncMagic) &&
-                std::memcmp(p + kMsgHeaderSize, kSyncMagic, sizeof(kSyncMagic)) == 0;
-        break;
-      case 'O': case 'R': sound = size == 2; break;
-      case 'L': sound = size >= 9; break;
-      case 'C': sound = size >= 11; break;
-      default: break;
+        return size != sizeof(kSyncMagic) ||
+               (body != nullptr && std::memcmp(body, kSyncMagic, sizeof(kSyncMagic)) != 0);
+      case 'O': case 'R': return size != 2;
+      case 'L': return size < 9;
+      case 'C': return size < 11;
+      default: return false;
     }
-    return sound ? size : 0;
   }
 
   /// The topic index of the D message at `p` (n bytes held) when it is whole in them, of a
@@ -606,15 +610,8 @@ class Parser {
         const DataEntry& e = data_entries_[static_cast<std::size_t>(idx)];
         return size - 2 < e.body_size || size - 2 > e.full_size;
       }
-      case 'S':
-        return size != sizeof(kSyncMagic) ||
-               (body_fits &&
-                std::memcmp(At(pos) + kMsgHeaderSize, kSyncMagic, sizeof(kSyncMagic)) != 0);
-      case 'O': case 'R': return size != 2;
       case 'A': return size < 4;
-      case 'L': return size < 9;
-      case 'C': return size < 11;
-      default: return false;
+      default: return FixedRuleBroken(type, size, body_fits ? At(pos) + kMsgHeaderSize : nullptr);
     }
   }
 
