@@ -70,7 +70,7 @@ class CalibrateCommand : public Command {
     AddSegmentOptions(app_, a.segments);
     AddExportOptions(app_, a.exports);
     app_->add_option("--jobs", a.jobs,
-                     "Threads for reading (a .bin or .ulg of 32 MiB or more in two parts) and the motion "
+                     "Threads for reading (a .bin, .tlog or .ulg of 32 MiB or more in two parts) and the motion "
                      "residuals' integration (default 0: every core); the result is the same "
                      "bit for bit")
         ->check(CLI::NonNegativeNumber)

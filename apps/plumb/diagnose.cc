@@ -77,7 +77,7 @@ class DiagnoseCommand : public Command {
     app_->add_option("--jobs", a.jobs,
                      "The two probe fits, then the refits, in parallel, each on one core "
                      "(the first refits while the second probe fit runs; default: every "
-                     "core), and a .bin or .ulg of 32 MiB or more read in two parts; the result is the "
+                     "core), and a .bin, .tlog or .ulg of 32 MiB or more read in two parts; the result is the "
                      "same whatever N")
         ->check(NonNegative);
     app_->add_option("--candidates", a.candidates,

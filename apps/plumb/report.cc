@@ -199,7 +199,7 @@ class ReportCommand : public Command {
         ->capture_default_str();
     app_->add_option("--jobs", a.jobs,
                      "Diagnose's probe fits, then its refits, in parallel, each on one core "
-                     "(default: every core), and a .bin or .ulg of 32 MiB or more read in two parts; "
+                     "(default: every core), and a .bin, .tlog or .ulg of 32 MiB or more read in two parts; "
                      "the page is the same whatever N")
         ->check(NonNegative);
     AddFitOptions(app_, a.fit);

@@ -17,9 +17,10 @@
 // both in one invocation: --benchmark_filter='BM_(Cat|Read)').
 // BM_WalkDataflash/<log> walks the records of the same file (ReadForward, headers and FMT
 // lengths only): the floor under the DataFlash reader's record loop (one thread).
-// BM_ReadDataflashInTwoParts/<log> and BM_ReadULogInTwoParts/<log> are BM_ReadDataflash and
-// BM_ReadULog in two parts at once on two threads, as `plumb` reads a .bin or .ulg of 32 MiB or
-// more (TwoPartReadOptions); their CPU time is the process's.
+// BM_ReadDataflashInTwoParts/<log>, BM_ReadULogInTwoParts/<log> and BM_ReadTlogInTwoParts/<log>
+// are BM_ReadDataflash, BM_ReadULog and BM_ReadTlog in two parts at once on two threads, as
+// `plumb` reads a .bin, .ulg or .tlog of 32 MiB or more (TwoPartReadOptions); their CPU time is
+// the process's.
 // Skipped with the reason when the shared data is absent. With PLUMB_BENCH_LOG_DIR=DIR set, the
 // repeated logs are written to DIR/big_<name> and kept (to time `plumb info` on them).
 #include <benchmark/benchmark.h>
@@ -430,13 +431,20 @@ BENCHMARK_CAPTURE(BM_WalkDataflash, copter36_chibios,
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// MAVLink .tlog: every frame's CRC checked and the IMU messages decoded.
+/// Reads the tlog at `path` as FlightLog does (every frame's CRC checked, the IMU messages
+/// decoded; in two parts at once with `run_jobs`) and returns the IMU messages decoded.
+std::size_t ReadTlogSamples(const std::string& path, const plumb::JobRunner& run_jobs = {}) {
+  plumb::io::TlogReadOptions options;
+  options.run_jobs = run_jobs;
+  const plumb::io::MavlinkLog decoded = plumb::io::ReadTlog(path, options);
+  benchmark::DoNotOptimize(decoded.raw_imu.data());
+  return decoded.raw_imu.size() + decoded.scaled_imu.size() + decoded.scaled_imu2.size() +
+         decoded.scaled_imu3.size() + decoded.highres_imu.size();
+}
+
+/// MAVLink .tlog: every frame's CRC checked and the IMU messages decoded (one thread).
 void BM_ReadTlog(benchmark::State& state, const std::string& relative) {
-  ReadRepeated(state, relative, [](const std::string& path) {
-    const plumb::io::MavlinkLog decoded = plumb::io::ReadTlog(path);
-    benchmark::DoNotOptimize(decoded.raw_imu.data());
-    return decoded.raw_imu.size() + decoded.scaled_imu2.size() + decoded.scaled_imu3.size();
-  });
+  ReadRepeated(state, relative, [](const std::string& path) { return ReadTlogSamples(path); });
 }
 BENCHMARK_CAPTURE(BM_ReadTlog, plane385_disarmed, std::string("mavlink/plane385_disarmed.tlog"))
     ->Unit(benchmark::kMillisecond)
@@ -475,6 +483,19 @@ void BM_ReadULogInTwoParts(benchmark::State& state, const std::string& relative)
                [](const std::string& path) { return ReadULogSamples(path, TwoThreads); });
 }
 BENCHMARK_CAPTURE(BM_ReadULogInTwoParts, sample, std::string("px4/sample.ulg"))
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+/// BM_ReadTlog in two parts at once on two threads, as `plumb` reads a .tlog of 32 MiB or more
+/// on a machine of two cores or more (TlogReadOptions): the same messages, every CRC checked.
+/// Its CPU time is the process's (both threads).
+void BM_ReadTlogInTwoParts(benchmark::State& state, const std::string& relative) {
+  ReadRepeated(state, relative,
+               [](const std::string& path) { return ReadTlogSamples(path, TwoThreads); });
+}
+BENCHMARK_CAPTURE(BM_ReadTlogInTwoParts, plane385_disarmed,
+                  std::string("mavlink/plane385_disarmed.tlog"))
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();

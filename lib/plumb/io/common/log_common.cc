@@ -57,14 +57,14 @@ LogFile::LogFile(const std::string& path, const std::string& what) {
   size_ = buffer_.size();
 }
 
-void LogFile::DropPages(std::size_t up_to) const {
+void LogFile::Release(std::size_t from, std::size_t up_to) const {
+  if (mapping_ == nullptr) return;
   const auto page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
-  const std::size_t begin = released_ / page * page;
+  const std::size_t begin = (from + page - 1) / page * page;  // whole pages only
   const std::size_t end = std::min(up_to, size_) / page * page;
   if (end > begin) {
     ::madvise(static_cast<std::uint8_t*>(mapping_) + begin, end - begin, MADV_DONTNEED);
   }
-  released_ = up_to;
 }
 
 namespace {

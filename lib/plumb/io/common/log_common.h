@@ -33,29 +33,23 @@ class LogFile {
   const std::uint8_t* data() const { return data_; }
   std::size_t size() const { return size_; }
 
-  /// Says the parser is done with the bytes [0, up_to) for now, so that a mapped file does not
-  /// stay resident as it is read: every kReleaseStep bytes, the whole pages before `up_to`
-  /// are dropped from this process's memory (madvise MADV_DONTNEED; the mapping is read-only,
-  /// so reading them again re-reads the same bytes from the file, slower but identical).
-  /// Cheap when called per record. An `up_to` below the last one starts over (a new pass, or
-  /// a jump back). No-op for a file read into a buffer.
-  void Release(std::size_t up_to) const {
-    if (mapping_ == nullptr) return;
-    if (up_to < released_) released_ = 0;
-    if (up_to >= released_ + kReleaseStep) DropPages(up_to);
-  }
+  /// Says a parser is done with the bytes [from, up_to) for now, so that a mapped file does
+  /// not stay resident as it is read: the whole pages inside them are dropped from this
+  /// process's memory (madvise MADV_DONTNEED; the mapping is read-only, so reading them again
+  /// re-reads the same bytes from the file, slower but identical). A parser calls it every
+  /// kReleaseStep bytes or so, with `from` where its last call ended; parsers going through
+  /// disjoint ranges at once (a two-part read) may each call it. No-op for a file read into a
+  /// buffer.
+  void Release(std::size_t from, std::size_t up_to) const;
 
-  /// Bytes between two actual releases (32 MiB).
+  /// Bytes a parser reads between two calls of Release (32 MiB).
   static constexpr std::size_t kReleaseStep = std::size_t{32} << 20;
 
  private:
-  void DropPages(std::size_t up_to) const;
-
   const std::uint8_t* data_ = nullptr;
   std::size_t size_ = 0;
   void* mapping_ = nullptr;             ///< the mmap'ed region, or nullptr
   std::vector<std::uint8_t> buffer_;    ///< the bytes when not mapped
-  mutable std::size_t released_ = 0;    ///< bytes [0, released_) were last released
 };
 
 /// The value of type T stored at `p` little endian, as every log format plumb reads stores it

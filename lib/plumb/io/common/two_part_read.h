@@ -1,5 +1,7 @@
 // plumb/io/common/two_part_read.h — reading a large log in two parts at once, for readers whose
-// parser decides each record from a bounded look-ahead (the DataFlash .bin and ULog readers).
+// parser decides each record from a bounded look-ahead (the DataFlash .bin and ULog readers; the
+// tlog reader, whose parser holds no definitions and looks ahead without bound over the mapped
+// file, takes TwoPartReadOptions and the boundary constants below but joins its own way).
 //
 // The first part is read alone for a lead (the log's definitions); a second parser, made from
 // the first and knowing what it knows then (Parser::Ahead), starts at a record boundary guessed

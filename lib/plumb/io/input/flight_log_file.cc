@@ -96,7 +96,7 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
       out.log_ = ReadDataflashText(path, ArdupilotSessionRecords());
       break;
     case FlightLogFormat::kMavlinkTlog:
-      out.log_ = ReadTlog(path);
+      out.log_ = ReadTlog(path, TwoParts(run_jobs));
       break;
     case FlightLogFormat::kPx4ULog:
       out.log_ = ReadULog(path, Px4SessionTopics(), TwoParts(run_jobs));

@@ -249,27 +249,36 @@ bool NextLooksLikeRecord(const std::uint8_t* data, std::size_t size, std::size_t
   return size - pos < kTimeBytes + 1 || LooksLikeTlogRecord(data + pos, size - pos);
 }
 
-/// The one-pass decoder.
+/// The one-pass decoder. What it does at a position depends only on the bytes from there on
+/// (Examine, NextLooksLikeRecord, FindRecord look ahead, never back) and on whether a record
+/// ended there, so a parser started at a record another one accepts goes on exactly as that one
+/// would: the two-part read (ReadInTwoParts) rests on it.
 class Parser {
  public:
-  /// `file`: the mapped file `data` is, told what has been read (LogFile::Release), or nullptr.
-  Parser(const std::uint8_t* data, std::size_t size, MavlinkLog* log, const LogFile* file)
-      : data_(data), size_(size), log_(log), file_(file) {
+  /// Decodes `data` (`size` bytes) into `log`. `file`: the mapped file `data` is, told what has
+  /// been read (LogFile::Release) from byte `from` on, or nullptr.
+  Parser(const std::uint8_t* data, std::size_t size, MavlinkLog* log, const LogFile* file,
+         std::size_t from = 0)
+      : data_(data), size_(size), log_(log), file_(file), released_(from), last_end_(from) {
     low_counts_.fill(0);
   }
 
-  void Run() {
-    std::size_t pos = 0;
-    std::size_t last_end = 0;  // end of the last accepted record
+  /// Decodes the records starting in [from, until); returns the position reached: `until` when
+  /// a record ends there (or a skipped byte does), past it when a record starting before it
+  /// runs on, size_ when the data end. Called again with what it returned, it goes on.
+  std::size_t Run(std::size_t from, std::size_t until) {
+    std::size_t pos = from;
     Frame f;
-    while (pos < size_) {
-      if (file_ != nullptr) file_->Release(pos);
+    while (pos < until) {
+      if (file_ != nullptr && pos >= released_ + LogFile::kReleaseStep) {
+        file_->Release(released_, pos);
+        released_ = pos;
+      }
       const Verdict v = Examine(data_, size_, pos, &f);
-      if (v == Verdict::kChecked ||
-          (v == Verdict::kUnchecked && NextLooksLikeRecord(data_, size_, pos + f.record_bytes))) {
+      if (Accepted(v, f, pos)) {
         Accept(f, v == Verdict::kChecked);
         pos += f.record_bytes;
-        last_end = pos;
+        last_end_ = pos;
         continue;
       }
       if (v == Verdict::kCrcFailed) {
@@ -278,15 +287,15 @@ class Parser {
         ++w.crc_failures;
       }
       if (v == Verdict::kIncomplete) {
-        if (size_ - pos < kTimeBytes + 1 && pos != last_end) {
+        if (size_ - pos < kTimeBytes + 1 && pos != last_end_) {
           SkipTo(pos, size_);
-          break;
+          return size_;
         }
         const std::size_t next = FindRecord(pos + 1);
         if (next == size_) {
           log_->warnings.truncated_records = 1;
           log_->warnings.truncated_bytes = size_ - pos;
-          break;
+          return size_;
         }
         SkipTo(pos, next);
         pos = next;
@@ -295,21 +304,47 @@ class Parser {
       SkipTo(pos, pos + 1);
       ++pos;
     }
+    return pos;
+  }
+
+  /// Adds the frames counted per id below 256 to the log's message_counts: once, after the
+  /// last Run.
+  void Finish() {
     for (std::uint32_t id = 0; id < 256; ++id) {
       if (low_counts_[id] > 0) log_->message_counts[id] += low_counts_[id];
     }
+    low_counts_.fill(0);
+  }
+
+  /// First position in [from, to) where `records` records this parser would accept follow one
+  /// another; `to` when there is none: where a second part may start.
+  std::size_t FindRecordChain(std::size_t from, std::size_t to, int records) const {
+    Frame f;
+    for (std::size_t p = from; p < to; ++p) {
+      std::size_t at = p;
+      int found = 0;
+      while (found < records && at < size_ && Accepted(Examine(data_, size_, at, &f), f, at)) {
+        at += f.record_bytes;
+        ++found;
+      }
+      if (found == records) return p;
+    }
+    return to;
   }
 
  private:
+  /// Whether the record Examine found at `pos` (verdict `v`, frame `f`) is accepted: its CRC
+  /// checked, or of an id it cannot check and followed by what looks like a record.
+  bool Accepted(Verdict v, const Frame& f, std::size_t pos) const {
+    return v == Verdict::kChecked ||
+           (v == Verdict::kUnchecked && NextLooksLikeRecord(data_, size_, pos + f.record_bytes));
+  }
+
   /// First position >= from where a record is accepted, or size_.
   std::size_t FindRecord(std::size_t from) const {
     Frame f;
     for (std::size_t p = from; p < size_; ++p) {
-      const Verdict v = Examine(data_, size_, p, &f);
-      if (v == Verdict::kChecked ||
-          (v == Verdict::kUnchecked && NextLooksLikeRecord(data_, size_, p + f.record_bytes))) {
-        return p;
-      }
+      if (Accepted(Examine(data_, size_, p, &f), f, p)) return p;
     }
     return size_;
   }
@@ -459,6 +494,8 @@ class Parser {
   std::size_t size_;
   MavlinkLog* log_;
   const LogFile* file_;
+  std::size_t released_;   // the file is released up to here (LogFile::Release)
+  std::size_t last_end_;   // end of the last accepted record
   std::array<std::size_t, 256> low_counts_;
   std::array<std::uint8_t, kMaxPayload + 1> buffer_{};
   std::size_t skip_end_ = 0;
@@ -553,14 +590,94 @@ std::vector<std::pair<std::string, std::size_t>> MavlinkLog::MessageCounts() con
 
 namespace {
 
+/// Appends `later`'s warnings, those of the bytes after `w`'s, to `w`.
+void AddWarnings(MavlinkWarnings& w, const MavlinkWarnings& later) {
+  if (w.bytes_skipped == 0) w.first_skip_offset = later.first_skip_offset;
+  if (w.crc_failures == 0) w.first_crc_failure_offset = later.first_crc_failure_offset;
+  w.bytes_skipped += later.bytes_skipped;
+  w.skip_runs += later.skip_runs;
+  w.crc_failures += later.crc_failures;
+  w.truncated_records += later.truncated_records;
+  w.truncated_bytes += later.truncated_bytes;
+  w.unchecked_frames += later.unchecked_frames;
+}
+
+/// Appends `later`, decoded from the bytes right after `log`'s (a second part starting on a
+/// record the first part reached), to `log`: as one parser going through both would have it.
+/// The message vectors are appended as jobs through `run_jobs`.
+void Join(MavlinkLog& log, const MavlinkLog& later, const JobRunner& run_jobs) {
+  log.frames_v1 += later.frames_v1;
+  log.frames_v2 += later.frames_v2;
+  log.frames_signed += later.frames_signed;
+  log.checked_frames += later.checked_frames;
+  log.record_bytes += later.record_bytes;
+  for (const auto& [id, n] : later.message_counts) log.message_counts[id] += n;
+  AddWarnings(log.warnings, later.warnings);
+  const auto append = [](auto& out, const auto& in) {
+    out.insert(out.end(), in.begin(), in.end());
+  };
+  RunJobs(run_jobs, 8, [&](int job) {  // each job appends its own vector
+    switch (job) {
+      case 0: append(log.heartbeat, later.heartbeat); break;
+      case 1: append(log.raw_imu, later.raw_imu); break;
+      case 2: append(log.scaled_imu, later.scaled_imu); break;
+      case 3: append(log.scaled_imu2, later.scaled_imu2); break;
+      case 4: append(log.scaled_imu3, later.scaled_imu3); break;
+      case 5: append(log.highres_imu, later.highres_imu); break;
+      case 6: append(log.gps_raw_int, later.gps_raw_int); break;
+      default: append(log.param_value, later.param_value); break;
+    }
+  });
+}
+
+/// Decodes `data` (`size` bytes) into `first`, which writes `log`, in two parts at once through
+/// options.run_jobs: the second part starts at a chain of records
+/// (detail::kBoundaryRecords) looked for from lead + second_part_at * (size - lead) on
+/// (no lead is read alone: a tlog has no definitions), and runs to the end; the first reads to
+/// it. The second part's log is joined when the first part ended exactly on its start; else
+/// the first reads on alone. Either way the log is the one a single pass makes.
+void ReadInTwoParts(const std::uint8_t* data, std::size_t size, Parser& first, MavlinkLog& log,
+                    const LogFile* file, const TwoPartReadOptions& options) {
+  const std::size_t lead = std::min(options.lead_bytes, size);
+  const double at = std::clamp(options.second_part_at, 0.0, 1.0);
+  const auto nominal = lead + static_cast<std::size_t>(at * static_cast<double>(size - lead));
+  const std::size_t window_end = std::min(size, nominal + detail::kBoundaryWindow);
+  const std::size_t start = first.FindRecordChain(nominal, window_end, detail::kBoundaryRecords);
+  if (start == window_end) {
+    first.Run(0, size);
+    return;
+  }
+  MavlinkLog later;
+  Parser second(data, size, &later, file, start);
+  std::size_t reached = 0;
+  RunJobs(options.run_jobs, 2, [&](int job) {
+    if (job == 0) {
+      reached = first.Run(0, start);
+    } else {
+      second.Run(start, size);
+      second.Finish();
+    }
+  });
+  if (reached != start) {
+    first.Run(reached, size);
+    return;
+  }
+  Join(log, later, options.run_jobs);
+}
+
 /// ParseTlog, telling `file` (nullptr: none) what the parser has read.
 MavlinkLog ParseTlogFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
-                         const LogFile* file) {
+                         const LogFile* file, const TlogReadOptions& options) {
   MavlinkLog log;
   log.source = source;
   log.size_bytes = size;
   Parser parser(data, size, &log, file);
-  parser.Run();
+  if (options.run_jobs && size > 0 && size >= options.two_part_bytes) {
+    ReadInTwoParts(data, size, parser, log, file, options);
+  } else {
+    parser.Run(0, size);
+  }
+  parser.Finish();
   if (log.frames_v1 + log.frames_v2 == 0) {
     throw InputError(source, "byte 0",
                      "no MAVLink frame ([8-byte big-endian unix time in µs][0xFE or 0xFD "
@@ -572,13 +689,14 @@ MavlinkLog ParseTlogFrom(const std::uint8_t* data, std::size_t size, const std::
 
 }  // namespace
 
-MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source) {
-  return ParseTlogFrom(data, size, source, nullptr);
+MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source,
+                     const TlogReadOptions& options) {
+  return ParseTlogFrom(data, size, source, nullptr, options);
 }
 
-MavlinkLog ReadTlog(const std::string& path) {
+MavlinkLog ReadTlog(const std::string& path, const TlogReadOptions& options) {
   const LogFile file(path, "MAVLink tlog");
-  return ParseTlogFrom(file.data(), file.size(), path, &file);
+  return ParseTlogFrom(file.data(), file.size(), path, &file, options);
 }
 
 }  // namespace plumb::io

@@ -19,7 +19,8 @@
 // Payload fields are little-endian, ordered by size (largest first), extension fields last in
 // declaration order.
 //
-// Decoding contract (one pass over the file held in memory, no per-frame allocation):
+// Decoding contract (one pass over the file held in memory, no per-frame allocation; a large
+// file may be read in two parts at once, TlogReadOptions, to the same log):
 //  * A record starts where the 8-byte time is plausible (unix time between 2000-01-01 and
 //    2100-01-01) and is followed by 0xFE or 0xFD (v2 with incompat_flags other than 1 is
 //    rejected: unknown incompatible features).
@@ -56,6 +57,8 @@
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "plumb/io/common/two_part_read.h"
 
 namespace plumb::io {
 
@@ -230,12 +233,20 @@ std::uint16_t MavlinkCrc(const std::uint8_t* data, std::size_t size, std::uint16
 /// between 2000-01-01 and 2100-01-01 (µs since the unix epoch), then 0xFE or 0xFD.
 bool LooksLikeTlogRecord(const std::uint8_t* data, std::size_t size);
 
+/// How ParseTlog and ReadTlog read: in one part, or, given run_jobs, a log of two_part_bytes
+/// or more in two parts at once (plumb/io/common/two_part_read.h). A tlog has no definitions:
+/// both parts start at once, the second at a chain of records found from
+/// lead_bytes + second_part_at * (size - lead_bytes) on, and reads to the end; the log is the
+/// same, to the byte, as read in one part.
+using TlogReadOptions = TwoPartReadOptions;
+
 /// Decodes a tlog held in memory; `source` names it in errors. Throws plumb::InputError(source,
 /// "byte 0", ...) when not a single MAVLink frame is found.
-MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source);
+MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::string& source,
+                     const TlogReadOptions& options = {});
 
 /// Reads and decodes a .tlog file. Throws plumb::InputError(path, "byte N", what) when it
 /// cannot be read or holds no MAVLink frame.
-MavlinkLog ReadTlog(const std::string& path);
+MavlinkLog ReadTlog(const std::string& path, const TlogReadOptions& options = {});
 
 }  // namespace plumb::io
