@@ -73,7 +73,7 @@ void AddInputFiles(const InputArgs& args, FileRoles& roles);
 /// Reads every input and joins them into one session (plumb::io::OpenInputs). Throws
 /// UsageError for contradictory or malformed options, plumb::InputError naming the file for bad
 /// input, plumb::Error when the session has no samples. The two-file form's files, and a large
-/// .bin, .tlog or .ulg log's two parts (io::TwoPartReadOptions), are read at once on up to
+/// .bin, .tlog or .ulg log's two parts (io::SplitReadOptions), are read at once on up to
 /// `jobs` threads (0: every core).
 Session ReadInputs(const InputArgs& args, int jobs = 0);
 

@@ -17,10 +17,10 @@
 // both in one invocation: --benchmark_filter='BM_(Cat|Read)').
 // BM_WalkDataflash/<log> walks the records of the same file (ReadForward, headers and FMT
 // lengths only): the floor under the DataFlash reader's record loop (one thread).
-// BM_ReadDataflashInTwoParts/<log>, BM_ReadULogInTwoParts/<log> and BM_ReadTlogInTwoParts/<log>
-// are BM_ReadDataflash, BM_ReadULog and BM_ReadTlog in two parts at once on two threads, as
-// `plumb` reads a .bin, .ulg or .tlog of 32 MiB or more (TwoPartReadOptions); their CPU time is
-// the process's.
+// BM_ReadDataflashInParts/<log>, BM_ReadULogInParts/<log> and BM_ReadTlogInParts/<log>
+// are BM_ReadDataflash, BM_ReadULog and BM_ReadTlog in parts at once on two threads, as `plumb`
+// reads a .bin, .ulg or .tlog of 32 MiB or more; their argument is the number of parts (/2 as
+// `plumb` reads, SplitReadOptions' default; /8 to compare), their CPU time the process's.
 // Skipped with the reason when the shared data is absent. With PLUMB_BENCH_LOG_DIR=DIR set, the
 // repeated logs are written to DIR/big_<name> and kept (to time `plumb info` on them).
 #include <benchmark/benchmark.h>
@@ -325,14 +325,27 @@ BENCHMARK_CAPTURE(BM_Cat, sample, std::string("px4/sample.ulg"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+/// A read in `parts` parts at once through `run_jobs` for any size (SplitReadOptions; the
+/// second part's start at 1 / parts of the bytes after the lead, the others at its multiples);
+/// empty run_jobs: one part.
+plumb::io::SplitReadOptions InParts(const plumb::JobRunner& run_jobs, int parts) {
+  plumb::io::SplitReadOptions options;
+  options.run_jobs = run_jobs;
+  options.parts = parts;
+  options.second_part_at = 1.0 / parts;
+  return options;
+}
+
+/// The parts of an InParts benchmark: its argument (2, as `plumb` reads; 8 to compare).
+int Parts(const benchmark::State& state) { return static_cast<int>(state.range(0)); }
+
 /// Reads the DataFlash log at `path` as FlightLog does (the bodies a session reads; the IMU
-/// messages' samples decoded in the pass; in two parts at once with `run_jobs`) and returns
+/// messages' samples decoded in the pass; in parts at once with `run_jobs`) and returns
 /// the number of IMU samples of every instance: counted where the reader put them, or with
 /// `copy_out` copied out as ImuFromDataflash returns them.
 std::size_t ReadDataflashSamples(const std::string& path, bool copy_out,
-                                 const plumb::JobRunner& run_jobs = {}) {
-  plumb::io::DataflashReadOptions options;
-  options.run_jobs = run_jobs;
+                                 const plumb::JobRunner& run_jobs = {}, int parts = 8) {
+  const plumb::io::DataflashReadOptions options = InParts(run_jobs, parts);
   const plumb::io::DataflashLog decoded =
       plumb::io::ReadDataflash(path, plumb::io::ArdupilotSessionRecords(), options);
   std::size_t samples = 0;
@@ -370,20 +383,26 @@ void TwoThreads(int count, const std::function<void(int)>& job) {
   for (int k = 0; k < count; ++k) job(k);
 }
 
-/// BM_ReadDataflash in two parts at once on two threads, as `plumb` reads a .bin of 32 MiB or
+/// BM_ReadDataflash in parts at once on two threads, as `plumb` reads a .bin of 32 MiB or
 /// more on a machine of two cores or more (DataflashReadOptions): the same samples. Its CPU
 /// time is the process's (both threads).
-void BM_ReadDataflashInTwoParts(benchmark::State& state, const std::string& relative) {
+void BM_ReadDataflashInParts(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative,
-               [](const std::string& path) { return ReadDataflashSamples(path, false, TwoThreads); });
+               [&](const std::string& path) {
+                 return ReadDataflashSamples(path, false, TwoThreads, Parts(state));
+               });
 }
-BENCHMARK_CAPTURE(BM_ReadDataflashInTwoParts, copter36_chibios,
+BENCHMARK_CAPTURE(BM_ReadDataflashInParts, copter36_chibios,
                   std::string("ardupilot/copter36_chibios.bin"))
+    ->Arg(2)
+    ->Arg(8)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_ReadDataflashInTwoParts, plane408_centre_point,
+BENCHMARK_CAPTURE(BM_ReadDataflashInParts, plane408_centre_point,
                   std::string("ardupilot/plane408_centre_point.BIN"))
+    ->Arg(2)
+    ->Arg(8)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
@@ -432,11 +451,10 @@ BENCHMARK_CAPTURE(BM_WalkDataflash, copter36_chibios,
     ->UseRealTime();
 
 /// Reads the tlog at `path` as FlightLog does (every frame's CRC checked, the IMU messages
-/// decoded; in two parts at once with `run_jobs`) and returns the IMU messages decoded.
-std::size_t ReadTlogSamples(const std::string& path, const plumb::JobRunner& run_jobs = {}) {
-  plumb::io::TlogReadOptions options;
-  options.run_jobs = run_jobs;
-  const plumb::io::MavlinkLog decoded = plumb::io::ReadTlog(path, options);
+/// decoded; in parts at once with `run_jobs`) and returns the IMU messages decoded.
+std::size_t ReadTlogSamples(const std::string& path, const plumb::JobRunner& run_jobs = {},
+                            int parts = 8) {
+  const plumb::io::MavlinkLog decoded = plumb::io::ReadTlog(path, InParts(run_jobs, parts));
   benchmark::DoNotOptimize(decoded.raw_imu.data());
   return decoded.raw_imu.size() + decoded.scaled_imu.size() + decoded.scaled_imu2.size() +
          decoded.scaled_imu3.size() + decoded.highres_imu.size();
@@ -451,14 +469,13 @@ BENCHMARK_CAPTURE(BM_ReadTlog, plane385_disarmed, std::string("mavlink/plane385_
     ->UseRealTime();
 
 /// Reads the ULog at `path` as FlightLog does (the bodies of the topics a session reads;
-/// sensor_combined's samples decoded in the pass; in two parts at once with `run_jobs`) and
+/// sensor_combined's samples decoded in the pass; in parts at once with `run_jobs`) and
 /// returns the samples of every IMU stream (sensor_combined, vehicle_imu, sensor_accel paired
 /// with sensor_gyro), of every copy.
-std::size_t ReadULogSamples(const std::string& path, const plumb::JobRunner& run_jobs = {}) {
-  plumb::io::ULogReadOptions options;
-  options.run_jobs = run_jobs;
+std::size_t ReadULogSamples(const std::string& path, const plumb::JobRunner& run_jobs = {},
+                            int parts = 8) {
   const plumb::io::ULog decoded =
-      plumb::io::ReadULog(path, plumb::io::Px4SessionTopics(), options);
+      plumb::io::ReadULog(path, plumb::io::Px4SessionTopics(), InParts(run_jobs, parts));
   std::size_t samples = 0;
   for (const plumb::io::ImuStreamInfo& s : plumb::io::ULogImuStreams(decoded)) {
     samples += s.samples;
@@ -475,27 +492,35 @@ BENCHMARK_CAPTURE(BM_ReadULog, sample, std::string("px4/sample.ulg"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// BM_ReadULog in two parts at once on two threads, as `plumb` reads a .ulg of 32 MiB or more
+/// BM_ReadULog in parts at once on two threads, as `plumb` reads a .ulg of 32 MiB or more
 /// on a machine of two cores or more (ULogReadOptions): the same samples. Its CPU time is the
 /// process's (both threads).
-void BM_ReadULogInTwoParts(benchmark::State& state, const std::string& relative) {
+void BM_ReadULogInParts(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative,
-               [](const std::string& path) { return ReadULogSamples(path, TwoThreads); });
+               [&](const std::string& path) {
+                 return ReadULogSamples(path, TwoThreads, Parts(state));
+               });
 }
-BENCHMARK_CAPTURE(BM_ReadULogInTwoParts, sample, std::string("px4/sample.ulg"))
+BENCHMARK_CAPTURE(BM_ReadULogInParts, sample, std::string("px4/sample.ulg"))
+    ->Arg(2)
+    ->Arg(8)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
 
-/// BM_ReadTlog in two parts at once on two threads, as `plumb` reads a .tlog of 32 MiB or more
+/// BM_ReadTlog in parts at once on two threads, as `plumb` reads a .tlog of 32 MiB or more
 /// on a machine of two cores or more (TlogReadOptions): the same messages, every CRC checked.
 /// Its CPU time is the process's (both threads).
-void BM_ReadTlogInTwoParts(benchmark::State& state, const std::string& relative) {
+void BM_ReadTlogInParts(benchmark::State& state, const std::string& relative) {
   ReadRepeated(state, relative,
-               [](const std::string& path) { return ReadTlogSamples(path, TwoThreads); });
+               [&](const std::string& path) {
+                 return ReadTlogSamples(path, TwoThreads, Parts(state));
+               });
 }
-BENCHMARK_CAPTURE(BM_ReadTlogInTwoParts, plane385_disarmed,
+BENCHMARK_CAPTURE(BM_ReadTlogInParts, plane385_disarmed,
                   std::string("mavlink/plane385_disarmed.tlog"))
+    ->Arg(2)
+    ->Arg(8)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();

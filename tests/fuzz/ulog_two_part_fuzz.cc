@@ -1,6 +1,6 @@
 // libFuzzer target, differential: any byte sequence as a PX4 ULog decoded in two parts
 // (ULogReadOptions) must give the very log decoded in one part, or the same error
-// (two_part_differential.h); never crash, hang or read out of bounds (build with
+// (split_read_differential.h); never crash, hang or read out of bounds (build with
 // -fsanitize=fuzzer,address,undefined).
 #include <cstddef>
 #include <cstdint>
@@ -8,10 +8,10 @@
 #include "../support/ulog_log_difference.h"
 #include "plumb/io/px4/px4_session.h"
 #include "plumb/io/px4/ulog.h"
-#include "two_part_differential.h"
+#include "split_read_differential.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  plumb::fuzz::CheckTwoPartRead(
+  plumb::fuzz::CheckSplitRead(
       data, size, plumb::io::Px4SessionTopics(),
       [](const uint8_t* bytes, size_t n, const plumb::io::RecordFilter& filter,
          const plumb::io::ULogReadOptions& options) {

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -141,7 +142,7 @@ DataflashLog ParseInTwo(const Bytes& bytes, std::size_t lead, std::size_t start,
   DataflashParser parser(&log, filter, n);
   const std::size_t reached = parser.Feed(data, lead + kRoom, 0, false);
   DataflashLog ahead_log;
-  DataflashParser ahead = parser.Ahead(&ahead_log);
+  DataflashParser ahead = parser.Ahead(&ahead_log, n - start);
   const std::size_t stop = ahead.FeedAhead(data + start, n - start, start);
   const std::size_t landed = parser.Feed(data + reached, start + kRoom - reached, reached, false);
   *joined = landed == start && parser.Absorb(ahead, ahead_log, {});
@@ -182,6 +183,41 @@ TEST(DataflashTwoParts, SameLogFromEverySecondPartStart) {
     EXPECT_GT(joined_count, tried / 2);
     EXPECT_LT(joined_count, tried);
     EXPECT_GT(long_joins, 100u);
+  }
+}
+
+/// The log in 3 to 16 parts at once through ParseDataflash (SplitReadOptions::parts; the
+/// starts at the multiples of `second_part_at`), jobs in order and in reverse on two threads:
+/// the log read in one part, with parts joined one after another and parts left to the first
+/// parser between them (a start inside a record, after a new type's FMT).
+TEST(DataflashTwoParts, SameLogInManyParts) {
+  const Bytes log = SeamLog();
+  const JobRunner in_order = [](int count, const std::function<void(int)>& job) {
+    for (int k = 0; k < count; ++k) job(k);
+  };
+  for (const RecordFilter& filter : {RecordFilter{}, ArdupilotSessionRecords()}) {
+    const DataflashLog one = ParseDataflash(log.data(), log.size(), "seam.bin", filter);
+    std::size_t joins = 0;  // the IMU samples' joins (AppendSamples: four column jobs)
+    const JobRunner counting = [&](int count, const std::function<void(int)>& job) {
+      if (count == 4) ++joins;
+      in_order(count, job);
+    };
+    for (const int parts : {3, 5, 8, 16}) {
+      for (int k = 1; k <= 40; ++k) {
+        DataflashReadOptions options;
+        options.run_jobs = counting;
+        options.split_bytes = 0;
+        options.parts = parts;
+        options.lead_bytes = 600;
+        options.second_part_at = k / (40.0 * (parts - 1));
+        SCOPED_TRACE(::testing::Message() << parts << " parts, at " << options.second_part_at);
+        ExpectSameLog(one, ParseDataflash(log.data(), log.size(), "seam.bin", filter, options));
+        options.run_jobs = plumb::testing::ReverseOnTwoThreads;
+        ExpectSameLog(one, ParseDataflash(log.data(), log.size(), "seam.bin", filter, options));
+        if (::testing::Test::HasFailure()) return;
+      }
+    }
+    if (filter.decode) EXPECT_GT(joins, 1800u);
   }
 }
 
@@ -262,7 +298,8 @@ TEST(DataflashTwoParts, EverySharedBinReadInTwoPartsAsInOne) {
         SCOPED_TRACE(at);
         DataflashReadOptions options;
         options.run_jobs = at == 0.5 ? JobRunner(plumb::testing::ReverseOnTwoThreads) : in_order;
-        options.two_part_bytes = 0;
+        options.split_bytes = 0;
+        options.parts = 2;
         options.lead_bytes = 32 << 10;
         options.second_part_at = at;
         ExpectSameLog(one, ReadDataflash(path, filter, options));

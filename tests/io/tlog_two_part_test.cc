@@ -1,4 +1,4 @@
-// The .tlog reader in two parts (TlogReadOptions, two_part_read.h): the log is the one the
+// The .tlog reader in two parts (TlogReadOptions, split_read.h): the log is the one the
 // reader gives in one part, to the byte (frame counts, every decoded message, message counts per
 // id, skipped bytes and their runs, CRC failures, unchecked frames, the truncated last record),
 // wherever the second part's start is looked for: among v1 and v2 frames, signed and with
@@ -62,7 +62,8 @@ JobRunner CountingJoins(std::size_t* joins) {
 TlogReadOptions TwoParts(double at, const JobRunner& run_jobs, std::size_t lead = 0) {
   TlogReadOptions options;
   options.run_jobs = run_jobs;
-  options.two_part_bytes = 0;
+  options.split_bytes = 0;
+  options.parts = 2;
   options.lead_bytes = lead;
   options.second_part_at = at;
   return options;
@@ -197,6 +198,31 @@ TEST(TlogTwoParts, SameLogWhereverTheSecondPartStarts) {
   }
 }
 
+/// The log in 3 to 16 parts at once (SplitReadOptions::parts; the starts at the multiples of
+/// `second_part_at`), jobs in order and in reverse on two threads: the log read in one part,
+/// with parts joined one after another and parts left to the first parser between them.
+TEST(TlogTwoParts, SameLogInManyParts) {
+  for (const int ending : {0, 1, 2}) {
+    const Bytes log = SeamLog(ending);
+    const MavlinkLog one = ParseTlog(log.data(), log.size(), "seam.tlog");
+    std::size_t joins = 0;
+    for (const int parts : {3, 5, 8, 16}) {
+      for (int k = 1; k <= 40; ++k) {
+        const double at = k / (40.0 * (parts - 1));
+        SCOPED_TRACE(::testing::Message() << "ending " << ending << ", " << parts << " parts, at "
+                                          << at);
+        TlogReadOptions options = TwoParts(at, CountingJoins(&joins));
+        options.parts = parts;
+        ExpectSameLog(one, ParseTlog(log.data(), log.size(), "seam.tlog", options));
+        options.run_jobs = plumb::testing::ReverseOnTwoThreads;
+        ExpectSameLog(one, ParseTlog(log.data(), log.size(), "seam.tlog", options));
+        if (::testing::Test::HasFailure()) return;
+      }
+    }
+    EXPECT_GT(joins, 1000u);  // of 160 reads of 2 to 15 parts after the first
+  }
+}
+
 TEST(TlogTwoParts, StartGuessedInsideAFrameIsNotJoined) {
   // A v2 HEARTBEAT of 255 payload bytes (beyond the message's 9 ignored, but in its CRC) that
   // holds 14 v1 HEARTBEATs of payload length 0 and a frame of an unknown id covering the rest
@@ -234,6 +260,40 @@ TEST(TlogTwoParts, StartGuessedInsideAFrameIsNotJoined) {
   // Looked for from the outer frame itself, the start is a real record: joined.
   ExpectSameLog(one, ParseTlog(log.data(), log.size(), "inside.tlog",
                                TwoParts(AtByte(outer_at, log.size()), CountingJoins(&joins))));
+  EXPECT_EQ(joins, 1u);
+}
+
+/// A part that ends past the next part's start (its last frame holds what looked like a chain
+/// of records) hands on to the first parser, which reads the rest as that part would have: here
+/// the log's short tail right after that frame is a cut last record, not skipped bytes.
+TEST(TlogTwoParts, PartEndingPastTheNextStartHandsOnToTheFirst) {
+  // A v2 HEARTBEAT of 255 payload bytes (its first 9 read as the message) holding 15 v1
+  // HEARTBEATs of payload length 0 and a 17-byte frame of an unknown id that ends with the
+  // outer frame (the outer CRC its last 2 bytes); then a 5-byte tail.
+  Bytes payload;
+  for (int k = 0; k < 15; ++k) {
+    Append(&payload, Record({kMavHeartbeat, {}, 1, 1, false, false, true, kT0_us + k}));
+  }
+  Append(&payload, Record({kUnknownId, {0x55}, 1, 1, false, false, true, kT0_us}));
+  ASSERT_EQ(payload.size(), 257u);
+  payload.resize(255);
+  Bytes log;
+  for (int k = 0; k < 40; ++k) Append(&log, CleanRecord(k));
+  const std::size_t inner_at = log.size() + 8 + 10;
+  Append(&log, Record({kMavHeartbeat, payload, 1, 1, true, false, false, kT0_us + 99}));
+  log.insert(log.end(), {0x00, 0x01, 0x02, 0x03, 0x04});
+
+  const MavlinkLog one = ParseTlog(log.data(), log.size(), "past.tlog");
+  ASSERT_EQ(one.warnings.truncated_records, 1u);
+  ASSERT_EQ(one.warnings.bytes_skipped, 0u);
+  // Three parts: the second from a record in the middle of the clean ones, the third guessed
+  // at the outer frame's inner records; the second joins, reads the outer frame whole and ends
+  // past the third's start, which does not join.
+  TlogReadOptions options = TwoParts(AtByte(inner_at, 2 * log.size()), {});
+  options.parts = 3;
+  std::size_t joins = 0;
+  options.run_jobs = CountingJoins(&joins);
+  ExpectSameLog(one, ParseTlog(log.data(), log.size(), "past.tlog", options));
   EXPECT_EQ(joins, 1u);
 }
 

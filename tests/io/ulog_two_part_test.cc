@@ -1,4 +1,4 @@
-// The .ulg reader in two parts (ULogReadOptions, two_part_read.h): the log is the one the
+// The .ulg reader in two parts (ULogReadOptions, split_read.h): the log is the one the
 // reader gives in one part, to the byte (formats, subscriptions, counts, last timestamps, kept
 // bodies, decoded sensor_combined samples, info, parameters and their changes, texts, sync and
 // dropout counts, warnings), wherever the second part's start is looked for: before and after
@@ -57,7 +57,8 @@ JobRunner CountingJoins(std::size_t* joins) {
 ULogReadOptions TwoParts(std::size_t lead, double at, const JobRunner& run_jobs) {
   ULogReadOptions options;
   options.run_jobs = run_jobs;
-  options.two_part_bytes = 0;
+  options.split_bytes = 0;
+  options.parts = 2;
   options.lead_bytes = lead;
   options.second_part_at = at;
   return options;
@@ -189,6 +190,33 @@ TEST(ULogTwoParts, SameLogWhereverTheSecondPartStarts) {
     // when the lead held every subscription (the others: a start inside a blob, or a second
     // part that stops at once).
     if (filter.decode) EXPECT_GT(joins, 1200u);
+  }
+}
+
+/// The log in 3 to 16 parts at once (SplitReadOptions::parts; the starts at the multiples of
+/// `second_part_at`), jobs in order and in reverse on two threads: the log read in one part,
+/// with parts joined one after another and parts left to the first parser between them.
+TEST(ULogTwoParts, SameLogInManyParts) {
+  std::size_t definitions_end = 0;
+  const Bytes log = SeamLog(&definitions_end);
+  for (const RecordFilter& filter : {RecordFilter{}, Px4SessionTopics()}) {
+    const ULog one = ParseULog(log.data(), log.size(), "seam.ulg", filter);
+    std::size_t joins = 0;
+    for (const int parts : {3, 5, 8, 16}) {
+      for (int k = 1; k <= 40; ++k) {
+        const double at = k / (40.0 * (parts - 1));
+        SCOPED_TRACE(::testing::Message() << parts << " parts, at " << at);
+        ULogReadOptions options = TwoParts(definitions_end, at, CountingJoins(&joins));
+        options.parts = parts;
+        ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", filter, options));
+        options.run_jobs = plumb::testing::ReverseOnTwoThreads;
+        ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", filter, options));
+        if (::testing::Test::HasFailure()) return;
+      }
+    }
+    // sensor_combined's samples joined about six times a read (about 960 in all; fewer than
+    // 800 when the first parser does not read on between the parts).
+    if (filter.decode) EXPECT_GT(joins, 900u);
   }
 }
 

@@ -13,7 +13,7 @@
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/dataflash_format.h"
 #include "plumb/io/ardupilot/dataflash_parser.h"
-#include "plumb/io/common/two_part_read.h"
+#include "plumb/io/common/split_read.h"
 
 namespace plumb::io {
 namespace {

@@ -46,7 +46,7 @@
 #include "plumb/core/jobs.h"
 #include "plumb/io/common/flight_log.h"
 #include "plumb/io/common/log_common.h"
-#include "plumb/io/common/two_part_read.h"
+#include "plumb/io/common/split_read.h"
 
 namespace plumb::io {
 
@@ -155,12 +155,12 @@ struct DataflashLog {
   std::vector<std::pair<std::string, std::size_t>> MessageCounts() const;
 };
 
-/// How ReadDataflash reads a file: in one part, or in two at once (TwoPartReadOptions). A .bin's
-/// second part starts at a record boundary (16 records of known types in a row); it stops at a
-/// record header of a type not defined in the lead (ArduPilot writes the FMTs of the types it
-/// logs first) or an FMT defining a new type; its IMU samples are joined to the first part's
-/// under the rule for times as if read in one pass (DataflashParser::Absorb).
-using DataflashReadOptions = TwoPartReadOptions;
+/// How ReadDataflash reads a file: in one part, or in parts at once, two by default
+/// (SplitReadOptions). A .bin's later part starts at a record boundary (16 records of known types
+/// in a row); it stops at a record header of a type not defined in the lead (ArduPilot writes the
+/// FMTs of the types it logs first) or an FMT defining a new type; its IMU samples are joined to
+/// the first part's under the rule for times as if read in one pass (DataflashParser::Absorb).
+using DataflashReadOptions = SplitReadOptions;
 
 /// Reads and decodes a .bin log. Throws plumb::InputError(path, "byte N", what) when the file
 /// cannot be read or holds no FMT record at all.

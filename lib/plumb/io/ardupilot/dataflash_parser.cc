@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "plumb/io/common/two_part_read.h"
+#include "plumb/io/common/split_read.h"
 
 namespace plumb::io::detail {
 namespace {
@@ -202,9 +202,14 @@ std::size_t DataflashParser::FeedTail(const std::uint8_t* data, std::size_t n,
   return offset + n;
 }
 
-DataflashParser DataflashParser::Ahead(DataflashLog* out) const {
+DataflashParser DataflashParser::Ahead(DataflashLog* out, std::size_t bytes) const {
   DataflashParser ahead = *this;
   ahead.log_ = out;
+  for (std::size_t id = 0; id < decoder_of_.size(); ++id) {  // samples of its bytes only
+    if (decoder_of_[id] < 0) continue;
+    const std::size_t length = std::max<std::size_t>(table_[id].length, 1);
+    ahead.decoders_[static_cast<std::size_t>(decoder_of_[id])].BoundRows(bytes / length + 1);
+  }
   ahead.rows_.fill(0);
   ahead.skip_end_ = 0;
   ahead.stopped_ = false;

@@ -1,7 +1,7 @@
 // plumb/io/ardupilot/dataflash_parser.h — INTERNAL to plumb::io_ardupilot: the binary .bin
 // reader's one-pass decoder (ReadDataflash and ParseDataflash in dataflash.cc are its users):
 // the walk from record to record, the IMU samples decoded inside it (DataflashImuDecoder), and
-// the pieces of the two-part read: a parser started further on in the same file, run beside
+// the pieces of the read in parts: a parser started further on in the same file, run beside
 // the first (DataflashParser::Ahead), and the join of what it decoded to what the first one
 // did (DataflashParser::Absorb), exactly as one parser going through both parts would have
 // decoded them. Not part of the public interface.
@@ -83,6 +83,10 @@ class DataflashImuDecoder {
   /// then kept, and ImuFromDataflash says what is missing). `rows_bound`: at most this many
   /// records are coming (0: unknown), to reserve each instance's samples once.
   static std::optional<DataflashImuDecoder> For(const DataflashType& t, std::size_t rows_bound);
+
+  /// Reserves samples (Reserve, at an instance's first record) for at most `rows_bound`
+  /// records from now on (kMaxReserve at most): a parser of part of the input (Ahead).
+  void BoundRows(std::size_t rows_bound) { rows_bound_ = std::min(rows_bound, kMaxReserve); }
 
   /// Decodes the record body `body` of `t` (the type this decoder was made for). `heads`
   /// (nullptr: none): where each instance's first kHeadRecords records are kept as decoded.
@@ -235,7 +239,7 @@ class DataflashParser {
   /// The longest record: its length is one byte, header included.
   static constexpr std::size_t kMaxRecord = 255;
   /// Bytes past a position Feed must be given to decode every record starting before it (and
-  /// none after): its look-ahead less one (two_part_read.h).
+  /// none after): its look-ahead less one (split_read.h).
   static constexpr std::size_t kUntilSlack = kMaxRecord - 1;
 
   /// `filter`: the types whose bodies are kept or samples decoded; `size_hint`: the input's
@@ -255,10 +259,11 @@ class DataflashParser {
   }
 
   /// A parser for the records from a later byte of the same input on, to run beside this one
-  /// (the two-part read): it knows the types this one knows now, decodes into `out` (which gets
-  /// their definitions, no records), keeps each IMU instance's first records as decoded
-  /// (DataflashImuHeads), and is fed with FeedAhead.
-  DataflashParser Ahead(DataflashLog* out) const;
+  /// (the read in parts, split_read.h): it knows the types this one knows now, decodes into
+  /// `out` (which gets their definitions, no records), keeps each IMU instance's first records
+  /// as decoded (DataflashImuHeads), reserves samples for the records of about `bytes` bytes,
+  /// and is fed with FeedAhead.
+  DataflashParser Ahead(DataflashLog* out, std::size_t bytes) const;
 
   /// Feed for a parser made by Ahead: the same, but it stops (stopped()) at the first byte it
   /// cannot decide as this parser's maker would there: a record header whose type it does not

@@ -69,9 +69,9 @@ const char* FlightLogFormatName(FlightLogFormat format) {
 
 namespace {
 
-/// Two parts at once through `run_jobs` for a large log (the defaults of TwoPartReadOptions).
-TwoPartReadOptions TwoParts(const JobRunner& run_jobs) {
-  TwoPartReadOptions options;
+/// Two parts at once through `run_jobs` for a large log (the defaults of SplitReadOptions).
+SplitReadOptions InParts(const JobRunner& run_jobs) {
+  SplitReadOptions options;
   options.run_jobs = run_jobs;
   return options;
 }
@@ -90,16 +90,16 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
   out.format_ = SniffFlightLog(path);
   switch (out.format_) {
     case FlightLogFormat::kDataflashBinary:
-      out.log_ = ReadDataflash(path, ArdupilotSessionRecords(), TwoParts(run_jobs));
+      out.log_ = ReadDataflash(path, ArdupilotSessionRecords(), InParts(run_jobs));
       break;
     case FlightLogFormat::kDataflashText:
       out.log_ = ReadDataflashText(path, ArdupilotSessionRecords());
       break;
     case FlightLogFormat::kMavlinkTlog:
-      out.log_ = ReadTlog(path, TwoParts(run_jobs));
+      out.log_ = ReadTlog(path, InParts(run_jobs));
       break;
     case FlightLogFormat::kPx4ULog:
-      out.log_ = ReadULog(path, Px4SessionTopics(), TwoParts(run_jobs));
+      out.log_ = ReadULog(path, Px4SessionTopics(), InParts(run_jobs));
       break;
     case FlightLogFormat::kNone:
       throw InputError(path, "byte 0",

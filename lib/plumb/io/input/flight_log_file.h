@@ -40,7 +40,7 @@ class FlightLog {
  public:
   /// Reads and decodes the log at `path`. Throws plumb::InputError naming the file when it is
   /// not a flight log plumb reads, and as the format's reader does. `run_jobs` (core/jobs.h):
-  /// a large .bin, .tlog or .ulg is read in two parts at once (TwoPartReadOptions; the same log
+  /// a large .bin, .tlog or .ulg is read in two parts at once (SplitReadOptions; the same log
   /// either way). Empty: one part.
   static FlightLog Open(const std::string& path, const JobRunner& run_jobs = {});
 

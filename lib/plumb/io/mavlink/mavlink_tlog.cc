@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <optional>
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
@@ -252,7 +253,7 @@ bool NextLooksLikeRecord(const std::uint8_t* data, std::size_t size, std::size_t
 /// The one-pass decoder. What it does at a position depends only on the bytes from there on
 /// (Examine, NextLooksLikeRecord, FindRecord look ahead, never back) and on whether a record
 /// ended there, so a parser started at a record another one accepts goes on exactly as that one
-/// would: the two-part read (ReadInTwoParts) rests on it.
+/// would: the read in parts (ReadInParts) rests on it.
 class Parser {
  public:
   /// Decodes `data` (`size` bytes) into `log`. `file`: the mapped file `data` is, told what has
@@ -316,8 +317,15 @@ class Parser {
     low_counts_.fill(0);
   }
 
+  /// Takes over where `part` (a parser of the same data whose log was joined to this one's)
+  /// got to: the next Run goes on as `part` would have.
+  void GoOnFrom(const Parser& part) {
+    last_end_ = part.last_end_;
+    skip_end_ = part.skip_end_;
+  }
+
   /// First position in [from, to) where `records` records this parser would accept follow one
-  /// another; `to` when there is none: where a second part may start.
+  /// another; `to` when there is none: where a later part may start.
   std::size_t FindRecordChain(std::size_t from, std::size_t to, int records) const {
     Frame f;
     for (std::size_t p = from; p < to; ++p) {
@@ -602,8 +610,8 @@ void AddWarnings(MavlinkWarnings& w, const MavlinkWarnings& later) {
   w.unchecked_frames += later.unchecked_frames;
 }
 
-/// Appends `later`, decoded from the bytes right after `log`'s (a second part starting on a
-/// record the first part reached), to `log`: as one parser going through both would have it.
+/// Appends `later`, decoded from the bytes right after `log`'s (a later part starting on a
+/// record the log so far reached), to `log`: as one parser going through both would have it.
 /// The message vectors are appended as jobs through `run_jobs`.
 void Join(MavlinkLog& log, const MavlinkLog& later, const JobRunner& run_jobs) {
   log.frames_v1 += later.frames_v1;
@@ -630,39 +638,54 @@ void Join(MavlinkLog& log, const MavlinkLog& later, const JobRunner& run_jobs) {
   });
 }
 
-/// Decodes `data` (`size` bytes) into `first`, which writes `log`, in two parts at once through
-/// options.run_jobs: the second part starts at a chain of records
-/// (detail::kBoundaryRecords) looked for from lead + second_part_at * (size - lead) on
-/// (no lead is read alone: a tlog has no definitions), and runs to the end; the first reads to
-/// it. The second part's log is joined when the first part ended exactly on its start; else
-/// the first reads on alone. Either way the log is the one a single pass makes.
-void ReadInTwoParts(const std::uint8_t* data, std::size_t size, Parser& first, MavlinkLog& log,
-                    const LogFile* file, const TwoPartReadOptions& options) {
+/// Decodes `data` (`size` bytes) into `first`, which writes `log`, in parts at once through
+/// options.run_jobs: each part after the first starts at a chain of records
+/// (detail::kBoundaryRecords) looked for near its nominal start (detail::PartStarts; no lead
+/// is read alone: a tlog has no definitions) and reads to the next part's start, the last to
+/// the end; the first reads to the second's start. Then, in order, a part's log is joined when
+/// the log so far ends exactly on its start; else `first` reads the part's bytes itself. Either
+/// way the log is the one a single pass makes.
+void ReadInParts(const std::uint8_t* data, std::size_t size, Parser& first, MavlinkLog& log,
+                 const LogFile* file, const SplitReadOptions& options) {
   const std::size_t lead = std::min(options.lead_bytes, size);
-  const double at = std::clamp(options.second_part_at, 0.0, 1.0);
-  const auto nominal = lead + static_cast<std::size_t>(at * static_cast<double>(size - lead));
-  const std::size_t window_end = std::min(size, nominal + detail::kBoundaryWindow);
-  const std::size_t start = first.FindRecordChain(nominal, window_end, detail::kBoundaryRecords);
-  if (start == window_end) {
+  const std::vector<std::size_t> starts =
+      detail::PartStarts(size, lead, options, [&](std::size_t from) -> std::optional<std::size_t> {
+        const std::size_t end = std::min(size, from + detail::kBoundaryWindow);
+        const std::size_t at = first.FindRecordChain(from, end, detail::kBoundaryRecords);
+        if (at == end) return std::nullopt;
+        return at;
+      });
+  if (starts.empty()) {
     first.Run(0, size);
     return;
   }
-  MavlinkLog later;
-  Parser second(data, size, &later, file, start);
+  const std::size_t later = starts.size();  // parts after the first
+  std::vector<MavlinkLog> logs(later);
+  std::vector<Parser> parts;
+  parts.reserve(later);
+  for (std::size_t i = 0; i < later; ++i) parts.emplace_back(data, size, &logs[i], file, starts[i]);
+  // parts[i] reads part i + 1 (part 0: `first`'s), from starts[i] to end_of(i).
+  const auto end_of = [&](std::size_t i) { return i + 1 < later ? starts[i + 1] : size; };
   std::size_t reached = 0;
-  RunJobs(options.run_jobs, 2, [&](int job) {
+  std::vector<std::size_t> stops(later, 0);
+  RunJobs(options.run_jobs, static_cast<int>(later + 1), [&](int job) {
     if (job == 0) {
-      reached = first.Run(0, start);
-    } else {
-      second.Run(start, size);
-      second.Finish();
+      reached = first.Run(0, starts[0]);
+      return;
     }
+    const auto i = static_cast<std::size_t>(job - 1);
+    stops[i] = parts[i].Run(starts[i], end_of(i));
+    parts[i].Finish();
   });
-  if (reached != start) {
-    first.Run(reached, size);
-    return;
+  for (std::size_t i = 0; i < later; ++i) {
+    if (reached == starts[i]) {
+      Join(log, logs[i], options.run_jobs);
+      first.GoOnFrom(parts[i]);
+      reached = stops[i];
+    } else {
+      reached = first.Run(reached, end_of(i));
+    }
   }
-  Join(log, later, options.run_jobs);
 }
 
 /// ParseTlog, telling `file` (nullptr: none) what the parser has read.
@@ -672,8 +695,8 @@ MavlinkLog ParseTlogFrom(const std::uint8_t* data, std::size_t size, const std::
   log.source = source;
   log.size_bytes = size;
   Parser parser(data, size, &log, file);
-  if (options.run_jobs && size > 0 && size >= options.two_part_bytes) {
-    ReadInTwoParts(data, size, parser, log, file, options);
+  if (options.run_jobs && size > 0 && size >= options.split_bytes) {
+    ReadInParts(data, size, parser, log, file, options);
   } else {
     parser.Run(0, size);
   }

@@ -58,7 +58,7 @@
 #include <utility>
 #include <vector>
 
-#include "plumb/io/common/two_part_read.h"
+#include "plumb/io/common/split_read.h"
 
 namespace plumb::io {
 
@@ -233,12 +233,12 @@ std::uint16_t MavlinkCrc(const std::uint8_t* data, std::size_t size, std::uint16
 /// between 2000-01-01 and 2100-01-01 (µs since the unix epoch), then 0xFE or 0xFD.
 bool LooksLikeTlogRecord(const std::uint8_t* data, std::size_t size);
 
-/// How ParseTlog and ReadTlog read: in one part, or, given run_jobs, a log of two_part_bytes
-/// or more in two parts at once (plumb/io/common/two_part_read.h). A tlog has no definitions:
+/// How ParseTlog and ReadTlog read: in one part, or, given run_jobs, a log of split_bytes
+/// or more in two parts at once (plumb/io/common/split_read.h). A tlog has no definitions:
 /// both parts start at once, the second at a chain of records found from
 /// lead_bytes + second_part_at * (size - lead_bytes) on, and reads to the end; the log is the
 /// same, to the byte, as read in one part.
-using TlogReadOptions = TwoPartReadOptions;
+using TlogReadOptions = SplitReadOptions;
 
 /// Decodes a tlog held in memory; `source` names it in errors. Throws plumb::InputError(source,
 /// "byte 0", ...) when not a single MAVLink frame is found.

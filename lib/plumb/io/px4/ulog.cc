@@ -9,7 +9,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
-#include "plumb/io/common/two_part_read.h"
+#include "plumb/io/common/split_read.h"
 #include "plumb/io/px4/ulog_format.h"
 
 namespace plumb::io {
@@ -232,16 +232,18 @@ class Parser {
   }
 
   /// Bytes past a position Feed must be given to decode no message starting at or after it
-  /// (and every one ending by it): none, Feed decodes only whole messages (two_part_read.h).
+  /// (and every one ending by it): none, Feed decodes only whole messages (split_read.h).
   static constexpr std::size_t kUntilSlack = 0;
 
   /// A parser for the messages from a later byte of the same input on, to run beside this one
-  /// (the two-part read, two_part_read.h): it knows the formats, subscriptions and column
+  /// (the read in parts, split_read.h): it knows the formats, subscriptions and column
   /// budget this one knows now, decodes into `out` (which gets their formats and topics,
-  /// without messages) and is fed with FeedAhead.
-  Parser Ahead(ULog* out) const {
+  /// without messages), reserves samples for the messages of about `bytes` bytes, and is fed
+  /// with FeedAhead.
+  Parser Ahead(ULog* out, std::size_t bytes) const {
     Parser ahead(size_, out, filter_);
     ahead.ahead_ = true;
+    ahead.reserve_bytes_ = bytes;
     ahead.pos_ = kNotStarted;
     ahead.index_ = index_;
     ahead.decoders_ = decoders_;
@@ -723,7 +725,7 @@ class Parser {
       return;
     }
     if (e.rows == 0 && t.body_size > 0) {  // at most one sample per remaining message
-      const std::size_t rest = size_ > pos_ ? size_ - pos_ : 0;
+      const std::size_t rest = ahead_ ? reserve_bytes_ : size_ > pos_ ? size_ - pos_ : 0;
       CombinedDecoder::Reserve(t.imu, std::min(rest / (t.body_size + 5) + 1, kMaxReserve));
     }
     decoders_[idx].Add(t.imu, fields);
@@ -950,6 +952,7 @@ class Parser {
   bool in_definitions_ = true;
   std::size_t skip_end_ = 0;  ///< end of the last skipped range (CountSkipped)
   bool ahead_ = false;        ///< made by Ahead: Run stops where AheadMessage says
+  std::size_t reserve_bytes_ = 0;  ///< made by Ahead: the bytes of its part, about
   bool stopped_ = false;      ///< FeedAhead stopped
   std::size_t formats_seen_ = 0;  ///< F messages read (well formed or not)
   /// Made by Ahead: its maker's topic count and formats_seen_ then.

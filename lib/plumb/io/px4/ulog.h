@@ -65,7 +65,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/io/common/log_common.h"
-#include "plumb/io/common/two_part_read.h"
+#include "plumb/io/common/split_read.h"
 
 namespace plumb::io {
 
@@ -227,18 +227,18 @@ struct ULog {
   std::vector<std::pair<std::string, std::size_t>> MessageCounts() const;
 };
 
-/// How ReadULog reads a file: in one part, or in two at once (TwoPartReadOptions). A ULog's
-/// second part starts at a message boundary (16 messages it decodes in a row) and knows the
+/// How ReadULog reads a file: in one part, or in parts at once, two by default (SplitReadOptions).
+/// A ULog's later part starts at a message boundary (16 messages it decodes in a row) and knows the
 /// formats, subscriptions and column budget of the lead. It decodes D messages of subscribed
-/// topics; S, O, L, C and R messages; parameter changes (their timestamps completed from the
-/// first part's topics in the join), default parameters, info and continued info; and
-/// subscriptions whose id is free and whose format it resolves. It stops, leaving the rest to
-/// the first part, at a format, a subscription it cannot take, a message that does not parse,
-/// a D of an id not subscribed, an unknown type, a corrupt header or a message cut by the end.
-/// What it read joins after the first part's (a decoded topic's samples under its rule,
-/// ULogTopic::imu); its subscriptions only when the first part subscribed none and defined no
-/// format after the lead. A log with appended data is read in one part.
-using ULogReadOptions = TwoPartReadOptions;
+/// topics; S, O, L, C and R messages; parameter changes (their timestamps completed from the first
+/// part's topics in the join), default parameters, info and continued info; and subscriptions whose
+/// id is free and whose format it resolves. It stops, leaving the rest to the first part, at a
+/// format, a subscription it cannot take, a message that does not parse, a D of an id not
+/// subscribed, an unknown type, a corrupt header or a message cut by the end. What it read joins
+/// after the first part's (a decoded topic's samples under its rule, ULogTopic::imu); its
+/// subscriptions only when the first part subscribed none and defined no format after the lead. A
+/// log with appended data is read in one part.
+using ULogReadOptions = SplitReadOptions;
 
 /// Reads and decodes a .ulg file. Throws plumb::InputError(path, "byte N", what) when the file
 /// cannot be read, is shorter than the 16-byte header, lacks the magic, or sets an
