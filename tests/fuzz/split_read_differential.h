@@ -16,6 +16,7 @@
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/common/split_read.h"
+#include "../support/split_read_testing.h"
 
 namespace plumb::fuzz {
 
@@ -25,9 +26,6 @@ namespace plumb::fuzz {
 template <class Parse, class Difference>
 void CheckSplitReadOf(std::size_t size, const Parse& parse, const Difference& difference,
                         const std::string& label) {
-  const JobRunner in_order = [](int count, const std::function<void(int)>& job) {
-    for (int k = 0; k < count; ++k) job(k);
-  };
   // The log, or the error's text (in `error`) when it throws.
   const auto decode = [&](const io::SplitReadOptions& options, std::string* error) {
     try {
@@ -46,12 +44,8 @@ void CheckSplitReadOf(std::size_t size, const Parse& parse, const Difference& di
   } splits[] = {{2, 0.0}, {2, 0.37}, {2, 0.71}, {5, 0.2}, {8, 0.125}};
   for (const auto& split : splits) {
     const double at = split.at;
-    io::SplitReadOptions options;
-    options.run_jobs = in_order;
-    options.split_bytes = 0;
-    options.parts = split.parts;
-    options.lead_bytes = size / 8;
-    options.second_part_at = at;
+    const io::SplitReadOptions options =
+        testing::TwoParts(size / 8, at, testing::InOrder, split.parts);
     std::string two_error;
     const auto two = decode(options, &two_error);
     const std::string what = one_error != two_error

@@ -23,6 +23,7 @@
 #include "plumb/io/ardupilot/dataflash_parser.h"
 #include "support/dataflash_log_difference.h"
 #include "support/reverse_jobs.h"
+#include "support/split_read_testing.h"
 
 namespace plumb::io {
 namespace {
@@ -192,24 +193,14 @@ TEST(DataflashTwoParts, SameLogFromEverySecondPartStart) {
 /// parser between them (a start inside a record, after a new type's FMT).
 TEST(DataflashTwoParts, SameLogInManyParts) {
   const Bytes log = SeamLog();
-  const JobRunner in_order = [](int count, const std::function<void(int)>& job) {
-    for (int k = 0; k < count; ++k) job(k);
-  };
   for (const RecordFilter& filter : {RecordFilter{}, ArdupilotSessionRecords()}) {
     const DataflashLog one = ParseDataflash(log.data(), log.size(), "seam.bin", filter);
     std::size_t joins = 0;  // the IMU samples' joins (AppendSamples: four column jobs)
-    const JobRunner counting = [&](int count, const std::function<void(int)>& job) {
-      if (count == 4) ++joins;
-      in_order(count, job);
-    };
+    const JobRunner counting = plumb::testing::CountingCalls(4, &joins);
     for (const int parts : {3, 5, 8, 16}) {
       for (int k = 1; k <= 40; ++k) {
-        DataflashReadOptions options;
-        options.run_jobs = counting;
-        options.split_bytes = 0;
-        options.parts = parts;
-        options.lead_bytes = 600;
-        options.second_part_at = k / (40.0 * (parts - 1));
+        DataflashReadOptions options =
+            plumb::testing::TwoParts(600, k / (40.0 * (parts - 1)), counting, parts);
         SCOPED_TRACE(::testing::Message() << parts << " parts, at " << options.second_part_at);
         ExpectSameLog(one, ParseDataflash(log.data(), log.size(), "seam.bin", filter, options));
         options.run_jobs = plumb::testing::ReverseOnTwoThreads;
@@ -279,9 +270,6 @@ TEST(DataflashTwoParts, RealLogJoinedAtItsMiddle) {
 TEST(DataflashTwoParts, EverySharedBinReadInTwoPartsAsInOne) {
   const std::string dir = SharedFile("ardupilot");
   if (!std::filesystem::is_directory(dir)) GTEST_SKIP() << "shared data absent: " << dir;
-  const JobRunner in_order = [](int count, const std::function<void(int)>& job) {
-    for (int k = 0; k < count; ++k) job(k);
-  };
   std::size_t files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     std::string ext = entry.path().extension().string();
@@ -296,12 +284,9 @@ TEST(DataflashTwoParts, EverySharedBinReadInTwoPartsAsInOne) {
       const DataflashLog one = ReadDataflash(path, filter);
       for (const double at : {0.0, 0.13, 0.5, 0.77, 0.999}) {
         SCOPED_TRACE(at);
-        DataflashReadOptions options;
-        options.run_jobs = at == 0.5 ? JobRunner(plumb::testing::ReverseOnTwoThreads) : in_order;
-        options.split_bytes = 0;
-        options.parts = 2;
-        options.lead_bytes = 32 << 10;
-        options.second_part_at = at;
+        const JobRunner run_jobs =
+            at == 0.5 ? JobRunner(plumb::testing::ReverseOnTwoThreads) : plumb::testing::InOrder;
+        const DataflashReadOptions options = plumb::testing::TwoParts(32 << 10, at, run_jobs);
         ExpectSameLog(one, ReadDataflash(path, filter, options));
         if (::testing::Test::HasFailure()) return;
       }

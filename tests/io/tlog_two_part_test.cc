@@ -21,6 +21,7 @@
 #include "plumb/io/mavlink/mavlink_tlog.h"
 #include "support/mavlink_log_difference.h"
 #include "support/reverse_jobs.h"
+#include "support/split_read_testing.h"
 #include "tlog_builder.h"
 
 namespace plumb::io {
@@ -44,30 +45,11 @@ void ExpectSameLog(const MavlinkLog& one, const MavlinkLog& two) {
   EXPECT_EQ(plumb::testing::MavlinkLogDifference(one, two), "");
 }
 
-/// Jobs one after another, in order (the serial RunJobs, through a runner).
-const JobRunner kInOrder = [](int count, const std::function<void(int)>& job) {
-  for (int k = 0; k < count; ++k) job(k);
-};
+using plumb::testing::TwoParts;
 
-/// kInOrder counting in `joins` the joins of the second part's messages (the eight vectors
+/// Jobs in order, counting in `joins` the joins of a later part's messages (the eight vectors
 /// appended at once are the only eight jobs run in a read).
-JobRunner CountingJoins(std::size_t* joins) {
-  return [joins](int count, const std::function<void(int)>& job) {
-    if (count == 8) ++*joins;
-    kInOrder(count, job);
-  };
-}
-
-/// Two parts for any size, the second's start looked for at `at` of the bytes after `lead`.
-TlogReadOptions TwoParts(double at, const JobRunner& run_jobs, std::size_t lead = 0) {
-  TlogReadOptions options;
-  options.run_jobs = run_jobs;
-  options.split_bytes = 0;
-  options.parts = 2;
-  options.lead_bytes = lead;
-  options.second_part_at = at;
-  return options;
-}
+JobRunner CountingJoins(std::size_t* joins) { return plumb::testing::CountingCalls(8, joins); }
 
 /// `second_part_at` that puts the nominal start of the second part at byte `at` of `size`
 /// (lead 0).
@@ -190,7 +172,7 @@ TEST(TlogTwoParts, SameLogWhereverTheSecondPartStarts) {
       const double at = k / 1000.0;
       SCOPED_TRACE(::testing::Message() << "at " << at);
       ExpectSameLog(one, ParseTlog(log.data(), log.size(), "seam.tlog",
-                                   TwoParts(at, CountingJoins(&joins))));
+                                   TwoParts(0, at, CountingJoins(&joins))));
       if (::testing::Test::HasFailure()) return;
     }
     // Every start but those in the last records (no chain of 16 after them) joins.
@@ -211,8 +193,7 @@ TEST(TlogTwoParts, SameLogInManyParts) {
         const double at = k / (40.0 * (parts - 1));
         SCOPED_TRACE(::testing::Message() << "ending " << ending << ", " << parts << " parts, at "
                                           << at);
-        TlogReadOptions options = TwoParts(at, CountingJoins(&joins));
-        options.parts = parts;
+        TlogReadOptions options = TwoParts(0, at, CountingJoins(&joins), parts);
         ExpectSameLog(one, ParseTlog(log.data(), log.size(), "seam.tlog", options));
         options.run_jobs = plumb::testing::ReverseOnTwoThreads;
         ExpectSameLog(one, ParseTlog(log.data(), log.size(), "seam.tlog", options));
@@ -255,11 +236,11 @@ TEST(TlogTwoParts, StartGuessedInsideAFrameIsNotJoined) {
   const std::size_t inner_at = outer_at + outer_header + hb.size();
   std::size_t joins = 0;
   ExpectSameLog(one, ParseTlog(log.data(), log.size(), "inside.tlog",
-                               TwoParts(AtByte(inner_at, log.size()), CountingJoins(&joins))));
+                               TwoParts(0, AtByte(inner_at, log.size()), CountingJoins(&joins))));
   EXPECT_EQ(joins, 0u);  // the guess was inside the outer frame: the first part went on
   // Looked for from the outer frame itself, the start is a real record: joined.
   ExpectSameLog(one, ParseTlog(log.data(), log.size(), "inside.tlog",
-                               TwoParts(AtByte(outer_at, log.size()), CountingJoins(&joins))));
+                               TwoParts(0, AtByte(outer_at, log.size()), CountingJoins(&joins))));
   EXPECT_EQ(joins, 1u);
 }
 
@@ -289,10 +270,9 @@ TEST(TlogTwoParts, PartEndingPastTheNextStartHandsOnToTheFirst) {
   // Three parts: the second from a record in the middle of the clean ones, the third guessed
   // at the outer frame's inner records; the second joins, reads the outer frame whole and ends
   // past the third's start, which does not join.
-  TlogReadOptions options = TwoParts(AtByte(inner_at, 2 * log.size()), {});
-  options.parts = 3;
   std::size_t joins = 0;
-  options.run_jobs = CountingJoins(&joins);
+  const TlogReadOptions options =
+      TwoParts(0, AtByte(inner_at, 2 * log.size()), CountingJoins(&joins), 3);
   ExpectSameLog(one, ParseTlog(log.data(), log.size(), "past.tlog", options));
   EXPECT_EQ(joins, 1u);
 }
@@ -314,7 +294,7 @@ TEST(TlogTwoParts, SharedTlogReadInTwoPartsAsInOne) {
       std::size_t joins = 0;
       const JobRunner run_jobs =
           at == 0.5 ? JobRunner(plumb::testing::ReverseOnTwoThreads) : CountingJoins(&joins);
-      ExpectSameLog(one, ReadTlog(path, TwoParts(at, run_jobs, 64 << 10)));
+      ExpectSameLog(one, ReadTlog(path, TwoParts(64 << 10, at, run_jobs)));
       if (::testing::Test::HasFailure()) return;
       if (at != 0.5 && at < 0.99) EXPECT_EQ(joins, 1u);
     }

@@ -22,6 +22,7 @@
 #include "plumb/io/px4/px4_session.h"
 #include "plumb/io/px4/ulog.h"
 #include "support/reverse_jobs.h"
+#include "support/split_read_testing.h"
 #include "support/ulog_log_difference.h"
 #include "ulog_builder.h"
 
@@ -38,31 +39,12 @@ void ExpectSameLog(const ULog& one, const ULog& two) {
   EXPECT_EQ(plumb::testing::ULogDifference(one, two), "");
 }
 
-/// Jobs one after another, in order (the serial RunJobs, through a runner).
-const JobRunner kInOrder = [](int count, const std::function<void(int)>& job) {
-  for (int k = 0; k < count; ++k) job(k);
-};
+using plumb::testing::InOrder;
+using plumb::testing::TwoParts;
 
-/// kInOrder counting in `joins` the joins of a decoded topic's samples (AppendSamples, whose
+/// InOrder counting in `joins` the joins of a decoded topic's samples (AppendSamples, whose
 /// four columns are the only four jobs run at once in a read).
-JobRunner CountingJoins(std::size_t* joins) {
-  return [joins](int count, const std::function<void(int)>& job) {
-    if (count == 4) ++*joins;
-    kInOrder(count, job);
-  };
-}
-
-/// Two parts for any size, the first read alone for `lead` bytes, the second's start looked
-/// for at `at` of the rest.
-ULogReadOptions TwoParts(std::size_t lead, double at, const JobRunner& run_jobs) {
-  ULogReadOptions options;
-  options.run_jobs = run_jobs;
-  options.split_bytes = 0;
-  options.parts = 2;
-  options.lead_bytes = lead;
-  options.second_part_at = at;
-  return options;
-}
+JobRunner CountingJoins(std::size_t* joins) { return plumb::testing::CountingCalls(4, joins); }
 
 /// A sensor_combined message of the PX4 layout (with its trailing padding when `padded`).
 Bytes Combined(std::uint64_t t_us, int n, bool padded) {
@@ -206,8 +188,7 @@ TEST(ULogTwoParts, SameLogInManyParts) {
       for (int k = 1; k <= 40; ++k) {
         const double at = k / (40.0 * (parts - 1));
         SCOPED_TRACE(::testing::Message() << parts << " parts, at " << at);
-        ULogReadOptions options = TwoParts(definitions_end, at, CountingJoins(&joins));
-        options.parts = parts;
+        ULogReadOptions options = TwoParts(definitions_end, at, CountingJoins(&joins), parts);
         ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", filter, options));
         options.run_jobs = plumb::testing::ReverseOnTwoThreads;
         ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", filter, options));
@@ -261,7 +242,7 @@ TEST(ULogTwoParts, SubscriptionsOnBothSidesOfTheSeam) {
   for (int k = 1; k < 40; ++k) {
     SCOPED_TRACE(k);
     ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", {},
-                                 TwoParts(lead, k / 100.0, kInOrder)));
+                                 TwoParts(lead, k / 100.0, InOrder)));
   }
 }
 
@@ -283,7 +264,7 @@ TEST(ULogTwoParts, ParametersBeforeAnySubscriptionAreInitialValues) {
   for (int k = 1; k < 60; ++k) {
     SCOPED_TRACE(k);
     ExpectSameLog(one, ParseULog(log.data(), log.size(), "seam.ulg", {},
-                                 TwoParts(lead, k / 100.0, kInOrder)));
+                                 TwoParts(lead, k / 100.0, InOrder)));
   }
 }
 
@@ -305,7 +286,7 @@ TEST(ULogTwoParts, AppendedDataIsReadInOnePart) {
   ASSERT_TRUE(one.data_appended);
   for (const double at : {0.1, 0.5, 0.9}) {
     ExpectSameLog(one, ParseULog(log.data(), log.size(), "appended.ulg", {},
-                                 TwoParts(200, at, kInOrder)));
+                                 TwoParts(200, at, InOrder)));
   }
 }
 
@@ -325,7 +306,7 @@ TEST(ULogTwoParts, EverySharedUlgReadInTwoPartsAsInOne) {
       for (const double at : {0.0, 0.13, 0.5, 0.77, 0.999}) {
         SCOPED_TRACE(at);
         const JobRunner run_jobs =
-            at == 0.5 ? JobRunner(plumb::testing::ReverseOnTwoThreads) : kInOrder;
+            at == 0.5 ? JobRunner(plumb::testing::ReverseOnTwoThreads) : InOrder;
         ExpectSameLog(one, ReadULog(path, filter, TwoParts(256 << 10, at, run_jobs)));
         if (::testing::Test::HasFailure()) return;
       }
