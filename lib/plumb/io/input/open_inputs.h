@@ -200,8 +200,9 @@ inline constexpr std::size_t kEstimatePrefixBytes = std::size_t{8} << 20;
 /// Memory per byte of kept record bodies: the bodies, the decoded series (64 bytes per sample
 /// against 30-50 bytes per IMU record) and the session's copy of it.
 inline constexpr double kKeptMemoryFactor = 3.0;
-/// Memory per byte of a .tlog (its frames are kept as decoded messages).
-inline constexpr double kTlogMemoryFactor = 0.75;
+/// Memory per byte of a .tlog (its frames are kept as decoded messages; read in two parts, the
+/// second part's messages are held until joined: 140 MB peak for a 150 MB .tlog).
+inline constexpr double kTlogMemoryFactor = 0.85;
 /// Memory per byte of a text table or CSV.
 inline constexpr double kTableMemoryFactor = 0.8;
 
