@@ -262,6 +262,8 @@ std::uint64_t EstimateReadMemory(const std::string& path) {
   switch (const FlightLogFormat format = SniffFlightLog(path)) {
     case FlightLogFormat::kDataflashBinary:
     case FlightLogFormat::kPx4ULog:
+      factor = kSplitKeptMemoryFactor * KeptFraction(path, format);
+      break;
     case FlightLogFormat::kDataflashText:
       factor = kKeptMemoryFactor * KeptFraction(path, format);
       break;

@@ -186,10 +186,11 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
 /// Peak memory, bytes, a run reading the file at `path` is expected to need (the process, the
 /// reader's storage and the decoded samples): kReadMemoryBaseBytes + factor * file size, the
 /// factor by format (SniffFlightLog; anything else is a text table):
-///   DataFlash .bin and .log, PX4 .ulg: kKeptMemoryFactor times the share of the file that
-///   the session's reader keeps (the bodies of its IMU, parameter and GPS messages, measured
-///   on the first kEstimatePrefixBytes: FlightLog reads with ArdupilotSessionRecords /
-///   Px4SessionTopics); MAVLink .tlog kTlogMemoryFactor; text tables and CSV
+///   DataFlash .bin and PX4 .ulg (read in two parts when large): kSplitKeptMemoryFactor, text
+///   .log: kKeptMemoryFactor, times the share of the file that the session's reader keeps (the
+///   bodies of its IMU, parameter and GPS messages, measured on the first
+///   kEstimatePrefixBytes: FlightLog reads with ArdupilotSessionRecords / Px4SessionTopics);
+///   MAVLink .tlog kTlogMemoryFactor; text tables and CSV
 ///   kTableMemoryFactor (about 50 bytes per decoded sample). Calibrated on the peak RSS of
 ///   `plumb info` / `plumb calibrate` on ~450 MB inputs (docs/performance.md, "Memory"),
 ///   rounded up. 0 when `path` cannot be sized.
@@ -200,6 +201,9 @@ inline constexpr std::size_t kEstimatePrefixBytes = std::size_t{8} << 20;
 /// Memory per byte of kept record bodies: the bodies, the decoded series (64 bytes per sample
 /// against 30-50 bytes per IMU record) and the session's copy of it.
 inline constexpr double kKeptMemoryFactor = 3.0;
+/// kKeptMemoryFactor for the readers that read a large file in two parts (.bin, .ulg): the
+/// second part's half of the decoded series is held twice while joined.
+inline constexpr double kSplitKeptMemoryFactor = 3.5;
 /// Memory per byte of a .tlog (its frames are kept as decoded messages; read in two parts, the
 /// second part's messages are held until joined: 140 MB peak for a 150 MB .tlog).
 inline constexpr double kTlogMemoryFactor = 0.85;
