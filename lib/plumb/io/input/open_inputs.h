@@ -171,8 +171,8 @@ struct InputOptions {
 
   // ---- Work ----
   /// Runs independent jobs at once (core/jobs.h): the two files of the two-file form are read
-  /// at once, and a large .bin, .tlog or .ulg log in two parts (FlightLog::Open). Empty: one after another.
-  /// The session is the same either way.
+  /// at once, and a large .bin, .tlog or .ulg log in two parts (FlightLog::Open). Empty: one
+  /// after another. The session is the same either way.
   JobRunner run_jobs;
 };
 
