@@ -31,14 +31,19 @@ function(plumb_module name)
   set_property(GLOBAL APPEND PROPERTY PLUMB_MODULES plumb_${name})
 endfunction()
 
-# plumb_test(NAME SOURCES ... DEPS ...): one GoogleTest executable registered with CTest.
+# plumb_test(NAME SOURCES ... DEPS ... [LABELS ...]): one GoogleTest executable registered with
+# CTest, its tests labelled LABELS (e.g. reality).
 function(plumb_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   target_compile_definitions(${name} PRIVATE
     PLUMB_SHARED_DATA_DIR="${PLUMB_SHARED_DATA_DIR}"
     PLUMB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60)
+  if(ARG_LABELS)
+    gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS "${ARG_LABELS}")
+  else()
+    gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60)
+  endif()
 endfunction()

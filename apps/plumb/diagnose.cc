@@ -132,13 +132,11 @@ class DiagnoseCommand : public Command {
     const diagnostics::ResidualAnalysis ra = diagnostics::AnalyseResiduals(series, d.fit, ra_options);
     std::cout << "plumb diagnose: " << report::FitVerdict(d.fit.fit) << "\n"
               << report::GateLines(d.fit.fit, session.source) << report::ResidualAnalysisText(ra) << report::DiagnosisText(d);
-    const auto best = std::find_if(d.candidates.begin(), d.candidates.end(),
-                                   [](const diagnostics::Candidate& c) { return c.refit.has_value(); });
-    if (best != d.candidates.end()) {
-      const bool velocity = best->with_velocity && d.fit_with_velocity.has_value();
-      std::cout << "\n"
-                << report::BeforeAfterSummary(velocity ? *d.fit_with_velocity : d.fit,
-                                              *best->refit);
+    // Before and after: the user's fit, and the refit advised (else the best one made).
+    const diagnostics::Candidate* shown = diagnostics::Recommended(d);
+    if (shown == nullptr) shown = diagnostics::BestRefitted(d);
+    if (shown != nullptr) {
+      std::cout << "\n" << report::BeforeAfterSummary(d.fit, *shown->refit);
     }
     PrintWarnings(d.fit.fit.warnings);
 

@@ -64,7 +64,12 @@ void RegisterDiagnose(py::module_& m) {
                              [](const PyDiagnosis& d) { return ToPython(d.document["candidates"]); },
                              "The effects tested, best evidence first: effect, lm (predicted "
                              "fall of chi2), dof, evidence, significant, predicted_drop, "
-                             "refit_drop, identifiable ...")
+                             "refit_drop, identifiable, recommended (its refit lowers the "
+                             "chi2/dof of the diagnosed fit) ...")
+      .def_property_readonly("recommendation",
+                             [](const PyDiagnosis& d) { return ToPython(d.document["recommendation"]); },
+                             "The model spec to fit next (the best recommended candidate added), "
+                             "or None when no candidate lowers the fit's chi2/dof")
       .def_property_readonly("fit", [](const PyDiagnosis& d) { return ToPython(d.document["fit"]); },
                              "The diagnosed model's fit: chi2, dof, ...");
   m.def("diagnose", &Diagnose, py::arg("session"), py::arg("model") = "base",

@@ -172,6 +172,17 @@ TEST_P(HiddenEffect, RankedFirstSignificantAndRecoveredByTheRefit) {
     ADD_FAILURE() << n.parameter << " not identifiable (ratio " << n.ratio << ", excited "
                   << n.excited << ")";
   }
+  // Like with like: an effect the user's own fit sees is advised; one scored in the velocity
+  // residuals, which the user's fit does not hold, only when its refit lowers that fit's
+  // chi^2/dof (VelocityCandidateAdvisedOnAFitThatHoldsItsResiduals).
+  if (!best.with_velocity) {
+    EXPECT_TRUE(best.recommended) << report::DiagnosisText(d);
+    EXPECT_EQ(NextModelSpec(d), "base+" + GetParam().effect) << report::DiagnosisText(d);
+  }
+  if (best.recommended) {
+    ASSERT_TRUE(best.refit.has_value());
+    EXPECT_LT(best.refit->fit.chi2_dof(), d.fit.fit.chi2_dof());
+  }
   // The refit with the effect (Diagnose's own when it confirmed it, else a fresh one).
   const estimation::CalibrationResult refit =
       it->refit ? *it->refit
@@ -211,6 +222,27 @@ INSTANTIATE_TEST_SUITE_P(
                       // turns), which diagnose adds for them:
                       OneEffect{"accel_size_effect", 108}, OneEffect{"time_offset", 109}),
     EffectName);
+
+// Like with like (issue 34): when the user's fit holds the velocity residuals, a hidden time
+// offset is scored and its refit compared on the same residuals, and it is advised; the fit
+// diagnosed is the user's (velocity residuals kept in the refits of the other candidates).
+TEST(Diagnose, VelocityCandidateAdvisedOnAFitThatHoldsItsResiduals) {
+  SessionSpec spec;
+  spec.hidden = {{"time_offset", 3.0}};
+  spec.seed = 109;
+  Session s = Simulate(spec);
+  s.options.calibration.accel_in_motion = true;
+  const Diagnosis d = DiagnoseSession(s, s.base);
+  EXPECT_GT(d.fit.fit.velocity_segments, 0);
+  ASSERT_FALSE(d.candidates.empty());
+  const Candidate& best = d.candidates.front();
+  EXPECT_EQ(best.effect, "time_offset") << report::DiagnosisText(d);
+  EXPECT_TRUE(best.recommended) << report::DiagnosisText(d);
+  EXPECT_EQ(NextModelSpec(d), "base+time_offset") << report::DiagnosisText(d);
+  for (const Candidate& c : d.candidates) {
+    if (c.refit) EXPECT_GT(c.refit->fit.velocity_segments, 0) << c.effect;
+  }
+}
 
 using ::plumb::testing::ReverseOnTwoThreads;
 

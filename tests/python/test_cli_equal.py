@@ -92,7 +92,11 @@ class CliEqual(unittest.TestCase):
     def test_diagnose_document_is_the_commands(self):
         run("diagnose", SESSION, *TABLE, "--json", out("diagnosis.json"))
         with open(out("diagnosis.json")) as f:
-            self.assertEqual(plumb.diagnose(self.session, model="base").to_json(), f.read())
+            document = f.read()
+        diagnosis = plumb.diagnose(self.session, model="base")
+        self.assertEqual(diagnosis.to_json(), document)
+        # The advice is the command's (issue 34: like with like), recommended or None.
+        self.assertEqual(diagnosis.recommendation, json.loads(document)["recommendation"])
 
     def test_apply_equals_plumb_apply(self):
         run("calibrate", SESSION, *TABLE, "--json", out("cal_apply.json"))

@@ -217,6 +217,12 @@ TEST(HtmlReport, ListsTheCandidatesOfTheDiagnosis) {
   best.evidence = 730.1;
   best.significant = true;
   best.refit_drop = 790.2;
+  best.refit = estimation::CalibrationResult{};
+  best.refit->fit.chi2 = 110.0;
+  best.refit->fit.dof = 100;
+  best.recommended = true;
+  d.fit.fit.chi2 = 900.0;
+  d.fit.fit.dof = 109;
   diagnostics::Candidate hidden;
   hidden.effect = "time_offset";
   hidden.identifiable = false;
@@ -230,8 +236,44 @@ TEST(HtmlReport, ListsTheCandidatesOfTheDiagnosis) {
   EXPECT_TRUE(Contains(page, "<td><code>gyro_g_sensitivity</code></td><td class=\"num\">812</td>"));
   EXPECT_TRUE(Contains(page, "<td class=\"num\">790</td>"));
   EXPECT_TRUE(Contains(page, "Most likely missing: <code>gyro_g_sensitivity</code>"));
+  EXPECT_TRUE(Contains(page, "the refit with it has chi2/dof 1.1 against 8.26"));
+  EXPECT_TRUE(Contains(page, "<td class=\"num\">1.1</td><td><b>yes</b></td>"));
   EXPECT_TRUE(Contains(page, "time_offset: time_offset.dt is not excited by this data"));
   EXPECT_TRUE(Contains(page, "accel_temperature_bias: needs a temperature column"));
+}
+
+// Like with like (issue 34): a significant candidate whose refit has a higher chi2/dof than
+// the fit diagnosed is listed but never advised, and the fit it was scored in is named.
+TEST(HtmlReport, NeverAdvisesWhatRaisesTheUsersChi2PerDof) {
+  PageParts parts;
+  diagnostics::Diagnosis d;
+  d.fit.fit.chi2 = 127.0;
+  d.fit.fit.dof = 103;
+  d.fit_with_velocity = estimation::CalibrationResult{};
+  d.fit_with_velocity->fit.chi2 = 8400.0;
+  d.fit_with_velocity->fit.dof = 400;
+  d.fit_with_velocity->fit.velocity_segments = 20;
+  diagnostics::Candidate offset;
+  offset.effect = "time_offset";
+  offset.lm = 8.0;
+  offset.dof = 1;
+  offset.significant = true;
+  offset.with_velocity = true;
+  offset.dispersion = 38.1;
+  offset.refit_drop = 325.0;
+  offset.refit = estimation::CalibrationResult{};
+  offset.refit->fit.chi2 = 7620.0;
+  offset.refit->fit.dof = 399;
+  offset.refit->fit.velocity_segments = 20;
+  d.candidates = {offset};
+  const std::string page = parts.Page(&d);
+  EXPECT_FALSE(Contains(page, "Most likely missing"));
+  EXPECT_FALSE(Contains(page, "Next: refit with the effect added"));
+  EXPECT_TRUE(Contains(page, "Nothing advised: no significant effect of the catalogue lowers"));
+  EXPECT_TRUE(Contains(page, "<td class=\"num\">19.1</td><td>no</td>"));
+  EXPECT_TRUE(Contains(page, "in the fit with velocity residuals: chi2 8.4e+03 on 400 dof, "
+                             "chi2/dof 21."));
+  EXPECT_TRUE(Contains(page, "scored in the fit with velocity residuals; LM divided by 38.1"));
 }
 
 TEST(HtmlReport, NamesTheWorstRanges) {

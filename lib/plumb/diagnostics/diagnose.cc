@@ -277,8 +277,10 @@ Refit RefitWith(const ImuSeries& series, const std::vector<StillSegment>& segmen
   try {
     model::Model with = model;
     with.Add(cand.effect, cand.option);
+    // As the user's `--model SPEC+EFFECT` fits: velocity residuals on when the effect needs
+    // them, otherwise as in the user's fit (unset: when its model needs them).
     estimation::CalibrationOptions refit_options = options.calibration;
-    refit_options.accel_in_motion = cand.with_velocity;
+    if (cand.with_velocity) refit_options.accel_in_motion = true;
     out.result = estimation::Calibrate(series, segments, with, site, refit_options);
   } catch (...) {
     out.error = std::current_exception();
@@ -353,6 +355,9 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
     const double before = cand.with_velocity ? fit_motion->fit.chi2 : fit.fit.chi2;
     cand.refit_drop = before - refits[k].result->fit.chi2;
     cand.refit = std::move(refits[k].result);
+    // Like with like: advised only when the user's own fit gets better.
+    cand.recommended = cand.refit->fit.dof > 0 && fit.fit.dof > 0 &&
+                       cand.refit->fit.chi2_dof() < fit.fit.chi2_dof();
   }
 }
 
@@ -376,9 +381,9 @@ struct ProbeFits {
 ProbeFits FitProbes(const ImuSeries& series, const std::vector<StillSegment>& segments,
                     const model::Model& model, const geo::Site& site, const ProbePlan& plan,
                     const DiagnoseOptions& options) {
-  estimation::CalibrationOptions own = options.calibration;
-  // Without velocity residuals unless asked for (its probes would otherwise turn them on).
-  if (!own.accel_in_motion) own.accel_in_motion = false;
+  // The user's fit as `calibrate` makes it: its probes need no velocity residuals, so these
+  // are on only when asked for or when the model itself needs them.
+  const estimation::CalibrationOptions& own = options.calibration;
   estimation::CalibrationOptions with = options.calibration;
   with.accel_in_motion = true;
   with.check_linearity = false;  // its columns score candidates; its covariance is not shown
@@ -431,11 +436,24 @@ std::string SpecWith(const model::Model& model, const std::string& effect,
   return model.spec() + "+" + effect + (option.empty() ? "" : ":" + option);
 }
 
-std::optional<std::string> NextModelSpec(const Diagnosis& d) {
+const Candidate* Recommended(const Diagnosis& d) {
   for (const Candidate& c : d.candidates) {
-    if (c.significant) return SpecWith(d.fit.calibration.model, c.effect, c.option);
+    if (c.recommended) return &c;
   }
-  return std::nullopt;
+  return nullptr;
+}
+
+const Candidate* BestRefitted(const Diagnosis& d) {
+  for (const Candidate& c : d.candidates) {
+    if (c.refit) return &c;
+  }
+  return nullptr;
+}
+
+std::optional<std::string> NextModelSpec(const Diagnosis& d) {
+  const Candidate* c = Recommended(d);
+  if (c == nullptr) return std::nullopt;
+  return SpecWith(d.fit.calibration.model, c->effect, c->option);
 }
 
 Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& segments,

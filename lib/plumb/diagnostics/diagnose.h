@@ -10,6 +10,13 @@
 //    the data) is said as such, never "absent".
 // 3. Confirm the best significant ones by refitting the model plus that effect: the actual fall
 //    of chi^2, and the new parameters with their sigma.
+// 4. Advise like with like: a confirmed candidate is recommended only when its refit, made as
+//    the user would make it (`--model SPEC+EFFECT`, velocity residuals included when the effect
+//    needs them), has a lower chi^2/dof than the user's own fit (Diagnosis::fit). A candidate
+//    judged in the fit with velocity residuals (lever arms, time offset) is scored against that
+//    fit (Diagnosis::fit_with_velocity, shown beside the user's), but advised against the
+//    user's: where those residuals are not modelled to the noise (hand-held turns), following
+//    it would make the user's fit worse, and it is not advised.
 //
 // Candidates: every registered effect that is not in the model and not part of the base, with
 // its default option, when the data can carry it (temperature effects need a temperature
@@ -87,8 +94,11 @@ struct Candidate {
   /// test), so such misfit is not taken for a lever arm or a time offset. 1 otherwise.
   double dispersion = 1.0;
   /// Refit with the effect added (only for confirmed candidates).
-  std::optional<double> refit_drop;            ///< actual fall of chi^2
+  std::optional<double> refit_drop;  ///< actual fall of chi^2 from the fit it was scored in
   std::optional<estimation::CalibrationResult> refit;
+  /// Confirmed, and its refit's chi^2/dof is below the user's fit's (Diagnosis::fit): adding
+  /// it makes the user's own fit better. Only recommended candidates are advised.
+  bool recommended = false;
 };
 
 /// An effect that was not tested, and why.
@@ -118,9 +128,17 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
 std::string SpecWith(const model::Model& model, const std::string& effect,
                      const std::string& option);
 
-/// The model to fit next: the spec of the diagnosed model plus its best significant candidate
-/// (the first significant one in the ranking), or nullopt when none is significant. What
-/// `plumb diagnose` suggests and `plumb report` shows as the next command.
+/// The model to fit next: the spec of the diagnosed model plus its best recommended candidate
+/// (the first recommended one in the ranking: confirmed by a refit whose chi^2/dof is below
+/// the user's fit's), or nullopt when none is. What `plumb diagnose` suggests and `plumb
+/// report` shows as the next command.
 std::optional<std::string> NextModelSpec(const Diagnosis& diagnosis);
+
+/// The candidate NextModelSpec advises, or null.
+const Candidate* Recommended(const Diagnosis& diagnosis);
+
+/// The best confirmed candidate (the first refitted one in the ranking), recommended or not;
+/// null when none was refitted. What the before/after comparison shows.
+const Candidate* BestRefitted(const Diagnosis& diagnosis);
 
 }  // namespace plumb::diagnostics

@@ -20,6 +20,7 @@ nlohmann::json ToJson(const diagnostics::Candidate& c) {
                       {"refit_drop", c.refit_drop ? Number(*c.refit_drop) : nullptr},
                       {"identifiable", c.identifiable},
                       {"with_velocity", c.with_velocity},
+                      {"recommended", c.recommended},
                       {"dispersion", Number(c.dispersion)}};
   nlohmann::json confounded = nlohmann::json::array();
   for (const auto& n : c.not_identifiable) {
@@ -106,6 +107,11 @@ nlohmann::json DiagnosisJson(const diagnostics::Diagnosis& d,
   const nlohmann::json fit = ToJson(d.fit);
   doc["model"] = d.fit.calibration.model.spec();
   doc["fit"] = fit["fit"];
+  // Like with like: the fit where the candidates with_velocity were scored, beside the user's.
+  doc["fit_with_velocity"] =
+      d.fit_with_velocity ? ToJson(*d.fit_with_velocity)["fit"] : nlohmann::json(nullptr);
+  const auto next = diagnostics::NextModelSpec(d);
+  doc["recommendation"] = next ? nlohmann::json(*next) : nlohmann::json(nullptr);
   doc["significance"] = d.significance;
   doc["num_residuals"] = d.num_residuals;
   doc["candidates"] = nlohmann::json::array();

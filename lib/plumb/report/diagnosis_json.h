@@ -4,9 +4,12 @@
 //
 // Every number is SI (series units for residuals, rad for motion); non-finite values are null.
 // Top-level keys of DiagnosisJson():
-//   model, fit {... as calibrate's ...}, significance, num_residuals,
+//   model, fit {... as calibrate's ...},
+//   fit_with_velocity {... as fit ...} or null (where the with_velocity candidates are scored),
+//   recommendation: the model spec to fit next (diagnostics::NextModelSpec) or null,
+//   significance, num_residuals,
 //   candidates [{effect, option, lm, dof, parameters, evidence, threshold, significant,
-//                predicted_drop, refit_drop, identifiable, with_velocity, dispersion,
+//                predicted_drop, refit_drop, identifiable, with_velocity, recommended, dispersion,
 //                not_identifiable [...], indistinguishable_from [...], refit {...}}]
 //                                                   best evidence first (Diagnosis order)
 //   skipped [{effect, reason}],

@@ -17,6 +17,46 @@ std::string Fixed(double v, int precision) {
 
 }  // namespace
 
+std::string AdviceText(const diagnostics::Diagnosis& d) {
+  using diagnostics::Candidate;
+  std::ostringstream out;
+  const double user = d.fit.fit.chi2_dof();
+  const Candidate* advised = diagnostics::Recommended(d);
+  int significant = 0, unconfirmed = 0;
+  for (const Candidate& c : d.candidates) {
+    if (&c == advised) break;
+    if (!c.significant) continue;
+    ++significant;
+    const std::string name = c.effect + (c.option.empty() ? "" : ":" + c.option);
+    if (!c.refit) {
+      ++unconfirmed;
+      continue;
+    }
+    out << "not advised: " << name << " is significant, but the refit with it has chi2/dof "
+        << Fixed(c.refit->fit.chi2_dof(), 3) << ", not below your fit's " << Fixed(user, 3);
+    if (c.refit->fit.velocity_segments > d.fit.fit.velocity_segments) {
+      out << " (the refit adds the velocity residuals of the turns, which this session does not"
+             " fit to their noise)";
+    }
+    out << "\n";
+  }
+  if (advised != nullptr) {
+    out << "best: " << advised->effect << (advised->option.empty() ? "" : ":" + advised->option)
+        << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
+        << Fixed(advised->refit->fit.chi2_dof(), 3) << ") -> refit with --model "
+        << diagnostics::NextModelSpec(d).value_or("") << "\n";
+  } else if (significant == 0) {
+    out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
+  } else if (unconfirmed > 0) {
+    out << "nothing advised: " << unconfirmed << " significant candidate"
+        << (unconfirmed > 1 ? "s were" : " was")
+        << " not refitted (raise --confirm to check whether it lowers your fit's chi2/dof)\n";
+  } else {
+    out << "nothing advised: no significant candidate lowers your fit's chi2/dof\n";
+  }
+  return out.str();
+}
+
 std::string DiagnosisText(const diagnostics::Diagnosis& d) {
   using diagnostics::Confounding;
   using diagnostics::Candidate;
@@ -24,18 +64,29 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
   const auto& f = d.fit.fit;
   out << "model " << d.fit.calibration.model.spec() << ": chi2 " << Fixed(f.chi2, 1) << " on " << f.dof
       << " dof, chi2/dof " << Fixed(f.chi2_dof(), 3) << "\n";
+  if (d.fit_with_velocity && d.fit_with_velocity->fit.velocity_segments > f.velocity_segments) {
+    // Like with like: the candidates that need velocity residuals are scored in this fit, so
+    // it stands beside the user's.
+    const auto& v = d.fit_with_velocity->fit;
+    out << "  with velocity residuals (the accelerometer during the turns), where the candidates"
+           " marked * are scored: chi2 "
+        << Fixed(v.chi2, 1) << " on " << v.dof << " dof, chi2/dof " << Fixed(v.chi2_dof(), 3)
+        << "\n";
+  }
   out << "candidates (score test at the current fit; significant at " << d.significance
       << "; evidence = LM - q ln N, N = " << d.num_residuals << "):\n";
   out << "  " << std::left << std::setw(26) << "effect" << std::right << std::setw(11) << "LM"
       << std::setw(5) << "q" << std::setw(11) << "evidence" << std::setw(13) << "significant"
-      << std::setw(13) << "refit drop" << "\n";
+      << std::setw(13) << "refit drop" << std::setw(16) << "chi2/dof after" << "\n";
   for (const auto& c : d.candidates) {
     if (!c.identifiable) continue;
-    const std::string name = c.effect + (c.option.empty() ? "" : ":" + c.option);
+    const std::string name =
+        c.effect + (c.option.empty() ? "" : ":" + c.option) + (c.with_velocity ? " *" : "");
     out << "  " << std::left << std::setw(26) << name << std::right << std::setw(11)
         << Fixed(c.lm, 1) << std::setw(5) << c.dof << std::setw(11) << Fixed(c.evidence, 1)
         << std::setw(13) << (c.significant ? "yes" : "no") << std::setw(13)
-        << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-"));
+        << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-")) << std::setw(16)
+        << (c.refit ? Fixed(c.refit->fit.chi2_dof(), 3) : std::string("-"));
     for (const auto& other : c.indistinguishable_from) out << "  (same as " << other << " here)";
     if (c.dispersion > 1.0) {
       out << "  (LM / " << std::setprecision(3) << c.dispersion
@@ -90,14 +141,7 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
     out << "\n";
   }
   for (const auto& s : d.skipped) out << "skipped " << s.effect << ": " << s.reason << "\n";
-  const auto best = std::find_if(d.candidates.begin(), d.candidates.end(),
-                                 [](const Candidate& c) { return c.significant; });
-  if (best == d.candidates.end()) {
-    out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
-  } else {
-    out << "best: " << best->effect << (best->option.empty() ? "" : ":" + best->option)
-        << " -> refit with --model " << diagnostics::NextModelSpec(d).value_or("") << "\n";
-  }
+  out << AdviceText(d);
   return out.str();
 }
 

@@ -10,10 +10,16 @@
 
 namespace plumb::report {
 
-/// The candidates of a diagnosis, a summary a person reads in ten seconds: the ranked
-/// identifiable candidates with LM, evidence and refit drop, the ones this data cannot judge
-/// and why, and the best candidate's refit command.
+/// The candidates of a diagnosis, a summary a person reads in ten seconds: the user's fit (and,
+/// beside it, the fit with velocity residuals where candidates marked * are scored), the ranked
+/// identifiable candidates with LM, evidence, refit drop and the refit's chi2/dof, the ones
+/// this data cannot judge and why, and AdviceText.
 std::string DiagnosisText(const diagnostics::Diagnosis& diagnosis);
+
+/// What to do next: the significant candidates ranked above the recommended one that are not
+/// advised, each with its refit's chi2/dof against the user's fit's; then the recommended
+/// candidate's refit command (diagnostics::NextModelSpec), or why nothing is advised.
+std::string AdviceText(const diagnostics::Diagnosis& diagnosis);
 
 /// Where the model fails: the worst ranges, the significant signatures (strongest first, at
 /// most `max_signatures`) and the Allan ratios above 3.

@@ -1,6 +1,7 @@
 #include "plumb/report/html_report.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -111,20 +112,22 @@ std::string SummarySection(const estimation::CalibrationResult& r,
                          " unobservable direction" + (lost > 1 ? "s" : "") +
                          ": see <a href=\"#observability\">observability</a>.</li>\n";
   if (d != nullptr) {
-    const diagnostics::Candidate* best = nullptr;
-    for (const auto& c : d->candidates) {
-      if (c.significant) {
-        best = &c;
-        break;
-      }
+    const diagnostics::Candidate* best = diagnostics::Recommended(*d);
+    const bool any_significant =
+        std::any_of(d->candidates.begin(), d->candidates.end(),
+                    [](const diagnostics::Candidate& c) { return c.significant; });
+    if (best != nullptr) {
+      out += "<li class=\"warn\">Most likely missing: " + Code(best->effect) +
+             " (predicted fall of chi2 " + G3(best->lm) + "; the refit with it has chi2/dof " +
+             G3(best->refit->fit.chi2_dof()) + " against " + G3(d->fit.fit.chi2_dof()) +
+             "): see <a href=\"#diagnosis\">missing effects</a>.</li>\n";
+    } else if (any_significant) {
+      out += "<li>Nothing advised: no significant effect of the catalogue lowers this fit's "
+             "chi2/dof when refitted (see <a href=\"#diagnosis\">missing effects</a>).</li>\n";
+    } else {
+      out += "<li>No effect of the catalogue is significantly missing at the " +
+             G2(100.0 * d->significance) + " % level.</li>\n";
     }
-    out += best == nullptr
-               ? "<li>No effect of the catalogue is significantly missing at the " +
-                     G2(100.0 * d->significance) + " % level.</li>\n"
-               : "<li class=\"warn\">Most likely missing: " + Code(best->effect) +
-                     " (predicted fall of chi2 " + G3(best->lm) +
-                     (best->refit_drop ? ", refit " + G3(*best->refit_drop) : std::string()) +
-                     "): see <a href=\"#diagnosis\">missing effects</a>.</li>\n";
   }
   return out + "</ul>\n" + NextCommandHtml(next_command);
 }
@@ -437,8 +440,9 @@ std::string ConfoundingWords(const diagnostics::Confounding& n) {
 /// The candidate's notes: the divisor of its LM, the candidates it cannot be told from.
 std::string CandidateNotes(const diagnostics::Candidate& c) {
   std::string notes;
+  if (c.with_velocity) notes = "scored in the fit with velocity residuals";
   if (c.dispersion > 1.0) {
-    notes = "LM divided by " + G3(c.dispersion) + " (the velocity residuals' misfit)";
+    notes += "; LM divided by " + G3(c.dispersion) + " (the velocity residuals' misfit)";
   }
   if (!c.indistinguishable_from.empty()) {
     std::string others;
@@ -448,12 +452,26 @@ std::string CandidateNotes(const diagnostics::Candidate& c) {
   return notes;
 }
 
+/// The fit with velocity residuals where some candidates are scored, in words ("" without).
+std::string VelocityFitWords(const diagnostics::Diagnosis& d) {
+  if (!d.fit_with_velocity ||
+      d.fit_with_velocity->fit.velocity_segments <= d.fit.fit.velocity_segments) {
+    return "";
+  }
+  const auto& v = d.fit_with_velocity->fit;
+  return " The candidates that need the accelerometer during the turns (noted in the table) are "
+         "scored, and their refit drop measured, in the fit with velocity residuals: chi2 " +
+         G3(v.chi2) + " on " + std::to_string(v.dof) + " dof, chi2/dof " + G3(v.chi2_dof()) + ".";
+}
+
 std::string CandidateRow(const diagnostics::Candidate& c) {
   return "<tr>" + Td(Code(c.effect + (c.option.empty() ? "" : ":" + c.option))) +
          TdNum(G3(c.lm)) + TdNum(std::to_string(c.dof)) + TdNum(G3(c.evidence)) +
          TdNum(G3(c.threshold)) +
          Td(c.significant ? "<b>yes</b>" : std::string("no")) + Td(YesNo(c.identifiable)) +
          TdNum(c.refit_drop ? G3(*c.refit_drop) : std::string("&ndash;")) +
+         TdNum(c.refit ? G3(c.refit->fit.chi2_dof()) : std::string("&ndash;")) +
+         Td(c.refit ? (c.recommended ? "<b>yes</b>" : std::string("no")) : "&ndash;") +
          Td(HtmlEscape(CandidateNotes(c))) + "</tr>\n";
 }
 
@@ -465,9 +483,11 @@ std::string DiagnosisSection(const diagnostics::Diagnosis* d, const std::string&
          "it is not missing), ranked by evidence = LM - q ln N (N = " +
          std::to_string(d->num_residuals) + " residuals); significant when LM exceeds the "
          "threshold (level " + G2(d->significance) + ") and the effect is identifiable; the "
-         "best ones refitted.</p>\n<table>\n" +
+         "best ones refitted. An effect is advised only when its refit, made as you would "
+         "make it, has a lower chi2/dof than this fit (" + G3(d->fit.fit.chi2_dof()) + ")." +
+         VelocityFitWords(*d) + "</p>\n<table>\n" +
          HeaderRow({"effect", "LM", "q", "evidence", "threshold", "significant", "identifiable",
-                    "refit drop", "notes"});
+                    "refit drop", "chi2/dof after", "advised", "notes"});
   std::vector<std::string> notes;
   for (const auto& c : d->candidates) {
     out += CandidateRow(c);

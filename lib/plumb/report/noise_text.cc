@@ -95,7 +95,8 @@ std::string MisfitWords(const signal::AxisNoise& a, const signal::StillNoise& no
          Format("%.3g", a.fit.chi2 / static_cast<double>(a.fit.points())) + ", above " +
          Format("%.3g", noise.options.terms.misfit_chi2_per_point) +
          "): the still data holds motion, vibration, a filter's correlation at the short taus "
-         "(raise --tau-min) or steps; only the upper bounds stand";
+         "(raise the shortest tau fitted: plumb allan --tau-min) or steps; only the upper bounds "
+         "stand";
 }
 
 namespace {

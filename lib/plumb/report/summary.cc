@@ -133,14 +133,29 @@ std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
     if (before.fit.motion_segments > 0) {
       row("motion RMS (rad)", vec(before.fit.rms_motion), vec(after.fit.rms_motion));
     }
-    if (before.fit.velocity_segments > 0) {
-      row("velocity RMS (m/s)", vec(before.fit.rms_velocity), vec(after.fit.rms_velocity));
+    if (before.fit.velocity_segments > 0 || after.fit.velocity_segments > 0) {
+      row("velocity RMS (m/s)",
+          before.fit.velocity_segments > 0 ? vec(before.fit.rms_velocity) : std::string("-"),
+          after.fit.velocity_segments > 0 ? vec(after.fit.rms_velocity) : std::string("-"));
     }
   }
-  os << "  chi2 fell by " << Format("%.1f", before.fit.chi2 - after.fit.chi2) << "\n";
+  const bool same_residuals = before.fit.velocity_segments == after.fit.velocity_segments;
+  const bool worse = after.fit.chi2_dof() >= before.fit.chi2_dof();
+  if (same_residuals) {
+    os << "  chi2 fell by " << Format("%.1f", before.fit.chi2 - after.fit.chi2) << "\n";
+  } else {
+    os << "  the refit also fits the velocity residuals of the turns (the accelerometer while "
+          "it turns), which the fit before does not: chi2 sums other residuals, compare "
+          "chi2/dof\n";
+  }
+  if (worse) {
+    os << "  chi2/dof rose from " << Format("%.3f", before.fit.chi2_dof()) << " to "
+       << Format("%.3f", after.fit.chi2_dof()) << ": not advised, the fit before is the better "
+       << "one\n";
+  }
   // Still above the band after the best effect: say how much of the misfit is left.
   const double upper = estimation::Chi2BandUpper(after.fit.dof);
-  if (after.fit.dof > 0 && after.fit.chi2_dof() > upper) {
+  if (!worse && same_residuals && after.fit.dof > 0 && after.fit.chi2_dof() > upper) {
     const double excess_before = std::max(before.fit.chi2 - before.fit.dof, 0.0);
     const double excess_after = std::max(after.fit.chi2 - after.fit.dof, 0.0);
     os << "  still above its band after the refit: chi2/dof " << Format("%.3g", after.fit.chi2_dof())

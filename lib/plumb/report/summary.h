@@ -34,9 +34,12 @@ std::string GateLines(const estimation::FitReport& fit, const std::string& sourc
 std::string CalibrationSummary(const estimation::CalibrationResult& result,
                                const std::string& source = "");
 
-/// Two fits of the same data side by side, `before` (e.g. base) and `after` (e.g.
-/// base+gyro_g_sensitivity): chi^2, dof, chi^2/dof, per-axis RMS of the still accelerometer,
-/// still gyroscope and motion residuals, and the parameters that `after` adds, with sigma.
+/// Two fits of the same data side by side, `before` (the user's fit, e.g. base) and `after`
+/// (e.g. base+gyro_g_sensitivity): chi^2, dof, chi^2/dof, per-axis RMS of the still
+/// accelerometer, still gyroscope, motion and velocity residuals, and the parameters that
+/// `after` adds, with sigma. When `after` holds velocity residuals that `before` does not, its
+/// chi^2 is not a fall but over other residuals, and it says so; when chi^2/dof rose, it says
+/// the refit is not advised.
 std::string BeforeAfterSummary(const estimation::CalibrationResult& before,
                                const estimation::CalibrationResult& after);
 
