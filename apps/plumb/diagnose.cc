@@ -24,6 +24,8 @@
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"
 #include "plumb/report/diagnosis_text.h"
+#include "plumb/report/time_base_text.h"
+#include "plumb/signal/time_base.h"
 #include "segment_options.h"
 #include "site_options.h"
 #include "json_output.h"
@@ -123,6 +125,8 @@ class DiagnoseCommand : public Command {
     options.calibration.run_jobs = options.run_jobs;  // the probe fit's motion residuals
 
     PrintSession(session);
+    const signal::TimeBase time_base = signal::AnalyseTimeBase(series.t_s);
+    std::cout << report::TimeBaseLine(time_base);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose)
               << "\n";
     const diagnostics::Diagnosis d =
@@ -141,7 +145,9 @@ class DiagnoseCommand : public Command {
     PrintWarnings(d.fit.fit.warnings);
 
     if (!a.json_path.empty()) {
-      WriteJsonOutput(a.json_path, report::DiagnosisJson(d, ra));
+      nlohmann::json doc = report::DiagnosisJson(d, ra);
+      doc["time_base"] = report::TimeBaseJson(time_base);
+      WriteJsonOutput(a.json_path, doc);
     }
     if (!a.residuals_path.empty()) {
       io::WriteFileAtomic(a.residuals_path, report::ResidualsCsv(ra.samples));

@@ -13,6 +13,8 @@
 #include "plumb/core/error.h"
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/report/json_report.h"
+#include "plumb/report/time_base_text.h"
+#include "plumb/signal/time_base.h"
 #include "plumb/segmentation/still_detector.h"
 #include "input_options.h"
 #include "jobs.h"
@@ -40,6 +42,9 @@ void DescribeStillPeriods(const io::FlightLog& log, const io::ImuStreamInfo& inf
     pick.imu = info.instance;
     pick.stream = info.name;
     const Session s = log.Select(pick);
+    const signal::TimeBase time_base = signal::AnalyseTimeBase(s.series.t_s);
+    j["time_base"] = report::TimeBaseJson(time_base);
+    std::cout << "    " << report::TimeBaseLine(time_base);
     const auto seg = FindSegments(s.series, SegmentArgs{});
     for (const auto& p : seg.segments) {
       still.push_back({{"t_start_s", s.series.t_s[p.begin]}, {"t_end_s", s.series.t_s[p.end - 1]}});

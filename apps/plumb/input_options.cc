@@ -73,6 +73,7 @@ io::InputOptions MakeInputOptions(const InputArgs& a, const std::vector<std::str
   o.time_unit_s = a.time_unit_s;
   o.rate_hz = a.rate_hz;
   o.drop_nan_rows = a.drop_nan;
+  o.clock = a.clock == "uniform" ? io::Clock::kUniform : io::Clock::kStamps;
   o.acc.unit = a.acc_unit == "g"        ? io::AccUnit::kStandardGravity
                : a.acc_unit == "counts" ? io::AccUnit::kCounts
                                         : io::AccUnit::kMetersPerSecond2;
@@ -156,6 +157,13 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
                  "samples instead of undoing it (the calibration is then of the corrected "
                  "signal)");
   AddMaxMemoryOption(app, a.max_memory);
+  app->add_option("--clock", a.clock,
+                  "Which clock the times follow: stamps (as read), or uniform (the sample "
+                  "clock fitted through each input's stamps, keeping the gaps where samples "
+                  "were dropped: for stamps a host wrote on arrival; `plumb info` and "
+                  "`plumb diagnose` say which the stamps are)")
+      ->check(CLI::IsMember({"stamps", "uniform"}))
+      ->capture_default_str();
   app->add_option("--acc", a.acc_file,
                   "Accelerometer table of the two-file form (imu_tk's `t x y z`), with --gyr")
       ->type_name("FILE");

@@ -8,6 +8,8 @@
 #include "plumb/diagnostics/residual_analysis.h"
 #include "plumb/report/diagnosis_json.h"
 #include "plumb/report/json_report.h"
+#include "plumb/report/time_base_text.h"
+#include "plumb/signal/time_base.h"
 
 namespace plumb::python {
 namespace {
@@ -51,6 +53,7 @@ std::shared_ptr<PyDiagnosis> Diagnose(const PySession& s, const std::string& mod
   const diagnostics::ResidualAnalysis ra =
       diagnostics::AnalyseResiduals(s.session.series, d.fit, ra_options);
   out->document = report::DiagnosisJson(d, ra);
+  out->document["time_base"] = report::TimeBaseJson(signal::AnalyseTimeBase(s.session.series.t_s));
   return out;
 }
 

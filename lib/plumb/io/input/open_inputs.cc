@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -22,6 +23,7 @@
 #include "plumb/io/px4/ulog.h"
 #include "plumb/io/text/native_csv.h"
 #include "plumb/io/text/text_table.h"
+#include "plumb/signal/time_base.h"
 
 namespace plumb::io {
 namespace {
@@ -192,6 +194,32 @@ void Append(Session& joined, Session next) {
 
 }  // namespace
 
+namespace {
+
+/// Replaces the session's stamps by the uniform clock fitted through them, and says so.
+void UseUniformClock(Session& s) {
+  const signal::TimeBase base = signal::AnalyseTimeBase(s.series.t_s);
+  if (base.kind == signal::ClockKind::kTooShort) {
+    s.warnings.push_back(s.source + ": too few samples (" + std::to_string(base.samples) +
+                         ") to fit a uniform clock; the stamps are kept");
+    return;
+  }
+  if (base.kind == signal::ClockKind::kIrregular) {
+    s.warnings.push_back(s.source + ": no uniform clock fits these stamps (irregular intervals, "
+                         "e.g. telemetry); the stamps are kept");
+    return;
+  }
+  signal::ApplyUniformClock(base, s.series.t_s);
+  std::ostringstream note;
+  note << std::setprecision(6) << s.source << ": times from a uniform " << base.rate_hz()
+       << " Hz clock fitted through the stamps (jitter RMS " << std::setprecision(3)
+       << base.jitter_rms_s * 1e3 << " ms removed; " << base.dropped
+       << " dropped samples kept as gaps)";
+  s.warnings.push_back(note.str());
+}
+
+}  // namespace
+
 Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& options) {
   if (inputs.empty()) throw Error("OpenInputs: no input");
   std::optional<Session> joined;
@@ -199,6 +227,7 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
     const InputKind kind = KindOf(inputs[i], options);
     if (options.before_read) options.before_read(i, kind);
     Session s = Read(inputs[i], kind, options);
+    if (options.clock == Clock::kUniform) UseUniformClock(s);
     if (options.acc.unit == AccUnit::kCounts) s.series.acc_unit = "counts";
     if (options.gyr.unit == GyrUnit::kCounts) s.series.gyr_unit = "counts";
     if (!joined) {

@@ -65,6 +65,14 @@ enum class InputFormat {
 };
 
 /// What an input turned out to be, as OpenInputs reads it.
+/// Which clock the samples' times follow (SPEC 6 "The time base").
+enum class Clock {
+  kStamps,  ///< the times as the input states them
+  /// The uniform sample clock fitted through each input's stamps (signal/time_base.h), the
+  /// gaps kept where samples were dropped: for stamps a host wrote on arrival.
+  kUniform
+};
+
 enum class InputKind {
   kFlightLog,  ///< ArduPilot .bin/.log, MAVLink .tlog or PX4 .ulg
   kNativeCsv,  ///< plumb's native CSV
@@ -159,6 +167,11 @@ struct InputOptions {
   // ---- Flight logs ----
   /// The stream, the time window (log time, s) and whether the firmware's correction is undone.
   FlightLogSelection flight_log;
+
+  // ---- Time ----
+  /// Clock::kUniform replaces each input's stamps by its fitted uniform clock (said in the
+  /// session's warnings, with the jitter removed and the samples found dropped).
+  Clock clock = Clock::kStamps;
 
   // ---- Reporting ----
   /// Ends the InputError for a file that is neither a flight log nor native CSV (kAuto): how
