@@ -287,7 +287,9 @@ class ReportCommand : public Command {
     }
     extras.files = files;
     if (diagnosis) {
-      if (const auto spec = diagnostics::NextModelSpec(*diagnosis)) {
+      if (diagnostics::UniformClockNext(*diagnosis)) {
+        extras.next_command = CalibrateCommand({"--clock"}, {"--clock", "uniform"});
+      } else if (const auto spec = diagnostics::NextModelSpec(*diagnosis)) {
         extras.next_command = CalibrateCommand({"--model"}, {"--model", *spec});
       }
     }

@@ -244,6 +244,41 @@ TEST(Diagnose, VelocityCandidateAdvisedOnAFitThatHoldsItsResiduals) {
   }
 }
 
+// The time base (issue 34 item 3): stamps a host wrote on arrival (late by 0.25 ms more each
+// sample, back every 25: the pattern of the ChanghyeonKim93 sessions) make the brisk turns'
+// integration misfit; the refit on the uniform clock is ranked first and advised; on the
+// sensor's own clock the time base is skipped, never a candidate.
+TEST(Diagnose, AHostArrivalClockIsFoundAndTheUniformClockAdvised) {
+  SessionSpec spec;
+  spec.seed = 110;
+  spec.turn_s = 0.3;  // brisk hand-held turns, ~5 rad/s: the stamps' errors show in them
+  Session s = Simulate(spec);
+  const Diagnosis on_sensor_clock = DiagnoseSession(s, s.base);
+  for (const Candidate& c : on_sensor_clock.candidates) EXPECT_NE(c.effect, kTimeBaseCandidate);
+  const auto skipped = std::find_if(on_sensor_clock.skipped.begin(), on_sensor_clock.skipped.end(),
+                                    [](const Skipped& k) { return k.effect == kTimeBaseCandidate; });
+  ASSERT_NE(skipped, on_sensor_clock.skipped.end());
+  EXPECT_EQ(skipped->reason, "the stamps are a uniform sample clock already");
+
+  std::vector<double>& t = s.sim.session.series.t_s;
+  for (std::size_t k = 0; k < t.size(); ++k) t[k] += 3e-4 * static_cast<double>(k % 25);
+  const Diagnosis d = DiagnoseSession(s, s.base);
+  ASSERT_FALSE(d.candidates.empty());
+  const Candidate& best = d.candidates.front();
+  EXPECT_EQ(best.kind, CandidateKind::kTimeBase) << report::DiagnosisText(d);
+  EXPECT_TRUE(best.significant) << report::DiagnosisText(d);
+  EXPECT_TRUE(best.recommended) << report::DiagnosisText(d);
+  EXPECT_TRUE(UniformClockNext(d));
+  EXPECT_EQ(NextModelSpec(d), "base");
+  // Back to the noise on the uniform clock.
+  ASSERT_TRUE(best.refit.has_value());
+  const auto [lo, hi] = Chi2DofBand(best.refit->fit.dof);
+  EXPECT_LT(best.refit->fit.chi2_dof(), hi) << report::DiagnosisText(d);
+  std::cout << "host clock: chi2/dof " << d.fit.fit.chi2_dof() << " on the stamps, "
+            << best.refit->fit.chi2_dof() << " on the uniform clock (99% band " << lo << " .. "
+            << hi << ")\n";
+}
+
 using ::plumb::testing::ReverseOnTwoThreads;
 
 TEST(Diagnose, TheSameBitForBitWhetherItsFitsRunInTurnOrAtOnce) {

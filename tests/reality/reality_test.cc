@@ -125,12 +125,11 @@ std::vector<RealSession> Sessions() {
        1.5, 1e9},
       // ChanghyeonKim93: host-stamped clock (issue 34 item 3); far above the noise.
       {"changhyeonkim93_good1",
-       Concat({"shared:multipose/changhyeonkim93/imu_good1.txt"}, kChk), "gyro_g_sensitivity",
+       Concat({"shared:multipose/changhyeonkim93/imu_good1.txt"}, kChk), "time_base",
        velocity, {"nonlinear"}, {"one_pose", "not_converged"}, 3.0, 1e9, "host_arrival"},
       {"changhyeonkim93_good2",
-       Concat({"shared:multipose/changhyeonkim93/imu_good2.txt"}, kChk),
-       "gyro_scale_nonlinearity", velocity, {}, {"one_pose", "not_converged"}, 20.0, 1e9,
-       "host_arrival"},
+       Concat({"shared:multipose/changhyeonkim93/imu_good2.txt"}, kChk), "time_base", velocity,
+       {}, {"one_pose", "not_converged"}, 20.0, 1e9, "host_arrival"},
       // The same sessions on the uniform clock fitted through their stamps (--clock uniform):
       // chi2/dof 9.2 -> 5.4 and 109 -> 44 (ClockUniformAtLeastHalvesImuGood2).
       {"changhyeonkim93_good1_uniform",
@@ -192,15 +191,21 @@ TEST_P(Reality, AdviceLowersTheUsersOwnFit) {
     EXPECT_TRUE(d.at("recommendation").is_null()) << diag.out;
     EXPECT_FALSE(Contains(diag.out, "-> refit with --model")) << diag.out;
   } else {
-    ASSERT_EQ(d.at("recommendation"), model + "+" + s.advice) << diag.out;
-    EXPECT_TRUE(Contains(diag.out, "best: " + s.advice + " (its refit: chi2/dof "));
-    EXPECT_TRUE(Contains(diag.out, ") -> refit with --model " + model + "+" + s.advice + "\n"))
+    // The next fit as the user runs it: the model with the effect, or the uniform clock.
+    const bool clock = s.advice == "time_base";
+    const std::vector<std::string> next_args =
+        clock ? std::vector<std::string>{"--clock", "uniform"}
+              : std::vector<std::string>{"--model", model + "+" + s.advice};
+    ASSERT_EQ(d.at("recommendation"), clock ? model : model + "+" + s.advice) << diag.out;
+    EXPECT_EQ(d.at("recommendation_options"),
+              clock ? json::array({"--clock", "uniform"}) : json::array());
+    EXPECT_TRUE(Contains(diag.out, "best: " + s.advice + " (its refit: chi2/dof ")) << diag.out;
+    EXPECT_TRUE(Contains(diag.out, ") -> refit with " + next_args[0] + " " + next_args[1] + "\n"))
         << diag.out;
     // Followed as the user follows it, the fit gets better.
-    const ToolRun next = Plumb(Concat(Concat({"calibrate"}, input),
-                                      {"--model", model + "+" + s.advice, "--json",
-                                       dir.File("n.json")}),
-                               dir);
+    const ToolRun next = Plumb(
+        Concat(Concat(Concat({"calibrate"}, input), next_args), {"--json", dir.File("n.json")}),
+        dir);
     ASSERT_EQ(next.exit_code, 0) << next.out << next.err;
     EXPECT_LT(Chi2Dof(ReadJson(dir.File("n.json")).at("fit")), user_chi2_dof) << next.out;
   }
@@ -211,9 +216,11 @@ TEST_P(Reality, AdviceLowersTheUsersOwnFit) {
   ASSERT_EQ(rep.exit_code, 0) << rep.out << rep.err;
   const std::string page = ReadAll(dir.File("report/index.html"));
   if (s.advice.empty()) {
-    EXPECT_FALSE(Contains(page, "Next: refit with the effect added")) << s.name;
+    EXPECT_FALSE(Contains(page, "Next: the refit diagnose advises")) << s.name;
   } else {
-    EXPECT_TRUE(Contains(page, "--model " + model + "+" + s.advice)) << s.name;
+    EXPECT_TRUE(Contains(page, s.advice == "time_base" ? std::string("--clock uniform")
+                                                        : "--model " + model + "+" + s.advice))
+        << s.name;
   }
 }
 

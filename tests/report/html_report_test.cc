@@ -268,7 +268,7 @@ TEST(HtmlReport, NeverAdvisesWhatRaisesTheUsersChi2PerDof) {
   d.candidates = {offset};
   const std::string page = parts.Page(&d);
   EXPECT_FALSE(Contains(page, "Most likely missing"));
-  EXPECT_FALSE(Contains(page, "Next: refit with the effect added"));
+  EXPECT_FALSE(Contains(page, "Next: the refit diagnose advises"));
   EXPECT_TRUE(Contains(page, "Nothing advised: no significant effect of the catalogue lowers"));
   EXPECT_TRUE(Contains(page, "<td class=\"num\">19.1</td><td>no</td>"));
   EXPECT_TRUE(Contains(page, "in the fit with velocity residuals: chi2 8.4e+03 on 400 dof, "

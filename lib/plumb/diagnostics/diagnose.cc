@@ -14,9 +14,12 @@
 #include "plumb/estimation/calibrator.h"
 #include "plumb/model/registry.h"
 #include "plumb/signal/chi_square.h"
+#include "plumb/signal/time_base.h"
 
 namespace plumb::diagnostics {
 namespace {
+
+void Tell(const DiagnoseOptions& options, const std::string& stage);
 
 struct CandidateSpec {
   std::string name;
@@ -71,7 +74,8 @@ estimation::CalibrationResult StripProbes(estimation::CalibrationResult fit,
   return fit;
 }
 
-/// The candidates asked for: options.candidates, or the whole catalogue.
+/// The catalogue candidates asked for: options.candidates (the time base aside), or the whole
+/// catalogue.
 std::vector<CandidateSpec> WantedCandidates(const DiagnoseOptions& options) {
   std::vector<CandidateSpec> wanted;
   if (options.candidates.empty()) {
@@ -79,9 +83,59 @@ std::vector<CandidateSpec> WantedCandidates(const DiagnoseOptions& options) {
       wanted.push_back({name, ""});
     }
   } else {
-    for (const auto& text : options.candidates) wanted.push_back(ParseCandidate(text));
+    for (const auto& text : options.candidates) {
+      if (text != kTimeBaseCandidate) wanted.push_back(ParseCandidate(text));
+    }
   }
   return wanted;
+}
+
+bool TimeBaseWanted(const DiagnoseOptions& options) {
+  return options.candidates.empty() ||
+         std::find(options.candidates.begin(), options.candidates.end(), kTimeBaseCandidate) !=
+             options.candidates.end();
+}
+
+/// The time-base candidate: the model refitted on the uniform clock fitted through the stamps,
+/// when they are a host's arrival clock (else skipped, with why). `fit` is the user's.
+std::optional<Candidate> TestTimeBase(const ImuSeries& series,
+                                      const std::vector<StillSegment>& segments,
+                                      const model::Model& model, const geo::Site& site,
+                                      const DiagnoseOptions& options,
+                                      const estimation::CalibrationResult& fit, int observations,
+                                      std::vector<Skipped>& skipped) {
+  const signal::TimeBase base = signal::AnalyseTimeBase(series.t_s);
+  switch (base.kind) {
+    case signal::ClockKind::kTooShort:
+      skipped.push_back({kTimeBaseCandidate, "too few samples to judge the stamps"});
+      return std::nullopt;
+    case signal::ClockKind::kUniform:
+      skipped.push_back({kTimeBaseCandidate, "the stamps are a uniform sample clock already"});
+      return std::nullopt;
+    case signal::ClockKind::kIrregular:
+      skipped.push_back({kTimeBaseCandidate, "no uniform clock fits the stamps (irregular)"});
+      return std::nullopt;
+    case signal::ClockKind::kHostArrival:
+      break;
+  }
+  Tell(options, "refit on the uniform clock");
+  ImuSeries uniform = series;
+  signal::ApplyUniformClock(base, uniform.t_s);
+  Candidate c;
+  c.kind = CandidateKind::kTimeBase;
+  c.effect = kTimeBaseCandidate;
+  c.refit = estimation::Calibrate(uniform, segments, model, site, options.calibration);
+  c.refit_drop = fit.fit.chi2 - c.refit->fit.chi2;
+  // No parameter is added: the actual fall stands for LM, the choice of clock for one degree
+  // of freedom.
+  c.lm = *c.refit_drop;
+  c.dof = 1;
+  c.evidence = c.lm - std::log(std::max(1.0, static_cast<double>(observations)));
+  c.threshold = signal::ChiSquareQuantileExact(1.0 - options.significance, 1);
+  c.significant = c.lm > c.threshold;
+  c.recommended = c.significant && c.refit->fit.dof > 0 && fit.fit.dof > 0 &&
+                  c.refit->fit.chi2_dof() < fit.fit.chi2_dof();
+  return c;
 }
 
 /// The candidates to test, as probes of two fits: those seen by the model's own residuals,
@@ -318,9 +372,12 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
                  const std::optional<estimation::CalibrationResult>& fit_motion,
                  std::vector<Candidate>& candidates) {
   std::vector<Candidate*> chosen;
+  int confirmed = 0;  // the time base is confirmed already (its refit is its test)
   for (auto& cand : candidates) {
-    if (static_cast<int>(chosen.size()) >= options.confirm) break;
-    if (cand.significant) chosen.push_back(&cand);
+    if (confirmed >= options.confirm) break;
+    if (!cand.significant) continue;
+    ++confirmed;
+    if (!cand.refit) chosen.push_back(&cand);
   }
   if (chosen.empty()) return;
   std::vector<Refit> refits(chosen.size());
@@ -450,9 +507,15 @@ const Candidate* BestRefitted(const Diagnosis& d) {
   return nullptr;
 }
 
+bool UniformClockNext(const Diagnosis& d) {
+  const Candidate* c = Recommended(d);
+  return c != nullptr && c->kind == CandidateKind::kTimeBase;
+}
+
 std::optional<std::string> NextModelSpec(const Diagnosis& d) {
   const Candidate* c = Recommended(d);
   if (c == nullptr) return std::nullopt;
+  if (c->kind == CandidateKind::kTimeBase) return d.fit.calibration.model.spec();
   return SpecWith(d.fit.calibration.model, c->effect, c->option);
 }
 
@@ -492,8 +555,15 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     bases.push_back(std::move(s.basis));
   }
 
-  // 3. Rank: which candidates this data cannot tell apart, then by evidence.
+  // 3. The time base, then rank: which candidates this data cannot tell apart, then by
+  // evidence.
   MarkIndistinguishable(bases, d.candidates);
+  if (TimeBaseWanted(options)) {
+    if (auto c = TestTimeBase(series, segments, model, site, options, d.fit, d.num_residuals,
+                              d.skipped)) {
+      d.candidates.push_back(std::move(*c));
+    }
+  }
   Rank(d.candidates);
 
   // 4. Confirm the best significant candidates by refitting.

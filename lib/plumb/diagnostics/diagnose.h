@@ -20,7 +20,11 @@
 //
 // Candidates: every registered effect that is not in the model and not part of the base, with
 // its default option, when the data can carry it (temperature effects need a temperature
-// column; gyroscope effects a gyroscope; earth_rate only without a site).
+// column; gyroscope effects a gyroscope; earth_rate only without a site). And the time base
+// (`time_base`, CandidateKind::kTimeBase): when the stamps are a host's arrival clock
+// (signal/time_base.h), the same model refitted on the uniform clock fitted through them. It
+// adds no parameter, so it has no score test: its LM is the refit's actual fall of chi^2, tested
+// as one degree of freedom (the choice of clock), and it is advised by the same rule.
 //
 // Example:
 //   Diagnosis d = Diagnose(series, segments, model::Model::Parse("base"), site, {});
@@ -49,7 +53,8 @@ struct DiagnoseOptions {
   double significance = 0.01;
   /// How many of the best significant candidates to confirm by refitting, >= 0.
   int confirm = 3;
-  /// Candidate effects ("name" or "name:option"); empty: the whole catalogue.
+  /// Candidate effects ("name" or "name:option", kTimeBaseCandidate for the time base);
+  /// empty: the whole catalogue and the time base.
   std::vector<std::string> candidates;
   /// Options of every fit (the probe fit and the refits).
   estimation::CalibrationOptions calibration;
@@ -69,8 +74,16 @@ struct DiagnoseOptions {
   JobRunner run_jobs;
 };
 
+/// What a candidate changes: the model (a catalogue effect added) or the time base (the
+/// samples' times from the uniform clock fitted through their stamps).
+enum class CandidateKind { kEffect, kTimeBase };
+
+/// The name of the time-base candidate.
+inline constexpr const char* kTimeBaseCandidate = "time_base";
+
 /// One candidate effect.
 struct Candidate {
+  CandidateKind kind = CandidateKind::kEffect;
   std::string effect;   ///< catalogue name, e.g. "gyro_g_sensitivity"
   std::string option;   ///< the option it was tested with ("" = default)
   double lm = 0.0;      ///< score statistic: predicted fall of chi^2
@@ -129,6 +142,7 @@ std::string SpecWith(const model::Model& model, const std::string& effect,
                      const std::string& option);
 
 /// The model to fit next: the spec of the diagnosed model plus its best recommended candidate
+/// (the model as it is when that is the time base: see UniformClockNext)
 /// (the first recommended one in the ranking: confirmed by a refit whose chi^2/dof is below
 /// the user's fit's), or nullopt when none is. What `plumb diagnose` suggests and `plumb
 /// report` shows as the next command.
@@ -136,6 +150,9 @@ std::optional<std::string> NextModelSpec(const Diagnosis& diagnosis);
 
 /// The candidate NextModelSpec advises, or null.
 const Candidate* Recommended(const Diagnosis& diagnosis);
+
+/// Whether the advised next fit is on the uniform clock (the time base is recommended).
+bool UniformClockNext(const Diagnosis& diagnosis);
 
 /// The best confirmed candidate (the first refitted one in the ranking), recommended or not;
 /// null when none was refitted. What the before/after comparison shows.

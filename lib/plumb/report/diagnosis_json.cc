@@ -8,7 +8,9 @@
 namespace plumb::report {
 
 nlohmann::json ToJson(const diagnostics::Candidate& c) {
-  nlohmann::json j = {{"effect", c.effect},
+  nlohmann::json j = {{"kind", c.kind == diagnostics::CandidateKind::kTimeBase ? "time_base"
+                                                                                : "effect"},
+                      {"effect", c.effect},
                       {"option", c.option},
                       {"lm", Number(c.lm)},
                       {"dof", c.dof},
@@ -112,6 +114,10 @@ nlohmann::json DiagnosisJson(const diagnostics::Diagnosis& d,
       d.fit_with_velocity ? ToJson(*d.fit_with_velocity)["fit"] : nlohmann::json(nullptr);
   const auto next = diagnostics::NextModelSpec(d);
   doc["recommendation"] = next ? nlohmann::json(*next) : nlohmann::json(nullptr);
+  // What else the next fit takes: the uniform clock when the time base is advised.
+  doc["recommendation_options"] = diagnostics::UniformClockNext(d)
+                                      ? nlohmann::json::array({"--clock", "uniform"})
+                                      : nlohmann::json::array();
   doc["significance"] = d.significance;
   doc["num_residuals"] = d.num_residuals;
   doc["candidates"] = nlohmann::json::array();

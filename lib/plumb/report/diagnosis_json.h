@@ -7,8 +7,9 @@
 //   model, fit {... as calibrate's ...},
 //   fit_with_velocity {... as fit ...} or null (where the with_velocity candidates are scored),
 //   recommendation: the model spec to fit next (diagnostics::NextModelSpec) or null,
+//   recommendation_options: what else that fit takes (["--clock", "uniform"] or []),
 //   significance, num_residuals,
-//   candidates [{effect, option, lm, dof, parameters, evidence, threshold, significant,
+//   candidates [{kind ("effect" | "time_base"), effect, option, lm, dof, parameters, evidence, threshold, significant,
 //                predicted_drop, refit_drop, identifiable, with_velocity, recommended, dispersion,
 //                not_identifiable [...], indistinguishable_from [...], refit {...}}]
 //                                                   best evidence first (Diagnosis order)

@@ -40,7 +40,11 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
     }
     out << "\n";
   }
-  if (advised != nullptr) {
+  if (advised != nullptr && advised->kind == diagnostics::CandidateKind::kTimeBase) {
+    out << "best: " << advised->effect << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
+        << Fixed(advised->refit->fit.chi2_dof(), 3)
+        << ": the stamps are a host's arrival clock) -> refit with --clock uniform\n";
+  } else if (advised != nullptr) {
     out << "best: " << advised->effect << (advised->option.empty() ? "" : ":" + advised->option)
         << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
         << Fixed(advised->refit->fit.chi2_dof(), 3) << ") -> refit with --model "
@@ -88,6 +92,10 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
         << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-")) << std::setw(16)
         << (c.refit ? Fixed(c.refit->fit.chi2_dof(), 3) : std::string("-"));
     for (const auto& other : c.indistinguishable_from) out << "  (same as " << other << " here)";
+    if (c.kind == diagnostics::CandidateKind::kTimeBase) {
+      out << "  (the times from the uniform clock fitted through the stamps; LM is the refit's"
+             " fall)";
+    }
     if (c.dispersion > 1.0) {
       out << "  (LM / " << std::setprecision(3) << c.dispersion
           << ": the velocity residuals' misfit)";

@@ -83,7 +83,8 @@ std::string SiteSourceWords(const std::string& source) {
 /// The command to run next, as a paragraph and a block to copy ("" without one).
 std::string NextCommandHtml(const std::string& command) {
   if (command.empty()) return "";
-  return "<p>Next: refit with the effect added:</p>\n<pre class=\"next\">" + HtmlEscape(command) +
+  return "<p>Next: the refit diagnose advises (it lowers this fit's chi2/dof):</p>\n"
+         "<pre class=\"next\">" + HtmlEscape(command) +
          "</pre>\n";
 }
 
