@@ -218,6 +218,54 @@ TEST(CompareCli, AgainstTheSimulatedTruthGivesTheNees) {
   EXPECT_TRUE(Contains(many.err, "several only with --truth")) << many.err;
 }
 
+// Issue 34 item 9: on a single still pose the parameters are not determined, the combinations
+// are; compare --truth scores those (their truth: the sum of the coefficients times the true
+// parameters) and their NEES over their covariance, and lists the held parameters unscored.
+TEST(CompareCli, OnePoseFitIsScoredOnItsDeterminedCombinations) {
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  ASSERT_EQ(Plumb({"simulate", "--schedule", "paper-static", "--out", at("s.csv"),
+                   "--random-truth", "1", "--accel-rw", "0", "--gyro-rw", "0", "--accel-bi", "0",
+                   "--gyro-bi", "0", "--lat", "6.67", "--lon", "-1.57", "--height", "250",
+                   "--truth-json", at("truth.json"), "--seed", "4"},
+                  dir).exit_code, 0);
+  ASSERT_EQ(Plumb({"calibrate", at("s.csv"), "--level-north", "--lat", "6.67", "--lon", "-1.57",
+                   "--height", "250", "--json", at("a.json")},
+                  dir).exit_code, 0);
+  const json a = ReadJson(at("a.json"));
+  const json& d0 = a["observability"]["determined"][0];
+  ASSERT_EQ(d0["parameters"].size(), d0["coefficients"].size());
+  const ToolRun run = Plumb({"compare", at("a.json"), "--truth", at("truth.json"), "--json",
+                             at("c.json")}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_FALSE(Contains(run.out, "older plumb")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "accel.bias.z - 9.78 accel.matrix.zz")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "not scored: 21 parameters the data does not determine"))
+      << run.out;
+  EXPECT_TRUE(Contains(run.out, "on 6 determined combinations (full covariance): chi^2(6)"))
+      << run.out;
+  const json c = ReadJson(at("c.json"));
+  EXPECT_EQ(c["nees"]["dof"], 6);
+  EXPECT_EQ(c["nees"]["over"], "determined_combinations");
+  EXPECT_EQ(c["undetermined"].size(), 21u);
+  // The truth of a combination is the sum over its parameters.
+  const json truth = ReadJson(at("truth.json"));
+  double sum = 0.0;
+  for (std::size_t i = 0; i < d0["parameters"].size(); ++i) {
+    for (const auto& t : truth["parameters"]) {
+      if (t["name"] == d0["parameters"][i]) sum += d0["coefficients"][i].get<double>() * t["value"].get<double>();
+    }
+  }
+  bool found = false;
+  for (const auto& row : c["parameters"]) {
+    if (row["name"] != d0["combination"]) continue;
+    found = true;
+    EXPECT_TRUE(row["combination"].get<bool>());
+    EXPECT_NEAR(row["truth"].get<double>(), sum, 1e-12 * (1.0 + std::abs(sum)));
+  }
+  EXPECT_TRUE(found) << c;
+}
+
 // --- imucal's own answer on its Ferraris session (shared data) ---------------------------------
 
 const std::string kImucal = std::string(PLUMB_SHARED_DATA_DIR) + "/ferraris/imucal";

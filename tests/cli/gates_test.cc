@@ -105,14 +105,20 @@ TEST(GatesCli, NotConvergedIsShownStrictExitsThreeAndExportIsRefused) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(LineStarting(run.out, "gate failed: "),
             "gate failed: not_converged: " + csv +
-                ": the solver did not converge: it stopped after 4 iterations (Termination: "
-                "NO_CONVERGENCE); the values, sigmas and chi2 are not those of a minimum. Check "
+                ": the solver did not converge: its last solve stopped after 2 iterations (4 "
+                "over its 2 solves; Termination: NO_CONVERGENCE); the values, sigmas and chi2 are not those of a minimum. Check "
                 "the segments and the input's units and rate (the other gates), or allow more "
                 "iterations (--max-iterations)")
       << run.out;
   EXPECT_EQ(Verdict(run.out),
             "chi2/dof 0.83, but the fit failed a gate (not_converged): not to be trusted as it "
             "stands");
+  // One count of iterations: the JSON's solver line is the last solve's, as the gate says.
+  const json fit = ReadJson(out).at("fit");
+  EXPECT_EQ(fit.at("solves"), 2);
+  EXPECT_EQ(fit.at("last_solve_iterations"), 2);
+  EXPECT_EQ(fit.at("iterations"), 4);
+  EXPECT_TRUE(Contains(fit.at("solver").get<std::string>(), "Iterations: 2,")) << fit;
   EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
   const json doc = ReadJson(out);
   EXPECT_EQ(doc["fit"]["converged"], false);

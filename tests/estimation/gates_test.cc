@@ -148,7 +148,7 @@ TEST(Gates, TheIterationLimitFailsNotConverged) {
   EXPECT_FALSE(r.fit.converged);
   const Gate* g = Find(r.fit.gates, "not_converged");
   ASSERT_NE(g, nullptr) << Names(r.fit.gates);
-  EXPECT_TRUE(Contains(g->message, "the solver did not converge: it stopped after ")) << g->message;
+  EXPECT_TRUE(Contains(g->message, "the solver did not converge: its last solve stopped after ")) << g->message;
   EXPECT_TRUE(Contains(g->message, "Termination: NO_CONVERGENCE")) << g->message;
   const std::string verdict = report::FitVerdict(r.fit);
   EXPECT_FALSE(Contains(verdict, "consistent with the noise")) << verdict;

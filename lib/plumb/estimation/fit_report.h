@@ -99,9 +99,14 @@ struct FitReport {
   int still_segments = 0;
   int motion_segments = 0;
   int velocity_segments = 0;  ///< motion intervals with a velocity residual (accel in motion)
+  /// Solver iterations (steps) over every solve of the fit (a rough and a refined one, a
+  /// second with null directions held); each solve is limited to
+  /// CalibrationOptions::max_iterations.
   int iterations = 0;
+  int solves = 0;                 ///< solves made
+  int last_solve_iterations = 0;  ///< iterations of the last solve (solver_report's count)
   bool converged = false;
-  std::string solver_report;  ///< ceres::Solver::Summary::BriefReport()
+  std::string solver_report;  ///< ceres::Solver::Summary::BriefReport() of the last solve
 
   std::vector<StillSegmentFit> still;  ///< per still segment used, in time order
   std::vector<MotionFit> motion;       ///< per motion interval integrated

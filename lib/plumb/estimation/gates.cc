@@ -322,8 +322,10 @@ Gate NotConverged(const FitReport& fit) {
   const std::string why =
       at == std::string::npos ? std::string("no convergence") : fit.solver_report.substr(at);
   return Gate{"not_converged",
-              "the solver did not converge: it stopped after " + std::to_string(fit.iterations) +
-                  " iterations (" + why +
+              "the solver did not converge: its last solve stopped after " +
+                  std::to_string(fit.last_solve_iterations) + " iterations (" +
+                  std::to_string(fit.iterations) + " over its " + std::to_string(fit.solves) +
+                  " solves; " + why +
                   "); the values, sigmas and chi2 are not those of a minimum. Check the "
                   "segments and the input's units and rate (the other gates), or allow more "
                   "iterations (--max-iterations)"};

@@ -32,7 +32,11 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
   fit.solver_report = summary.BriefReport();
-  fit.iterations += static_cast<int>(summary.iterations.size());
+  // Counted as the report counts them (the steps taken; Ceres's iteration 0 is the start).
+  const int steps = summary.num_successful_steps + summary.num_unsuccessful_steps;
+  fit.iterations += steps;
+  fit.last_solve_iterations = steps;
+  ++fit.solves;
   fit.converged = summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) throw Error("the solver failed: " + summary.BriefReport());
 }

@@ -97,6 +97,53 @@ void ReadCovariance(const json& cov, const std::string& path, PlumbResult& r) {
   r.sigma_scaled_by_chi2 = cov.contains("sigma_scaled_by_chi2") &&
                            cov.at("sigma_scaled_by_chi2").is_boolean() &&
                            cov.at("sigma_scaled_by_chi2").get<bool>();
+  if (cov.contains("determined") && cov.at("determined").is_object() &&
+      cov.at("determined").contains("matrix")) {
+    const json& m = cov.at("determined").at("matrix");
+    if (!m.is_array()) throw InputError(path, KeyPlace("covariance.determined.matrix"), "expected a matrix");
+    const auto k = static_cast<Eigen::Index>(m.size());
+    r.determined_covariance.resize(k, k);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const json& row = m[static_cast<std::size_t>(i)];
+      const std::string where = "covariance.determined.matrix[" + std::to_string(i) + "]";
+      if (!row.is_array() || row.size() != m.size()) {
+        throw InputError(path, KeyPlace(where), "expected " + std::to_string(k) + " numbers");
+      }
+      for (Eigen::Index j = 0; j < k; ++j) {
+        r.determined_covariance(i, j) =
+            detail::FiniteNumber(row[static_cast<std::size_t>(j)], path, where);
+      }
+    }
+  }
+}
+
+/// "observability.determined": [{combination, parameters, coefficients, value, sigma}, ...].
+void ReadDetermined(const json& list, const std::string& path, PlumbResult& r) {
+  if (!list.is_array()) throw InputError(path, KeyPlace("observability.determined"), "expected a list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const json& d = list[i];
+    const std::string where = "observability.determined[" + std::to_string(i) + "]";
+    if (!d.is_object()) throw InputError(path, KeyPlace(where), "expected an object");
+    PlumbCombination c;
+    c.text = TextOr(d, "combination", "");
+    c.value = detail::FiniteNumber(Field(d, "value", path, where + ".value", "a number"), path,
+                                   where + ".value");
+    if (d.contains("sigma") && d.at("sigma").is_number()) c.sigma = d.at("sigma").get<double>();
+    if (d.contains("parameters") && d.contains("coefficients")) {
+      const json& names = d.at("parameters");
+      const json& coefficients = d.at("coefficients");
+      if (!names.is_array() || !coefficients.is_array() || names.size() != coefficients.size()) {
+        throw InputError(path, KeyPlace(where),
+                         "expected parameters and coefficients, one coefficient each");
+      }
+      for (std::size_t j = 0; j < names.size(); ++j) {
+        if (!names[j].is_string()) throw InputError(path, KeyPlace(where + ".parameters"), "expected names");
+        c.names.push_back(names[j].get<std::string>());
+        c.coefficients.push_back(detail::FiniteNumber(coefficients[j], path, where + ".coefficients"));
+      }
+    }
+    r.determined.push_back(std::move(c));
+  }
 }
 
 }  // namespace
@@ -141,6 +188,10 @@ PlumbResult ReadPlumbResult(const std::string& path) {
   if (noise_known) r.noise_accel = detail::Vector3(noise_accel, path, "noise.accel");
   if (root.contains("covariance") && root.at("covariance").is_object()) {
     ReadCovariance(root.at("covariance"), path, r);
+  }
+  if (root.contains("observability") && root.at("observability").is_object() &&
+      root.at("observability").contains("determined")) {
+    ReadDetermined(root.at("observability").at("determined"), path, r);
   }
   if (root.contains("inputs") && root.at("inputs").is_array()) {
     for (const auto& input : root.at("inputs")) {

@@ -27,6 +27,16 @@ struct PlumbParameter {
   std::string unit;              ///< as written by plumb ("1", "m/s^2", "rad/s", ...)
 };
 
+/// One entry of "observability.determined": a combination of parameters the data determines
+/// where the parameters themselves are not (a single pose's gauge).
+struct PlumbCombination {
+  std::string text;                 ///< e.g. "accel.bias.z - 9.78 accel.matrix.zz"
+  std::vector<std::string> names;   ///< its parameters ...
+  std::vector<double> coefficients; ///< ... and their coefficients (empty: an older plumb)
+  double value = 0.0;
+  std::optional<double> sigma;
+};
+
 /// One entry of "segments" (a still segment).
 struct PlumbStillSegment {
   std::string label;
@@ -58,6 +68,10 @@ struct PlumbResult {
   std::vector<std::string> covariance_names;
   Eigen::MatrixXd covariance;
   bool sigma_scaled_by_chi2 = false;  ///< covariance.sigma_scaled_by_chi2
+  /// "observability.determined", and their covariance ("covariance.determined.matrix", in
+  /// their order; empty when absent).
+  std::vector<PlumbCombination> determined;
+  Eigen::MatrixXd determined_covariance;
 };
 
 /// Reads the JSON document. Throws plumb::InputError naming `path` and the key when the JSON is

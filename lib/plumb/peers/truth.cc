@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "plumb/core/error.h"
 #include "plumb/peers/json_fields.h"
@@ -20,14 +21,49 @@ const TrueParameter* FindTruth(const std::vector<TrueParameter>& truth, const st
   return nullptr;
 }
 
-/// Sets c.nees and its band, or c.nees_note.
-void Nees(const PlumbResult& result, const std::vector<TrueParameter>& truth, TruthComparison& c) {
+/// The true value of a determined combination (the sum of its coefficients times the true
+/// parameters); nullopt when a parameter has no truth or the file gives no coefficients.
+std::optional<double> TrueCombination(const PlumbCombination& d,
+                                      const std::vector<TrueParameter>& truth) {
+  if (d.names.empty()) return std::nullopt;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < d.names.size(); ++i) {
+    const TrueParameter* t = FindTruth(truth, d.names[i]);
+    if (t == nullptr) return std::nullopt;
+    sum += d.coefficients[i] * t->value;
+  }
+  return sum;
+}
+
+/// The errors the NEES is over and their covariance: the covariance's parameters, or (none:
+/// a single pose's gauge) the determined combinations. False, with c.nees_note, when missing.
+bool NeesErrors(const PlumbResult& result, const std::vector<TrueParameter>& truth,
+                TruthComparison& c, Eigen::VectorXd& e, Eigen::MatrixXd& covariance) {
   if (result.covariance_names.empty()) {
-    c.nees_note = "no covariance in " + result.path + " (written by an older plumb?)";
-    return;
+    const auto k = static_cast<Eigen::Index>(result.determined.size());
+    if (k == 0 || result.determined_covariance.rows() != k) {
+      c.nees_note = "no covariance in " + result.path + " (written by an older plumb?)";
+      return false;
+    }
+    e.resize(k);
+    for (Eigen::Index j = 0; j < k; ++j) {
+      const PlumbCombination& d = result.determined[static_cast<std::size_t>(j)];
+      const std::optional<double> t = TrueCombination(d, truth);
+      if (!t) {
+        c.nees_note = "the determined combination " + d.text +
+                      (d.names.empty() ? " has no coefficients (written by an older plumb?)"
+                                       : " has a parameter without truth") +
+                      ": no NEES";
+        return false;
+      }
+      e[j] = d.value - *t;
+    }
+    covariance = result.determined_covariance;
+    c.nees_over_combinations = true;
+    return true;
   }
   const auto n = static_cast<Eigen::Index>(result.covariance_names.size());
-  Eigen::VectorXd e(n);
+  e.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const std::string& name = result.covariance_names[static_cast<std::size_t>(i)];
     const TrueParameter* t = FindTruth(truth, name);
@@ -35,11 +71,21 @@ void Nees(const PlumbResult& result, const std::vector<TrueParameter>& truth, Tr
     if (t == nullptr || p == nullptr) {
       c.nees_note = "the covariance's parameter " + name + " has no " +
                     (t == nullptr ? "truth" : "estimate") + ": no NEES";
-      return;
+      return false;
     }
     e[i] = p->value - t->value;
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(result.covariance);
+  covariance = result.covariance;
+  return true;
+}
+
+/// Sets c.nees and its band, or c.nees_note.
+void Nees(const PlumbResult& result, const std::vector<TrueParameter>& truth, TruthComparison& c) {
+  Eigen::VectorXd e;
+  Eigen::MatrixXd covariance;
+  if (!NeesErrors(result, truth, c, e, covariance)) return;
+  const Eigen::Index n = e.size();
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
       (ldlt.vectorD().array() <= 0.0).any()) {
     c.nees_note = "the covariance is not positive definite: no NEES";
@@ -92,7 +138,18 @@ TruthComparison CompareWithTruth(const PlumbResult& result, const std::vector<Tr
   for (const PlumbParameter& p : result.parameters) {
     const TrueParameter* t = FindTruth(truth, p.name);
     if (t == nullptr) continue;
-    TruthRow row{p.name, p.unit, p.value, t->value, p.sigma};
+    if (!p.observable && !p.fixed) {  // held at a gauge value the data does not determine
+      c.undetermined.push_back(p.name);
+      continue;
+    }
+    TruthRow row{p.name, p.unit, false, p.value, t->value, p.sigma};
+    if (row.sigma && std::abs(row.error()) > 3.0 * *row.sigma) ++c.beyond_3_sigma;
+    c.rows.push_back(row);
+  }
+  for (const PlumbCombination& d : result.determined) {
+    const std::optional<double> t = TrueCombination(d, truth);
+    if (!t) continue;
+    TruthRow row{d.text, "", true, d.value, *t, d.sigma};
     if (row.sigma && std::abs(row.error()) > 3.0 * *row.sigma) ++c.beyond_3_sigma;
     c.rows.push_back(row);
   }
@@ -121,15 +178,24 @@ std::string TruthComparisonText(const TruthComparison& c, bool table) {
       out += line;
     }
     out += std::to_string(c.beyond_3_sigma) + " of " + std::to_string(c.rows.size()) +
-           " parameters beyond 3 sigma\n";
+           (c.nees_over_combinations ? " parameters and combinations" : " parameters") +
+           " beyond 3 sigma\n";
+    if (!c.undetermined.empty()) {
+      std::string names;
+      for (const auto& n : c.undetermined) names += (names.empty() ? "" : ", ") + n;
+      out += "not scored: " + std::to_string(c.undetermined.size()) +
+             " parameters the data does not determine (held at their gauge values; the "
+             "combinations above are what it determines): " + names + "\n";
+    }
   }
   if (!c.nees) return out + (table ? "" : c.result_path + ": ") + c.nees_note + "\n";
   const bool inside = *c.nees >= c.band_low && *c.nees <= c.band_high;
   char line[320];
   std::snprintf(line, sizeof line,
-                "%s%sNEES %.1f on %d parameters (full covariance%s): chi^2(%d) 95%% band %.1f .. "
+                "%s%sNEES %.1f on %d %s (full covariance%s): chi^2(%d) 95%% band %.1f .. "
                 "%.1f, %s\n",
                 table ? "" : c.result_path.c_str(), table ? "" : ": ", *c.nees, c.nees_dof,
+                c.nees_over_combinations ? "determined combinations" : "parameters",
                 c.sigma_scaled_by_chi2 ? ", scaled by chi2/dof" : "", c.nees_dof, c.band_low,
                 c.band_high,
                 inside ? "inside"
@@ -142,6 +208,7 @@ json TruthComparisonJson(const TruthComparison& c) {
   json rows = json::array();
   for (const TruthRow& r : c.rows) {
     rows.push_back({{"name", r.name},
+                    {"combination", r.combination},
                     {"unit", r.unit},
                     {"estimate", Num(r.estimate)},
                     {"truth", Num(r.truth)},
@@ -152,10 +219,12 @@ json TruthComparisonJson(const TruthComparison& c) {
            {"truth", c.truth_path},
            {"parameters", rows},
            {"beyond_3_sigma", c.beyond_3_sigma},
+           {"undetermined", c.undetermined},
            {"sigma_scaled_by_chi2", c.sigma_scaled_by_chi2}};
   if (c.nees) {
     out["nees"] = {{"value", Num(*c.nees)},
                    {"dof", c.nees_dof},
+                   {"over", c.nees_over_combinations ? "determined_combinations" : "parameters"},
                    {"band_95", {Num(c.band_low), Num(c.band_high)}}};
   } else {
     out["nees"] = nullptr;

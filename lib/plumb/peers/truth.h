@@ -30,7 +30,8 @@ struct TrueParameter {
 std::vector<TrueParameter> ReadSimulationTruth(const std::string& path);
 
 struct TruthRow {
-  std::string name, unit;
+  std::string name, unit;  ///< a parameter's, or a determined combination's text
+  bool combination = false;  ///< a combination the data determines (its truth: the sum)
   double estimate = 0.0, truth = 0.0;
   std::optional<double> sigma;  ///< none when the calibration gives none (fixed, unobservable)
   double error() const { return estimate - truth; }
@@ -38,14 +39,20 @@ struct TruthRow {
 
 struct TruthComparison {
   std::string result_path, truth_path;
-  std::vector<TruthRow> rows;  ///< the calibration's parameters that the truth has, in its order
+  /// The calibration's determined parameters that the truth has, in its order, then the
+  /// combinations it determines where the parameters are not (a single pose's gauge).
+  std::vector<TruthRow> rows;
+  /// Parameters the data does not determine (held at their gauge values): not scored.
+  std::vector<std::string> undetermined;
   int beyond_3_sigma = 0;      ///< rows with |error| > 3 sigma
-  /// NEES over the covariance's parameters; nullopt (with `nees_note` saying why) when the
-  /// file has no covariance, a parameter of it has no truth, or it is not positive definite.
+  /// NEES over the covariance's parameters, or over the determined combinations when the
+  /// parameters have none; nullopt (with `nees_note` saying why) when the file has no
+  /// covariance, a parameter of it has no truth, or it is not positive definite.
   std::optional<double> nees;
   int nees_dof = 0;
   double band_low = 0.0, band_high = 0.0;  ///< chi^2(nees_dof) 2.5 % and 97.5 % quantiles
   std::string nees_note;
+  bool nees_over_combinations = false;  ///< the NEES is over the determined combinations
   bool sigma_scaled_by_chi2 = false;  ///< the covariance was scaled by chi^2/dof
 };
 

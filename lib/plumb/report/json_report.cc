@@ -125,6 +125,8 @@ json FitJson(const estimation::CalibrationResult& r) {
               {"segments", {{"still", f.still_segments}, {"motion", f.motion_segments}}},
               {"converged", f.converged},
               {"iterations", f.iterations},
+              {"solves", f.solves},
+              {"last_solve_iterations", f.last_solve_iterations},
               {"solver", f.solver_report},
               {"chi2_above_band", estimation::Chi2AboveBand(f)},
               {"misfit_beyond_noise", estimation::MisfitBeyondNoise(f)},
@@ -136,6 +138,9 @@ json ObservabilityJson(const estimation::Observability& o, double sigma_scale) {
   json determined = json::array();
   for (const auto& d : o.determined) {
     determined.push_back({{"combination", d.text},
+                          // The combination as numbers: sum of coefficients[i] * parameters[i].
+                          {"parameters", d.names},
+                          {"coefficients", d.coefficients},
                           {"value", Number(d.value)},
                           {"sigma", Number(sigma_scale * d.sigma)},
                           {"sigma_formal", Number(d.sigma)}});

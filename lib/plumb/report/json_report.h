@@ -21,7 +21,8 @@
 //               sigma_scale, determined {combinations [texts], matrix [[...]]}}
 //                                                 see CovarianceJson
 //   fit {chi2, dof, chi2_dof, num_residuals, residual_rms {accel, gyro, motion},
-//        segments {still, motion}, converged, iterations, solver, chi2_above_band,
+//        segments {still, motion}, converged, iterations (over every solve), solves,
+//        last_solve_iterations (the count in solver), solver, chi2_above_band,
 //        distinct_poses, linearity {step_sigmas, worst_ratio, worst_direction} or null}
 //   gates [{name, message}]                       the gates the fit failed (estimation/gates.h)
 //   observability {rank, unknowns, unobservable [],
