@@ -96,7 +96,7 @@ TEST_F(ReportOnDemoSession, PageHoldsTheParametersTheFitAndTheCommand) {
   char chi2[64];
   std::snprintf(chi2, sizeof chi2, "%.6g over ", result["fit"]["chi2"].get<double>());
   EXPECT_TRUE(Contains(page, chi2)) << chi2;
-  EXPECT_TRUE(Contains(page, "99 % band"));
+  EXPECT_TRUE(Contains(page, "band of a complete model"));
   EXPECT_TRUE(Contains(page, "id=\"diagnosis\""));
   EXPECT_TRUE(Contains(page, "id=\"noise\""));
   EXPECT_TRUE(Contains(page, "velocity random walk"));

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "plumb/estimation/uncertainty.h"
+#include "plumb/report/summary.h"
 #include "report_test_util.h"
 
 namespace plumb::report {
@@ -88,19 +90,29 @@ TEST(HtmlReport, ShowsChi2TheRatioAndItsBand) {
   const std::string page = parts.Page();
   EXPECT_TRUE(Contains(page, "12.5 over 18 whitened residuals"));
   EXPECT_TRUE(Contains(page, "<b>1.25</b>"));
-  const auto band = Chi2DofBand(10);
-  char text[128];
-  std::snprintf(text, sizeof text, "99 %% band of a complete model: %.3g to %.3g", band.first,
+  const auto band = estimation::Chi2Band(10);
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "band of a complete model, 1 &plusmn; 3 sqrt(2/dof): %.3g to %.3g", band.first,
                 band.second);
   EXPECT_TRUE(Contains(page, text)) << text;
 }
 
-TEST(HtmlReport, Chi2BandMatchesTheChiSquareQuantiles) {
-  // chi2(10) quantiles: 2.155856 at 0.005 and 25.18818 at 0.995 (R: qchisq), exactly.
-  const auto band = Chi2DofBand(10);
-  EXPECT_NEAR(band.first, 0.2155856, 1e-6);
-  EXPECT_NEAR(band.second, 2.518818, 1e-6);
-  EXPECT_TRUE(std::isnan(Chi2DofBand(0).first));
+// Issue 34 item 9: one meaning of "consistent": the page marks the verdict ok exactly when the
+// terminal calls the fit consistent with the noise (estimation::Chi2Band), on both sides of
+// either edge.
+TEST(HtmlReport, MarksTheVerdictOkExactlyWhenTheTerminalSaysConsistent) {
+  const auto band = estimation::Chi2Band(10);
+  EXPECT_NEAR(band.second, 1.0 + 3.0 * std::sqrt(0.2), 1e-12);
+  EXPECT_EQ(band.first, 0.0);  // 1 - 3 sqrt(0.2) < 0
+  for (const double ratio : {0.5, 1.25, 2.3, 2.4, 3.0}) {
+    PageParts parts;
+    parts.result.fit.chi2 = ratio * parts.result.fit.dof;
+    const std::string page = parts.Page();
+    const bool consistent = Contains(FitVerdict(parts.result.fit), "consistent with the noise");
+    EXPECT_EQ(Contains(page, "<p class=\"ok\">"), consistent) << ratio;
+    EXPECT_EQ(consistent, ratio <= band.second) << ratio;
+  }
 }
 
 TEST(HtmlReport, ShowsUnobservableDirectionsAndDeterminedCombinations) {

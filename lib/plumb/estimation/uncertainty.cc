@@ -2,10 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace plumb::estimation {
 
 double Chi2BandUpper(int dof) { return 1.0 + kChi2BandSigmas * std::sqrt(2.0 / std::max(dof, 1)); }
+
+std::pair<double, double> Chi2Band(int dof) {
+  if (dof <= 0) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {nan, nan};
+  }
+  const double spread = kChi2BandSigmas * std::sqrt(2.0 / dof);
+  return {std::max(0.0, 1.0 - spread), 1.0 + spread};
+}
 
 bool Chi2AboveBand(const FitReport& fit) {
   return fit.dof > 0 && fit.chi2_dof() > Chi2BandUpper(fit.dof);

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "plumb/estimation/calibration.h"
@@ -25,6 +26,11 @@ inline constexpr double kChi2BandSigmas = 3.0;
 
 /// The upper edge of chi^2/dof's band, 1 + kChi2BandSigmas sqrt(2 / dof) (dof >= 1).
 double Chi2BandUpper(int dof);
+
+/// chi^2/dof's band under a complete model, 1 -+ kChi2BandSigmas sqrt(2 / dof) (the lower edge
+/// at least 0): the one meaning of "consistent with the noise" for every output (the
+/// terminal's verdict, the report page, the sigmas' scaling). {NaN, NaN} when dof <= 0.
+std::pair<double, double> Chi2Band(int dof);
 
 /// chi^2/dof is above Chi2BandUpper (false without degrees of freedom).
 bool Chi2AboveBand(const FitReport& fit);

@@ -20,7 +20,6 @@ namespace plumb::report {
 namespace {
 
 /// Two-sided probability outside the band of chi^2/dof drawn on the page.
-constexpr double kBandOutside = 0.01;
 /// Unobservable directions name at most this many of their terms in words.
 constexpr std::size_t kNamedTerms = 6;
 
@@ -90,8 +89,9 @@ std::string NextCommandHtml(const std::string& command) {
 
 std::string SummarySection(const estimation::CalibrationResult& r,
                            const diagnostics::Diagnosis* d, const std::string& next_command) {
-  const auto band = Chi2DofBand(r.fit.dof);
+  const auto band = estimation::Chi2Band(r.fit.dof);
   const double ratio = r.fit.chi2_dof();
+  // "ok" exactly when the verdict says consistent (one meaning, estimation::Chi2Band).
   const bool good = r.fit.dof > 0 && ratio >= band.first && ratio <= band.second &&
                     r.fit.gates.empty();
   std::string out = "<h2 id=\"summary\">Summary</h2>\n<p class=\"" +
@@ -193,12 +193,13 @@ std::string ModelSection(const estimation::CalibrationResult& r) {
 
 std::string FitSection(const estimation::CalibrationResult& r) {
   const auto& f = r.fit;
-  const auto band = Chi2DofBand(f.dof);
+  const auto band = estimation::Chi2Band(f.dof);
   std::string out = "<h2 id=\"fit\">Fit quality</h2>\n<table>\n";
   out += KeyRow("chi2", G6(f.chi2) + " over " + std::to_string(f.num_residuals) +
                             " whitened residuals");
   out += KeyRow("degrees of freedom", std::to_string(f.dof));
-  out += KeyRow("chi2/dof", "<b>" + G3(f.chi2_dof()) + "</b> (99 % band of a complete model: " +
+  out += KeyRow("chi2/dof", "<b>" + G3(f.chi2_dof()) +
+                                "</b> (band of a complete model, 1 &plusmn; 3 sqrt(2/dof): " +
                                 G3(band.first) + " to " + G3(band.second) + ")");
   out += KeyRow("verdict", HtmlEscape(FitVerdict(f)));
   out += KeyRow("solver", std::string(f.converged ? "converged" : "<span class=\"warn\">not "
@@ -578,15 +579,6 @@ std::string HtmlEscape(std::string_view text) {
   return out;
 }
 
-std::pair<double, double> Chi2DofBand(int dof) {
-  if (dof <= 0) {
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    return {nan, nan};
-  }
-  const double n = static_cast<double>(dof);
-  return {signal::ChiSquareQuantileExact(0.5 * kBandOutside, n) / n,
-          signal::ChiSquareQuantileExact(1.0 - 0.5 * kBandOutside, n) / n};
-}
 
 std::string HtmlReport(const InputSummary& input,
                        const segmentation::SegmentationResult& segmentation,

@@ -5,7 +5,7 @@
 // Sections, in order: summary (the verdict on chi^2/dof, unobservable directions, the best
 // candidate and the command to run next), input (source, samples, rate, duration, site and where it came from, still
 // segments, reader warnings), model (spec, terms), fit quality (chi^2, dof, chi^2/dof with
-// the 99 % band of a complete model, per-axis RMS, noise), sensor noise (the IEEE terms of the
+// the band of a complete model, per-axis RMS, noise), sensor noise (the IEEE terms of the
 // still data per axis, noise_text.h, when PageExtras has them), figures, parameters (value +- sigma
 // with units, or "unobservable"/"fixed"), forward model and correction matrices, firmware (what
 // each export would write and the error it leaves, export_section.h), observability
@@ -16,9 +16,8 @@
 // The page stands alone: the CSS is inline, the figures are inline SVG (figures.h), and it
 // has no script, no link to another file and no reference that a browser would fetch.
 //
-// The 99 % band: under a complete model chi^2 ~ chi^2(dof), so chi^2/dof lies in
-// [Q(0.005), Q(0.995)] / dof with probability 0.99 (Q the chi^2(dof) quantile,
-// plumb/signal/chi_square.h).
+// The band of a complete model: estimation::Chi2Band, 1 -+ 3 sqrt(2/dof), the one meaning of
+// "consistent with the noise" that the terminal's verdict uses too.
 //
 // Every piece of text from outside (file names, labels, warnings, the command) is
 // HTML-escaped; numbers are printed with %.6g (values) and %.2g (sigmas).
@@ -92,8 +91,5 @@ std::string HtmlReport(const InputSummary& input,
                        const estimation::CalibrationResult& result,
                        const diagnostics::ResidualAnalysis& analysis,
                        const diagnostics::Diagnosis* diagnosis, const PageExtras& extras);
-
-/// The 99 % band of chi^2/dof under a complete model, [lower, upper]; {NaN, NaN} when dof <= 0.
-std::pair<double, double> Chi2DofBand(int dof);
 
 }  // namespace plumb::report

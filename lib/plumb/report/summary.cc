@@ -90,7 +90,7 @@ std::string FitVerdict(const estimation::FitReport& fit) {
   if (estimation::Chi2AboveBand(fit)) {
     return value + ": residuals exceed the noise; the model or the segments miss something";
   }
-  if (ratio < 1.0 - 3.0 * spread) {
+  if (ratio < estimation::Chi2Band(fit.dof).first) {
     return value + ": residuals below the noise; the noise level is overestimated";
   }
   return value + ": consistent with the noise";
