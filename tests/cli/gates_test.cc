@@ -170,6 +170,29 @@ TEST(GatesCli, SegmentsCutOutOfOnePoseAreOnePose) {
   EXPECT_EQ(Calibrate(csv, {"--segments", pieces, "--strict"}, dir).exit_code, 3);
 }
 
+// Issue 34 item 4: poses are counted by one function; the advice's "found N", the JSON's
+// distinct_poses and the one_pose gate say the same number (a single hold cut in three).
+TEST(GatesCli, TheAdviceTheJsonAndTheGateCountTheSamePoses) {
+  TempDir dir;
+  const std::string csv = dir.File("static.csv");
+  ASSERT_EQ(Plumb({"simulate", "--schedule", "paper-static", "--out", csv, "--random-truth", "1",
+                   "--accel-rw", "0", "--gyro-rw", "0", "--accel-bi", "0", "--gyro-bi", "0",
+                   "--seed", "5"},
+                  dir).exit_code, 0);
+  const std::string pieces = dir.Write("pieces.csv", "start,end\n100,3000\n3100,6000\n6100,9000\n");
+  const ToolRun run = Plumb({"calibrate", csv, "--segments", pieces, "--json", dir.File("c.json")}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json c = ReadJson(dir.File("c.json"));
+  const int poses = c.at("fit").at("distinct_poses").get<int>();
+  EXPECT_EQ(poses, 1);
+  EXPECT_TRUE(Contains(run.err, "distinct orientations (fewer when attitudes are known); found " +
+                                    std::to_string(poses) + ";"))
+      << run.err;
+  EXPECT_TRUE(Contains(LineStarting(run.out, "gate failed: one_pose"),
+                       "the 3 still segments lie in " + std::to_string(poses) + " distinct pose "))
+      << run.out;
+}
+
 TEST(GatesCli, SamplesOutOfRangeAreNamedWithTheFirstTimeAndTheCount) {
   TempDir dir;
   const std::string csv = Simulate(dir);

@@ -3,13 +3,12 @@
 #include <string>
 
 #include "plumb/core/error.h"
-#include "plumb/estimation/calibrator.h"
 
 namespace plumb::estimation {
 namespace {
 
 /// "the data cannot determine ...; <what to record>", or "" when every parameter is determined.
-std::string Undetermined(const Calibration& calibration, const StillSet& still,
+std::string Undetermined(const Calibration& calibration,
                          const FitReport& fit) {
   bool accel_short = false, gyro_short = false;
   std::vector<std::string> lost;
@@ -22,10 +21,10 @@ std::string Undetermined(const Calibration& calibration, const StillSet& still,
   if (lost.empty()) return "";
   std::vector<std::string> advice;
   if (accel_short) {
-    const int orientations = CountDistinctOrientations(still.AtRestMeans(false));
+    // The fit's count (gates.h CountDistinctPoses), as its JSON and the one_pose gate say it.
     advice.push_back("the base accelerometer model needs still poses in at least 9 distinct "
                      "orientations (fewer when attitudes are known); found " +
-                     std::to_string(orientations));
+                     std::to_string(fit.distinct_poses));
   }
   if (gyro_short) {
     advice.push_back("the gyroscope matrix needs turns about three independent axes between still "
@@ -46,7 +45,7 @@ std::string Undetermined(const Calibration& calibration, const StillSet& still,
 void AddAdvice(const Calibration& calibration, const StillSet& still,
                const CalibrationOptions& options, FitReport& fit) {
   const geo::Site& site = calibration.site;
-  const std::string undetermined = Undetermined(calibration, still, fit);
+  const std::string undetermined = Undetermined(calibration, fit);
   if (!undetermined.empty()) {
     if (options.on_insufficient == InsufficientData::kError) {
       throw InsufficientDataError(undetermined);

@@ -48,18 +48,6 @@ model::Model ModelForSession(const model::Model& requested, const ImuSeries& ser
 
 }  // namespace
 
-int CountDistinctOrientations(const std::vector<Vec3>& acc_means, double min_angle_deg) {
-  std::vector<Vec3> reps;
-  for (const auto& m : acc_means) {
-    const Vec3 u = m.normalized();
-    const bool seen = std::any_of(reps.begin(), reps.end(), [&](const Vec3& r) {
-      return std::acos(std::clamp(r.dot(u), -1.0, 1.0)) * units::kDegPerRad < min_angle_deg;
-    });
-    if (!seen) reps.push_back(u);
-  }
-  return static_cast<int>(reps.size());
-}
-
 FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
                          const model::Model& model_in, const geo::Site& site,
                          const CalibrationOptions& options, CalibrationResult& result) {
@@ -153,6 +141,8 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   fit.still_segments = static_cast<int>(problem.still().poses.size());
   fit.motion_segments = static_cast<int>(problem.still().motions.size());
   problem.ReportResiduals(solution.all_free, fit);
+  // Counted once: the advice, the one_pose gate and the JSON all say this number.
+  fit.distinct_poses = CountDistinctPoses(series, fit.still, cal.noise);
 
   // 8. What the data cannot determine; diagnose's probe columns.
   AddAdvice(cal, problem.still(), options, fit);

@@ -33,8 +33,4 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
                             const model::Model& model, const geo::Site& site,
                             const CalibrationOptions& options = {});
 
-/// Number of distinct still orientations (gravity directions more than `min_angle_deg`
-/// apart) among the segments' accelerometer means.
-int CountDistinctOrientations(const std::vector<Vec3>& acc_means, double min_angle_deg = 10.0);
-
 }  // namespace plumb::estimation

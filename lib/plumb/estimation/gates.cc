@@ -540,7 +540,6 @@ std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibrati
                            FitReport& fit) {
   std::vector<Gate> gates;
   if (!fit.converged) gates.push_back(NotConverged(fit));
-  fit.distinct_poses = CountDistinctPoses(series, fit.still, calibration.noise);
   const auto one_pose = OnePose(series, calibration, fit);
   if (one_pose) gates.push_back(*one_pose);
   if (fit.converged && !one_pose) {

@@ -91,7 +91,7 @@ inline constexpr double kMaxLinearityRatio = 1.5;
 std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillSegment>& still);
 
 /// not_converged, one_pose and unit_or_rate, on a finished fit (its still segments, noise
-/// levels and parameters). Also sets fit.distinct_poses.
+/// levels, parameters and fit.distinct_poses, which Calibrate counts with CountDistinctPoses).
 std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibration,
                            FitReport& fit);
 
@@ -100,7 +100,8 @@ std::vector<Gate> CheckGates(const ImuSeries& series, const std::vector<StillSeg
                              const Calibration& calibration, FitReport& fit);
 
 /// Distinct poses among the fit's still segments at rest (the one_pose rule above), given the
-/// noise levels the fit was whitened with.
+/// noise levels the fit was whitened with: the one count of poses (FitReport::distinct_poses,
+/// the advice's "found N", the one_pose gate).
 int CountDistinctPoses(const ImuSeries& series, const std::vector<StillSegmentFit>& still,
                        const NoiseLevels& noise);
 
