@@ -170,6 +170,38 @@ TEST(GatesCli, SegmentsCutOutOfOnePoseAreOnePose) {
   EXPECT_EQ(Calibrate(csv, {"--segments", pieces, "--strict"}, dir).exit_code, 3);
 }
 
+// Issue 34 item 4: a "still" segment that holds motion (here a turn given as still, as a
+// flight taken for a still pose) fails not_still with its figures; the real poses do not.
+TEST(GatesCli, ASegmentThatMovesIsNotStill) {
+  TempDir dir;
+  const std::string csv = Simulate(dir);
+  // The first pose is samples [0, 400), the first turn [400, 550); then poses every 550.
+  std::string rows = "start,end,label\n";
+  for (int k = 0; k < 12; ++k) {
+    rows += std::to_string(20 + 550 * k) + "," + std::to_string(380 + 550 * k) + ",pose " +
+            std::to_string(k + 1) + "\n";
+    if (k == 0) rows += "400,550,the first turn\n";
+  }
+  const std::string segments = dir.Write("segments.csv", rows);
+  const ToolRun run = Calibrate(csv, {"--segments", segments}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string line = LineStarting(run.out, "gate failed: not_still");
+  EXPECT_TRUE(Contains(line, "gate failed: not_still: " + csv +
+                                 ": 1 of 13 still segments scatter far beyond an IMU at rest, "
+                                 "per sample: 'the first turn' (4-5.49 s): "))
+      << run.out;
+  EXPECT_TRUE(Contains(line, "above 0.1 rad/s")) << line;
+  EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
+  // The poses alone pass.
+  std::string poses = "start,end\n";
+  for (int k = 0; k < 12; ++k) {
+    poses += std::to_string(20 + 550 * k) + "," + std::to_string(380 + 550 * k) + "\n";
+  }
+  const ToolRun clean = Calibrate(csv, {"--segments", dir.Write("poses.csv", poses)}, dir);
+  ASSERT_EQ(clean.exit_code, 0) << clean.err;
+  EXPECT_FALSE(Contains(clean.out, "not_still")) << clean.out;
+}
+
 // Issue 34 item 4: poses are counted by one function; the advice's "found N", the JSON's
 // distinct_poses and the one_pose gate say the same number (a single hold cut in three).
 TEST(GatesCli, TheAdviceTheJsonAndTheGateCountTheSamePoses) {

@@ -536,6 +536,88 @@ int CountDistinctPoses(const ImuSeries& series, const std::vector<StillSegmentFi
   return poses;
 }
 
+namespace {
+
+/// Per-sample scatter, the largest axis's RMS about the mean, of `v` over [begin, end).
+double Scatter(const std::vector<Vec3f>& v, std::size_t begin, std::size_t end) {
+  if (end <= begin + 1) return 0.0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), sum2 = Eigen::Vector3d::Zero();
+  for (std::size_t k = begin; k < end; ++k) {
+    const Eigen::Vector3d x = v[k].cast<double>();
+    sum += x;
+    sum2 += x.cwiseProduct(x);
+  }
+  const double n = static_cast<double>(end - begin);
+  const Eigen::Vector3d mean = sum / n;
+  return ((sum2 / n - mean.cwiseProduct(mean)).cwiseMax(0.0)).cwiseSqrt().maxCoeff();
+}
+
+/// One sensor's scatter per segment, SI (the output divided by the fitted scale).
+std::vector<double> ScatterSi(const std::vector<Vec3f>& v,
+                              const std::vector<const StillSegmentFit*>& still,
+                              const Mat3& matrix) {
+  const double scale = matrix.diagonal().cwiseAbs().mean();
+  std::vector<double> out;
+  for (const StillSegmentFit* s : still) {
+    out.push_back(Scatter(v, s->segment.begin, s->segment.end) / (scale > 0 ? scale : 1.0));
+  }
+  return out;
+}
+
+/// Why segment k of one sensor is not still ("" when it is).
+std::string Unstill(const std::vector<double>& scatter, std::size_t k, double limit,
+                    double floor, const char* sensor, const char* unit) {
+  const double quietest =
+      std::max(floor, *std::min_element(scatter.begin(), scatter.end()));
+  const bool loud = scatter[k] > limit;
+  const bool apart = scatter.size() > 1 && scatter[k] > kNotStillRatio * quietest;
+  if (!loud && !apart) return "";
+  return std::string(sensor) + " " + Num(scatter[k]) + " " + unit + " (" +
+         Num(scatter[k] / quietest) + " times the quietest segment's" +
+         (loud ? ", above " + Num(limit) + " " + unit : std::string()) + ")";
+}
+
+/// The not_still gate (gates.h).
+std::optional<Gate> NotStill(const ImuSeries& series, const Calibration& cal,
+                             const FitReport& fit) {
+  // At rest only: a turntable's spinning segments are meant to move.
+  const std::vector<const StillSegmentFit*> rest = AtRest(fit.still);
+  if (rest.empty()) return std::nullopt;
+  const std::vector<double> acc = ScatterSi(series.acc, rest, cal.AccelMatrix());
+  const bool gyro = cal.has_gyro && series.has_gyro();
+  const std::vector<double> gyr = gyro ? ScatterSi(series.gyr, rest, cal.GyroMatrix())
+                                       : std::vector<double>();
+  std::string list;
+  int count = 0;
+  for (std::size_t k = 0; k < rest.size(); ++k) {
+    std::string why = Unstill(acc, k, kNotStillAccel, kStillScatterFloorAccel,
+                              "accelerometer", "m/s^2");
+    if (gyro) {
+      const std::string g =
+          Unstill(gyr, k, kNotStillGyro, kStillScatterFloorGyro, "gyroscope", "rad/s");
+      if (!g.empty()) why += (why.empty() ? "" : ", ") + g;
+    }
+    if (why.empty()) continue;
+    ++count;
+    if (count <= 3) {
+      const StillSegmentFit& s = *rest[k];
+      list += std::string(list.empty() ? "" : "; ") + "'" + s.segment.label + "' (" +
+              Num(series.t_s[s.segment.begin]) + "-" + Num(series.t_s[s.segment.end - 1]) +
+              " s): " + why;
+    }
+  }
+  if (count == 0) return std::nullopt;
+  return Gate{"not_still",
+              std::to_string(count) + " of " + std::to_string(rest.size()) +
+                  " still segments scatter far beyond an IMU at rest, per sample: " + list +
+                  (count > 3 ? "; ..." : "") +
+                  ". A flight, running motors or a vehicle carried is not a still pose, and "
+                  "the noise measured there is motion: give the still periods (a segments "
+                  "file, or the log's time window before take-off)"};
+}
+
+}  // namespace
+
 std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibration,
                            FitReport& fit) {
   std::vector<Gate> gates;
@@ -545,6 +627,7 @@ std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibrati
   if (fit.converged && !one_pose) {
     if (auto g = Nonlinear(fit)) gates.push_back(*g);
   }
+  if (auto g = NotStill(series, calibration, fit)) gates.push_back(*g);
   const auto rest = Plausible(AtRest(fit.still), calibration);
   if (rest.empty()) return gates;
   const bool usable = fit.converged && !one_pose;

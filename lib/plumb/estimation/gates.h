@@ -24,6 +24,11 @@
 //   nonlinear      chi^2 is far from the quadratic the covariance assumes, a few sigma out from
 //                  the solution (linearity.h): the covariance does not describe the fit's
 //                  error (only on a converged fit of enough poses)
+//   not_still      a still segment whose samples scatter (RMS about its mean, per axis, in SI
+//                  through the fitted scale) more than kNotStillAccel or kNotStillGyro, or more
+//                  than kNotStillRatio times the session's quietest segment: a flight, running
+//                  motors, a vehicle carried, not a pose at rest (the detector adapts to the
+//                  data's own scatter, so a session that is all motion can pass it)
 //   implausible_walk  a bias random walk estimated from the session (--estimate-rw) more than
 //                  10 times the typical MEMS walk: more likely a missing effect seen between
 //                  the poses, which a walk that large hides from chi2 (walk_estimate.h)
@@ -47,7 +52,22 @@ namespace plumb::estimation {
 /// The gates' names, in the order they are checked.
 inline constexpr const char* kGateNames[] = {"out_of_range", "saturated", "not_converged",
                                              "one_pose", "nonlinear", "unit_or_rate",
-                                             "implausible_walk"};
+                                             "not_still", "implausible_walk"};
+
+/// not_still: a segment's per-sample scatter above kNotStillAccel (50 mg: 25 times a consumer
+/// MEMS accelerometer's noise per sample at 1 kHz, 0.02 m/s^2; spinning motors and flight give
+/// 1-10 m/s^2) or kNotStillGyro (5.7 deg/s: 60 times a MEMS gyroscope's 1.6e-3 rad/s at
+/// 1 kHz), or above kNotStillRatio times the quietest segment's (one sensor at rest has the
+/// same white noise in every pose; hand-held holds on real sessions reach 22 times it, the
+/// ChanghyeonKim93 and mikoff sessions; flight 100-1000 times), the quietest taken at least
+/// kStillScatterFloorAccel /
+/// kStillScatterFloorGyro (below any MEMS part's noise per sample: quantised outputs can
+/// scatter by zero).
+inline constexpr double kNotStillAccel = 0.5;
+inline constexpr double kNotStillGyro = 0.1;
+inline constexpr double kNotStillRatio = 50.0;
+inline constexpr double kStillScatterFloorAccel = 0.005;
+inline constexpr double kStillScatterFloorGyro = 5e-4;
 
 /// out_of_range: per-axis limits. 32 g is twice the largest common MEMS full scale (16 g;
 /// 24 g parts stay inside), 4000 deg/s twice the common 2000 deg/s; 2^20 counts holds any
@@ -90,7 +110,7 @@ inline constexpr double kMaxLinearityRatio = 1.5;
 /// out_of_range and saturated, on the samples and the still segments (given or detected).
 std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillSegment>& still);
 
-/// not_converged, one_pose and unit_or_rate, on a finished fit (its still segments, noise
+/// not_converged, one_pose, not_still and unit_or_rate, on a finished fit (its still segments, noise
 /// levels, parameters and fit.distinct_poses, which Calibrate counts with CountDistinctPoses).
 std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibration,
                            FitReport& fit);
