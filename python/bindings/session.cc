@@ -29,7 +29,9 @@ Keywords are the command line's input options (`plumb calibrate --help`), '-' as
   acc_unit='m/s^2'|'g'|'counts', acc_scale (number or 'a/b'), acc_offset (file units);
   gyr_unit='rad/s'|'deg/s'|'counts', gyr_scale, gyr_offset; axis_map='1,-2,-3';
   drop_nan (bool); flight logs: imu (instance, 0-based), stream (name), from_s, to_s (log
-  time window, s), as_logged (bool: keep the firmware's correction).
+  time window, s), as_logged (bool: keep the firmware's correction); clock='stamps'|'uniform'
+  (the times as read, or the uniform sample clock fitted through each input's stamps, for
+  stamps a host wrote on arrival: `plumb diagnose` says which they are).
 Returns a Session. Raises plumb.InputError naming the file and place for bad input,
 plumb.Error for options that do not fit.)doc";
 
@@ -89,6 +91,11 @@ io::InputOptions Options(Keywords& k) {
   if (auto from = k.Take<double>("from_s")) o.flight_log.from_s = *from;
   if (auto to = k.Take<double>("to_s")) o.flight_log.to_s = *to;
   o.flight_log.undo_correction = !k.Take<bool>("as_logged", false);
+  const std::string clock = k.Take<std::string>("clock", "stamps");
+  if (clock != "stamps" && clock != "uniform") {
+    throw Error("open: clock must be 'stamps' or 'uniform', not '" + clock + "'");
+  }
+  o.clock = clock == "uniform" ? io::Clock::kUniform : io::Clock::kStamps;
   o.not_native_hint = "describe the table, e.g. columns='t,ax,ay,az,gx,gy,gz' (by position; "
                       "'-' skips a column, no 't' needs rate=HZ), with skip_lines, header, "
                       "acc_unit='g', gyr_unit='deg/s', acc_scale, acc_offset";

@@ -69,6 +69,27 @@ class CliEqual(unittest.TestCase):
         with open(out("cal_site.json")) as f:
             self.assertEqual(result.to_json(), f.read())
 
+    def test_uniform_clock_is_the_commands(self):
+        # A simulated session whose stamps a host wrote on arrival (late by 0.1 ms more each
+        # sample, back every 25), calibrated on the uniform clock fitted through them.
+        run("simulate", "--out", out("clock_sim.csv"), "--poses", "12", "--seed", "8")
+        with open(out("clock_sim.csv")) as f:
+            lines = f.read().splitlines()
+        stamped = [lines[0]]
+        for k, line in enumerate(lines[1:]):
+            fields = line.split(",")
+            fields[0] = repr(float(fields[0]) + 1e-4 * (k % 25))
+            stamped.append(",".join(fields))
+        with open(out("clock_host.csv"), "w") as f:
+            f.write("\n".join(stamped) + "\n")
+        run("calibrate", out("clock_host.csv"), "--clock", "uniform", "--json",
+            out("clock_cal.json"))
+        session = plumb.open(out("clock_host.csv"), clock="uniform")
+        with open(out("clock_cal.json")) as f:
+            self.assertEqual(plumb.calibrate(session).to_json(), f.read())
+        with self.assertRaises(plumb.Error):
+            plumb.open(out("clock_host.csv"), clock="host")
+
     def test_datasheet_units_are_the_commands(self):
         # The bias wander levels in a datasheet's units, parsed by the command's parser.
         levels = {"gyro_bi": "4 deg/h", "accel_rw": "10 ug/sqrt(h)"}
