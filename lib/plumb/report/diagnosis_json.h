@@ -15,7 +15,7 @@
 //                                                   best evidence first (Diagnosis order)
 //   skipped [{effect, reason}],
 //   compare {still [...], motion [...], worst [...], signatures [...], p_threshold, allan [...]}
-//   site {...}, warnings [...]
+//   site {...}, warnings [...], gates [{name, message}] (the diagnosed fit's)
 #pragma once
 
 #include <nlohmann/json.hpp>
