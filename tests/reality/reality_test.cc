@@ -133,6 +133,15 @@ std::vector<RealSession> Sessions() {
       {"changhyeonkim93_good2",
        Concat({"shared:multipose/changhyeonkim93/imu_good2.txt"}, kChk), "time_base", velocity,
        {}, {"one_pose", "not_converged", "not_still"}, 20.0, 1e9, "host_arrival"},
+      // imucal's Ferraris session (six faces and three 360 deg turns, 102.4 Hz, gyroscope in
+      // deg/s, gravity 9.81 as imucal's): the turns show a gyroscope scale nonlinearity
+      // (chi2/dof 22.5 -> 5.7).
+      {"imucal_ferraris",
+       {"shared:ferraris/imucal/example_ferraris_session.csv", "--skip-lines", "1", "--columns",
+        "t,gx,gy,gz,ax,ay,az", "--gyr-unit", "deg/s", "--time-scale", "0.009765625",
+        "--gravity", "9.81"},
+       "gyro_scale_nonlinearity", velocity, {}, {"one_pose", "not_converged", "not_still"},
+       10.0, 40.0},
       // The same sessions on the uniform clock fitted through their stamps (--clock uniform):
       // chi2/dof 9.2 -> 5.4 and 109 -> 44 (ClockUniformAtLeastHalvesImuGood2).
       {"changhyeonkim93_good1_uniform",
