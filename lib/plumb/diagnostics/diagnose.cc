@@ -21,6 +21,12 @@ namespace {
 
 void Tell(const DiagnoseOptions& options, const std::string& stage);
 
+/// Like with like: a refit is advised only when its chi^2/dof is below the user's fit's.
+bool LowersTheUsersFit(const estimation::CalibrationResult& refit,
+                       const estimation::CalibrationResult& user) {
+  return refit.fit.dof > 0 && user.fit.dof > 0 && refit.fit.chi2_dof() < user.fit.chi2_dof();
+}
+
 struct CandidateSpec {
   std::string name;
   std::string option;
@@ -133,8 +139,7 @@ std::optional<Candidate> TestTimeBase(const ImuSeries& series,
   c.evidence = c.lm - std::log(std::max(1.0, static_cast<double>(observations)));
   c.threshold = signal::ChiSquareQuantileExact(1.0 - options.significance, 1);
   c.significant = c.lm > c.threshold;
-  c.recommended = c.significant && c.refit->fit.dof > 0 && fit.fit.dof > 0 &&
-                  c.refit->fit.chi2_dof() < fit.fit.chi2_dof();
+  c.recommended = c.significant && LowersTheUsersFit(*c.refit, fit);
   return c;
 }
 
@@ -413,8 +418,7 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
     cand.refit_drop = before - refits[k].result->fit.chi2;
     cand.refit = std::move(refits[k].result);
     // Like with like: advised only when the user's own fit gets better.
-    cand.recommended = cand.refit->fit.dof > 0 && fit.fit.dof > 0 &&
-                       cand.refit->fit.chi2_dof() < fit.fit.chi2_dof();
+    cand.recommended = LowersTheUsersFit(*cand.refit, fit);
   }
 }
 
