@@ -68,10 +68,11 @@ void AddWanderOptions(CLI::App* app, FitArgs& a) {
             "deg/s/sqrt(s)" + units + "2e-6 (or --estimate-rw)",
             pipeline::WanderLevel::kGyroWalk),
       app->add_flag("--estimate-rw", a.options.estimate_walk,
-                    "Estimate the bias random walks not given from the session (variance "
-                    "components over the walk factors; 6 or more still poses). The differences "
-                    "between poses it reads as a walk also carry any effect the model misses: "
-                    "check with 'plumb diagnose' first"),
+                    "Estimate the bias wander levels not given (walk and instability) from the "
+                    "session: variance components over the wander factors, marginalised over "
+                    "the estimate's own scatter; 6 or more still poses. The differences between "
+                    "poses it reads as wander also carry any effect the model misses: check "
+                    "with 'plumb diagnose' first"),
       level("--accel-bi", a.options.accel_instability,
             "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 or ug, "
             "mg" + units + "4e-4",

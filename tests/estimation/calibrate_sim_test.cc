@@ -35,7 +35,7 @@ enum class Noise {
 enum class Fit {
   kWander,    ///< the default: the bias wanders, its levels from the session's still data's
               ///< Allan deviation or typical (wander_levels.h), nothing given
-  kEstimate,  ///< the walk estimated from the session (--estimate-rw), typical instability
+  kEstimate,  ///< the wander levels estimated from the session (--estimate-rw)
   kConstant,  ///< one constant bias (--constant-bias)
 };
 
@@ -47,12 +47,17 @@ CalibrationOptions OptionsFor(Fit fit) {
 }
 
 /// A multi-pose session at 100 Hz with random true parameters, calibrated with the true
-/// still segments given (attitudes unknown).
+/// still segments given (attitudes unknown); `wander` scales the sensor's bias walk and
+/// instability (both sensors).
 Outcome CalibrateMultiPose(std::uint64_t seed, const std::string& spec = "base",
                            int poses = 16, double still_s = 5.0, Noise noise = Noise::kWhite,
-                           Fit fit = Fit::kConstant) {
+                           Fit fit = Fit::kConstant, double wander = 1.0) {
   sim::SimulationOptions opt = noise == Noise::kWhite ? sim::SimulationOptions::WhiteMems()
                                                       : sim::SimulationOptions::TypicalMems();
+  opt.accel_bias_walk_density *= wander;
+  opt.gyro_bias_walk_density *= wander;
+  opt.accel_bias_instability *= wander;
+  opt.gyro_bias_instability *= wander;
   opt.rate_hz = 100.0;
   opt.model = model::Model::Parse(spec);
   opt.truth = sim::RandomParameters(opt.model, 1.0, seed);
@@ -127,16 +132,21 @@ TEST(CalibrateSimulated, CovarianceIsHonestOverMonteCarlo) {
 }
 
 /// Mean NEES per degree of freedom over `runs` seeded sessions of 12 poses held `still_s`
-/// seconds with the simulator's default (realistic) noise, fitted as `fit` says.
-double MeanNeesPerDof(int runs, double still_s, Fit fit, double* lo, double* hi) {
+/// seconds with the simulator's default (realistic) noise, its wander scaled by `wander`,
+/// fitted as `fit` says; `chi2_dof` (optional) the mean chi2/dof.
+double MeanNeesPerDof(int runs, double still_s, Fit fit, double* lo, double* hi,
+                      double wander = 1.0, double* chi2_dof = nullptr) {
   constexpr int kParams = 21;
-  double sum = 0;
+  double sum = 0, chi2 = 0;
   for (int run = 0; run < runs; ++run) {
-    sum += Nees(CalibrateMultiPose(3000 + static_cast<std::uint64_t>(run), "base", 12, still_s,
-                                   Noise::kRealistic, fit));
+    const Outcome o = CalibrateMultiPose(3000 + static_cast<std::uint64_t>(run), "base", 12,
+                                         still_s, Noise::kRealistic, fit, wander);
+    sum += Nees(o);
+    chi2 += o.result.fit.chi2_dof();
   }
   *lo = signal::ChiSquareQuantileExact(0.025, runs * kParams) / (runs * kParams);
   *hi = signal::ChiSquareQuantileExact(0.975, runs * kParams) / (runs * kParams);
+  if (chi2_dof != nullptr) *chi2_dof = chi2 / runs;
   return sum / (runs * kParams);
 }
 
@@ -272,17 +282,44 @@ TEST(CalibrateSimulated, CovarianceIsHonestOnThePaperBenchmarkWithRealisticNoise
   std::cout << "paper benchmark: NEES/dof " << nees << " (95% band " << lo << " .. " << hi << ")\n";
 }
 
-// The walk estimated from the session (--estimate-rw) on the same sessions as
-// CovarianceIsHonestWithRealisticNoise: the figures model.md quotes. Several fits per session,
-// so not in every run of the suite: --gtest_also_run_disabled_tests runs it (about 2 minutes).
-TEST(CalibrateSimulated, DISABLED_EstimatedWalkNeesOnRealisticNoise) {
-  for (double still_s : {5.0, 30.0}) {
+// Issue 34 item 6: sensors from five times quieter to five times noisier than the typical
+// MEMS sensor (walk and instability of both sensors scaled), 12 holds, nothing given. Holds
+// of seconds neither resolve the levels nor bound them below typical, so by default the
+// typical levels stand: a quiet sensor's sigmas are too large, a noisy one's too small (its
+// chi2/dof says so: the fit is flagged). With the levels estimated from the session
+// (--estimate-rw: variance components over the wander factors, marginalised over their own
+// scatter, estimation/walk_estimate.h) the average NEES with the full covariance lies in its
+// 95 % band at every level for holds of 30 s, and at 1 and 5 times for holds of 5 s, where a
+// sensor five times quieter stays somewhat conservative: its 5 s holds barely show a wander
+// that small (the factors are absorbed), so part of it keeps the typical level.
+TEST(CalibrateSimulated, CovarianceIsHonestFromQuietToWanderingSensors) {
+  constexpr int kRuns = 60;
+  struct Case {
+    double still_s, wander;
+    bool in_band;  ///< else: no more than 15 % conservative
+  };
+  for (const Case c : {Case{30.0, 0.2, true}, Case{30.0, 1.0, true}, Case{30.0, 5.0, true},
+                       Case{5.0, 0.2, false}, Case{5.0, 5.0, true}}) {
     double lo = 0, hi = 0;
-    const double nees = MeanNeesPerDof(kRealisticRuns, still_s, Fit::kEstimate, &lo, &hi);
-    EXPECT_LT(nees, 1.5) << still_s << " s holds";
-    std::cout << "walk estimated, holds of " << still_s << " s: NEES/dof " << nees
-              << " (95% band " << lo << " .. " << hi << ")\n";
+    const double nees = MeanNeesPerDof(kRuns, c.still_s, Fit::kEstimate, &lo, &hi, c.wander);
+    if (c.in_band) EXPECT_GT(nees, lo) << c.wander << " x typical, holds of " << c.still_s << " s";
+    if (!c.in_band) EXPECT_GT(nees, 0.85) << c.wander << " x typical, holds of " << c.still_s << " s";
+    EXPECT_LT(nees, hi) << c.wander << " x typical, holds of " << c.still_s << " s";
+    std::cout << c.wander << " x the typical wander, holds of " << c.still_s
+              << " s, levels estimated: NEES/dof " << nees << " (95% band " << lo << " .. " << hi
+              << ")\n";
   }
+  // The default on the same sessions: conservative when quiet, optimistic when noisy, and
+  // then its chi2/dof above its band says the sigmas are not to be trusted.
+  double lo = 0, hi = 0, chi2_dof = 0;
+  const double quiet = MeanNeesPerDof(kRuns, 30.0, Fit::kWander, &lo, &hi, 0.2);
+  const double noisy = MeanNeesPerDof(kRuns, 30.0, Fit::kWander, &lo, &hi, 5.0, &chi2_dof);
+  EXPECT_LT(quiet, lo);
+  EXPECT_GT(noisy, hi);
+  EXPECT_GT(chi2_dof, 5.0);
+  std::cout << "typical levels assumed, holds of 30 s: NEES/dof " << quiet
+            << " at 0.2 x the typical wander, " << noisy << " at 5 x (mean chi2/dof " << chi2_dof
+            << ")\n";
 }
 
 TEST(CalibrateSimulated, AConstantBiasUnderstatesSigmaWhenTheBiasWanders) {

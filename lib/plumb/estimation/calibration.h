@@ -64,7 +64,7 @@ enum class LevelSource {
   kMeasured,   ///< resolved by the Allan deviation of still data
   kBounded,    ///< not resolved; the Allan deviation's upper bound, below the typical level
   kTypical,    ///< the typical MEMS level (core/typical_mems.h), within the data's bound
-  kEstimated,  ///< estimated over the fit by variance components (--estimate-rw)
+  kEstimated,  ///< estimated over the fit by variance components (walk_estimate.h)
 };
 /// "none", "given", "allan", "allan_bound", "typical", "estimated" (the JSON's words).
 const char* LevelSourceName(LevelSource source);

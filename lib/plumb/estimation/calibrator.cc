@@ -72,18 +72,18 @@ FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment
   AssignHeadingGauge(still, cal.has_gyro);
   if (options.ModelsWander()) {
     // 2a. The wander's levels: given, from the still data's Allan deviation, or typical;
-    // 2b. the walk estimated over the fit (opt-in).
+    // 2b. those the still data cannot resolve estimated over the fit (walk_estimate.h).
     std::vector<const signal::StillNoise*> measured;
     const std::optional<signal::StillNoise> own =
         MeasureStillNoise(series, still, options.instability_time_s, fit.notes, options.run_jobs);
     if (own) measured.push_back(&*own);
     for (const signal::StillNoise& other : options.other_still_noise) measured.push_back(&other);
-    WanderLevels levels = AssignWanderLevels(out.noise, measured, out.start, cal.has_gyro,
-                                             series.duration_s(), options);
-    out.noise = levels.noise;
+    WanderLevels levels =
+        AssignWanderLevels(out.noise, measured, out.start, cal.has_gyro, series.duration_s(),
+                           options, static_cast<int>(still.poses.size()));
     fit.notes.insert(fit.notes.end(), levels.notes.begin(), levels.notes.end());
     WalkEstimate wander =
-        ResolveWander(series, cal.model, site, still, theta, out.noise, out.start, options);
+        ResolveWander(series, cal.model, site, still, theta, levels, out.start, options);
     out.noise = wander.noise;
     fit.notes.insert(fit.notes.end(), wander.notes.begin(), wander.notes.end());
     fit.warnings.insert(fit.warnings.end(), wander.warnings.begin(), wander.warnings.end());

@@ -63,13 +63,14 @@ struct CalibrationOptions {
   std::optional<double> accel_instability;
   std::optional<double> gyro_instability;
   double instability_time_s = typical_mems::kInstabilityTime_s;
-  /// Estimate the walk densities that are not given from the session itself, by
-  /// variance-component estimation over the walk factors (estimation/walk_estimate.h), when
-  /// it has walk_min_poses still poses (else the level of wander_levels.h, said in the
-  /// warnings). Off by default: the differences between holds that the estimate reads as a
-  /// walk also carry whatever effect the model misses (a session with a hidden g-sensitivity
-  /// read as "consistent with the noise" with it on), so the default is the level from still
-  /// data alone (wander_levels.h) and a misfit stays visible.
+  /// Estimate the wander levels (walk and instability) that are not given from the session
+  /// itself, by variance-component estimation over the wander factors, marginalised over the
+  /// estimate's scatter (estimation/walk_estimate.h), when it has walk_min_poses still poses
+  /// (else the levels of wander_levels.h, said in the warnings). Off by default: the
+  /// differences between holds that the estimate reads as wander also carry whatever effect
+  /// the model misses (a session with a hidden g-sensitivity read as "consistent with the
+  /// noise" with it on), so the default is the level from still data alone (wander_levels.h)
+  /// and a misfit stays visible.
   bool estimate_walk = false;
   /// One constant bias over the session: no walk, no instability, whatever the fields above
   /// say. Honest only for white noise (the report says so); for comparisons and peers' methods.

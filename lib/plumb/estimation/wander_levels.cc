@@ -25,6 +25,7 @@ struct Slot {
   const std::optional<double>* given;
   Vec3* level;
   std::array<LevelSource, 3>* from;
+  Vec3* bound;
   double typical;                     ///< in the sensor's units
 };
 
@@ -161,19 +162,20 @@ std::string Quantisation(const std::vector<const signal::StillNoise*>& measured,
 WanderLevels AssignWanderLevels(const NoiseModel& noise,
                                 const std::vector<const signal::StillNoise*>& measured,
                                 const StartingValues& start, bool has_gyro, double span_s,
-                                const CalibrationOptions& options) {
-  WanderLevels out{noise, {}};
+                                const CalibrationOptions& options, int still_poses) {
+  WanderLevels out{noise, {}, {}};
   NoiseModel& n = out.noise;
+  WanderBounds& b = out.bounds;
   const double acc_scale = start.accel.scale, gyr_scale = 1.0 / start.gyro_rad_per_unit;
   const std::array<Slot, 4> slots{{
       {signal::Sensor::kAccel, false, &options.accel_instability, &n.instability_acc,
-       &n.from.instability_acc, typical_mems::kAccelInstability * acc_scale},
+       &n.from.instability_acc, &b.instability_acc, typical_mems::kAccelInstability * acc_scale},
       {signal::Sensor::kAccel, true, &options.accel_walk_density, &n.walk_acc, &n.from.walk_acc,
-       typical_mems::kAccelWalk * acc_scale},
+       &b.walk_acc, typical_mems::kAccelWalk * acc_scale},
       {signal::Sensor::kGyro, false, &options.gyro_instability, &n.instability_gyr,
-       &n.from.instability_gyr, typical_mems::kGyroInstability * gyr_scale},
+       &n.from.instability_gyr, &b.instability_gyr, typical_mems::kGyroInstability * gyr_scale},
       {signal::Sensor::kGyro, true, &options.gyro_walk_density, &n.walk_gyr, &n.from.walk_gyr,
-       typical_mems::kGyroWalk * gyr_scale},
+       &b.walk_gyr, typical_mems::kGyroWalk * gyr_scale},
   }};
   std::string acc_unit = "sensor units", gyr_unit = "sensor units";
   double still_s = 0.0;
@@ -192,6 +194,7 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
       axes[static_cast<std::size_t>(i)] = a;
       (*slot.level)[i] = a.level;
       (*slot.from)[static_cast<std::size_t>(i)] = a.from;
+      (*slot.bound)[i] = a.bound;
     }
     const bool acc = slot.sensor == signal::Sensor::kAccel;
     const std::string unit = slot.walk ? WalkUnit(acc ? acc_unit : gyr_unit) : (acc ? acc_unit : gyr_unit);
@@ -200,7 +203,10 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
   }
   note += Quantisation(measured, has_gyro, n);
   if (note.empty()) return out;
-  char head[160], tail[200];
+  // The session's holds can estimate what the still data leave to the typical sensor.
+  const bool estimable = !options.estimate_walk && still_poses >= options.walk_min_poses &&
+                         note.find(" typical") != std::string::npos;
+  char head[160], tail[320];
   std::snprintf(head, sizeof head, "bias wander levels (Allan deviation of %.0f s of still data): ",
                 still_s);
   const std::string lead = measured.empty() ? "bias wander levels (no still data long enough for "
@@ -208,7 +214,10 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
                                             : head;
   std::snprintf(tail, sizeof tail, "; instability: Gauss-Markov sigma, correlation time %.3g "
                 "s; override with --accel-rw/--gyro-rw/--accel-bi/--gyro-bi (a datasheet's "
-                "values) or --noise-from a long still recording", n.instability_time_s);
+                "values)%s --noise-from a long still recording%s", n.instability_time_s,
+                estimable ? "," : " or",
+                estimable ? " or --estimate-rw (from the session's holds, once diagnose finds "
+                            "no missing effect)" : "");
   out.notes.push_back(lead + note + tail);
   return out;
 }

@@ -34,6 +34,7 @@
 // resolved by several is taken from the longest still data; the bound is the smallest.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,17 +48,29 @@
 
 namespace plumb::estimation {
 
+/// The still data's 95 % upper bound on each wander level, per axis, in the level's units
+/// (+inf where no still data bound it): what the session's own estimate of a level
+/// (walk_estimate.h) may not exceed.
+struct WanderBounds {
+  static constexpr double kNone = std::numeric_limits<double>::infinity();
+  Vec3 walk_acc = Vec3::Constant(kNone), walk_gyr = Vec3::Constant(kNone);
+  Vec3 instability_acc = Vec3::Constant(kNone), instability_gyr = Vec3::Constant(kNone);
+};
+
 struct WanderLevels {
   NoiseModel noise;                ///< with every wander level set
+  WanderBounds bounds;             ///< the still data's bounds on them
   std::vector<std::string> notes;  ///< the levels and where they came from, in words
 };
 
 /// Sets the wander levels that `noise` (stage 2) leaves unset because the options do not give
 /// them (file comment). `measured`: the still data analysed (may be empty: the typical levels).
+/// `still_poses`: the session's still segments (with enough of them, the note names the
+/// estimate from the session, walk_estimate.h, for the levels left typical).
 WanderLevels AssignWanderLevels(const NoiseModel& noise,
                                 const std::vector<const signal::StillNoise*>& measured,
                                 const StartingValues& start, bool has_gyro, double span_s,
-                                const CalibrationOptions& options);
+                                const CalibrationOptions& options, int still_poses = 0);
 
 /// The options of AnalyseStillNoise that fit the instability as the estimator's Gauss-Markov
 /// process of `instability_time_s` (so that AssignWanderLevels need not fit again).
