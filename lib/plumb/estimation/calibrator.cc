@@ -19,6 +19,7 @@
 #include "plumb/estimation/still_set.h"
 #include "plumb/estimation/walk_estimate.h"
 #include "plumb/estimation/wander_levels.h"
+#include "plumb/estimation/wander_sensitivity.h"
 
 namespace plumb::estimation {
 namespace {
@@ -82,6 +83,7 @@ FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment
         AssignWanderLevels(out.noise, measured, out.start, cal.has_gyro, series.duration_s(),
                            options, static_cast<int>(still.poses.size()));
     fit.notes.insert(fit.notes.end(), levels.notes.begin(), levels.notes.end());
+    out.wander_bounds = levels.bounds;
     WalkEstimate wander =
         ResolveWander(series, cal.model, site, still, theta, levels, out.start, options);
     out.noise = wander.noise;
@@ -109,6 +111,14 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
   CalibrationResult result;
   FittedProblem fitted = FitProblem(series, segments, model_in, site, options, result);
   FinishCalibration(series, segments, options, fitted, result);
+  // 9. How far the sigmas rest on wander levels the session could not measure.
+  if (const std::optional<CalibrationOptions> at_bound = OptionsAtTheWanderBound(
+          fitted.noise, fitted.wander_bounds, result.fit.still_segments, options)) {
+    const CalibrationResult bound = Calibrate(series, segments, model_in, site, *at_bound);
+    if (const std::optional<std::string> w = SigmaRestsOnTheTypicalWander(result, bound)) {
+      result.fit.warnings.push_back(*w);
+    }
+  }
   return result;
 }
 

@@ -14,6 +14,7 @@
 #include "plumb/estimation/options.h"
 #include "plumb/estimation/result.h"
 #include "plumb/estimation/solve.h"
+#include "plumb/estimation/wander_levels.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
 
@@ -26,6 +27,7 @@ struct FittedProblem {
   NoiseModel noise;        ///< the noise the residuals are whitened with (stage 2)
   StartingValues start;    ///< stage 3
   std::string implausible_walk;  ///< the walk estimate's gate message, or ""
+  WanderBounds wander_bounds;    ///< the still data's bounds on the wander levels (stage 2a)
 };
 
 /// Stages 1-5 of Calibrate (the still set, the noise model and the wander's levels, starting
