@@ -289,6 +289,8 @@ class ReportCommand : public Command {
     if (diagnosis) {
       if (diagnostics::UniformClockNext(*diagnosis)) {
         extras.next_command = CalibrateCommand({"--clock"}, {"--clock", "uniform"});
+      } else if (diagnostics::EstimateWanderNext(*diagnosis)) {
+        extras.next_command = CalibrateCommand({}, {"--estimate-rw"});
       } else if (const auto spec = diagnostics::NextModelSpec(*diagnosis)) {
         extras.next_command = CalibrateCommand({"--model"}, {"--model", *spec});
       }

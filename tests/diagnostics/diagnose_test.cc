@@ -96,6 +96,19 @@ model::Model WithReferences(const std::string& spec, const model::Model& truth) 
   return m;
 }
 
+/// `schedule` simulated with `opt`: the true segments with their attitudes unknown, the base
+/// model with the simulation's references, the first heading stated.
+Session SessionOf(const sim::Schedule& schedule, const sim::SimulationOptions& opt) {
+  Session s;
+  s.sim = sim::Simulate(schedule, opt);
+  s.segments = s.sim.truth_segments;
+  for (auto& seg : s.segments) seg.known_R_n_b.reset();
+  s.base = WithReferences("base", s.sim.model);
+  const Mat3 R0 = s.sim.true_R_n_b.front().toRotationMatrix();
+  s.options.calibration.first_heading_deg = std::atan2(R0(1, 0), R0(0, 0)) * kRadToDeg;
+  return s;
+}
+
 Session Simulate(const SessionSpec& spec) {
   const sim::Schedule schedule = sim::MultiPose(spec.poses, spec.still_s, spec.turn_s, spec.seed);
   std::string model_spec = "base";
@@ -118,13 +131,7 @@ Session Simulate(const SessionSpec& spec) {
   opt.temperature = sim::TemperatureProfile::UpDown(24.5, 25.5, schedule.duration_s() / 2.0);
   opt.seed = spec.seed;
 
-  Session s;
-  s.sim = sim::Simulate(schedule, opt);
-  s.segments = s.sim.truth_segments;
-  for (auto& seg : s.segments) seg.known_R_n_b.reset();
-  s.base = WithReferences("base", s.sim.model);
-  const Mat3 R0 = s.sim.true_R_n_b.front().toRotationMatrix();
-  s.options.calibration.first_heading_deg = std::atan2(R0(1, 0), R0(0, 0)) * kRadToDeg;
+  Session s = SessionOf(schedule, opt);
   s.options.calibration.constant_bias = true;  // white noise: one constant bias matches
   return s;
 }
@@ -277,6 +284,78 @@ TEST(Diagnose, AHostArrivalClockIsFoundAndTheUniformClockAdvised) {
   std::cout << "host clock: chi2/dof " << d.fit.fit.chi2_dof() << " on the stamps, "
             << best.refit->fit.chi2_dof() << " on the uniform clock (99% band " << lo << " .. "
             << hi << ")\n";
+}
+
+/// A session of the simulator's default sensor (white noise, walk, instability, warming), its
+/// walk and instability times `wander`, 12 holds of 30 s, with `hidden` at 3 times its
+/// typical size; fitted as a user would (the bias wandering at the levels the still data give
+/// or the typical ones).
+Session SimulateWandering(double wander, const std::string& hidden, std::uint64_t seed) {
+  const sim::Schedule schedule = sim::MultiPose(12, 30.0, 2.0, seed);
+  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  opt.rate_hz = kRateHz;
+  opt.accel_bias_walk_density *= wander;
+  opt.gyro_bias_walk_density *= wander;
+  opt.accel_bias_instability *= wander;
+  opt.gyro_bias_instability *= wander;
+  opt.model = model::Model::Parse(hidden.empty() ? "base" : "base+" + hidden);
+  opt.truth = sim::RandomParameters(model::Model::Parse(opt.model.spec()), 1.0, seed);
+  if (!hidden.empty()) {
+    for (const auto& [name, value] : TrueValues({{hidden, 3.0}})) {
+      sim::SetParameter(opt.model, opt.truth, name, value);
+    }
+  }
+  opt.site = geo::Site::At(51.64, -1.2, 100.0, "test");
+  opt.seed = seed;
+  return SessionOf(schedule, opt);
+}
+
+TEST(Diagnose, ASensorWanderingMoreThanTypicalIsTheWanderNotAnEffect) {
+  // Five times the typical wander and no effect missing: the holds disagree far beyond the
+  // typical levels the fit assumes (chi2/dof about 16), which the score tests pin on catalogue
+  // effects (g-sensitivity, scale nonlinearity: "significant"). The bias-wander candidate, the
+  // same model with the levels estimated from the session, explains it and is advised.
+  const Session s = SimulateWandering(5.0, "", 120);
+  const Diagnosis d = DiagnoseSession(s, s.base);
+  ASSERT_FALSE(d.candidates.empty());
+  const Candidate& best = d.candidates.front();
+  EXPECT_EQ(best.kind, CandidateKind::kWander) << report::DiagnosisText(d);
+  EXPECT_EQ(best.effect, kWanderCandidate);
+  EXPECT_EQ(best.dof, 2);
+  EXPECT_TRUE(best.recommended) << report::DiagnosisText(d);
+  EXPECT_EQ(Recommended(d), &best);
+  EXPECT_TRUE(EstimateWanderNext(d));
+  EXPECT_FALSE(UniformClockNext(d));
+  EXPECT_EQ(NextModelSpec(d), "base");
+  ASSERT_TRUE(best.refit.has_value());
+  const auto [lo, hi] = Chi2DofBand(best.refit->fit.dof);
+  EXPECT_GT(d.fit.fit.chi2_dof(), 5.0);
+  EXPECT_LT(best.refit->fit.chi2_dof(), hi) << report::DiagnosisText(d);
+  EXPECT_TRUE(best.refit->fit.gates.empty());
+  EXPECT_NE(report::DiagnosisText(d).find("best: bias_wander (its refit: chi2/dof "),
+            std::string::npos) << report::DiagnosisText(d);
+  std::cout << "5 x the typical wander: chi2/dof " << d.fit.fit.chi2_dof()
+            << " with the typical levels, " << best.refit->fit.chi2_dof()
+            << " with the levels from the session\n";
+
+  // The typical wander and a g-sensitivity three times its typical size: the effect is
+  // advised, not the wander.
+  const Session g = SimulateWandering(1.0, "gyro_g_sensitivity", 121);
+  const Diagnosis dg = DiagnoseSession(g, g.base);
+  const Candidate* advised = Recommended(dg);
+  ASSERT_NE(advised, nullptr) << report::DiagnosisText(dg);
+  EXPECT_EQ(advised->effect, "gyro_g_sensitivity") << report::DiagnosisText(dg);
+  EXPECT_FALSE(EstimateWanderNext(dg));
+
+  // A fit that estimates the levels already has no such candidate.
+  Session held = s;
+  held.options.calibration.estimate_walk = true;
+  const Diagnosis dh = DiagnoseSession(held, held.base);
+  for (const Candidate& c : dh.candidates) EXPECT_NE(c.kind, CandidateKind::kWander);
+  const auto skipped = std::find_if(dh.skipped.begin(), dh.skipped.end(),
+                                    [](const Skipped& k) { return k.effect == kWanderCandidate; });
+  ASSERT_NE(skipped, dh.skipped.end());
+  EXPECT_EQ(skipped->reason, "the wander levels are estimated from the session already");
 }
 
 using ::plumb::testing::ReverseOnTwoThreads;

@@ -90,7 +90,9 @@ std::vector<CandidateSpec> WantedCandidates(const DiagnoseOptions& options) {
     }
   } else {
     for (const auto& text : options.candidates) {
-      if (text != kTimeBaseCandidate) wanted.push_back(ParseCandidate(text));
+      if (text != kTimeBaseCandidate && text != kWanderCandidate) {
+        wanted.push_back(ParseCandidate(text));
+      }
     }
   }
   return wanted;
@@ -140,6 +142,75 @@ std::optional<Candidate> TestTimeBase(const ImuSeries& series,
   c.threshold = signal::ChiSquareQuantileExact(1.0 - options.significance, 1);
   c.significant = c.lm > c.threshold;
   c.recommended = c.significant && LowersTheUsersFit(*c.refit, fit);
+  return c;
+}
+
+bool WanderWanted(const DiagnoseOptions& options) {
+  return options.candidates.empty() ||
+         std::find(options.candidates.begin(), options.candidates.end(), kWanderCandidate) !=
+             options.candidates.end();
+}
+
+/// Whether a level of the fit's wander was assumed rather than given or measured.
+bool AnyLevelAssumed(const estimation::NoiseLevels& noise) {
+  for (const auto* from : {&noise.from.walk_acc, &noise.from.walk_gyr,
+                           &noise.from.instability_acc, &noise.from.instability_gyr}) {
+    for (const estimation::LevelSource s : *from) {
+      if (s == estimation::LevelSource::kTypical || s == estimation::LevelSource::kBounded) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+/// Sensors whose wander the refit moved from the user's fit's levels.
+int SensorsMoved(const estimation::NoiseLevels& user, const estimation::NoiseLevels& refit) {
+  const bool acc = refit.walk_acc != user.walk_acc || refit.instability_acc != user.instability_acc;
+  const bool gyr = refit.walk_gyr != user.walk_gyr || refit.instability_gyr != user.instability_gyr;
+  return (acc ? 1 : 0) + (gyr ? 1 : 0);
+}
+
+/// The bias-wander candidate (file comment): the model refitted with the wander levels
+/// estimated from the session, when the user's fit assumed them on a session with holds
+/// enough (else skipped, with why). `fit` is the user's.
+std::optional<Candidate> TestWander(const ImuSeries& series,
+                                    const std::vector<StillSegment>& segments,
+                                    const model::Model& model, const geo::Site& site,
+                                    const DiagnoseOptions& options,
+                                    const estimation::CalibrationResult& fit, int observations,
+                                    std::vector<Skipped>& skipped) {
+  const estimation::CalibrationOptions& calibration = options.calibration;
+  auto skip = [&](const std::string& why) {
+    skipped.push_back({kWanderCandidate, why});
+    return std::nullopt;
+  };
+  if (!calibration.ModelsWander()) return skip("the bias is held constant");
+  if (calibration.estimate_walk) return skip("the wander levels are estimated from the session already");
+  if (!AnyLevelAssumed(fit.calibration.noise)) return skip("the wander levels are given or measured");
+  if (fit.fit.still_segments < calibration.walk_min_poses) {
+    return skip("fewer than " + std::to_string(calibration.walk_min_poses) +
+                " still segments to compare");
+  }
+  Tell(options, "refit with the wander levels from the session");
+  estimation::CalibrationOptions estimated = calibration;
+  estimated.estimate_walk = true;
+  Candidate c;
+  c.kind = CandidateKind::kWander;
+  c.effect = kWanderCandidate;
+  c.refit = estimation::Calibrate(series, segments, model, site, estimated);
+  c.refit_drop = fit.fit.chi2 - c.refit->fit.chi2;
+  // No parameter is added: the actual fall stands for LM, each sensor whose level moved for a
+  // degree of freedom.
+  c.lm = *c.refit_drop;
+  c.dof = SensorsMoved(fit.calibration.noise, c.refit->calibration.noise);
+  if (c.dof == 0) return skip("the session's holds cannot estimate the levels (their wander "
+                              "factors are absorbed by the fit)");
+  c.evidence = c.lm - c.dof * std::log(std::max(1.0, static_cast<double>(observations)));
+  c.threshold = signal::ChiSquareQuantileExact(1.0 - options.significance, c.dof);
+  c.significant = c.lm > c.threshold;
+  // Advised only where the estimate reads a wander, not a misfit (file comment).
+  c.recommended = c.significant && c.refit->fit.gates.empty() && LowersTheUsersFit(*c.refit, fit);
   return c;
 }
 
@@ -499,14 +570,25 @@ std::string SpecWith(const model::Model& model, const std::string& effect,
 
 const Candidate* Recommended(const Diagnosis& d) {
   for (const Candidate& c : d.candidates) {
-    if (c.recommended) return &c;
+    if (!c.recommended) continue;
+    // The wander reads every disagreement between holds as wander: an effect whose refit
+    // explains the session better comes first.
+    if (c.kind == CandidateKind::kWander) {
+      const bool better = std::any_of(d.candidates.begin(), d.candidates.end(), [&](const Candidate& o) {
+        return o.recommended && &o != &c && o.refit->fit.chi2_dof() < c.refit->fit.chi2_dof();
+      });
+      if (better) continue;
+    }
+    return &c;
   }
   return nullptr;
 }
 
 const Candidate* BestRefitted(const Diagnosis& d) {
   for (const Candidate& c : d.candidates) {
-    if (c.refit) return &c;
+    // Confirmed: significant and refitted (the time base's and the wander's refit is their
+    // test, made whether significant or not).
+    if (c.refit && c.significant) return &c;
   }
   return nullptr;
 }
@@ -516,10 +598,15 @@ bool UniformClockNext(const Diagnosis& d) {
   return c != nullptr && c->kind == CandidateKind::kTimeBase;
 }
 
+bool EstimateWanderNext(const Diagnosis& d) {
+  const Candidate* c = Recommended(d);
+  return c != nullptr && c->kind == CandidateKind::kWander;
+}
+
 std::optional<std::string> NextModelSpec(const Diagnosis& d) {
   const Candidate* c = Recommended(d);
   if (c == nullptr) return std::nullopt;
-  if (c->kind == CandidateKind::kTimeBase) return d.fit.calibration.model.spec();
+  if (c->kind != CandidateKind::kEffect) return d.fit.calibration.model.spec();
   return SpecWith(d.fit.calibration.model, c->effect, c->option);
 }
 
@@ -559,12 +646,18 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
     bases.push_back(std::move(s.basis));
   }
 
-  // 3. The time base, then rank: which candidates this data cannot tell apart, then by
-  // evidence.
+  // 3. The time base and the bias wander, then rank: which candidates this data cannot tell
+  // apart, then by evidence.
   MarkIndistinguishable(bases, d.candidates);
   if (TimeBaseWanted(options)) {
     if (auto c = TestTimeBase(series, segments, model, site, options, d.fit, d.num_residuals,
                               d.skipped)) {
+      d.candidates.push_back(std::move(*c));
+    }
+  }
+  if (WanderWanted(options)) {
+    if (auto c = TestWander(series, segments, model, site, options, d.fit, d.num_residuals,
+                            d.skipped)) {
       d.candidates.push_back(std::move(*c));
     }
   }

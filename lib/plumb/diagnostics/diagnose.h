@@ -25,6 +25,16 @@
 // (signal/time_base.h), the same model refitted on the uniform clock fitted through them. It
 // adds no parameter, so it has no score test: its LM is the refit's actual fall of chi^2, tested
 // as one degree of freedom (the choice of clock), and it is advised by the same rule.
+// And the bias wander (`bias_wander`, CandidateKind::kWander): when the fit's wander levels
+// were assumed (the typical sensor's, or the still data's bound) on a session with holds
+// enough to estimate them, the same model refitted with the levels estimated from the session
+// (estimation/walk_estimate.h, `--estimate-rw`). A sensor that wanders more than typical
+// leaves a misfit between its holds that the score tests would otherwise pin on some catalogue
+// effect (a simulated sensor at 5 times the typical wander: g-sensitivity "advised", chi2/dof
+// 16.2 -> 12.9; the wander's refit: 0.85). Its LM is the refit's fall, one degree of freedom
+// per sensor whose level it moved. The estimate reads any misfit between holds as wander, so
+// it is advised only when its refit also passes every gate: a wander read more than 10 times
+// the typical one (implausible_walk) is an effect the catalogue lacks, not wander.
 //
 // Example:
 //   Diagnosis d = Diagnose(series, segments, model::Model::Parse("base"), site, {});
@@ -53,8 +63,9 @@ struct DiagnoseOptions {
   double significance = 0.01;
   /// How many of the best significant candidates to confirm by refitting, >= 0.
   int confirm = 3;
-  /// Candidate effects ("name" or "name:option", kTimeBaseCandidate for the time base);
-  /// empty: the whole catalogue and the time base.
+  /// Candidate effects ("name" or "name:option", kTimeBaseCandidate for the time base,
+  /// kWanderCandidate for the bias wander); empty: the whole catalogue, the time base and the
+  /// bias wander.
   std::vector<std::string> candidates;
   /// Options of every fit (the probe fit and the refits).
   estimation::CalibrationOptions calibration;
@@ -74,12 +85,15 @@ struct DiagnoseOptions {
   JobRunner run_jobs;
 };
 
-/// What a candidate changes: the model (a catalogue effect added) or the time base (the
-/// samples' times from the uniform clock fitted through their stamps).
-enum class CandidateKind { kEffect, kTimeBase };
+/// What a candidate changes: the model (a catalogue effect added), the time base (the
+/// samples' times from the uniform clock fitted through their stamps) or the bias wander's
+/// levels (estimated from the session).
+enum class CandidateKind { kEffect, kTimeBase, kWander };
 
 /// The name of the time-base candidate.
 inline constexpr const char* kTimeBaseCandidate = "time_base";
+/// The name of the bias-wander candidate.
+inline constexpr const char* kWanderCandidate = "bias_wander";
 
 /// One candidate effect.
 struct Candidate {
@@ -148,14 +162,20 @@ std::string SpecWith(const model::Model& model, const std::string& effect,
 /// report` shows as the next command.
 std::optional<std::string> NextModelSpec(const Diagnosis& diagnosis);
 
-/// The candidate NextModelSpec advises, or null.
+/// The candidate NextModelSpec advises, or null: the first recommended one in the ranking,
+/// passing over the bias wander when another recommended candidate's refit has a lower
+/// chi^2/dof (the wander can absorb any misfit between holds; an effect that explains them
+/// better comes first).
 const Candidate* Recommended(const Diagnosis& diagnosis);
 
 /// Whether the advised next fit is on the uniform clock (the time base is recommended).
 bool UniformClockNext(const Diagnosis& diagnosis);
 
-/// The best confirmed candidate (the first refitted one in the ranking), recommended or not;
-/// null when none was refitted. What the before/after comparison shows.
+/// Whether the advised next fit estimates the wander levels (the bias wander is recommended).
+bool EstimateWanderNext(const Diagnosis& diagnosis);
+
+/// The best confirmed candidate (the first significant refitted one in the ranking),
+/// recommended or not; null when none was. What the before/after comparison shows.
 const Candidate* BestRefitted(const Diagnosis& diagnosis);
 
 }  // namespace plumb::diagnostics

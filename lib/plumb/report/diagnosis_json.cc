@@ -9,7 +9,8 @@ namespace plumb::report {
 
 nlohmann::json ToJson(const diagnostics::Candidate& c) {
   nlohmann::json j = {{"kind", c.kind == diagnostics::CandidateKind::kTimeBase ? "time_base"
-                                                                                : "effect"},
+                               : c.kind == diagnostics::CandidateKind::kWander ? "bias_wander"
+                                                                                 : "effect"},
                       {"effect", c.effect},
                       {"option", c.option},
                       {"lm", Number(c.lm)},
@@ -114,9 +115,12 @@ nlohmann::json DiagnosisJson(const diagnostics::Diagnosis& d,
       d.fit_with_velocity ? ToJson(*d.fit_with_velocity)["fit"] : nlohmann::json(nullptr);
   const auto next = diagnostics::NextModelSpec(d);
   doc["recommendation"] = next ? nlohmann::json(*next) : nlohmann::json(nullptr);
-  // What else the next fit takes: the uniform clock when the time base is advised.
+  // What else the next fit takes: the uniform clock when the time base is advised, the wander
+  // estimated when the bias wander is.
   doc["recommendation_options"] = diagnostics::UniformClockNext(d)
                                       ? nlohmann::json::array({"--clock", "uniform"})
+                                  : diagnostics::EstimateWanderNext(d)
+                                      ? nlohmann::json::array({"--estimate-rw"})
                                       : nlohmann::json::array();
   doc["significance"] = d.significance;
   doc["num_residuals"] = d.num_residuals;

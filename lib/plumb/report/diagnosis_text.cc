@@ -32,6 +32,21 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
       ++unconfirmed;
       continue;
     }
+    if (c.kind == diagnostics::CandidateKind::kWander && c.recommended && advised != nullptr) {
+      out << "not advised yet: " << name << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
+          << Fixed(c.refit->fit.chi2_dof(), 3) << "): " << advised->effect
+          << "'s refit explains the holds better (" << Fixed(advised->refit->fit.chi2_dof(), 3)
+          << "); the wander would absorb what an effect explains: add the effect, then "
+             "diagnose again\n";
+      continue;
+    }
+    if (c.kind == diagnostics::CandidateKind::kWander && !c.refit->fit.gates.empty()) {
+      out << "not advised: " << name << " is significant, but its refit fails the gate "
+          << c.refit->fit.gates.front().name << " (chi2/dof " << Fixed(user, 3) << " -> "
+          << Fixed(c.refit->fit.chi2_dof(), 3) << "): the holds disagree by more than any MEMS "
+             "sensor wanders, so what they show is a misfit, not wander\n";
+      continue;
+    }
     out << "not advised: " << name << " is significant, but the refit with it has chi2/dof "
         << Fixed(c.refit->fit.chi2_dof(), 3) << ", not below your fit's " << Fixed(user, 3);
     if (c.refit->fit.velocity_segments > d.fit.fit.velocity_segments) {
@@ -44,6 +59,11 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
     out << "best: " << advised->effect << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
         << Fixed(advised->refit->fit.chi2_dof(), 3)
         << ": the stamps are a host's arrival clock) -> refit with --clock uniform\n";
+  } else if (advised != nullptr && advised->kind == diagnostics::CandidateKind::kWander) {
+    out << "best: " << advised->effect << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
+        << Fixed(advised->refit->fit.chi2_dof(), 3)
+        << ": the holds show the bias wandering more than the levels your fit assumed) -> refit "
+           "with --estimate-rw\n";
   } else if (advised != nullptr) {
     out << "best: " << advised->effect << (advised->option.empty() ? "" : ":" + advised->option)
         << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
@@ -95,6 +115,9 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
     if (c.kind == diagnostics::CandidateKind::kTimeBase) {
       out << "  (the times from the uniform clock fitted through the stamps; LM is the refit's"
              " fall)";
+    }
+    if (c.kind == diagnostics::CandidateKind::kWander) {
+      out << "  (the wander levels estimated from the session; LM is the refit's fall)";
     }
     if (c.dispersion > 1.0) {
       out << "  (LM / " << std::setprecision(3) << c.dispersion
