@@ -41,10 +41,15 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
       continue;
     }
     if (c.kind == diagnostics::CandidateKind::kWander && !c.refit->fit.gates.empty()) {
-      out << "not advised: " << name << " is significant, but its refit fails the gate "
-          << c.refit->fit.gates.front().name << " (chi2/dof " << Fixed(user, 3) << " -> "
-          << Fixed(c.refit->fit.chi2_dof(), 3) << "): the holds disagree by more than any MEMS "
-             "sensor wanders, so what they show is a misfit, not wander\n";
+      const std::string& gate = c.refit->fit.gates.front().name;
+      out << "not advised: " << name << " is significant, but its refit fails the gate " << gate
+          << " (chi2/dof " << Fixed(user, 3) << " -> " << Fixed(c.refit->fit.chi2_dof(), 3)
+          << "): "
+          << (gate == "implausible_walk"
+                  ? "the holds disagree by more than any MEMS sensor wanders, so what they show "
+                    "is a misfit, not wander"
+                  : "that fit is not to be trusted as it stands")
+          << "\n";
       continue;
     }
     out << "not advised: " << name << " is significant, but the refit with it has chi2/dof "
