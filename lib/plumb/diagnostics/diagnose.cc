@@ -98,9 +98,11 @@ std::vector<CandidateSpec> WantedCandidates(const DiagnoseOptions& options) {
   return wanted;
 }
 
-bool TimeBaseWanted(const DiagnoseOptions& options) {
+/// Whether a candidate that is not a catalogue effect (the time base, the bias wander) is to
+/// be tested: every candidate is when none is named.
+bool Wanted(const DiagnoseOptions& options, const char* name) {
   return options.candidates.empty() ||
-         std::find(options.candidates.begin(), options.candidates.end(), kTimeBaseCandidate) !=
+         std::find(options.candidates.begin(), options.candidates.end(), name) !=
              options.candidates.end();
 }
 
@@ -143,12 +145,6 @@ std::optional<Candidate> TestTimeBase(const ImuSeries& series,
   c.significant = c.lm > c.threshold;
   c.recommended = c.significant && LowersTheUsersFit(*c.refit, fit);
   return c;
-}
-
-bool WanderWanted(const DiagnoseOptions& options) {
-  return options.candidates.empty() ||
-         std::find(options.candidates.begin(), options.candidates.end(), kWanderCandidate) !=
-             options.candidates.end();
 }
 
 /// Whether a level of the fit's wander was assumed rather than given or measured.
@@ -649,13 +645,13 @@ Diagnosis Diagnose(const ImuSeries& series, const std::vector<StillSegment>& seg
   // 3. The time base and the bias wander, then rank: which candidates this data cannot tell
   // apart, then by evidence.
   MarkIndistinguishable(bases, d.candidates);
-  if (TimeBaseWanted(options)) {
+  if (Wanted(options, kTimeBaseCandidate)) {
     if (auto c = TestTimeBase(series, segments, model, site, options, d.fit, d.num_residuals,
                               d.skipped)) {
       d.candidates.push_back(std::move(*c));
     }
   }
-  if (WanderWanted(options)) {
+  if (Wanted(options, kWanderCandidate)) {
     if (auto c = TestWander(series, segments, model, site, options, d.fit, d.num_residuals,
                             d.skipped)) {
       d.candidates.push_back(std::move(*c));

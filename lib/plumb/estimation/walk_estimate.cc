@@ -216,8 +216,6 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
       if (s.walk_free) s.walk_from->fill(LevelSource::kEstimated);
       if (s.instability_free) s.instability_from->fill(LevelSource::kEstimated);
     }
-    (s.sensor == model::Sensor::kAccel ? out.redundancy_acc : out.redundancy_gyr) = s.redundancy;
-    (s.sensor == model::Sensor::kAccel ? out.scale_acc : out.scale_gyr) = s.scale;
     note += std::string(note.back() == ':' ? " " : "; ") + Describe(s, marginal);
   }
   out.notes.push_back(note);

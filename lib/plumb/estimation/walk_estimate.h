@@ -62,10 +62,6 @@ namespace plumb::estimation {
 struct WalkEstimate {
   NoiseModel noise;        ///< the noise model with the wander levels the session resolves
   int iterations = 0;      ///< fits made
-  /// Per sensor: the redundancy red_g of its wander factors at the last fit (0: not estimated).
-  double redundancy_acc = 0, redundancy_gyr = 0;
-  /// Per sensor: the factor applied to stage 2a's wander standard deviations (1: kept).
-  double scale_acc = 1, scale_gyr = 1;
   std::vector<std::string> notes;     ///< what was done, in words
   std::vector<std::string> warnings;  ///< what was assumed for lack of data
   /// Non-empty when an estimated walk is implausibly large (the gate implausible_walk).
