@@ -99,6 +99,11 @@ void AddWanderOptions(CLI::App* app, FitArgs& a) {
 }  // namespace
 
 void AddFitOptions(CLI::App* app, FitArgs& a) {
+  app->add_flag_callback(
+      "--white-turns", [&a] { a.options.turn_vibration = false; },
+      "Weight the turns' velocity residuals (used by time_offset and accel_size_effect) by the "
+      "white noise alone, not by the vibration measured in each turn: to see what the "
+      "vibration does (on turns made by hand it understates their sigma)");
   app->add_flag("--strict", a.strict,
                 "Fail (exit 1) when the data cannot determine every parameter of the model, "
                 "instead of reporting the unobservable directions, and (exit 3, nothing "

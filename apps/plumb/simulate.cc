@@ -228,6 +228,19 @@ class SimulateCommand : public Command {
                      "Gyroscope quantisation step, rad/s (0 = none)")
         ->check(NonNegative)
         ->capture_default_str();
+    auto* hand = app_->add_option_group(
+        "Turns by hand", "Turns made by hand rather than on a turntable (default: none)");
+    hand->add_option("--hand-vibration", a.noise.hand.vibration_accel,
+                     "Vibration folded into the accelerometer's samples during each turn: "
+                     "per-sample sigma at its peak (mid-turn), m/s^2; each turn takes 0.25-1 "
+                     "times it (0 = none)")
+        ->check(NonNegative)
+        ->capture_default_str();
+    hand->add_option("--hand-translation", a.noise.hand.translation_m,
+                     "Displacement over each turn, m, in a direction drawn per turn, at rest "
+                     "at both ends (0 = none)")
+        ->check(NonNegative)
+        ->capture_default_str();
     app_->add_option("--temperature", a.temperature,
                      "Sensor temperature profile, degC: const:T, ramp:T0:T1 (over the session) "
                      "or updown:T0:T1:PERIOD_S")

@@ -27,7 +27,8 @@ Keywords (the command's options, '-' as '_'):
   data cannot determine the model or a gate fails); accel_rw (m/s^3/sqrt(Hz)), gyro_rw
   (rad/s^2/sqrt(Hz)), estimate_rw (bool), accel_bi (m/s^2), gyro_bi (rad/s), bi_time (s),
   constant_bias (bool): the bias wander, each level a number in SI or a text with a datasheet's
-  unit as the command takes it ('4 deg/h', '40 ug', '0.3 deg/h/sqrt(h)', '10 ug/sqrt(h)').
+  unit as the command takes it ('4 deg/h', '40 ug', '0.3 deg/h/sqrt(h)', '10 ug/sqrt(h)');
+  white_turns (bool: the turns' velocity residuals weighted by the white noise alone).
 Returns a Result. Raises plumb.Error (plumb.InsufficientDataError when the data cannot
 support the model).)doc";
 
@@ -77,6 +78,7 @@ void WanderOptions(Keywords& k, estimation::CalibrationOptions& o) {
   o.gyro_instability = Level(k, "gyro_bi", WanderLevel::kGyroInstability);
   o.instability_time_s = k.Take<double>("bi_time", o.instability_time_s);
   o.constant_bias = k.Take<bool>("constant_bias", false);
+  o.turn_vibration = !k.Take<bool>("white_turns", false);
   if (o.constant_bias && (o.accel_walk_density || o.gyro_walk_density || o.estimate_walk ||
                           o.accel_instability || o.gyro_instability)) {
     throw Error("constant_bias excludes accel_rw, gyro_rw, estimate_rw, accel_bi, gyro_bi");

@@ -23,6 +23,7 @@ Keywords (the command's options, '-' as '_'):
   accel_noise (m/s^2/sqrt(Hz)), gyro_noise (rad/s/sqrt(Hz)), accel_rw (m/s^3/sqrt(Hz)),
   gyro_rw (rad/s^2/sqrt(Hz)), accel_bi (m/s^2), gyro_bi (rad/s), bi_time (s),
   quantisation_acc (m/s^2), quantisation_gyr (rad/s): default a typical MEMS IMU;
+  hand_vibration (m/s^2), hand_translation (m): turns made by hand (default 0, none);
   temperature (('const', T) | ('ramp', T0, T1) | ('updown', T0, T1, period_s), degC, s;
   default ('ramp', 25, 35)); no_temperature (bool); temp_ref (degC, 25); t0 (s, 0);
   site ((lat_deg, lon_deg[, height_m]) or dict; default none: no Earth rate); seed (1).
@@ -78,6 +79,8 @@ void Noise(Keywords& k, sim::SimulationOptions& o) {
   set("bi_time", o.bias_instability_time_s);
   set("quantisation_acc", o.accel_quantum);
   set("quantisation_gyr", o.gyro_quantum);
+  set("hand_vibration", o.hand.vibration_accel);
+  set("hand_translation", o.hand.translation_m);
 }
 
 std::shared_ptr<PySimulation> Simulate(const py::kwargs& kwargs) {

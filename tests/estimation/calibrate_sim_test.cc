@@ -322,6 +322,89 @@ TEST(CalibrateSimulated, CovarianceIsHonestFromQuietToWanderingSensors) {
             << ")\n";
 }
 
+// Issue 34 item 2: turns made by hand carry vibration (folded into the accelerometer's
+// samples) and translation; the velocity residuals that time_offset needs are weighted by the
+// vibration measured in each turn (estimation/turn_noise.h), so the fit with them stays
+// honest: the average NEES with the full covariance (time offset included) lies in its 95 %
+// band with realistic noise from a turntable's turns to a hand's, at wander levels from
+// well below to well above typical (there with the levels estimated, --estimate-rw), and the
+// shaken turns' velocity residuals sit at their noise.
+struct HandCase {
+  double vibration_accel = 0.0;  ///< per-sample sigma at the turn's peak, m/s^2
+  double translation_m = 0.0;
+  double wander = 1.0;           ///< times the typical walk and instability
+  double still_s = 5.0;          ///< length of each of the 12 holds
+};
+
+struct HandOutcome {
+  double nees_per_dof = 0.0, lo = 0.0, hi = 0.0;
+  double velocity_chi2_per_residual = 0.0;  ///< over every run's velocity residuals
+};
+
+HandOutcome NeesWithTurnsByHand(int runs, const HandCase& c) {
+  HandOutcome out;
+  double nees = 0.0, velocity_ss = 0.0;
+  int params = 0, velocity_n = 0;
+  for (int run = 0; run < runs; ++run) {
+    const std::uint64_t seed = 7000 + static_cast<std::uint64_t>(run);
+    sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+    opt.accel_bias_walk_density *= c.wander;
+    opt.gyro_bias_walk_density *= c.wander;
+    opt.accel_bias_instability *= c.wander;
+    opt.gyro_bias_instability *= c.wander;
+    opt.rate_hz = 100.0;
+    opt.model = model::Model::Parse("base+time_offset");
+    opt.truth = sim::RandomParameters(opt.model, 1.0, seed);
+    opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
+    opt.seed = seed;
+    opt.hand.vibration_accel = c.vibration_accel;
+    opt.hand.translation_m = c.translation_m;
+    Outcome o;
+    o.sim = sim::Simulate(sim::MultiPose(12, c.still_s, 2.0, seed), opt);
+    std::vector<StillSegment> segments = o.sim.truth_segments;
+    for (auto& seg : segments) seg.known_R_n_b.reset();
+    // Away from the typical wander its levels are estimated from the session, as the quiet and
+    // wandering sensors above need (--estimate-rw).
+    o.result = Calibrate(o.sim.session.series, segments, o.sim.model, o.sim.site,
+                         OptionsFor(c.wander == 1.0 ? Fit::kWander : Fit::kEstimate));
+    nees += Nees(o);
+    for (const auto& p : o.result.calibration.parameters) params += p.fixed ? 0 : 1;
+    for (const auto& m : o.result.fit.motion) {
+      velocity_ss += m.velocity_whitened.squaredNorm();
+      velocity_n += m.has_velocity ? 3 : 0;
+    }
+  }
+  out.nees_per_dof = nees / params;
+  out.lo = signal::ChiSquareQuantileExact(0.025, params) / params;
+  out.hi = signal::ChiSquareQuantileExact(0.975, params) / params;
+  out.velocity_chi2_per_residual = velocity_ss / std::max(1, velocity_n);
+  return out;
+}
+
+TEST(CalibrateSimulated, CovarianceIsHonestWithTurnsMadeByHand) {
+  constexpr int kRuns = 30;
+  // Vibration of 1 m/s^2 per sample at its peak: the real hand-held sessions' turns scatter by
+  // 0.3-1.5 m/s^2 per axis (mikoff imu0), 0.1 m carried over each 2 s turn.
+  // A sensor five times quieter than typical needs holds of 30 s to show its wander (with 5 s
+  // holds part of it keeps the typical level: CovarianceIsHonestFromQuietToWanderingSensors).
+  for (const HandCase c : {HandCase{0.0, 0.0, 1.0}, HandCase{1.0, 0.1, 0.2, 30.0},
+                           HandCase{1.0, 0.1, 1.0}, HandCase{1.0, 0.1, 5.0}}) {
+    const HandOutcome o = NeesWithTurnsByHand(kRuns, c);
+    const std::string what = "vibration " + std::to_string(c.vibration_accel) + " m/s^2, " +
+                             std::to_string(c.wander) + " x the typical wander";
+    EXPECT_GT(o.nees_per_dof, o.lo) << what;
+    EXPECT_LT(o.nees_per_dof, o.hi) << what;
+    // Shaken turns: their measured vibration is their noise. A turntable's keep the white
+    // noise's variance, whose attitude term (the gyroscope's random walk over the whole turn)
+    // ignores that both ends' attitudes are pinned by the holds: conservative there.
+    EXPECT_LT(o.velocity_chi2_per_residual, 1.2) << what;
+    EXPECT_GT(o.velocity_chi2_per_residual, c.vibration_accel > 0.0 ? 0.8 : 0.5) << what;
+    std::cout << what << ", translation " << c.translation_m << " m: NEES/dof "
+              << o.nees_per_dof << " (95% band " << o.lo << " .. " << o.hi
+              << "), velocity chi2 per residual " << o.velocity_chi2_per_residual << "\n";
+  }
+}
+
 /// The warnings of `result` that start with `prefix`.
 std::vector<std::string> WarningsStarting(const CalibrationResult& result, const std::string& prefix) {
   std::vector<std::string> out;

@@ -139,6 +139,42 @@ TEST(Gates, PiecesOfOnePoseAreOnePose) {
   EXPECT_FALSE(Contains(report::FitVerdict(r.fit), "consistent with the noise"));
 }
 
+// Issue 34 item 4: motion longer than CalibrationOptions::max_motion_s is left out of the fit,
+// named in a note and in FitReport::not_turns; not_a_turn fires only where that leaves the
+// gyroscope's matrix undetermined.
+TEST(Gates, MotionLeftOutAsNoTurnIsNamedAndGatedWhereTheGyroscopeNeedsIt) {
+  const sim::Simulation s = MultiPose(35);
+  std::vector<StillSegment> segments = FreeAttitudes(s.truth_segments);
+  // Without hold 6 the motion from hold 5 to hold 7 lasts 10 s, every other one 2 s.
+  segments.erase(segments.begin() + 5);
+  CalibrationOptions options;
+  options.max_motion_s = 8.0;
+  const CalibrationResult one = Calibrate(s.session.series, segments, s.model, s.site, options);
+  ASSERT_EQ(one.fit.not_turns.size(), 1u);
+  EXPECT_EQ(one.fit.not_turns[0].from, 4u);
+  EXPECT_EQ(one.fit.not_turns[0].to, 5u);
+  EXPECT_EQ(one.fit.motion_segments, 9);
+  EXPECT_EQ(Find(one.fit.gates, "not_a_turn"), nullptr) << Names(one.fit.gates);
+  const std::string note = "between '" + segments[4].label + "' and '" + segments[5].label +
+                           "' is left out of the fit, not a turn: longer than 8 s";
+  EXPECT_EQ(std::count_if(one.fit.notes.begin(), one.fit.notes.end(),
+                          [&](const std::string& n) { return Contains(n, note); }),
+            1)
+      << report::FullReport(one);
+  // Every turn longer than allowed: no turn determines the gyroscope's matrix.
+  options.max_motion_s = 1.0;
+  const CalibrationResult none = Calibrate(s.session.series, segments, s.model, s.site, options);
+  EXPECT_EQ(none.fit.not_turns.size(), 10u);
+  EXPECT_EQ(none.fit.motion_segments, 0);
+  const Gate* g = Find(none.fit.gates, "not_a_turn");
+  ASSERT_NE(g, nullptr) << Names(none.fit.gates) << report::FullReport(none);
+  EXPECT_TRUE(Contains(g->message, "without it the turns left (0) leave 9 parameters of the "
+                                   "gyroscope's matrix undetermined or known only to more than "
+                                   "0.03 (gyro.matrix.xx, ...)"))
+      << g->message;
+  EXPECT_FALSE(Contains(report::FitVerdict(none.fit), "consistent with the noise"));
+}
+
 TEST(Gates, TheIterationLimitFailsNotConverged) {
   const sim::Simulation s = MultiPose(33);
   CalibrationOptions options;

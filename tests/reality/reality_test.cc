@@ -277,6 +277,113 @@ TEST(RealityFlight, AFlightGivenAsStillIsNotStill) {
   EXPECT_NE(std::find(gates.begin(), gates.end(), "not_still"), gates.end());
 }
 
+// Issue 34 item 4: the ArduPilot copter's flight between two "holds" (the still 3 s before
+// take-off and the last 2 s of the log, in flight) is no turn: 146 s of motion, left out of
+// the fit and named, and with nothing else to determine the gyroscope's matrix, not_a_turn
+// fails beside not_still; no verdict says consistent.
+TEST(RealityFlight, AFlightBetweenTwoHoldsIsNotATurn) {
+  const std::string log =
+      std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/copter344_pixhawk1_oldformat.bin";
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  const TempDir dir;
+  const std::string segments =
+      dir.Write("segments.csv", "start,end,label\n10,70,before\n3700,3750,after\n");
+  const ToolRun run =
+      Plumb({"calibrate", log, "--segments", segments, "--json", dir.File("c.json")}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  EXPECT_TRUE(Contains(run.out, "gate failed: not_a_turn: ")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "the motion 227.4-373.1 s (145.7 s) between 'before' and 'after' "
+                                "is left out of the fit, not a turn: longer than 120 s"))
+      << run.out;
+  EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
+  const json c = ReadJson(dir.File("c.json"));
+  std::vector<std::string> gates;
+  for (const auto& g : c.at("gates")) gates.push_back(g.at("name").get<std::string>());
+  EXPECT_NE(std::find(gates.begin(), gates.end(), "not_a_turn"), gates.end());
+  EXPECT_NE(std::find(gates.begin(), gates.end(), "not_still"), gates.end());
+  ASSERT_EQ(c.at("not_turns").size(), 1u);
+  EXPECT_EQ(c.at("not_turns")[0].at("limit_s"), 120);
+  EXPECT_EQ(c.at("motion").size(), 0u);
+}
+
+/// The velocity residuals' chi^2 per residual in a calibrate --json document.
+double VelocityChi2PerResidual(const json& doc) {
+  double ss = 0.0;
+  int n = 0;
+  for (const auto& m : doc.at("motion")) {
+    if (!m.contains("velocity_whitened")) continue;
+    for (const auto& v : m.at("velocity_whitened")) {
+      ss += v.get<double>() * v.get<double>();
+      ++n;
+    }
+  }
+  return n > 0 ? ss / n : 0.0;
+}
+
+double BandUpper(double dof) { return 1.0 + 3.0 * std::sqrt(2.0 / dof); }
+
+// Issue 34 item 2: the velocity residuals of hand-held turns, weighted by each turn's measured
+// vibration (estimation/turn_noise.h), sit at their noise where the base model does: on
+// mikoff imu0 and imu1 (base chi2/dof 1.29 and 1.11) the fit with them (--model
+// base+time_offset) keeps chi2/dof in its band and says nothing against them; weighted by the
+// white noise alone (--white-turns) they sit 30-50 times above it.
+TEST(RealityTurns, HandHeldVelocityResidualsSitAtTheirNoise) {
+  for (const std::string session :
+       {"repo:data/mikoff/imu0.log", "shared:multipose/mikoff/imu1.log"}) {
+    const std::string path = Resolve(session);
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+    const TempDir dir;
+    const std::vector<std::string> input = Concat({path}, kMikoff);
+    const ToolRun run = Plumb(Concat(Concat({"calibrate"}, input),
+                                     {"--model", "base+time_offset", "--json", dir.File("v.json")}),
+                              dir);
+    ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+    const json v = ReadJson(dir.File("v.json"));
+    const double dof = v.at("fit").at("dof").get<double>();
+    EXPECT_LE(Chi2Dof(v.at("fit")), BandUpper(dof)) << session << "\n" << run.out;
+    const int turns = static_cast<int>(v.at("motion").size());
+    EXPECT_LE(VelocityChi2PerResidual(v), BandUpper(3.0 * turns)) << session;
+    EXPECT_GT(VelocityChi2PerResidual(v), 0.5) << session;
+    EXPECT_FALSE(Contains(run.out + run.err, "the velocity residuals of the")) << run.out << run.err;
+    const ToolRun white = Plumb(Concat(Concat({"calibrate"}, input),
+                                       {"--model", "base+time_offset", "--white-turns", "--json",
+                                        dir.File("w.json")}),
+                                dir);
+    ASSERT_EQ(white.exit_code, 0) << white.out << white.err;
+    EXPECT_GT(VelocityChi2PerResidual(ReadJson(dir.File("w.json"))), 20.0) << session;
+    EXPECT_TRUE(Contains(white.out + white.err, "the velocity residuals of the ")) << white.out;
+  }
+}
+
+// Where they cannot be made honest they stay out, and the output says why: tomisuarez2's
+// MPU-6050 leaves its turns' velocity residuals far above their band even with its
+// g-sensitivity in and weighted by their vibration; nothing seen only in the turns is advised
+// there, and a fit that needs them warns.
+TEST(RealityTurns, TurnsFarFromTheirNoiseAreNotTrusted) {
+  std::string missing;
+  const RealSession tomi{"tomisuarez2", kTomi};
+  const std::vector<std::string> input = Args(tomi, missing);
+  if (!missing.empty()) GTEST_SKIP() << "shared data absent: " << missing;
+  const TempDir dir;
+  const ToolRun diag = Plumb(Concat(Concat({"diagnose"}, input),
+                                    {"--model", "base+gyro_g_sensitivity", "--confirm", "3",
+                                     "--json", dir.File("d.json")}),
+                             dir);
+  ASSERT_EQ(diag.exit_code, 0) << diag.out << diag.err;
+  for (const auto& c : ReadJson(dir.File("d.json")).at("candidates")) {
+    if (c.at("with_velocity").get<bool>()) EXPECT_FALSE(c.at("recommended").get<bool>()) << diag.out;
+  }
+  const ToolRun cal = Plumb(Concat(Concat({"calibrate"}, input),
+                                   {"--model", "base+gyro_g_sensitivity+time_offset"}),
+                            dir);
+  ASSERT_EQ(cal.exit_code, 0) << cal.out << cal.err;
+  EXPECT_TRUE(Contains(cal.out + cal.err, "even weighted by the vibration measured in each turn: "
+                                          "the accelerometer during the turns carries what the "
+                                          "model lacks, so what only they determine (time_offset) "
+                                          "is not to be trusted as it stands"))
+      << cal.out << cal.err;
+}
+
 /// Parameters of two calibrations of one sensor more than 3 combined sigma apart, of those
 /// both determine.
 std::pair<int, int> PairsBeyond3Sigma(const json& a, const json& b) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -320,6 +321,58 @@ TEST(Schedule, PaperBenchmarkFollowsSection31) {
   for (std::size_t j : stills) EXPECT_DOUBLE_EQ(s.step_duration_s(j), 20.0);
 }
 
+// Turns made by hand (SimulationOptions::hand): the holds stay bit for bit as without a hand
+// (its draws come from a generator of its own), the turns carry the vibration, and the hand's
+// displacement ends at rest: the specific force integrated over a turn with the true attitude
+// gives back gravity's velocity change, as a turntable's turn does.
+TEST(Simulate, HandHeldTurnsLeaveTheHoldsAsTheyWere) {
+  SimulationOptions options = SimulationOptions::TypicalMems();
+  options.rate_hz = 100.0;
+  options.seed = 21;
+  const Schedule schedule = MultiPose(6, 2.0, 2.0, 21);
+  const Simulation table = Simulate(schedule, options);
+  options.hand.vibration_accel = 1.0;
+  options.hand.translation_m = 0.1;
+  const Simulation hand = Simulate(schedule, options);
+  ASSERT_EQ(table.session.series.size(), hand.session.series.size());
+  std::size_t turn_samples = 0, differing = 0;
+  for (std::size_t k = 0; k < hand.session.series.size(); ++k) {
+    const bool still = std::any_of(hand.truth_segments.begin(), hand.truth_segments.end(),
+                                   [&](const StillSegment& s) { return s.begin <= k && k < s.end; });
+    if (still) {
+      ASSERT_EQ(hand.session.series.acc[k], table.session.series.acc[k]) << "sample " << k;
+    } else {
+      ++turn_samples;
+      differing += hand.session.series.acc[k] != table.session.series.acc[k] ? 1 : 0;
+    }
+    ASSERT_EQ(hand.session.series.gyr[k], table.session.series.gyr[k]) << "sample " << k;
+  }
+  EXPECT_GT(turn_samples, 0u);
+  EXPECT_GT(differing, turn_samples * 9 / 10);
+}
+
+TEST(Simulate, AHandsTranslationEndsAtRest) {
+  Schedule schedule;
+  schedule.Hold(1.0).Turn(Vec3(1.0, 2.0, -0.5).normalized(), 1.7, 2.0).Hold(1.0);
+  SimulationOptions options;  // noiseless, Site::Unknown
+  options.rate_hz = 400.0;
+  options.hand.translation_m = 0.3;
+  const Simulation sim = Simulate(schedule, options);
+  const auto& s = sim.session.series;
+  // Over the turn's samples (400 .. 1200): sum h R_n_b f_b + g_n T = the velocity change, 0.
+  Vec3 dv = Vec3::Zero();
+  double largest = 0.0;
+  for (std::size_t k = 400; k < 1200; ++k) {
+    const Motion m = schedule.At(static_cast<double>(k) / 400.0);
+    const Vec3 f_n = m.R_n_b * s.acc[k].cast<double>();
+    dv += (f_n + options.site.g_n) / 400.0;
+    largest = std::max(largest, (f_n + options.site.g_n).norm());
+  }
+  EXPECT_LT(dv.norm(), 1e-5);
+  // It moved: 0.3 m over 2 s peaks at 0.3 (2 pi / 4) = 0.47 m/s^2.
+  EXPECT_NEAR(largest, 0.3 * 2.0 * kPi / 4.0, 1e-3);
+}
+
 TEST(Simulate, BadOptionsThrowNamingTheField) {
   SimulationOptions options;
   options.rate_hz = 0.0;
@@ -334,6 +387,14 @@ TEST(Simulate, BadOptionsThrowNamingTheField) {
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("blocks"), std::string::npos);
+  }
+  options = SimulationOptions();
+  options.hand.vibration_accel = -1.0;
+  try {
+    Simulate(PaperStatic(1.0), options);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("hand.vibration_accel"), std::string::npos);
   }
   EXPECT_THROW(Simulate(Schedule(), SimulationOptions()), Error);
   EXPECT_THROW(Schedule().Turn(Vec3::Zero(), 1.0, 1.0), Error);

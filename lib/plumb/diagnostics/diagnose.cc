@@ -12,6 +12,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/uncertainty.h"
 #include "plumb/model/registry.h"
 #include "plumb/signal/chi_square.h"
 #include "plumb/signal/time_base.h"
@@ -25,6 +26,10 @@ void Tell(const DiagnoseOptions& options, const std::string& stage);
 bool LowersTheUsersFit(const estimation::CalibrationResult& refit,
                        const estimation::CalibrationResult& user) {
   return refit.fit.dof > 0 && user.fit.dof > 0 && refit.fit.chi2_dof() < user.fit.chi2_dof();
+}
+
+bool TurnsAboveTheirNoise(const estimation::CalibrationResult& refit) {
+  return estimation::VelocityFit(refit.fit).above_band();
 }
 
 struct CandidateSpec {
@@ -484,8 +489,11 @@ void ConfirmBest(const ImuSeries& series, const std::vector<StillSegment>& segme
     const double before = cand.with_velocity ? fit_motion->fit.chi2 : fit.fit.chi2;
     cand.refit_drop = before - refits[k].result->fit.chi2;
     cand.refit = std::move(refits[k].result);
-    // Like with like: advised only when the user's own fit gets better.
-    cand.recommended = LowersTheUsersFit(*cand.refit, fit);
+    // Like with like: advised only when the user's own fit gets better, and, for an effect
+    // seen only in the turns, when its refit brings their velocity residuals to their noise
+    // (else the turns carry more than the effect explains: estimation/turn_noise.h).
+    cand.recommended = LowersTheUsersFit(*cand.refit, fit) &&
+                       !(cand.with_velocity && TurnsAboveTheirNoise(*cand.refit));
   }
 }
 

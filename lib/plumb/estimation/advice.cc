@@ -1,8 +1,12 @@
 #include "plumb/estimation/advice.h"
 
+#include <cmath>
+#include <optional>
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/estimation/gates.h"
+#include "plumb/estimation/uncertainty.h"
 
 namespace plumb::estimation {
 namespace {
@@ -40,6 +44,33 @@ std::string Undetermined(const Calibration& calibration,
   return message;
 }
 
+/// To two decimals, as a chi^2 per residual is read.
+double Rounded(double x) { return std::round(x * 100.0) / 100.0; }
+
+/// When the velocity residuals of the turns sit above their band: what rests on them.
+std::optional<std::string> TurnsNotAtTheirNoise(const Calibration& calibration,
+                                                const CalibrationOptions& options,
+                                                const FitReport& fit) {
+  const TurnVelocityFit turns = VelocityFit(fit);
+  if (!turns.above_band()) return std::nullopt;
+  std::string needing;
+  for (const auto& term : calibration.model.terms()) {
+    const auto& info = term.effect->info();
+    if (!info.excitation.angular_acceleration) continue;
+    needing += (needing.empty() ? "" : ", ") + info.name;
+  }
+  return "the velocity residuals of the " + std::to_string(turns.residuals / 3) +
+         " turns sit at chi2 " + Number(Rounded(turns.per_residual())) +
+         " per residual, above their band (" + Number(Rounded(Chi2BandUpper(turns.residuals))) +
+         (options.turn_vibration ? ") even weighted by the vibration measured in each turn"
+                                 : ") weighted by the white noise alone") +
+         ": the accelerometer during the turns carries what the model lacks, so what only they "
+         "determine (" +
+         (needing.empty() ? std::string("the effects that need the accelerometer in motion")
+                          : needing) +
+         ") is not to be trusted as it stands";
+}
+
 }  // namespace
 
 void AddAdvice(const Calibration& calibration, const StillSet& still,
@@ -51,6 +82,10 @@ void AddAdvice(const Calibration& calibration, const StillSet& still,
       throw InsufficientDataError(undetermined);
     }
     fit.warnings.push_back(undetermined);
+  }
+  for (const NotATurn& m : fit.not_turns) fit.notes.push_back(NotATurnText(fit, m));
+  if (const std::optional<std::string> turns = TurnsNotAtTheirNoise(calibration, options, fit)) {
+    fit.warnings.push_back(*turns);
   }
   if (!site.known) {
     fit.warnings.push_back(

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "plumb/core/error.h"
+#include "plumb/estimation/turn_noise.h"
 #include "plumb/residuals/bias_walk_residual.h"
 #include "plumb/residuals/manifolds.h"
 #include "plumb/residuals/motion_residual.h"
@@ -145,9 +146,9 @@ void CalibrationProblem::SetMotionSamples() {
 
 // The angular acceleration input of the effects (time_offset, accel_size_effect) is the
 // derivative of the corrected rate, E^-1 d y_g / dt (central differences). The velocity
-// residual's variance: accelerometer noise summed over the steps, and gravity tilted by the
-// attitude random walk of the gyroscope noise (mean over the axes), which moves the velocity
-// only across gravity: d, the direction of gravity in the body at the start.
+// residual's variance: the accelerometer's white noise or the turn's measured vibration summed
+// over the steps, and gravity tilted by the attitude random walk of the gyroscope's (mean over
+// the axes), which moves the velocity only across gravity (turn_noise.h).
 void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
   const auto& motions = still_.motions;
   const Mat3 E_inv = E.inverse();
@@ -155,6 +156,11 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
   const Mat3 cov_f = F_inv * noise_.sigma_acc.cwiseAbs2().asDiagonal() * F_inv.transpose();
   const Mat3 cov_rate = E_inv * noise_.sigma_gyr.cwiseAbs2().asDiagonal() * E_inv.transpose();
   const double g = site_.gravity();
+  TurnNoise turn_noise;
+  turn_noise.measure_vibration = options_.turn_vibration;
+  turn_noise.cov_f = cov_f;
+  turn_noise.tau_acc = noise_.tau_acc;
+  turn_noise.var_rate = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();
   for (std::size_t k = 0; k < motions.size(); ++k) {
     // New samples (problems built before keep reading theirs).
     auto samples = std::make_shared<residuals::MotionSamples>(*motion_samples_[k]);
@@ -179,16 +185,11 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
     }
     // Quantisation: the integrated angle carries 2 Q^2 (noise_model.h).
     AddVariance(samples->sqrt_info, E_inv, 2.0 * noise_.quantisation_gyr.cwiseAbs2());
+    // The velocity residual: the white noise or the turn's measured vibration (turn_noise.h).
+    const Vec3 var_v = TurnVelocityVariance(*samples, E_inv, F_inv, turn_noise,
+                                            start_.Down(still_.poses[mo.from]), g);
+    velocity_info_[k] = var_v.cwiseSqrt().cwiseInverse();
     motion_samples_[k] = std::move(samples);
-    const double n = std::max(1.0, steps);
-    const double var_w = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();
-    const Vec3 d = start_.Down(still_.poses[mo.from]);
-    for (int i = 0; i < 3; ++i) {
-      const double across = std::max(0.0, 1.0 - d[i] * d[i]);
-      const double var_v = cov_f(i, i) * noise_.tau_acc[i] * dt * dt * n +
-                           across * g * g * var_w * dt * dt * dt * dt * n * n * n / 3.0;
-      velocity_info_[k][i] = 1.0 / std::sqrt(var_v);
-    }
     // Each accelerometer wander process about its line (the velocity residual takes the line
     // off): its bridge's mean over T, times T, through F^-1; the instability as the walk of
     // equal short-time spread, as for the rotation above.

@@ -150,6 +150,10 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   fit.dof = fit.num_residuals - analysis.summary.rank - analysis.summary.wander_states;
   fit.still_segments = static_cast<int>(problem.still().poses.size());
   fit.motion_segments = static_cast<int>(problem.still().motions.size());
+  for (const MotionInterval& m : problem.still().not_turns) {
+    fit.not_turns.push_back({m.from, m.from + 1, series.t_s[m.first], series.t_s[m.last],
+                             options.max_motion_s});
+  }
   problem.ReportResiduals(solution.all_free, fit);
   // Counted once: the advice, the one_pose gate and the JSON all say this number.
   fit.distinct_poses = CountDistinctPoses(series, fit.still, cal.noise);

@@ -45,6 +45,14 @@ struct MotionFit {
   Vec3 velocity_whitened = Vec3::Zero();
 };
 
+/// Motion between two still segments that the fit leaves out, not a turn: longer than
+/// CalibrationOptions::max_motion_s (estimation/still_set.h).
+struct NotATurn {
+  std::size_t from = 0, to = 0;  ///< still segment indices
+  double t_begin_s = 0.0, t_end_s = 0.0;
+  double limit_s = 0.0;          ///< the longest motion the fit integrates
+};
+
 /// The whitened problem at the optimum with the columns of the model's probe terms
 /// (model::Model::AddProbe), for the score test of plumb/diagnostics. Rows are the whitened
 /// residuals in the order still segment 0 (accelerometer, gyroscope), segment 1, ..., then the
@@ -110,6 +118,7 @@ struct FitReport {
 
   std::vector<StillSegmentFit> still;  ///< per still segment used, in time order
   std::vector<MotionFit> motion;       ///< per motion interval integrated
+  std::vector<NotATurn> not_turns;     ///< motion between poses left out of the fit
   std::vector<std::string> warnings;   ///< what the user must know, in words
   std::vector<std::string> notes;      ///< how the fit was made, in words (e.g. the noise)
   /// Checks the fit failed (empty: all passed); a failed gate means the numbers above are

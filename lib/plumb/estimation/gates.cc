@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "plumb/core/units.h"
+#include "plumb/model/effects/gyro_linear.h"
 
 namespace plumb::estimation {
 namespace {
@@ -513,7 +514,54 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
                   Num(*scale / dt) + " Hz (check --rate, or the time column's unit)"};
 }
 
+/// The free parameters of the gyroscope's matrix (its linear stage's block before the bias,
+/// model/effects/gyro_linear.h) that the fit leaves undetermined, or determines only to more
+/// than kNotATurnMatrixSigma (Earth rate alone), by name.
+std::vector<std::string> UndeterminedGyroMatrix(const Calibration& cal) {
+  std::vector<std::string> out;
+  const int base = cal.model.BaseTerm(model::Sensor::kGyro);
+  if (!cal.has_gyro || base < 0) return out;
+  std::size_t offset = 0;
+  for (int t = 0; t < base; ++t) {
+    offset += static_cast<std::size_t>(cal.model.terms()[static_cast<std::size_t>(t)].effect->info().size());
+  }
+  for (int i = 0; i < model::gyro_linear::kBias; ++i) {
+    const std::size_t k = offset + static_cast<std::size_t>(i);
+    if (k >= cal.parameters.size()) break;
+    const ParameterEstimate& p = cal.parameters[k];
+    if (!p.fixed && (!p.observable || !(p.sigma <= kNotATurnMatrixSigma))) out.push_back(p.name);
+  }
+  return out;
+}
+
+/// not_a_turn: motion left out where no turn is left to determine the gyroscope's matrix.
+std::optional<Gate> NotATurnGate(const Calibration& cal, const FitReport& fit) {
+  if (fit.not_turns.empty()) return std::nullopt;
+  const std::vector<std::string> undetermined = UndeterminedGyroMatrix(cal);
+  if (undetermined.empty()) return std::nullopt;
+  std::string what;
+  for (const NotATurn& m : fit.not_turns) what += (what.empty() ? "" : "; ") + NotATurnText(fit, m);
+  return Gate{"not_a_turn", what + "; without it the turns left (" +
+                                std::to_string(fit.motion_segments) + ") leave " +
+                                Count(undetermined.size(), "parameter") +
+                                " of the gyroscope's matrix undetermined or known only to more "
+                                "than " + Num(kNotATurnMatrixSigma) + " (" + undetermined.front() +
+                                (undetermined.size() > 1 ? ", ..." : "") +
+                                "): record turns of seconds between the still poses"};
+}
+
 }  // namespace
+
+std::string NotATurnText(const FitReport& fit, const NotATurn& m) {
+  auto label = [&](std::size_t k) {
+    return k < fit.still.size() ? "'" + fit.still[k].segment.label + "'" : "#" + std::to_string(k);
+  };
+  auto tenth = [](double t) { return Num(std::round(t * 10.0) / 10.0); };
+  return "the motion " + tenth(m.t_begin_s) + "-" + tenth(m.t_end_s) + " s (" +
+         tenth(m.t_end_s - m.t_begin_s) + " s) between " + label(m.from) + " and " + label(m.to) +
+         " is left out of the fit, not a turn: longer than " + Num(m.limit_s) +
+         " s, more than a MEMS gyroscope integrates to its noise (a flight, a vehicle carried)";
+}
 
 std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillSegment>& still) {
   std::vector<Gate> gates;
@@ -628,6 +676,7 @@ std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibrati
     if (auto g = Nonlinear(fit)) gates.push_back(*g);
   }
   if (auto g = NotStill(series, calibration, fit)) gates.push_back(*g);
+  if (auto g = NotATurnGate(calibration, fit)) gates.push_back(*g);
   const auto rest = Plausible(AtRest(fit.still), calibration);
   if (rest.empty()) return gates;
   const bool usable = fit.converged && !one_pose;

@@ -29,6 +29,11 @@
 //                  than kNotStillRatio times the session's quietest segment: a flight, running
 //                  motors, a vehicle carried, not a pose at rest (the detector adapts to the
 //                  data's own scatter, so a session that is all motion can pass it)
+//   not_a_turn     motion between two poses left out of the fit as no turn (longer than
+//                  CalibrationOptions::max_motion_s: a flight, a vehicle carried; the
+//                  poses after it start a chain of their own), where that leaves the
+//                  gyroscope's matrix (scale and misalignment, which only turns determine)
+//                  undetermined or known only to more than kNotATurnMatrixSigma
 //   implausible_walk  a bias random walk estimated from the session (--estimate-rw) more than
 //                  10 times the typical MEMS walk: more likely a missing effect seen between
 //                  the poses, which a walk that large hides from chi2 (walk_estimate.h)
@@ -52,7 +57,7 @@ namespace plumb::estimation {
 /// The gates' names, in the order they are checked.
 inline constexpr const char* kGateNames[] = {"out_of_range", "saturated", "not_converged",
                                              "one_pose", "nonlinear", "unit_or_rate",
-                                             "not_still", "implausible_walk"};
+                                             "not_still", "not_a_turn", "implausible_walk"};
 
 /// not_still: a segment's per-sample scatter above kNotStillAccel (50 mg: 25 times a consumer
 /// MEMS accelerometer's noise per sample at 1 kHz, 0.02 m/s^2; spinning motors and flight give
@@ -68,6 +73,11 @@ inline constexpr double kNotStillGyro = 0.1;
 inline constexpr double kNotStillRatio = 50.0;
 inline constexpr double kStillScatterFloorAccel = 0.005;
 inline constexpr double kStillScatterFloorGyro = 5e-4;
+
+/// not_a_turn: a gyroscope matrix entry known only to more than this (a datasheet's scale
+/// tolerance, +-3 %: a fit that cannot do better has not determined it; Earth rate alone, on the
+/// still poses, gives some 0.3) counts as undetermined.
+inline constexpr double kNotATurnMatrixSigma = 0.03;
 
 /// out_of_range: per-axis limits. 32 g is twice the largest common MEMS full scale (16 g;
 /// 24 g parts stay inside), 4000 deg/s twice the common 2000 deg/s; 2^20 counts holds any
@@ -107,10 +117,13 @@ inline constexpr double kMaxGyroBiasDegS = 25.0;
 /// (LinearityReport::worst_ratio; a linear model gives 1, well-posed fits 1.00-1.2).
 inline constexpr double kMaxLinearityRatio = 1.5;
 
+/// The motion `m` in words: when, between which poses, and why it is not a turn.
+std::string NotATurnText(const FitReport& fit, const NotATurn& m);
+
 /// out_of_range and saturated, on the samples and the still segments (given or detected).
 std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillSegment>& still);
 
-/// not_converged, one_pose, not_still and unit_or_rate, on a finished fit (its still segments, noise
+/// not_converged, one_pose, not_still, not_a_turn and unit_or_rate, on a finished fit (its still segments, noise
 /// levels, parameters and fit.distinct_poses, which Calibrate counts with CountDistinctPoses).
 std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibration,
                            FitReport& fit);

@@ -40,6 +40,10 @@ struct CalibrationOptions {
   /// angular_acceleration); set, forced on or off (e.g. to compare two models on the same
   /// residuals).
   std::optional<bool> accel_in_motion;
+  /// The velocity residuals weighted by the vibration measured in each turn where it exceeds
+  /// the white noise (estimation/turn_noise.h; true), or by the white noise alone (false: to
+  /// see what the vibration does; on turns made by hand it understates their sigma).
+  bool turn_vibration = true;
   /// Relative singular-value threshold of the column-scaled whitened Jacobian below which a
   /// direction counts as unobservable (0 < value < 1).
   double rank_tolerance = 1e-9;

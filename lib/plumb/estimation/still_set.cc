@@ -72,7 +72,11 @@ StillSet MakeStillSet(const ImuSeries& series, const std::vector<StillSegment>& 
     const std::size_t first = set.poses[k].segment.end - 1;
     const std::size_t last = set.poses[k + 1].segment.begin;
     const double gap = series.t_s[last] - series.t_s[first];
-    if (!motion_on || last <= first || gap > options.max_motion_s) continue;
+    if (!motion_on || last <= first) continue;
+    if (gap > options.max_motion_s) {
+      set.not_turns.push_back({k, first, last});
+      continue;
+    }
     set.motions.push_back({k, first, last});
   }
   set.joined_to_previous.assign(set.poses.size(), false);

@@ -47,6 +47,10 @@ struct MotionInterval {
 struct StillSet {
   std::vector<StillPose> poses;          ///< in time order
   std::vector<MotionInterval> motions;   ///< in time order
+  /// Motion between consecutive poses longer than CalibrationOptions::max_motion_s: not a
+  /// turn (no MEMS gyroscope integrates to its noise that long; a flight, a vehicle carried),
+  /// left out of the fit (the poses after it start a chain of their own).
+  std::vector<MotionInterval> not_turns;
   std::vector<bool> joined_to_previous;  ///< per pose: a motion interval leads into it
 
   /// Mean accelerometer (or gyroscope) output of every pose at rest (not turning at a stated

@@ -25,6 +25,16 @@ bool MisfitBeyondNoise(const FitReport& fit) {
   return fit.dof > 0 && fit.chi2_dof() > kMisfitFactor * Chi2BandUpper(fit.dof);
 }
 
+TurnVelocityFit VelocityFit(const FitReport& fit) {
+  TurnVelocityFit out;
+  for (const MotionFit& m : fit.motion) {
+    if (!m.has_velocity) continue;
+    out.chi2 += m.velocity_whitened.squaredNorm();
+    out.residuals += 3;
+  }
+  return out;
+}
+
 double SigmaScale(const FitReport& fit) {
   return Chi2AboveBand(fit) ? std::sqrt(fit.chi2_dof()) : 1.0;
 }

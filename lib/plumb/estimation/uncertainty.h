@@ -41,6 +41,20 @@ bool Chi2AboveBand(const FitReport& fit);
 inline constexpr double kMisfitFactor = 3.0;
 bool MisfitBeyondNoise(const FitReport& fit);
 
+/// The velocity residuals of the turns in a fit (3 per turn that has one): their chi^2 and
+/// count. Weighted by the white noise or each turn's measured vibration (turn_noise.h), they
+/// sit at their noise when the model explains the accelerometer during the turns; above
+/// their band they carry what it lacks, and what only they determine (the effects that need
+/// the accelerometer in motion: time_offset, accel_size_effect) is not to be trusted.
+struct TurnVelocityFit {
+  double chi2 = 0.0;
+  int residuals = 0;
+  double per_residual() const { return residuals > 0 ? chi2 / residuals : 0.0; }
+  /// chi^2 per residual above Chi2BandUpper(residuals) (false without any).
+  bool above_band() const { return residuals > 0 && per_residual() > Chi2BandUpper(residuals); }
+};
+TurnVelocityFit VelocityFit(const FitReport& fit);
+
 /// sqrt(chi^2/dof) when Chi2AboveBand(fit), else 1: the factor on every reported sigma.
 double SigmaScale(const FitReport& fit);
 

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <vector>
 
+#include "plumb/estimation/uncertainty.h"
+
 namespace plumb::report {
 namespace {
 
@@ -50,6 +52,15 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
                     "is a misfit, not wander"
                   : "that fit is not to be trusted as it stands")
           << "\n";
+      continue;
+    }
+    const estimation::TurnVelocityFit turns = estimation::VelocityFit(c.refit->fit);
+    if (c.with_velocity && turns.above_band() && c.refit->fit.chi2_dof() < user) {
+      out << "not advised: " << name << " is significant and its refit lowers your fit's chi2/dof ("
+          << Fixed(user, 3) << " -> " << Fixed(c.refit->fit.chi2_dof(), 3)
+          << "), but leaves the turns' velocity residuals at chi2 " << Fixed(turns.per_residual(), 2)
+          << " per residual, above their band (" << Fixed(estimation::Chi2BandUpper(turns.residuals), 2)
+          << "): the accelerometer during the turns carries more than this effect explains\n";
       continue;
     }
     out << "not advised: " << name << " is significant, but the refit with it has chi2/dof "

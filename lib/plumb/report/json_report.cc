@@ -370,6 +370,14 @@ json ToJson(const estimation::CalibrationResult& r) {
   for (const auto& s : r.fit.still) doc["segments"].push_back(StillJson(s, r.calibration.has_gyro));
   doc["motion"] = json::array();
   for (const auto& m : r.fit.motion) doc["motion"].push_back(MotionJson(m));
+  doc["not_turns"] = json::array();
+  for (const auto& m : r.fit.not_turns) {
+    doc["not_turns"].push_back({{"from", m.from},
+                                {"to", m.to},
+                                {"t_begin_s", Number(m.t_begin_s)},
+                                {"t_end_s", Number(m.t_end_s)},
+                                {"limit_s", Number(m.limit_s)}});
+  }
   doc["warnings"] = r.fit.warnings;
   if (!r.fit.notes.empty()) doc["notes"] = r.fit.notes;
   return doc;

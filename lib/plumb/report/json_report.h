@@ -37,6 +37,9 @@
 //   segments [{label, begin, end, t_mid_s, acc_residual, gyr_residual, acc_whitened,
 //              gyr_whitened, attitude_quaternion_wxyz, attitude_known}]
 //   motion [{from, to, duration_s, rotation_residual, whitened}]
+//   not_turns [{from, to, t_begin_s, t_end_s, limit_s}]: motion between poses left out of the
+//        fit as no turn (longer than limit_s; the gate not_a_turn where that leaves the
+//        gyroscope's matrix undetermined)
 //   segmentation {...}                             see ToJson(SegmentationResult)
 //   inputs [file names], warnings [text]
 #pragma once

@@ -7,6 +7,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/core/typical_mems.h"
+#include "plumb/core/units.h"
 
 namespace plumb::sim {
 namespace {
@@ -38,6 +39,8 @@ void ValidateOptions(const SimulationOptions& o) {
     throw Error("simulation option bias_instability_time_s = " +
                 Number(o.bias_instability_time_s) + " must be finite and > 0 (s)");
   }
+  CheckNonNegative(o.hand.translation_m, "hand.translation_m (m)");
+  CheckNonNegative(o.hand.vibration_accel, "hand.vibration_accel (m/s^2)");
   CheckNonNegative(o.accel_quantum, "accel_quantum (m/s^2)");
   CheckNonNegative(o.gyro_quantum, "gyro_quantum (rad/s)");
   if (!std::isfinite(o.t0_s)) throw Error("simulation option t0_s must be finite");
@@ -79,13 +82,14 @@ Vec3 Quantise(const Vec3& y, double quantum) {
   return (y / quantum).array().round().matrix() * quantum;
 }
 
-/// The model inputs for a motion at a site, at time dt_s after t_ref and temperature offset.
+/// The model inputs for a motion at a site, at time dt_s after t_ref and temperature offset,
+/// with the body's acceleration a_n (NED, m/s^2).
 model::SensorInput<double> InputFor(const Motion& motion, const geo::Site& site, double dt_s,
-                                    double dtemp_c) {
+                                    double dtemp_c, const Vec3& a_n = Vec3::Zero()) {
   const Mat3 R_b_n = motion.R_n_b.toRotationMatrix().transpose();
   const Vec3 omega_ie_b = R_b_n * site.omega_ie_n;
   model::SensorInput<double> in;
-  in.f_b = -(R_b_n * site.g_n);
+  in.f_b = R_b_n * (a_n - site.g_n);
   in.omega_b = omega_ie_b + motion.omega_nb_b;
   in.alpha_b = motion.alpha_nb_b - motion.omega_nb_b.cross(omega_ie_b);
   in.dt_s = dt_s;
@@ -103,6 +107,41 @@ struct NoiseSource {
     const double z = normal(rng);
     return Vec3(x, y, z);
   }
+};
+
+using units::kPi;
+using units::kTwoPi;
+
+/// One turn's hand: the direction of its displacement (NED, unit) and its vibration's scale.
+struct HandTurn {
+  Vec3 d_n = Vec3::Zero();
+  double vibration_scale = 0.0;
+};
+
+/// Draws the hand's motion of each turn, from its own generator.
+class Hand {
+ public:
+  Hand(const HandHeldTurns& hand, std::uint64_t seed) : hand_(hand), noise_{std::mt19937_64(seed)} {}
+  bool on() const { return hand_.on(); }
+  HandTurn NextTurn() {
+    HandTurn turn;
+    turn.d_n = noise_.Draw().normalized();
+    turn.vibration_scale = std::uniform_real_distribution<double>(0.25, 1.0)(noise_.rng);
+    return turn;
+  }
+  /// The body's acceleration, NED, m/s^2, u = t / T into a turn of T s.
+  Vec3 Acceleration(const HandTurn& turn, double u, double T) const {
+    return hand_.translation_m * kTwoPi / (T * T) * std::sin(kTwoPi * u) * turn.d_n;
+  }
+  /// The vibration folded into one accelerometer sample, m/s^2.
+  Vec3 Vibration(const HandTurn& turn, double u) {
+    const double s = std::sin(kPi * u);
+    return hand_.vibration_accel * turn.vibration_scale * s * s * noise_.Draw();
+  }
+
+ private:
+  HandHeldTurns hand_;
+  NoiseSource noise_;
 };
 
 /// The bias instability of one sensor: per axis a first-order Gauss-Markov process,
@@ -241,20 +280,29 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
                                rate_hz);
   std::vector<const double*> theta;
   for (const auto& block : sim.truth) theta.push_back(block.data());
+  // The hand's generator: the main one's seed with its bits mixed (any fixed map would do).
+  Hand hand(options.hand, options.seed ^ 0x9E3779B97F4A7C15ULL);
 
   for (std::size_t i = 0; i < schedule.size(); ++i) {
     const std::size_t begin = std::min(n, FirstSampleAt(schedule.step_start_s(i), rate_hz));
     const std::size_t end = std::min(n, FirstSampleAt(schedule.step_start_s(i + 1), rate_hz));
     StillTruth still;
     still.step = i;
+    const bool by_hand = hand.on() && !schedule.is_still(i);
+    const HandTurn turn = by_hand ? hand.NextTurn() : HandTurn{};
+    const double turn_s = schedule.step_duration_s(i);
     for (std::size_t k = begin; k < end; ++k) {
       const double t_rel_s = static_cast<double>(k) / rate_hz;
       const double t_s = options.t0_s + t_rel_s;
       const double temp_c = sim.temperature.At(t_rel_s, schedule.duration_s());
-      const Motion motion = schedule.AtStep(i, t_rel_s - schedule.step_start_s(i));
-      const model::SensorInput<double> in =
-          InputFor(motion, sim.site, t_s - sim.model.t_ref_s, temp_c - sim.model.temp_ref_c);
-      const model::SensorOutput<double> out = sim.model.Predict<double>(theta.data(), in);
+      const double t_step_s = t_rel_s - schedule.step_start_s(i);
+      const Motion motion = schedule.AtStep(i, t_step_s);
+      const double u = by_hand ? std::clamp(t_step_s / turn_s, 0.0, 1.0) : 0.0;
+      const Vec3 a_n = by_hand ? hand.Acceleration(turn, u, turn_s) : Vec3::Zero();
+      const model::SensorInput<double> in = InputFor(motion, sim.site, t_s - sim.model.t_ref_s,
+                                                     temp_c - sim.model.temp_ref_c, a_n);
+      model::SensorOutput<double> out = sim.model.Predict<double>(theta.data(), in);
+      if (by_hand) out.acc += hand.Vibration(turn, u);
       const Vec3 accel_white = noise.Draw();
       const Vec3 gyro_white = noise.Draw();
       const Vec3 accel_wander = accel_walk + accel_instability.value();

@@ -57,6 +57,23 @@ struct TemperatureProfile {
   void Validate() const;
 };
 
+/// Turns made by hand rather than on a turntable (all zero: a turntable's, the default).
+/// During every turn the IMU is also carried by a smooth displacement of hand_translation_m
+/// along a direction drawn per turn (zero velocity and acceleration at both ends, the turn's
+/// own profile: it adds a_n = L (2 pi / T^2) sin(2 pi u) d_n to the specific force), and
+/// shaken: vibration above the Nyquist frequency folds into the accelerometer's samples as a
+/// broadband scatter, per sample per axis sigma hand_vibration_accel (m/s^2) times a scale
+/// drawn per turn in [0.25, 1] times sin^2(pi u) (strongest mid-turn). A hand's rotation
+/// vibration is left out: on the real hand-held sessions the turns' rotation residuals sit
+/// at the gyroscope's white noise (estimation/turn_noise.h). These draws come from a second
+/// generator (seeded from `seed`), only when an amplitude is set, so sessions without them
+/// keep their noise bit for bit.
+struct HandHeldTurns {
+  double translation_m = 0.0;   ///< displacement over each turn, m, >= 0
+  double vibration_accel = 0.0; ///< vibration's per-sample sigma at its peak, m/s^2, >= 0
+  bool on() const { return translation_m > 0.0 || vibration_accel > 0.0; }
+};
+
 /// Everything the simulator needs besides the schedule.
 struct SimulationOptions {
   /// Sample rate, Hz, in (0, 100000].
@@ -89,6 +106,8 @@ struct SimulationOptions {
   /// Quantisation steps of the outputs: accelerometer m/s^2, gyroscope rad/s; >= 0, 0 = none.
   double accel_quantum = 0.0;
   double gyro_quantum = 0.0;
+  /// The turns made by hand: translation and vibration (none by default).
+  HandHeldTurns hand;
   /// Sensor temperature, degC (fed to the model as dtemp_c = T - model.temp_ref_c).
   TemperatureProfile temperature;
   /// Whether the session's series carries the temperature column.
@@ -156,7 +175,8 @@ struct Simulation {
 Simulation Simulate(const Schedule& schedule, const SimulationOptions& options);
 
 /// The true inputs of the error model at session time t_s (same origin as the samples),
-/// without noise: what Simulate fed to Model::Predict for a sample at t_s.
+/// without noise: what Simulate fed to Model::Predict for a sample at t_s (without a hand's
+/// translation, SimulationOptions::hand).
 model::SensorInput<double> TrueInput(const Simulation& sim, double t_s);
 
 }  // namespace plumb::sim

@@ -38,6 +38,8 @@ sim::SimulationOptions SensorOf(const Base& b, const model::Model& model, std::u
   set(b.gyro_bi, o.gyro_bias_instability);
   o.bias_instability_time_s = b.bi_time_s;
   o.temperature = sim::TemperatureProfile::Ramp(25.0, 25.0 + b.temperature_rise_c);
+  o.hand.vibration_accel = b.hand_vibration;
+  o.hand.translation_m = b.hand_translation_m;
   o.rate_hz = b.rate_hz;
   o.site = geo::Site::At(b.lat_deg, b.lon_deg, b.height_m, "study");
   o.model = model;

@@ -31,6 +31,8 @@ double* Field(Base& b, const std::string& name) {
       {"gyro_bi", &Base::gyro_bi},
       {"bi_time_s", &Base::bi_time_s},
       {"temperature_rise_c", &Base::temperature_rise_c},
+      {"hand_vibration", &Base::hand_vibration},
+      {"hand_translation_m", &Base::hand_translation_m},
       {"lat_deg", &Base::lat_deg},
       {"height_m", &Base::height_m},
       {"fit_lat_error_deg", &Base::fit_lat_error_deg},
@@ -170,7 +172,7 @@ const std::vector<std::string>& FactorNames() {
       "poses",   "still_s",  "turn_s",   "rate_hz",   "accel_noise", "gyro_noise",
       "accel_rw", "gyro_rw", "accel_bi", "gyro_bi",   "bi_time_s",   "temperature_rise_c",
       "lat_deg", "height_m", "fit_lat_error_deg", "fit_gravity_m_s2", "level_error_deg",
-      "heading_error_deg"};
+      "heading_error_deg", "hand_vibration", "hand_translation_m"};
   return kNames;
 }
 

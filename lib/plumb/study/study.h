@@ -65,6 +65,9 @@ struct Base {
   double accel_noise = kSensor, gyro_noise = kSensor, accel_rw = kSensor, gyro_rw = kSensor;
   double accel_bi = kSensor, gyro_bi = kSensor;
   double bi_time_s = 30.0, temperature_rise_c = 10.0;
+  /// Turns made by hand (sim::HandHeldTurns): vibration folded into the accelerometer's
+  /// samples, per-sample sigma at its peak, m/s^2, and the displacement over each turn, m.
+  double hand_vibration = 0.0, hand_translation_m = 0.0;
   double fit_lat_error_deg = 0.0, fit_gravity_m_s2 = 0.0;
   /// paper_static only: the true hold is tilted about body y by level_error_deg and turned
   /// from north by heading_error_deg, while the fit assumes level, x north.
