@@ -7,7 +7,12 @@
 #include <malloc.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
+#include <optional>
+#include <string>
 #include <iostream>
 #include <memory>
 #include <utility>
@@ -25,6 +30,18 @@ namespace {
 /// Error messages are printed through plumb::Printable (a NUL or a binary byte quoted from a
 /// file shows as \\xNN), at most this long.
 constexpr std::size_t kMessageBytes = 4000;
+
+/// Flushes the standard output (std::cout and stdio): why what was printed did not arrive
+/// (a full disk, a closed or broken stdout), or nullopt.
+std::optional<std::string> StandardOutputLost() {
+  std::cout.flush();
+  errno = 0;
+  const bool failed = !std::cout.good() || std::fflush(stdout) != 0 || std::ferror(stdout) != 0;
+  if (!failed) return std::nullopt;
+  return std::string("cannot write the standard output") +
+         (errno != 0 ? std::string(" (") + std::strerror(errno) + ")" : std::string()) +
+         ": what was printed is lost";
+}
 
 std::string UsageMessage(const CLI::App* app, const CLI::Error& e) {
   const std::string name = app->get_parent() ? "plumb " + app->get_name() : "plumb";
@@ -114,6 +131,11 @@ int main(int argc, char** argv) {
     progress.Start(selected->app()->get_name(), ::isatty(STDERR_FILENO) == 1);
     const int code = selected->Run();
     progress.Stop();
+    // What the command printed must have reached its reader: a full disk, a closed stdout.
+    if (const std::optional<std::string> lost = StandardOutputLost()) {
+      std::cerr << "plumb: error: " << *lost << "\n";
+      return code == 0 ? 1 : code;
+    }
     return code;
   } catch (const plumb::cli::UsageError& e) {
     progress.Stop();

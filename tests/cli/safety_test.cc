@@ -5,11 +5,15 @@
 // byte as it was.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <utility>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "run_tool.h"
@@ -130,6 +134,64 @@ TEST(Safety, AReportReplacesOnlyItsOwnFolder) {
   for (const auto& entry : fs::directory_iterator(dir.path())) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp."), std::string::npos) << entry.path();
   }
+}
+
+/// Makes a character device node `name` in `dir` (major, minor); false where that is not
+/// permitted (it needs root). Never on the machine's /dev.
+bool MakeDevice(const TempDir& dir, const std::string& name, unsigned major, unsigned minor) {
+  return ::mknod(dir.File(name).c_str(), S_IFCHR | 0666, makedev(major, minor)) == 0;
+}
+
+// Issue 35: as root, an output onto a device, a link to one or a FIFO is written in place,
+// never renamed over: the device stays a device, the FIFO's reader gets the JSON.
+TEST(Safety, AnOutputOntoADeviceOrAFifoIsWrittenInPlace) {
+  TempDir dir;
+  const std::string csv = Session(dir);
+  const std::string fifo = dir.File("pipe");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string received;
+  std::thread reader([&] { received = ReadAll(fifo); });
+  const ToolRun to_fifo = Plumb({"calibrate", csv, "--json", fifo}, dir);
+  reader.join();
+  EXPECT_EQ(to_fifo.exit_code, 0) << to_fifo.err;
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_TRUE(Contains(received, "\"schema_version\"")) << received.substr(0, 200);
+  if (!MakeDevice(dir, "null", 1, 3)) GTEST_SKIP() << "cannot make a device node here: needs root";
+  fs::create_symlink(dir.File("null"), dir.File("link_to_null"));
+  for (const std::string out : {"null", "link_to_null"}) {
+    const ToolRun run = Plumb({"calibrate", csv, "--json", dir.File(out)}, dir);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+  }
+  EXPECT_TRUE(fs::is_character_file(dir.File("null")));
+  EXPECT_TRUE(fs::is_symlink(dir.File("link_to_null")));
+}
+
+// `--json /dev/stdout > F`: F holds what calibrate prints, the JSON, then what it prints after,
+// in that order; not the JSON alone.
+TEST(Safety, JsonOntoTheProcesssOwnStdoutKeepsTheText) {
+  TempDir dir;
+  const std::string csv = Session(dir);
+  const ToolRun run = Plumb({"calibrate", csv, "--json", "/dev/stdout"}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto line = run.out.find("\n{");  // the document starts on a line of its own
+  ASSERT_NE(line, std::string::npos) << run.out;
+  const std::size_t json_at = line + 1;
+  EXPECT_TRUE(Contains(run.out.substr(0, json_at), "chi2/dof")) << run.out.substr(0, 400);
+  const auto end = run.out.find("\n}\n", json_at);  // then the "wrote /dev/stdout" line
+  ASSERT_NE(end, std::string::npos) << run.out;
+  EXPECT_NO_THROW((void)nlohmann::json::parse(run.out.substr(json_at, end + 2 - json_at)));
+  EXPECT_TRUE(Contains(run.out.substr(end), "wrote /dev/stdout")) << run.out.substr(end);
+}
+
+// What a command prints must reach its reader: a full stdout is an error, not exit 0.
+TEST(Safety, AFullStandardOutputIsAnError) {
+  TempDir dir;
+  if (!MakeDevice(dir, "full", 1, 7)) GTEST_SKIP() << "cannot make a device node here: needs root";
+  const ToolRun run = testing::Run(
+      "/bin/sh", {"-c", std::string("exec '") + PLUMB_TOOL + "' effects > '" + dir.File("full") + "'"},
+      dir);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_TRUE(Contains(run.err, "plumb: error: cannot write the standard output")) << run.err;
 }
 
 TEST(Safety, AMissingLogOrAFolderIsSaidAsSuch) {

@@ -7,6 +7,7 @@
 
 #include <signal.h>
 
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstdlib>
@@ -35,9 +36,32 @@ fs::path Destination(const std::string& path) {
   return ec ? fs::path(path) : target;
 }
 
-/// Removes the temporary files left in `dir` by writers that were killed: ".NAME.tmp.PID.*"
-/// whose process no longer runs, and the unnumbered ".NAME.tmp.XXXXXX" of earlier versions an
-/// hour old. Once per folder and process (a sweep writes thousands of files into one).
+/// The marker of plumb's temporary names, ".NAME.plumb-tmp.PID.XXXXXX": a name no user gives.
+constexpr std::string_view kTempMarker = ".plumb-tmp.";
+/// The longest file name a folder takes (NAME_MAX on Linux's file systems).
+constexpr std::size_t kNameMax = 255;
+
+/// Whether `name` is a temporary name plumb made: ".<anything>.plumb-tmp.<pid>.<6 of
+/// mkstemp's letters>"; its pid in `pid`.
+bool IsPlumbTemporary(const std::string& name, long* pid) {
+  if (name.size() < 2 || name[0] != '.') return false;
+  const auto marker = name.rfind(kTempMarker);
+  if (marker == std::string::npos) return false;
+  const std::string tail = name.substr(marker + kTempMarker.size());  // "PID.XXXXXX"
+  const auto dot = tail.find('.');
+  if (dot == std::string::npos || dot == 0 || tail.size() != dot + 7) return false;
+  if (tail.find_first_not_of("0123456789") != dot) return false;
+  for (std::size_t i = dot + 1; i < tail.size(); ++i) {
+    if (!std::isalnum(static_cast<unsigned char>(tail[i]))) return false;
+  }
+  *pid = std::strtol(tail.substr(0, dot).c_str(), nullptr, 10);
+  return *pid > 0;
+}
+
+/// Removes the temporary files left in `dir` by writers that were killed: regular files with
+/// a name only plumb gives (IsPlumbTemporary) whose process no longer runs. Never a folder,
+/// never a name by pattern alone. Once per folder and process (a sweep writes thousands of
+/// files into one).
 void RemoveStaleTemporaries(const fs::path& dir) {
   static std::mutex mutex;
   static std::set<std::string> cleaned;
@@ -48,41 +72,76 @@ void RemoveStaleTemporaries(const fs::path& dir) {
   }
   std::error_code ec;
   for (fs::directory_iterator it(key, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    const auto tmp = name.find(".tmp.");
-    if (name.empty() || name[0] != '.' || tmp == std::string::npos) continue;
-    const std::string tail = name.substr(tmp + 5);
-    const auto dot = tail.find('.');
-    bool stale = false;
-    if (dot != std::string::npos && dot > 0 &&
-        tail.find_first_not_of("0123456789") == dot) {  // ".tmp.PID.XXXXXX"
-      const long pid = std::strtol(tail.substr(0, dot).c_str(), nullptr, 10);
-      stale = pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
-    } else if (tail.size() == 6 && dot == std::string::npos) {  // ".tmp.XXXXXX", old versions
-      std::error_code age_ec;
-      const auto age = fs::file_time_type::clock::now() - fs::last_write_time(it->path(), age_ec);
-      stale = !age_ec && age > std::chrono::hours(1);
+    long pid = 0;
+    if (!IsPlumbTemporary(it->path().filename().string(), &pid)) continue;
+    std::error_code type_ec;
+    if (!it->is_regular_file(type_ec) || it->is_symlink(type_ec)) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+      std::error_code rm_ec;
+      fs::remove(it->path(), rm_ec);
     }
-    if (stale) fs::remove_all(it->path(), ec), ec.clear();
   }
 }
 
-/// The mkstemp/mkdtemp template of a temporary beside `dest`, ".NAME.tmp.PID.XXXXXX" (NUL
-/// ended), after removing the stale ones of that folder.
+/// The mkstemp/mkdtemp template of a temporary beside `dest`, ".NAME.plumb-tmp.PID.XXXXXX"
+/// (NUL ended; NAME shortened to keep the whole within kNameMax), after removing the stale
+/// ones of that folder.
 std::vector<char> TemporaryTemplate(const fs::path& dest) {
   const fs::path dir = dest.parent_path();
   RemoveStaleTemporaries(dir);
-  const std::string name =
-      "." + dest.filename().string() + ".tmp." + std::to_string(::getpid()) + ".XXXXXX";
+  const std::string tail =
+      std::string(kTempMarker) + std::to_string(::getpid()) + ".XXXXXX";
+  std::string stem = dest.filename().string();
+  if (1 + stem.size() + tail.size() > kNameMax) stem.resize(kNameMax - 1 - tail.size());
+  const std::string name = "." + stem + tail;
   const std::string templ = (dir.empty() ? fs::path(name) : dir / name).string();
   std::vector<char> buffer(templ.begin(), templ.end());
   buffer.push_back('\0');
   return buffer;
 }
 
+/// The descriptor a name of the process's own streams stands for (/dev/stdout, /dev/stderr,
+/// /dev/fd/N, /proc/self/fd/N), or -1.
+int OwnStream(const std::string& path) {
+  if (path == "/dev/stdout") return 1;
+  if (path == "/dev/stderr") return 2;
+  for (const char* prefix : {"/dev/fd/", "/proc/self/fd/"}) {
+    const std::string p(prefix);
+    if (path.rfind(p, 0) != 0 || path.size() == p.size()) continue;
+    const std::string n = path.substr(p.size());
+    if (n.find_first_not_of("0123456789") != std::string::npos || n.size() > 9) return -1;
+    return std::atoi(n.c_str());
+  }
+  return -1;
+}
+
+/// Whether `path` exists and is not a regular file once its links are followed (a device, a
+/// FIFO, a socket): written in place, never renamed over.
+bool IsSpecial(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+}
+
 }  // namespace
 
 AtomicFileWriter::AtomicFileWriter(std::string path) : path_(std::move(path)) {
+  // The process's own streams, and what is not a regular file (a device, a FIFO, a socket, or
+  // a link to one), are written in place: renaming over them would replace /dev/null with a
+  // file, or a redirected stdout's file with the JSON alone.
+  const int stream = OwnStream(path_);
+  if (stream >= 0) {
+    std::fflush(nullptr);  // what the process printed before comes first
+    fd_ = ::fcntl(stream, F_DUPFD_CLOEXEC, 3);
+    if (fd_ < 0) Fail("its descriptor " + std::to_string(stream) + " is not open");
+    in_place_ = true;
+    return;
+  }
+  if (IsSpecial(path_)) {
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+    if (fd_ < 0) Fail("cannot open it for writing (it is not a regular file, so it is written in place)");
+    in_place_ = true;
+    return;
+  }
   const fs::path dest = Destination(path_);
   std::vector<char> buffer = TemporaryTemplate(dest);
   fd_ = ::mkstemp(buffer.data());
@@ -109,13 +168,19 @@ void AtomicFileWriter::Write(std::string_view bytes) {
   while (!bytes.empty()) {
     const ssize_t n = ::write(fd_, bytes.data(), bytes.size());
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) Fail("write to " + temp_path_ + " failed");
+    if (n <= 0) Fail(in_place_ ? std::string("write failed") : "write to " + temp_path_ + " failed");
     bytes.remove_prefix(static_cast<std::size_t>(n));
   }
 }
 
 void AtomicFileWriter::Commit() {
   if (fd_ < 0) throw Error("cannot write " + path_ + ": file already committed");
+  if (in_place_) {
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) Fail("close failed");
+    return;
+  }
   if (::fsync(fd_) != 0) Fail("fsync of " + temp_path_ + " failed");
   const int fd = fd_;
   fd_ = -1;
@@ -129,6 +194,12 @@ void AtomicFileWriter::Commit() {
 StagedFolder::StagedFolder(std::string path) : path_(std::move(path)) {
   fs::path dest(path_);
   if (dest.filename().empty()) dest = dest.parent_path();  // "DIR/"
+  // A link to a folder is written through: the folder it leads to is replaced, the link stays.
+  std::error_code link_ec;
+  if (fs::is_symlink(dest, link_ec) && fs::is_directory(dest, link_ec)) {
+    const fs::path target = fs::canonical(dest, link_ec);
+    if (!link_ec) dest = target;
+  }
   std::vector<char> buffer = TemporaryTemplate(dest);
   if (::mkdtemp(buffer.data()) == nullptr) {
     throw Error("cannot write " + path_ + ": cannot create a temporary folder beside it (" +

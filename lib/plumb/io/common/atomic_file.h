@@ -1,12 +1,17 @@
 // plumb/io/common/atomic_file.h — output files written atomically (SPEC section 8).
 //
-// The content goes to a temporary file in the destination's folder (`.<name>.tmp.<pid>.XXXXXX`),
-// is flushed to disk (fsync) and then renamed over the destination, so a reader never sees a
-// half-written file and a failed write leaves the old file untouched. A destination that is a
-// symlink stays one: the file it leads to is replaced. A replaced file keeps its mode; new files
-// get 0644. A writer killed before it could remove its temporary file (SIGKILL) leaves it
-// behind; the next write into that folder removes those whose process no longer runs.
-// Failures throw plumb::Error naming the destination path and the system's reason.
+// A regular file (or a new one): the content goes to a temporary file in the destination's
+// folder (`.<name>.plumb-tmp.<pid>.XXXXXX`, the name shortened to fit NAME_MAX), is flushed to
+// disk (fsync) and then renamed over the destination, so a reader never sees a half-written
+// file and a failed write leaves the old file untouched. A destination that is a symlink stays
+// one: the file it leads to is replaced. A replaced file keeps its mode; new files get 0644.
+// Anything else (a device such as /dev/null, a FIFO, a socket, or a link to one) and the
+// process's own streams (/dev/stdout, /dev/stderr, /dev/fd/N, /proc/self/fd/N) are opened and
+// written in place, never renamed over (plumb often runs as root). A writer killed before it
+// could remove its temporary file (SIGKILL) leaves it behind; the next write into that folder
+// removes those: regular files with a name only plumb gives, whose process no longer runs;
+// never a folder, never another name. Every write and close is checked. Failures throw
+// plumb::Error naming the destination path and the system's reason.
 #pragma once
 
 #include <string>
@@ -40,14 +45,16 @@ class AtomicFileWriter {
   std::string target_;     ///< the file replaced: path_, or where its symlinks lead
   std::string temp_path_;
   int fd_ = -1;
+  bool in_place_ = false;  ///< written in place: not a regular file, or the process's stream
 };
 
 /// A folder written as a whole (`plumb report --out DIR`): its files go into a temporary
 /// sibling folder (`.<name>.tmp.<pid>.XXXXXX`), and Commit() puts that folder in place of the
 /// destination in one step (renameat2 RENAME_EXCHANGE with the old folder, which is then
 /// removed; a plain rename when there is none). Without Commit() (an error, an interruption)
-/// the destination is left as it was: never files of two runs side by side. A killed writer's
-/// temporary folder is removed by the next write into the same parent, as for files.
+/// the destination is left as it was: never files of two runs side by side. A link to a folder
+/// is written through (the folder it leads to is replaced; the link stays). A killed writer's
+/// temporary folder stays (a folder is never removed by name): its name says whose it was.
 class StagedFolder {
  public:
   /// Creates the temporary folder beside `path` (the parent must exist); throws plumb::Error
