@@ -56,6 +56,21 @@ std::vector<std::string> InputFiles(const std::string& input) {
 }
 
 void RefuseOverwritingInputs(const FileRoles& roles) {
+  // Every output file's folder exists: found after the work, a missing one would leave the
+  // outputs written before it (a command that fails writes none of its outputs).
+  for (const NamedPath& out : roles.output_files) {
+    if (out.path.empty() || out.path == "-") continue;
+    std::error_code ec;
+    const std::filesystem::path path(out.path);
+    if (std::filesystem::is_directory(path, ec)) {
+      throw UsageError(Said(out) + " is a folder, not a file; nothing was written");
+    }
+    const std::filesystem::path folder = path.parent_path();
+    if (!folder.empty() && !std::filesystem::is_directory(folder, ec)) {
+      throw UsageError(Said(out) + ": its folder " + folder.string() +
+                       " does not exist (make it first); nothing was written");
+    }
+  }
   for (const NamedPath& out : roles.output_files) {
     for (const NamedPath& in : roles.inputs) {
       if (SameFile(out.path, in.path)) Refuse(out, in, "is the same file as the input");

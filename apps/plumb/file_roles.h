@@ -31,7 +31,9 @@ struct FileRoles {
 std::vector<std::string> InputFiles(const std::string& input);
 
 /// Throws UsageError (exit 2) naming both options and paths when an output is an input,
-/// two outputs are one file, or an output folder is or holds an input.
+/// two outputs are one file, or an output folder is or holds an input; and naming the option
+/// when an output file is a folder or its folder does not exist (found only after the work,
+/// that would leave the outputs written before it).
 void RefuseOverwritingInputs(const FileRoles& roles);
 
 /// `message` (an error of the run) as the user reads it: when it names none of the command's

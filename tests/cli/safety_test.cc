@@ -194,6 +194,26 @@ TEST(Safety, AFullStandardOutputIsAnError) {
   EXPECT_TRUE(Contains(run.err, "plumb: error: cannot write the standard output")) << run.err;
 }
 
+// Issue 35: a command that fails writes none of its outputs. An output whose folder does not
+// exist, or that is a folder, is refused before any work (exit 2), so no output written before
+// it is left behind.
+TEST(Safety, AnOutputWithoutAFolderIsRefusedBeforeAnythingIsWritten) {
+  TempDir dir;
+  const std::string csv = Session(dir);
+  const std::string a = dir.File("A.json");
+  const ToolRun run =
+      Plumb({"diagnose", csv, "--json", a, "--residuals", dir.File("nodir/r.csv")}, dir);
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_TRUE(Contains(run.err, "--residuals " + dir.File("nodir/r.csv") + ": its folder " +
+                                    dir.File("nodir") + " does not exist (make it first); "
+                                    "nothing was written"))
+      << run.err;
+  EXPECT_FALSE(fs::exists(a));
+  const ToolRun folder = Plumb({"calibrate", csv, "--json", dir.path().string()}, dir);
+  EXPECT_EQ(folder.exit_code, 2) << folder.err;
+  EXPECT_TRUE(Contains(folder.err, "is a folder, not a file; nothing was written")) << folder.err;
+}
+
 TEST(Safety, AMissingLogOrAFolderIsSaidAsSuch) {
   TempDir dir;
   const ToolRun missing = Plumb({"info", dir.File("nothing.bin")}, dir);
