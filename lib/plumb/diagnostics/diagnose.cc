@@ -111,6 +111,26 @@ bool Wanted(const DiagnoseOptions& options, const char* name) {
              options.candidates.end();
 }
 
+/// A candidate that adds no parameter and is tested by its refit (the time base, the bias
+/// wander): the refit's actual fall from the user's `fit` stands for LM, on `dof` degrees of
+/// freedom (what the refit chose); evidence and significance as for a score test.
+Candidate RefitCandidate(CandidateKind kind, const char* name,
+                         estimation::CalibrationResult refit,
+                         const estimation::CalibrationResult& fit, int dof, int observations,
+                         double significance) {
+  Candidate c;
+  c.kind = kind;
+  c.effect = name;
+  c.refit = std::move(refit);
+  c.refit_drop = fit.fit.chi2 - c.refit->fit.chi2;
+  c.lm = *c.refit_drop;
+  c.dof = dof;
+  c.evidence = c.lm - dof * std::log(std::max(1.0, static_cast<double>(observations)));
+  c.threshold = signal::ChiSquareQuantileExact(1.0 - significance, dof);
+  c.significant = c.lm > c.threshold;
+  return c;
+}
+
 /// The time-base candidate: the model refitted on the uniform clock fitted through the stamps,
 /// when they are a host's arrival clock (else skipped, with why). `fit` is the user's.
 std::optional<Candidate> TestTimeBase(const ImuSeries& series,
@@ -136,18 +156,11 @@ std::optional<Candidate> TestTimeBase(const ImuSeries& series,
   Tell(options, "refit on the uniform clock");
   ImuSeries uniform = series;
   signal::ApplyUniformClock(base, uniform.t_s);
-  Candidate c;
-  c.kind = CandidateKind::kTimeBase;
-  c.effect = kTimeBaseCandidate;
-  c.refit = estimation::Calibrate(uniform, segments, model, site, options.calibration);
-  c.refit_drop = fit.fit.chi2 - c.refit->fit.chi2;
-  // No parameter is added: the actual fall stands for LM, the choice of clock for one degree
-  // of freedom.
-  c.lm = *c.refit_drop;
-  c.dof = 1;
-  c.evidence = c.lm - std::log(std::max(1.0, static_cast<double>(observations)));
-  c.threshold = signal::ChiSquareQuantileExact(1.0 - options.significance, 1);
-  c.significant = c.lm > c.threshold;
+  // The choice of clock stands for one degree of freedom.
+  Candidate c = RefitCandidate(
+      CandidateKind::kTimeBase, kTimeBaseCandidate,
+      estimation::Calibrate(uniform, segments, model, site, options.calibration), fit, 1,
+      observations, options.significance);
   c.recommended = c.significant && LowersTheUsersFit(*c.refit, fit);
   return c;
 }
@@ -196,20 +209,13 @@ std::optional<Candidate> TestWander(const ImuSeries& series,
   Tell(options, "refit with the wander levels from the session");
   estimation::CalibrationOptions estimated = calibration;
   estimated.estimate_walk = true;
-  Candidate c;
-  c.kind = CandidateKind::kWander;
-  c.effect = kWanderCandidate;
-  c.refit = estimation::Calibrate(series, segments, model, site, estimated);
-  c.refit_drop = fit.fit.chi2 - c.refit->fit.chi2;
-  // No parameter is added: the actual fall stands for LM, each sensor whose level moved for a
-  // degree of freedom.
-  c.lm = *c.refit_drop;
-  c.dof = SensorsMoved(fit.calibration.noise, c.refit->calibration.noise);
-  if (c.dof == 0) return skip("the session's holds cannot estimate the levels (their wander "
-                              "factors are absorbed by the fit)");
-  c.evidence = c.lm - c.dof * std::log(std::max(1.0, static_cast<double>(observations)));
-  c.threshold = signal::ChiSquareQuantileExact(1.0 - options.significance, c.dof);
-  c.significant = c.lm > c.threshold;
+  estimation::CalibrationResult refit = estimation::Calibrate(series, segments, model, site, estimated);
+  // Each sensor whose level moved stands for a degree of freedom.
+  const int dof = SensorsMoved(fit.calibration.noise, refit.calibration.noise);
+  if (dof == 0) return skip("the session's holds cannot estimate the levels (their wander "
+                            "factors are absorbed by the fit)");
+  Candidate c = RefitCandidate(CandidateKind::kWander, kWanderCandidate, std::move(refit), fit,
+                               dof, observations, options.significance);
   // Advised only where the estimate reads a wander, not a misfit (file comment).
   c.recommended = c.significant && c.refit->fit.gates.empty() && LowersTheUsersFit(*c.refit, fit);
   return c;

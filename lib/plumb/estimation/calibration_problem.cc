@@ -185,17 +185,20 @@ void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
     }
     // Quantisation: the integrated angle carries 2 Q^2 (noise_model.h).
     AddVariance(samples->sqrt_info, E_inv, 2.0 * noise_.quantisation_gyr.cwiseAbs2());
-    // The velocity residual: the white noise or the turn's measured vibration (turn_noise.h).
-    const Vec3 var_v = TurnVelocityVariance(*samples, E_inv, F_inv, turn_noise,
-                                            start_.Down(still_.poses[mo.from]), g);
-    velocity_info_[k] = var_v.cwiseSqrt().cwiseInverse();
-    motion_samples_[k] = std::move(samples);
-    // Each accelerometer wander process about its line (the velocity residual takes the line
-    // off): its bridge's mean over T, times T, through F^-1; the instability as the walk of
-    // equal short-time spread, as for the rotation above.
-    for (std::size_t p : WanderOf(model::Sensor::kAccel)) {
-      AddVariance(velocity_info_[k], F_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
+    // The velocity residual, where the fit has one (a pass over the turn's samples): the white
+    // noise or the turn's measured vibration (turn_noise.h), then each accelerometer wander
+    // process about its line (the velocity residual takes the line off): its bridge's mean
+    // over T, times T, through F^-1; the instability as the walk of equal short-time spread,
+    // as for the rotation above.
+    if (velocity_on_) {
+      const Vec3 var_v = TurnVelocityVariance(*samples, E_inv, F_inv, turn_noise,
+                                              start_.Down(still_.poses[mo.from]), g);
+      velocity_info_[k] = var_v.cwiseSqrt().cwiseInverse();
+      for (std::size_t p : WanderOf(model::Sensor::kAccel)) {
+        AddVariance(velocity_info_[k], F_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
+      }
     }
+    motion_samples_[k] = std::move(samples);
   }
 }
 

@@ -27,17 +27,6 @@ std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series
   return matrix ? out + " per " + in : out;
 }
 
-/// Offset of each term's block among all parameters.
-std::vector<Eigen::Index> TermOffsets(const model::Model& model) {
-  std::vector<Eigen::Index> out;
-  Eigen::Index off = 0;
-  for (const auto& term : model.terms()) {
-    out.push_back(off);
-    off += term.effect->info().size();
-  }
-  return out;
-}
-
 /// ceres::Covariance over the free model blocks of `fitted` into `cov` (zero elsewhere);
 /// false when Ceres finds the problem singular or there is nothing to compute.
 bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
@@ -59,7 +48,6 @@ bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
   cov_options.num_threads = 1;
   ceres::Covariance covariance(cov_options);
   if (pairs.empty() || !covariance.Compute(pairs, &fitted)) return false;
-  const std::vector<Eigen::Index> offset = TermOffsets(model);
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     for (std::size_t j = i; j < blocks.size(); ++j) {
       const auto ti = static_cast<std::size_t>(block_term[i]);
@@ -68,8 +56,10 @@ bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
       const int nj = model.terms()[tj].effect->info().size();
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> C(ni, nj);
       covariance.GetCovarianceBlock(blocks[i], blocks[j], C.data());
-      cov.block(offset[ti], offset[tj], ni, nj) = C;
-      cov.block(offset[tj], offset[ti], nj, ni) = C.transpose();
+      const int oi = model.FirstParameter(block_term[i]);
+      const int oj = model.FirstParameter(block_term[j]);
+      cov.block(oi, oj, ni, nj) = C;
+      cov.block(oj, oi, nj, ni) = C.transpose();
     }
   }
   return true;

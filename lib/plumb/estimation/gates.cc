@@ -521,10 +521,7 @@ std::vector<std::string> UndeterminedGyroMatrix(const Calibration& cal) {
   std::vector<std::string> out;
   const int base = cal.model.BaseTerm(model::Sensor::kGyro);
   if (!cal.has_gyro || base < 0) return out;
-  std::size_t offset = 0;
-  for (int t = 0; t < base; ++t) {
-    offset += static_cast<std::size_t>(cal.model.terms()[static_cast<std::size_t>(t)].effect->info().size());
-  }
+  const auto offset = static_cast<std::size_t>(cal.model.FirstParameter(base));
   for (int i = 0; i < model::gyro_linear::kBias; ++i) {
     const std::size_t k = offset + static_cast<std::size_t>(i);
     if (k >= cal.parameters.size()) break;

@@ -146,6 +146,12 @@ int Model::num_parameters() const {
   return n;
 }
 
+int Model::FirstParameter(int term) const {
+  int n = 0;
+  for (int t = 0; t < term; ++t) n += terms_.at(static_cast<std::size_t>(t)).effect->info().size();
+  return n;
+}
+
 int Model::num_free_parameters() const {
   int n = 0;
   for (const auto& t : terms_) {

@@ -68,6 +68,8 @@ class Model {
   ParameterBlocks ZeroParameters() const;
   /// Total number of scalar parameters, and of free ones.
   int num_parameters() const;
+  /// Index of term `term`'s first parameter among all of them (ParameterNames() order).
+  int FirstParameter(int term) const;
   int num_free_parameters() const;
   /// Full names of all parameters, in block order.
   std::vector<std::string> ParameterNames() const;
