@@ -106,8 +106,13 @@ class ApplyCommand : public Command {
     PrintSession(session);
     correction::ApplyOptions options;
     options.uncertainty = a.sigma;
-    const correction::CorrectedSeries corrected =
-        correction::ApplyCalibration(calibration, session.series, options);
+    const correction::CorrectedSeries corrected = [&] {
+      try {
+        return correction::ApplyCalibration(calibration, session.series, options);
+      } catch (const correction::NonFiniteCorrection& e) {  // the sample is the session's
+        throw InputError(session.source, "", e.what());
+      }
+    }();
     WriteCorrected(a.out_path, session.series, corrected);
     std::cout << "applied " << a.calibration << " (model " << calibration.model.spec() << ") to "
               << session.series.size() << " samples; wrote " << a.out_path

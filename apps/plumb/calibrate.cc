@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "validators.h"
 #include "export_options.h"
 #include "fit_options.h"
 #include "input_options.h"
@@ -73,7 +74,7 @@ class CalibrateCommand : public Command {
                      "Threads for reading (a .bin, .tlog or .ulg of 32 MiB or more in two parts) and the motion "
                      "residuals' integration (default 0: every core); the result is the same "
                      "bit for bit")
-        ->check(CLI::NonNegativeNumber)
+        ->check(Jobs)
         ->capture_default_str();
   }
 

@@ -81,7 +81,7 @@ class DiagnoseCommand : public Command {
                      "(the first refits while the second probe fit runs; default: every "
                      "core), and a .bin, .tlog or .ulg of 32 MiB or more read in two parts; the result is the "
                      "same whatever N")
-        ->check(NonNegative);
+        ->check(Jobs);
     app_->add_option("--candidates", a.candidates,
                      "Test only these effects (NAME or NAME:OPTION, comma-separated); default: "
                      "every catalogue effect not in the model")

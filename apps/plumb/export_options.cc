@@ -6,6 +6,7 @@
 #include "fit_options.h"
 #include "plumb/core/error.h"
 #include "plumb/export/export.h"
+#include "plumb/export/kalibr.h"
 #include "plumb/io/common/atomic_file.h"
 #include "validators.h"
 
@@ -34,7 +35,13 @@ void AddExportOptions(CLI::App* app, ExportArgs& a) {
                 "contradict, a saturated axis); without it such an export is refused (exit 1) "
                 "and nothing is written");
   app->add_option("--kalibr-topic", a.rostopic, "rostopic written in Kalibr's imu.yaml")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](const std::string& topic) {
+            const std::string p = exporter::RosTopicProblem(topic);
+            return p.empty() ? p : "not a ROS topic name (" + p + ")";
+          },
+          "ROS topic"));
   app->add_flag("--keep-gyro-offsets", a.keep_gyro_offsets,
                 "Also write what keeps plumb's gyroscope offsets: INS_GYR_CAL 0 (ArduPilot "
                 "measures them at rest after every boot while it is 1) and SENS_IMU_AUTOCAL 0 "

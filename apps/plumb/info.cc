@@ -150,6 +150,16 @@ class InfoCommand : public Command {
       std::cout << "site: no GPS 3D fix in the log (give --lat --lon --height to calibrate)\n";
     }
 
+    doc["vehicle_motion"] = nlohmann::json::array();
+    for (const LogMotion& m : summary.motion) {
+      doc["vehicle_motion"].push_back(report::LogMotionJson(m));
+      std::cout << "the log says: " << Describe(m) << "\n";
+    }
+    if (summary.motion.empty()) {
+      std::cout << "the log says nothing of flight: no land detector saying airborne, no GPS "
+                   "speed above " << kGpsMovingSpeed << " m/s\n";
+    }
+
     nlohmann::json params = nlohmann::json::object();
     for (const auto& [name, value] : summary.params) params[name] = report::Number(value);
     doc["params"] = params;

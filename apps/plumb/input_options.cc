@@ -150,8 +150,11 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
                    "sensor_accel; default: the one with accelerometer and gyroscope at the "
                    "highest rate")
       ->type_name("NAME");
-  a.from = logs->add_option("--from", a.from_s, "Use the samples from this log time on, s");
-  a.to = logs->add_option("--to", a.to_s, "Use the samples up to this log time, s");
+  a.from = logs->add_option("--from", a.from_s,
+                            "Use the samples from this time on, s (a log's time, a table's "
+                            "time column or its --rate clock)");
+  a.to = logs->add_option("--to", a.to_s,
+                          "Use the samples up to this time, s (as --from)");
   logs->add_flag("--as-logged", a.as_logged,
                  "Keep the firmware's correction (ArduPilot INS_*, PX4 CAL_*/TC_*) in the "
                  "samples instead of undoing it (the calibration is then of the corrected "

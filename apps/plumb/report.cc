@@ -201,7 +201,7 @@ class ReportCommand : public Command {
                      "Diagnose's probe fits, then its refits, in parallel, each on one core "
                      "(default: every core), and a .bin, .tlog or .ulg of 32 MiB or more read in two parts; "
                      "the page is the same whatever N")
-        ->check(NonNegative);
+        ->check(Jobs);
     AddFitOptions(app_, a.fit);
     app_->add_flag("--no-figures", a.no_figures, "Write the page without figures (no gnuplot)");
     app_->add_option("--gnuplot", a.gnuplot,
@@ -403,8 +403,15 @@ class ReportCommand : public Command {
     const report::GnuplotOutcome outcome = report::RunGnuplot(dir, plan.job, args_.gnuplot);
     extras.figures = report::EmbedDrawnFigures(dir, plan, outcome);  // inside the page
     if (!outcome.message.empty()) {
-      extras.figure_notes.push_back(outcome.message);
-      std::cerr << "plumb: warning: " << outcome.message << "\n";
+      // `dir` is the staging folder, renamed to --out once the page is written: the message
+      // names the files where the user will find them.
+      std::string message = outcome.message;
+      for (std::size_t at = message.find(dir); at != std::string::npos;
+           at = message.find(dir, at + args_.out_dir.size())) {
+        message.replace(at, dir.size(), args_.out_dir);
+      }
+      extras.figure_notes.push_back(message);
+      std::cerr << "plumb: warning: " << message << "\n";
     }
     files.push_back(plan.job.script_name);
     for (const auto& data : plan.job.data) files.push_back(data.name);

@@ -45,18 +45,33 @@ struct SweepArgs {
   std::string merge_out;                ///< merge --out DIR
 };
 
+/// The most values a study file may hold once its YAML aliases are expanded: a study is tens
+/// to a few thousand values (factors, levels, options); nested aliases ("billion laughs")
+/// expand to billions from a few lines.
+constexpr std::size_t kMaxStudyValues = 100000;
+
 /// A YAML node as JSON: mappings, sequences, and scalars as integers, numbers, true/false,
-/// null or text, in that order of trial.
-json FromYaml(const YAML::Node& node) {
+/// null or text, in that order of trial. Each node taken (an alias each time it is used) costs
+/// one of `budget`; past it, InputError naming `path`.
+json FromYaml(const YAML::Node& node, std::size_t& budget, const std::string& path) {
+  if (budget == 0) {
+    throw InputError(path, "",
+                     "more than " + std::to_string(kMaxStudyValues) +
+                         " values once its aliases are expanded (nested YAML aliases, an "
+                         "\"alias bomb\"?): a study holds far fewer; refused");
+  }
+  --budget;
   switch (node.Type()) {
     case YAML::NodeType::Map: {
       json out = json::object();
-      for (const auto& item : node) out[item.first.as<std::string>()] = FromYaml(item.second);
+      for (const auto& item : node) {
+        out[item.first.as<std::string>()] = FromYaml(item.second, budget, path);
+      }
       return out;
     }
     case YAML::NodeType::Sequence: {
       json out = json::array();
-      for (const auto& item : node) out.push_back(FromYaml(item));
+      for (const auto& item : node) out.push_back(FromYaml(item, budget, path));
       return out;
     }
     case YAML::NodeType::Scalar: {
@@ -78,7 +93,8 @@ json ReadStudyFile(const std::string& path) {
   const std::string ext = fs::path(path).extension().string();
   if (ext != ".yaml" && ext != ".yml") return ReadJsonFile(path);
   try {
-    return FromYaml(YAML::LoadFile(path));
+    std::size_t budget = kMaxStudyValues;
+    return FromYaml(YAML::LoadFile(path), budget, path);
   } catch (const YAML::BadFile&) {
     throw InputError(path, "", "cannot be read");
   } catch (const YAML::Exception& e) {
@@ -153,7 +169,7 @@ class SweepCommand : public Command {
                      "the shards with 'plumb sweep merge'")
         ->type_name("K/N");
     app_->add_option("--jobs", a.jobs, "Runs in parallel (default: every core)")
-        ->check(NonNegative);
+        ->check(Jobs);
     merge_ = app_->add_subcommand("merge", "Join the folders of a study's shards into one result");
     merge_->add_option("DIR", a.merge_dirs, "The shards' --out folders")->required();
     merge_->add_option("--out", a.merge_out, "Folder for the joined result")->required();

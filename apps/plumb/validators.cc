@@ -1,5 +1,6 @@
 #include "validators.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -7,6 +8,7 @@
 #include <string>
 
 #include "commands.h"
+#include "jobs.h"
 #include "plumb/core/units.h"
 
 namespace plumb::cli {
@@ -82,6 +84,18 @@ void CheckOptions(const CLI::App& app) {
 
 const CLI::Validator Positive = Bound(true);
 const CLI::Validator NonNegative = Bound(false);
+const CLI::Validator Jobs(
+    [](std::string& text) {
+      const int most = std::max(kMinJobsBound, kJobsPerCore * Cores());
+      double v = 0.0;
+      const bool ok = ReadNumber(text, v) && v >= 0.0 && v <= most && v == std::floor(v);
+      return ok ? std::string()
+                : "must be a whole number of threads from 0 (every core) to " +
+                      std::to_string(most) + " (" + std::to_string(kJobsPerCore) +
+                      " per core of this machine's " + std::to_string(Cores()) + "; got '" +
+                      text + "')";
+    },
+    "0 or more threads", "JOBS");
 const CLI::Validator EarthGravity(
     [](std::string& text) {
       double v = 0.0;

@@ -16,6 +16,13 @@ extern const CLI::Validator Positive;
 /// A finite number >= 0.
 extern const CLI::Validator NonNegative;
 
+/// --jobs: a whole number from 0 (every core) to kJobsPerCore times the machine's cores (at
+/// least kMinJobsBound): more threads than that only wait for the cores, and thousands fail to
+/// start (libgomp: "Thread creation failed").
+inline constexpr int kJobsPerCore = 16;
+inline constexpr int kMinJobsBound = 64;
+extern const CLI::Validator Jobs;
+
 /// A gravity magnitude found on Earth, m/s^2 (units::kMinEarthGravity..kMaxEarthGravity).
 extern const CLI::Validator EarthGravity;
 

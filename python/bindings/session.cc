@@ -155,6 +155,26 @@ py::object SiteOf(const PySession& s) {
   return std::move(d);
 }
 
+/// Session::log_motion as dicts, with the keys of `plumb info --json`'s vehicle_motion[].
+py::list VehicleMotionOf(const PySession& s) {
+  py::list out;
+  for (const LogMotion& m : s.session.log_motion) {
+    const bool gps = m.evidence == LogMotion::Evidence::kGpsMoving;
+    py::dict d;
+    d["evidence"] = gps ? "gps_moving" : "airborne";
+    d["t_begin_s"] = m.t_begin_s;
+    d["t_end_s"] = m.t_end_s;
+    d["source"] = m.source;
+    if (gps) {
+      d["max_ground_speed_m_s"] = m.max_ground_speed_m_s;
+      d["max_climb_m_s"] = m.max_climb_m_s;
+      d["ground_distance_m"] = m.ground_distance_m;
+    }
+    out.append(std::move(d));
+  }
+  return out;
+}
+
 /// The getter of a numpy view over one column of the session's series (`cols` 0: a vector
 /// of numbers; 3: rows of Vec3f), kept alive by the Python session.
 template <typename Column>
@@ -218,6 +238,12 @@ void RegisterSession(py::module_& m) {
                              "not undo; empty when the samples are the sensor's own output.")
       .def_property_readonly("log_params", [](const PySession& s) { return s.session.log_params; },
                              "A flight log's firmware parameters (name -> value).")
+      .def_property_readonly("vehicle_motion", &VehicleMotionOf,
+                             "Where a flight log says the vehicle flew or moved (its land "
+                             "detector, its GPS): dicts evidence ('airborne' or 'gps_moving'), "
+                             "t_begin_s, t_end_s, source, and for the GPS "
+                             "max_ground_speed_m_s, max_climb_m_s, ground_distance_m. Still "
+                             "segments there fail not_still; motion there is no turn.")
       .def("__len__", [](const PySession& s) { return s.session.series.size(); },
            "Number of samples.")
       .def("__repr__", [](const PySession& s) {

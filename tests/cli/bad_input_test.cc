@@ -222,5 +222,72 @@ TEST_F(BadInput, CalibrationTruthAndStudyFiles) {
   EXPECT_GE(runs_, 12u);
 }
 
+// Issue 35 item 5: calibrations no sensor has, well-formed JSON all: apply and compare refuse
+// each, naming the file and the key (they used to write NaN and inf columns with exit 0, take
+// the second of two values, print a sigma of -1). compare reads the headline keys only
+// (peers/plumb_result.h), without the model's typical magnitudes: a huge bias is apply's to
+// refuse.
+TEST_F(BadInput, CalibrationsNoSensorHasAreRefusedWithTheKey) {
+  using nlohmann::json;
+  const json good = json::parse(ReadAll(calibration_));
+  const auto index = [&](const std::string& name) {
+    for (std::size_t k = 0; k < good["parameters"].size(); ++k) {
+      if (good["parameters"][k]["name"] == name) return k;
+    }
+    return std::size_t{0};
+  };
+  std::map<std::string, std::pair<json, std::string>> cases;  // name: document, key named
+  json twice = good;
+  twice["parameters"].push_back(good["parameters"][index("accel.bias.x")]);
+  cases["twice"] = {twice, "].name': 'accel.bias.x' given twice"};
+  json huge = good;
+  huge["parameters"][index("accel.bias.y")]["value"] = 1.7e308;
+  huge["accel"]["bias"][1] = 1.7e308;
+  cases["huge"] = {huge, "'accel.bias.y' = 1.7e+308 is no sensor's"};
+  json singular = good;
+  for (const char* name : {"accel.matrix.xx", "accel.matrix.xy", "accel.matrix.xz"}) {
+    singular["parameters"][index(name)]["value"] = 0.0;
+  }
+  singular["accel"]["matrix"][0] = {0.0, 0.0, 0.0};
+  cases["singular"] = {singular, "matrix is singular (it maps some input to zero)"};
+  json negative = good;
+  negative["covariance"]["matrix"][0][0] = -1e-6;
+  negative["parameters"][0]["sigma"] = -1e-3;
+  cases["negative"] = {negative, "negative"};
+  for (const auto& [name, c] : cases) {
+    const std::string path = dir_.File("cal_" + name + ".json");
+    Write(path, c.first.dump(1));
+    const std::string out = dir_.File("applied_" + name + ".csv");
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"apply", path, session_, "--out", out},
+          std::vector<std::string>{"compare", path, "--truth", truth_}}) {
+      if (args[0] == "compare" && name == "huge") continue;
+      const ToolRun run = Plumb(args, dir_);
+      EXPECT_EQ(run.exit_code, 1) << args[0] << " " << name << "\n" << run.out << run.err;
+      EXPECT_TRUE(Contains(run.err, path + ":key '")) << args[0] << " " << name << "\n" << run.err;
+      if (args[0] == "apply") EXPECT_TRUE(Contains(run.err, c.second)) << name << "\n" << run.err;
+      EXPECT_FALSE(fs::exists(out)) << name;
+    }
+  }
+  // A sample no sensor gives (1e308, read as an infinite float): apply names it, writes nothing.
+  std::string rows = ReadAll(session_);
+  const std::size_t third = [&] {
+    std::size_t at = 0;
+    for (int k = 0; k < 2; ++k) at = rows.find('\n', at) + 1;
+    return at;
+  }();
+  rows.replace(rows.find(',', third) + 1, rows.find(',', rows.find(',', third) + 1) - rows.find(',', third) - 1,
+               "1e308");
+  const std::string samples = dir_.File("huge_sample.csv");
+  Write(samples, rows);
+  const std::string out = dir_.File("applied_sample.csv");
+  const ToolRun run = Plumb({"apply", calibration_, samples, "--out", out}, dir_);
+  EXPECT_EQ(run.exit_code, 1) << run.out << run.err;
+  EXPECT_TRUE(Contains(run.err, samples + ": sample 1 (t = 0.020000 s) corrects to a value that "
+                                          "is not finite"))
+      << run.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace plumb::cli

@@ -158,6 +158,10 @@ TEST(Report, WithoutGnuplotWritesThePageWithoutFiguresAndWarns) {
   const ToolRun run = Plumb(args, dir);
   ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
   EXPECT_TRUE(Contains(run.err, "warning")) << run.err;
+  // Issue 35 item 8: the warning names the page's folder, not the staging folder it was
+  // written in (gone once the page is in place).
+  EXPECT_TRUE(Contains(run.err, "' in " + dir.File("page") + " to draw the figures")) << run.err;
+  EXPECT_FALSE(Contains(run.err, "plumb-tmp")) << run.err;
   const std::string page = ReadAll(dir.File("page/index.html"));
   EXPECT_TRUE(Contains(page, "No figures"));
   EXPECT_TRUE(Contains(page, "Not run (--no-diagnose)"));

@@ -71,6 +71,15 @@ inline bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
+/// The line of `text` that starts with `prefix` ("" when none).
+inline std::string LineStarting(const std::string& text, const std::string& prefix) {
+  std::stringstream ss(text);
+  for (std::string line; std::getline(ss, line);) {
+    if (line.rfind(prefix, 0) == 0) return line;
+  }
+  return "";
+}
+
 /// Parses a JSON file; throws (failing the test) on invalid JSON, e.g. a bare NaN.
 inline nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);

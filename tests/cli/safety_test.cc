@@ -253,6 +253,27 @@ TEST(Safety, GravityNotFoundOnEarthIsRefused) {
   }
 }
 
+// Issue 35 item 8: --jobs is bounded by what the machine can start (10000 threads failed in
+// libgomp: "Thread creation failed"; -1 printed the 310-digit DBL_MAX).
+TEST(Safety, JobsBeyondTheMachineAreRefused) {
+  TempDir dir;
+  const std::string csv = Session(dir);
+  for (const char* jobs : {"10000", "-1", "1.5"}) {
+    for (const char* command : {"calibrate", "diagnose", "report", "sweep"}) {
+      std::vector<std::string> args = {command, csv, "--jobs", jobs};
+      if (std::string(command) == "report") args.insert(args.end(), {"--out", dir.File("page")});
+      if (std::string(command) == "sweep") args = {command, csv, "--out", dir.File("s"), "--jobs", jobs};
+      const ToolRun run = Plumb(args, dir);
+      EXPECT_EQ(run.exit_code, 2) << command << " --jobs " << jobs << ": " << run.err;
+      EXPECT_TRUE(Contains(run.err, "--jobs: must be a whole number of threads from 0 (every "
+                                    "core) to "))
+          << run.err;
+      EXPECT_LT(run.err.size(), 400u) << run.err;
+    }
+  }
+  EXPECT_EQ(Plumb({"calibrate", csv, "--jobs", "2"}, dir).exit_code, 0);
+}
+
 /// The numeric options of `command` as its --help lists them ("--heading FLOAT ...").
 std::vector<std::string> NumericOptions(const std::string& command, const TempDir& dir) {
   std::vector<std::string> args = {command, "--help"};

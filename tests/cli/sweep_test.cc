@@ -2,6 +2,7 @@
 // one run, byte for byte (whatever the threads); a rerun resumes; bad input names the file.
 #include <gtest/gtest.h>
 
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -90,6 +91,29 @@ TEST(SweepCli, AYamlStudyIsTheSameStudy) {
   const ToolRun bad = Plumb({"sweep", at("bad.yaml"), "--out", at("b")}, dir);
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_TRUE(Contains(bad.err, at("bad.yaml") + ":line 2: not valid YAML")) << bad.err;
+}
+
+// Issue 35 item 4: nested aliases ("billion laughs": 9 levels of 10 make 10^9 values) are
+// refused at the bound: the reading stops at the 100000th value, not after expanding a
+// billion (minutes); nothing is written.
+TEST(SweepCli, AYamlAliasBombIsRefusedAtOnce) {
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  std::string bomb = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int k = 1; k <= 9; ++k) {
+    const std::string prev = "*a" + std::to_string(k - 1);
+    bomb += "a" + std::to_string(k) + ": &a" + std::to_string(k) + " [" + prev;
+    for (int j = 1; j < 10; ++j) bomb += ", " + prev;
+    bomb += "]\n";
+  }
+  bomb += "name: t\nruns: 1\nfactors: *a9\n";
+  std::ofstream(at("bomb.yaml")) << bomb;
+  const ToolRun run = Plumb({"sweep", at("bomb.yaml"), "--out", at("b")}, dir);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_TRUE(Contains(run.err, at("bomb.yaml") + ": more than 100000 values once its aliases "
+                                                  "are expanded"))
+      << run.err;
+  EXPECT_FALSE(std::filesystem::exists(at("b")));
 }
 
 TEST(SweepCli, ARealSessionIsTheTemplate) {

@@ -63,6 +63,28 @@ TEST(Gates, OutOfRangeNamesTheFirstSampleAndTheCount) {
       << g->message;
 }
 
+// Issue 35 item 7: a temperature no MEMS IMU operates at (1e6 degC was taken) is out of range.
+TEST(Gates, ATemperatureNoImuOperatesAtIsOutOfRange) {
+  ImuSeries s = Level(1000);
+  s.temp_c.assign(s.size(), 31.5f);
+  EXPECT_EQ(Find(CheckSamples(s, {}), "out_of_range"), nullptr);
+  s.temp_c[250] = 1e6f;
+  s.temp_c[700] = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<Gate> gates = CheckSamples(s, {});
+  const Gate* g = Find(gates, "out_of_range");
+  ASSERT_NE(g, nullptr) << Names(gates);
+  EXPECT_EQ(g->message, "2 temperatures outside any MEMS IMU's operating range (beyond -60 .. 150 "
+                        "degC, or not finite); the first at t = 2.5 s (sample 250): 1000000 degC. "
+                        "A corrupt log or a column that is not degC: cut them out (--from/--to) "
+                        "or fix the input before trusting a temperature model");
+  s.acc[300].z() = 4.7e21f;  // with a sample out of range too: one gate, both said
+  const std::vector<Gate> both = CheckSamples(s, {});
+  ASSERT_EQ(std::count_if(both.begin(), both.end(),
+                          [](const Gate& x) { return x.name == "out_of_range"; }),
+            1);
+  EXPECT_TRUE(Contains(Find(both, "out_of_range")->message, "; and 2 temperatures outside"));
+}
+
 TEST(Gates, CountsHaveTheirOwnRange) {
   ImuSeries s = Level(200);
   for (auto& a : s.acc) a *= -16384.0f / 9.81f;  // a 2 g MPU-6050 in counts
@@ -173,6 +195,53 @@ TEST(Gates, MotionLeftOutAsNoTurnIsNamedAndGatedWhereTheGyroscopeNeedsIt) {
                                    "0.03 (gyro.matrix.xx, ...)"))
       << g->message;
   EXPECT_FALSE(Contains(report::FitVerdict(none.fit), "consistent with the noise"));
+}
+
+// Issue 34 item 4: what the log says the vehicle did (CalibrationOptions::log_motion, from
+// its land detector or GPS) makes a quiet hold not still and a short motion no turn, whatever
+// the samples say: a smooth cruise or a hover logged at tens of hertz can look still.
+TEST(Gates, WhereTheLogSaysTheVehicleFlewNothingIsStillAndNothingATurn) {
+  const sim::Simulation s = MultiPose(35);
+  const std::vector<StillSegment> segments = FreeAttitudes(s.truth_segments);
+  const std::vector<double>& t = s.session.series.t_s;
+  const CalibrationResult clean = Calibrate(s.session.series, segments, s.model, s.site);
+  ASSERT_TRUE(clean.fit.gates.empty()) << Names(clean.fit.gates);
+  CalibrationOptions options;
+  // Airborne over the motion from hold 5 to hold 6 only (it ends before hold 6 begins).
+  LogMotion air;
+  air.t_begin_s = t[segments[4].end - 1] + 0.1;
+  air.t_end_s = t[segments[5].begin] - 0.1;
+  air.source = "EV NOT_LANDED .. LAND_COMPLETE";
+  // Moving by GPS in the middle of hold 9: a vehicle driven, its IMU quiet.
+  LogMotion gps;
+  gps.evidence = LogMotion::Evidence::kGpsMoving;
+  gps.t_begin_s = t[(segments[8].begin + segments[8].end) / 2];
+  gps.t_end_s = gps.t_begin_s + 1.5;
+  gps.source = "GPS";
+  gps.max_ground_speed_m_s = 4.0;
+  gps.ground_distance_m = 2.0;
+  options.log_motion = {air, gps};
+  const CalibrationResult r = Calibrate(s.session.series, segments, s.model, s.site, options);
+  ASSERT_EQ(r.fit.not_turns.size(), 1u);  // into hold 6 (the GPS's run lies inside hold 9)
+  EXPECT_EQ(r.fit.not_turns[0].from, 4u);
+  ASSERT_TRUE(r.fit.not_turns[0].flown.has_value());
+  EXPECT_EQ(r.fit.not_turns[0].flown->source, air.source);
+  const std::string note = "between '" + segments[4].label + "' and '" + segments[5].label +
+                           "' is left out of the fit, not a turn: the log says the vehicle was "
+                           "airborne ";
+  EXPECT_EQ(std::count_if(r.fit.notes.begin(), r.fit.notes.end(),
+                          [&](const std::string& n) { return Contains(n, note); }),
+            1)
+      << report::FullReport(r);
+  const Gate* g = Find(r.fit.gates, "not_still");
+  ASSERT_NE(g, nullptr) << Names(r.fit.gates);
+  EXPECT_TRUE(Contains(g->message, "1 of 12 still segments scatter far beyond an IMU at rest, "
+                                   "per sample, or fall where the log says the vehicle flew or "
+                                   "moved: '" + segments[8].label + "' ("))
+      << g->message;
+  EXPECT_TRUE(Contains(g->message, "the log says the vehicle was moving ")) << g->message;
+  EXPECT_TRUE(Contains(g->message, " by GPS (up to 4.0 m/s over ground, 2 m)")) << g->message;
+  EXPECT_FALSE(Contains(report::FitVerdict(r.fit), "consistent with the noise"));
 }
 
 TEST(Gates, TheIterationLimitFailsNotConverged) {

@@ -91,6 +91,26 @@ TEST(OpenInputs, TableWithUnitsScalesOffsetsAndAxisMap) {
   EXPECT_EQ(s.series.acc_unit, "m/s^2");
 }
 
+// Issue 35 item 7: --from/--to work on every input with times, not on flight logs alone (they
+// were silently ignored on CSV).
+TEST(OpenInputs, TheTimeWindowKeepsATablesSamplesByItsOwnTimes) {
+  TempDir dir;
+  const std::string path = dir.Write("a.csv", kNative);
+  InputOptions o;
+  o.flight_log.from_s = 0.05;
+  const Session s = OpenInputs({path}, o);
+  ASSERT_EQ(s.series.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.series.t_s.front(), 0.1);
+  const std::string acc = dir.Write("acc.txt", "0 1 2 3\n1 1 2 3\n2 1 2 3\n3 1 2 3\n");
+  const std::string gyr = dir.Write("gyr.txt", "0 4 5 6\n1 4 5 6\n2 4 5 6\n3 4 5 6\n");
+  InputOptions two;
+  two.flight_log.to_s = 1.0;
+  EXPECT_EQ(OpenInputs({{acc, gyr}}, two).series.size(), 2u);
+  o.flight_log.from_s = 0.15;  // one sample left
+  ExpectInputError([&] { OpenInputs({path}, o); }, path, "",
+                   {"fewer than 2 samples in the time window 0.15 s .. end; the stream spans 0 .."});
+}
+
 TEST(OpenInputs, TwoFileFormAndCountsUnits) {
   TempDir dir;
   const std::string acc = dir.Write("acc.txt", "0 1 2 3\n1 1 2 3\n2 1 2 3\n");

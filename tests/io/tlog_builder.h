@@ -115,11 +115,13 @@ inline Bytes HighresImu(std::uint64_t time_us, const std::array<float, 13>& v,
   return p.b;
 }
 
+/// GPS_RAW_INT payload: time_usec 1, the position, eph 100, epv 200, `vel_cm_s`, cog 0, the
+/// fix, 9 satellites, the extensions zero.
 inline Bytes GpsRawInt(std::int32_t lat_e7, std::int32_t lon_e7, std::int32_t alt_mm,
-                std::uint8_t fix_type) {
+                std::uint8_t fix_type, std::uint16_t vel_cm_s = 0) {
   Payload p;
   p.Put<std::uint64_t>(1).Put(lat_e7).Put(lon_e7).Put(alt_mm);
-  p.Put<std::uint16_t>(100).Put<std::uint16_t>(200).Put<std::uint16_t>(0).Put<std::uint16_t>(0);
+  p.Put<std::uint16_t>(100).Put<std::uint16_t>(200).Put(vel_cm_s).Put<std::uint16_t>(0);
   p.Put(fix_type).Put<std::uint8_t>(9);
   for (int k = 0; k < 5; ++k) p.Put<std::uint32_t>(0);
   p.Put<std::uint16_t>(0);

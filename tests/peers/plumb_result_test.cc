@@ -96,5 +96,45 @@ TEST(PlumbResult, ErrorsNameTheFileAndTheKey) {
   EXPECT_NE(message.find(path + ":byte "), std::string::npos) << message;
 }
 
+// Issue 35 item 5: what no calibration can be is refused, the key named (a negative sigma
+// printed as "-1" and "error/sigma -0.00"; a repeated name shifted the mapping).
+TEST(PlumbResult, WhatNoCalibrationCanBeIsRefused) {
+  const TempFolder dir;
+  json doc = SmallResult();
+  doc["parameters"][0]["sigma"] = -1.0;
+  std::string path = dir.Write("sigma.json", doc.dump());
+  EXPECT_EQ(ErrorOf([&] { ReadPlumbResult(path); }),
+            path + ":key 'parameters[0].sigma': expected a standard deviation >= 0, not -1.0");
+
+  doc = SmallResult();
+  doc["parameters"][1]["name"] = "accel.matrix.xx";
+  path = dir.Write("twice.json", doc.dump());
+  EXPECT_EQ(ErrorOf([&] { ReadPlumbResult(path); }),
+            path + ":key 'parameters[1].name': 'accel.matrix.xx' given twice (first at "
+                   "parameters[0])");
+
+  doc = SmallResult();
+  doc["gyro"]["matrix"] = {{5.0, 0.0, 0.0}, {5.0, 0.0, 0.0}, {0.0, 0.0, 7.0}};
+  path = dir.Write("singular.json", doc.dump());
+  EXPECT_EQ(ErrorOf([&] { ReadPlumbResult(path); }),
+            path + ":key 'gyro.matrix': the matrix is singular (it maps some input to zero): "
+                   "not a sensor's calibration");
+
+  doc = SmallResult();
+  doc["covariance"] = {{"parameters", {"accel.matrix.xx", "accel.matrix.xx"}},
+                       {"matrix", {{1e-4, 0.0}, {0.0, 1e-4}}}};
+  path = dir.Write("cov_twice.json", doc.dump());
+  EXPECT_EQ(ErrorOf([&] { ReadPlumbResult(path); }),
+            path + ":key 'covariance.parameters[1]': 'accel.matrix.xx' given twice (first at [0])");
+
+  doc = SmallResult();
+  doc["covariance"] = {{"parameters", {"accel.matrix.xx", "accel.bias.z"}},
+                       {"matrix", {{-1e-4, 0.0}, {0.0, 1e-4}}}};
+  path = dir.Write("cov_negative.json", doc.dump());
+  EXPECT_EQ(ErrorOf([&] { ReadPlumbResult(path); }),
+            path + ":key 'covariance.matrix': the covariance has a negative variance on row 0 "
+                   "(-0.0001)");
+}
+
 }  // namespace
 }  // namespace plumb::peers

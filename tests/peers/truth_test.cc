@@ -69,8 +69,15 @@ TEST(Truth, SaysWhyThereIsNoNees) {
                        {"matrix", {{1.0, 0.0}, {0.0, 1.0}}}}),
             "the covariance's parameter gyro.bias.x has no truth: no NEES");
   EXPECT_EQ(nees_note({{"parameters", {"accel.bias.x", "accel.bias.y"}},
-                       {"matrix", {{1.0, 2.0}, {2.0, 1.0}}}}),
+                       {"matrix", {{1.0, 1.0}, {1.0, 1.0}}}}),
             "the covariance is not positive definite: no NEES");
+  // One that is no covariance at all (an eigenvalue -1) is refused as the file is read
+  // (issue 35 item 5).
+  EXPECT_NE(ErrorOf([&] {
+              nees_note({{"parameters", {"accel.bias.x", "accel.bias.y"}},
+                         {"matrix", {{1.0, 2.0}, {2.0, 1.0}}}});
+            }).find(":key 'covariance.matrix': the covariance is not positive semidefinite"),
+            std::string::npos);
 }
 
 TEST(Truth, BadFilesNameTheFileAndKey) {

@@ -111,6 +111,27 @@ class Errors(unittest.TestCase):
             cal.apply(np.zeros((5, 3)))
 
 
+class VehicleMotion(unittest.TestCase):
+    COPTER = os.path.join(SOURCE, "../shared/data/ardupilot/copter344_pixhawk1_oldformat.bin")
+
+    def test_a_text_table_says_nothing_of_flight(self):
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        self.assertEqual(s.vehicle_motion, [])
+
+    def test_a_flight_log_says_where_the_vehicle_flew(self):
+        if not os.path.exists(self.COPTER):
+            self.skipTest("shared data absent: " + self.COPTER)
+        s = plumb.open(self.COPTER)
+        air = [m for m in s.vehicle_motion if m["evidence"] == "airborne"]
+        self.assertEqual(len(air), 1)
+        self.assertAlmostEqual(air[0]["t_begin_s"], 228.075573, places=5)
+        self.assertAlmostEqual(air[0]["t_end_s"], 375.270177, places=5)
+        self.assertEqual(air[0]["source"], "EV NOT_LANDED .. LAND_COMPLETE")
+        gps = [m for m in s.vehicle_motion if m["evidence"] == "gps_moving"]
+        self.assertGreater(len(gps), 0)
+        self.assertAlmostEqual(max(m["max_ground_speed_m_s"] for m in gps), 5.602, places=3)
+
+
 class Arrays(unittest.TestCase):
     def test_session_arrays_are_views_of_one_storage(self):
         s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)

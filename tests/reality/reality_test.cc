@@ -33,6 +33,7 @@ namespace {
 
 using nlohmann::json;
 using testing::Contains;
+using testing::LineStarting;
 using testing::Plumb;
 using testing::ReadAll;
 using testing::ReadJson;
@@ -269,7 +270,11 @@ TEST(RealityFlight, AFlightGivenAsStillIsNotStill) {
       Plumb({"calibrate", log, "--segments", segments, "--json", dir.File("c.json")}, dir);
   ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
   EXPECT_TRUE(Contains(run.out, "gate failed: not_still: ")) << run.out;
-  EXPECT_TRUE(Contains(run.out, "'flight' (232.6-345 s): gyroscope ")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "'flight' (232.6-345.0 s): gyroscope ")) << run.out;
+  // The log's land detector says so too (EV NOT_LANDED at 228.08 s, LAND_COMPLETE at 375.27).
+  EXPECT_TRUE(Contains(run.out, "the log says the vehicle was airborne 228.1-375.3 s (EV "
+                                "NOT_LANDED .. LAND_COMPLETE)"))
+      << run.out;
   EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
   const json c = ReadJson(dir.File("c.json"));
   std::vector<std::string> gates;
@@ -278,9 +283,11 @@ TEST(RealityFlight, AFlightGivenAsStillIsNotStill) {
 }
 
 // Issue 34 item 4: the ArduPilot copter's flight between two "holds" (the still 3 s before
-// take-off and the last 2 s of the log, in flight) is no turn: 146 s of motion, left out of
-// the fit and named, and with nothing else to determine the gyroscope's matrix, not_a_turn
-// fails beside not_still; no verdict says consistent.
+// take-off and the last 2 s of the log, in flight) is no turn: the log's land detector says
+// the vehicle flew through it, so it is left out of the fit and named, and with nothing else to
+// determine the gyroscope's matrix, not_a_turn fails beside not_still; no verdict says
+// consistent. Without the log's word (its EV records cut out of the reading: --to before the
+// landing keeps them, so the motion is shortened instead) the 146 s are too long to be a turn.
 TEST(RealityFlight, AFlightBetweenTwoHoldsIsNotATurn) {
   const std::string log =
       std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/copter344_pixhawk1_oldformat.bin";
@@ -293,7 +300,8 @@ TEST(RealityFlight, AFlightBetweenTwoHoldsIsNotATurn) {
   ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
   EXPECT_TRUE(Contains(run.out, "gate failed: not_a_turn: ")) << run.out;
   EXPECT_TRUE(Contains(run.out, "the motion 227.4-373.1 s (145.7 s) between 'before' and 'after' "
-                                "is left out of the fit, not a turn: longer than 120 s"))
+                                "is left out of the fit, not a turn: the log says the vehicle was "
+                                "airborne 228.1-375.3 s (EV NOT_LANDED .. LAND_COMPLETE), a flight"))
       << run.out;
   EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
   const json c = ReadJson(dir.File("c.json"));
@@ -303,7 +311,36 @@ TEST(RealityFlight, AFlightBetweenTwoHoldsIsNotATurn) {
   EXPECT_NE(std::find(gates.begin(), gates.end(), "not_still"), gates.end());
   ASSERT_EQ(c.at("not_turns").size(), 1u);
   EXPECT_EQ(c.at("not_turns")[0].at("limit_s"), 120);
+  EXPECT_EQ(c.at("not_turns")[0].at("reason"), "log_says_flown");
+  EXPECT_EQ(c.at("not_turns")[0].at("log_motion").at("evidence"), "airborne");
   EXPECT_EQ(c.at("motion").size(), 0u);
+}
+
+// Issue 34 item 4, the log's word alone: a hold in the copter's flight whose samples pass for
+// still in a short window. ArduPilot's copter log hovers at 25 Hz; given the pre-flight hold
+// and a 2 s piece of hover 30 s later (the motion between them 30 s, no length limit
+// reached), the log's land detector and GPS make the hover not still and the take-off no
+// turn.
+TEST(RealityFlight, TheLogsLandDetectorMakesAHoverNotStillAndTheTakeOffNoTurn) {
+  const std::string log =
+      std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/copter344_pixhawk1_oldformat.bin";
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  const TempDir dir;
+  const std::string segments =
+      dir.Write("segments.csv", "start,end,label\n10,70,before\n800,850,hover\n");
+  const ToolRun run =
+      Plumb({"calibrate", log, "--segments", segments, "--json", dir.File("c.json")}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  EXPECT_TRUE(Contains(run.out, "between 'before' and 'hover' is left out of the fit, not a "
+                                "turn: the log says the vehicle was airborne 228.1-375.3 s"))
+      << run.out;
+  const std::string line = LineStarting(run.out, "gate failed: not_still");
+  EXPECT_TRUE(Contains(line, "'hover' (")) << run.out;
+  EXPECT_TRUE(Contains(line, "the log says the vehicle was airborne 228.1-375.3 s")) << line;
+  EXPECT_FALSE(Contains(run.out, "consistent with the noise")) << run.out;
+  const json c = ReadJson(dir.File("c.json"));
+  ASSERT_EQ(c.at("not_turns").size(), 1u);
+  EXPECT_EQ(c.at("not_turns")[0].at("reason"), "log_says_flown");
 }
 
 /// The velocity residuals' chi^2 per residual in a calibrate --json document.

@@ -90,6 +90,21 @@ TEST(Gnuplot, MissingProgramIsAnOutcomeNotAnError) {
   EXPECT_TRUE(std::filesystem::exists(dir.File("figures.gp")));
 }
 
+// Issue 35 item 4: a --gnuplot that never exits (here one that sleeps for a minute) is stopped
+// at the limit and said; the report then goes on without its figures.
+TEST(Gnuplot, AProgramThatNeverFinishesIsStoppedAtTheLimit) {
+  testing::TempDir dir;
+  const std::string stuck = dir.File("stuck-gnuplot");
+  std::ofstream(stuck) << "#!/bin/sh\nexec sleep 60\n";
+  std::filesystem::permissions(stuck, std::filesystem::perms::owner_all);
+  const GnuplotOutcome out = RunGnuplot(dir.path().string(), LineJob(), stuck, 0.3);
+  EXPECT_FALSE(out.ran);
+  EXPECT_EQ(out.exit_code, -1);
+  EXPECT_EQ(out.message, "'" + stuck + " figures.gp' did not finish within 0.3 s and was "
+                         "stopped: no figures (is it waiting for input, or a window?)");
+  EXPECT_TRUE(out.written.empty());
+}
+
 TEST(Gnuplot, FailingScriptReportsGnuplotsMessage) {
   if (!GnuplotOnPath()) GTEST_SKIP() << "gnuplot is not on the PATH";
   testing::TempDir dir;

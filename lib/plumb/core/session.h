@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/log_motion.h"
 #include "plumb/core/segment.h"
 
 namespace plumb {
@@ -37,6 +38,9 @@ struct Session {
   /// The vehicle's MAVLink system id, when the log says it (SYSID_THISMAV, MAV_SYS_ID, or the
   /// system that sent a tlog's IMU frames).
   std::optional<int> system_id;
+  /// Where the log says the vehicle flew or moved (its land detector, its GPS), on the
+  /// samples' clock, in time order per evidence; empty for inputs that say nothing of it.
+  std::vector<LogMotion> log_motion;
 };
 
 }  // namespace plumb

@@ -1,6 +1,7 @@
 #include "plumb/correction/apply.h"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "plumb/core/error.h"
@@ -120,6 +121,14 @@ CorrectedSeries ApplyCalibration(const CalibrationFile& calibration, const ImuSe
   if (series.has_gyro()) out.omega_b.resize(series.size());
   for (std::size_t i = 0; i < series.size(); ++i) {
     const auto [f, w] = correct(i);
+    if (!f.allFinite() || (series.has_gyro() && !w.allFinite())) {
+      char t[48];
+      std::snprintf(t, sizeof t, "%.6f", series.t_s[i]);
+      throw NonFiniteCorrection("sample " + std::to_string(i) + " (t = " + t +
+                  " s) corrects to a value that is not finite: the sample is beyond any "
+                  "sensor's range (a corrupt row) or the calibration " + calibration.path +
+                  " cannot be inverted there; nothing written");
+    }
     out.f_b[i] = f;
     if (series.has_gyro()) out.omega_b[i] = w;
   }

@@ -19,6 +19,7 @@
 
 #include <vector>
 
+#include "plumb/core/error.h"
 #include "plumb/core/imu_series.h"
 #include "plumb/core/types.h"
 #include "plumb/correction/calibration_file.h"
@@ -40,9 +41,18 @@ struct CorrectedSeries {
   std::vector<Vec3> f_sigma, omega_sigma;
 };
 
+/// The correction of a sample is not finite (ApplyCalibration): its message names the sample
+/// by index and time, not the file the samples came from (the caller's to add).
+class NonFiniteCorrection : public Error {
+ public:
+  using Error::Error;
+};
+
 /// Applies `calibration` to every sample of `series`. Throws plumb::Error naming the file when
 /// the series does not fit the calibration: a gyroscope model without gyroscope samples, a
-/// temperature effect without temperatures, samples in other units than the calibration's.
+/// temperature effect without temperatures, samples in other units than the calibration's;
+/// and throws NonFiniteCorrection for the first sample (index and time) whose correction is
+/// not finite (a value no sensor gives, 1e308): never a NaN or an infinity in the result.
 CorrectedSeries ApplyCalibration(const CalibrationFile& calibration, const ImuSeries& series,
                                  const ApplyOptions& options = {});
 

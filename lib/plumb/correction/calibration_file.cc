@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
 
 namespace plumb::correction {
@@ -53,6 +55,36 @@ model::Model ReadModel(const json& doc, const std::string& path) {
   return model;
 }
 
+/// The catalogue's description of parameter (term t, index i) of `model`.
+const model::ParameterInfo& Info(const model::Model& model, int t, int i) {
+  return model.terms()[static_cast<std::size_t>(t)]
+      .effect->info()
+      .parameters[static_cast<std::size_t>(i)];
+}
+
+/// Why `value` is no sensor's (core/calibration_checks.h kMaxTypicals), with the figures.
+std::string NoSensors(double value, const model::ParameterInfo& info) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%.4g is no sensor's: more than %.0e times its typical magnitude (%.3g %s)",
+                value, kMaxTypicals, info.typical, info.unit.c_str());
+  return buf;
+}
+
+/// The checks of core/calibration_checks.h on the sensors' matrices of `out`.
+void CheckMatrices(const CalibrationFile& out) {
+  const model::SensorOutput<double> linear =
+      out.model.Predict(out.theta, model::SensorInput<double>());
+  if (const std::string p = SensorMatrixProblem(linear.F); !p.empty()) {
+    throw InputError(out.path, "key 'parameters' (accel.matrix.*)",
+                     "the accelerometer's matrix is " + p + ": not a calibration to apply");
+  }
+  if (!out.model.has_gyro()) return;
+  if (const std::string p = SensorMatrixProblem(linear.E); !p.empty()) {
+    throw InputError(out.path, "key 'parameters' (gyro.matrix.*)",
+                     "the gyroscope's matrix is " + p + ": not a calibration to apply");
+  }
+}
+
 /// The covariance over named parameters of the model (none: empty).
 void ReadCovariance(const json& doc, const std::string& path, CalibrationFile& out) {
   if (!doc.contains("covariance") || doc.at("covariance").is_null()) return;
@@ -69,6 +101,11 @@ void ReadCovariance(const json& doc, const std::string& path, CalibrationFile& o
     }
     out.covariance_names.push_back(name.get<std::string>());
   }
+  if (const auto repeat = FirstRepeat(out.covariance_names)) {
+    throw InputError(path, "key 'covariance.parameters[" + std::to_string(repeat->first) + "]'",
+                     "'" + out.covariance_names[repeat->first] + "' given twice (first at [" +
+                         std::to_string(repeat->second) + "])");
+  }
   const json& m = cov.at("matrix");
   if (static_cast<Eigen::Index>(m.size()) != n) {
     throw InputError(path, "key 'covariance.matrix'", "expected " + std::to_string(n) + " rows");
@@ -83,6 +120,18 @@ void ReadCovariance(const json& doc, const std::string& path, CalibrationFile& o
     for (Eigen::Index j = 0; j < n; ++j) {
       out.covariance(i, j) = FiniteNumber(row.at(static_cast<std::size_t>(j)), path,
                                           "covariance.matrix[" + std::to_string(i) + "]");
+    }
+  }
+  if (const std::string p = CovarianceProblem(out.covariance); !p.empty()) {
+    throw InputError(path, "key 'covariance.matrix'", p);
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto [t, k] = *out.model.FindParameter(out.covariance_names[static_cast<std::size_t>(i)]);
+    const double sigma = std::sqrt(out.covariance(i, i));
+    if (sigma > kMaxTypicals * Info(out.model, t, k).typical) {
+      throw InputError(path, "key 'covariance.matrix[" + std::to_string(i) + "]'",
+                       "the sigma of '" + out.covariance_names[static_cast<std::size_t>(i)] +
+                           "', " + NoSensors(sigma, Info(out.model, t, k)));
     }
   }
 }
@@ -105,6 +154,16 @@ CalibrationFile ReadCalibrationFile(const json& doc, const std::string& path) {
   out.theta = out.model.ZeroParameters();
   std::vector<bool> seen(static_cast<std::size_t>(out.model.num_parameters()), false);
   const std::vector<std::string> names = out.model.ParameterNames();
+  std::vector<std::string> given;
+  for (const json& p : params) {
+    const bool named = p.is_object() && p.contains("name") && p.at("name").is_string();
+    given.push_back(named ? p.at("name").get<std::string>() : std::string());
+  }
+  if (const auto repeat = FirstRepeat(given); repeat && !given[repeat->first].empty()) {
+    throw InputError(path, "key 'parameters[" + std::to_string(repeat->first) + "].name'",
+                     "'" + given[repeat->first] + "' given twice (first at parameters[" +
+                         std::to_string(repeat->second) + "])");
+  }
   for (std::size_t k = 0; k < params.size(); ++k) {
     const json& p = params[k];
     const std::string key = "parameters[" + std::to_string(k) + "]";
@@ -118,10 +177,12 @@ CalibrationFile ReadCalibrationFile(const json& doc, const std::string& path) {
                        "'" + name + "' is not a parameter of the model '" + out.model.spec() + "'");
     }
     const auto [t, i] = *where;
-    const double nominal =
-        out.model.terms()[static_cast<std::size_t>(t)].effect->info().parameters[static_cast<std::size_t>(i)].nominal;
-    out.theta[static_cast<std::size_t>(t)][static_cast<std::size_t>(i)] =
-        FiniteNumber(p.at("value"), path, key + ".value") - nominal;
+    const model::ParameterInfo& info = Info(out.model, t, i);
+    const double value = FiniteNumber(p.at("value"), path, key + ".value");
+    if (std::abs(value - info.nominal) > kMaxTypicals * info.typical) {
+      throw InputError(path, "key '" + key + ".value'", "'" + name + "' = " + NoSensors(value, info));
+    }
+    out.theta[static_cast<std::size_t>(t)][static_cast<std::size_t>(i)] = value - info.nominal;
     seen[static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin())] = true;
     if (p.contains("unit") && p.at("unit").is_string()) {
       if (name == "accel.bias.x") out.acc_unit = p.at("unit").get<std::string>();
@@ -131,6 +192,7 @@ CalibrationFile ReadCalibrationFile(const json& doc, const std::string& path) {
   for (std::size_t j = 0; j < names.size(); ++j) {
     if (!seen[j]) throw InputError(path, "key 'parameters'", "no value for '" + names[j] + "'");
   }
+  CheckMatrices(out);
   ReadCovariance(doc, path, out);
   return out;
 }

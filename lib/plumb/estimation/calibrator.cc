@@ -152,7 +152,7 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   fit.motion_segments = static_cast<int>(problem.still().motions.size());
   for (const MotionInterval& m : problem.still().not_turns) {
     fit.not_turns.push_back({m.from, m.from + 1, series.t_s[m.first], series.t_s[m.last],
-                             options.max_motion_s});
+                             options.max_motion_s, m.flown});
   }
   problem.ReportResiduals(solution.all_free, fit);
   // Counted once: the advice, the one_pose gate and the JSON all say this number.
@@ -170,7 +170,8 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
                                    kLinearityStepSigmas, same ? &at.jacobian : nullptr, at.cost,
                                    same ? at.eliminated.get() : nullptr, options.run_jobs);
   }
-  fit.gates = CheckGates(series, segments, cal, fit);  // what says not to trust it (gates.h)
+  // What says not to trust it (gates.h).
+  fit.gates = CheckGates(series, segments, cal, options.log_motion, fit);
   if (!fitted.implausible_walk.empty()) {
     fit.gates.push_back(Gate{"implausible_walk", fitted.implausible_walk});
   }

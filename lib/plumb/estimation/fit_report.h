@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/log_motion.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/types.h"
 
@@ -51,6 +52,9 @@ struct NotATurn {
   std::size_t from = 0, to = 0;  ///< still segment indices
   double t_begin_s = 0.0, t_end_s = 0.0;
   double limit_s = 0.0;          ///< the longest motion the fit integrates
+  /// What the log says the vehicle did in it, when that is why it is left out (else its
+  /// length, beyond limit_s).
+  std::optional<LogMotion> flown;
 };
 
 /// The whitened problem at the optimum with the columns of the model's probe terms

@@ -29,6 +29,14 @@ std::string Exact(double v) {
   return buf;
 }
 
+/// A time or a duration to a tenth of a second ("%.1f"): log times since boot and unix times
+/// alike ("1710773367.1", not "1.711e+09").
+std::string Tenth(double t) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.1f", t);
+  return buf;
+}
+
 /// "N thing" or "N things".
 std::string Count(std::size_t n, const std::string& thing) {
   return std::to_string(n) + " " + thing + (n == 1 ? "" : "s");
@@ -175,6 +183,26 @@ std::optional<Gate> OutOfRange(const ImuSeries& series, const SampleScan& scan) 
                   " s (sample " + std::to_string(first) + "): " + sample +
                   ". A corrupt log (flipped bytes, a bad record) or a wrong unit: cut them out "
                   "(--from/--to, --segments) or fix the input before trusting this fit"};
+}
+
+/// out_of_range for the sensor's temperature: readings beyond kMinTemperatureC ..
+/// kMaxTemperatureC or not finite, counted, the first named (nullopt without any).
+std::optional<Gate> TemperatureOutOfRange(const ImuSeries& series) {
+  std::size_t bad = 0, first = 0;
+  for (std::size_t i = 0; i < series.temp_c.size(); ++i) {
+    const float c = series.temp_c[i];
+    if (c >= kMinTemperatureC && c <= kMaxTemperatureC) continue;  // false for NaN too
+    if (bad++ == 0) first = i;
+  }
+  if (bad == 0) return std::nullopt;
+  return Gate{"out_of_range",
+              Count(bad, "temperature") + " outside any MEMS IMU's operating range (beyond " +
+                  Num(kMinTemperatureC) + " .. " + Num(kMaxTemperatureC) +
+                  " degC, or not finite); the first at t = " + Num(series.t_s[first]) +
+                  " s (sample " + std::to_string(first) + "): " +
+                  Exact(series.temp_c[first]) +
+                  " degC. A corrupt log or a column that is not degC: cut them out "
+                  "(--from/--to) or fix the input before trusting a temperature model"};
 }
 
 /// Runs of samples at one axis's extreme value outside the still segments.
@@ -553,10 +581,16 @@ std::string NotATurnText(const FitReport& fit, const NotATurn& m) {
   auto label = [&](std::size_t k) {
     return k < fit.still.size() ? "'" + fit.still[k].segment.label + "'" : "#" + std::to_string(k);
   };
-  auto tenth = [](double t) { return Num(std::round(t * 10.0) / 10.0); };
-  return "the motion " + tenth(m.t_begin_s) + "-" + tenth(m.t_end_s) + " s (" +
-         tenth(m.t_end_s - m.t_begin_s) + " s) between " + label(m.from) + " and " + label(m.to) +
-         " is left out of the fit, not a turn: longer than " + Num(m.limit_s) +
+  const std::string motion = "the motion " + Tenth(m.t_begin_s) + "-" + Tenth(m.t_end_s) +
+                             " s (" + Tenth(m.t_end_s - m.t_begin_s) + " s) between " +
+                             label(m.from) + " and " + label(m.to) +
+                             " is left out of the fit, not a turn: ";
+  if (m.flown) {
+    return motion + "the log says the vehicle was " + Describe(*m.flown) +
+           ", a flight or a vehicle carried, whose vibration and translation logged samples "
+           "do not resolve";
+  }
+  return motion + "longer than " + Num(m.limit_s) +
          " s, more than a MEMS gyroscope integrates to its noise (a flight, a vehicle carried)";
 }
 
@@ -564,7 +598,15 @@ std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillS
   std::vector<Gate> gates;
   StillRanges ranges(still);
   const SampleScan scan = Scan(series, ranges);
-  if (auto g = OutOfRange(series, scan)) gates.push_back(*g);
+  std::optional<Gate> range = OutOfRange(series, scan);
+  if (auto t = TemperatureOutOfRange(series)) {
+    if (range) {
+      range->message += "; and " + t->message;
+    } else {
+      range = t;
+    }
+  }
+  if (range) gates.push_back(*range);
   if (auto g = Saturated(series, SaturationRuns(series, still, scan, ranges))) gates.push_back(*g);
   return gates;
 }
@@ -597,11 +639,13 @@ double Scatter(const std::vector<Vec3f>& v, std::size_t begin, std::size_t end) 
   return ((sum2 / n - mean.cwiseProduct(mean)).cwiseMax(0.0)).cwiseSqrt().maxCoeff();
 }
 
-/// One sensor's scatter per segment, SI (the output divided by the fitted scale).
+/// One sensor's scatter per segment, SI: as logged for SI samples (`si`), else divided by the
+/// fitted scale (counts per SI unit). SI samples are not divided by the fit's scale: a fit
+/// left without turns (not_a_turn) or poses (one_pose) leaves it undetermined, at any value.
 std::vector<double> ScatterSi(const std::vector<Vec3f>& v,
                               const std::vector<const StillSegmentFit*>& still,
-                              const Mat3& matrix) {
-  const double scale = matrix.diagonal().cwiseAbs().mean();
+                              const Mat3& matrix, bool si) {
+  const double scale = si ? 1.0 : matrix.diagonal().cwiseAbs().mean();
   std::vector<double> out;
   for (const StillSegmentFit* s : still) {
     out.push_back(Scatter(v, s->segment.begin, s->segment.end) / (scale > 0 ? scale : 1.0));
@@ -624,16 +668,17 @@ std::string Unstill(const std::vector<double>& scatter, std::size_t k, double li
 
 /// The not_still gate (gates.h).
 std::optional<Gate> NotStill(const ImuSeries& series, const Calibration& cal,
-                             const FitReport& fit) {
+                             const std::vector<LogMotion>& log_motion, const FitReport& fit) {
   // At rest only: a turntable's spinning segments are meant to move.
   const std::vector<const StillSegmentFit*> rest = AtRest(fit.still);
   if (rest.empty()) return std::nullopt;
-  const std::vector<double> acc = ScatterSi(series.acc, rest, cal.AccelMatrix());
+  const std::vector<double> acc = ScatterSi(series.acc, rest, cal.AccelMatrix(), SiAccel(series));
   const bool gyro = cal.has_gyro && series.has_gyro();
-  const std::vector<double> gyr = gyro ? ScatterSi(series.gyr, rest, cal.GyroMatrix())
-                                       : std::vector<double>();
+  const std::vector<double> gyr =
+      gyro ? ScatterSi(series.gyr, rest, cal.GyroMatrix(), SiGyro(series)) : std::vector<double>();
   std::string list;
   int count = 0;
+  bool flown = false;  // some segment falls where the log says the vehicle flew or moved
   for (std::size_t k = 0; k < rest.size(); ++k) {
     std::string why = Unstill(acc, k, kNotStillAccel, kStillScatterFloorAccel,
                               "accelerometer", "m/s^2");
@@ -642,19 +687,28 @@ std::optional<Gate> NotStill(const ImuSeries& series, const Calibration& cal,
           Unstill(gyr, k, kNotStillGyro, kStillScatterFloorGyro, "gyroscope", "rad/s");
       if (!g.empty()) why += (why.empty() ? "" : ", ") + g;
     }
+    const StillSegment& seg = rest[k]->segment;
+    for (const LogMotion& m : log_motion) {
+      if (!m.Covers(series.t_s[seg.begin], series.t_s[seg.end - 1])) continue;
+      why += (why.empty() ? "" : ", ") + std::string("the log says the vehicle was ") + Describe(m);
+      flown = true;
+      break;
+    }
     if (why.empty()) continue;
     ++count;
     if (count <= 3) {
       const StillSegmentFit& s = *rest[k];
       list += std::string(list.empty() ? "" : "; ") + "'" + s.segment.label + "' (" +
-              Num(series.t_s[s.segment.begin]) + "-" + Num(series.t_s[s.segment.end - 1]) +
+              Tenth(series.t_s[s.segment.begin]) + "-" + Tenth(series.t_s[s.segment.end - 1]) +
               " s): " + why;
     }
   }
   if (count == 0) return std::nullopt;
   return Gate{"not_still",
               std::to_string(count) + " of " + std::to_string(rest.size()) +
-                  " still segments scatter far beyond an IMU at rest, per sample: " + list +
+                  " still segments scatter far beyond an IMU at rest, per sample" +
+                  (flown ? ", or fall where the log says the vehicle flew or moved" : "") +
+                  ": " + list +
                   (count > 3 ? "; ..." : "") +
                   ". A flight, running motors or a vehicle carried is not a still pose, and "
                   "the noise measured there is motion: give the still periods (a segments "
@@ -664,7 +718,7 @@ std::optional<Gate> NotStill(const ImuSeries& series, const Calibration& cal,
 }  // namespace
 
 std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibration,
-                           FitReport& fit) {
+                           const std::vector<LogMotion>& log_motion, FitReport& fit) {
   std::vector<Gate> gates;
   if (!fit.converged) gates.push_back(NotConverged(fit));
   const auto one_pose = OnePose(series, calibration, fit);
@@ -672,7 +726,7 @@ std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibrati
   if (fit.converged && !one_pose) {
     if (auto g = Nonlinear(fit)) gates.push_back(*g);
   }
-  if (auto g = NotStill(series, calibration, fit)) gates.push_back(*g);
+  if (auto g = NotStill(series, calibration, log_motion, fit)) gates.push_back(*g);
   if (auto g = NotATurnGate(calibration, fit)) gates.push_back(*g);
   const auto rest = Plausible(AtRest(fit.still), calibration);
   if (rest.empty()) return gates;
@@ -683,9 +737,10 @@ std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibrati
 }
 
 std::vector<Gate> CheckGates(const ImuSeries& series, const std::vector<StillSegment>& still,
-                             const Calibration& calibration, FitReport& fit) {
+                             const Calibration& calibration,
+                             const std::vector<LogMotion>& log_motion, FitReport& fit) {
   std::vector<Gate> gates = CheckSamples(series, still);
-  for (auto& g : CheckFit(series, calibration, fit)) gates.push_back(std::move(g));
+  for (auto& g : CheckFit(series, calibration, log_motion, fit)) gates.push_back(std::move(g));
   return gates;
 }
 

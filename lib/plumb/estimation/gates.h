@@ -10,7 +10,8 @@
 //                  attitudes, one per three when some attitude is known: 9 or 3 for base)
 //   out_of_range   samples no IMU can give: |accel| > kMaxAccelG g or |gyro| >
 //                  kMaxGyroDegS deg/s on any axis in SI data, |value| > kMaxCounts in raw
-//                  counts, or not finite
+//                  counts, or not finite; a temperature beyond kMinTemperatureC ..
+//                  kMaxTemperatureC or not finite
 //   unit_or_rate   a unit or a sample rate the data contradict: the still accelerometer's
 //                  norm against gravity (raw, SI data; and corrected, F^-1 (mean - b_a)), the
 //                  still gyroscope's norm against Earth rate plus a plausible bias (SI data),
@@ -24,13 +25,17 @@
 //   nonlinear      chi^2 is far from the quadratic the covariance assumes, a few sigma out from
 //                  the solution (linearity.h): the covariance does not describe the fit's
 //                  error (only on a converged fit of enough poses)
-//   not_still      a still segment whose samples scatter (RMS about its mean, per axis, in SI
-//                  through the fitted scale) more than kNotStillAccel or kNotStillGyro, or more
+//   not_still      a still segment whose samples scatter (RMS about its mean, per axis, SI; raw
+//                  counts through the fitted scale) more than kNotStillAccel or kNotStillGyro, or more
 //                  than kNotStillRatio times the session's quietest segment: a flight, running
 //                  motors, a vehicle carried, not a pose at rest (the detector adapts to the
-//                  data's own scatter, so a session that is all motion can pass it)
+//                  data's own scatter, so a session that is all motion can pass it); or one
+//                  during which the log says the vehicle flew or moved (its land detector,
+//                  its GPS: CalibrationOptions::log_motion), however quiet its samples (a
+//                  smooth cruise, a hover, logged at tens of hertz)
 //   not_a_turn     motion between two poses left out of the fit as no turn (longer than
-//                  CalibrationOptions::max_motion_s: a flight, a vehicle carried; the
+//                  CalibrationOptions::max_motion_s, or during which the log says the vehicle
+//                  flew or moved: a flight, a vehicle carried; the
 //                  poses after it start a chain of their own), where that leaves the
 //                  gyroscope's matrix (scale and misalignment, which only turns determine)
 //                  undetermined or known only to more than kNotATurnMatrixSigma
@@ -86,6 +91,12 @@ inline constexpr double kMaxAccelG = 32.0;
 inline constexpr double kMaxGyroDegS = 4000.0;
 inline constexpr double kMaxCounts = 1048576.0;
 
+/// out_of_range, the temperature: a MEMS IMU operates within -40 .. 85 degC (consumer and
+/// industrial parts; automotive ones to 125), its die reading some 10-20 degC above the air;
+/// beyond kMinTemperatureC .. kMaxTemperatureC a reading is corrupt or not in degC.
+inline constexpr float kMinTemperatureC = -60.0f;
+inline constexpr float kMaxTemperatureC = 150.0f;
+
 /// saturated: samples in a row at the axis's extreme, outside the still segments; in SI data
 /// the extreme must also be beyond kSaturationMinAccelG g or kSaturationMinGyroDegS deg/s
 /// (below the smallest full scales, 2 g and 125 deg/s), in counts beyond 1.5 times the still
@@ -123,14 +134,17 @@ std::string NotATurnText(const FitReport& fit, const NotATurn& m);
 /// out_of_range and saturated, on the samples and the still segments (given or detected).
 std::vector<Gate> CheckSamples(const ImuSeries& series, const std::vector<StillSegment>& still);
 
-/// not_converged, one_pose, not_still, not_a_turn and unit_or_rate, on a finished fit (its still segments, noise
-/// levels, parameters and fit.distinct_poses, which Calibrate counts with CountDistinctPoses).
+/// not_converged, one_pose, not_still, not_a_turn and unit_or_rate, on a finished fit (its
+/// still segments, noise levels, parameters and fit.distinct_poses, which Calibrate counts
+/// with CountDistinctPoses), and what the log says the vehicle did (`log_motion`,
+/// CalibrationOptions::log_motion).
 std::vector<Gate> CheckFit(const ImuSeries& series, const Calibration& calibration,
-                           FitReport& fit);
+                           const std::vector<LogMotion>& log_motion, FitReport& fit);
 
 /// CheckSamples then CheckFit: what Calibrate puts in FitReport::gates.
 std::vector<Gate> CheckGates(const ImuSeries& series, const std::vector<StillSegment>& still,
-                             const Calibration& calibration, FitReport& fit);
+                             const Calibration& calibration,
+                             const std::vector<LogMotion>& log_motion, FitReport& fit);
 
 /// Distinct poses among the fit's still segments at rest (the one_pose rule above), given the
 /// noise levels the fit was whitened with: the one count of poses (FitReport::distinct_poses,

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "plumb/core/jobs.h"
+#include "plumb/core/log_motion.h"
 #include "plumb/core/typical_mems.h"
 #include "plumb/signal/noise_terms.h"
 
@@ -29,6 +30,11 @@ struct CalibrationOptions {
   /// Motion intervals longer than this are not integrated, s (> 0): the attitude before and
   /// after are then treated as unrelated and each chain gets its own heading gauge.
   double max_motion_s = 120.0;
+  /// Where the log says the vehicle flew or moved (Session::log_motion, core/log_motion.h), on
+  /// the samples' clock: a motion interval one covers (LogMotion::Covers: more than its edges)
+  /// is no turn and is left out like one longer than max_motion_s; a still segment one covers
+  /// fails the not_still gate. Empty: the input says nothing of it.
+  std::vector<LogMotion> log_motion;
   /// Heading of the first still segment's x axis from north, degrees, if the user states it
   /// (e.g. 0 for "x points north"); otherwise the heading gauge is held at its initial value.
   std::optional<double> first_heading_deg;

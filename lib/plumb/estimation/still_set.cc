@@ -73,11 +73,19 @@ StillSet MakeStillSet(const ImuSeries& series, const std::vector<StillSegment>& 
     const std::size_t last = set.poses[k + 1].segment.begin;
     const double gap = series.t_s[last] - series.t_s[first];
     if (!motion_on || last <= first) continue;
-    if (gap > options.max_motion_s) {
-      set.not_turns.push_back({k, first, last});
+    const auto flown = std::find_if(
+        options.log_motion.begin(), options.log_motion.end(), [&](const LogMotion& m) {
+          return m.Covers(series.t_s[first], series.t_s[last]);
+        });
+    if (flown != options.log_motion.end()) {
+      set.not_turns.push_back({k, first, last, *flown});
       continue;
     }
-    set.motions.push_back({k, first, last});
+    if (gap > options.max_motion_s) {
+      set.not_turns.push_back({k, first, last, std::nullopt});
+      continue;
+    }
+    set.motions.push_back({k, first, last, std::nullopt});
   }
   set.joined_to_previous.assign(set.poses.size(), false);
   for (const auto& m : set.motions) set.joined_to_previous[m.from + 1] = true;

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "plumb/core/imu_series.h"
@@ -42,14 +43,19 @@ struct StillPose {
 struct MotionInterval {
   std::size_t from = 0;
   std::size_t first = 0, last = 0;
+  /// For a motion left out (StillSet::not_turns): what the log says the vehicle did in it, when
+  /// that is the reason; empty when the motion is left out for its length.
+  std::optional<LogMotion> flown;
 };
 
 struct StillSet {
   std::vector<StillPose> poses;          ///< in time order
   std::vector<MotionInterval> motions;   ///< in time order
-  /// Motion between consecutive poses longer than CalibrationOptions::max_motion_s: not a
-  /// turn (no MEMS gyroscope integrates to its noise that long; a flight, a vehicle carried),
-  /// left out of the fit (the poses after it start a chain of their own).
+  /// Motion between consecutive poses longer than CalibrationOptions::max_motion_s (no MEMS
+  /// gyroscope integrates to its noise that long; a flight, a vehicle carried), or during
+  /// which the log says the vehicle flew or moved (CalibrationOptions::log_motion: a flight's
+  /// vibration and translation, which samples logged at tens of hertz do not resolve): not a
+  /// turn, left out of the fit (the poses after it start a chain of their own).
   std::vector<MotionInterval> not_turns;
   std::vector<bool> joined_to_previous;  ///< per pose: a motion interval leads into it
 

@@ -131,9 +131,37 @@ std::string SourceNote(const char* sensor, const SensorNoise& n) {
 
 }  // namespace
 
+std::string RosTopicProblem(const std::string& topic) {
+  if (topic.empty()) return "an empty name";
+  const auto letter = [](char ch) { return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z'); };
+  const auto digit = [](char ch) { return ch >= '0' && ch <= '9'; };
+  for (std::size_t k = 0; k < topic.size(); ++k) {
+    const char ch = topic[k];
+    const bool allowed = letter(ch) || digit(ch) || ch == '_' || ch == '/' || (k == 0 && ch == '~');
+    if (!allowed) {
+      const unsigned code = static_cast<unsigned char>(ch);
+      char what[32];
+      std::snprintf(what, sizeof what, code < 32 || code > 126 ? "byte 0x%02x" : "'%c'", code);
+      return std::string(what) + " at " + std::to_string(k) +
+             ": a ROS name holds letters, digits, '_' and '/' only";
+    }
+  }
+  const std::size_t start = topic.find_first_not_of("~/");
+  if (start == std::string::npos || !letter(topic[start])) {
+    return "a ROS name starts with a letter (after a leading '/' or '~')";
+  }
+  if (topic.find("//") != std::string::npos || topic.back() == '/') {
+    return "an empty part between '/' separators";
+  }
+  return "";
+}
+
 KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
                       const std::vector<estimation::StillSegmentFit>& still,
                       const std::string& rostopic) {
+  if (const std::string p = RosTopicProblem(rostopic); !p.empty()) {
+    throw Error("the Kalibr topic is not a ROS topic name (" + p + ")");
+  }
   if (c.acc_unit != "m/s^2" || (c.has_gyro && c.gyr_unit != "rad/s")) {
     throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: Kalibr's noise densities are in SI, so plumb cannot "

@@ -77,10 +77,16 @@ struct KalibrImu {
   double gyroscope_random_walk() const { return gyro.walk.maxCoeff(); }
 };
 
+/// Why `topic` is not a ROS topic name ("" when it is): ROS names are letters, digits, '_'
+/// and '/' separators, starting with a letter, '/' or '~' ("/imu0", "~imu", "vio/imu"), with
+/// no empty part. What reaches the YAML file is checked, so no text can add keys to it.
+std::string RosTopicProblem(const std::string& topic);
+
 /// The noise of the session (file comment): the IEEE terms of the still segments `still`
 /// where resolved, otherwise the calibration's noise levels checked with the Allan deviation
-/// of the longest still segment that is not turning. Throws plumb::Error when the outputs are
-/// not in SI or the series has fewer than two samples.
+/// of the longest still segment that is not turning. Throws plumb::Error when `rostopic` is
+/// not a ROS topic name (RosTopicProblem), the outputs are not in SI or the series has fewer
+/// than two samples.
 KalibrImu KalibrNoise(const estimation::Calibration& calibration, const ImuSeries& series,
                       const std::vector<estimation::StillSegmentFit>& still,
                       const std::string& rostopic);

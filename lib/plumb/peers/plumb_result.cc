@@ -4,6 +4,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
 #include "plumb/peers/json_fields.h"
 
@@ -37,6 +38,10 @@ void ReadSensor(const json& root, const std::string& name, const std::string& pa
                            path, name + ".matrix");
   bias = detail::Vector3(Field(sensor, "bias", path, name + ".bias", "[x, y, z]"), path,
                          name + ".bias");
+  if (const std::string p = SensorMatrixProblem(matrix); !p.empty()) {
+    throw InputError(path, KeyPlace(name + ".matrix"),
+                     "the matrix is " + p + ": not a sensor's calibration");
+  }
 }
 
 PlumbParameter ReadParameter(const json& p, const std::string& path, std::size_t index) {
@@ -49,6 +54,10 @@ PlumbParameter ReadParameter(const json& p, const std::string& path, std::size_t
                                    where + ".value");
   if (p.contains("sigma") && !p.at("sigma").is_null()) {
     out.sigma = detail::FiniteNumber(p.at("sigma"), path, where + ".sigma");
+    if (*out.sigma < 0.0) {
+      throw InputError(path, KeyPlace(where + ".sigma"),
+                       "expected a standard deviation >= 0, not " + p.at("sigma").dump());
+    }
   }
   out.observable = BoolOr(p, "observable", true);
   out.fixed = BoolOr(p, "fixed", false);
@@ -93,6 +102,14 @@ void ReadCovariance(const json& cov, const std::string& path, PlumbResult& r) {
     for (Eigen::Index j = 0; j < n; ++j) {
       r.covariance(i, j) = detail::FiniteNumber(row[static_cast<std::size_t>(j)], path, where);
     }
+  }
+  if (const auto repeat = FirstRepeat(r.covariance_names)) {
+    throw InputError(path, KeyPlace("covariance.parameters[" + std::to_string(repeat->first) + "]"),
+                     "'" + r.covariance_names[repeat->first] + "' given twice (first at [" +
+                         std::to_string(repeat->second) + "])");
+  }
+  if (const std::string p = CovarianceProblem(r.covariance); !p.empty()) {
+    throw InputError(path, KeyPlace("covariance.matrix"), p);
   }
   r.sigma_scaled_by_chi2 = cov.contains("sigma_scaled_by_chi2") &&
                            cov.at("sigma_scaled_by_chi2").is_boolean() &&
@@ -163,8 +180,15 @@ PlumbResult ReadPlumbResult(const std::string& path) {
 
   const json& params = Field(root, "parameters", path, "parameters", "a list of parameters");
   if (!params.is_array()) throw InputError(path, KeyPlace("parameters"), "expected a list");
+  std::vector<std::string> names;
   for (std::size_t i = 0; i < params.size(); ++i) {
     r.parameters.push_back(ReadParameter(params[i], path, i));
+    names.push_back(r.parameters.back().name);
+  }
+  if (const auto repeat = FirstRepeat(names)) {
+    throw InputError(path, KeyPlace("parameters[" + std::to_string(repeat->first) + "].name"),
+                     "'" + names[repeat->first] + "' given twice (first at parameters[" +
+                         std::to_string(repeat->second) + "])");
   }
   if (root.contains("segments")) {
     const json& segments = root.at("segments");

@@ -41,6 +41,7 @@ FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResu
   out.model.t_ref_s = session.series.t_s.front();
   out.model.temp_ref_c = request.temp_ref_c;
   out.options = std::move(request.options);
+  out.options.log_motion = session.log_motion;
   return out;
 }
 

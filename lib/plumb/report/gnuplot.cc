@@ -5,8 +5,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -37,9 +41,10 @@ std::string FirstLines(const std::string& path, int lines) {
 }
 
 /// Starts `program script` in `folder` with stdin /dev/null and stdout, stderr to `log_path`
-/// (absolute), waits for it; returns the spawn error (0 when started) and the exit status.
+/// (absolute), waits for it up to `limit_s` (then kills it: `stopped`); returns the spawn
+/// error (0 when started) and the exit status.
 int Spawn(const std::string& folder, const std::string& program, const std::string& script,
-          const std::string& log_path, int& exit_code) {
+          const std::string& log_path, double limit_s, int& exit_code, bool& stopped) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
@@ -55,8 +60,20 @@ int Spawn(const std::string& folder, const std::string& program, const std::stri
   exit_code = -1;
   if (error != 0) return error;
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return 0;
+  stopped = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit_s);
+  for (;;) {
+    const pid_t done = waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) return 0;
+    if (std::chrono::steady_clock::now() >= deadline) {
+      kill(pid, SIGKILL);
+      while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      stopped = true;
+      return 0;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   if (WIFEXITED(status)) exit_code = WEXITSTATUS(status);
   return 0;
@@ -79,12 +96,14 @@ std::string GnuplotQuote(const std::string& text) {
 }
 
 GnuplotOutcome RunGnuplot(const std::string& folder, const GnuplotJob& job,
-                          const std::string& program) {
+                          const std::string& program, double limit_s) {
   for (const auto& file : job.data) io::WriteFileAtomic(Join(folder, file.name), file.content);
   io::WriteFileAtomic(Join(folder, job.script_name), job.script);
   const std::string log_path = std::filesystem::absolute(Join(folder, job.log_name)).string();
   GnuplotOutcome outcome;
-  const int error = Spawn(folder, program, job.script_name, log_path, outcome.exit_code);
+  bool stopped = false;
+  const int error =
+      Spawn(folder, program, job.script_name, log_path, limit_s, outcome.exit_code, stopped);
   if (error == ENOENT) {
     outcome.message = "'" + program + "' was not found on the PATH: install gnuplot (Debian: "
                       "apt-get install gnuplot-nox) and run 'gnuplot " + job.script_name +
@@ -106,7 +125,13 @@ GnuplotOutcome RunGnuplot(const std::string& folder, const GnuplotJob& job,
       missing.push_back(name);
     }
   }
-  if (!outcome.ran) {
+  if (stopped) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", limit_s);
+    outcome.message = "'" + program + " " + job.script_name + "' did not finish within " +
+                      limit + " s and was stopped: no figures (is it waiting for input, or a "
+                      "window?)";
+  } else if (!outcome.ran) {
     outcome.message = "'" + program + " " + job.script_name + "' failed (" +
                       (outcome.exit_code < 0 ? std::string("killed")
                                              : "exit " + std::to_string(outcome.exit_code)) +

@@ -61,11 +61,18 @@ std::string SvgTerminal(int width_px, int height_px);
 /// A string as a gnuplot single-quoted literal: 'text', with ' doubled.
 std::string GnuplotQuote(const std::string& text);
 
+/// How long gnuplot may draw a job, s: a report's figures take a second or two; a program
+/// that has not finished in this is stuck (a --gnuplot that waits for input, a hung X
+/// terminal) and is stopped, so that the report is written without its figures.
+inline constexpr double kGnuplotLimit_s = 120.0;
+
 /// Writes job.data and job.script into `folder` (which must exist), runs `program
-/// job.script_name` there (program looked up on PATH unless it contains '/'), and checks
-/// job.outputs. Throws plumb::Error naming the file when a data or script file cannot be
-/// written; everything else is reported in the outcome.
+/// job.script_name` there (program looked up on PATH unless it contains '/'), stops it
+/// (SIGKILL) when it has not finished within `limit_s`, and checks job.outputs. Throws
+/// plumb::Error naming the file when a data or script file cannot be written; everything else
+/// is reported in the outcome.
 GnuplotOutcome RunGnuplot(const std::string& folder, const GnuplotJob& job,
-                          const std::string& program = "gnuplot");
+                          const std::string& program = "gnuplot",
+                          double limit_s = kGnuplotLimit_s);
 
 }  // namespace plumb::report

@@ -283,6 +283,20 @@ json DetectionJson(const segmentation::DetectionDetail& d) {
 
 json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
+json LogMotionJson(const LogMotion& m) {
+  const bool gps = m.evidence == LogMotion::Evidence::kGpsMoving;
+  json j = {{"evidence", gps ? "gps_moving" : "airborne"},
+            {"t_begin_s", Number(m.t_begin_s)},
+            {"t_end_s", Number(m.t_end_s)},
+            {"source", m.source}};
+  if (gps) {
+    j["max_ground_speed_m_s"] = Number(m.max_ground_speed_m_s);
+    j["max_climb_m_s"] = Number(m.max_climb_m_s);
+    j["ground_distance_m"] = Number(m.ground_distance_m);
+  }
+  return j;
+}
+
 json Vector(const Vec3& v) { return json::array({Number(v.x()), Number(v.y()), Number(v.z())}); }
 
 json Matrix(const Mat3& m) {
@@ -372,11 +386,14 @@ json ToJson(const estimation::CalibrationResult& r) {
   for (const auto& m : r.fit.motion) doc["motion"].push_back(MotionJson(m));
   doc["not_turns"] = json::array();
   for (const auto& m : r.fit.not_turns) {
-    doc["not_turns"].push_back({{"from", m.from},
-                                {"to", m.to},
-                                {"t_begin_s", Number(m.t_begin_s)},
-                                {"t_end_s", Number(m.t_end_s)},
-                                {"limit_s", Number(m.limit_s)}});
+    json j = {{"from", m.from},
+              {"to", m.to},
+              {"t_begin_s", Number(m.t_begin_s)},
+              {"t_end_s", Number(m.t_end_s)},
+              {"limit_s", Number(m.limit_s)},
+              {"reason", m.flown ? "log_says_flown" : "too_long"}};
+    if (m.flown) j["log_motion"] = LogMotionJson(*m.flown);
+    doc["not_turns"].push_back(j);
   }
   doc["warnings"] = r.fit.warnings;
   if (!r.fit.notes.empty()) doc["notes"] = r.fit.notes;

@@ -56,6 +56,11 @@ namespace plumb::report {
 
 /// A finite number, or null when `value` is NaN or infinite.
 nlohmann::json Number(double value);
+
+/// What a log says the vehicle did (core/log_motion.h), as calibrate's not_turns[].log_motion
+/// and info's vehicle_motion[] give it: evidence "airborne" or "gps_moving", t_begin_s,
+/// t_end_s, source, and for the GPS max_ground_speed_m_s, max_climb_m_s, ground_distance_m.
+nlohmann::json LogMotionJson(const LogMotion& m);
 /// [x, y, z], non-finite entries null.
 nlohmann::json Vector(const Vec3& v);
 /// [[row x], [row y], [row z]], non-finite entries null.

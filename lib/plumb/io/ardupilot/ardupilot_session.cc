@@ -13,6 +13,7 @@
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/ardupilot_correction.h"
 #include "plumb/io/ardupilot/dataflash_format.h"
+#include "plumb/io/ardupilot/dataflash_parser.h"
 
 namespace plumb::io {
 namespace {
@@ -47,7 +48,70 @@ void WarnCorrectionChanges(const DataflashLog& log, const std::string& who,
   }
 }
 
+/// The time column of a GPS record, s since boot: TimeUS, or in the oldest layout (TimeMS the
+/// GPS's time of week, beside Week) the boot time T in ms. {-1, 0} without one.
+detail::DataflashTimeColumn GpsBootTime(const DataflashType& gps) {
+  if (const int c = gps.ColumnIndex("TimeUS"); c >= 0) return {c, 1e-6};
+  if (const int c = gps.ColumnIndex("T"); c >= 0 && gps.ColumnIndex("Week") >= 0) {
+    return {c, 1e-3};
+  }
+  return {};
+}
+
+/// The first GPS's velocity reports (GPS, or its records with I = 0), Status >= 3 a 3D fix,
+/// Spd the ground speed and VZ the vertical speed, m/s.
+std::vector<GpsVelocity> DataflashGpsVelocity(const DataflashLog& log) {
+  std::vector<GpsVelocity> out;
+  const DataflashType* gps = log.Find("GPS");
+  if (gps == nullptr || !gps->bodies_kept) return out;
+  const detail::DataflashTimeColumn time = GpsBootTime(*gps);
+  const int status = gps->ColumnIndex("Status");
+  const int spd = gps->ColumnIndex("Spd");
+  const int vz = gps->ColumnIndex("VZ");
+  const int instance = gps->ColumnIndex("I");
+  if (time.col < 0 || status < 0 || spd < 0) return out;
+  const auto at = [&](std::size_t r, int c) { return gps->Value(r, static_cast<std::size_t>(c)); };
+  for (std::size_t r = 0; r < gps->rows; ++r) {
+    if (instance >= 0 && at(r, instance) != 0.0) continue;
+    GpsVelocity v;
+    v.t_s = at(r, time.col) * time.scale;
+    v.fix_3d = at(r, status) >= 3;
+    v.ground_speed_m_s = at(r, spd);
+    v.climb_m_s = vz >= 0 ? at(r, vz) : 0.0;
+    if (std::isfinite(v.t_s)) out.push_back(v);
+  }
+  return out;
+}
+
+/// ArduPilot's land detector as its EV records give it (AP_Logger's LogEvent: NOT_LANDED 28
+/// airborne; LAND_COMPLETE 18 and DISARMED 11 landed). Only records with a TimeUS: the oldest
+/// layout's EV has no time, and its place among the other messages is not kept.
+std::vector<LandedState> DataflashLandedStates(const DataflashLog& log) {
+  std::vector<LandedState> out;
+  const DataflashType* ev = log.Find("EV");
+  if (ev == nullptr || !ev->bodies_kept) return out;
+  const int time = ev->ColumnIndex("TimeUS");
+  const int id = ev->ColumnIndex("Id");
+  if (time < 0 || id < 0) return out;
+  for (std::size_t r = 0; r < ev->rows; ++r) {
+    const double t = ev->Value(r, static_cast<std::size_t>(time)) * 1e-6;
+    const double e = ev->Value(r, static_cast<std::size_t>(id));
+    if (!std::isfinite(t)) continue;
+    if (e == 28.0) out.push_back({t, true, "NOT_LANDED"});
+    if (e == 18.0) out.push_back({t, false, "LAND_COMPLETE"});
+    if (e == 11.0) out.push_back({t, false, "DISARMED"});
+  }
+  return out;
+}
+
 }  // namespace
+
+std::vector<LogMotion> DataflashMotion(const DataflashLog& log, double t_end_s) {
+  std::vector<LogMotion> out =
+      AirborneIntervals(DataflashLandedStates(log), t_end_s, "EV");
+  for (LogMotion& m : GpsMotion(DataflashGpsVelocity(log), "GPS")) out.push_back(std::move(m));
+  return out;
+}
 
 std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
   const DataflashType* gps = log.Find("GPS");
@@ -94,6 +158,7 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
   s.warnings.insert(s.warnings.end(), undone.begin(), undone.end());
   WarnCorrectionChanges(log, label + ": ", &s.warnings);
   s.site = SiteFromDataflash(log);
+  s.log_motion = DataflashMotion(log, s.series.t_s.back());
   s.log_params = log.params;
   if (const auto id = log.params.find("SYSID_THISMAV"); id != log.params.end()) {
     s.system_id = static_cast<int>(id->second);
@@ -121,7 +186,7 @@ bool LooksLikeDataflash(const std::string& path) {
 RecordFilter ArdupilotSessionRecords() {
   RecordFilter filter;
   filter.keep = [](std::string_view name) {
-    for (const char* exact : {"FMT", "FMTU", "UNIT", "MULT", "PARM", "ISBH", "ISBD"}) {
+    for (const char* exact : {"FMT", "FMTU", "UNIT", "MULT", "PARM", "ISBH", "ISBD", "EV"}) {
       if (name == exact) return true;
     }
     // A family and its numbered instances: IMU, IMU2, IMU3; ACC, ACC1; GPS, GPS2.

@@ -20,6 +20,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "plumb/core/session.h"
 #include "plumb/io/ardupilot/dataflash.h"
@@ -38,6 +39,12 @@ struct ArdupilotSessionOptions {
 /// altitude (Alt, m above mean sea level, used as the height: the geoid separation, tens of
 /// metres, changes gravity by about 1e-5 relative). nullopt without such fixes.
 std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log);
+
+/// Where the log says the vehicle flew or moved (core/log_motion.h), on the IMU's clock (time
+/// since boot): airborne from its EV records (NOT_LANDED until LAND_COMPLETE or DISARMED, or
+/// until `t_end_s`, the log's last time), moving from its first GPS's Spd and VZ
+/// (io/common/log_common.h GpsMotion).
+std::vector<LogMotion> DataflashMotion(const DataflashLog& log, double t_end_s);
 
 /// The session of one IMU stream of a decoded log (see DataflashStream for the selection and
 /// ArdupilotSession's file comment for the undo). Throws plumb::InputError naming the log when

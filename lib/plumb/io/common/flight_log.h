@@ -10,6 +10,7 @@
 // ReadFlightLog()/FlightLogSession() dispatch on the file's content (not its name).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <map>
 #include <optional>
@@ -58,9 +59,24 @@ struct FlightLogSummary {
   std::size_t size_bytes = 0;          ///< file size, bytes
   std::vector<ImuStreamInfo> imus;     ///< every IMU stream
   std::optional<SiteInput> site;       ///< from the log's GPS, when it has a fix
+  /// Where the log says the vehicle flew or moved (its land detector, its GPS), on the IMU
+  /// streams' clock (for a tlog, its first stream's).
+  std::vector<LogMotion> motion;
   std::map<std::string, double> params;  ///< the calibration parameters in force (firmware names)
   std::vector<std::pair<std::string, std::size_t>> messages;  ///< (message, count), log order
   std::vector<std::string> warnings;   ///< what the reader skipped or repaired, with counts
 };
+
+/// The first and last sample times over the streams with samples, s ({0, 0} without any).
+inline std::pair<double, double> LogSpan(const std::vector<ImuStreamInfo>& imus) {
+  std::optional<std::pair<double, double>> span;
+  for (const ImuStreamInfo& i : imus) {
+    if (i.samples == 0) continue;
+    if (!span) span = std::pair<double, double>{i.t_start_s, i.t_end_s};
+    span->first = std::min(span->first, i.t_start_s);
+    span->second = std::max(span->second, i.t_end_s);
+  }
+  return span.value_or(std::pair<double, double>{0.0, 0.0});
+}
 
 }  // namespace plumb::io

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -399,6 +400,80 @@ std::string EmptyWindowMessage(const std::optional<double>& from_s,
   return "fewer than 2 samples in the time window " + at(from_s, "start") + " .. " +
          at(to_s, "end") + "; the stream spans " + Number(t_start_s) + " .. " +
          Number(t_end_s) + " s (log times, as plumb info shows them)";
+}
+
+}  // namespace plumb::io
+
+namespace plumb::io {
+
+std::vector<LogMotion> GpsMotion(std::vector<GpsVelocity> reports, const std::string& source) {
+  std::stable_sort(reports.begin(), reports.end(),
+                   [](const GpsVelocity& a, const GpsVelocity& b) { return a.t_s < b.t_s; });
+  std::vector<LogMotion> out;
+  const auto moving = [](const GpsVelocity& r) {
+    return r.fix_3d && std::isfinite(r.ground_speed_m_s) && std::isfinite(r.climb_m_s) &&
+           (r.ground_speed_m_s > kGpsMovingSpeed || std::abs(r.climb_m_s) > kGpsMovingSpeed);
+  };
+  std::size_t i = 0;
+  while (i < reports.size()) {
+    if (!moving(reports[i])) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i + 1;  // one past the run of moving reports
+    while (end < reports.size() && moving(reports[end])) ++end;
+    if (end - i >= 2) {
+      LogMotion m;
+      m.evidence = LogMotion::Evidence::kGpsMoving;
+      m.source = source;
+      m.t_begin_s = reports[i].t_s;
+      m.t_end_s = reports[end - 1].t_s;
+      for (std::size_t k = i; k < end; ++k) {
+        m.max_ground_speed_m_s = std::max(m.max_ground_speed_m_s, reports[k].ground_speed_m_s);
+        m.max_climb_m_s = std::max(m.max_climb_m_s, std::abs(reports[k].climb_m_s));
+        if (k > i) {
+          m.ground_distance_m += 0.5 * (reports[k].ground_speed_m_s +
+                                        reports[k - 1].ground_speed_m_s) *
+                                 (reports[k].t_s - reports[k - 1].t_s);
+        }
+      }
+      if (!out.empty() && m.t_begin_s - out.back().t_end_s < kGpsRunGap_s) {
+        LogMotion& last = out.back();
+        last.t_end_s = m.t_end_s;
+        last.max_ground_speed_m_s = std::max(last.max_ground_speed_m_s, m.max_ground_speed_m_s);
+        last.max_climb_m_s = std::max(last.max_climb_m_s, m.max_climb_m_s);
+        last.ground_distance_m += m.ground_distance_m;
+      } else {
+        out.push_back(m);
+      }
+    }
+    i = end;
+  }
+  return out;
+}
+
+std::vector<LogMotion> AirborneIntervals(std::vector<LandedState> events, double t_end_s,
+                                         const std::string& source) {
+  std::stable_sort(events.begin(), events.end(),
+                   [](const LandedState& a, const LandedState& b) { return a.t_s < b.t_s; });
+  std::vector<LogMotion> out;
+  std::optional<double> since;   // airborne from here
+  std::string since_what;
+  for (const LandedState& e : events) {
+    if (e.airborne && !since) {
+      since = e.t_s;
+      since_what = e.what;
+    } else if (!e.airborne && since) {
+      out.push_back({*since, std::max(*since, e.t_s), LogMotion::Evidence::kAirborne,
+                     source + " " + since_what + " .. " + e.what});
+      since.reset();
+    }
+  }
+  if (since) {
+    out.push_back({*since, std::max(*since, t_end_s), LogMotion::Evidence::kAirborne,
+                   source + " " + since_what + " .. the log's end"});
+  }
+  return out;
 }
 
 }  // namespace plumb::io

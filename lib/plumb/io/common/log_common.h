@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "plumb/core/log_motion.h"
 #include "plumb/core/session.h"
 #include "plumb/core/types.h"
 
@@ -237,5 +238,41 @@ inline Vec3f SaturatedFloat(const Vec3& v) {
 /// relative), source "gps". The three vectors have one entry per fix. nullopt when empty.
 std::optional<SiteInput> MedianSite(std::vector<double> lat_deg, std::vector<double> lon_deg,
                                     std::vector<double> height_m);
+
+/// One GPS velocity report as a log gives it, time on the samples' clock.
+struct GpsVelocity {
+  double t_s = 0.0;               ///< s
+  bool fix_3d = false;            ///< a 3D fix (or better): the speed means something
+  double ground_speed_m_s = 0.0;  ///< horizontal speed, m/s, >= 0
+  double climb_m_s = 0.0;         ///< vertical speed, m/s (either sign; 0 where not given)
+};
+
+/// The intervals during which `reports` (any order; taken in time order) show the vehicle
+/// moving: runs of at
+/// least two reports in a row with a 3D fix and a ground speed or climb magnitude above
+/// kGpsMovingSpeed, from the first such report to the last, runs less than kGpsRunGap_s apart
+/// joined. `source` names the message ("GPS", "vehicle_gps_position", "GPS_RAW_INT").
+std::vector<LogMotion> GpsMotion(std::vector<GpsVelocity> reports, const std::string& source);
+
+/// Runs of moving GPS reports closer than this, s, are one interval (a copter's hover between
+/// legs, a report or two under the threshold).
+inline constexpr double kGpsRunGap_s = 2.0;
+
+/// A land detector's state as a log records it: at t_s the vehicle is (or stops being)
+/// airborne.
+struct LandedState {
+  double t_s = 0.0;       ///< s, on the samples' clock
+  bool airborne = false;  ///< not landed from here on
+  std::string what;       ///< the event's name in the log ("NOT_LANDED", "LAND_COMPLETE", ...)
+};
+
+/// The airborne intervals of `events` (any order; taken in time order): from an event saying
+/// airborne to the next saying
+/// landed, or to `t_end_s` (the log's last time) when none follows. Before the first event
+/// the state is not known and taken as landed: a land detector that publishes on change
+/// (PX4) or logs events (ArduPilot) says "landed" first in a log that starts on the ground.
+/// `source` names the message ("EV", "vehicle_land_detected").
+std::vector<LogMotion> AirborneIntervals(std::vector<LandedState> events, double t_end_s,
+                                         const std::string& source);
 
 }  // namespace plumb::io

@@ -33,6 +33,7 @@ FlightLogSummary DataflashSummary(const DataflashLog& log, FlightLogFormat forma
   out.size_bytes = log.size_bytes;
   out.imus = DataflashImuStreams(log);
   out.site = SiteFromDataflash(log);
+  out.motion = DataflashMotion(log, LogSpan(out.imus).second);
   for (const auto& [name, value] : log.params) {
     if (IsArdupilotCalibrationParameter(name)) out.params[name] = value;
   }

@@ -15,6 +15,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
+#include "plumb/io/common/log_common.h"
 #include "plumb/io/common/text_scan.h"
 #include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/ardupilot/dataflash.h"
@@ -147,22 +148,52 @@ InputKind KindOf(const InputFile& input, const InputOptions& o) {
   return InputKind::kNativeCsv;
 }
 
+/// The samples of a text session inside the time window [from_s, to_s] (the file's own times:
+/// its time column, or the clock --rate gives), as a flight log's reader keeps its window.
+/// Throws InputError naming the file when fewer than 2 samples are left.
+void KeepWindow(Session& s, const FlightLogSelection& window) {
+  if (!window.from_s && !window.to_s) return;
+  ImuSeries& in = s.series;
+  if (in.empty()) return;
+  const double t_start = in.t_s.front(), t_end = in.t_s.back();
+  ImuSeries out;
+  out.acc_unit = in.acc_unit;
+  out.gyr_unit = in.gyr_unit;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const double t = in.t_s[i];
+    if ((window.from_s && t < *window.from_s) || (window.to_s && t > *window.to_s)) continue;
+    out.t_s.push_back(t);
+    out.acc.push_back(in.acc[i]);
+    if (in.has_gyro()) out.gyr.push_back(in.gyr[i]);
+    if (in.has_temperature()) out.temp_c.push_back(in.temp_c[i]);
+  }
+  if (out.size() < 2) {
+    throw InputError(s.source, "", EmptyWindowMessage(window.from_s, window.to_s, t_start, t_end));
+  }
+  in = std::move(out);
+}
+
 Session Read(const InputFile& input, InputKind kind, const InputOptions& o) {
+  const auto windowed = [&](Session s) {
+    KeepWindow(s, o.flight_log);
+    return s;
+  };
   switch (kind) {
     case InputKind::kTwoTables:
       if (o.format == InputFormat::kNative) {
         throw Error(input.path + "," + input.gyr_path +
                     ": the two-file form is a table, not native CSV");
       }
-      return ReadSplitTables(input.path, input.gyr_path, TableOptions(o, true), o.run_jobs);
+      return windowed(
+          ReadSplitTables(input.path, input.gyr_path, TableOptions(o, true), o.run_jobs));
     case InputKind::kFlightLog:
       return FlightLog::Open(input.path, o.run_jobs).Select(o.flight_log);
     case InputKind::kTextTable:
-      return ReadTextTable(input.path, TableOptions(o, false));
+      return windowed(ReadTextTable(input.path, TableOptions(o, false)));
     case InputKind::kNativeCsv:
       break;
   }
-  return ReadNative(input.path, o.format == InputFormat::kNative, o.not_native_hint);
+  return windowed(ReadNative(input.path, o.format == InputFormat::kNative, o.not_native_hint));
 }
 
 /// Joins `next` after `joined`, keeping the clock when it increases.

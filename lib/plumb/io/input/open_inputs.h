@@ -166,6 +166,8 @@ struct InputOptions {
 
   // ---- Flight logs ----
   /// The stream, the time window (log time, s) and whether the firmware's correction is undone.
+  /// The window (from_s, to_s) applies to every input, on its own times: a flight log's log
+  /// time, a table's time column or the clock its rate gives (each file of several alike).
   FlightLogSelection flight_log;
 
   // ---- Time ----

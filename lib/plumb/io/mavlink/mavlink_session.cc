@@ -23,6 +23,7 @@ constexpr double kMicro = 1e-6;                // s per µs
 constexpr double kDegE7 = 1e-7;                // degrees per degE7
 constexpr double kMilli = 1e-3;                // m per mm
 constexpr int kMinFix3d = 3;                   // GPS_FIX_TYPE_3D_FIX
+constexpr std::uint16_t kUnknownU16 = 65535;   // GPS_RAW_INT: a field not known
 constexpr std::uint64_t kWrap32 = 1ull << 32;  // a 32-bit µs counter wraps here (71.6 min)
 constexpr std::uint64_t kWrapMargin_us = 60000000ull;  // 60 s either side of the wrap
 
@@ -378,6 +379,47 @@ std::optional<SiteInput> SiteFromTlog(const MavlinkLog& log) {
   return MedianSite(std::move(lats), std::move(lons), std::move(alts));
 }
 
+std::vector<LogMotion> TlogMotion(const MavlinkLog& log, const std::vector<double>& log_time_s,
+                                  const std::vector<double>& t_s) {
+  std::vector<GpsVelocity> reports;
+  if (log_time_s.empty() || log_time_s.size() != t_s.size()) return {};
+  const std::optional<MavlinkVehicle> v = TlogVehicle(log);
+  for (const MavlinkGpsRawInt& g : log.gps_raw_int) {
+    if (v && g.system_id != v->system_id) continue;
+    if (g.vel_cm_s == kUnknownU16) continue;
+    // The IMU sample received nearest in tlog time carries the offset between the clocks.
+    const auto it = std::lower_bound(log_time_s.begin(), log_time_s.end(), g.log_time_s);
+    std::size_t k = static_cast<std::size_t>(it - log_time_s.begin());
+    if (k == log_time_s.size() ||
+        (k > 0 && g.log_time_s - log_time_s[k - 1] < log_time_s[k] - g.log_time_s)) {
+      --k;
+    }
+    GpsVelocity r;
+    r.t_s = t_s[k] + (g.log_time_s - log_time_s[k]);
+    r.fix_3d = g.fix_type >= kMinFix3d;
+    r.ground_speed_m_s = g.vel_cm_s * 0.01;
+    reports.push_back(r);
+  }
+  return GpsMotion(reports, "GPS_RAW_INT");
+}
+
+namespace {
+
+/// TlogMotion on the clock of stream `d`: the pairs (tlog time, sample time) of its samples in
+/// tlog order, tlog time increasing.
+std::vector<LogMotion> StreamMotion(const MavlinkLog& log, const StreamData& d) {
+  std::vector<double> log_time, t;
+  for (std::size_t i = 0; i < d.samples.size(); ++i) {
+    const bool later = log_time.empty() || d.samples[i].log_time_s > log_time.back();
+    if (!std::isfinite(d.t_s[i]) || !later) continue;
+    log_time.push_back(d.samples[i].log_time_s);
+    t.push_back(d.t_s[i]);
+  }
+  return TlogMotion(log, log_time, t);
+}
+
+}  // namespace
+
 std::map<std::string, double> TlogParams(const MavlinkLog& log) {
   const std::optional<MavlinkVehicle> v = TlogVehicle(log);
   const bool bytewise = v && v->autopilot == kMavAutopilotPx4;
@@ -483,6 +525,7 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
     s.warnings.push_back(who + "raw sensor output as sent");
   }
   s.site = SiteFromTlog(log);
+  s.log_motion = StreamMotion(log, d);
   return s;
 }
 
@@ -502,6 +545,10 @@ FlightLogSummary TlogSummary(const MavlinkLog& log) {
   }
   out.imus = TlogImuStreams(log);
   out.site = SiteFromTlog(log);
+  if (const std::optional<MavlinkVehicle> v = TlogVehicle(log)) {
+    const std::vector<StreamData> streams = AllStreams(log, *v);
+    if (!streams.empty()) out.motion = StreamMotion(log, streams.front());
+  }
   for (const auto& [name, value] : TlogParams(log)) {
     for (const char* prefix :
          {"INS_ACC", "INS_GYR", "INS_TCAL", "AHRS_ORIENTATION", "CAL_ACC", "CAL_GYRO"}) {

@@ -72,6 +72,13 @@ std::vector<ImuStreamInfo> TlogImuStreams(const MavlinkLog& log);
 /// nullopt without such fixes.
 std::optional<SiteInput> SiteFromTlog(const MavlinkLog& log);
 
+/// Where the tlog's GPS_RAW_INT (vel, cm/s, with fix_type >= 3) says the vehicle moved
+/// (core/log_motion.h), on the IMU stream's clock: each report placed by the IMU sample received
+/// nearest to it (`log_time_s`, increasing, tlog time; `t_s`, that sample's time), since the
+/// message's own time_usec may count from boot or from the unix epoch.
+std::vector<LogMotion> TlogMotion(const MavlinkLog& log, const std::vector<double>& log_time_s,
+                                  const std::vector<double>& t_s);
+
 /// The vehicle's parameters from PARAM_VALUE (param_id up to its first NUL, last value wins).
 /// ArduPilot (and any autopilot other than PX4) sends integer parameters converted to float
 /// (MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_C_CAST), so the float is the value; PX4 sends them

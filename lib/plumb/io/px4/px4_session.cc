@@ -227,13 +227,28 @@ ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topi
   return s;
 }
 
+/// The samples of `src`; with `notes`, what was left out is said there: samples whose time
+/// did not increase (Push), counted against the topic's messages.
 ImuSeries Extract(const StreamSource& src, std::vector<std::string>* notes) {
+  ImuSeries s;
   switch (src.kind) {
-    case StreamKind::kCombined: return FromCombined(*src.topic);
-    case StreamKind::kVehicleImu: return FromVehicleImu(*src.topic);
-    case StreamKind::kSensorAccel: return FromSensorAccel(*src.topic, src.gyro, notes);
+    case StreamKind::kCombined: s = FromCombined(*src.topic); break;
+    case StreamKind::kVehicleImu: s = FromVehicleImu(*src.topic); break;
+    case StreamKind::kSensorAccel: s = FromSensorAccel(*src.topic, src.gyro, notes); break;
   }
-  return {};
+  const std::size_t rows = src.topic->rows;
+  const bool paired_out = src.kind == StreamKind::kSensorAccel && src.gyro != nullptr;
+  if (notes != nullptr && !paired_out && s.size() < rows) {
+    notes->push_back(std::string(KindName(src.kind)) + " instance " +
+                     std::to_string(src.instance) + ": dropped " +
+                     std::to_string(rows - s.size()) + " of " + std::to_string(rows) +
+                     " messages whose time did not increase past the last kept one, or with "
+                     "no sample interval (a corrupt or backwards time stamp: one far ahead "
+                     "hides every sample after it)" +
+                     (s.empty() ? "" : "; the last kept at " + std::to_string(s.t_s.back()) +
+                                           " s"));
+  }
+  return s;
 }
 
 std::vector<StreamSource> Sources(const ULog& log) {
@@ -443,6 +458,63 @@ std::optional<SiteInput> SiteFromULog(const ULog& log) {
   return MedianSite(std::move(lats), std::move(lons), std::move(alts));
 }
 
+namespace {
+
+/// The velocity reports of the log's first GPS: vehicle_gps_position instance 0, else
+/// sensor_gps instance 0; vel_m_s the ground speed, vel_d_m_s the vertical (down) speed, m/s;
+/// fix_type >= 3 a 3D fix. Times are the topic's timestamp (us since boot), as the samples'.
+std::vector<GpsVelocity> ULogGpsVelocity(const ULog& log, std::string* source) {
+  std::vector<GpsVelocity> out;
+  for (const char* name : {"vehicle_gps_position", "sensor_gps"}) {
+    for (const ULogTopic& t : log.topics) {
+      if (t.name != name || t.multi_id != 0 || !t.bodies_kept) continue;
+      const int fix = t.ColumnIndex("fix_type");
+      const int speed = t.ColumnIndex("vel_m_s");
+      const int down = t.ColumnIndex("vel_d_m_s");
+      if (fix < 0 || speed < 0 || t.timestamp_col < 0) continue;
+      for (std::size_t r = 0; r < t.rows; ++r) {
+        GpsVelocity v;
+        v.t_s = static_cast<double>(t.TimestampUs(r)) * 1e-6;
+        v.fix_3d = t.Value(r, static_cast<std::size_t>(fix)) >= 3;
+        v.ground_speed_m_s = t.Value(r, static_cast<std::size_t>(speed));
+        v.climb_m_s = down >= 0 ? -t.Value(r, static_cast<std::size_t>(down)) : 0.0;
+        out.push_back(v);
+      }
+      *source = name;
+      return out;
+    }
+  }
+  return out;
+}
+
+/// vehicle_land_detected's `landed` field as a land detector's states (landed false:
+/// airborne), repeated states kept (AirborneIntervals reads the changes).
+std::vector<LandedState> ULogLandedStates(const ULog& log) {
+  std::vector<LandedState> out;
+  for (const ULogTopic& t : log.topics) {
+    if (t.name != "vehicle_land_detected" || t.multi_id != 0 || !t.bodies_kept) continue;
+    const int landed = t.ColumnIndex("landed");
+    if (landed < 0 || t.timestamp_col < 0) continue;
+    for (std::size_t r = 0; r < t.rows; ++r) {
+      const bool down = t.Value(r, static_cast<std::size_t>(landed)) != 0.0;
+      out.push_back({static_cast<double>(t.TimestampUs(r)) * 1e-6, !down,
+                     down ? "landed" : "not landed"});
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<LogMotion> ULogMotion(const ULog& log, double t_end_s) {
+  std::vector<LogMotion> out =
+      AirborneIntervals(ULogLandedStates(log), t_end_s, "vehicle_land_detected");
+  std::string source;
+  const std::vector<GpsVelocity> gps = ULogGpsVelocity(log, &source);
+  for (LogMotion& m : GpsMotion(gps, source)) out.push_back(std::move(m));
+  return out;
+}
+
 std::map<std::string, double> ULogParams(const ULog& log) {
   std::map<std::string, double> out;
   for (const auto& [name, value] : log.params) {
@@ -526,6 +598,7 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
     WarnParamChanges(log, &s);
   }
   s.site = SiteFromULog(log);
+  s.log_motion = ULogMotion(log, s.series.t_s.back());
   return s;
 }
 
@@ -542,6 +615,7 @@ FlightLogSummary ULogSummary(const ULog& log) {
   out.size_bytes = log.size_bytes;
   out.imus = ULogImuStreams(log);
   out.site = SiteFromULog(log);
+  out.motion = ULogMotion(log, LogSpan(out.imus).second);
   out.params = ULogParams(log);
   out.messages = log.MessageCounts();
   out.warnings = log.warnings.Describe();
@@ -567,7 +641,7 @@ RecordFilter Px4SessionTopics() {
   filter.keep = [](std::string_view name) {
     for (const char* topic : {"sensor_combined", "vehicle_imu", "vehicle_imu_status",
                               "sensor_accel", "sensor_gyro", "sensor_gps",
-                              "vehicle_gps_position"}) {
+                              "vehicle_gps_position", "vehicle_land_detected"}) {
       if (name == topic) return true;
     }
     return false;

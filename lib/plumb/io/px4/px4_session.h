@@ -51,6 +51,12 @@ std::vector<ImuStreamInfo> ULogImuStreams(const ULog& log);
 /// gravity by about 1e-5 relative). nullopt without such fixes.
 std::optional<SiteInput> SiteFromULog(const ULog& log);
 
+/// Where the log says the vehicle flew or moved (core/log_motion.h), on the samples' clock
+/// (us since boot * 1e-6): airborne while vehicle_land_detected says not landed (until it says
+/// landed, or `t_end_s`), moving by its first GPS (vehicle_gps_position, else sensor_gps:
+/// vel_m_s and vel_d_m_s with a 3D fix; io/common/log_common.h GpsMotion).
+std::vector<LogMotion> ULogMotion(const ULog& log, double t_end_s);
+
 /// The calibration parameters of the log's initial parameter set (names starting with
 /// CAL_ACC, CAL_GYRO, TC_A, TC_G or SENS_BOARD_), firmware names and units.
 std::map<std::string, double> ULogParams(const ULog& log);
@@ -74,7 +80,7 @@ bool LooksLikeULog(const std::string& path);
 
 /// The ULog topics a session and `plumb info` read the values of (sensor_combined,
 /// vehicle_imu, vehicle_imu_status, sensor_accel, sensor_gyro, sensor_gps,
-/// vehicle_gps_position): the filter FlightLog reads .ulg files with, so a big log keeps only
+/// vehicle_gps_position, vehicle_land_detected): the filter FlightLog reads .ulg files with, so a big log keeps only
 /// these bodies in memory. Its `decode` names sensor_combined: the reader decodes its samples
 /// in its pass and keeps those instead of the bodies (ULogTopic::imu).
 RecordFilter Px4SessionTopics();
