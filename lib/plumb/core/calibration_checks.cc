@@ -4,17 +4,14 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <cmath>
-#include <cstdio>
 #include <map>
+
+#include "plumb/core/number_text.h"
 
 namespace plumb {
 namespace {
 
-std::string Figure(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string Figure(double v) { return SignificantText(v, 3); }
 
 }  // namespace
 

@@ -2,17 +2,14 @@
 #include "plumb/core/log_motion.h"
 
 #include <algorithm>
-#include <cstdio>
+
+#include "plumb/core/number_text.h"
 
 namespace plumb {
 namespace {
 
 /// A time or speed to a tenth, as a user reads it ("228.1").
-std::string Tenth(double v) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.1f", v);
-  return buf;
-}
+std::string Tenth(double v) { return FixedText(v, 1); }
 
 }  // namespace
 
@@ -29,9 +26,8 @@ std::string Describe(const LogMotion& m) {
   }
   std::string what = "up to " + Tenth(m.max_ground_speed_m_s) + " m/s over ground";
   if (m.max_climb_m_s > 0.0) what += ", " + Tenth(m.max_climb_m_s) + " m/s climb or sink";
-  char metres[48];
-  std::snprintf(metres, sizeof metres, "%.0f m", m.ground_distance_m);
-  return "moving " + span + " by " + m.source + " (" + what + ", " + metres + ")";
+  return "moving " + span + " by " + m.source + " (" + what + ", " +
+         FixedText(m.ground_distance_m, 0) + " m)";
 }
 
 }  // namespace plumb

@@ -1,10 +1,10 @@
 #include "plumb/correction/apply.h"
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
 
 namespace plumb::correction {
 namespace {
@@ -122,9 +122,8 @@ CorrectedSeries ApplyCalibration(const CalibrationFile& calibration, const ImuSe
   for (std::size_t i = 0; i < series.size(); ++i) {
     const auto [f, w] = correct(i);
     if (!f.allFinite() || (series.has_gyro() && !w.allFinite())) {
-      char t[48];
-      std::snprintf(t, sizeof t, "%.6f", series.t_s[i]);
-      throw NonFiniteCorrection("sample " + std::to_string(i) + " (t = " + t +
+      throw NonFiniteCorrection("sample " + std::to_string(i) + " (t = " +
+                                FixedText(series.t_s[i], 6) +
                   " s) corrects to a value that is not finite: the sample is beyond any "
                   "sensor's range (a corrupt row) or the calibration " + calibration.path +
                   " cannot be inverted there; nothing written");

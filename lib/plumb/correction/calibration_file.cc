@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
 
 namespace plumb::correction {
 namespace {
@@ -64,10 +64,9 @@ const model::ParameterInfo& Info(const model::Model& model, int t, int i) {
 
 /// Why `value` is no sensor's (core/calibration_checks.h kMaxTypicals), with the figures.
 std::string NoSensors(double value, const model::ParameterInfo& info) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%.4g is no sensor's: more than %.0e times its typical magnitude (%.3g %s)",
-                value, kMaxTypicals, info.typical, info.unit.c_str());
-  return buf;
+  return SignificantText(value, 4) + " is no sensor's: more than " +
+         SignificantText(kMaxTypicals, 1) + " times its typical magnitude (" +
+         SignificantText(info.typical, 3) + " " + info.unit + ")";
 }
 
 /// The checks of core/calibration_checks.h on the sensors' matrices of `out`.

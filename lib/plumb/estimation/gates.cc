@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <optional>
 
+#include "plumb/core/number_text.h"
 #include "plumb/core/units.h"
 #include "plumb/model/effects/gyro_linear.h"
 
@@ -16,26 +16,14 @@ namespace {
 constexpr const char* kAxis[3] = {"x", "y", "z"};
 
 /// A number with 4 significant digits ("%.4g").
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
+std::string Num(double v) { return SignificantText(v, 4); }
 
 /// A sample value as logged, to float precision ("%.7g"): -32768, not -3.277e+04.
-std::string Exact(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.7g", v);
-  return buf;
-}
+std::string Exact(double v) { return SignificantText(v, 7); }
 
 /// A time or a duration to a tenth of a second ("%.1f"): log times since boot and unix times
 /// alike ("1710773367.1", not "1.711e+09").
-std::string Tenth(double t) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.1f", t);
-  return buf;
-}
+std::string Tenth(double t) { return FixedText(t, 1); }
 
 /// "N thing" or "N things".
 std::string Count(std::size_t n, const std::string& thing) {
