@@ -126,8 +126,13 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
   if (n < 2) return Vec3::Zero();  // no step: no velocity change
   // The wander along its line over the motion (file comment), per sensor.
   double const* const* wander = theta + model_->num_terms();
-  const auto [acc_from, acc_to] = WanderEnds(wander, accel_wander_);
-  const auto [gyr_from, gyr_to] = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
+  // Named, not structured bindings: a lambda may not capture those in C++17 (clang refuses).
+  const std::pair<Vec3, Vec3> acc_ends = WanderEnds(wander, accel_wander_);
+  const std::pair<Vec3, Vec3> gyr_ends = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
+  const Vec3& acc_from = acc_ends.first;
+  const Vec3& acc_to = acc_ends.second;
+  const Vec3& gyr_from = gyr_ends.first;
+  const Vec3& gyr_to = gyr_ends.second;
   const double t0 = s_.dt_s[0], span = std::max(s_.dt_s[n - 1] - t0, 1e-12);
   // Corrected specific force and rate of sample i.
   auto correct = [&](std::size_t i) -> std::pair<Vec3, Vec3> {
@@ -189,8 +194,12 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
   const int a_term = model_->BaseTerm(model::Sensor::kAccel);
   const int g_term = model_->BaseTerm(model::Sensor::kGyro);
   double const* const* wander = theta + model_->num_terms();
-  const auto [acc0, acc1] = WanderEnds(wander, accel_wander_);
-  const auto [gyr0, gyr1] = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
+  const std::pair<Vec3, Vec3> acc_ends = WanderEnds(wander, accel_wander_);
+  const std::pair<Vec3, Vec3> gyr_ends = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
+  const Vec3& acc0 = acc_ends.first;
+  const Vec3& acc1 = acc_ends.second;
+  const Vec3& gyr0 = gyr_ends.first;
+  const Vec3& gyr1 = gyr_ends.second;
   const double t0 = n > 0 ? s_.dt_s[0] : 0.0;
   const double span = n > 0 ? std::max(s_.dt_s[n - 1] - t0, 1e-12) : 1.0;
   struct Sample {
