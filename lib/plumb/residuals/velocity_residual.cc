@@ -99,14 +99,22 @@ struct LinearStage {
   Mat3 F_inv, E_inv;
 };
 
-/// The sum over `count` processes of the (b_from, b_to) block pairs starting at `blocks`.
-std::pair<Vec3, Vec3> WanderEnds(double const* const* blocks, int count) {
+/// A sensor's bias wander over the motion: the line from its value at the motion's start to
+/// its value at the end (the file comment), in output units.
+struct WanderLine {
   Vec3 from = Vec3::Zero(), to = Vec3::Zero();
+  /// The wander at fraction `u` of the motion, u in [0, 1].
+  Vec3 At(double u) const { return from + u * (to - from); }
+};
+
+/// The sum over `count` processes of the (b_from, b_to) block pairs starting at `blocks`.
+WanderLine WanderEnds(double const* const* blocks, int count) {
+  WanderLine line;
   for (int p = 0; p < count; ++p) {
-    from += Eigen::Map<const Vec3>(blocks[2 * p]);
-    to += Eigen::Map<const Vec3>(blocks[2 * p + 1]);
+    line.from += Eigen::Map<const Vec3>(blocks[2 * p]);
+    line.to += Eigen::Map<const Vec3>(blocks[2 * p + 1]);
   }
-  return {from, to};
+  return line;
 }
 
 }  // namespace
@@ -126,19 +134,14 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
   if (n < 2) return Vec3::Zero();  // no step: no velocity change
   // The wander along its line over the motion (file comment), per sensor.
   double const* const* wander = theta + model_->num_terms();
-  // Named, not structured bindings: a lambda may not capture those in C++17 (clang refuses).
-  const std::pair<Vec3, Vec3> acc_ends = WanderEnds(wander, accel_wander_);
-  const std::pair<Vec3, Vec3> gyr_ends = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
-  const Vec3& acc_from = acc_ends.first;
-  const Vec3& acc_to = acc_ends.second;
-  const Vec3& gyr_from = gyr_ends.first;
-  const Vec3& gyr_to = gyr_ends.second;
+  const WanderLine acc_wander = WanderEnds(wander, accel_wander_);
+  const WanderLine gyr_wander = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
   const double t0 = s_.dt_s[0], span = std::max(s_.dt_s[n - 1] - t0, 1e-12);
   // Corrected specific force and rate of sample i.
   auto correct = [&](std::size_t i) -> std::pair<Vec3, Vec3> {
     const double u = (s_.dt_s[i] - t0) / span;
-    const Vec3 y_a = s_.acc[i] - (acc_from + u * (acc_to - acc_from));
-    const Vec3 y_g = s_.gyr[i] - (gyr_from + u * (gyr_to - gyr_from));
+    const Vec3 y_a = s_.acc[i] - acc_wander.At(u);
+    const Vec3 y_g = s_.gyr[i] - gyr_wander.At(u);
     if (closed_form) return {F_inv * (y_a - b_a), E_inv * (y_g - b_g)};
     model::SensorInput<double> in;
     in.alpha_b = s_.alpha_b[i];
@@ -194,12 +197,8 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
   const int a_term = model_->BaseTerm(model::Sensor::kAccel);
   const int g_term = model_->BaseTerm(model::Sensor::kGyro);
   double const* const* wander = theta + model_->num_terms();
-  const std::pair<Vec3, Vec3> acc_ends = WanderEnds(wander, accel_wander_);
-  const std::pair<Vec3, Vec3> gyr_ends = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
-  const Vec3& acc0 = acc_ends.first;
-  const Vec3& acc1 = acc_ends.second;
-  const Vec3& gyr0 = gyr_ends.first;
-  const Vec3& gyr1 = gyr_ends.second;
+  const WanderLine acc_wander = WanderEnds(wander, accel_wander_);
+  const WanderLine gyr_wander = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
   const double t0 = n > 0 ? s_.dt_s[0] : 0.0;
   const double span = n > 0 ? std::max(s_.dt_s[n - 1] - t0, 1e-12) : 1.0;
   struct Sample {
@@ -208,8 +207,8 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
   };
   auto correct = [&](std::size_t i) {
     const double u = (s_.dt_s[i] - t0) / span;
-    return Sample{F_inv * (s_.acc[i] - (acc0 + u * (acc1 - acc0)) - b_a),
-                  E_inv * (s_.gyr[i] - (gyr0 + u * (gyr1 - gyr0)) - b_g), u};
+    return Sample{F_inv * (s_.acc[i] - acc_wander.At(u) - b_a),
+                  E_inv * (s_.gyr[i] - gyr_wander.At(u) - b_g), u};
   };
   using Cols = Eigen::Matrix<double, 3, Eigen::Dynamic>;
   // Adds K d w / dx (rate) or K d f / dx (force) of sample `x` to `out`.
