@@ -5,6 +5,15 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
 # Boost.Math (header-only): the exact chi-square quantile of the Allan deviation's intervals.
 find_package(Boost 1.71 REQUIRED)
+# yaml-cpp: YAML study files (study/study_file.h), turned into the JSON the library takes.
+# Wrapped in an interface target, as GeographicLib below, so that the plumb command can link
+# its archive (PlumbStaticDependencies.cmake) while shared objects (the Python module) link its
+# shared object.
+find_package(yaml-cpp REQUIRED)
+if(NOT TARGET plumb_yaml::yaml-cpp)
+  add_library(plumb_yaml::yaml-cpp INTERFACE IMPORTED)
+  set_target_properties(plumb_yaml::yaml-cpp PROPERTIES INTERFACE_LINK_LIBRARIES yaml-cpp)
+endif()
 
 # Debian ships GeographicLib with a Find module only; wrap it in an imported target.
 if(NOT TARGET GeographicLib::GeographicLib)

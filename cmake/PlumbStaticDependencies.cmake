@@ -11,9 +11,9 @@
 # Only the target named gets this (the `plumb` command): the tests, the benchmarks, the Python
 # module and an installed plumb's consumers (plumbConfig.cmake does not include this file) link
 # as before. The switch is a target property, PLUMB_STATIC_LINK, read by generator expressions
-# in the imported targets' link interfaces, so the same imported targets serve both kinds
-# (yaml-cpp, which only the command links, is pointed at its archive outright). Call it after
-# the target's target_link_libraries, in the directory that found yaml-cpp.
+# in the imported targets' link interfaces (Ceres's, GeographicLib's and yaml-cpp's wrapper,
+# plumb_yaml::yaml-cpp), so the same imported targets serve both kinds. Call it after the
+# target's target_link_libraries.
 option(PLUMB_STATIC_DEPENDENCIES
        "Link the plumb command with Debian's static archives of its C++ dependencies" ON)
 
@@ -129,22 +129,6 @@ function(_plumb_static_interface target extra)
   set_target_properties(${target} PROPERTIES INTERFACE_LINK_LIBRARIES "${rewritten}")
 endfunction()
 
-# yaml-cpp, which only the plumb command links: its imported location is the archive.
-function(_plumb_static_location target)
-  if(NOT TARGET ${target})
-    return()
-  endif()
-  _plumb_archive_of_target(archive ${target})
-  if(archive)
-    foreach(property IN LISTS _PLUMB_LOCATIONS)
-      get_target_property(location ${target} ${property})
-      if(location)
-        set_target_properties(${target} PROPERTIES ${property} "${archive}")
-      endif()
-    endforeach()
-  endif()
-endfunction()
-
 function(plumb_link_dependencies_statically target)
   if(NOT PLUMB_STATIC_DEPENDENCIES)
     return()
@@ -172,7 +156,7 @@ function(plumb_link_dependencies_statically target)
   if(NOT done)
     _plumb_static_interface(Ceres::ceres "${extra}")
     _plumb_static_interface(GeographicLib::GeographicLib "")
-    _plumb_static_location(yaml-cpp)
+    _plumb_static_interface(plumb_yaml::yaml-cpp "")
     set_property(GLOBAL PROPERTY PLUMB_STATIC_INTERFACES_DONE ON)
   endif()
   set_target_properties(${target} PROPERTIES PLUMB_STATIC_LINK ON)

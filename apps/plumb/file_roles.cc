@@ -95,6 +95,14 @@ void RefuseOverwritingInputs(const FileRoles& roles) {
 }
 
 std::string WithInputsNamed(const std::string& message, const FileRoles& roles) {
+  // A message about an output ("cannot write OUT: ...") names its file already.
+  for (const auto* outputs : {&roles.output_files, &roles.output_folders}) {
+    for (const NamedPath& p : *outputs) {
+      if (!p.path.empty() && p.path != "-" && message.find(p.path) != std::string::npos) {
+        return message;
+      }
+    }
+  }
   std::vector<std::string> named;
   for (const NamedPath& p : roles.inputs) {
     if (p.path.empty() || p.path == "-") continue;

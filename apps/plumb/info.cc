@@ -11,6 +11,8 @@
 
 #include "commands.h"
 #include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
+#include "plumb/io/common/stream_spool.h"
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/time_base_text.h"
@@ -31,6 +33,10 @@ struct InfoArgs {
   std::uint64_t max_memory = 0;  ///< --max-memory SIZE, bytes; 0 = MemAvailable
 };
 
+/// Decimals of a log time printed, s: milliseconds, on a boot clock (16.734) as on a unix
+/// clock (1710773367.086), where 7 significant digits printed "1.710773e+09".
+constexpr int kTimeDecimals = 3;
+
 /// The still periods of one stream, into `j["still"]`, printed as they are found: the still
 /// segments `plumb calibrate LOG --imu N --stream NAME` would use (the same detector with its
 /// default options, on the samples with the firmware's correction undone where it can be).
@@ -48,15 +54,16 @@ void DescribeStillPeriods(const io::FlightLog& log, const io::ImuStreamInfo& inf
     const auto seg = FindSegments(s.series, SegmentArgs{});
     for (const auto& p : seg.segments) {
       still.push_back({{"t_start_s", s.series.t_s[p.begin]}, {"t_end_s", s.series.t_s[p.end - 1]}});
-      std::cout << "    still " << s.series.t_s[p.begin] << " .. " << s.series.t_s[p.end - 1]
-                << " s\n";
+      std::cout << "    still " << FixedText(s.series.t_s[p.begin], kTimeDecimals) << " .. "
+                << FixedText(s.series.t_s[p.end - 1], kTimeDecimals) << " s\n";
     }
     if (seg.segments.empty()) std::cout << "    still: no still period of 2 s or more\n";
     if (s.series.has_temperature()) {
       const auto [lo, hi] = std::minmax_element(s.series.temp_c.begin(), s.series.temp_c.end());
       j["temp_min_c"] = *lo;
       j["temp_max_c"] = *hi;
-      std::cout << "    temperature " << *lo << " .. " << *hi << " degC\n";
+      std::cout << "    temperature " << FixedText(*lo, 2) << " .. " << FixedText(*hi, 2)
+                << " degC\n";
     }
   } catch (const Error& e) {
     j["still_note"] = e.what();
@@ -89,6 +96,7 @@ class InfoCommand : public Command {
     const InfoArgs& a = args_;
     const TextAsideForJson text_aside(a.json_path);
     // The estimate reads the log's first 8 MiB; then the log is read once, whole.
+    const io::StreamSpool stream({a.log_path}, io::StreamBound(a.max_memory));  // a pipe
     const std::uint64_t estimate = CheckMemory({a.log_path}, a.max_memory);
     const io::FlightLog log = io::FlightLog::Open(a.log_path, ParallelJobs(0));
     const io::FlightLogSummary summary = log.Summary();
@@ -121,8 +129,13 @@ class InfoCommand : public Command {
       std::cout << "IMU instance " << imu.instance << ", " << imu.name << " (" << contents
                 << "): " << imu.samples << " samples";
       if (imu.samples > 0) {
-        std::cout << ", " << std::setprecision(5) << imu.rate_hz << " Hz, " << std::setprecision(7)
-                  << imu.t_start_s << " .. " << imu.t_end_s << " s";
+        std::cout << ", " << std::setprecision(5) << imu.rate_hz << " Hz, "
+                  << FixedText(imu.t_start_s, kTimeDecimals) << " .. "
+                  << FixedText(imu.t_end_s, kTimeDecimals) << " s";
+      }
+      if (const auto left_out = io::DroppedRecordsWarning(imu)) {
+        std::cout << "\n    " << *left_out;
+        j["records"] = imu.records;
       }
       if (imu.samples == 0) {
         std::cout << " (declared by the log's formats, no rows)\n";

@@ -198,7 +198,7 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
       group
           ->add_option("--rate", a.rate_hz,
                        "Sample rate, Hz, when the table has no time column (time = row / rate)")
-          ->check(Positive),
+          ->check(SampleRate),
       group->add_option("--acc-unit", a.acc_unit,
                         "Accelerometer unit in the file: m/s^2, g, or counts (unscaled sensor "
                         "output: calibrated in counts, the matrix then in counts per m/s^2)")
@@ -230,7 +230,8 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
 void AddMaxMemoryOption(CLI::App* app, std::uint64_t& max_memory) {
   app->add_option("--max-memory", max_memory,
                   "Refuse inputs whose estimated memory exceeds SIZE (bytes, a whole number with an "
-                  "optional unit: 500M, 2G, 2GiB); "
+                  "optional unit: 500M, 2G, 2GiB); a pipe or standard input is read whole "
+                  "first and refused once it goes on past SIZE; "
                   "default: the memory available (MemAvailable)")
       ->transform(CLI::AsSizeValue(true))
       ->type_name("SIZE");
@@ -288,9 +289,12 @@ Session ReadInputs(const InputArgs& a, int jobs) {
     files.push_back(parts.size() == 2 ? io::InputFile(parts[0], parts[1]) : io::InputFile(input));
     paths.insert(paths.end(), parts.begin(), parts.end());
   }
+  // A pipe or standard input is read whole first (within --max-memory), then estimated.
+  const io::StreamSpool streams(paths, io::StreamBound(a.max_memory));
   CheckMemory(paths, a.max_memory);
   Progress::Of().Stage("reading " + names);
   io::InputOptions options = MakeInputOptions(a, inputs);
+  options.max_stream_bytes = a.max_memory;
   options.run_jobs = ParallelJobs(jobs);
   return io::OpenInputs(files, options);
 }

@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 #include <iostream>
+#include <new>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -142,6 +143,18 @@ int main(int argc, char** argv) {
     std::cerr << "plumb: error: " << plumb::Printable(e.what(), kMessageBytes) << "\nRun 'plumb "
               << selected->app()->get_name() << " --help' for the options.\n";
     return 2;
+  } catch (const plumb::InputError& e) {  // names its file and place already
+    progress.Stop();
+    std::cerr << "plumb: error: " << plumb::Printable(e.what(), kMessageBytes) << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    const std::string stage = progress.CurrentStage();
+    progress.Stop();
+    std::cerr << "plumb: error: out of memory"
+              << (stage.empty() ? std::string() : " while " + stage)
+              << ": the run needs more memory than this machine gives it; read less of the "
+                 "input (--from/--to, one IMU) or run it where more memory is free\n";
+    return 1;
   } catch (const std::exception& e) {
     progress.Stop();
     std::cerr << "plumb: error: "

@@ -505,13 +505,21 @@ class PaperCommand : public Command {
                          record.begin, record.end, site};
     const PaperResults r = CalibrateBoth(in, sections, a.stride);
 
-    std::filesystem::create_directories(a.out_dir);
+    const bool made_folder = std::filesystem::create_directories(a.out_dir);
     const std::string dir = a.out_dir + "/";
     const std::string md = TablesMarkdown(in, r);
-    io::WriteFileAtomic(dir + "tables.md", md);
-    report::WriteJson(dir + "paper.json", PaperJson(in, r));
-    io::WriteFileAtomic(dir + "inputs.csv", InputsCsv(r.rec));
-    io::WriteFileAtomic(dir + "figures.gp", FiguresGnuplot());
+    try {
+      io::AtomicFileSet files;  // the four, or none (a full disk changes no file)
+      files.Add(dir + "tables.md", md);
+      files.Add(dir + "paper.json", report::JsonText(PaperJson(in, r)));
+      files.Add(dir + "inputs.csv", InputsCsv(r.rec));
+      files.Add(dir + "figures.gp", FiguresGnuplot());
+      files.Commit();
+    } catch (const Error&) {
+      std::error_code ec;
+      if (made_folder) std::filesystem::remove(a.out_dir, ec);  // this run's, left empty
+      throw;
+    }
 
     std::cout << md;
     std::cout << "wrote " << dir << "tables.md, paper.json, inputs.csv, figures.gp\n";

@@ -71,6 +71,11 @@ void Progress::Stage(const std::string& what) {
   wake_.notify_all();
 }
 
+std::string Progress::CurrentStage() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stage_;
+}
+
 void Progress::Clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   stage_.clear();

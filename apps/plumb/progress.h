@@ -40,6 +40,9 @@ class Progress {
   /// The stage is over: its line is erased now.
   void Clear();
 
+  /// The stage the command is in ("" between stages): what an error met there was doing.
+  std::string CurrentStage();
+
   /// Erases the line (the stage goes on and is drawn again at the next redraw). std::cout
   /// and std::cerr call it before every write while progress is drawn (GuardStreams), so
   /// the command's own text never lands after a progress line.

@@ -25,7 +25,7 @@ std::vector<study::PointSummary> ReadStudyPoints(const study::Study& study,
   std::vector<study::PointSummary> out;
   for (const study::Point& p : points) {
     const std::string path = PointPath(dir, p.index);
-    out.push_back(study::PointFromJson(study, ReadJsonFile(path), path));
+    out.push_back(study::PointFromJson(study, ReadJsonFile(path), path, p));
   }
   return out;
 }

@@ -16,7 +16,6 @@
 #include <iostream>
 #include <sstream>
 
-#include <yaml-cpp/yaml.h>
 
 #include "validators.h"
 #include "progress.h"
@@ -28,6 +27,7 @@
 #include "plumb/pipeline/study_template.h"
 #include "plumb/report/json_report.h"
 #include "plumb/study/run.h"
+#include "plumb/study/study_file.h"
 #include "plumb/study/summary.h"
 
 namespace plumb::cli {
@@ -45,61 +45,16 @@ struct SweepArgs {
   std::string merge_out;                ///< merge --out DIR
 };
 
-/// The most values a study file may hold once its YAML aliases are expanded: a study is tens
-/// to a few thousand values (factors, levels, options); nested aliases ("billion laughs")
-/// expand to billions from a few lines.
-constexpr std::size_t kMaxStudyValues = 100000;
-
-/// A YAML node as JSON: mappings, sequences, and scalars as integers, numbers, true/false,
-/// null or text, in that order of trial. Each node taken (an alias each time it is used) costs
-/// one of `budget`; past it, InputError naming `path`.
-json FromYaml(const YAML::Node& node, std::size_t& budget, const std::string& path) {
-  if (budget == 0) {
-    throw InputError(path, "",
-                     "more than " + std::to_string(kMaxStudyValues) +
-                         " values once its aliases are expanded (nested YAML aliases, an "
-                         "\"alias bomb\"?): a study holds far fewer; refused");
-  }
-  --budget;
-  switch (node.Type()) {
-    case YAML::NodeType::Map: {
-      json out = json::object();
-      for (const auto& item : node) {
-        out[item.first.as<std::string>()] = FromYaml(item.second, budget, path);
-      }
-      return out;
-    }
-    case YAML::NodeType::Sequence: {
-      json out = json::array();
-      for (const auto& item : node) out.push_back(FromYaml(item, budget, path));
-      return out;
-    }
-    case YAML::NodeType::Scalar: {
-      long long i = 0;
-      double d = 0.0;
-      bool b = false;
-      if (YAML::convert<long long>::decode(node, i)) return i;
-      if (YAML::convert<double>::decode(node, d)) return d;
-      if (YAML::convert<bool>::decode(node, b)) return b;
-      return node.as<std::string>();
-    }
-    default:
-      return nullptr;
-  }
-}
-
-/// The study file: YAML when its name ends in .yaml or .yml, else JSON.
-json ReadStudyFile(const std::string& path) {
-  const std::string ext = fs::path(path).extension().string();
-  if (ext != ".yaml" && ext != ".yml") return ReadJsonFile(path);
-  try {
-    std::size_t budget = kMaxStudyValues;
-    return FromYaml(YAML::LoadFile(path), budget, path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path, "", "cannot be read");
-  } catch (const YAML::Exception& e) {
-    throw InputError(path, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+/// `sweep merge --out DIR` replaces DIR whole: it must be new, empty, or a study folder plumb
+/// wrote (its study.json), never a folder of the user's other files.
+void CheckMergeFolder(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) return;
+  if (!fs::is_directory(dir, ec)) throw UsageError("merge --out " + dir + " exists and is not a folder");
+  if (fs::is_empty(dir, ec) || fs::is_regular_file(fs::path(dir) / "study.json", ec)) return;
+  throw UsageError("merge --out " + dir + " holds files that are not a plumb study's, and a "
+                   "merge replaces its folder whole: give a new or empty folder; nothing was "
+                   "written");
 }
 
 /// --shard K/N as {K, N}; {1, 1} when empty.
@@ -195,7 +150,7 @@ class SweepCommand : public Command {
       throw UsageError("sweep needs a study file and --out DIR (or: sweep merge DIR... --out DIR)");
     }
     const auto [k, n] = ParseShard(a.shard);
-    study::Study s = study::ParseStudy(ReadStudyFile(a.study_path), a.study_path);
+    study::Study s = study::ParseStudy(study::ReadStudyFile(a.study_path), a.study_path);
     // A session template: relative to the study file's folder.
     pipeline::ReadSessionTemplate(s, fs::path(a.study_path).parent_path().string());
     const std::vector<study::Point> points = study::DesignPoints(s);
@@ -208,7 +163,8 @@ class SweepCommand : public Command {
       if (p.index % n != k - 1) continue;
       const std::string path = PointPath(a.out, p.index);
       if (fs::exists(path)) {
-        study::PointFromJson(s, ReadJsonFile(path), path);  // another study's point: an error
+        // Another study's point, another point's copy, an edited one: an error.
+        study::PointFromJson(s, ReadJsonFile(path), path, p);
         ++kept;
         continue;
       }
@@ -278,8 +234,8 @@ class SweepCommand : public Command {
       }
     }
     const std::vector<study::Point> points = study::DesignPoints(s);
-    fs::create_directories(fs::path(a.merge_out) / "points");
-    report::WriteJson((fs::path(a.merge_out) / "study.json").string(), s.source);
+    // Every point found and read before anything is written: a shard missing writes nothing.
+    std::vector<study::PointSummary> summaries;
     for (const study::Point& p : points) {
       std::string found;
       for (const std::string& dir : a.merge_dirs) {
@@ -287,12 +243,23 @@ class SweepCommand : public Command {
       }
       if (found.empty()) {
         throw Error("sweep merge: point " + std::to_string(p.index) + " is in none of the shards "
-                    "(run the missing shard, or rerun it to resume)");
+                    "(run the missing shard, or rerun it to resume); nothing was written");
       }
-      const study::PointSummary summary = study::PointFromJson(s, ReadJsonFile(found), found);
-      report::WriteJson(PointPath(a.merge_out, p.index), study::PointJson(s, summary));
+      summaries.push_back(study::PointFromJson(s, ReadJsonFile(found), found, p));
     }
-    WriteResults(s, points, a.merge_out);
+    // The folder is written whole, then put in place (a full disk leaves no half of it).
+    CheckMergeFolder(a.merge_out);
+    const fs::path parent = fs::absolute(a.merge_out).parent_path();
+    if (!parent.empty()) fs::create_directories(parent);
+    io::StagedFolder staged(a.merge_out);
+    const std::string out = staged.staging();
+    fs::create_directories(fs::path(out) / "points");
+    report::WriteJson((fs::path(out) / "study.json").string(), s.source);
+    for (const study::PointSummary& summary : summaries) {
+      report::WriteJson(PointPath(out, summary.point.index), study::PointJson(s, summary));
+    }
+    WriteResults(s, points, out);
+    staged.Commit();
     std::cout << "merged " << points.size() << " points from " << a.merge_dirs.size()
               << " folders; wrote " << (fs::path(a.merge_out) / "results.csv").string()
               << ", results.json and index.html\n";

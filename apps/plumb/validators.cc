@@ -109,6 +109,18 @@ const CLI::Validator EarthGravity(
     },
     "m/s^2 on Earth", "GRAVITY");
 
+const CLI::Validator SampleRate(
+    [](std::string& text) {
+      double v = 0.0;
+      const bool ok = ReadNumber(text, v) && v > 0.0 && v <= units::kMaxImuRate_hz;
+      std::ostringstream bound;
+      bound << units::kMaxImuRate_hz;
+      return ok ? std::string()
+                : "must be an IMU's sample rate, more than 0 and at most " + bound.str() +
+                      " Hz (got '" + text + "')";
+    },
+    "Hz", "HZ");
+
 void RejectNonFiniteNumbers(const CLI::App& app) { CheckOptions(app); }
 
 }  // namespace plumb::cli

@@ -26,6 +26,9 @@ extern const CLI::Validator Jobs;
 /// A gravity magnitude found on Earth, m/s^2 (units::kMinEarthGravity..kMaxEarthGravity).
 extern const CLI::Validator EarthGravity;
 
+/// An IMU's sample rate, Hz: > 0 and at most units::kMaxImuRate_hz.
+extern const CLI::Validator SampleRate;
+
 /// Throws UsageError naming the option and its value when a given option of `app` or of its
 /// parsed subcommands holds a number that is not finite (file comment).
 void RejectNonFiniteNumbers(const CLI::App& app);

@@ -13,6 +13,7 @@
 #include "plumb/report/json_report.h"
 #include "plumb/study/run.h"
 #include "plumb/study/study.h"
+#include "plumb/study/study_file.h"
 #include "plumb/study/summary.h"
 
 namespace plumb::python {
@@ -21,9 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 
 const char* const kStudyArg =
-    "study: a JSON study file's path (a session template relative to its folder), or the "
-    "study as a dict (a template relative to the current folder); YAML files: read them "
-    "into a dict first.";
+    "study: a study file's path, JSON or YAML (.yaml, .yml) as plumb sweep reads it (a "
+    "session template relative to its folder), or the study as a dict (a template relative "
+    "to the current folder).";
 
 /// The study as the command reads it: parsed, with its session template read.
 study::Study LoadStudy(const py::object& source) {
@@ -33,7 +34,7 @@ study::Study LoadStudy(const py::object& source) {
     doc = FromPython(source);
   } else {
     path = py::str(py::module_::import("os").attr("fspath")(source));
-    doc = io::ReadJsonFile(path);
+    doc = study::ReadStudyFile(path);
   }
   study::Study s = study::ParseStudy(doc, path);
   pipeline::ReadSessionTemplate(s, path == "<dict>" ? "" : fs::path(path).parent_path().string());

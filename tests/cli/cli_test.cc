@@ -563,6 +563,27 @@ TEST(Cli, PaperCommandWritesTablesInputsAndFigures) {
   EXPECT_TRUE(std::filesystem::exists(out + "/inputs.csv"));
   EXPECT_TRUE(std::filesystem::exists(out + "/figures.gp"));
   EXPECT_TRUE(std::filesystem::exists(out + "/tables.md"));
+  // Issue 35 item 1: a disk that fills part way (a file-size limit here; inputs.csv is the
+  // largest file) changes none of the four files: never this run's tables.md beside an
+  // earlier paper.json. A folder the run made is removed again.
+  const auto size = [&](const char* name) { return std::filesystem::file_size(out + "/" + name); };
+  ASSERT_GT(size("inputs.csv"), 2 * size("tables.md"));
+  const std::uintmax_t limit_blocks = (size("tables.md") + size("paper.json")) / 512 + 2;
+  ASSERT_LT(limit_blocks * 512, size("inputs.csv"));
+  for (const std::string& target : {out, dir.File("paper_new")}) {
+    std::string command = "trap '' XFSZ; ulimit -f " + std::to_string(limit_blocks) +
+                          "; exec '" + PLUMB_TOOL + "'";
+    for (const std::string& a : args) command += " '" + (a == out ? target : a) + "'";
+    if (target == out) std::ofstream(out + "/tables.md") << "an earlier run's";
+    const ToolRun full = testing::Run("/bin/sh", {"-c", command}, dir);
+    EXPECT_EQ(full.exit_code, 1) << full.err;
+    EXPECT_TRUE(Contains(full.err, "plumb: error: cannot write " + target + "/inputs.csv")) << full.err;
+    if (target == out) {
+      EXPECT_EQ(testing::ReadAll(out + "/tables.md"), "an earlier run's");
+    } else {
+      EXPECT_FALSE(std::filesystem::exists(target)) << "the run's own folder is removed";
+    }
+  }
   // Without the section-5 record: a usage error naming both ways to give it.
   const ToolRun missing = Plumb({"paper", bench, "--segments", segs, "--out", out}, dir);
   EXPECT_EQ(missing.exit_code, 2);

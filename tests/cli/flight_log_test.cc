@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -85,6 +86,107 @@ TEST(FlightLogCli, InfoOnAPx4ULog) {
   EXPECT_TRUE(doc["params"].contains("CAL_ACC0_XOFF"));
 }
 
+/// The bytes of the file at `path`.
+std::vector<char> BytesOf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<char>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// Writes `bytes` to `path`; returns `path`.
+std::string WriteBytes(const std::string& path, const std::vector<char>& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
+// Issue 35 item 7 on the real log: one sensor_combined time stamp corrupted to 5e12 s hid
+// 17013 of its 17070 samples without a word (info showed "1.1e-11 Hz"). Now it costs that
+// one sample, and info and calibrate say so with the first place.
+TEST(FlightLogCli, OneCorruptUlogStampCostsOneSampleAndIsSaid) {
+  const std::string log = Shared("px4/sample.ulg");
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  std::vector<char> bytes = BytesOf(log);
+  // ULog messages after the 16-byte header: [uint16 size][uint8 type][body]; 'A' subscribes
+  // [uint8 multi_id][uint16 msg_id][name]; 'D' is [uint16 msg_id][fields: timestamp first].
+  const auto u16 = [&](std::size_t at) {
+    return static_cast<std::size_t>(static_cast<unsigned char>(bytes[at])) |
+           static_cast<std::size_t>(static_cast<unsigned char>(bytes[at + 1])) << 8;
+  };
+  int combined = -1, seen = 0;
+  std::size_t corrupted = 0;
+  for (std::size_t at = 16; at + 3 <= bytes.size() && corrupted == 0;) {
+    const std::size_t size = u16(at);
+    const char type = bytes[at + 2];
+    const std::size_t body = at + 3;
+    if (type == 'A' && std::string(&bytes[body + 3], size - 3) == "sensor_combined") {
+      combined = static_cast<int>(u16(body + 1));
+    } else if (type == 'D' && static_cast<int>(u16(body)) == combined && ++seen == 5000) {
+      const std::uint64_t far_us = 5000000000000000000ULL;  // 5e12 s
+      std::memcpy(&bytes[body + 2], &far_us, sizeof far_us);
+      corrupted = body + 2;
+    }
+    at = body + size;
+  }
+  ASSERT_NE(corrupted, 0u) << "no 5000th sensor_combined message";
+  const std::string bad = WriteBytes(dir.File("corrupt.ulg"), bytes);
+  const std::string said =
+      "sensor_combined of IMU instance 0: left out 1 of 17070 records by their time (not finite, "
+      "not above the last kept one, or a spike above the next record's: a corrupt or backwards "
+      "time stamp); the first with time 5000000000000.000000 s";
+  const ToolRun info = Plumb({"info", bad}, dir);
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_TRUE(Contains(info.out, "sensor_combined (accel+gyro): 17069 samples, 247.8")) << info.out;
+  EXPECT_TRUE(Contains(info.out, "\n    " + said + "\n")) << info.out;
+  const ToolRun fit = Plumb({"calibrate", bad, "--to", "150"}, dir);
+  EXPECT_TRUE(Contains(fit.err, "warning: " + said + "\n")) << fit.err;
+}
+
+// The same on a real DataFlash log: one IMU record's TimeUS set 5e12 s ahead.
+TEST(FlightLogCli, OneCorruptDataflashStampCostsOneSampleAndIsSaid) {
+  const std::string log = Shared("ardupilot/copter36_chibios.bin");
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  std::vector<char> bytes = BytesOf(log);
+  // Records: 0xA3 0x95 type; FMT (type 128): type, length, name[4], format[16], columns[64].
+  int imu = -1, seen = 0;
+  std::size_t length = 0, corrupted = 0;
+  for (std::size_t at = 0; at + 3 < bytes.size() && corrupted == 0;) {
+    if (static_cast<unsigned char>(bytes[at]) != 0xA3 ||
+        static_cast<unsigned char>(bytes[at + 1]) != 0x95) {
+      ++at;
+      continue;
+    }
+    const int type = static_cast<unsigned char>(bytes[at + 2]);
+    if (type == 128) {
+      if (std::string(&bytes[at + 5], 4) == std::string("IMU\0", 4)) {
+        imu = static_cast<unsigned char>(bytes[at + 3]);
+        length = static_cast<unsigned char>(bytes[at + 4]);
+      }
+      at += 89;
+      continue;
+    }
+    if (type == imu && ++seen == 3000) {
+      const std::uint64_t far_us = 5000000000000000000ULL;  // 5e12 s
+      std::memcpy(&bytes[at + 3], &far_us, sizeof far_us);
+      corrupted = at + 3;
+    }
+    at += type == imu ? length : 1;
+  }
+  ASSERT_NE(corrupted, 0u) << "no 3000th IMU record";
+  const std::string bad = WriteBytes(dir.File("corrupt.bin"), bytes);
+  const ToolRun before = Plumb({"info", log}, dir), info = Plumb({"info", bad}, dir);
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const std::string said =
+      "IMU of IMU instance 0: left out 1 of 6113 records by their time (not finite, not above "
+      "the last kept one, or a spike above the next record's: a corrupt or backwards time "
+      "stamp); the first with time 5000000000000.000000 s";
+  EXPECT_TRUE(Contains(before.out, "IMU (accel+gyro): 6113 samples")) << before.out;
+  EXPECT_TRUE(Contains(info.out, "IMU (accel+gyro): 6112 samples")) << info.out;
+  EXPECT_TRUE(Contains(info.out, "\n    " + said + "\n")) << info.out;
+  const ToolRun fit = Plumb({"calibrate", bad, "--to", "19"}, dir);
+  EXPECT_TRUE(Contains(fit.err, "warning: " + bad + ": " + said + "\n")) << fit.err;
+}
+
 TEST(FlightLogCli, InfoOnAnArdupilotTextLog) {
   const std::string log = Shared("ardupilot/copter311_nan.log");
   if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
@@ -153,15 +255,12 @@ TEST(FlightLogCli, AnArdupilotLogWithoutImuRowsSaysSo) {
 /// A copy of `log` in `dir` whose PARM AHRS_ORIENTATION (name field of 16 characters, then
 /// the float value) reads `value`.
 std::string WithOrientation(const std::string& log, float value, TempDir& dir) {
-  std::ifstream in(log, std::ios::binary);
-  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  std::vector<char> bytes = BytesOf(log);
   const std::string name = "AHRS_ORIENTATION";
   const auto it = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
   EXPECT_NE(it, bytes.end());
   if (it != bytes.end()) std::memcpy(&*(it + 16), &value, sizeof value);
-  const std::string out = dir.File("custom_orientation.bin");
-  std::ofstream(out, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return out;
+  return WriteBytes(dir.File("custom_orientation.bin"), bytes);
 }
 
 TEST(FlightLogCli, NoFirmwareExportFromSamplesStillCarryingTheFirmwaresCorrection) {

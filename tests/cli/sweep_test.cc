@@ -74,6 +74,32 @@ TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
   const ToolRun missing = Plumb({"sweep", "merge", at("shard1"), "--out", at("m2")}, dir);
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_TRUE(Contains(missing.err, "point 1 is in none of the shards")) << missing.err;
+  EXPECT_FALSE(fs::exists(at("m2"))) << "a failed merge leaves no half-written folder";
+  // Issue 35 item 4: a point file copied over another is refused on resume (it kept one point
+  // twice and lost the other, exit 0), and by a merge; nothing is run or written.
+  fs::copy_file(at("whole/points/point-00000.json"), at("whole/points/point-00002.json"),
+                fs::copy_options::overwrite_existing);
+  const std::string results = ReadAll(at("whole/results.csv"));
+  const ToolRun copied = Plumb({"sweep", at("study.json"), "--out", at("whole")}, dir);
+  EXPECT_EQ(copied.exit_code, 1) << copied.err;
+  EXPECT_TRUE(Contains(copied.err, "plumb: error: " + at("whole/points/point-00002.json") +
+                                       ":key 'point': holds point 0, not point 2 of the design (a "
+                                       "file copied?): remove the file to run point 2 again"))
+      << copied.err;
+  EXPECT_EQ(ReadAll(at("whole/results.csv")), results);
+  const ToolRun merge_copied =
+      Plumb({"sweep", "merge", at("whole"), "--out", at("m3")}, dir);
+  EXPECT_EQ(merge_copied.exit_code, 1) << merge_copied.err;
+  EXPECT_TRUE(Contains(merge_copied.err, "holds point 0, not point 2")) << merge_copied.err;
+  EXPECT_FALSE(fs::exists(at("m3")));
+  // Merging into a folder of other files is refused: a merge replaces its folder whole.
+  fs::create_directories(at("mine"));
+  std::ofstream(at("mine/thesis.tex")) << "mine";
+  const ToolRun into_mine =
+      Plumb({"sweep", "merge", at("shard1"), at("shard2"), "--out", at("mine")}, dir);
+  EXPECT_EQ(into_mine.exit_code, 2) << into_mine.err;
+  EXPECT_TRUE(Contains(into_mine.err, "holds files that are not a plumb study's")) << into_mine.err;
+  EXPECT_EQ(ReadAll(at("mine/thesis.tex")), "mine");
 }
 
 TEST(SweepCli, AYamlStudyIsTheSameStudy) {

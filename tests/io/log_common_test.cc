@@ -192,8 +192,58 @@ TEST(LogCommon, ReadForwardReportsAFileCutShortWhileItIsRead) {
   } catch (const InputError& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find(path), std::string::npos) << what;
-    EXPECT_NE(what.find("read failed before the end of the file"), std::string::npos) << what;
+    EXPECT_NE(what.find("cut short or replaced while plumb read it"), std::string::npos) << what;
     EXPECT_LE(handed, kCut);
+  }
+}
+
+// A parser inside a span when the file is cut (log rotation) touches pages past the new end:
+// they read as zeros instead of raising SIGBUS, and the reading ends with the cut named.
+TEST(LogCommon, ReadForwardSurvivesACutInsideTheSpanBeingParsed) {
+  ::plumb::testing::TempDir dir;
+  const std::vector<std::uint8_t> file = Pattern(std::size_t{12} << 20);
+  const std::string path = WriteFile(dir, file);
+  constexpr std::size_t kCut = std::size_t{1} << 20;
+  int last_byte = -1;
+  try {
+    ReadForward(path, "test log", 16,
+                [&](const std::uint8_t* data, std::size_t n, std::size_t offset, bool at_end) {
+                  if (offset == 0) {
+                    std::filesystem::resize_file(path, kCut);
+                    last_byte = *static_cast<const volatile std::uint8_t*>(data + n - 1);
+                  }
+                  return at_end ? offset + n : offset + n - 16;
+                });
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path + ": the file was cut short or replaced while plumb read it (it had " +
+                        std::to_string(file.size()) + " bytes when opened"),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_EQ(last_byte, 0) << "the page past the cut reads as zeros";
+}
+
+// The same for a whole file mapped at once (the tlog reader's LogFile): the pages past the
+// cut read as zeros, and ThrowIfCut names the cut; an intact file passes it.
+TEST(LogCommon, LogFileSurvivesACutAndSaysSo) {
+  ::plumb::testing::TempDir dir;
+  const std::vector<std::uint8_t> bytes = Pattern(std::size_t{1} << 20);
+  const std::string path = WriteFile(dir, bytes);
+  {
+    const LogFile intact(path, "test log");
+    EXPECT_EQ(intact.data()[bytes.size() - 1], bytes.back());
+    EXPECT_NO_THROW(intact.ThrowIfCut());
+  }
+  const LogFile file(path, "test log");
+  std::filesystem::resize_file(path, 4096);
+  EXPECT_EQ(*static_cast<const volatile std::uint8_t*>(file.data() + bytes.size() - 1), 0);
+  try {
+    file.ThrowIfCut();
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut short or replaced"), std::string::npos) << e.what();
   }
 }
 

@@ -5,6 +5,8 @@
 // copies of the real log, and the session with ArduPilot's correction undone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -621,6 +623,29 @@ TEST(MavlinkSession, Wrapped32BitMicrosecondsAreUnwrapped) {
   ASSERT_EQ(s.series.size(), 4u);
   EXPECT_NEAR(s.series.t_s[2] - s.series.t_s[1], 0.1, 1e-9);
   EXPECT_NEAR(s.series.t_s[3], (wrap + 100000) * 1e-6, 1e-9);
+}
+
+// Issue 35 item 7: a time far ahead costs that sample alone (not every later one), a time that
+// goes back costs one, and the warning counts them with the first one's time.
+TEST(MavlinkSession, BadTimesCostOneSampleEachAndAreSaid) {
+  Bytes t;
+  Append(&t, Record({kMavHeartbeat, Heartbeat(kMavAutopilotArdupilotMega), 1, 1}));
+  for (std::uint64_t t_us : {std::uint64_t{100000}, std::uint64_t{200000},
+                             std::uint64_t{900000000000}, std::uint64_t{300000},
+                             std::uint64_t{400000}, std::uint64_t{350000},
+                             std::uint64_t{500000}, std::uint64_t{600000}}) {
+    Append(&t, Record({kMavRawImu, RawImu(t_us, {0, 0, -1000, 0, 0, 0, 0, 0, 0}), 1, 1}));
+  }
+  const Session s = TlogSession(Parse(t), FlightLogSelection{});
+  const std::vector<double> kept = {0.1, 0.2, 0.3, 0.35, 0.5, 0.6};
+  ASSERT_EQ(s.series.size(), kept.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) EXPECT_NEAR(s.series.t_s[k], kept[k], 1e-12);
+  const std::string said =
+      "RAW_IMU instance 0: dropped 2 sample(s) whose time did not increase past the last kept "
+      "one, or ran ahead of the next (a reboot or a corrupted time); the first with time "
+      "900000.000000 s";
+  EXPECT_NE(std::find(s.warnings.begin(), s.warnings.end(), said), s.warnings.end())
+      << ::testing::PrintToString(s.warnings);
 }
 
 // --- the real log as a session ------------------------------------------------------------------

@@ -5,9 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -46,6 +50,42 @@ TEST(OpenInputs, MemoryEstimateFromSizeAndFormat) {
   EXPECT_LT(EstimateReadMemory(log), kReadMemoryBaseBytes + 1000u);
   EXPECT_EQ(EstimateReadMemory(dir.File("absent")), 0u);
   EXPECT_EQ(EstimateReadMemory(dir.File("")), 0u);  // the folder
+}
+
+// A FIFO gives its bytes once: it is read whole into memory (StreamSpool) before its format is
+// sniffed, so the session is the file's; the copy is named by OpenPath only while held, and
+// one longer than the bound is refused with the byte where it stopped.
+TEST(OpenInputs, AFifoIsReadWholeBeforeItsFormatIsSniffed) {
+  TempDir dir;
+  const std::string fifo = dir.File("samples.fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto feed = [&](const std::string& text) {
+    return std::thread([fifo, text] { std::ofstream(fifo, std::ios::binary) << text; });
+  };
+  std::thread writer = feed(kNative);
+  const Session s = OpenInputs({fifo});
+  writer.join();
+  ASSERT_EQ(s.series.size(), 3u);
+  EXPECT_FLOAT_EQ(static_cast<float>(s.series.acc[2].z()), -9.8f);
+  EXPECT_EQ(s.source, fifo);
+  EXPECT_EQ(OpenPath(fifo), fifo);  // released with the read
+  EXPECT_EQ(SpooledBytes(fifo), 0u);
+
+  writer = feed(kNative);
+  {
+    const StreamSpool spool({fifo}, 1000);
+    EXPECT_NE(OpenPath(fifo), fifo);
+    EXPECT_EQ(SpooledBytes(fifo), std::string(kNative).size());
+    EXPECT_EQ(OpenInputs({fifo}).series.size(), 3u);  // the copy, read twice
+    EXPECT_EQ(OpenInputs({fifo}).series.size(), 3u);
+  }
+  writer.join();
+
+  writer = feed(kNative);
+  ExpectInputError([&] { const StreamSpool spool({fifo}, 20); }, fifo, "byte 20",
+                   {"the stream goes on past 20 bytes (2e-05 MB), the memory allowed for reading "
+                    "inputs, before its end"});
+  writer.join();
 }
 
 TEST(OpenInputs, NativeCsvByItsHeader) {

@@ -3,6 +3,7 @@
 // shared .bin, .log and .ulg; a value asked of a message left out is an error, not garbage.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <cstdio>
@@ -167,6 +168,27 @@ TEST(RecordFilter, DataflashImuDecodedKeepsTheTimeRuleAndInstances) {
   CheckDecodedImu(all, kept);
   EXPECT_LT(ImuFromDataflash(kept, 0).size(), std::size(times));  // the rule dropped some
   EXPECT_GT(ImuFromDataflash(kept, 0).size(), 3u);
+  // Issue 35 item 7: the records left out are counted (they went without a word), the same
+  // from the reader's pass as from the bodies.
+  for (const DataflashLog* log : {&all, &kept}) {
+    const std::size_t samples = ImuFromDataflash(*log, 0).size();
+    EXPECT_EQ(DataflashImuRecords(*log, 0), std::size(times));
+    const Session s = ArdupilotSession(*log, FlightLogSelection{});
+    // Instance 0's records: times + n % 3 with n = 7 k: 1000, 2001, 1502, 3000, 3001, ...;
+    // 2001 is the first left out (the record after it goes back).
+    ASSERT_TRUE(DataflashImuFirstDropped(*log, 0).has_value());
+    EXPECT_DOUBLE_EQ(*DataflashImuFirstDropped(*log, 0), 2001 * 1e-6);
+    const std::string said = "decoded.bin: IMU of IMU instance 0: left out " +
+                             std::to_string(std::size(times) - samples) + " of " +
+                             std::to_string(std::size(times)) +
+                             " records by their time (not finite, not above the last kept one, "
+                             "or a spike above the next record's: a corrupt or backwards time "
+                             "stamp); the first with time 0.002001 s";
+    EXPECT_EQ(std::count_if(s.warnings.begin(), s.warnings.end(),
+                            [&](const std::string& w) { return w.rfind(said, 0) == 0; }),
+              1)
+        << ::testing::PrintToString(s.warnings);
+  }
 }
 
 /// The layout ArduPilot writes (TimeUS Q, I B, the axes and T f: the decoder's UsualColumns),

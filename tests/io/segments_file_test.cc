@@ -119,7 +119,8 @@ TEST(SegmentsFileBadInput, OutsideTheSession) {
 TEST(SegmentsFileBadInput, MalformedJson) {
   TempDir dir;
   const std::string path = dir.Write("seg.json", R"({"x_p": {"start": 1,)");
-  ExpectInputError([&] { ReadSegments(path, TenHertz(100)); }, path, "byte 21", {"invalid JSON"});
+  ExpectInputError([&] { ReadSegments(path, TenHertz(100)); }, path, "line 1, column 21",
+                   {"not valid JSON: syntax error while parsing object key - unexpected end of input"});
   const std::string shape = dir.Write("shape.json", R"({"x_p": [1, 2]})");
   ExpectInputError([&] { ReadSegments(shape, TenHertz(100)); }, shape, "section 'x_p'",
                    {"expected {\"start\": index"});

@@ -490,17 +490,48 @@ TEST(ULogBuilt, SensorCombinedDecodedInThePassAsFromBodies) {
   EXPECT_EQ(sa.series.gyr, sk.series.gyr);
   // Issue 35 item 7: the samples left out are counted and said, the same either way (a time
   // going back was dropped without a word; the message 90 s ahead is lost to the corrupt
-  // header before it).
+  // header before it). The rule keeps a time below the next record's, so 2000 before the
+  // 1500 that steps back goes, and the first of two 3000s.
+  EXPECT_EQ(sk.series.t_s, (std::vector<double>{0.001, 0.0015, 0.003, 0.004, 0.005}));
   for (const Session* s : {&sa, &sk}) {
-    const std::string dropped = "sensor_combined instance 0: dropped " +
-                                std::to_string(t->rows - s->series.size()) + " of " +
-                                std::to_string(t->rows) + " messages whose time did not increase";
-    EXPECT_EQ(std::count_if(s->warnings.begin(), s->warnings.end(),
-                            [&](const std::string& w) { return w.rfind(dropped, 0) == 0; }),
-              1);
-    EXPECT_TRUE(std::any_of(s->warnings.begin(), s->warnings.end(), [](const std::string& w) {
-      return w.find("the last kept at 0.005000 s") != std::string::npos;
-    })) << ::testing::PrintToString(s->warnings);
+    const std::string dropped =
+        "sensor_combined of IMU instance 0: left out 2 of 7 records by their time (not finite, "
+        "not above the last kept one, or a spike above the next record's: a corrupt or "
+        "backwards time stamp); the first with time 0.002000 s";
+    EXPECT_EQ(std::count(s->warnings.begin(), s->warnings.end(), dropped), 1)
+        << ::testing::PrintToString(s->warnings);
+  }
+}
+
+// One time stamp far ahead (5e12 s in a real log) hid every later sample when a sample was
+// kept for being above the last kept one alone: now it costs that one sample.
+TEST(ULogBuilt, OneStampFarAheadCostsOneSample) {
+  Writer w(1);
+  w.Format("sensor_combined:uint64_t timestamp;float[3] gyro_rad;uint32_t gyro_integral_dt;"
+           "float[3] accelerometer_m_s2;");
+  w.Add(0, 3, "sensor_combined");
+  for (std::uint64_t k = 0; k < 100; ++k) {
+    const std::uint64_t t = k == 40 ? std::uint64_t{5000000000000000000} : 1000 + 4000 * k;
+    w.Data(3, Cat({Le(t), Le(0.0f), Le(0.0f), Le(0.0f), Le<std::uint32_t>(4000), Le(0.0f),
+                   Le(0.0f), Le(-9.8f)}));
+  }
+  const Bytes& b = w.bytes();
+  for (const ULog& log : {ParseULog(b.data(), b.size(), "built"),
+                          ParseULog(b.data(), b.size(), "built", Px4SessionTopics())}) {
+    const Session s = ULogSession(log, FlightLogSelection{});
+    EXPECT_EQ(s.series.size(), 99u);
+    EXPECT_DOUBLE_EQ(s.series.t_s.back(), (1000 + 4000 * 99) * 1e-6);
+    const std::vector<ImuStreamInfo> info = ULogImuStreams(log);
+    ASSERT_EQ(info.size(), 1u);
+    EXPECT_EQ(info[0].records, 100u);
+    EXPECT_EQ(info[0].samples, 99u);
+    EXPECT_NE(std::find(s.warnings.begin(), s.warnings.end(),
+                        "sensor_combined of IMU instance 0: left out 1 of 100 records by their time "
+                        "(not finite, not above the last kept one, or a spike above the next "
+                        "record's: a corrupt or backwards time stamp); the first with time "
+                        "5000000000000.000000 s"),
+              s.warnings.end())
+        << ::testing::PrintToString(s.warnings);
   }
 }
 

@@ -60,6 +60,9 @@ TEST(Truth, SaysWhyThereIsNoNees) {
   const auto nees_note = [&](const json& cov) {
     json r = Result(cov);
     if (cov.is_null()) r.erase("covariance");
+    // The sigma column would disagree with these covariances (a file changed after it was
+    // written is refused): without it, only the covariance speaks.
+    for (json& p : r["parameters"]) p.erase("sigma");
     return CompareWithTruth(ReadPlumbResult(dir.Write("r.json", r.dump())),
                             ReadSimulationTruth(truth), truth)
         .nees_note;

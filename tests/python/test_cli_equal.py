@@ -170,6 +170,12 @@ class CliEqual(unittest.TestCase):
         with open(os.path.join(out("sweep"), "study.json")) as f:
             self.assertEqual(plumb.study_json(path), f.read())
 
+    def test_a_yaml_study_is_the_json_study(self):
+        # As plumb sweep reads them: examples/studies/gravity.yaml is gravity.json in YAML.
+        studies = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "studies")
+        self.assertEqual(plumb.study_json(os.path.join(studies, "gravity.yaml")),
+                         plumb.study_json(os.path.join(studies, "gravity.json")))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -350,12 +350,52 @@ TEST(Study, PointsRoundTripThroughJson) {
   const Point p = DesignPoints(s)[0];
   const PointSummary sum = Summarise(p, {RunOnce(s, p, 0), RunOnce(s, p, 1)});
   const json doc = PointJson(s, sum);
-  const PointSummary back = PointFromJson(s, doc, "p.json");
+  const PointSummary back = PointFromJson(s, doc, "p.json", p);
   EXPECT_EQ(PointJson(s, back), doc);
   EXPECT_EQ(ResultsCsv(s, {back}), ResultsCsv(s, {sum}));
+  // Through the file's indented text, as a resume reads it: the same checksum.
+  EXPECT_EQ(PointChecksum(json::parse(doc.dump(2))), doc.at("checksum"));
   Study other = s;
   other.source["seed"] = 8;
-  EXPECT_THROW(PointFromJson(other, doc, "p.json"), InputError);
+  EXPECT_THROW(PointFromJson(other, doc, "p.json", p), InputError);
+}
+
+// Issue 35 item 4: a point file copied over another (sweep's resume then kept one point twice
+// and lost the other, exit 0) or edited is refused, naming the key and what to do.
+TEST(Study, ACopiedOrEditedPointIsRefused) {
+  const Study s = ParseStudy(Small(2), "s.json");
+  const std::vector<Point> points = DesignPoints(s);
+  ASSERT_GE(points.size(), 2U);
+  const PointSummary first = Summarise(points[0], {RunOnce(s, points[0], 0), RunOnce(s, points[0], 1)});
+  const json doc = PointJson(s, first);
+  const auto message = [&](const json& d, const Point& as) {
+    try {
+      PointFromJson(s, d, "points/p.json", as);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(doc, points[1]),
+            "points/p.json:key 'point': holds point " + std::to_string(points[0].index) +
+                ", not point " + std::to_string(points[1].index) +
+                " of the design (a file copied?): remove the file to run point " +
+                std::to_string(points[1].index) + " again");
+  json edited = doc;
+  edited["runs"] = 99;
+  EXPECT_EQ(message(edited, points[0]),
+            "points/p.json:key 'checksum': does not match the point's content (edited or "
+            "damaged): remove the file to run point " + std::to_string(points[0].index) + " again");
+  json unsigned_doc = doc;
+  unsigned_doc.erase("checksum");
+  EXPECT_EQ(message(unsigned_doc, points[0]),
+            "points/p.json:key 'checksum': missing (edited, or written by an older plumb): remove "
+            "the file to run point " + std::to_string(points[0].index) + " again");
+  // A copy re-signed by hand is still another point.
+  json resigned = doc;
+  resigned["point"] = points[1].index;
+  resigned["checksum"] = PointChecksum(resigned);
+  EXPECT_NE(message(resigned, points[1]).find("key 'point'"), std::string::npos);
 }
 
 }  // namespace

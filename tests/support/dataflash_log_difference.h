@@ -56,6 +56,11 @@ inline std::string DataflashLogDifference(const io::DataflashLog& a, const io::D
         return instance + "first or last time";
       }
       if (x.last_on_trial != y.last_on_trial) return instance + "last sample's state";
+      if (x.first_dropped.has_value() != y.first_dropped.has_value() ||
+          (x.first_dropped && (x.first_dropped->record != y.first_dropped->record ||
+                               !SameDoubles(x.first_dropped->t_s, y.first_dropped->t_s)))) {
+        return instance + "first record left out";
+      }
       if (const std::string d = ImuSeriesDifference(x.series, y.series); !d.empty()) {
         return instance + d;
       }

@@ -15,6 +15,13 @@ std::string Figure(double v) { return SignificantText(v, 3); }
 
 }  // namespace
 
+std::string NoSensorsProblem(double value, double nominal, double typical, const std::string& unit) {
+  if (std::abs(value - nominal) <= kMaxTypicals * typical) return "";
+  return SignificantText(value, 4) + " is no sensor's: more than " +
+         SignificantText(kMaxTypicals, 1) + " times its typical magnitude (" +
+         SignificantText(typical, 3) + " " + unit + ")";
+}
+
 std::optional<std::pair<std::size_t, std::size_t>> FirstRepeat(
     const std::vector<std::string>& names) {
   std::map<std::string, std::size_t> first;

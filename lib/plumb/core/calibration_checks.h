@@ -26,6 +26,11 @@ inline constexpr double kMaxSensorMatrixCondition = 1e3;
 /// (1.7e308) is far beyond.
 inline constexpr double kMaxTypicals = 1e9;
 
+/// Why `value` (a parameter's value or sigma, `nominal` its value without error, `typical`
+/// and `unit` its typical magnitude and unit) is no sensor's ("" when it can be): more than
+/// kMaxTypicals typical magnitudes from nominal, with the figures.
+std::string NoSensorsProblem(double value, double nominal, double typical, const std::string& unit);
+
 /// The first repeated name: (index of the repeat, index of its first use); nullopt when every
 /// name is given once.
 std::optional<std::pair<std::size_t, std::size_t>> FirstRepeat(

@@ -46,6 +46,32 @@ std::string Printable(std::string_view text, std::size_t max_chars) {
   return out;
 }
 
+InputError JsonTextError(const std::string& path, std::string_view parser_what) {
+  std::string_view what = parser_what;
+  if (!what.empty() && what.front() == '[') {  // the library's tag: "[json.exception.x.N] "
+    const auto close = what.find("] ");
+    if (close != std::string_view::npos) what.remove_prefix(close + 2);
+  }
+  std::string where;
+  if (const auto at = what.find(" at line "); at != std::string_view::npos) {
+    const auto colon = what.find(": ", at);
+    if (colon != std::string_view::npos) {
+      where = std::string(what.substr(at + 4, colon - at - 4));  // "line 3, column 7"
+      what.remove_prefix(colon + 2);
+    }
+  }
+  if (what.rfind("number overflow", 0) == 0) {
+    const auto quote = what.find('\'');
+    return InputError(path, where,
+                      "a number beyond the range of a double" +
+                          (quote == std::string_view::npos
+                               ? std::string()
+                               : " (" + std::string(what.substr(quote)) + ")") +
+                          ": not valid here; fix or remove that value");
+  }
+  return InputError(path, where, "not valid JSON: " + std::string(what));
+}
+
 std::string Number(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", value);

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -50,6 +51,29 @@ class InsufficientDataError : public Error {
   explicit InsufficientDataError(const std::string& what) : Error(what) {}
 };
 
+
+/// The error for a JSON file at `path` that its parser refused, from the parser's own message
+/// (`parser_what`, nlohmann's "[json.exception.parse_error.101] parse error at line 3, column
+/// 7: syntax error ..." or "[json.exception.out_of_range.406] number overflow parsing
+/// '1e400'"): the library's tag dropped, the line and column as the place, a number beyond a
+/// double said so.
+InputError JsonTextError(const std::string& path, std::string_view parser_what);
+
+/// `parse()` (a JSON parser's call), its exceptions turned into JsonTextError naming `path`:
+/// the one way plumb's readers of JSON files parse them.
+///   const nlohmann::json doc = ParseJsonText(path, [&] { return nlohmann::json::parse(text); });
+template <typename Parse>
+auto ParseJsonText(const std::string& path, Parse&& parse) -> decltype(parse()) {
+  try {
+    return parse();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw JsonTextError(path, e.what());
+  }
+}
 
 /// A number as messages print it: 6 significant digits ("1e+300", "0.0199", "200"), never
 /// std::to_string's fixed 6 decimals (309 digits for 1e300, "0.000000" for 1e-9).

@@ -62,12 +62,6 @@ const model::ParameterInfo& Info(const model::Model& model, int t, int i) {
       .parameters[static_cast<std::size_t>(i)];
 }
 
-/// Why `value` is no sensor's (core/calibration_checks.h kMaxTypicals), with the figures.
-std::string NoSensors(double value, const model::ParameterInfo& info) {
-  return SignificantText(value, 4) + " is no sensor's: more than " +
-         SignificantText(kMaxTypicals, 1) + " times its typical magnitude (" +
-         SignificantText(info.typical, 3) + " " + info.unit + ")";
-}
 
 /// The checks of core/calibration_checks.h on the sensors' matrices of `out`.
 void CheckMatrices(const CalibrationFile& out) {
@@ -127,10 +121,11 @@ void ReadCovariance(const json& doc, const std::string& path, CalibrationFile& o
   for (Eigen::Index i = 0; i < n; ++i) {
     const auto [t, k] = *out.model.FindParameter(out.covariance_names[static_cast<std::size_t>(i)]);
     const double sigma = std::sqrt(out.covariance(i, i));
-    if (sigma > kMaxTypicals * Info(out.model, t, k).typical) {
+    const model::ParameterInfo& info = Info(out.model, t, k);
+    if (const std::string p = NoSensorsProblem(sigma, 0.0, info.typical, info.unit); !p.empty()) {
       throw InputError(path, "key 'covariance.matrix[" + std::to_string(i) + "]'",
                        "the sigma of '" + out.covariance_names[static_cast<std::size_t>(i)] +
-                           "', " + NoSensors(sigma, Info(out.model, t, k)));
+                           "', " + p);
     }
   }
 }
@@ -178,8 +173,9 @@ CalibrationFile ReadCalibrationFile(const json& doc, const std::string& path) {
     const auto [t, i] = *where;
     const model::ParameterInfo& info = Info(out.model, t, i);
     const double value = FiniteNumber(p.at("value"), path, key + ".value");
-    if (std::abs(value - info.nominal) > kMaxTypicals * info.typical) {
-      throw InputError(path, "key '" + key + ".value'", "'" + name + "' = " + NoSensors(value, info));
+    if (const std::string p = NoSensorsProblem(value, info.nominal, info.typical, info.unit);
+        !p.empty()) {
+      throw InputError(path, "key '" + key + ".value'", "'" + name + "' = " + p);
     }
     out.theta[static_cast<std::size_t>(t)][static_cast<std::size_t>(i)] = value - info.nominal;
     seen[static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin())] = true;

@@ -28,12 +28,7 @@ json ParseJsonFile(const std::string& path) {
   if (!in) throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno));
   std::ostringstream text;
   text << in.rdbuf();
-  try {
-    return json::parse(text.str());
-  } catch (const json::parse_error& e) {
-    throw InputError(path, "byte " + std::to_string(e.byte),
-                     std::string("invalid JSON: ") + e.what());
-  }
+  return ParseJsonText(path, [&] { return json::parse(text.str()); });
 }
 
 const json& Field(const json& object, const std::string& key, const std::string& path,

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
+#include "plumb/model/model.h"
 #include "plumb/peers/json_fields.h"
 
 namespace plumb::peers {
@@ -163,6 +166,74 @@ void ReadDetermined(const json& list, const std::string& path, PlumbResult& r) {
   }
 }
 
+/// The values against their parameters' typical magnitudes (core/calibration_checks.h
+/// NoSensorsProblem), where the file's model is one plumb knows (a method's own layout, such
+/// as the paper's, is not): the parameters' values, and the biases of the sensors' blocks.
+void CheckMagnitudes(const PlumbResult& r, const std::string& path) {
+  std::optional<model::Model> m;
+  try {
+    m = model::Model::Parse(r.model);
+  } catch (const Error&) {
+    return;
+  }
+  const auto problem = [&](const std::string& name, double value) -> std::string {
+    const auto where = m->FindParameter(name);
+    if (!where) return "";
+    const model::ParameterInfo& info =
+        m->terms()[static_cast<std::size_t>(where->first)]
+            .effect->info()
+            .parameters[static_cast<std::size_t>(where->second)];
+    return NoSensorsProblem(value, info.nominal, info.typical, info.unit);
+  };
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
+    const PlumbParameter& p = r.parameters[i];
+    if (const std::string why = problem(p.name, p.value); !why.empty()) {
+      throw InputError(path, KeyPlace("parameters[" + std::to_string(i) + "].value"),
+                       "'" + p.name + "' = " + why);
+    }
+  }
+  const char* const kAxes[] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    if (const std::string why = problem(std::string("accel.bias.") + kAxes[k], r.accel_bias[k]);
+        !why.empty()) {
+      throw InputError(path, KeyPlace("accel.bias[" + std::to_string(k) + "]"), why);
+    }
+    if (!r.has_gyro) continue;
+    if (const std::string why = problem(std::string("gyro.bias.") + kAxes[k], r.gyro_bias[k]);
+        !why.empty()) {
+      throw InputError(path, KeyPlace("gyro.bias[" + std::to_string(k) + "]"), why);
+    }
+  }
+}
+
+/// Relative difference allowed between a parameter's "sigma" and the square root of its
+/// covariance diagonal: plumb writes both from one matrix at full precision (17 digits), so
+/// they agree to rounding; a file whose sigma column says 25586 sigma off while its
+/// covariance gives an NEES inside the band was edited.
+constexpr double kSigmaAgreement = 1e-6;
+
+/// Each parameter's sigma against the covariance's, where the file gives both.
+void CheckSigmasAgree(const PlumbResult& r, const std::string& path) {
+  for (std::size_t i = 0; i < r.parameters.size(); ++i) {
+    const PlumbParameter& p = r.parameters[i];
+    if (!p.sigma) continue;
+    const auto at = std::find(r.covariance_names.begin(), r.covariance_names.end(), p.name);
+    if (at == r.covariance_names.end()) continue;
+    const auto k = static_cast<Eigen::Index>(at - r.covariance_names.begin());
+    const double from_covariance = std::sqrt(std::max(0.0, r.covariance(k, k)));
+    if (std::abs(*p.sigma - from_covariance) <=
+        kSigmaAgreement * std::max(*p.sigma, from_covariance)) {
+      continue;
+    }
+    throw InputError(path, KeyPlace("parameters[" + std::to_string(i) + "].sigma"),
+                     "'" + p.name + "' has sigma " + SignificantText(*p.sigma, 6) +
+                         " but the covariance gives " + SignificantText(from_covariance, 6) +
+                         " (covariance.matrix[" + std::to_string(k) + "][" + std::to_string(k) +
+                         "]): plumb writes the two alike; the file was changed after it was "
+                         "written");
+  }
+}
+
 }  // namespace
 
 PlumbResult ReadPlumbResult(const std::string& path) {
@@ -190,6 +261,7 @@ PlumbResult ReadPlumbResult(const std::string& path) {
                      "'" + names[repeat->first] + "' given twice (first at parameters[" +
                          std::to_string(repeat->second) + "])");
   }
+  CheckMagnitudes(r, path);
   if (root.contains("segments")) {
     const json& segments = root.at("segments");
     if (!segments.is_array()) throw InputError(path, KeyPlace("segments"), "expected a list");
@@ -222,6 +294,7 @@ PlumbResult ReadPlumbResult(const std::string& path) {
       if (input.is_string()) r.inputs.push_back(input.get<std::string>());
     }
   }
+  CheckSigmasAgree(r, path);
   return r;
 }
 

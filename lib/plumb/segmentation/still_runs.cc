@@ -42,8 +42,14 @@ class RunBuilder {
 
 }  // namespace
 
+/// The most samples a still-detection window holds: more than any recording has (a day at
+/// 1 MHz is 8.6e10).
+constexpr double kMaxWindowSamples = 1e12;
+
 Geometry MakeGeometry(double window_s, double dt_s) {
-  const double target = std::max(5.0, window_s / dt_s);  // samples per window
+  // Samples per window; bounded so that a sample interval near zero (a rate of 1e300 Hz)
+  // gives a window longer than any series, not an integer overflow.
+  const double target = std::min(std::max(5.0, window_s / dt_s), kMaxWindowSamples);
   Geometry g;
   if (target >= static_cast<double>(kBlocksPerWindow)) {
     g.blocks = kBlocksPerWindow;

@@ -189,8 +189,11 @@ CorrelationTime EstimateCorrelationTime(const std::vector<AxisView>& chunks,
   out.variance = sum_sq / static_cast<double>(out.samples - fitted);
   const double c0 = sum_sq / static_cast<double>(out.samples);
   if (!(c0 > 0.0) || !std::isfinite(c0)) {
-    throw Error("correlation time: the samples have zero or non-finite variance (" +
-                Number(out.variance) + ")");
+    throw InsufficientDataError(
+        "the samples have " + std::string(std::isfinite(c0) ? "no variance" : "a non-finite variance") +
+        " about their line in every still segment (the same value throughout, or a straight "
+        "line): there is no sensor noise to weigh the fit by, and a real IMU's output at rest "
+        "varies by a few counts; check that the file's columns are the sensor's");
   }
 
   double tau = 1.0;
@@ -230,7 +233,12 @@ CorrelationTime EstimateCorrelationTime(const ImuSeries& series,
   for (const StillSegment& segment : segments) {
     chunks.push_back(ViewAxis(series, sensor, axis, segment.begin, segment.end));
   }
-  return EstimateCorrelationTime(chunks, options);
+  try {
+    return EstimateCorrelationTime(chunks, options);
+  } catch (const InsufficientDataError& e) {
+    throw InsufficientDataError(std::string(SensorName(sensor)) + " " + "xyz"[axis] + ": " +
+                                e.what());
+  }
 }
 
 std::vector<CorrelationTime> EstimateCorrelationTimes(const ImuSeries& series,

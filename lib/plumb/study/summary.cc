@@ -6,6 +6,8 @@
 #include <map>
 #include <regex>
 
+#include <boost/crc.hpp>
+
 #include "plumb/core/error.h"
 #include "plumb/signal/chi_square.h"
 
@@ -208,7 +210,7 @@ json PointJson(const Study& study, const PointSummary& s) {
   for (double v : s.nees) nees.push_back(Num(v));
   json values = json::array();
   for (double v : s.point.values) values.push_back(Num(v));
-  return json{{"study", study.source},
+  json doc{{"study", study.source},
               {"point", s.point.index},
               {"values", values},
               {"runs", s.runs},
@@ -225,19 +227,48 @@ json PointJson(const Study& study, const PointSummary& s) {
               {"nees_per_run", nees},
               {"first_order_covariance", FirstOrderJson(study, s)},
               {"parameters", params}};
+  doc["checksum"] = PointChecksum(doc);
+  return doc;
 }
 
-PointSummary PointFromJson(const Study& study, const json& doc, const std::string& path) {
+std::string PointChecksum(json doc) {
+  doc.erase("checksum");
+  const std::string text = doc.dump(-1, ' ', false, json::error_handler_t::replace);
+  boost::crc_32_type crc;
+  crc.process_bytes(text.data(), text.size());
+  char out[16];
+  std::snprintf(out, sizeof out, "crc32:%08x", static_cast<unsigned>(crc.checksum()));
+  return out;
+}
+
+PointSummary PointFromJson(const Study& study, const json& doc, const std::string& path,
+                           const Point& expected) {
   if (!doc.is_object() || !doc.contains("study") || !doc.contains("point")) {
     throw InputError(path, "", "not a point of a study (written by plumb sweep)");
   }
   if (doc.at("study") != study.source) {
     throw InputError(path, "key 'study'", "this point belongs to another study");
   }
+  const std::string redo = ": remove the file to run point " + std::to_string(expected.index) +
+                           " again";
+  if (!doc.contains("checksum") || doc.at("checksum") != PointChecksum(doc)) {
+    throw InputError(path, "key 'checksum'",
+                     std::string(doc.contains("checksum") ? "does not match the point's content "
+                                                            "(edited or damaged)"
+                                                          : "missing (edited, or written by an "
+                                                            "older plumb)") +
+                         redo);
+  }
   try {
     PointSummary s;
     s.point.index = doc.at("point").get<int>();
     for (const json& v : doc.at("values")) s.point.values.push_back(FromNum(v));
+    if (s.point.index != expected.index || s.point.values != expected.values) {
+      throw InputError(path, "key 'point'",
+                       "holds point " + std::to_string(s.point.index) + ", not point " +
+                           std::to_string(expected.index) + " of the design (a file copied?)" +
+                           redo);
+    }
     s.runs = doc.at("runs").get<int>();
     s.failed = doc.at("failed").get<int>();
     s.flagged = doc.at("flagged").get<int>();

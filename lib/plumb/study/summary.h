@@ -63,11 +63,20 @@ PointSummary Summarise(const Point& point, const std::vector<RunOutcome>& runs,
 std::vector<std::vector<double>> FirstOrderCovariance(const Study& study, const PointSummary& point);
 
 /// A point as JSON, with the study it belongs to (Study::source) so that a merge or a resume
-/// can tell points of another study apart.
+/// can tell points of another study apart, its index and factor values, and a checksum of
+/// the rest ("checksum": PointChecksum) so that an edited or damaged file is told apart.
 nlohmann::json PointJson(const Study& study, const PointSummary& summary);
-/// Reads PointJson back; throws plumb::InputError naming `path` when it is not such a point or
-/// belongs to another study.
-PointSummary PointFromJson(const Study& study, const nlohmann::json& doc, const std::string& path);
+/// Reads PointJson back as design point `expected`; throws plumb::InputError naming `path`
+/// and the key when it is not such a point, belongs to another study, is another point (a
+/// file copied over this one: its index or values differ) or its checksum does not match
+/// its content (edited, damaged, or written before points had one).
+PointSummary PointFromJson(const Study& study, const nlohmann::json& doc, const std::string& path,
+                           const Point& expected);
+/// The checksum of a point document: "crc32:" and the 8 hex digits of the CRC-32
+/// (boost::crc_32_type) of its compact JSON text without its "checksum" key (the keys sorted,
+/// numbers as they round-trip), so the same content gives the same checksum however the
+/// file is indented.
+std::string PointChecksum(nlohmann::json doc);
 
 /// One row per point and parameter: point, the factors' values, parameter, unit, runs,
 /// failed, flagged, mean_error, rms_error, sd_error, mean_sigma, nees_per_dof, nees_low,

@@ -14,6 +14,7 @@
 #include "plumb/io/ardupilot/ardupilot_correction.h"
 #include "plumb/io/ardupilot/dataflash_format.h"
 #include "plumb/io/ardupilot/dataflash_parser.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
 namespace {
@@ -146,6 +147,7 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
   const std::string label = stream + " of IMU instance " + std::to_string(instance);
   s.source = log.source + " " + stream + " (IMU instance " + std::to_string(instance) + ")";
   for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
+  if (auto w = DroppedRecordsWarning(info)) s.warnings.push_back(log.source + ": " + *w);
   if (s.series.size() < 2) {
     throw InputError(log.source, label,
                      EmptyWindowMessage(selection.from_s, selection.to_s,
@@ -176,7 +178,7 @@ Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions&
 }
 
 bool LooksLikeDataflash(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(OpenPath(path), std::ios::binary);
   unsigned char head[2] = {0, 0};
   in.read(reinterpret_cast<char*>(head), 2);
   return in.gcount() == 2 && head[0] == detail::kDataflashHead1 &&

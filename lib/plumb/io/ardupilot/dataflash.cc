@@ -274,7 +274,27 @@ const ImuSeries* DecodedDataflashImu(const DataflashLog& log, int instance) {
   return &t->imu[k].series;
 }
 
-ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
+std::size_t DataflashImuRecords(const DataflashLog& log, int instance) {
+  int col = -1;
+  const DataflashType* t = instance >= 0 ? ImuType(log, instance, &col) : nullptr;
+  if (t == nullptr) return 0;
+  if (t->imu_decoded) {
+    const std::size_t k = col >= 0 ? static_cast<std::size_t>(instance) : 0;
+    return k < t->imu.size() ? t->imu[k].records : 0;
+  }
+  if (!t->bodies_kept) return 0;
+  if (col < 0) return t->rows;
+  const auto inst = detail::DataflashColumnReader::Of(*t, col);
+  std::size_t n = 0;
+  for (std::size_t r = 0; r < t->rows; ++r) n += inst.Read(t->bodies.Row(r)) == instance ? 1 : 0;
+  return n;
+}
+
+namespace {
+
+/// ImuFromDataflash, noting in `first_dropped` the time of the first record its rule leaves
+/// out (from the reader's notes for samples it decoded in its pass).
+ImuSeries ImuSamples(const DataflashLog& log, int instance, std::optional<double>& first_dropped) {
   int instance_col = -1;
   const DataflashType* type = instance >= 0 ? ImuType(log, instance, &instance_col) : nullptr;
   const std::string what = "IMU instance " + std::to_string(instance);
@@ -298,7 +318,11 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
                          " rows: no IMU samples were logged (LOG_BITMASK without IMU?)");
   }
   if (type->imu_decoded) {  // decoded by the reader, with the rule below
-    if (const ImuSeries* decoded = DecodedDataflashImu(log, instance)) return CopySeries(*decoded);
+    if (const ImuSeries* decoded = DecodedDataflashImu(log, instance)) {
+      const std::size_t k = instance_col >= 0 ? static_cast<std::size_t>(instance) : 0;
+      if (const auto& dropped = type->imu[k].first_dropped) first_dropped = dropped->t_s;
+      return CopySeries(*decoded);
+    }
     throw InputError(log.source, "", "no " + type->name + " rows with I == " +
                                          std::to_string(instance) + " for " + what);
   }
@@ -341,9 +365,14 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
   const std::uint8_t* pending = nullptr;
   double pending_t = 0.0;
   const auto decide = [&](bool below_next) {
-    if (pending == nullptr || !std::isfinite(pending_t)) return;
-    if (!s.t_s.empty() && !(pending_t > s.t_s.back())) return;
-    if (below_next) keep(pending, pending_t);
+    if (pending == nullptr) return;
+    const bool kept = std::isfinite(pending_t) && (s.t_s.empty() || pending_t > s.t_s.back()) &&
+                      below_next;
+    if (kept) {
+      keep(pending, pending_t);
+    } else if (!first_dropped) {
+      first_dropped = pending_t;
+    }
   };
   for (std::size_t r = 0; r < type->rows; ++r) {
     const std::uint8_t* body = type->bodies.Row(r);
@@ -355,6 +384,23 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
   }
   decide(true);
   return s;
+}
+
+}  // namespace
+
+ImuSeries ImuFromDataflash(const DataflashLog& log, int instance) {
+  std::optional<double> first_dropped;
+  return ImuSamples(log, instance, first_dropped);
+}
+
+std::optional<double> DataflashImuFirstDropped(const DataflashLog& log, int instance) {
+  std::optional<double> first_dropped;
+  try {
+    (void)ImuSamples(log, instance, first_dropped);
+  } catch (const InputError&) {
+    return std::nullopt;  // no such instance, no samples
+  }
+  return first_dropped;
 }
 
 }  // namespace plumb::io

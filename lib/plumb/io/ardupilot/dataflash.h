@@ -63,6 +63,13 @@ struct DataflashColumn {
   double multiplier = 0.0;
 };
 
+/// A record an IMU's rule for times left out: its place among the instance's records (0 for the
+/// first) and its time as read, s.
+struct DataflashDroppedRecord {
+  std::size_t record = 0;
+  double t_s = 0.0;
+};
+
 /// The samples of one instance of an IMU message, decoded by the binary reader as it met the
 /// records (RecordFilter::decode; see DataflashType::imu).
 struct DataflashImuDecoded {
@@ -76,6 +83,11 @@ struct DataflashImuDecoded {
   /// only if the next record's time is above its own (else taken out again); false after the
   /// last record.
   bool last_on_trial = false;
+  /// The first record the rule left out; nullopt when none was.
+  std::optional<DataflashDroppedRecord> first_dropped;
+  /// The first it left out after the first DataflashImuDecoder::kHeadRecords records: what a
+  /// join of this part after another needs, its first records being replayed there.
+  std::optional<DataflashDroppedRecord> first_dropped_after_head;
 };
 
 /// All records of one message type.
@@ -234,6 +246,15 @@ ImuSeries ImuFromDataflash(const DataflashLog& log, int instance);
 /// returns a copy of. nullptr when the reader kept that message's bodies instead (a text log,
 /// a filter without decode) or the instance has no records.
 const ImuSeries* DecodedDataflashImu(const DataflashLog& log, int instance);
+
+/// The records of IMU instance `instance` in the log, kept as samples or not: more than
+/// ImuFromDataflash's samples when its rule for times left some out. 0 when there is no such
+/// instance.
+std::size_t DataflashImuRecords(const DataflashLog& log, int instance);
+
+/// The time as read (s) of the first record of IMU instance `instance` that ImuFromDataflash's
+/// rule for times leaves out; nullopt when it leaves none out (or there is no such instance).
+std::optional<double> DataflashImuFirstDropped(const DataflashLog& log, int instance);
 
 /// Every IMU stream of a DataFlash log (binary or text), in this order per instance:
 ///  * "IMU" (rows with I == k) or "IMU", "IMU2", "IMU3" (k = 0, 1, 2): accelerometer and

@@ -326,6 +326,13 @@ ImuStreamInfo Describe(const DataflashLog& log, const StreamRef& ref, const ImuS
   info.name = ref.name;
   info.instance = ref.instance;
   info.samples = s.size();
+  // An IMU message's records left out by their times (ImuFromDataflash); the other streams
+  // are paired or batched, and say nothing of it.
+  info.records = ref.kind == Kind::kImu ? std::max(s.size(), DataflashImuRecords(log, ref.instance))
+                                        : s.size();
+  if (info.records > info.samples) {
+    info.first_left_out_t_s = DataflashImuFirstDropped(log, ref.instance);
+  }
   if (!s.empty()) {
     info.t_start_s = s.t_s.front();
     info.t_end_s = s.t_s.back();

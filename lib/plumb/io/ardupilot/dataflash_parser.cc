@@ -46,6 +46,36 @@ struct ReplayKept {
   std::size_t Size() const { return a_kept + pushed.size(); }
 };
 
+/// A ReplayKept that notes what the rule leaves out, in order: a's last sample taken out again,
+/// and head records (by their place in the head) taken out or refused.
+struct NotingReplay : ReplayKept {
+  std::optional<double> a_last_dropped_t_s;
+  std::optional<DataflashDroppedRecord> first_dropped;
+
+  void PopBack() {
+    if (pushed.empty()) {
+      if (!first_dropped && !a_last_dropped_t_s) a_last_dropped_t_s = BackTime();
+    } else if (!first_dropped && !a_last_dropped_t_s) {
+      first_dropped = DataflashDroppedRecord{pushed.back(), (*head)[pushed.back()].t_s};
+    }
+    ReplayKept::PopBack();
+  }
+  void Refused(std::size_t j) {
+    if (!first_dropped && !a_last_dropped_t_s) {
+      first_dropped = DataflashDroppedRecord{j, (*head)[j].t_s};
+    }
+  }
+  bool Dropped() const { return first_dropped || a_last_dropped_t_s; }
+  /// Applies the rule to head record `j`, noting what it leaves out.
+  void Apply(bool& on_trial, std::size_t j) {
+    if (ApplyDataflashTimeRule(*this, on_trial, (*head)[j].t_s)) {
+      pushed.push_back(j);
+    } else {
+      Refused(j);
+    }
+  }
+};
+
 /// Whether the rule for times meets every later record in the same way after `s` (its last
 /// sample on trial when `s_on_trial`) as after `r`: it reads only the last sample, on trial or
 /// not, and below an on-trial one the sample it would bring back.
@@ -119,13 +149,13 @@ std::optional<DataflashImuSeam> DataflashImuDecoder::PlanJoin(
   // through both parts keeps) and from no samples (r, what b's parser kept). Once both meet
   // the next record in the same state, they keep the same samples from then on: the samples
   // settled in s, then b's from where r's settled ones end.
-  ReplayKept s{&a.series.t_s, a.series.size(), &head, {}};
-  ReplayKept r{nullptr, 0, &head, {}};
+  NotingReplay s{{&a.series.t_s, a.series.size(), &head, {}}, {}, {}};
+  NotingReplay r{{nullptr, 0, &head, {}}, {}, {}};
   bool s_on_trial = a.last_on_trial;
   bool r_on_trial = false;
   for (std::size_t j = 0; j < head.size(); ++j) {
-    if (ApplyDataflashTimeRule(s, s_on_trial, head[j].t_s)) s.pushed.push_back(j);
-    if (ApplyDataflashTimeRule(r, r_on_trial, head[j].t_s)) r.pushed.push_back(j);
+    s.Apply(s_on_trial, j);
+    r.Apply(r_on_trial, j);
     if (!SameState(s, s_on_trial, r, r_on_trial)) continue;
     const std::size_t trial = s_on_trial ? 1 : 0;  // the last sample, still undecided
     DataflashImuSeam seam;
@@ -133,6 +163,16 @@ std::optional<DataflashImuSeam> DataflashImuDecoder::PlanJoin(
     seam.from_head.assign(s.pushed.begin(), s.pushed.end() - static_cast<std::ptrdiff_t>(trial));
     seam.from_b = r.Size() - trial;
     seam.on_trial = b.last_on_trial;
+    // What the joined rule leaves out first: up to here what the replay from a's state did;
+    // from here on what b's own parser did (the states are the same), found by replaying the
+    // rest of the head and then from what b noted after its head.
+    seam.a_last_dropped_t_s = s.a_last_dropped_t_s;
+    seam.first_dropped_in_b = s.first_dropped;
+    if (!s.Dropped()) {
+      NotingReplay rest{{r.a_t_s, r.a_kept, &head, r.pushed}, {}, {}};
+      for (std::size_t k = j + 1; k < head.size() && !rest.Dropped(); ++k) rest.Apply(r_on_trial, k);
+      seam.first_dropped_in_b = rest.first_dropped ? rest.first_dropped : b.first_dropped_after_head;
+    }
     return seam;
   }
   if (head.size() < b.records) return std::nullopt;
@@ -142,6 +182,8 @@ std::optional<DataflashImuSeam> DataflashImuDecoder::PlanJoin(
   seam.from_head = s.pushed;
   seam.from_b = b.series.size();
   seam.on_trial = s_on_trial;
+  seam.a_last_dropped_t_s = s.a_last_dropped_t_s;
+  seam.first_dropped_in_b = s.first_dropped;
   return seam;
 }
 
@@ -163,6 +205,12 @@ void DataflashImuDecoder::Join(const DataflashImuSeam& seam, DataflashImuDecoded
     if (has_temp_) s.temp_c.push_back(r.temp_c);
   }
   AppendSamples(s, b.series, seam.from_b, run_jobs);  // b lacks the columns a lacks
+  if (!a.first_dropped && seam.a_last_dropped_t_s) {
+    a.first_dropped = DataflashDroppedRecord{a.records - 1, *seam.a_last_dropped_t_s};
+  } else if (!a.first_dropped && seam.first_dropped_in_b) {
+    a.first_dropped = DataflashDroppedRecord{a.records + seam.first_dropped_in_b->record,
+                                             seam.first_dropped_in_b->t_s};
+  }
   a.records += b.records;
   a.last_time = b.last_time;
   a.last_on_trial = seam.on_trial;

@@ -66,6 +66,12 @@ struct DataflashImuSeam {
   std::vector<std::size_t> from_head;
   std::size_t from_b = 0;
   bool on_trial = false;
+  /// The time of a's last record when the joined rule takes it out again (it was on trial
+  /// when a ended), else nullopt.
+  std::optional<double> a_last_dropped_t_s;
+  /// The first of b's records the joined rule leaves out (its place among b's records);
+  /// nullopt when none is.
+  std::optional<DataflashDroppedRecord> first_dropped_in_b;
 };
 
 /// Decodes the IMU samples of one message inside the reader's pass (RecordFilter::decode):
@@ -159,14 +165,28 @@ class DataflashImuDecoder {
     }
   };
 
-  /// The samples of `s` as the rule for times sees them (ApplyDataflashTimeRule).
+  /// The samples of `decoded` as the rule for times sees them (ApplyDataflashTimeRule); a
+  /// sample taken out again (the record before the one being added) is noted as dropped.
   struct SeriesKept {
     const DataflashImuDecoder& d;
-    ImuSeries& s;
-    double BackTime() const { return s.t_s.back(); }
-    void PopBack() const { d.PopBack(s); }
-    bool Empty() const { return s.t_s.empty(); }
+    DataflashImuDecoded& decoded;
+    double BackTime() const { return decoded.series.t_s.back(); }
+    void PopBack() const {
+      NoteDropped(decoded, decoded.records - 2, decoded.series.t_s.back());
+      d.PopBack(decoded.series);
+    }
+    bool Empty() const { return decoded.series.t_s.empty(); }
   };
+
+  /// Notes record `record` (time `t_s`) of `d` as left out by the rule while its latest
+  /// record is added (a rare path). "After the head": while a record after the first
+  /// kHeadRecords is added.
+  static void NoteDropped(DataflashImuDecoded& d, std::size_t record, double t_s) {
+    if (!d.first_dropped) d.first_dropped = DataflashDroppedRecord{record, t_s};
+    if (d.records > kHeadRecords && !d.first_dropped_after_head) {
+      d.first_dropped_after_head = DataflashDroppedRecord{record, t_s};
+    }
+  }
 
   /// Add with the columns read by `columns` (AnyColumns or UsualColumns).
   template <typename Columns>
@@ -192,8 +212,11 @@ class DataflashImuDecoder {
       if (k >= heads->size()) heads->resize(k + 1);
       (*heads)[k].push_back(Record(t_s, body, columns));
     }
-    SeriesKept kept{*this, d.series};
-    if (!ApplyDataflashTimeRule(kept, d.last_on_trial, t_s)) return;
+    SeriesKept kept{*this, d};
+    if (!ApplyDataflashTimeRule(kept, d.last_on_trial, t_s)) {
+      NoteDropped(d, d.records - 1, t_s);
+      return;
+    }
     ImuSeries& s = d.series;
     s.t_s.push_back(t_s);
     s.acc.push_back(columns.Axes(body, acc_));

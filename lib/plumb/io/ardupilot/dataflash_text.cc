@@ -14,6 +14,7 @@
 #include "plumb/io/ardupilot/dataflash.h"
 #include "plumb/io/ardupilot/dataflash_format.h"
 #include "plumb/io/common/text_scan.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
 namespace {
@@ -349,7 +350,7 @@ DataflashLog ReadDataflashText(const std::string& path, const RecordFilter& filt
 }
 
 bool LooksLikeDataflashText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(OpenPath(path), std::ios::binary);
   if (!in) return false;
   std::string head(kSniffBytes, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));

@@ -173,22 +173,44 @@ void AtomicFileWriter::Write(std::string_view bytes) {
   }
 }
 
-void AtomicFileWriter::Commit() {
+void AtomicFileWriter::Finish() {
+  if (finished_) return;
   if (fd_ < 0) throw Error("cannot write " + path_ + ": file already committed");
   if (in_place_) {
     const int fd = fd_;
     fd_ = -1;
     if (::close(fd) != 0) Fail("close failed");
+    finished_ = true;
     return;
   }
   if (::fsync(fd_) != 0) Fail("fsync of " + temp_path_ + " failed");
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) Fail("close of " + temp_path_ + " failed");
+  finished_ = true;
+}
+
+void AtomicFileWriter::Commit() {
+  if (finished_ && temp_path_.empty() && !in_place_) {
+    throw Error("cannot write " + path_ + ": file already committed");
+  }
+  Finish();
+  if (in_place_) return;
   if (std::rename(temp_path_.c_str(), target_.c_str()) != 0) {
     Fail("rename from " + temp_path_ + " failed");
   }
   temp_path_.clear();
+}
+
+void AtomicFileSet::Add(const std::string& path, std::string_view content) {
+  files_.push_back(std::make_unique<AtomicFileWriter>(path));
+  files_.back()->Write(content);
+}
+
+void AtomicFileSet::Commit() {
+  for (const auto& file : files_) file->Finish();
+  for (const auto& file : files_) file->Commit();
+  files_.clear();
 }
 
 StagedFolder::StagedFolder(std::string path) : path_(std::move(path)) {

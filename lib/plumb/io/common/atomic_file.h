@@ -14,8 +14,10 @@
 // plumb::Error naming the destination path and the system's reason.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace plumb::io {
 
@@ -36,7 +38,11 @@ class AtomicFileWriter {
 
   /// Appends bytes to the temporary file.
   void Write(std::string_view bytes);
-  /// Flushes, closes and renames the temporary file over the destination.
+  /// Puts every byte on disk (fsync) and closes the temporary file, so that what can fail
+  /// (a full disk, a quota) fails here; the destination is not touched yet. A file written in
+  /// place is closed. Called by Commit when not called before.
+  void Finish();
+  /// Finishes, then renames the temporary file over the destination.
   void Commit();
 
  private:
@@ -46,6 +52,23 @@ class AtomicFileWriter {
   std::string temp_path_;
   int fd_ = -1;
   bool in_place_ = false;  ///< written in place: not a regular file, or the process's stream
+  bool finished_ = false;  ///< Finish() done: the bytes are on disk, the file closed
+};
+
+/// A command's several output files written as one: Add() writes each to its temporary file
+/// beside it; Commit() finishes every one first (AtomicFileWriter::Finish: a full disk fails
+/// there, before any destination changes) and only then renames them all into place. Without
+/// a successful Commit() (an error, an early return) no destination changes and the temporary
+/// files are removed: never tables.md of this run beside paper.json of the last.
+class AtomicFileSet {
+ public:
+  /// Writes `content` to the temporary file of `path`; throws plumb::Error naming `path`.
+  void Add(const std::string& path, std::string_view content);
+  /// Finishes every file, then puts each in place, in the order added.
+  void Commit();
+
+ private:
+  std::vector<std::unique_ptr<AtomicFileWriter>> files_;
 };
 
 /// A folder written as a whole (`plumb report --out DIR`): its files go into a temporary

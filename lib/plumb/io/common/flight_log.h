@@ -27,6 +27,13 @@ struct ImuStreamInfo {
   std::string name;          ///< message or topic name, e.g. "IMU2", "SCALED_IMU2", "sensor_combined"
   int instance = 0;          ///< sensor instance, 0-based, >= 0
   std::size_t samples = 0;   ///< samples in the log
+  /// The stream's records (messages) in the log: more than `samples` when the reader left
+  /// some out (a time not finite, not above the last kept one, or a spike above the next
+  /// record's); DroppedRecordsWarning says so.
+  std::size_t records = 0;
+  /// The time as read (s; NaN for a stamp that is not a number) of the first record left
+  /// out, when the reader knows it.
+  std::optional<double> first_left_out_t_s;
   double rate_hz = 0.0;      ///< (samples - 1) / (t_end_s - t_start_s), Hz; 0 when undefined
   double t_start_s = 0.0;    ///< first sample's log time, s
   double t_end_s = 0.0;      ///< last sample's log time, s
@@ -39,6 +46,11 @@ struct ImuStreamInfo {
   /// True when the reader can undo `applied` from the log's own parameters.
   bool undoable = false;
 };
+
+/// The warning for the records of `info`'s stream a reader left out because of their times
+/// ("IMU of IMU instance 0: left out 3 of 17070 records ..."), with the time of the first
+/// left out when the reader knows it; nullopt when none was.
+std::optional<std::string> DroppedRecordsWarning(const ImuStreamInfo& info);
 
 /// Which samples of a log become the session.
 struct FlightLogSelection {

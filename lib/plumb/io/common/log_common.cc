@@ -10,12 +10,16 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <memory>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <new>
 
 #include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
+#include "plumb/io/common/flight_log.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
 namespace {
@@ -27,8 +31,8 @@ double Median(std::vector<double> v) {
 
 }  // namespace
 
-LogFile::LogFile(const std::string& path, const std::string& what) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+LogFile::LogFile(const std::string& path, const std::string& what) : path_(path) {
+  const int fd = ::open(OpenPath(path).c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     throw InputError(path, "byte 0",
                      "cannot open the " + what + " for reading: " + std::strerror(errno));
@@ -40,6 +44,7 @@ LogFile::LogFile(const std::string& path, const std::string& what) {
     if (m != MAP_FAILED) {
       ::madvise(m, size_, MADV_SEQUENTIAL);
       mapping_ = m;
+      guard_ = std::make_unique<detail::MappingGuard>(m, size_);
       data_ = static_cast<const std::uint8_t*>(m);
       ::close(fd);
       return;
@@ -47,7 +52,7 @@ LogFile::LogFile(const std::string& path, const std::string& what) {
   }
   ::close(fd);
   // Not mappable (empty, a pipe, a special file): read it.
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(OpenPath(path), std::ios::binary);
   if (!in) throw InputError(path, "byte 0", "cannot open the " + what + " for reading");
   buffer_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   if (in.bad()) {
@@ -56,6 +61,10 @@ LogFile::LogFile(const std::string& path, const std::string& what) {
   }
   data_ = buffer_.data();
   size_ = buffer_.size();
+}
+
+void LogFile::ThrowIfCut() const {
+  if (guard_ != nullptr && guard_->cut()) throw detail::CutShortError(path_, size_);
 }
 
 void LogFile::Release(std::size_t from, std::size_t up_to) const {
@@ -131,8 +140,9 @@ constexpr std::size_t kDropStep = std::size_t{2} << 20;
 
 /// A whole regular file mapped read-only. Before the parser gets a span, the file's size is
 /// checked and the span's new pages read in with MADV_POPULATE_READ, which reports a read
-/// error (a failing card) as an error: touching a page that cannot be read, or one past the
-/// end of a file cut short meanwhile, would raise SIGBUS instead.
+/// error (a failing card) as an error. A file cut short while the parser is inside a span
+/// unmaps the pages past its new end, populated or not: touching one reads zeros (the
+/// mapping is guarded, detail::MappingGuard) and cut() turns true.
 class ForwardMapping {
  public:
   /// The file `fd` of `size` bytes, to be read from byte `from` on.
@@ -142,15 +152,21 @@ class ForwardMapping {
     void* m = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
     if (m == MAP_FAILED) return;
     base_ = static_cast<std::uint8_t*>(m);
+    guard_ = std::make_unique<detail::MappingGuard>(base_, size);
     ::madvise(base_, size, MADV_SEQUENTIAL);  // a hint: errors ignored
   }
   ~ForwardMapping() {
+    guard_.reset();  // before the range can be mapped again by anything else
     if (base_ != nullptr) ::munmap(base_, size_);
   }
   ForwardMapping(const ForwardMapping&) = delete;
   ForwardMapping& operator=(const ForwardMapping&) = delete;
 
   const std::uint8_t* data() const { return base_; }
+
+  /// Whether a page was found past the file's end (the file was cut short while read; the
+  /// page reads as zeros: see detail::MappingGuard).
+  bool cut() const { return guard_ != nullptr && guard_->cut(); }
 
   /// Makes the bytes [0, to) safe to touch: the file still holds them (fstat; a file cut
   /// short meanwhile would raise SIGBUS there) and the pages not read in yet are read in
@@ -190,6 +206,7 @@ class ForwardMapping {
   std::size_t size_ = 0;
   std::size_t populated_ = 0;  ///< bytes up to this one, from the first read, were read in
   std::size_t dropped_ = 0;    ///< pages before this byte were dropped
+  std::unique_ptr<detail::MappingGuard> guard_;  ///< turns a cut's SIGBUS into cut()
 };
 
 /// ReadForward over a mapped file (see ForwardMapping): each call gets `span` bytes of the
@@ -201,14 +218,20 @@ void ConsumeMapped(ForwardMapping& map, std::size_t size, std::size_t span, std:
   while (true) {
     const std::size_t n = std::min(span, size - at);
     if (const int error = map.Prepare(at + n); error != 0) {
+      if (error == EFAULT) throw detail::CutShortError(path, size);
       throw InputError(path, "byte " + std::to_string(at),
                        std::string("read failed before the end of the file: ") +
-                           (error == EFAULT ? "the file is shorter than when it was opened "
-                                              "(cut or replaced while it was read)"
-                                            : std::strerror(error)));
+                           std::strerror(error));
     }
     const bool at_end = at + n >= size;
-    const std::size_t next = consume(map.data() + at, n, at, at_end);
+    std::size_t next = 0;
+    try {
+      next = consume(map.data() + at, n, at, at_end);
+    } catch (const Error&) {
+      if (map.cut()) throw detail::CutShortError(path, size);  // the zeros may have caused it
+      throw;
+    }
+    if (map.cut()) throw detail::CutShortError(path, size);
     if (at_end || next == kStopReading) return;
     if (next < at) throw Error("ReadForward: the parser of " + path + " went backwards");
     if (next == at) {  // nothing consumed from a full span: hand over more
@@ -276,15 +299,55 @@ ImuSeries CopySeries(const ImuSeries& s) {
   return out;
 }
 
+LeftOutTimes KeepIncreasingTimes(ImuSeries& s) {
+  LeftOutTimes out;
+  const std::size_t n = s.size();
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = s.t_s[i];
+    const bool keep = std::isfinite(t) && (kept == 0 || t > s.t_s[kept - 1]) &&
+                      (i + 1 == n || t < s.t_s[i + 1]);
+    if (!keep) {
+      if (out.count++ == 0) out.first_t_s = t;
+      continue;
+    }
+    if (kept != i) {
+      s.t_s[kept] = t;
+      s.acc[kept] = s.acc[i];
+      if (s.has_gyro()) s.gyr[kept] = s.gyr[i];
+      if (s.has_temperature()) s.temp_c[kept] = s.temp_c[i];
+    }
+    ++kept;
+  }
+  s.t_s.resize(kept);
+  s.acc.resize(kept);
+  if (!s.gyr.empty()) s.gyr.resize(kept);
+  if (!s.temp_c.empty()) s.temp_c.resize(kept);
+  return out;
+}
+
+std::optional<std::string> DroppedRecordsWarning(const ImuStreamInfo& info) {
+  const std::optional<double>& first_t_s = info.first_left_out_t_s;
+  if (info.records <= info.samples) return std::nullopt;
+  return info.name + " of IMU instance " + std::to_string(info.instance) + ": left out " +
+         std::to_string(info.records - info.samples) + " of " + std::to_string(info.records) +
+         " records by their time (not finite, not above the last kept one, or a spike above "
+         "the next record's: a corrupt or backwards time stamp)" +
+         (first_t_s ? "; the first with time " + (std::isfinite(*first_t_s)
+                                                      ? FixedText(*first_t_s, 6) + " s"
+                                                      : std::string("not a number"))
+                    : std::string());
+}
+
 std::size_t RegularFileSize(const std::string& path) {
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return 0;
+  if (::stat(OpenPath(path).c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return 0;
   return static_cast<std::size_t>(st.st_size);
 }
 
 void ReadForward(const std::string& path, const std::string& what, std::size_t lookahead,
                  const ForwardConsumer& consume, std::size_t from) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(OpenPath(path).c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     throw InputError(path, "byte 0",
                      "cannot open the " + what + " for reading: " + std::strerror(errno));
@@ -374,6 +437,7 @@ void RecordStore::FreeBlock::operator()(std::uint8_t* p) const {
 }
 
 LogFile::~LogFile() {
+  guard_.reset();  // before the range can be mapped again by anything else
   if (mapping_ != nullptr) ::munmap(mapping_, size_);
 }
 

@@ -17,13 +17,16 @@
 #include "plumb/core/log_motion.h"
 #include "plumb/core/session.h"
 #include "plumb/core/types.h"
+#include "plumb/io/common/mapping_guard.h"
 
 namespace plumb::io {
 
 /// The whole file at `path`, read-only in memory: mapped (mmap, read ahead sequentially) when
 /// the system can, else read into a buffer. `what` names the format in errors ("DataFlash
 /// log", "ULog file", ...). The constructor throws plumb::InputError(path, "byte N", ...) when
-/// the file cannot be opened, sized or read to its end. Not copyable.
+/// the file cannot be opened, sized or read to its end. A mapping is guarded
+/// (detail::MappingGuard): should the file be cut short while it is read, the pages past its
+/// new end read as zeros instead of raising SIGBUS, and ThrowIfCut says so. Not copyable.
 class LogFile {
  public:
   LogFile(const std::string& path, const std::string& what);
@@ -33,6 +36,11 @@ class LogFile {
 
   const std::uint8_t* data() const { return data_; }
   std::size_t size() const { return size_; }
+
+  /// Throws detail::CutShortError when the mapped file was found cut short (or replaced)
+  /// after it was opened: what was parsed from it is not the file. A reader calls it after
+  /// its parse, and before reporting an error the parse met (the zeros may have caused it).
+  void ThrowIfCut() const;
 
   /// Says a parser is done with the bytes [from, up_to) for now, so that a mapped file does
   /// not stay resident as it is read: the whole pages inside them are dropped from this
@@ -49,7 +57,9 @@ class LogFile {
  private:
   const std::uint8_t* data_ = nullptr;
   std::size_t size_ = 0;
+  std::string path_;                    ///< the file, for errors
   void* mapping_ = nullptr;             ///< the mmap'ed region, or nullptr
+  std::unique_ptr<detail::MappingGuard> guard_;  ///< guards mapping_ against a cut
   std::vector<std::uint8_t> buffer_;    ///< the bytes when not mapped
 };
 
@@ -120,6 +130,19 @@ void ReserveHugePages(std::vector<T>& v, std::size_t n) {
 /// A copy of `s` whose large buffers are reserved first and backed by huge pages
 /// (AdviseHugePages): samples a reader decoded in its pass, handed out by value.
 ImuSeries CopySeries(const ImuSeries& s);
+
+/// The first sample KeepIncreasingTimes left out, and how many it did.
+struct LeftOutTimes {
+  std::size_t count = 0;           ///< samples left out
+  std::optional<double> first_t_s; ///< the first one's time as read, s (NaN for a bad stamp)
+};
+
+/// Keeps the samples of `s` (in record order, every record with its time as read) whose time
+/// is finite, above the last kept one and below the next record's: a time above the next
+/// record's is a corrupt spike (one ULog stamp of 5e12 s hid 17013 of 17070 samples when
+/// only "above the last kept" was asked), so one bad stamp costs one sample. The rule of
+/// ImuFromDataflash. Returns what was left out.
+LeftOutTimes KeepIncreasingTimes(ImuSeries& s);
 
 /// The size of the file at `path` in bytes (0 when it is not a regular file or cannot be
 /// read).

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "plumb/core/error.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io::detail {
 namespace {
@@ -17,10 +18,11 @@ LineSource LineSource::FromFile(const std::string& path) {
   LineSource source;
   source.name_ = path;
   struct stat info {};
-  if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) {
+  const std::string open_path = OpenPath(path);
+  if (::stat(open_path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) {
     throw InputError(path, "", "is a folder, expected a file");
   }
-  source.file_.reset(std::fopen(path.c_str(), "rb"));
+  source.file_.reset(std::fopen(open_path.c_str(), "rb"));
   if (!source.file_) {
     throw InputError(path, "", std::string("cannot open: ") + std::strerror(errno));
   }

@@ -11,6 +11,7 @@
 #include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/mavlink/mavlink_session.h"
 #include "plumb/io/px4/px4_session.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
 namespace {
@@ -80,10 +81,11 @@ SplitReadOptions InParts(const JobRunner& run_jobs) {
 }  // namespace
 
 FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
+  const StreamSpool stream({path}, StreamBound(0));  // a pipe: held already, or read whole now
   {  // a missing, unreadable or folder path says so (not "not a flight log")
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw InputError(path, "", "is a folder, not a file");
-    std::ifstream probe(path, std::ios::binary);
+    std::ifstream probe(OpenPath(path), std::ios::binary);
     if (!probe) throw InputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
   }
   FlightLog out;

@@ -25,6 +25,7 @@
 #include "plumb/io/text/native_csv.h"
 #include "plumb/io/text/text_table.h"
 #include "plumb/signal/time_base.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
 namespace {
@@ -40,7 +41,7 @@ constexpr std::streamsize kHeaderLineBytes = 4 * 1024;
 
 /// The first line that is neither blank nor a comment, or "" when there is none.
 std::string FirstContentLine(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(OpenPath(path), std::ios::binary);
   if (!in) throw InputError(path, "", std::string("cannot open the file: ") + std::strerror(errno));
   std::string head(kHeaderSearchBytes, '\0');
   in.read(head.data(), kHeaderSearchBytes);
@@ -253,6 +254,12 @@ void UseUniformClock(Session& s) {
 
 Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& options) {
   if (inputs.empty()) throw Error("OpenInputs: no input");
+  std::vector<std::string> paths;
+  for (const InputFile& input : inputs) {
+    paths.push_back(input.path);
+    if (input.two_files) paths.push_back(input.gyr_path);
+  }
+  const StreamSpool streams(paths, StreamBound(options.max_stream_bytes));
   std::optional<Session> joined;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const InputKind kind = KindOf(inputs[i], options);
@@ -277,7 +284,7 @@ namespace {
 /// Px4SessionTopics) per byte of file, measured on the first kEstimatePrefixBytes of `path`;
 /// 1 (the most it can be) when that start does not decode.
 double KeptFraction(const std::string& path, FlightLogFormat format) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(OpenPath(path), std::ios::binary);
   std::string prefix(kEstimatePrefixBytes, '\0');
   in.read(prefix.data(), static_cast<std::streamsize>(prefix.size()));
   prefix.resize(static_cast<std::size_t>(in.gcount()));
@@ -317,7 +324,7 @@ double KeptFraction(const std::string& path, FlightLogFormat format) {
 
 std::uint64_t EstimateReadMemory(const std::string& path) {
   struct stat info {};
-  if (::stat(path.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) return 0;
+  if (::stat(OpenPath(path).c_str(), &info) != 0 || !S_ISREG(info.st_mode)) return 0;
   double factor = kTableMemoryFactor;
   switch (const FlightLogFormat format = SniffFlightLog(path)) {
     case FlightLogFormat::kDataflashBinary:
@@ -330,19 +337,9 @@ std::uint64_t EstimateReadMemory(const std::string& path) {
     case FlightLogFormat::kMavlinkTlog: factor = kTlogMemoryFactor; break;
     case FlightLogFormat::kNone: break;
   }
-  return kReadMemoryBaseBytes +
+  return kReadMemoryBaseBytes + SpooledBytes(path) +
          static_cast<std::uint64_t>(factor * static_cast<double>(info.st_size));
 }
 
-std::optional<std::uint64_t> AvailableMemory() {
-  std::ifstream in("/proc/meminfo");
-  std::string key, unit;
-  std::uint64_t value = 0;
-  while (in >> key >> value) {
-    std::getline(in, unit);
-    if (key == "MemAvailable:") return value * 1024;  // the file says kB (KiB)
-  }
-  return std::nullopt;
-}
 
 }  // namespace plumb::io

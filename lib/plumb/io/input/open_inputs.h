@@ -54,6 +54,7 @@
 #include "plumb/core/jobs.h"
 #include "plumb/core/session.h"
 #include "plumb/io/common/flight_log.h"
+#include "plumb/io/common/stream_spool.h"  // AvailableMemory, StreamBound
 
 namespace plumb::io {
 
@@ -185,6 +186,10 @@ struct InputOptions {
   std::function<void(std::size_t input, InputKind kind)> before_read;
 
   // ---- Work ----
+  /// The most bytes an input that gives its bytes once (standard input, a pipe, a FIFO,
+  /// process substitution) may hold: it is read whole into memory first (StreamSpool), and
+  /// one that goes on past this is refused. 0: the memory available (MemAvailable).
+  std::uint64_t max_stream_bytes = 0;
   /// Runs independent jobs at once (core/jobs.h): the two files of the two-file form are read
   /// at once, and a large .bin, .tlog or .ulg log in two parts (FlightLog::Open). Empty: one
   /// after another. The session is the same either way.
@@ -208,8 +213,10 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
 ///   MAVLink .tlog kTlogMemoryFactor; text tables and CSV
 ///   kTableMemoryFactor (about 50 bytes per decoded sample). Calibrated on the peak RSS of
 ///   `plumb info` / `plumb calibrate` on ~450 MB inputs (docs/performance.md, "Memory"),
-///   rounded up. 0 when `path` cannot be sized.
+///   rounded up. A stream held in memory (StreamSpool) is estimated from its copy, whose
+///   bytes are added. 0 when `path` cannot be sized (a stream not read yet).
 std::uint64_t EstimateReadMemory(const std::string& path);
+
 
 /// EstimateReadMemory's sample of a log's start, bytes.
 inline constexpr std::size_t kEstimatePrefixBytes = std::size_t{8} << 20;
@@ -227,8 +234,5 @@ inline constexpr double kTableMemoryFactor = 0.8;
 
 /// The fixed part of EstimateReadMemory: the process with its libraries (20 MiB).
 inline constexpr std::uint64_t kReadMemoryBaseBytes = std::uint64_t{20} << 20;
-
-/// MemAvailable from /proc/meminfo, bytes; nullopt where the system does not say.
-std::optional<std::uint64_t> AvailableMemory();
 
 }  // namespace plumb::io

@@ -10,9 +10,11 @@
 #include <unordered_set>
 
 #include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
 #include "plumb/core/units.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/ardupilot_correction.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
 namespace {
@@ -276,7 +278,7 @@ int ChooseStream(const std::vector<ImuStreamInfo>& infos, const FlightLogSelecti
 /// dropped (counted in `*dropped`) when its time is not finite, does not exceed the last kept
 /// sample's, or is not below the next sample's (a corrupted spike), as in the DataFlash reader.
 ImuSeries WindowedSeries(const StreamData& d, const FlightLogSelection& selection,
-                         const Units& units, bool has_temp, std::size_t* dropped) {
+                         const Units& units, bool has_temp, LeftOutTimes* dropped) {
   ImuSeries out;
   out.acc_unit = units.acc_unit;
   out.gyr_unit = units.gyr_unit;
@@ -286,7 +288,7 @@ ImuSeries WindowedSeries(const StreamData& d, const FlightLogSelection& selectio
     const double t = d.t_s[i];
     const bool spike = i + 1 < d.samples.size() && !(t < d.t_s[i + 1]);
     if (!std::isfinite(t) || (any && !(t > last_t)) || spike) {
-      ++*dropped;
+      if (dropped->count++ == 0) dropped->first_t_s = t;
       continue;
     }
     any = true;
@@ -498,12 +500,16 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
                                   ? "message times all zero: times from the tlog (unix s)"
                                   : "times from the message's own time stamps (s)"));
 
-  std::size_t dropped = 0;
+  LeftOutTimes dropped;
   s.series = WindowedSeries(d, selection, units, info.has_temperature, &dropped);
   ImuSeries& out = s.series;
-  if (dropped > 0) {
-    s.warnings.push_back(who + "dropped " + std::to_string(dropped) +
-                         " sample(s) whose time did not increase (a reboot or a corrupted time)");
+  if (dropped.count > 0) {
+    s.warnings.push_back(
+        who + "dropped " + std::to_string(dropped.count) +
+        " sample(s) whose time did not increase past the last kept one, or ran ahead of the "
+        "next (a reboot or a corrupted time); the first with time " +
+        (std::isfinite(*dropped.first_t_s) ? FixedText(*dropped.first_t_s, 6) + " s"
+                                           : std::string("not a number")));
   }
   if (out.size() < 2) {
     throw InputError(log.source, info.name + " instance " + std::to_string(d.instance),
@@ -564,7 +570,7 @@ FlightLogSummary TlogSummary(const MavlinkLog& log) {
 }
 
 bool LooksLikeTlog(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(OpenPath(path), std::ios::binary);
   std::uint8_t head[9] = {};
   in.read(reinterpret_cast<char*>(head), sizeof(head));
   return in.gcount() == static_cast<std::streamsize>(sizeof(head)) &&

@@ -719,7 +719,14 @@ MavlinkLog ParseTlog(const std::uint8_t* data, std::size_t size, const std::stri
 
 MavlinkLog ReadTlog(const std::string& path, const TlogReadOptions& options) {
   const LogFile file(path, "MAVLink tlog");
-  return ParseTlogFrom(file.data(), file.size(), path, &file, options);
+  try {
+    MavlinkLog log = ParseTlogFrom(file.data(), file.size(), path, &file, options);
+    file.ThrowIfCut();
+    return log;
+  } catch (const Error&) {
+    file.ThrowIfCut();  // the zeros of a cut may have caused it
+    throw;
+  }
 }
 
 }  // namespace plumb::io

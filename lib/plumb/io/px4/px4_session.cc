@@ -10,6 +10,7 @@
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/px4/px4_correction.h"
 #include "plumb/io/px4/ulog_format.h"
+#include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
 namespace {
@@ -102,14 +103,12 @@ void Reserve(ImuSeries* s, std::size_t n, bool gyr, bool temp) {
   if (temp) ReserveHugePages(s->temp_c, n);
 }
 
-/// Appends a sample when its time increases; returns whether it was kept.
-bool Push(ImuSeries* s, double t_s, const Vec3f& acc, const Vec3f* gyr, const float* temp) {
-  if (!std::isfinite(t_s) || (!s->t_s.empty() && !(t_s > s->t_s.back()))) return false;
+/// Appends a message's sample, whatever its time (Extract leaves bad times out after).
+void Push(ImuSeries* s, double t_s, const Vec3f& acc, const Vec3f* gyr, const float* temp) {
   s->t_s.push_back(t_s);
   s->acc.push_back(acc);
   if (gyr != nullptr) s->gyr.push_back(*gyr);
   if (temp != nullptr) s->temp_c.push_back(*temp);
-  return true;
 }
 
 ImuSeries FromCombined(const ULogTopic& t) {
@@ -227,28 +226,26 @@ ImuSeries FromSensorAccel(const ULogTopic& acc_topic, const ULogTopic* gyro_topi
   return s;
 }
 
-/// The samples of `src`; with `notes`, what was left out is said there: samples whose time
-/// did not increase (Push), counted against the topic's messages.
-ImuSeries Extract(const StreamSource& src, std::vector<std::string>* notes) {
-  ImuSeries s;
+/// The samples of a stream, with what their times left out.
+struct Extracted {
+  ImuSeries series;
+  LeftOutTimes left_out;  ///< KeepIncreasingTimes's
+};
+
+/// The samples of `src`, those with bad times left out (KeepIncreasingTimes: the reader did
+/// it already for sensor_combined decoded in its pass); with `notes`, the pairing of
+/// sensor_accel with sensor_gyro is said there.
+Extracted Extract(const StreamSource& src, std::vector<std::string>* notes) {
+  Extracted out;
   switch (src.kind) {
-    case StreamKind::kCombined: s = FromCombined(*src.topic); break;
-    case StreamKind::kVehicleImu: s = FromVehicleImu(*src.topic); break;
-    case StreamKind::kSensorAccel: s = FromSensorAccel(*src.topic, src.gyro, notes); break;
+    case StreamKind::kCombined: out.series = FromCombined(*src.topic); break;
+    case StreamKind::kVehicleImu: out.series = FromVehicleImu(*src.topic); break;
+    case StreamKind::kSensorAccel: out.series = FromSensorAccel(*src.topic, src.gyro, notes); break;
   }
-  const std::size_t rows = src.topic->rows;
-  const bool paired_out = src.kind == StreamKind::kSensorAccel && src.gyro != nullptr;
-  if (notes != nullptr && !paired_out && s.size() < rows) {
-    notes->push_back(std::string(KindName(src.kind)) + " instance " +
-                     std::to_string(src.instance) + ": dropped " +
-                     std::to_string(rows - s.size()) + " of " + std::to_string(rows) +
-                     " messages whose time did not increase past the last kept one, or with "
-                     "no sample interval (a corrupt or backwards time stamp: one far ahead "
-                     "hides every sample after it)" +
-                     (s.empty() ? "" : "; the last kept at " + std::to_string(s.t_s.back()) +
-                                           " s"));
-  }
-  return s;
+  out.left_out = src.kind == StreamKind::kCombined && src.topic->imu_decoded
+                     ? src.topic->imu_left_out
+                     : KeepIncreasingTimes(out.series);
+  return out;
 }
 
 std::vector<StreamSource> Sources(const ULog& log) {
@@ -390,11 +387,14 @@ const StreamSource* Select(const std::vector<StreamSource>& sources,
   return best;
 }
 
-ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries& s) {
+ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries& s,
+                       const LeftOutTimes& left_out) {
   ImuStreamInfo info;
   info.name = KindName(src.kind);
   info.instance = src.instance;
   info.samples = s.size();
+  info.records = s.size() + left_out.count;
+  info.first_left_out_t_s = left_out.first_t_s;
   if (!s.empty()) {
     info.t_start_s = s.t_s.front();
     info.t_end_s = s.t_s.back();
@@ -418,9 +418,11 @@ std::vector<ImuStreamInfo> ULogImuStreams(const ULog& log) {
   std::vector<ImuStreamInfo> out;
   for (const StreamSource& src : Sources(log)) {
     if (src.kind == StreamKind::kCombined && src.topic->imu_decoded) {
-      out.push_back(Describe(log, src, src.topic->imu));  // no copy of the reader's samples
+      // No copy of the reader's samples.
+      out.push_back(Describe(log, src, src.topic->imu, src.topic->imu_left_out));
     } else {
-      out.push_back(Describe(log, src, Extract(src, nullptr)));
+      const Extracted e = Extract(src, nullptr);
+      out.push_back(Describe(log, src, e.series, e.left_out));
     }
   }
   return out;
@@ -541,8 +543,12 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   std::vector<ImuSeries> all;
   std::vector<std::vector<std::string>> notes(sources.size());
   for (std::size_t i = 0; i < sources.size(); ++i) {
-    all.push_back(Extract(sources[i], &notes[i]));
-    infos.push_back(Describe(log, sources[i], all.back()));
+    Extracted e = Extract(sources[i], &notes[i]);
+    infos.push_back(Describe(log, sources[i], e.series, e.left_out));
+    if (auto w = DroppedRecordsWarning(infos.back())) {
+      notes[i].push_back(std::move(*w));
+    }
+    all.push_back(std::move(e.series));
   }
   const StreamSource* src = Select(sources, infos, selection);
   const std::string wanted = (selection.stream.empty() ? std::string("IMU") : selection.stream) +
@@ -627,7 +633,7 @@ FlightLogSummary ULogSummary(const ULog& log) {
 }
 
 bool LooksLikeULog(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(OpenPath(path), std::ios::binary);
   unsigned char head[sizeof(detail::kULogMagic)] = {};
   in.read(reinterpret_cast<char*>(head), sizeof(head));
   return in.gcount() == static_cast<std::streamsize>(sizeof(head)) &&

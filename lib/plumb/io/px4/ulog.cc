@@ -119,8 +119,9 @@ std::uint64_t TimestampOf(const ULogTopic& t, const std::uint8_t* body) {
 
 /// Decodes sensor_combined's IMU samples inside the reader's pass (RecordFilter::decode), as
 /// the PX4 session reads them from bodies (px4_session.cc, FromCombined): t_s = timestamp *
-/// 1e-6, accelerometer_m_s2[0..2] and gyro_rad[0..2] (or gyro_rad_s) saturated to float, a
-/// sample kept when its time is finite and above the last kept one.
+/// 1e-6, accelerometer_m_s2[0..2] and gyro_rad[0..2] (or gyro_rad_s) saturated to float,
+/// every message's sample in order (KeepIncreasingTimes leaves out bad times once the whole
+/// log is read: a spike is told only by the message after it).
 class CombinedDecoder {
  public:
   /// The decoder of `t`, or nullopt when `t` is not sensor_combined or lacks a column.
@@ -142,9 +143,7 @@ class CombinedDecoder {
 
   /// Decodes the message body `body` (after the msg_id) into `s`.
   void Add(ImuSeries& s, const std::uint8_t* body) const {
-    const double t_s = DecodeULogValue(body + time_.offset, time_.type) * 1e-6;
-    if (!std::isfinite(t_s) || (!s.t_s.empty() && !(t_s > s.t_s.back()))) return;
-    s.t_s.push_back(t_s);
+    s.t_s.push_back(DecodeULogValue(body + time_.offset, time_.type) * 1e-6);
     s.acc.push_back(Triad3(body, acc_));
     s.gyr.push_back(Triad3(body, gyr_));
   }
@@ -440,17 +439,14 @@ class Parser {
     return out;
   }
 
-  /// Appends the samples of `more` (decoded from the messages after those of `s`, starting
-  /// with no sample kept) to `s` as one decoder would have kept them: a sample is kept when its
-  /// time is above the last kept one, so `more`'s kept times (increasing) from the first above
-  /// `s`'s last on.
+  /// Appends the samples of `more` (decoded from the messages after those of `s`) to `s`:
+  /// every message's, as one decoder keeps them.
   static void JoinSamples(ImuSeries& s, ImuSeries& more, const JobRunner& run_jobs) {
     if (s.empty()) {
       s = std::move(more);
       return;
     }
-    const auto first = std::upper_bound(more.t_s.begin(), more.t_s.end(), s.t_s.back());
-    AppendSamples(s, more, static_cast<std::size_t>(first - more.t_s.begin()), run_jobs);
+    AppendSamples(s, more, 0, run_jobs);
   }
 
   /// The parameter changes `ahead` logged, added after this part's with their timestamps as
@@ -1079,6 +1075,9 @@ ULog Decode(const ByteSource& source, std::size_t size, const std::string& name,
     return parser->Feed(data, n, offset, at_end);
   });
   if (parser) parser->Finish();
+  for (ULogTopic& t : log.topics) {
+    if (t.imu_decoded) t.imu_left_out = KeepIncreasingTimes(t.imu);
+  }
   return log;
 }
 

@@ -121,9 +121,11 @@ struct ULogTopic {
   /// and gyro_rad[3] or gyro_rad_s[3]): bodies_kept is then false and `imu` holds them.
   bool imu_decoded = false;
   /// With imu_decoded: the samples, t_s = timestamp * 1e-6, acc and gyr saturated to float,
-  /// those whose time is not finite or does not increase dropped (as the PX4 session reads
-  /// sensor_combined from bodies).
+  /// those KeepIncreasingTimes leaves out left out once the whole log is read (as the PX4
+  /// session reads sensor_combined from bodies).
   ImuSeries imu;
+  /// With imu_decoded: what KeepIncreasingTimes left out of `imu`.
+  LeftOutTimes imu_left_out;
 
   /// Bytes this topic holds of the log: its bodies, or with imu_decoded its messages counted
   /// at body size (the decoded samples take a little less).

@@ -12,11 +12,7 @@ nlohmann::json ReadJsonFile(const std::string& path) {
   if (std::filesystem::is_directory(path)) throw InputError(path, "", "is a folder, not a JSON file");
   std::ifstream in(path);
   if (!in) throw InputError(path, "", "cannot be read");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
-  }
+  return ParseJsonText(path, [&] { return nlohmann::json::parse(in); });
 }
 
 }  // namespace plumb::io

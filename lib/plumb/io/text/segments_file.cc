@@ -59,13 +59,8 @@ std::pair<std::size_t, std::size_t> ToRange(const RawSection& raw, const ImuSeri
 }
 
 std::vector<RawSection> ParseJson(const std::string& path, std::string_view text) {
-  nlohmann::ordered_json root;
-  try {
-    root = nlohmann::ordered_json::parse(text.begin(), text.end());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, "byte " + std::to_string(e.byte),
-                     std::string("invalid JSON: ") + e.what());
-  }
+  const nlohmann::ordered_json root =
+      ParseJsonText(path, [&] { return nlohmann::ordered_json::parse(text.begin(), text.end()); });
   if (!root.is_object()) {
     throw InputError(path, "",
                      "expected a JSON object of sections {\"label\": {\"start\": i, \"end\": j}}");
