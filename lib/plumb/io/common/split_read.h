@@ -61,7 +61,8 @@ struct SplitReadOptions {
   /// Parts, the first included (2 or more to split at all). 2: more parts let a fast thread
   /// take over parts a slowed one has not started, but each part's samples are copied once
   /// more in the joins; measured on two cores, eight parts read 15-35 % slower than two on an
-  /// idle machine and no faster beside a busy thread (docs/performance.md, session 20).
+  /// idle machine and no faster beside a busy thread (docs/performance.md, "More than two
+  /// parts, measured").
   int parts = 2;
   /// Where the second part's start is looked for, as a fraction of the bytes after the lead;
   /// the later parts' at its multiples (those below 1). 0.5 with two parts: the middle, which
