@@ -333,10 +333,11 @@ std::optional<std::string> DroppedRecordsWarning(const ImuStreamInfo& info) {
          std::to_string(info.records - info.samples) + " of " + std::to_string(info.records) +
          " records by their time (not finite, not above the last kept one, or a spike above "
          "the next record's: a corrupt or backwards time stamp)" +
-         (first_t_s ? "; the first with time " + (std::isfinite(*first_t_s)
-                                                      ? FixedText(*first_t_s, 6) + " s"
-                                                      : std::string("not a number"))
-                    : std::string());
+         (first_t_s ? "; the first with time " + LeftOutTimeText(*first_t_s) : std::string());
+}
+
+std::string LeftOutTimeText(double t_s) {
+  return std::isfinite(t_s) ? FixedText(t_s, 6) + " s" : std::string("not a number");
 }
 
 std::size_t RegularFileSize(const std::string& path) {

@@ -144,6 +144,9 @@ struct LeftOutTimes {
 /// ImuFromDataflash. Returns what was left out.
 LeftOutTimes KeepIncreasingTimes(ImuSeries& s);
 
+/// A left-out record's time as warnings say it: "5000000000000.000000 s", or "not a number".
+std::string LeftOutTimeText(double t_s);
+
 /// The size of the file at `path` in bytes (0 when it is not a regular file or cannot be
 /// read).
 std::size_t RegularFileSize(const std::string& path);

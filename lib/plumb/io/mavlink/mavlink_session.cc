@@ -10,7 +10,6 @@
 #include <unordered_set>
 
 #include "plumb/core/error.h"
-#include "plumb/core/number_text.h"
 #include "plumb/core/units.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ardupilot/ardupilot_correction.h"
@@ -508,8 +507,7 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
         who + "dropped " + std::to_string(dropped.count) +
         " sample(s) whose time did not increase past the last kept one, or ran ahead of the "
         "next (a reboot or a corrupted time); the first with time " +
-        (std::isfinite(*dropped.first_t_s) ? FixedText(*dropped.first_t_s, 6) + " s"
-                                           : std::string("not a number")));
+        LeftOutTimeText(*dropped.first_t_s));
   }
   if (out.size() < 2) {
     throw InputError(log.source, info.name + " instance " + std::to_string(d.instance),
