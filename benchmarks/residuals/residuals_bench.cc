@@ -1,8 +1,9 @@
 // The motion residual's cost per sample (docs/performance.md, "The motion residual"): one
-// 5 s turn at 100 Hz (500 samples, the length of imu_tk's session's turns), base model, with
-// and without the bias walk's states and Earth rate, evaluated for its value alone (what a
-// trust-region step's candidate and the linearity check ask) and with every Jacobian (what a
-// Gauss-Newton iteration asks). The counter samples/s counts the samples integrated.
+// 5 s turn at 100 Hz (500 samples, the length of imu_tk's session's turns), the base model or
+// one with two gyroscope effects (general: the rates' Jacobians by implicit differentiation),
+// with and without the bias walk's states and Earth rate, evaluated for its value alone (what
+// a trust-region step's candidate and the linearity check ask) and with every Jacobian (what
+// a Gauss-Newton iteration asks). The counter samples/s counts the samples integrated.
 //
 //   build/benchmarks/residuals/plumb_bench_residuals
 #include <benchmark/benchmark.h>
@@ -38,16 +39,22 @@ residuals::MotionSamples Turn() {
   return s;
 }
 
-/// Arguments: jacobians (0/1), walk processes (0/2), Earth rate (0/1).
+/// Arguments: jacobians (0/1), walk processes (0/2), Earth rate (0/1), model (0: base, 1:
+/// base+gyro_g_sensitivity+gyro_scale_nonlinearity, its effects off zero).
 void BM_MotionResidual(benchmark::State& state) {
   const bool jacobians = state.range(0) != 0;
   const int walk = static_cast<int>(state.range(1));
   const bool earth = state.range(2) != 0;
-  const model::Model m = model::Model::Parse("base");
+  const bool general = state.range(3) != 0;
+  const model::Model m =
+      model::Model::Parse(general ? "base+gyro_g_sensitivity+gyro_scale_nonlinearity" : "base");
   const residuals::MotionSamples s = Turn();
   const residuals::MotionResidual r(m, s, earth ? Vec3(4e-5, 0, -5e-5) : Vec3::Zero(), walk);
   auto theta = m.ZeroParameters();
   for (int d = 0; d < 3; ++d) theta[1][static_cast<std::size_t>(4 * d)] = 0.01;  // E = 1.01 I
+  for (std::size_t t = 2; t < theta.size(); ++t) {
+    for (std::size_t j = 0; j < theta[t].size(); ++j) theta[t][j] = 1e-4 * (1.0 + 0.5 * j);
+  }
   const double q0[4] = {0, 0, 0, 1}, q1[4] = {0.1, 0.2, 0.3, 0.927};
   const double zero[3] = {0, 0, 0};
   std::vector<const double*> p = {q0, q1};
@@ -70,8 +77,8 @@ void BM_MotionResidual(benchmark::State& state) {
       benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_MotionResidual)
-    ->ArgNames({"jacobians", "walk", "earth"})
-    ->ArgsProduct({{0, 1}, {0, 2}, {0, 1}})
+    ->ArgNames({"jacobians", "walk", "earth", "model"})
+    ->ArgsProduct({{0, 1}, {0, 2}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -52,10 +52,13 @@ Analyses AnalyseBothWays(int poses, bool wander, std::uint64_t seed) {
   FitReport fit;
   Solution solution = SolveWithGauge(problem, options, fit);
   Analyses out;
-  double cost = 0;
-  out.eliminated = AnalyseAt(problem, *solution.all_free.problem, options, out.columns, &cost, nullptr);
-  Eigen::MatrixXd J;
-  out.dense = AnalyseAt(problem, *solution.all_free.problem, options, out.columns, &cost, nullptr, &J);
+  AnalysedSolution eliminated = AnalyseAt(problem, *solution.all_free.problem, options);
+  AnalysisOptions dense;
+  dense.dense = true;
+  AnalysedSolution analysed = AnalyseAt(problem, *solution.all_free.problem, options, dense);
+  out.eliminated = std::move(eliminated.analysis);
+  out.dense = std::move(analysed.analysis);
+  out.columns = std::move(analysed.columns);
   return out;
 }
 

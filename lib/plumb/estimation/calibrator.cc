@@ -52,6 +52,7 @@ model::Model ModelForSession(const model::Model& requested, const ImuSeries& ser
 FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
                          const model::Model& model_in, const geo::Site& site,
                          const CalibrationOptions& options, CalibrationResult& result) {
+  options.Validate();
   Calibration& cal = result.calibration;
   FitReport& fit = result.fit;
   cal.method = options.method;

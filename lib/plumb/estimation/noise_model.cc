@@ -106,22 +106,7 @@ NoiseModel EstimateNoise(const ImuSeries& series, const StillSet& set, bool has_
       noise.tau_gyr[i] = std::max(1.0, axes[gyr].tau_int);
     }
   }
-  for (const auto& density : {options.accel_walk_density, options.gyro_walk_density}) {
-    if (density && !(std::isfinite(*density) && *density >= 0)) {
-      throw Error("a bias random-walk density must be finite and >= 0 (got " +
-                  std::to_string(*density) + ")");
-    }
-  }
-  for (const auto& level : {options.accel_instability, options.gyro_instability}) {
-    if (level && !(std::isfinite(*level) && *level >= 0)) {
-      throw Error("a bias instability must be finite and >= 0 (got " + std::to_string(*level) +
-                  ")");
-    }
-  }
-  if (!(std::isfinite(options.instability_time_s) && options.instability_time_s > 0)) {
-    throw Error("the bias instability's correlation time must be finite and > 0 s (got " +
-                Number(options.instability_time_s) + ")");
-  }
+  // The levels given are in their ranges (CalibrationOptions::Validate, stage 0).
   noise.instability_time_s = options.instability_time_s;
   if (options.constant_bias) return noise;  // no walk, no instability
   // The levels given; the others are set by stage 2a (wander_levels.h).

@@ -53,7 +53,7 @@ struct CalibrationOptions {
   /// Relative singular-value threshold of the column-scaled whitened Jacobian below which a
   /// direction counts as unobservable (0 < value < 1).
   double rank_tolerance = 1e-9;
-  /// Minimum samples for a still segment to be used.
+  /// Minimum samples for a still segment to be used (>= 1).
   int min_segment_samples = 10;
   /// Bias random-walk densities K (IEEE Std 952 rate / acceleration random walk) of the
   /// accelerometer and the gyroscope, sensor units / s / sqrt(Hz) (m/s^3/sqrt(Hz) and
@@ -96,10 +96,11 @@ struct CalibrationOptions {
   /// Fewest still segments for the walk estimate (>= 2); with fewer the typical walk is used.
   int walk_min_poses = 6;
   /// Lower bound on the noise standard deviation per sample, in sensor units, guarding
-  /// against quantised data whose scatter reads zero (> 0).
+  /// against quantised data whose scatter reads zero (finite, > 0).
   double min_sigma_acc = 1e-6;
   double min_sigma_gyr = 1e-8;
-  /// Solver limits.
+  /// Solver limits: iterations per solve (>= 1) and Ceres's relative tolerances of the final
+  /// solves, each in (0, 1).
   int max_iterations = 200;
   double function_tolerance = 1e-12;
   double parameter_tolerance = 1e-12;
@@ -114,6 +115,10 @@ struct CalibrationOptions {
   /// Costs two evaluations of the residuals per direction checked; off for fits whose
   /// covariance nobody reads (diagnose's candidate scores).
   bool check_linearity = true;
+
+  /// Throws plumb::Error naming the first field out of its documented range (the calibration
+  /// runs it first).
+  void Validate() const;
 };
 
 }  // namespace plumb::estimation

@@ -8,8 +8,8 @@
 
 namespace plumb::estimation {
 
-void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& options,
-           FitReport& fit, bool refine) {
+SolveOutcome Solve(ceres::Problem& problem, SolveStage stage, const CalibrationOptions& options) {
+  const bool rough = stage == SolveStage::kRough;
   ceres::Solver::Options solver_options;
   // Problems with bias-wander states have several unknowns per pose, most of them in a
   // banded chain: a sparse factorisation keeps their cost linear in the poses.
@@ -26,27 +26,30 @@ void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& option
   // A solve that refines another starts next to the optimum: Gauss-Newton's full step is
   // right there, and a trust region grown from Ceres's default (1e4, three times per step)
   // would damp the weakly determined directions for several iterations.
-  solver_options.initial_trust_region_radius = refine ? kRefineTrustRegion : kStartTrustRegion;
+  solver_options.initial_trust_region_radius =
+      stage == SolveStage::kRefine ? kRefineTrustRegion : kStartTrustRegion;
   solver_options.num_threads = 1;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
-  fit.solver_report = summary.BriefReport();
-  // Counted as the report counts them (the steps taken; Ceres's iteration 0 is the start).
-  const int steps = summary.num_successful_steps + summary.num_unsuccessful_steps;
-  fit.iterations += steps;
-  fit.last_solve_iterations = steps;
-  ++fit.solves;
-  fit.converged = summary.termination_type == ceres::CONVERGENCE;
   if (!summary.IsSolutionUsable()) throw Error("the solver failed: " + summary.BriefReport());
+  // Counted as the report counts them (the steps taken; Ceres's iteration 0 is the start).
+  return {summary.num_successful_steps + summary.num_unsuccessful_steps,
+          summary.termination_type == ceres::CONVERGENCE, summary.BriefReport()};
 }
 
-ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
-                                const CalibrationOptions& options, UnknownColumns& columns,
-                                double* cost, std::vector<double>* residuals,
-                                Eigen::MatrixXd* jacobian,
-                                Eigen::SparseMatrix<double>* sparse_jacobian,
-                                std::shared_ptr<const EliminatedJacobian>* eliminated) {
+void Record(const SolveOutcome& solve, FitReport& fit) {
+  fit.solver_report = solve.report;
+  fit.iterations += solve.steps;
+  fit.last_solve_iterations = solve.steps;
+  ++fit.solves;
+  fit.converged = solve.converged;
+}
+
+AnalysedSolution AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
+                           const CalibrationOptions& options, const AnalysisOptions& how) {
+  AnalysedSolution out;
+  UnknownColumns& columns = out.columns;
   columns = calibration.Columns(problem);
   ObservabilityInput in;
   in.names = columns.names;
@@ -56,32 +59,33 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
   const auto n = static_cast<Eigen::Index>(columns.names.size());
   const auto first_wander = static_cast<Eigen::Index>(columns.first_wander);
   const Eigen::Index n_m = LeadingModelColumns(columns.is_model);
-  if (jacobian != nullptr || (n_m == n && sparse_jacobian == nullptr)) {
-    in.J = calibration.Jacobian(problem, columns, cost, residuals);
-    ObservabilityAnalysis out = AnalyseObservability(in);
-    if (jacobian != nullptr) *jacobian = std::move(in.J);
+  if (how.dense || (n_m == n && !how.keep_jacobian)) {
+    in.J = calibration.Jacobian(problem, columns, &out.cost, &out.residuals);
+    out.analysis = AnalyseObservability(in);
+    if (how.dense) out.dense_jacobian = std::move(in.J);
     return out;
   }
   Eigen::SparseMatrix<double> J_local;
-  Eigen::SparseMatrix<double>& J = sparse_jacobian != nullptr ? *sparse_jacobian : J_local;
-  J = calibration.SparseJacobian(problem, columns, cost, residuals);
+  Eigen::SparseMatrix<double>& J = how.keep_jacobian ? out.jacobian : J_local;
+  J = calibration.SparseJacobian(problem, columns, &out.cost, &out.residuals);
   // The attitudes and wander states eliminated together when the data determine the attitudes
   // clearly (the cost is then linear in the poses), else the wander states alone; kept for
   // the caller (`eliminated`) in the first case.
   auto kept_elimination = std::make_shared<EliminatedJacobian>();
-  if (eliminated != nullptr) kept_elimination->J = J;
-  const Eigen::SparseMatrix<double>& J_e = eliminated != nullptr ? kept_elimination->J : J;
+  if (how.keep_jacobian) kept_elimination->J = J;
+  const Eigen::SparseMatrix<double>& J_e = how.keep_jacobian ? kept_elimination->J : J;
   kept_elimination->elimination = EliminatePoses(J_e, n_m, first_wander);
   const Elimination* elimination = kept_elimination->elimination.get();
   if (elimination == nullptr) {
     in.J = Eigen::MatrixXd(J);
-    return AnalyseObservability(in);
+    out.analysis = AnalyseObservability(in);
+    return out;
   }
   const Eigen::Index kept = elimination->first();
   in.J = elimination->Reduced(options.run_jobs);
-  if (eliminated != nullptr && kept == n_m) {
+  if (how.keep_jacobian && kept == n_m) {
     kept_elimination->M = in.J;
-    *eliminated = kept_elimination;
+    out.eliminated = kept_elimination;
   }
   in.names.resize(static_cast<std::size_t>(kept));
   in.values.resize(static_cast<std::size_t>(kept));
@@ -96,9 +100,9 @@ ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem&
       return -elimination->Solve(J_k * directions).topRows(n_attitudes);
     };
   }
-  ObservabilityAnalysis out = AnalyseObservability(in);
+  out.analysis = AnalyseObservability(in);
   // The wander states are always determined (their factors tie them down): counted apart.
-  out.summary.wander_states = static_cast<int>(n - first_wander);
+  out.analysis.summary.wander_states = static_cast<int>(n - first_wander);
   return out;
 }
 
@@ -119,10 +123,9 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
 
 AnalysedSolution AnalyseSolution(CalibrationProblem& calibration, ceres::Problem& problem,
                                  const CalibrationOptions& options) {
-  AnalysedSolution out;
-  out.analysis = AnalyseAt(calibration, problem, options, out.columns, &out.cost, &out.residuals,
-                           nullptr, &out.jacobian, &out.eliminated);
-  return out;
+  AnalysisOptions how;
+  how.keep_jacobian = true;
+  return AnalyseAt(calibration, problem, options, how);
 }
 
 // Solves with every unknown free (with motion: roughly, then again with the motion weights
@@ -134,12 +137,14 @@ Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOption
   Solution out;
   calibration.SaveValues();
   out.all_free = calibration.Build({});
-  Solve(*out.all_free.problem, calibration.has_motion(), options, fit);
+  Record(Solve(*out.all_free.problem,
+               calibration.has_motion() ? SolveStage::kRough : SolveStage::kFromStart, options),
+         fit);
   FitReport refined = fit;  // the fit's account, kept only when nothing is held
   if (calibration.has_motion()) {
     calibration.SetMotionWeightsFromSolution();
     out.all_free = calibration.Build({});
-    Solve(*out.all_free.problem, false, options, refined, true);
+    Record(Solve(*out.all_free.problem, SolveStage::kRefine, options), refined);
   }
   out.analysed = AnalyseSolution(calibration, *out.all_free.problem, options);
   for (int c : out.analysed->analysis.pivots) {
@@ -154,7 +159,7 @@ Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOption
   calibration.RestoreValues();
   out.all_free = calibration.Build({});
   out.held = calibration.Build(out.held_parameters);
-  Solve(*out.held.problem, false, options, fit);
+  Record(Solve(*out.held.problem, SolveStage::kFromStart, options), fit);
   return out;
 }
 

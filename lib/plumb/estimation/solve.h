@@ -14,6 +14,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "plumb/estimation/calibration_problem.h"
@@ -44,27 +45,60 @@ inline constexpr double kRefineTrustRegion = 1e12;
 /// tolerances decide convergence.
 inline constexpr double kGradientTolerance = 1e-14;
 
-/// One solve of `problem`; `rough` uses the rough tolerances; `refine` says it starts from
-/// another solve's solution (kRefineTrustRegion). Adds its iterations to `fit`, records
-/// convergence and Ceres's brief report; throws plumb::Error when the solution is not usable.
-void Solve(ceres::Problem& problem, bool rough, const CalibrationOptions& options,
-           FitReport& fit, bool refine = false);
+/// Which solve of a fit: its tolerances and its first trust region.
+enum class SolveStage {
+  kFromStart,  ///< from the starting values to the final tolerances (options' function and
+               ///< parameter tolerances; kStartTrustRegion)
+  kRough,      ///< from the starting values to the rough tolerances; another solve refines it
+  kRefine,     ///< from another solve's solution to the final tolerances (kRefineTrustRegion)
+};
 
-/// The observability analysis (observability.h) of `problem` at the current values: its free
-/// unknowns go to `columns`, the cost and whitened residuals (optional) to `cost` and
-/// `residuals`, and the whitened Jacobian it analysed to `jacobian` (optional). Without
-/// `jacobian`, bias-wander states are eliminated first (a sparse QR): the analysis and its
-/// covariance are then over the columns before columns.first_wander, the wander marginalised;
-/// with it, over every column (dense, O(unknowns^3)). `sparse_jacobian` (optional, without
-/// `jacobian`) receives the whitened Jacobian over `columns` for other checks at the same point,
-/// and `eliminated` (optional, with it) the elimination of every column after the model's
-/// when the analysis made one (else it is left alone).
-ObservabilityAnalysis AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
-                                const CalibrationOptions& options, UnknownColumns& columns,
-                                double* cost, std::vector<double>* residuals,
-                                Eigen::MatrixXd* jacobian = nullptr,
-                                Eigen::SparseMatrix<double>* sparse_jacobian = nullptr,
-                                std::shared_ptr<const EliminatedJacobian>* eliminated = nullptr);
+/// What one solve did.
+struct SolveOutcome {
+  int steps = 0;           ///< steps taken (successful and not; Ceres's iteration 0 is the start)
+  bool converged = false;  ///< Ceres's termination is CONVERGENCE
+  std::string report;      ///< ceres::Solver::Summary::BriefReport()
+};
+
+/// One solve of `problem` at `stage`, limited to options.max_iterations; throws plumb::Error
+/// when the solution is not usable.
+SolveOutcome Solve(ceres::Problem& problem, SolveStage stage, const CalibrationOptions& options);
+
+/// Adds a solve to the fit's account: its steps to the iterations, one solve, its convergence
+/// and Ceres's brief report (the last solve's).
+void Record(const SolveOutcome& solve, FitReport& fit);
+
+/// The analysis (observability.h) of a problem at the current values, with what the calibration
+/// reads of it besides: the unknowns' columns, the cost, the whitened residuals and Jacobian.
+struct AnalysedSolution {
+  ObservabilityAnalysis analysis;
+  UnknownColumns columns;
+  double cost = 0;
+  std::vector<double> residuals;  ///< whitened
+  /// Over `columns`, for the linearity check (AnalysisOptions::keep_jacobian).
+  Eigen::SparseMatrix<double> jacobian;
+  /// The analysis's elimination when it took every column after the model's (attitudes and
+  /// wander together; else null), for the linearity check (AnalysisOptions::keep_jacobian).
+  std::shared_ptr<const EliminatedJacobian> eliminated;
+  /// Every column's whitened Jacobian, as analysed (AnalysisOptions::dense).
+  Eigen::MatrixXd dense_jacobian;
+};
+
+/// How AnalyseAt analyses and what it keeps.
+struct AnalysisOptions {
+  /// Analyse every column densely (O(unknowns^3)) and keep the Jacobian analysed
+  /// (dense_jacobian). Otherwise the bias-wander states are eliminated first (a sparse QR): the
+  /// analysis and its covariance are then over the columns before columns.first_wander, the
+  /// wander marginalised.
+  bool dense = false;
+  /// Without `dense`: keep the whitened sparse Jacobian and, when the analysis made one, the
+  /// elimination of every column after the model's, for other checks at the same point.
+  bool keep_jacobian = false;
+};
+
+/// The observability analysis of `problem` at the current values (see AnalysisOptions).
+AnalysedSolution AnalyseAt(CalibrationProblem& calibration, ceres::Problem& problem,
+                           const CalibrationOptions& options, const AnalysisOptions& how = {});
 
 /// The leverages h_ii = J_i (J^T J)^+ J_i^T of the whitened residual rows `rows` of `problem`
 /// (every free unknown, the wander states eliminated by a sparse QR first), and its whitened
@@ -73,20 +107,7 @@ Eigen::VectorXd Leverages(CalibrationProblem& calibration, ceres::Problem& probl
                           const CalibrationOptions& options, const std::vector<Eigen::Index>& rows,
                           std::vector<double>* residuals);
 
-/// The analysis (AnalyseAt) of a problem at its solution, with what the calibration reads of
-/// it besides: the unknowns' columns, the cost, the whitened residuals and Jacobian.
-struct AnalysedSolution {
-  ObservabilityAnalysis analysis;
-  UnknownColumns columns;
-  double cost = 0;
-  std::vector<double> residuals;
-  Eigen::SparseMatrix<double> jacobian;  ///< over `columns`, for the linearity check
-  /// The analysis's elimination when it took every column after the model's (attitudes and
-  /// wander together; else null), for the linearity check.
-  std::shared_ptr<const EliminatedJacobian> eliminated;
-};
-
-/// AnalyseAt with every output kept.
+/// AnalyseAt at a solution, keeping the Jacobian for the linearity check.
 AnalysedSolution AnalyseSolution(CalibrationProblem& calibration, ceres::Problem& problem,
                                  const CalibrationOptions& options);
 

@@ -12,7 +12,9 @@
 #include "plumb/core/so3.h"
 #include "plumb/model/effects/accel_linear.h"
 #include "plumb/model/effects/gyro_linear.h"
+#include "plumb/residuals/corrected_rates.h"
 #include "plumb/residuals/motion_residual.h"
+#include "plumb/residuals/strapdown.h"
 
 namespace plumb::residuals {
 
@@ -149,20 +151,7 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
     in.dtemp_c = s_.dtemp_c[i];
     return model_->Correct<double>(theta, y_a, y_g, in, F_inv, E_inv, 3);
   };
-  const Vec3 omega_k = R_b_n * omega_ie_n_;
-  Mat3 dR = Mat3::Identity();
-  Vec3 dv = Vec3::Zero();
-  auto [f0, w0] = correct(0);
-  for (std::size_t i = 0; i + 1 < n; ++i) {
-    const double h = s_.dt_s[i + 1] - s_.dt_s[i];
-    const auto [f1, w1] = correct(i + 1);
-    const Vec3 e = dR.transpose() * omega_k;
-    const Mat3 dR_next = dR * so3::Exp(so3::ConingIncrement(w0 - e, w1 - e, h));
-    dv += 0.5 * h * (dR * f0 + dR_next * f1);
-    dR = dR_next;
-    f0 = f1;
-    w0 = w1;
-  }
+  const Vec3 dv = strapdown::IntegratedChange(s_.dt_s, R_b_n * omega_ie_n_, correct).second;
   const double T = s_.dt_s[n - 1] - s_.dt_s[0];
   return dv + R_b_n * g_n_ * T;
 }
@@ -173,127 +162,127 @@ bool VelocityResidual::IsLinearBlock(std::size_t block) const {
          model_->terms()[static_cast<std::size_t>(t)].effect->info().linear_stage;
 }
 
+namespace {
+
+/// Columns of the unknowns in EvaluateLinear: the model's P parameters (block by block), the
+/// left perturbation of R_k, then the wander's ends: accelerometer from, to, gyroscope from, to
+/// (every process of a sensor has the same columns).
+struct VelocityColumns {
+  explicit VelocityColumns(int P) : model(P) {}
+  int model;
+  int start_attitude = model, acc_from = model + 3, acc_to = model + 6;
+  int gyr_from = model + 9, gyr_to = model + 12, count = model + 15;
+};
+
+/// The samples corrected by the linear stage, f = F^-1 (y_a - wander - b_a) and w = E^-1 (y_g -
+/// wander - b_g), with their Jacobians in VelocityColumns: the strapdown core's add_rate_H_x
+/// and force_H_x (residuals/strapdown.h).
+class LinearlyCorrected {
+ public:
+  struct Sample {
+    Vec3 f, w;  ///< m/s^2 and rad/s, body frame
+    double u;   ///< fraction of the motion, the wander line's weight
+  };
+  LinearlyCorrected(const model::Model& model, const MotionSamples& s, const LinearStage& stage,
+                    const WanderLine& acc_wander, const WanderLine& gyr_wander)
+      : model_(model), stage_(stage), layout_(model), columns_(layout_.parameters),
+        a_term_(model.BaseTerm(model::Sensor::kAccel)),
+        g_term_(model.BaseTerm(model::Sensor::kGyro)) {
+    const std::size_t n = s.size();
+    const double t0 = n > 0 ? s.dt_s[0] : 0.0;
+    const double span = n > 0 ? std::max(s.dt_s[n - 1] - t0, 1e-12) : 1.0;
+    samples_.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double u = (s.dt_s[i] - t0) / span;
+      samples_.push_back({stage.F_inv * (s.acc[i] - acc_wander.At(u) - stage.linear.acc),
+                          stage.E_inv * (s.gyr[i] - gyr_wander.At(u) - stage.linear.gyr), u});
+    }
+  }
+  const Sample& operator[](std::size_t i) const { return samples_[i]; }
+  const VelocityColumns& columns() const { return columns_; }
+  const ModelColumns& layout() const { return layout_; }
+
+  /// out += K d w_i / d x.
+  void AddRate(const Mat3& K, std::size_t i, strapdown::Sensitivity& out) const {
+    if (g_term_ < 0) return;
+    const Sample& x = samples_[i];
+    const Mat3 KE_inv = K * stage_.E_inv;
+    model::gyro_linear::SubtractRateJacobian(
+        KE_inv, x.w, out.middleCols(layout_.Offset(g_term_), model::gyro_linear::kSize));
+    out.middleCols<3>(columns_.gyr_from).noalias() -= (1.0 - x.u) * KE_inv;
+    out.middleCols<3>(columns_.gyr_to).noalias() -= x.u * KE_inv;
+  }
+  /// out = d f_i / d x (3 x count, preallocated: no allocation per sample).
+  void Force(std::size_t i, strapdown::Sensitivity& out) const {
+    const Sample& x = samples_[i];
+    out.setZero();
+    if (a_term_ >= 0) {
+      const int size = model_.terms()[static_cast<std::size_t>(a_term_)].effect->info().size();
+      model::accel_linear::SubtractForceJacobian(stage_.F_inv, x.f,
+                                                 size == model::accel_linear::kSizeFull,
+                                                 out.middleCols(layout_.Offset(a_term_), size));
+    }
+    out.middleCols<3>(columns_.acc_from) -= (1.0 - x.u) * stage_.F_inv;
+    out.middleCols<3>(columns_.acc_to) -= x.u * stage_.F_inv;
+  }
+
+ private:
+  const model::Model& model_;
+  const LinearStage& stage_;
+  ModelColumns layout_;
+  VelocityColumns columns_;
+  int a_term_, g_term_;
+  std::vector<Sample> samples_;
+};
+
+}  // namespace
+
 void VelocityResidual::EvaluateLinear(double const* const* parameters, double* residuals,
                                       double** jacobians) const {
   const LinearStage stage(*model_, parameters);
-  const Quat& q_k = stage.q_k;
-  const Mat3& R_b_n = stage.R_b_n;
-  double const* const* theta = parameters + 1;
-  const Mat3& F_inv = stage.F_inv;
-  const Mat3& E_inv = stage.E_inv;
-  const Vec3 b_a = stage.linear.acc, b_g = stage.linear.gyr;
+  double const* const* wander = parameters + 1 + model_->num_terms();
+  const LinearlyCorrected x(*model_, s_, stage, WanderEnds(wander, accel_wander_),
+                            WanderEnds(wander + 2 * accel_wander_, gyro_wander_));
+  const VelocityColumns& cols = x.columns();
   const std::size_t n = s_.size();
-  // Columns of the unknowns: the model's P parameters (block by block), the left perturbation
-  // of R_k, then the wander's ends: accelerometer from, to, gyroscope from, to (every process
-  // of a sensor has the same columns).
-  std::vector<int> offset;
-  int P = 0;
-  for (const auto& t : model_->terms()) {
-    offset.push_back(P);
-    P += t.effect->info().size();
-  }
-  const int att = P, acc_from = P + 3, acc_to = P + 6, gyr_from = P + 9, gyr_to = P + 12;
-  const int U = P + 15;
-  const int a_term = model_->BaseTerm(model::Sensor::kAccel);
-  const int g_term = model_->BaseTerm(model::Sensor::kGyro);
-  double const* const* wander = theta + model_->num_terms();
-  const WanderLine acc_wander = WanderEnds(wander, accel_wander_);
-  const WanderLine gyr_wander = WanderEnds(wander + 2 * accel_wander_, gyro_wander_);
-  const double t0 = n > 0 ? s_.dt_s[0] : 0.0;
-  const double span = n > 0 ? std::max(s_.dt_s[n - 1] - t0, 1e-12) : 1.0;
-  struct Sample {
-    Vec3 f, w;
-    double u;
+  strapdown::Propagation propagation(stage.R_b_n * omega_ie_n_,
+                                     stage.R_b_n * so3::Skew(omega_ie_n_), cols.count,
+                                     cols.start_attitude, true);
+  auto add_rate_H_x = [&](const Mat3& K, std::size_t i, strapdown::Sensitivity& out) {
+    x.AddRate(K, i, out);
   };
-  auto correct = [&](std::size_t i) {
-    const double u = (s_.dt_s[i] - t0) / span;
-    return Sample{F_inv * (s_.acc[i] - acc_wander.At(u) - b_a),
-                  E_inv * (s_.gyr[i] - gyr_wander.At(u) - b_g), u};
-  };
-  using Cols = Eigen::Matrix<double, 3, Eigen::Dynamic>;
-  // Adds K d w / dx (rate) or K d f / dx (force) of sample `x` to `out`.
-  auto add_rate = [&](const Mat3& K, const Sample& x, Cols& out) {
-    if (g_term < 0) return;
-    const Mat3 KE_inv = K * E_inv;
-    model::gyro_linear::SubtractRateJacobian(
-        KE_inv, x.w, out.middleCols(offset[static_cast<std::size_t>(g_term)], model::gyro_linear::kSize));
-    out.middleCols<3>(gyr_from).noalias() -= (1.0 - x.u) * KE_inv;
-    out.middleCols<3>(gyr_to).noalias() -= x.u * KE_inv;
-  };
-  // Writes K d f / dx of sample `x` to `out` (3 x U, preallocated: no allocation per sample).
-  auto force_jacobian = [&](const Sample& x, Cols& out) {
-    out.setZero();
-    if (a_term >= 0) {
-      const int size = model_->terms()[static_cast<std::size_t>(a_term)].effect->info().size();
-      model::accel_linear::SubtractForceJacobian(
-          F_inv, x.f, size == model::accel_linear::kSizeFull,
-          out.middleCols(offset[static_cast<std::size_t>(a_term)], size));
-    }
-    out.middleCols<3>(acc_from) -= (1.0 - x.u) * F_inv;
-    out.middleCols<3>(acc_to) -= x.u * F_inv;
-  };
-
-  const Vec3 omega_k = R_b_n * omega_ie_n_;
-  const Mat3 d_omega_k = R_b_n * so3::Skew(omega_ie_n_);  // d omega_k / d delta_k
-  Mat3 dR = Mat3::Identity();
-  Vec3 dv = Vec3::Zero();
-  // A: d(right perturbation of dR_i)/dx; D: d(dR_i f_i)/dx; B: d(dv)/dx (file comment).
-  Cols A = Cols::Zero(3, U), A_next(3, U), B = Cols::Zero(3, U);
-  Sample x0 = n > 0 ? correct(0) : Sample{Vec3::Zero(), Vec3::Zero(), 0.0};
-  Cols D0 = Cols::Zero(3, U), D1(3, U), dR_D1(3, U);
-  if (n > 0) force_jacobian(x0, D0);
+  auto force_H_x = [&](std::size_t i, strapdown::Sensitivity& out) { x.Force(i, out); };
+  if (n > 0) propagation.Start(x[0].f, force_H_x);
   for (std::size_t i = 0; i + 1 < n; ++i) {
-    const double h = s_.dt_s[i + 1] - s_.dt_s[i];
-    const Sample x1 = correct(i + 1);
-    const Vec3 e = dR.transpose() * omega_k;
-    const Vec3 u0 = x0.w - e, u1 = x1.w - e;
-    const Vec3 phi = so3::ConingIncrement(u0, u1, h);
-    const Mat3 Ex = so3::Exp(phi);
-    const Mat3 dR_next = dR * Ex;
-    dv += 0.5 * h * (dR * x0.f + dR_next * x1.f);
-    const Mat3 Jr = so3::RightJacobian(phi);
-    const Mat3 K0 = Jr * (0.5 * h * Mat3::Identity() - (h * h / 12.0) * so3::Skew(u1));
-    const Mat3 K1 = Jr * (0.5 * h * Mat3::Identity() + (h * h / 12.0) * so3::Skew(u0));
-    const Mat3 K = K0 + K1;
-    A_next.noalias() = (Ex.transpose() - K * so3::Skew(e)) * A;
-    add_rate(K0, x0, A_next);
-    add_rate(K1, x1, A_next);
-    A_next.middleCols<3>(att).noalias() -= K * (dR.transpose() * d_omega_k);
-    force_jacobian(x1, D1);
-    D1.noalias() -= so3::Skew(x1.f) * A_next;
-    dR_D1.noalias() = dR_next * D1;
-    B += 0.5 * h * (D0 + dR_D1);
-    D0.swap(dR_D1);
-    A.swap(A_next);
-    dR = dR_next;
-    x0 = x1;
+    propagation.Advance(i, s_.dt_s[i + 1] - s_.dt_s[i], x[i].w, x[i + 1].w, x[i + 1].f,
+                        add_rate_H_x, force_H_x);
   }
+  // r = dv + R_k^T g_n T; d(R_k^T g_n T) / d delta_k = R_k^T [g_n]x T.
   const double T = n > 0 ? s_.dt_s[n - 1] - s_.dt_s[0] : 0.0;
-  const Vec3 r = n < 2 ? Vec3::Zero() : Vec3(dv + R_b_n * g_n_ * T);
-  if (n >= 2) B.middleCols<3>(att) += R_b_n * so3::Skew(g_n_) * T;
-  else B.setZero();
-  const Eigen::DiagonalMatrix<double, 3> W(sqrt_info_);
+  const Vec3 r = n < 2 ? Vec3::Zero() : Vec3(propagation.dv() + stage.R_b_n * g_n_ * T);
+  strapdown::Sensitivity r_H_x = propagation.dv_H_x();
+  if (n >= 2) r_H_x.middleCols<3>(cols.start_attitude) += stage.R_b_n * so3::Skew(g_n_) * T;
+  else r_H_x.setZero();
   for (int k = 0; k < 3; ++k) residuals[k] = sqrt_info_[k] * r[k];
-  const Cols J = W * B;
-  using RowMajor = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
+  const strapdown::Sensitivity J = Eigen::DiagonalMatrix<double, 3>(sqrt_info_) * r_H_x;
   if (jacobians[0] != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>> out(jacobians[0]);
-    out = J.middleCols<3>(att) * 4.0 * LeftPlusJacobian(q_k).transpose();
+    out = J.middleCols<3>(cols.start_attitude) * 4.0 * LeftPlusJacobian(stage.q_k).transpose();
   }
+  using RowMajor = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
   for (int t = 0; t < model_->num_terms(); ++t) {
     if (jacobians[1 + t] == nullptr) continue;
     const int size = model_->terms()[static_cast<std::size_t>(t)].effect->info().size();
-    Eigen::Map<RowMajor>(jacobians[1 + t], 3, size) = J.middleCols(offset[static_cast<std::size_t>(t)], size);
+    Eigen::Map<RowMajor>(jacobians[1 + t], 3, size) = J.middleCols(x.layout().Offset(t), size);
   }
-  const int first_wander = 1 + model_->num_terms();
+  double** wander_jacobians = jacobians + 1 + model_->num_terms();
   for (int b = 0; b < 2 * (accel_wander_ + gyro_wander_); ++b) {
-    double* out = jacobians[first_wander + b];
-    if (out == nullptr) continue;
+    if (wander_jacobians[b] == nullptr) continue;
     const bool accel = b < 2 * accel_wander_;
     const bool to = b % 2 == 1;
-    const int col = accel ? (to ? acc_to : acc_from) : (to ? gyr_to : gyr_from);
-    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> J_out(out);
-    J_out = J.middleCols<3>(col);
+    const int col = accel ? (to ? cols.acc_to : cols.acc_from) : (to ? cols.gyr_to : cols.gyr_from);
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> out(wander_jacobians[b]);
+    out = J.middleCols<3>(col);
   }
 }
 

@@ -1,9 +1,10 @@
 // plumb/residuals/velocity_residual.h — the accelerometer during the motion between two still
 // segments: the IMU is at rest at both ends, so its velocity does not change.
 //
-// With the corrected gyroscope integrated as in MotionResidual (coning-corrected product of
-// exponentials of u_i = w_i - dR_i^T R_k^T omega_ie_n, dR_0 = I) and the corrected specific force
-// f_i (both from model::Model::Correct on the sample's outputs, with its angular acceleration):
+// With the corrected gyroscope integrated as in MotionResidual (the strapdown core, residuals/
+// strapdown.h: coning-corrected product of exponentials of u_i = w_i - dR_i^T R_k^T omega_ie_n,
+// dR_0 = I) and the corrected specific force f_i (both from model::Model::Correct on the
+// sample's outputs, with its angular acceleration):
 //
 //   r = W_v ( sum_i (h_i / 2) (dR_i f_i + dR_i+1 f_i+1) + R_k^T g_n T ),   m/s, body frame of k
 //
@@ -27,7 +28,8 @@
 // Jacobians: analytic where the model acts as its linear stage (every other effect at zero:
 // the base model, and diagnose's probe fits, whose probe columns alone are then
 // differentiated numerically), in the same pass:
-// with A_i the right-perturbation sensitivity of dR_i (propagated as in MotionResidual) and
+// by the strapdown core (residuals/strapdown.h), with A_i the right-perturbation sensitivity
+// of dR_i and
 // df_i/dx closed-form (f = F^-1 (y_a - b_a): d f / d F_rc = -F^-1 e_r f_c, d f / d b_a = -F^-1),
 //   d(dR_i f_i) = dR_i (d f_i - [f_i]x A_i dx),   d(R_k^T g_n T) / d delta_k = R_k^T [g_n]x T.
 // Otherwise central differences (ceres::DynamicNumericDiffCostFunction), one pass over the
