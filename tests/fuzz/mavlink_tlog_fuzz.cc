@@ -5,9 +5,12 @@
 // Built by tests/fuzz/CMakeLists.txt (scripts/fuzz); by hand:
 //   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I lib -I /usr/include/eigen3 \
 //     -I build/lib/plumb/io/mavlink/generated \
-//     tests/fuzz/mavlink_tlog_fuzz.cc lib/plumb/io/mavlink/mavlink_tlog.cc \
+//     tests/fuzz/mavlink_tlog_fuzz.cc lib/plumb/io/mavlink/mavlink_dialect.cc \
+//     lib/plumb/io/mavlink/mavlink_frame.cc lib/plumb/io/mavlink/mavlink_tlog.cc \
 //     lib/plumb/io/mavlink/mavlink_session.cc lib/plumb/io/ardupilot/ardupilot_correction.cc \
-//     lib/plumb/io/common/log_common.cc lib/plumb/core/imu_series.cc
+//     lib/plumb/io/common/log_common.cc lib/plumb/io/common/mapping_guard.cc \
+//     lib/plumb/io/common/stream_spool.cc lib/plumb/core/imu_series.cc \
+//     lib/plumb/core/error.cc lib/plumb/core/number_text.cc
 #include <cstddef>
 #include <cstdint>
 #include <vector>

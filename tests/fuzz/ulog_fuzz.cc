@@ -2,8 +2,12 @@
 // plumb::Error, never a crash, a hang or a huge allocation; the streams and sessions built
 // from whatever was decoded must behave the same way.
 //   clang++ -fsanitize=fuzzer,address,undefined -std=c++17 -I lib -I <eigen> \
-//     tests/fuzz/ulog_fuzz.cc lib/plumb/io/px4/ulog.cc lib/plumb/io/px4/px4_session.cc \
-//     lib/plumb/io/common/log_common.cc lib/plumb/core/imu_series.cc
+//     tests/fuzz/ulog_fuzz.cc lib/plumb/io/px4/ulog_format.cc lib/plumb/io/px4/ulog_parser.cc \
+//     lib/plumb/io/px4/ulog_two_part.cc lib/plumb/io/px4/ulog.cc \
+//     lib/plumb/io/px4/px4_session.cc lib/plumb/io/px4/px4_correction.cc \
+//     lib/plumb/io/common/log_common.cc lib/plumb/io/common/mapping_guard.cc \
+//     lib/plumb/io/common/stream_spool.cc lib/plumb/core/imu_series.cc \
+//     lib/plumb/core/error.cc lib/plumb/core/number_text.cc
 #include <cstddef>
 #include <cstdint>
 

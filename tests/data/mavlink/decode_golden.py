@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Independent golden-data decoder for MAVLink telemetry logs (.tlog), standard library only.
 
-Written separately from plumb's C++ reader (lib/plumb/io/mavlink_tlog.cc) to produce the JSON
-files the C++ tests compare against. It is NOT run by the tests.
+Written separately from plumb's C++ reader (lib/plumb/io/mavlink/mavlink_*) to produce the
+JSON files the C++ tests compare against. It is NOT run by the tests.
 
 Usage:  python3 decode_golden.py LOG.tlog [LOG2.tlog ...] --out-dir DIR
 Writes DIR/<basename>.golden.json for each log.

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Independent golden-data decoder for PX4 ULog (.ulg) files (standard library only).
 
-Written separately from plumb's C++ reader (lib/plumb/io/ulog.cc) to produce the JSON files the
-C++ tests compare against. It is NOT run by the tests.
+Written separately from plumb's C++ reader (lib/plumb/io/px4/ulog*.cc) to produce the JSON files
+the C++ tests compare against. It is NOT run by the tests.
 
 Usage:  python3 decode_golden.py LOG.ulg [LOG2.ulg ...] --out-dir DIR [--damaged]
 Writes DIR/<basename>.golden.json for each log (with --damaged: <basename>.damaged.golden.json

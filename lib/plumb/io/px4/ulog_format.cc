@@ -48,6 +48,57 @@ std::optional<std::pair<ULogType, std::size_t>> ULogBasicType(std::string_view n
   return std::nullopt;
 }
 
+std::optional<ULogKeyValue> ParseULogKeyValue(const std::uint8_t* p, std::size_t n) {
+  if (n < 1) return std::nullopt;
+  const std::size_t key_len = p[0];
+  if (key_len == 0 || 1 + key_len > n) return std::nullopt;
+  const std::string key(reinterpret_cast<const char*>(p + 1), key_len);
+  const std::size_t space = key.find(' ');
+  if (space == std::string::npos || space == 0 || space + 1 >= key.size()) return std::nullopt;
+  ULogKeyValue kv;
+  kv.type = key.substr(0, space);
+  kv.name = key.substr(space + 1);
+  kv.value = p + 1 + key_len;
+  kv.value_size = n - 1 - key_len;
+  return kv;
+}
+
+std::optional<double> ULogParamValue(const ULogKeyValue& kv) {
+  if (kv.value_size != 4) return std::nullopt;
+  if (kv.type == "int32_t") return LoadLittleEndian<std::int32_t>(kv.value);
+  if (kv.type == "float") return LoadLittleEndian<float>(kv.value);
+  return std::nullopt;
+}
+
+std::string ULogInfoText(const ULogKeyValue& kv) {
+  if (kv.type.rfind("char[", 0) == 0) {
+    return std::string(reinterpret_cast<const char*>(kv.value), kv.value_size);
+  }
+  if (const auto basic = ULogBasicType(kv.type); basic && basic->second == kv.value_size) {
+    const std::uint8_t* p = kv.value;
+    switch (basic->first) {
+      case ULogType::kInt8: return std::to_string(LoadLittleEndian<std::int8_t>(p));
+      case ULogType::kUInt8: case ULogType::kBool: case ULogType::kChar:
+        return std::to_string(LoadLittleEndian<std::uint8_t>(p));
+      case ULogType::kInt16: return std::to_string(LoadLittleEndian<std::int16_t>(p));
+      case ULogType::kUInt16: return std::to_string(LoadLittleEndian<std::uint16_t>(p));
+      case ULogType::kInt32: return std::to_string(LoadLittleEndian<std::int32_t>(p));
+      case ULogType::kUInt32: return std::to_string(LoadLittleEndian<std::uint32_t>(p));
+      case ULogType::kInt64: return std::to_string(LoadLittleEndian<std::int64_t>(p));
+      case ULogType::kUInt64: return std::to_string(LoadLittleEndian<std::uint64_t>(p));
+      case ULogType::kFloat: return std::to_string(LoadLittleEndian<float>(p));
+      case ULogType::kDouble: return std::to_string(LoadLittleEndian<double>(p));
+    }
+  }
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (std::size_t k = 0; k < kv.value_size; ++k) {
+    out += kHex[kv.value[k] >> 4];
+    out += kHex[kv.value[k] & 15];
+  }
+  return out;
+}
+
 bool ParseULogFormat(std::string_view text, std::string* name,
                      std::vector<ULogFormatField>* fields) {
   const std::size_t colon = text.find(':');
