@@ -8,11 +8,11 @@
 #include <iostream>
 #include <optional>
 
+#include "plumb/core/datasheet_level.h"
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/gates.h"
 #include "plumb/estimation/wander_levels.h"
-#include "plumb/pipeline/datasheet_level.h"
 #include "plumb/signal/noise_terms.h"
 #include "segment_options.h"
 #include "validators.h"
@@ -28,14 +28,14 @@ void AddModelOption(CLI::App* app, FitArgs& a) {
 
 namespace {
 
-/// A wander level as a datasheet states it (pipeline::ParseDatasheetLevel), rewritten to the
+/// A wander level as a datasheet states it (ParseDatasheetLevel), rewritten to the
 /// SI number; CLI11 puts the option's name before the parser's message.
-CLI::Validator DatasheetLevel(pipeline::WanderLevel level) {
+CLI::Validator DatasheetLevel(WanderLevel level) {
   return CLI::Validator(
       [level](std::string& text) -> std::string {
         double v = 0;
         try {
-          v = pipeline::ParseDatasheetLevel(text, level);
+          v = ParseDatasheetLevel(text, level);
         } catch (const Error& e) {
           return e.what();
         }
@@ -52,7 +52,7 @@ CLI::Validator DatasheetLevel(pipeline::WanderLevel level) {
 /// (estimation/wander_levels.h).
 void AddWanderOptions(CLI::App* app, FitArgs& a) {
   const auto level = [&](const char* name, std::optional<double>& target, const std::string& text,
-                         pipeline::WanderLevel units) {
+                         WanderLevel units) {
     return app->add_option(name, target, text)->transform(DatasheetLevel(units));
   };
   const std::string units =
@@ -62,11 +62,11 @@ void AddWanderOptions(CLI::App* app, FitArgs& a) {
       level("--accel-rw", a.options.accel_walk_density,
             "Accelerometer bias random walk, m/s^3/sqrt(Hz) or ug/sqrt(s), ug/sqrt(h)" + units +
                 "1e-4 (or --estimate-rw)",
-            pipeline::WanderLevel::kAccelWalk),
+            WanderLevel::kAccelWalk),
       level("--gyro-rw", a.options.gyro_walk_density,
             "Gyroscope bias random walk (rate random walk), rad/s^2/sqrt(Hz) or deg/h/sqrt(h), "
             "deg/s/sqrt(s)" + units + "2e-6 (or --estimate-rw)",
-            pipeline::WanderLevel::kGyroWalk),
+            WanderLevel::kGyroWalk),
       app->add_flag("--estimate-rw", a.options.estimate_walk,
                     "Estimate the bias wander levels not given (walk and instability) from the "
                     "session: variance components over the wander factors, marginalised over "
@@ -76,11 +76,11 @@ void AddWanderOptions(CLI::App* app, FitArgs& a) {
       level("--accel-bi", a.options.accel_instability,
             "Accelerometer bias instability as a Gauss-Markov process: its sigma, m/s^2 or ug, "
             "mg" + units + "4e-4",
-            pipeline::WanderLevel::kAccelInstability),
+            WanderLevel::kAccelInstability),
       level("--gyro-bi", a.options.gyro_instability,
             "Gyroscope bias instability as a Gauss-Markov process: its sigma, rad/s or deg/h, "
             "deg/s" + units + "2e-5",
-            pipeline::WanderLevel::kGyroInstability),
+            WanderLevel::kGyroInstability),
       app->add_option("--bi-time", a.options.instability_time_s, "Correlation time of the bias instability, s")
           ->check(CLI::Range(1e-3, 1e9))
           ->capture_default_str(),

@@ -4,10 +4,10 @@
 #include <pybind11/stl.h>
 
 #include "common.h"
+#include "plumb/core/datasheet_level.h"
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/uncertainty.h"
-#include "plumb/pipeline/datasheet_level.h"
 #include "plumb/report/json_report.h"
 
 namespace plumb::python {
@@ -52,8 +52,8 @@ pipeline::SegmentRequest Segments(Keywords& k) {
 }
 
 /// A bias wander level: a number (SI) or a datasheet's text ("4 deg/h"), both through the
-/// command's parser (plumb/pipeline/datasheet_level.h), so that the same checks apply.
-std::optional<double> Level(Keywords& k, const char* name, pipeline::WanderLevel level) {
+/// command's parser (plumb/core/datasheet_level.h), so that the same checks apply.
+std::optional<double> Level(Keywords& k, const char* name, WanderLevel level) {
   const std::optional<py::object> value = k.Take<py::object>(name);
   if (!value) return std::nullopt;
   const std::string text = py::str(*value).cast<std::string>();
@@ -63,14 +63,13 @@ std::optional<double> Level(Keywords& k, const char* name, pipeline::WanderLevel
                 "got " + py::str(py::repr(*value)).cast<std::string>());
   }
   try {
-    return pipeline::ParseDatasheetLevel(text, level);
+    return ParseDatasheetLevel(text, level);
   } catch (const Error& e) {
     throw Error(std::string("calibrate: ") + name + ": " + e.what());
   }
 }
 
 void WanderOptions(Keywords& k, estimation::CalibrationOptions& o) {
-  using pipeline::WanderLevel;
   o.accel_walk_density = Level(k, "accel_rw", WanderLevel::kAccelWalk);
   o.gyro_walk_density = Level(k, "gyro_rw", WanderLevel::kGyroWalk);
   o.estimate_walk = k.Take<bool>("estimate_rw", false);

@@ -119,6 +119,38 @@ TEST(SweepCli, AYamlStudyIsTheSameStudy) {
   EXPECT_TRUE(Contains(bad.err, at("bad.yaml") + ":line 2: not valid YAML")) << bad.err;
 }
 
+// A study's bias wander levels take a datasheet's units, as calibrate's --gyro-bi does: the
+// same results as with the SI numbers; a unit the level does not take names the file and the
+// key.
+TEST(SweepCli, WanderLevelsTakeADatasheetsUnits) {
+  TempDir dir;
+  auto at = [&](const char* name) { return (dir.path() / name).string(); };
+  // 4 deg/h and 40 ug in SI, as %.17g writes them (the same doubles).
+  std::ofstream(at("s.json")) << R"({"name": "t", "seed": 3, "runs": 2, "design": "grid",
+    "base": {"poses": 9, "still_s": 3, "turn_s": 2, "rate_hz": 100,
+             "accel_bi": 0.00039226599999999995},
+    "fit": {"wander_levels": "given"},
+    "factors": [{"name": "gyro_bi", "levels": [1.9392547244381439e-05]}]})";
+  std::ofstream(at("s.yaml")) << "name: t\nseed: 3\nruns: 2\ndesign: grid\n"
+                                 "base: {poses: 9, still_s: 3, turn_s: 2, rate_hz: 100, "
+                                 "accel_bi: 40 ug}\n"
+                                 "fit: {wander_levels: given}\n"
+                                 "factors:\n  - name: gyro_bi\n    levels: [4 deg/h]\n";
+  const ToolRun si = Plumb({"sweep", at("s.json"), "--out", at("j")}, dir);
+  ASSERT_EQ(si.exit_code, 0) << si.err;
+  const ToolRun text = Plumb({"sweep", at("s.yaml"), "--out", at("y")}, dir);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_EQ(ReadAll(at("y/results.csv")), ReadAll(at("j/results.csv")));
+  EXPECT_TRUE(Contains(ReadAll(at("y/study.json")), "4 deg/h"));  // the study as read
+  std::ofstream(at("bad.yaml")) << "name: t\nruns: 1\nbase: {gyro_bi: 4 ug}\n";
+  const ToolRun bad = Plumb({"sweep", at("bad.yaml"), "--out", at("b")}, dir);
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_TRUE(Contains(bad.err, at("bad.yaml") + ":key 'base.gyro_bi': unit 'ug' not known "
+                                                 "here; use one of rad/s, deg/s, deg/h"))
+      << bad.err;
+  EXPECT_FALSE(fs::exists(at("b")));
+}
+
 // Issue 35 item 4: nested aliases ("billion laughs": 9 levels of 10 make 10^9 values) are
 // refused at the bound: the reading stops at the 100000th value, not after expanding a
 // billion (minutes); nothing is written.

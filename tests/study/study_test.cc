@@ -7,8 +7,10 @@
 #include <set>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/study/run.h"
 #include "plumb/study/study.h"
+#include "plumb/study/study_file.h"
 #include "plumb/study/summary.h"
 
 namespace plumb::study {
@@ -54,6 +56,84 @@ TEST(Study, ErrorsNameTheFileAndTheKey) {
   base["base"]["schedule"] = "spiral";
   EXPECT_NE(ErrorOf(base).find("base.schedule"), std::string::npos);
   EXPECT_EQ(ErrorOf(Small()), "");
+}
+
+// The bias wander levels take a datasheet's units, as the command's --gyro-bi and the Python
+// module's gyro_bi do (core/datasheet_level.h): a YAML study written so is the study with the
+// SI numbers, point for point.
+TEST(Study, WanderLevelsTakeADatasheetsUnits) {
+  const std::string path = std::string(PLUMB_SOURCE_DIR) + "/tests/study/data/datasheet_levels.yaml";
+  const Study text = ParseStudy(ReadStudyFile(path), path);
+  const double deg_per_h = 1.0 / units::kDegPerHourPerRadPerS;
+  const double ug_per_sqrt_h = units::kMicroG / units::kSqrtSecondsPerSqrtHour;
+  EXPECT_DOUBLE_EQ(text.base.gyro_bi, 4.0 * deg_per_h);
+  EXPECT_DOUBLE_EQ(text.base.accel_bi, 40.0 * units::kMicroG);
+  EXPECT_DOUBLE_EQ(text.base.accel_rw, 10.0 * ug_per_sqrt_h);
+  EXPECT_DOUBLE_EQ(text.base.gyro_rw, 0.5 * deg_per_h / units::kSqrtSecondsPerSqrtHour);
+  const json si = {
+      {"name", "datasheet levels"}, {"seed", 5}, {"runs", 2}, {"design", "grid"},
+      {"base", {{"poses", 9}, {"still_s", 3}, {"turn_s", 2}, {"rate_hz", 100},
+                {"accel_rw", text.base.accel_rw}, {"gyro_rw", text.base.gyro_rw},
+                {"accel_bi", text.base.accel_bi}, {"gyro_bi", text.base.gyro_bi}}},
+      {"fit", {{"wander_levels", "given"}}},
+      {"factors", json::array({{{"name", "gyro_bi"},
+                                {"levels", {2.0 * deg_per_h, 4e-5, 8.0 * deg_per_h}},
+                                {"sigma", 0.5 * deg_per_h}},
+                               {{"name", "accel_rw"}, {"levels", {5.0 * ug_per_sqrt_h, 2e-4}}}})}};
+  const Study numbers = ParseStudy(si, "s.json");
+  ASSERT_EQ(text.factors.size(), 2u);
+  for (std::size_t f = 0; f < 2; ++f) {
+    EXPECT_EQ(text.factors[f].levels, numbers.factors[f].levels) << text.factors[f].name;
+    EXPECT_EQ(text.factors[f].sigma, numbers.factors[f].sigma) << text.factors[f].name;
+  }
+  const std::vector<Point> points = DesignPoints(text);
+  ASSERT_EQ(points.size(), 6u);
+  for (const Point& p : points) {
+    EXPECT_EQ(p.values, DesignPoints(numbers)[static_cast<std::size_t>(p.index)].values);
+    const Base a = Apply(text, p), b = Apply(numbers, p);
+    EXPECT_EQ(a.gyro_bi, b.gyro_bi);
+    EXPECT_EQ(a.accel_rw, b.accel_rw);
+    EXPECT_EQ(a.gyro_rw, b.gyro_rw);
+    EXPECT_EQ(a.accel_bi, b.accel_bi);
+  }
+  // The study as read keeps the text (a sweep's study.json), and reads back the same.
+  EXPECT_EQ(text.source["base"]["gyro_bi"], "4 deg/h");
+  EXPECT_EQ(ParseStudy(text.source, path).factors[0].levels, text.factors[0].levels);
+}
+
+// A level's unit that the level does not take, or text for another key, is an error naming
+// the file and the key, with the parser's words (the command's and Python's).
+TEST(Study, AWanderLevelsWrongUnitNamesTheFileAndTheKey) {
+  json base = Small();
+  base["base"]["gyro_bi"] = "4 furlong/h";
+  EXPECT_EQ(ErrorOf(base),
+            "s.json:key 'base.gyro_bi': unit 'furlong/h' not known here; use one of rad/s, "
+            "deg/s, deg/h (got '4 furlong/h')");
+  json level = Small();
+  level["factors"][0] = {{"name", "accel_bi"}, {"levels", {"40 ug", "4 deg/h"}}};
+  EXPECT_EQ(ErrorOf(level),
+            "s.json:key 'factors[0].levels[1]': unit 'deg/h' not known here; use one of m/s^2, "
+            "ug, mg (got '4 deg/h')");
+  json negative = Small();
+  negative["factors"][0] = {{"name", "gyro_bi"}, {"levels", {"4 deg/h"}}, {"sigma", "-1 deg/h"}};
+  EXPECT_EQ(ErrorOf(negative),
+            "s.json:key 'factors[0].sigma': must be a finite number >= 0 (got '-1 deg/h')");
+  json flag = Small();
+  flag["base"]["accel_rw"] = true;
+  EXPECT_EQ(ErrorOf(flag),
+            "s.json:key 'base.accel_rw': expected a finite number or a text with a unit "
+            "(m/s^3/sqrt(Hz), m/s^2/sqrt(s), ug/sqrt(s), ug/sqrt(h))");
+  json other = Small();  // only the wander levels take units
+  other["base"]["still_s"] = "3 s";
+  EXPECT_EQ(ErrorOf(other), "s.json:key 'base.still_s': expected a finite number");
+  try {
+    ParseStudy(StudyYamlToJson("name: t\nbase: {gyro_rw: 2 deg/h}\n", "s.yaml"), "s.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "s.yaml:key 'base.gyro_rw': unit 'deg/h' not known here; use one of "
+              "rad/s^2/sqrt(Hz), rad/s/sqrt(s), deg/s/sqrt(s), deg/h/sqrt(h) (got '2 deg/h')");
+  }
 }
 
 TEST(Study, GridOneAtATimeAndLatinHypercube) {

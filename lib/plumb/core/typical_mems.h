@@ -2,6 +2,8 @@
 // (ICM-20602 / ICM-42688 / BMI088 class), SI. The simulator's default sensor
 // (sim::SimulationOptions::TypicalMems) and what the estimator assumes for a noise term the
 // session cannot measure and the user did not give (estimation/walk_estimate.h) are these.
+// It sits in core rather than beside the noise model (estimation/noise_model.h) because the
+// simulator's default comes from it too, and sim does not depend on estimation.
 #pragma once
 
 namespace plumb::typical_mems {

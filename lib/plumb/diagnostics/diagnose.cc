@@ -12,6 +12,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/estimation/elimination.h"
 #include "plumb/estimation/uncertainty.h"
 #include "plumb/model/registry.h"
 #include "plumb/signal/chi_square.h"

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "plumb/core/error.h"
+#include "plumb/estimation/elimination.h"
 
 namespace plumb::diagnostics {
 ScoreTestResult ScoreTest(const Eigen::VectorXd& r, const Eigen::MatrixXd& J,

@@ -26,7 +26,11 @@
 #include <string>
 #include <vector>
 
-#include "plumb/estimation/elimination.h"
+namespace plumb::estimation {
+/// The fit's Jacobian factorised once (estimation/elimination.h, internal to the library: it
+/// holds Eigen's sparse Cholesky factor, which this header does not bring along).
+class JacobianRange;
+}  // namespace plumb::estimation
 
 namespace plumb::diagnostics {
 

@@ -22,6 +22,9 @@
 // blocks in term order then the attitudes in pose order, so that every ordering by address
 // (ceres::Covariance sorts parameter blocks by address) is the same on every run: results do
 // not depend on how the heap happened to be laid out.
+//
+// INTERNAL to plumb::estimation (not installed): it exposes Ceres's problem; the public
+// interface is calibrator.h and what it returns.
 #pragma once
 
 #include <ceres/ceres.h>

@@ -7,6 +7,9 @@
 // member of a null direction is held, so it equals the observability analysis's pseudo-inverse
 // (tests/estimation checks this); held pivots get zero rows and columns. Should Ceres find the
 // held problem singular, or options.use_ceres_covariance be off, the pseudo-inverse is used.
+//
+// INTERNAL to plumb::estimation (not installed): it works on Ceres's problem
+// (calibration_problem.h); what it reports is in calibration.h and uncertainty.h.
 #pragma once
 
 #include <ceres/ceres.h>

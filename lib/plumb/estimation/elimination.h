@@ -14,6 +14,9 @@
 // range(J) = range(J_e) + range(M), orthogonal. So the observability analysis (solve.h) and
 // the score tests of diagnose (diagnostics/score_test.h) need a factorisation linear in the
 // poses and an SVD of M, never an SVD over every unknown.
+//
+// INTERNAL to plumb::estimation (not installed; diagnostics and study include it in their
+// sources): it holds Eigen's sparse Cholesky factor. score_test.h declares JacobianRange only.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,5 +1,7 @@
 // plumb/estimation/fitted_problem.h — the backend (calibrator.cc) in two halves: stages 1-5,
 // the problem at its solution, and stages 6-8 on it; sensitivity.h works on the same solution.
+// INTERNAL to plumb::estimation (not installed): it holds Ceres's problem (calibration_problem.h,
+// solve.h).
 #pragma once
 
 #include <memory>

@@ -17,6 +17,9 @@
 // exactly c^2 in a linear model. The actual rise, through the problem's own residuals and
 // manifolds, over c^2 is the direction's ratio: 1 where the covariance holds, far above 1
 // where the model curves away within c sigma (LinearityReport, fit_report.h).
+//
+// INTERNAL to plumb::estimation (not installed): it works on Ceres's problem
+// (calibration_problem.h); its report is fit_report.h's LinearityReport.
 #pragma once
 
 #include <ceres/ceres.h>

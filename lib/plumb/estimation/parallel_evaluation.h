@@ -4,6 +4,8 @@
 // one after another as always and takes each motion residual's value and Jacobians from what
 // was precomputed (residuals/cached_cost_function.h): the fit is the same bit for bit with
 // and without threads.
+//
+// INTERNAL to plumb::estimation (not installed): a piece of calibration_problem.h.
 #pragma once
 
 #include <ceres/evaluation_callback.h>

@@ -8,6 +8,8 @@
 // accel.matrix.zz") held at its start value. With motion intervals, the motion residuals'
 // whitening is set again from the first solution's E and F before the final solve, so chi^2
 // does not depend on the starting values.
+//
+// INTERNAL to plumb::estimation (not installed): it exposes Ceres's problem.
 #pragma once
 
 #include <ceres/ceres.h>

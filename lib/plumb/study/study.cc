@@ -1,10 +1,13 @@
+// plumb/study/study.cc — see study.h.
 #include "plumb/study/study.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <random>
 
+#include "plumb/core/datasheet_level.h"
 #include "plumb/core/error.h"
 
 namespace plumb::study {
@@ -55,6 +58,36 @@ double Number(const json& v, const std::string& path, const std::string& where) 
   return v.get<double>();
 }
 
+/// The bias wander level a base key or factor of this name is (accel_rw, gyro_rw, accel_bi,
+/// gyro_bi), or none.
+std::optional<WanderLevel> LevelOf(const std::string& name) {
+  if (name == "accel_rw") return WanderLevel::kAccelWalk;
+  if (name == "gyro_rw") return WanderLevel::kGyroWalk;
+  if (name == "accel_bi") return WanderLevel::kAccelInstability;
+  if (name == "gyro_bi") return WanderLevel::kGyroInstability;
+  return std::nullopt;
+}
+
+/// A value of the base field or factor `name` at `where`: a finite number (SI) or, for a bias
+/// wander level, also a datasheet's text such as "4 deg/h" or "40 ug", read by the parser of
+/// the command's --gyro-bi and the Python module's gyro_bi (core/datasheet_level.h), in SI.
+double Value(const json& v, const std::string& name, const std::string& path,
+             const std::string& where) {
+  const std::optional<WanderLevel> level = LevelOf(name);
+  if (!level || v.is_number()) return Number(v, path, where);
+  if (!v.is_string()) {
+    std::string units;
+    for (const auto& u : DatasheetUnits(*level)) units += (units.empty() ? "" : ", ") + u.first;
+    throw InputError(path, "key '" + where + "'",
+                     "expected a finite number or a text with a unit (" + units + ")");
+  }
+  try {
+    return ParseDatasheetLevel(v.get<std::string>(), *level);
+  } catch (const Error& e) {
+    throw InputError(path, "key '" + where + "'", e.what());
+  }
+}
+
 void ReadBase(const json& b, const std::string& path, Base& base) {
   if (!b.is_object()) throw InputError(path, "key 'base'", "expected an object");
   for (const auto& [key, value] : b.items()) {
@@ -73,7 +106,7 @@ void ReadBase(const json& b, const std::string& path, Base& base) {
         base.truth.emplace_back(name, Number(v, path, "base.truth." + name));
       }
     } else if (double* field = Field(base, key)) {
-      *field = Number(value, path, where);
+      *field = Value(value, key, path, where);
     } else {
       throw InputError(path, "key '" + where + "'", "not a field of the base");
     }
@@ -114,7 +147,8 @@ Factor ReadFactor(const json& f, const std::string& path, std::size_t i, DesignK
       throw InputError(path, "key '" + where + ".levels'", "expected a non-empty list of numbers");
     }
     for (std::size_t j = 0; j < levels.size(); ++j) {
-      out.levels.push_back(Number(levels[j], path, where + ".levels[" + std::to_string(j) + "]"));
+      out.levels.push_back(
+          Value(levels[j], out.name, path, where + ".levels[" + std::to_string(j) + "]"));
     }
   } else if (f.contains("range")) {
     const json& range = f.at("range");
@@ -126,14 +160,14 @@ Factor ReadFactor(const json& f, const std::string& path, std::size_t i, DesignK
     if (!range.is_array() || range.size() != 2) {
       throw InputError(path, "key '" + where + ".range'", "expected [low, high]");
     }
-    out.low = Number(range[0], path, where + ".range[0]");
-    out.high = Number(range[1], path, where + ".range[1]");
+    out.low = Value(range[0], out.name, path, where + ".range[0]");
+    out.high = Value(range[1], out.name, path, where + ".range[1]");
     if (!(out.low < out.high)) throw InputError(path, "key '" + where + ".range'", "expected low < high");
   } else {
     throw InputError(path, "key '" + where + "'", "expected levels or a range");
   }
   if (f.contains("sigma")) {
-    out.sigma = Number(f.at("sigma"), path, where + ".sigma");
+    out.sigma = Value(f.at("sigma"), out.name, path, where + ".sigma");
     if (!(out.sigma >= 0.0)) throw InputError(path, "key '" + where + ".sigma'", "expected >= 0");
     if (out.name == "poses" && out.sigma > 0.0) {
       throw InputError(path, "key '" + where + ".sigma'", "poses is a count: it cannot be drawn");

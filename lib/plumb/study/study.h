@@ -32,6 +32,12 @@
 // about body y and its heading from north, while the fit assumes level, x north), and
 // truth.PARAMETER (a true parameter of the simulated model in its unit, e.g.
 // truth.gyro_g_sensitivity.G.xy). Each sets the field of the base of that name.
+//
+// Values are SI numbers. The bias wander levels (accel_rw, gyro_rw, accel_bi, gyro_bi: the base's
+// keys, and those factors' levels, range and sigma) may also be given as a datasheet states
+// them, as the command's --gyro-bi and the Python module's gyro_bi take them: "4 deg/h",
+// "40 ug", "0.5 deg/h/sqrt(h)" (core/datasheet_level.h); ParseStudy turns them into SI, and a
+// unit the level does not take is an InputError naming the file and the key.
 #pragma once
 
 #include <cstdint>
@@ -112,8 +118,9 @@ struct Study {
 /// The factor names a study may use besides truth.PARAMETER.
 const std::vector<std::string>& FactorNames();
 
-/// Reads a study from its JSON (file comment). Throws plumb::InputError naming `path` and the
-/// key for anything out of place (an unknown factor, a range in a grid, runs < 1, ...).
+/// Reads a study from its JSON (file comment), the wander levels given with a unit in SI.
+/// Throws plumb::InputError naming `path` and the key for anything out of place (an unknown
+/// factor, a range in a grid, runs < 1, a unit a level does not take, ...).
 Study ParseStudy(const nlohmann::json& document, const std::string& path);
 
 /// One point of the design: the value of every factor, in Study::factors order.

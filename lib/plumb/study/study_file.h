@@ -1,5 +1,7 @@
 // plumb/study/study_file.h — a study file as the JSON document study::ParseStudy takes: JSON,
 // or YAML turned into the same JSON (`plumb sweep STUDY.yaml`), with YAML's aliases bounded.
+// A wander level written with its unit (`gyro_bi: 4 deg/h`) stays text here; ParseStudy reads
+// it (study.h), so a study given as a Python dict takes the same.
 //
 //   const study::Study s = study::ParseStudy(study::ReadStudyFile(path), path);
 #pragma once

@@ -8,6 +8,8 @@
 // Parameter block (3 values per order, lowest order first, zero = no temperature effect):
 //   [0..2] c1.x c1.y c1.z, [3..5] c2.* (order >= 2), [6..8] c3.* (order 3), in the sensor's
 //   output unit per degC^k. The term uses SensorInput::dtemp_c.
+//
+// INTERNAL to plumb::model (not installed): the two effects' sources share it.
 #pragma once
 
 #include <string>

@@ -1,5 +1,5 @@
 // See datasheet_level.h.
-#include "plumb/pipeline/datasheet_level.h"
+#include "plumb/core/datasheet_level.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
 
-namespace plumb::pipeline {
+namespace plumb {
 
 const std::vector<std::pair<std::string, double>>& DatasheetUnits(WanderLevel level) {
   static const double kDegPerHour = 1.0 / units::kDegPerHourPerRadPerS;
@@ -62,4 +62,4 @@ double ParseDatasheetLevel(const std::string& text, WanderLevel level) {
   return v * scale;
 }
 
-}  // namespace plumb::pipeline
+}  // namespace plumb

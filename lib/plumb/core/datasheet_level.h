@@ -1,14 +1,16 @@
-// plumb/pipeline/datasheet_level.h — the bias wander levels (estimation/options.h: the random
+// plumb/core/datasheet_level.h — the bias wander levels (estimation/options.h: the random
 // walk densities and the Gauss-Markov instability) as a datasheet states them, e.g. "4 deg/h"
 // or "40ug", turned into SI numbers: one parser for the command's --accel-rw, --gyro-rw,
-// --accel-bi, --gyro-bi and the Python module's keywords of the same names.
+// --accel-bi, --gyro-bi, the Python module's keywords of the same names and a study file's
+// keys and factors of the same names (study/study.h). It needs only units.h and error.h, so it
+// sits in core, below every module that reads a level.
 #pragma once
 
 #include <string>
 #include <utility>
 #include <vector>
 
-namespace plumb::pipeline {
+namespace plumb {
 
 /// Which level: the accelerometer's or gyroscope's bias random walk density, or its bias
 /// instability (Gauss-Markov sigma).
@@ -26,4 +28,4 @@ const std::vector<std::pair<std::string, double>>& DatasheetUnits(WanderLevel le
 /// unit (...), got '...'"), for the front end to prefix with its own name of the option.
 double ParseDatasheetLevel(const std::string& text, WanderLevel level);
 
-}  // namespace plumb::pipeline
+}  // namespace plumb
