@@ -22,6 +22,24 @@ TEST(Model, PaperSpecFixesTheLowerTriangleOfE) {
   const Model m = Model::Parse("paper");
   EXPECT_EQ(m.spec(), "paper");
   EXPECT_EQ(m.num_free_parameters(), 18);
+  // The option's held parameters are the effect's own (EffectInfo::held), by layout.
+  const ModelTerm& gyro = m.terms()[static_cast<std::size_t>(m.BaseTerm(Sensor::kGyro))];
+  for (int j = 0; j < gyro.effect->info().size(); ++j) {
+    const std::string name = gyro.effect->info().ParameterName(j);
+    const bool lower = name == "gyro.matrix.yx" || name == "gyro.matrix.zx" || name == "gyro.matrix.zy";
+    EXPECT_EQ(gyro.fixed[static_cast<std::size_t>(j)], lower) << name;
+  }
+}
+
+// Each alias is written back as itself, with or without terms after it, and its terms spelled
+// out read as the alias.
+TEST(Model, AliasesReadAndWriteAsThemselves) {
+  for (const std::string spec : {"base", "paper", "base+accel_bias_drift", "paper+gyro_bias_drift"}) {
+    EXPECT_EQ(Model::Parse(spec).spec(), spec);
+  }
+  EXPECT_EQ(Model::Parse("accel_linear+gyro_linear:triangular+accel_bias_drift").spec(),
+            "paper+accel_bias_drift");
+  EXPECT_EQ(Model::Parse("accel_linear+gyro_linear").spec(), "base");
 }
 
 TEST(Model, UnknownEffectNamesTheCatalogue) {

@@ -45,16 +45,14 @@ std::string TimeText(double t0_s, double t1_s) {
 }
 
 /// The model's inputs on still segment `s` at time t_s and temperature temp_c (NaN: none),
-/// as plumb/residuals/still_residuals.cc forms them.
+/// as the still residuals form them (model::AtRest).
 model::SensorInput<double> StillInput(const CalibrationResult& fit, const StillSegmentFit& s,
                                       double t_s, double temp_c) {
-  model::SensorInput<double> in;
-  in.R_b_n = s.R_n_b.toRotationMatrix().transpose();
-  in.f_b = in.R_b_n * (-fit.calibration.site.g_n);
-  in.omega_b = in.R_b_n * fit.calibration.site.omega_ie_n + s.segment.known_omega_eb_b.value_or(Vec3::Zero());
-  in.dt_s = t_s - fit.calibration.model.t_ref_s;
-  in.dtemp_c = std::isfinite(temp_c) ? temp_c - fit.calibration.model.temp_ref_c : 0.0;
-  return in;
+  const model::Model& m = fit.calibration.model;
+  return model::AtRest<double>(s.R_n_b.toRotationMatrix().transpose(), fit.calibration.site.g_n,
+                               fit.calibration.site.omega_ie_n,
+                               s.segment.known_omega_eb_b.value_or(Vec3::Zero()), t_s - m.t_ref_s,
+                               std::isfinite(temp_c) ? temp_c - m.temp_ref_c : 0.0);
 }
 
 /// Model::Predict on the fit's blocks.

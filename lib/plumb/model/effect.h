@@ -73,6 +73,9 @@ struct EffectInfo {
   bool input_side = false;
   std::string term;           ///< its term in the forward model, as text
   std::vector<ParameterInfo> parameters;
+  /// Parameters (indices into `parameters`) the option holds at their nominal value in every
+  /// fit, e.g. gyro_linear:triangular's lower triangle of E.
+  std::vector<int> held;
   Excitation excitation;
 
   int size() const { return static_cast<int>(parameters.size()); }
@@ -101,6 +104,22 @@ struct SensorInput {
   /// (samples of motion intervals). Used by earth_rate.
   Mat3T<T> R_b_n = Mat3T<T>::Zero();
 };
+
+/// What a sensor at rest sees (SPEC section 1): gravity's reaction and the Earth's rate (plus
+/// a known turn omega_eb_b, e.g. a turntable's, rad/s) in the body frame of attitude R_b_n =
+/// R_n_b^T; `g_n` and `omega_ie_n` in NED. The still residuals predict with it, and what
+/// compares a fit with its still segments.
+template <typename T>
+SensorInput<T> AtRest(const Mat3T<T>& R_b_n, const Vec3& g_n, const Vec3& omega_ie_n,
+                      const Vec3& omega_eb_b, T dt_s, T dtemp_c) {
+  SensorInput<T> in;
+  in.f_b = R_b_n * (-g_n.cast<T>());
+  in.omega_b = R_b_n * omega_ie_n.cast<T>() + omega_eb_b.cast<T>();
+  in.dt_s = dt_s;
+  in.dtemp_c = dtemp_c;
+  in.R_b_n = R_b_n;
+  return in;
+}
 
 /// The predicted outputs, built up effect by effect.
 template <typename T>

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <Eigen/LU>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "plumb/core/error.h"
 #include "plumb/model/registry.h"
@@ -24,6 +26,26 @@ std::string Trim(const std::string& s) {
   return b == std::string::npos ? "" : s.substr(b, e - b + 1);
 }
 
+/// A name that stands for several terms in a model spec.
+struct ModelAlias {
+  const char* name;
+  std::vector<std::pair<const char*, const char*>> terms;  ///< (effect, option), in order
+};
+
+/// The spec's aliases (SPEC section 2): "base" is the linear stage; "paper" the same with the
+/// paper's upper-triangular gyroscope matrix.
+const std::vector<ModelAlias> kAliases = {
+    {"base", {{"accel_linear", ""}, {"gyro_linear", ""}}},
+    {"paper", {{"accel_linear", ""}, {"gyro_linear", "triangular"}}},
+};
+
+const ModelAlias* FindAlias(const std::string& token) {
+  for (const ModelAlias& alias : kAliases) {
+    if (token == alias.name) return &alias;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 Model Model::Parse(const std::string& spec) {
@@ -33,12 +55,8 @@ Model Model::Parse(const std::string& spec) {
   for (const auto& raw : tokens) {
     const std::string token = Trim(raw);
     if (token.empty()) throw Error("model spec '" + spec + "' has an empty term");
-    if (token == "base") {
-      m.Add("accel_linear");
-      m.Add("gyro_linear");
-    } else if (token == "paper") {
-      m.Add("accel_linear");
-      m.Add("gyro_linear", "triangular");
+    if (const ModelAlias* alias = FindAlias(token)) {
+      for (const auto& [name, option] : alias->terms) m.Add(name, option);
     } else {
       const auto colon = token.find(':');
       m.Add(token.substr(0, colon), colon == std::string::npos ? "" : token.substr(colon + 1));
@@ -55,6 +73,7 @@ void Model::Add(const std::string& name, const std::string& option) {
   ModelTerm term;
   term.effect = Registry::Global().Make(name, option);
   term.fixed.assign(static_cast<std::size_t>(term.effect->info().size()), false);
+  for (int j : term.effect->info().held) term.fixed[static_cast<std::size_t>(j)] = true;
   // The linear stage runs first: insert linear effects before the additive ones.
   if (term.effect->info().linear_stage) {
     auto it = terms_.begin();
@@ -64,10 +83,6 @@ void Model::Add(const std::string& name, const std::string& option) {
     terms_.push_back(std::move(term));
   }
   RebuildSpec();
-  // The triangular gyro variant holds E's lower triangle at zero.
-  if (name == "gyro_linear" && option == "triangular") {
-    for (const char* p : {"gyro.matrix.yx", "gyro.matrix.zx", "gyro.matrix.zy"}) Fix(p);
-  }
 }
 
 void Model::RebuildSpec() {
@@ -76,14 +91,20 @@ void Model::RebuildSpec() {
   for (const auto& t : terms_) {
     if (!t.probe) spec_terms.push_back(&t);
   }
-  auto is = [&](std::size_t i, const char* name, const char* option) {
-    return i < spec_terms.size() && spec_terms[i]->effect->info().name == name &&
-           spec_terms[i]->effect->info().option == option;
-  };
+  // The spec starts with the alias whose terms the model starts with, if one does.
   std::size_t first = 0;
-  if (is(0, "accel_linear", "") && (is(1, "gyro_linear", "") || is(1, "gyro_linear", "triangular"))) {
-    spec_ = is(1, "gyro_linear", "") ? "base" : "paper";
-    first = 2;
+  for (const ModelAlias& alias : kAliases) {
+    const std::size_t n = alias.terms.size();
+    bool starts = spec_terms.size() >= n;
+    for (std::size_t i = 0; starts && i < n; ++i) {
+      const EffectInfo& info = spec_terms[i]->effect->info();
+      starts = info.name == alias.terms[i].first && info.option == alias.terms[i].second;
+    }
+    if (starts) {
+      spec_ = alias.name;
+      first = n;
+      break;
+    }
   }
   for (std::size_t i = first; i < spec_terms.size(); ++i) {
     const auto& info = spec_terms[i]->effect->info();

@@ -25,12 +25,8 @@ template <typename T>
 Vec3T<T> StillResidual::PredictT(T const* const* parameters) const {
   const Eigen::Map<const Eigen::Quaternion<T>> q_n_b(parameters[0]);
   const Mat3T<T> R_b_n = q_n_b.toRotationMatrix().transpose();
-  model::SensorInput<T> in;
-  in.f_b = R_b_n * (-g_n_.cast<T>());
-  in.omega_b = R_b_n * omega_ie_n_.cast<T>() + omega_eb_b_.cast<T>();
-  in.dt_s = T(m_.dt_s);
-  in.dtemp_c = T(m_.dtemp_c);
-  in.R_b_n = R_b_n;
+  const model::SensorInput<T> in =
+      model::AtRest<T>(R_b_n, g_n_, omega_ie_n_, omega_eb_b_, T(m_.dt_s), T(m_.dtemp_c));
   model::SensorOutput<T> out;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     model_->terms()[static_cast<std::size_t>(terms_[i])].effect->Apply(parameters[i + 1], in, out);

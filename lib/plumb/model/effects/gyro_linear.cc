@@ -34,6 +34,10 @@ EffectInfo MakeInfo(const std::string& option) {
   }
   auto bias = AxisParameters("bias", "rad/s", 0.02);
   info.parameters.insert(info.parameters.end(), bias.begin(), bias.end());
+  if (option == "triangular") {
+    info.held = {gyro_linear::MatrixIndex(1, 0), gyro_linear::MatrixIndex(2, 0),
+                 gyro_linear::MatrixIndex(2, 1)};
+  }
   info.excitation.still_orientations = true;
   info.excitation.rotation = true;
   return info;
