@@ -241,8 +241,8 @@ TEST(CalibrationSchema, ApplyReadsEveryMethodsOutput) {
   const ToolRun refused =
       Plumb(Join({"apply", files[7], s.still, "--out", s.dir.File("c.csv")}, {}), s.dir);
   EXPECT_EQ(refused.exit_code, 1) << refused.err;
-  EXPECT_TRUE(Contains(refused.err, files[7] + ":key 'parameters' (gyro.matrix.*): the "
-                                               "gyroscope's matrix is near-singular"))
+  EXPECT_TRUE(Contains(refused.err, files[7] + ":key 'gyro.matrix': the matrix is "
+                                               "near-singular"))
       << refused.err;
   EXPECT_FALSE(std::filesystem::exists(s.dir.File("c.csv")));
   for (std::size_t k : {std::size_t{0}, std::size_t{6}, std::size_t{8}}) {

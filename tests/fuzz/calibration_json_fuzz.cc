@@ -1,8 +1,9 @@
-// libFuzzer target for the calibration document's reader (correction/calibration_file.h, what
-// `plumb apply`, `plumb compare` and Python's load_calibration read): any byte sequence must
-// give a calibration, a plumb::Error naming the key, or nlohmann's parse error, never a crash,
-// a hang or a huge allocation; a calibration it gives must apply to a few samples without a
-// NaN or an infinity (or say which sample it cannot correct).
+// libFuzzer target for the calibration document's one reader (document/calibration_document.h,
+// what `plumb apply`, `plumb compare` and Python's load_calibration read) and its two adapters
+// (correction/calibration_file.h, peers/plumb_result.h): any byte sequence must give a
+// calibration, a plumb::Error naming the key, or nlohmann's parse error, never a crash, a hang
+// or a huge allocation; a calibration it gives must apply to a few samples without a NaN or an
+// infinity (or say which sample it cannot correct).
 #include <cstddef>
 #include <cstdint>
 
@@ -11,6 +12,8 @@
 #include "plumb/core/error.h"
 #include "plumb/correction/apply.h"
 #include "plumb/correction/calibration_file.h"
+#include "plumb/document/calibration_document.h"
+#include "plumb/peers/plumb_result.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   nlohmann::json doc;
@@ -19,9 +22,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const nlohmann::json::exception&) {
     return 0;  // not JSON: the command names the file and the byte (io/text/json_file.h)
   }
-  try {
-    const plumb::correction::CalibrationFile file =
-        plumb::correction::ReadCalibrationFile(doc, "fuzz.json");
+  try {  // compare's view
+    (void)plumb::peers::PlumbResultFromDocument(
+        plumb::document::ReadCalibrationDocument(doc, "fuzz.json"));
+  } catch (const plumb::Error&) {
+  }
+  try {  // apply's (and Python's): the same reader, its segments left unread
+    plumb::document::ReadOptions read;
+    read.still_segments = false;
+    const plumb::correction::CalibrationFile file = plumb::correction::CalibrationFromDocument(
+        plumb::document::ReadCalibrationDocument(doc, "fuzz.json", read));
     plumb::ImuSeries s;
     for (int k = 0; k < 3; ++k) {
       s.t_s.push_back(0.01 * k);

@@ -1,7 +1,8 @@
 // plumb/core/calibration_checks.h — what a calibration read from a file must be before anything
 // is computed from it: names once each, matrices a sensor can have, a covariance that is one.
-// The readers of the calibration document (correction/calibration_file.h for apply, export and
-// Python; peers/plumb_result.h for compare) refuse a file that fails them, naming the key.
+// The one reader of the calibration document (document/calibration_document.h, under
+// correction/calibration_file.h for apply, export and Python and peers/plumb_result.h for
+// compare) refuses a file that fails them, naming the key.
 #pragma once
 
 #include <Eigen/Core>

@@ -3,11 +3,13 @@
 // every parameter's value as its parameter blocks, the reference time and temperature, and
 // the covariance over the parameters it determined.
 //
-// Only what applying the calibration needs is read: "model" (the spec), "model_reference"
-// {t_ref_s, temp_ref_c}, "parameters" [{name, value}] (reported values: nominal + block),
-// "covariance" {parameters, matrix} (optional: without it no uncertainty is propagated) and
-// "units" {accel, gyro} when present (the units the samples were in, to refuse samples in
-// others).
+// The document is read, and checked, by the one reader (document/calibration_document.h);
+// this takes from it what applying the calibration needs and requires: "model" (a spec this
+// plumb knows), "model_reference" {t_ref_s, temp_ref_c}, a value for each of the model's
+// parameters in "parameters" [{name, value, unit}] (reported values: nominal + block; the
+// bias's unit is the units the samples were in, to refuse samples in others) and "covariance"
+// {parameters, matrix} over parameters of the model (optional: without it no uncertainty is
+// propagated).
 #pragma once
 
 #include <Eigen/Core>
@@ -15,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/document/calibration_document.h"
 #include "plumb/model/model.h"
 
 namespace plumb::correction {
@@ -32,9 +35,16 @@ struct CalibrationFile {
   std::string acc_unit, gyr_unit;
 };
 
-/// Reads `doc` (from `path`, named in errors). Throws plumb::InputError naming the file and
-/// the key when the model spec is missing or unknown, a parameter is missing, unknown, not a
-/// finite number, or the covariance is not a square matrix over named parameters.
+/// Reads `doc` (from `path`, named in errors) with document::ReadCalibrationDocument (its
+/// "segments" left unread: a simulation's truth document is read as a calibration too), then
+/// CalibrationFromDocument. Throws plumb::InputError naming the file and the key.
 CalibrationFile ReadCalibrationFile(const nlohmann::json& doc, const std::string& path);
+
+/// The calibration of a document read. Throws plumb::InputError naming the file and the key
+/// when the model spec is missing or unknown, the reference is missing, a parameter of the model
+/// has no value or a value is not a parameter of the model, a sensor's matrix (from the
+/// parameters) is singular, or the covariance is over a name that is not a parameter of the
+/// model.
+CalibrationFile CalibrationFromDocument(const document::CalibrationDocument& document);
 
 }  // namespace plumb::correction

@@ -6,9 +6,12 @@
 
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
-#include "plumb/peers/json_fields.h"
+#include "plumb/document/json_fields.h"
 
 namespace plumb::peers {
+
+namespace detail = document::detail;
+
 namespace {
 
 using nlohmann::json;

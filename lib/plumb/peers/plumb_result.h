@@ -1,7 +1,9 @@
 // plumb/peers/plumb_result.h — reads back what `plumb calibrate --json` wrote
 // (plumb/report/json_report.h), the part a comparison with another tool needs: the headline
 // keys of SPEC section 6, which every method's document has (a paper method's are its closed
-// form's answer).
+// form's answer). The document is read and checked by the one reader
+// (document/calibration_document.h); this requires "accel" of it and keeps what a comparison
+// uses.
 //
 // Values are in the units of the data plumb was given (SI after plumb's own conversion; raw
 // counts when it was given counts), as in the file.
@@ -14,35 +16,15 @@
 #include <vector>
 
 #include "plumb/core/types.h"
+#include "plumb/document/calibration_document.h"
 
 namespace plumb::peers {
 
-/// One entry of "parameters".
-struct PlumbParameter {
-  std::string name;              ///< e.g. "accel.matrix.xy", "gyro.bias.z"
-  double value = 0.0;            ///< the estimate, in `unit`
-  std::optional<double> sigma;   ///< standard deviation, `unit`; none when fixed/unobservable
-  bool observable = true;
-  bool fixed = false;
-  std::string unit;              ///< as written by plumb ("1", "m/s^2", "rad/s", ...)
-};
-
-/// One entry of "observability.determined": a combination of parameters the data determines
-/// where the parameters themselves are not (a single pose's gauge).
-struct PlumbCombination {
-  std::string text;                 ///< e.g. "accel.bias.z - 9.78 accel.matrix.zz"
-  std::vector<std::string> names;   ///< its parameters ...
-  std::vector<double> coefficients; ///< ... and their coefficients (empty: an older plumb)
-  double value = 0.0;
-  std::optional<double> sigma;
-};
-
-/// One entry of "segments" (a still segment).
-struct PlumbStillSegment {
-  std::string label;
-  Vec3 acc_mean = Vec3::Zero();  ///< mean accelerometer output, output units
-  double count = 0.0;            ///< samples in the mean, >= 0
-};
+/// An entry of "parameters", of "observability.determined", of "segments" (as the one reader
+/// of the document reads them).
+using PlumbParameter = document::DocumentParameter;
+using PlumbCombination = document::DocumentCombination;
+using PlumbStillSegment = document::DocumentSegment;
 
 struct PlumbResult {
   std::string path;    ///< the file read
@@ -74,11 +56,15 @@ struct PlumbResult {
   Eigen::MatrixXd determined_covariance;
 };
 
-/// Reads the JSON document. Throws plumb::InputError naming `path` and the key when the JSON is
-/// invalid (with its byte offset), or "accel" or "parameters" are missing or malformed; a
-/// segment without acc_mean/count is an error too, a document without "segments" is not; a
-/// "covariance" must be a square matrix of finite numbers over its "parameters".
+/// Reads the JSON document (document::ReadCalibrationDocumentFile). Throws plumb::InputError
+/// naming `path` and the key when the JSON is invalid (with its line and column), when the one
+/// reader refuses the document (a segment without acc_mean/count is an error, a document
+/// without "segments" is not; a "covariance" must be a square matrix of finite numbers over
+/// its "parameters"), or "accel" is missing.
 PlumbResult ReadPlumbResult(const std::string& path);
+
+/// The comparison's view of a document read.
+PlumbResult PlumbResultFromDocument(const document::CalibrationDocument& document);
 
 /// The parameter called `name`, or nullptr.
 const PlumbParameter* FindParameter(const PlumbResult& result, const std::string& name);

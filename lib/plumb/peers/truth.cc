@@ -6,10 +6,13 @@
 #include <optional>
 
 #include "plumb/core/error.h"
-#include "plumb/peers/json_fields.h"
+#include "plumb/document/json_fields.h"
 #include "plumb/signal/chi_square.h"
 
 namespace plumb::peers {
+
+namespace detail = document::detail;
+
 namespace {
 
 using nlohmann::json;

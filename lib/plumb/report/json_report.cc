@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "plumb/document/calibration_keys.h"
 #include "plumb/estimation/uncertainty.h"
 #include "plumb/io/common/atomic_file.h"
 #include "plumb/report/version.h"
@@ -12,6 +13,7 @@ namespace plumb::report {
 namespace {
 
 using nlohmann::json;
+namespace keys = document::keys;  // the key names its reader reads, spelled once
 
 /// Names of the model's non-base effects, for the correction's note.
 std::vector<std::string> ExtraEffects(const model::Model& model, model::Sensor sensor) {
@@ -41,19 +43,21 @@ json Correction(const Mat3& forward, const Vec3& bias, const std::string& formul
 }
 
 json Sensor(const Mat3& forward, const Vec3& bias, const json& correction) {
-  return json{{"matrix", Matrix(forward)}, {"bias", Vector(bias)}, {"correction", correction}};
+  return json{{keys::kMatrix, Matrix(forward)},
+              {keys::kBias, Vector(bias)},
+              {"correction", correction}};
 }
 
 /// `sigma_scale` (estimation::SigmaScale) multiplies "sigma"; "sigma_formal" is the fit's own.
 json ParameterJson(const estimation::ParameterEstimate& p, double sigma_scale) {
   const bool none = p.fixed || !p.observable;
-  return json{{"name", p.name},
-              {"value", Number(p.value)},
-              {"sigma", none ? json(nullptr) : Number(sigma_scale * p.sigma)},
+  return json{{keys::kName, p.name},
+              {keys::kValue, Number(p.value)},
+              {keys::kSigma, none ? json(nullptr) : Number(sigma_scale * p.sigma)},
               {"sigma_formal", none ? json(nullptr) : Number(p.sigma)},
-              {"observable", p.observable},
-              {"fixed", p.fixed},
-              {"unit", p.unit}};
+              {keys::kObservable, p.observable},
+              {keys::kFixed, p.fixed},
+              {keys::kUnit, p.unit}};
 }
 
 /// One entry of "effects": the effect's parameters in block order with sigma and units.
@@ -118,8 +122,8 @@ json FitJson(const estimation::CalibrationResult& r) {
            {"gyro", r.calibration.has_gyro ? Vector(f.rms_gyr) : json(nullptr)},
            {"motion", f.motion_segments > 0 ? Vector(f.rms_motion) : json(nullptr)}};
   return json{{"chi2", Number(f.chi2)},
-              {"dof", f.dof},
-              {"chi2_dof", Number(f.chi2_dof())},
+              {keys::kDof, f.dof},
+              {keys::kChi2Dof, Number(f.chi2_dof())},
               {"num_residuals", f.num_residuals},
               {"residual_rms", rms},
               {"segments", {{"still", f.still_segments}, {"motion", f.motion_segments}}},
@@ -137,19 +141,19 @@ json FitJson(const estimation::CalibrationResult& r) {
 json ObservabilityJson(const estimation::Observability& o, double sigma_scale) {
   json determined = json::array();
   for (const auto& d : o.determined) {
-    determined.push_back({{"combination", d.text},
+    determined.push_back({{keys::kCombination, d.text},
                           // The combination as numbers: sum of coefficients[i] * parameters[i].
-                          {"parameters", d.names},
-                          {"coefficients", d.coefficients},
-                          {"value", Number(d.value)},
-                          {"sigma", Number(sigma_scale * d.sigma)},
+                          {keys::kParameters, d.names},
+                          {keys::kCoefficients, d.coefficients},
+                          {keys::kValue, Number(d.value)},
+                          {keys::kSigma, Number(sigma_scale * d.sigma)},
                           {"sigma_formal", Number(d.sigma)}});
   }
   return json{{"rank", o.rank},
               {"unknowns", o.num_unknowns},
               {"wander_states", o.wander_states},
               {"unobservable", o.unobservable},
-              {"determined", determined}};
+              {keys::kDetermined, determined}};
 }
 
 json SiteJson(const geo::Site& site) {
@@ -157,14 +161,14 @@ json SiteJson(const geo::Site& site) {
   return json{{"lat_deg", site.known ? Number(site.lat_deg) : none},
               {"lon_deg", site.known ? Number(site.lon_deg) : none},
               {"height_m", site.known ? Number(site.height_m) : none},
-              {"gravity", Number(site.gravity())},
+              {keys::kGravity, Number(site.gravity())},
               {"earth_rate", site.known ? Number(site.omega_ie_n.norm()) : none},
-              {"source", site.known ? site.source : std::string("none")}};
+              {keys::kSource, site.known ? site.source : std::string("none")}};
 }
 
 json NoiseJson(const estimation::CalibrationResult& r) {
   const auto& n = r.calibration.noise;
-  json out{{"accel", Vector(n.acc)},
+  json out{{keys::kAccel, Vector(n.acc)},
            {"gyro", r.calibration.has_gyro ? Vector(n.gyr) : json(nullptr)},
            {"tau_accel", Number(n.tau_acc)},
            {"tau_gyro", r.calibration.has_gyro ? Number(n.tau_gyr) : json(nullptr)},
@@ -215,12 +219,12 @@ json NoiseJson(const estimation::CalibrationResult& r) {
 json StillJson(const estimation::StillSegmentFit& s, bool has_gyro) {
   const Quat& q = s.R_n_b;
   json out{
-      {"label", s.segment.label},
+      {keys::kLabel, s.segment.label},
       {"begin", s.segment.begin},
       {"end", s.segment.end},
       {"t_mid_s", Number(s.t_mid_s)},
-      {"count", s.count},
-      {"acc_mean", Vector(s.acc_mean)},
+      {keys::kCount, s.count},
+      {keys::kAccMean, Vector(s.acc_mean)},
       {"gyr_mean", has_gyro ? Vector(s.gyr_mean) : json(nullptr)},
       {"acc_residual", Vector(s.acc_residual)},
       {"gyr_residual", has_gyro ? Vector(s.gyr_residual) : json(nullptr)},
@@ -329,13 +333,14 @@ json CovarianceJson(const estimation::CalibrationResult& r) {
       if (p.name == name) units.push_back(p.unit);
     }
   }
-  return json{{"parameters", params.names},
+  return json{{keys::kParameters, params.names},
               {"units", units},
-              {"matrix", Rows(scale * scale * params.matrix)},
-              {"sigma_scaled_by_chi2", scale > 1.0},
+              {keys::kMatrix, Rows(scale * scale * params.matrix)},
+              {keys::kSigmaScaledByChi2, scale > 1.0},
               {"sigma_scale", scale},
-              {"determined",
-               {{"combinations", combos.names}, {"matrix", Rows(scale * scale * combos.matrix)}}}};
+              {keys::kDetermined,
+               {{"combinations", combos.names},
+                {keys::kMatrix, Rows(scale * scale * combos.matrix)}}}};
 }
 
 json GatesJson(const estimation::FitReport& fit) {
@@ -348,10 +353,10 @@ json ToJson(const estimation::CalibrationResult& r) {
   json doc;
   doc["schema_version"] = kSchemaVersion;
   doc["plumb_version"] = Version();
-  doc["method"] = r.calibration.method;
-  doc["model"] = r.calibration.model.spec();
-  doc["model_reference"] = {{"t_ref_s", Number(r.calibration.model.t_ref_s)},
-                            {"temp_ref_c", Number(r.calibration.model.temp_ref_c)}};
+  doc[keys::kMethod] = r.calibration.method;
+  doc[keys::kModel] = r.calibration.model.spec();
+  doc[keys::kModelReference] = {{keys::kTRefS, Number(r.calibration.model.t_ref_s)},
+                                {keys::kTempRefC, Number(r.calibration.model.temp_ref_c)}};
   doc["convention"] = {
       {"frame", "body = accelerometer-defined, FRD; navigation NED; SI units"},
       {"accel",
@@ -360,28 +365,30 @@ json ToJson(const estimation::CalibrationResult& r) {
       {"gyro",
        "forward: y_g = matrix omega_b + bias + effects; correction: omega_b = "
        "correction.matrix (y_g - correction.offset)"}};
-  doc["accel"] = Sensor(r.calibration.AccelMatrix(), r.calibration.AccelBias(),
+  doc[keys::kAccel] = Sensor(r.calibration.AccelMatrix(), r.calibration.AccelBias(),
                         Correction(r.calibration.AccelMatrix(), r.calibration.AccelBias(), "f_b = matrix (y_a - offset)",
                                    ExtraEffects(r.calibration.model, model::Sensor::kAccel)));
-  doc["gyro"] =
+  doc[keys::kGyro] =
       r.calibration.has_gyro ? Sensor(r.calibration.GyroMatrix(), r.calibration.GyroBias(),
                           Correction(r.calibration.GyroMatrix(), r.calibration.GyroBias(), "omega_b = matrix (y_g - offset)",
                                      ExtraEffects(r.calibration.model, model::Sensor::kGyro)))
                  : json(nullptr);
   doc["effects"] = EffectsJson(r);
-  doc["parameters"] = json::array();
+  doc[keys::kParameters] = json::array();
   const double sigma_scale = estimation::SigmaScale(r.fit);
   for (const auto& p : r.calibration.parameters) {
-    doc["parameters"].push_back(ParameterJson(p, sigma_scale));
+    doc[keys::kParameters].push_back(ParameterJson(p, sigma_scale));
   }
-  doc["covariance"] = CovarianceJson(r);
-  doc["fit"] = FitJson(r);
+  doc[keys::kCovariance] = CovarianceJson(r);
+  doc[keys::kFit] = FitJson(r);
   doc["gates"] = GatesJson(r.fit);
-  doc["observability"] = ObservabilityJson(r.calibration.observability, sigma_scale);
-  doc["site"] = SiteJson(r.calibration.site);
-  doc["noise"] = NoiseJson(r);
-  doc["segments"] = json::array();
-  for (const auto& s : r.fit.still) doc["segments"].push_back(StillJson(s, r.calibration.has_gyro));
+  doc[keys::kObservability] = ObservabilityJson(r.calibration.observability, sigma_scale);
+  doc[keys::kSite] = SiteJson(r.calibration.site);
+  doc[keys::kNoise] = NoiseJson(r);
+  doc[keys::kSegments] = json::array();
+  for (const auto& s : r.fit.still) {
+    doc[keys::kSegments].push_back(StillJson(s, r.calibration.has_gyro));
+  }
   doc["motion"] = json::array();
   for (const auto& m : r.fit.motion) doc["motion"].push_back(MotionJson(m));
   doc["not_turns"] = json::array();
@@ -422,7 +429,7 @@ json CalibrationJson(const estimation::CalibrationResult& result,
                      const std::vector<std::string>& input_warnings) {
   json doc = ToJson(result);
   doc["segmentation"] = ToJson(segmentation);
-  doc["inputs"] = inputs;
+  doc[keys::kInputs] = inputs;
   std::vector<std::string> warnings = input_warnings;
   warnings.insert(warnings.end(), result.fit.warnings.begin(), result.fit.warnings.end());
   doc["warnings"] = warnings;

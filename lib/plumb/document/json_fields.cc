@@ -1,4 +1,4 @@
-#include "plumb/peers/json_fields.h"
+#include "plumb/document/json_fields.h"
 
 #include <cerrno>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "plumb/core/error.h"
 
-namespace plumb::peers::detail {
+namespace plumb::document::detail {
 
 using nlohmann::json;
 
@@ -69,4 +69,4 @@ Mat3 Matrix3(const json& value, const std::string& path, const std::string& wher
   return out;
 }
 
-}  // namespace plumb::peers::detail
+}  // namespace plumb::document::detail

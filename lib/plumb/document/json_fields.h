@@ -1,5 +1,6 @@
-// plumb/peers/json_fields.h — INTERNAL to plumb::peers: reading a JSON file and its numeric
-// fields with errors that name the file and the key (SPEC section 8).
+// plumb/document/json_fields.h — INTERNAL to plumb::document (its calibration reader; also
+// peers' readers of other tools' files): reading a JSON file and its numeric fields with errors
+// that name the file and the key (SPEC section 8).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -7,7 +8,7 @@
 
 #include "plumb/core/types.h"
 
-namespace plumb::peers::detail {
+namespace plumb::document::detail {
 
 /// The file parsed as JSON; plumb::InputError naming it (and the byte offset) otherwise.
 nlohmann::json ParseJsonFile(const std::string& path);
@@ -30,4 +31,4 @@ Mat3 Matrix3(const nlohmann::json& value, const std::string& path, const std::st
 /// "key 'name'", the place of a key in error messages.
 inline std::string KeyPlace(const std::string& name) { return "key '" + name + "'"; }
 
-}  // namespace plumb::peers::detail
+}  // namespace plumb::document::detail
