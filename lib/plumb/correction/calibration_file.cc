@@ -6,6 +6,7 @@
 #include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
 #include "plumb/core/number_text.h"
+#include "plumb/core/option_name.h"
 
 namespace plumb::correction {
 namespace {
@@ -22,7 +23,7 @@ double FiniteNumber(const json& v, const std::string& path, const std::string& k
 const json& Required(const json& doc, const char* key, const std::string& path) {
   if (!doc.contains(key)) {
     throw InputError(path, "key '" + std::string(key) + "'",
-                     "missing: not a calibration written by 'plumb calibrate --json'");
+                     "missing: not a calibration written by " + OptionText(Option::kCalibrationJson));
   }
   return doc.at(key);
 }

@@ -8,6 +8,7 @@
 #include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
 #include "plumb/core/number_text.h"
+#include "plumb/core/option_name.h"
 #include "plumb/model/model.h"
 #include "plumb/peers/json_fields.h"
 
@@ -239,7 +240,7 @@ void CheckSigmasAgree(const PlumbResult& r, const std::string& path) {
 PlumbResult ReadPlumbResult(const std::string& path) {
   const json root = detail::ParseJsonFile(path);
   if (!root.is_object()) {
-    throw InputError(path, "", "expected the JSON object that 'plumb calibrate --json' writes");
+    throw InputError(path, "", "expected the JSON object that " + OptionText(Option::kCalibrationJson) + " writes");
   }
   PlumbResult r;
   r.path = path;
