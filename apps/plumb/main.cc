@@ -21,8 +21,10 @@
 
 #include "commands.h"
 #include "file_roles.h"
+#include "option_flags.h"
 #include "progress.h"
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "validators.h"
 #include "plumb/report/version.h"
 
@@ -74,6 +76,8 @@ int main(int argc, char** argv) {
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   plumb::cli::CommandLineArgs().assign(argv, argv + argc);
+  // The library's messages name options as this command spells them ("--acc-unit g").
+  plumb::SetOptionSpeller(&plumb::cli::SpellFlag);
   CLI::App app("plumb " + plumb::report::Version() +
                    ": calibrate an IMU's accelerometer and gyroscope from real logs, with "
                    "honest uncertainty",

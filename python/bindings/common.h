@@ -12,11 +12,17 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/option_name.h"
 #include "plumb/core/session.h"
 #include "plumb/geo/site.h"
 #include "plumb/report/json_report.h"
 
 namespace plumb::python {
+
+/// `option` (core/option_name.h) as this module's keyword: "max_iterations", acc_unit="g" (a
+/// value in capitals, a placeholder, unquoted: heading=DEG); an option the module does not
+/// take keeps the library's name. The module's init installs it (plumb::SetOptionSpeller).
+std::string SpellKeyword(Option option, std::string_view value);
 
 namespace py = pybind11;
 
@@ -106,7 +112,8 @@ Class& DocumentMethods(Class& c, const std::string& command) {
   c.def_property_readonly("document", [](const T& t) { return ToPython(t.document); },
                           ("The whole " + command + " --json document as a dict.").c_str());
   c.def("to_json", [](const T& t) { return report::JsonText(t.document); },
-        ("The " + command + " --json document as text, byte for byte what the command writes.")
+        ("The " + command + " --json document as text, byte for byte what the command writes "
+         "(the options its messages name spelled as this module's keywords).")
             .c_str());
   return c;
 }

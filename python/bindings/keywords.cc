@@ -5,6 +5,58 @@
 #include "plumb/core/error.h"
 
 namespace plumb::python {
+namespace {
+
+const char* Keyword(Option option) {
+  switch (option) {
+    case Option::kTimeWindow: return "from_s/to_s";
+    case Option::kSegments: return "segments";
+    case Option::kRate: return "rate";
+    case Option::kDropNan: return "drop_nan";
+    case Option::kAccUnit: return "acc_unit";
+    case Option::kAccScale: return "acc_scale";
+    case Option::kAccOffset: return "acc_offset";
+    case Option::kGyrUnit: return "gyr_unit";
+    case Option::kGyrScale: return "gyr_scale";
+    case Option::kGyrOffset: return "gyr_offset";
+    case Option::kSite: return "site=(lat_deg, lon_deg, height_m)";
+    case Option::kHeading: return "heading";
+    case Option::kLevelNorth: return "level_north";
+    case Option::kGravity: return "gravity";
+    case Option::kMaxIterations: return "max_iterations";
+    case Option::kEstimateWalk: return "estimate_rw";
+    case Option::kAccelWalk: return "accel_rw";
+    case Option::kGyroWalk: return "gyro_rw";
+    case Option::kAccelInstability: return "accel_bi";
+    case Option::kGyroInstability: return "gyro_bi";
+    case Option::kSigma: return "sigma";
+    case Option::kCalibrationJson: return "Result.save";
+    case Option::kNoiseFrom:
+    case Option::kExport:
+    case Option::kExportUndetermined:
+    case Option::kKeepGyroOffsets:
+    case Option::kSystemId:
+    case Option::kTruthJson: return "";  // the command's only
+  }
+  return "";
+}
+
+bool Placeholder(std::string_view value) {
+  for (const char c : value) {
+    if (c < 'A' || c > 'Z') return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string SpellKeyword(Option option, std::string_view value) {
+  const char* keyword = Keyword(option);
+  if (*keyword == '\0') return LibrarySpelling(option, value);
+  if (value.empty()) return keyword;
+  const std::string text(value);
+  return std::string(keyword) + "=" + (Placeholder(value) ? text : "\"" + text + "\"");
+}
 
 Keywords::Keywords(std::string function, const py::kwargs& kwargs)
     : function_(std::move(function)), kwargs_(kwargs) {}

@@ -13,6 +13,8 @@ PYBIND11_MODULE(_plumb, m) {
     FLAGS_logtostderr = true;
     google::InitGoogleLogging("plumb");
   }
+  // The library's messages name options as this module's keywords (acc_unit="g").
+  plumb::SetOptionSpeller(&plumb::python::SpellKeyword);
   m.doc() = "plumb: calibrate an IMU's accelerometer and gyroscope from real logs, with honest "
             "uncertainty (the library behind the plumb command). SI units throughout: s, m/s^2, "
             "rad/s, degC.";

@@ -75,7 +75,8 @@ TEST(Gates, ATemperatureNoImuOperatesAtIsOutOfRange) {
   ASSERT_NE(g, nullptr) << Names(gates);
   EXPECT_EQ(g->message, "2 temperatures outside any MEMS IMU's operating range (beyond -60 .. 150 "
                         "degC, or not finite); the first at t = 2.5 s (sample 250): 1000000 degC. "
-                        "A corrupt log or a column that is not degC: cut them out (--from/--to) "
+                        "A corrupt log or a column that is not degC: cut them out "
+                        "(FlightLogSelection::from_s/to_s) "
                         "or fix the input before trusting a temperature model");
   s.acc[300].z() = 4.7e21f;  // with a sample out of range too: one gate, both said
   const std::vector<Gate> both = CheckSamples(s, {});
@@ -279,7 +280,7 @@ TEST(Gates, AccelerometerInGUnitsIsNamed) {
       Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site);
   const Gate* g = Find(r.fit.gates, "unit_or_rate");
   ASSERT_NE(g, nullptr) << Names(r.fit.gates);
-  EXPECT_TRUE(Contains(g->message, "the samples look like g, not m/s^2: give --acc-unit g"))
+  EXPECT_TRUE(Contains(g->message, "the samples look like g, not m/s^2: give InputOptions::acc.unit = g"))
       << g->message;
 }
 
@@ -290,7 +291,7 @@ TEST(Gates, GyroscopeInDegreesIsNamed) {
       Calibrate(s.session.series, FreeAttitudes(s.truth_segments), s.model, s.site);
   const Gate* g = Find(r.fit.gates, "unit_or_rate");
   ASSERT_NE(g, nullptr) << Names(r.fit.gates);
-  EXPECT_TRUE(Contains(g->message, "--gyr-unit deg/s")) << g->message;
+  EXPECT_TRUE(Contains(g->message, "InputOptions::gyr.unit = deg/s")) << g->message;
 }
 
 TEST(Uncertainty, ParameterCovarianceHoldsTheSigmasInOrder) {

@@ -260,7 +260,7 @@ TEST(VehicleState, TheFilesSayAndKeepWhatTheFirmwareWouldReplace) {
   EXPECT_EQ(plain.text.find("_ID\t"), std::string::npos) << plain.text;
   EXPECT_NE(plain.text.find("are not written (the input does not record them)"), std::string::npos);
   EXPECT_NE(plain.text.find("\n1\t1\tCAL_ACC0_XOFF"), std::string::npos);
-  EXPECT_NE(plain.text.find("--sysid N gives it"), std::string::npos);
+  EXPECT_NE(plain.text.find("ExportOptions::system_id = N gives it"), std::string::npos);
 }
 
 TEST(Evaluate, OffDiagonalTermMatchesTheHandComputation) {

@@ -119,7 +119,7 @@ TEST(Comparison, CostsAreImuTksOnTheSegmentMeans) {
   CompareOptions options;
   options.gravity_m_s2 = 9.9;
   const Comparison other_g = Compare(r, p, options);
-  EXPECT_EQ(other_g.cost.gravity_source, "--gravity");
+  EXPECT_EQ(other_g.cost.gravity_source, "CompareOptions::gravity_m_s2");
   EXPECT_NEAR(other_g.cost.plumb_means.rms_m_s2, 0.1, 1e-12);
 }
 

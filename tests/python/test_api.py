@@ -91,6 +91,22 @@ class Errors(unittest.TestCase):
                 plumb.simulate(**kwargs)
             self.assertIn(text, str(c.exception))
 
+    def test_messages_name_options_as_keywords(self):
+        # Issue 36 item 3: the library's errors and gates name an option by meaning; Python
+        # spells it as its keyword, never as the command's flag.
+        path = out("nan.csv")
+        with open(path, "w") as f:
+            f.write("0,0,0,9.8\n0.01,nan,0,9.8\n")
+        with self.assertRaises(plumb.InputError) as c:
+            plumb.open(path, columns="t,ax,ay,az")
+        self.assertIn("(to skip such rows: drop_nan)", str(c.exception))
+        self.assertNotIn("--", str(c.exception))
+        s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
+        fit = plumb.calibrate(s, max_iterations=1).fit
+        gates = {g["name"]: g["message"] for g in fit["gates"]}
+        self.assertIn("allow more iterations (max_iterations)", gates["not_converged"])
+        self.assertNotIn("--", gates["not_converged"])
+
     def test_bad_calibration_file_names_it(self):
         path = out("not_a_calibration.json")
         with open(path, "w") as f:

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "plumb/core/number_text.h"
+
 namespace plumb {
 namespace {
 
@@ -72,10 +74,6 @@ InputError JsonTextError(const std::string& path, std::string_view parser_what) 
   return InputError(path, where, "not valid JSON: " + std::string(what));
 }
 
-std::string Number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", value);
-  return text;
-}
+std::string Number(double value, int digits) { return SignificantText(value, digits); }
 
 }  // namespace plumb

@@ -76,7 +76,8 @@ auto ParseJsonText(const std::string& path, Parse&& parse) -> decltype(parse()) 
 }
 
 /// A number as messages print it: 6 significant digits ("1e+300", "0.0199", "200"), never
-/// std::to_string's fixed 6 decimals (309 digits for 1e300, "0.000000" for 1e-9).
-std::string Number(double value);
+/// std::to_string's fixed 6 decimals (309 digits for 1e300, "0.000000" for 1e-9); `digits`
+/// significant digits where a message wants fewer or more ("%.*g", 4 for the gates' figures).
+std::string Number(double value, int digits = 6);
 
 }  // namespace plumb

@@ -5,6 +5,7 @@
 
 #include "plumb/core/error.h"
 #include "plumb/core/number_text.h"
+#include "plumb/core/option_name.h"
 
 namespace plumb::correction {
 namespace {
@@ -136,7 +137,8 @@ CorrectedSeries ApplyCalibration(const CalibrationFile& calibration, const ImuSe
       throw Error(calibration.path +
                   ": the calibration has no covariance over its parameters to propagate (none "
                   "in the file, or its data determined only combinations of them: see its "
-                  "'observability'); apply it without the uncertainty (--sigma)");
+                  "'observability'); apply it without the uncertainty (" +
+                  OptionText(Option::kSigma) + ")");
     }
     Propagate(calibration, series, steps, out);
   }

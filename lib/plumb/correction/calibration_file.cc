@@ -4,6 +4,7 @@
 
 #include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 
 namespace plumb::correction {
 namespace {
@@ -11,7 +12,9 @@ namespace {
 std::string KeyPlace(const std::string& name) { return "key '" + name + "'"; }
 
 /// The message of a key a calibration to apply requires and the document lacks.
-constexpr const char* kMissing = "missing: not a calibration written by 'plumb calibrate --json'";
+std::string Missing() {
+  return "missing: not a calibration written by " + OptionText(Option::kCalibrationJson);
+}
 
 /// The checks of core/calibration_checks.h on the sensors' matrices of `out`, as the
 /// parameters give them.
@@ -35,10 +38,10 @@ CalibrationFile CalibrationFromDocument(const document::CalibrationDocument& d) 
   const std::string& path = d.path;
   CalibrationFile out;
   out.path = path;
-  if (!d.has_model) throw InputError(path, KeyPlace("model"), kMissing);
+  if (!d.has_model) throw InputError(path, KeyPlace("model"), Missing());
   if (!d.model) throw InputError(path, KeyPlace("model"), d.model_problem);
   out.model = *d.model;
-  if (!d.reference) throw InputError(path, KeyPlace("model_reference"), kMissing);
+  if (!d.reference) throw InputError(path, KeyPlace("model_reference"), Missing());
   out.model.t_ref_s = d.reference->t_ref_s;
   out.model.temp_ref_c = d.reference->temp_ref_c;
   // An accelerometer-only session's fit dropped the gyroscope terms of its spec.

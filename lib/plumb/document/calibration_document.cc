@@ -5,6 +5,7 @@
 
 #include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/number_text.h"
 #include "plumb/document/calibration_keys.h"
 #include "plumb/document/json_fields.h"
@@ -323,7 +324,7 @@ void CheckSigmasAgree(const CalibrationDocument& d) {
 CalibrationDocument ReadCalibrationDocument(const json& root, const std::string& path,
                                             const ReadOptions& options) {
   if (!root.is_object()) {
-    throw InputError(path, "", "expected the JSON object that 'plumb calibrate --json' writes");
+    throw InputError(path, "", "expected the JSON object that " + OptionText(Option::kCalibrationJson) + " writes");
   }
   CalibrationDocument d;
   d.path = path;

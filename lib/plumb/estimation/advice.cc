@@ -5,6 +5,7 @@
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/estimation/gates.h"
 #include "plumb/estimation/uncertainty.h"
 
@@ -93,15 +94,16 @@ void AddAdvice(const Calibration& calibration, const StillSet& still,
         (calibration.has_gyro ? " and Earth rate left out; the accelerometer scale and the "
                                 "gyroscope bias depend on it"
                               : "; the accelerometer scale depends on it") +
-        " (give --lat --lon --height)");
+        " (give " + OptionText(Option::kSite) + ")");
   }
   if (site.known && calibration.has_gyro && !still.AnyAttitudeKnown() &&
       !options.first_heading_deg) {
     fit.warnings.push_back(
         "the heading of the first still pose is held at 0 (x north) as the gauge; with a site, "
         "Earth rate (" + Number(site.omega_ie_n.head<2>().norm()) +
-        " rad/s horizontal) is predicted for that heading: state it (--heading DEG or "
-        "--level-north) or the gyroscope biases absorb up to that much");
+        " rad/s horizontal) is predicted for that heading: state it (" +
+        OptionText(Option::kHeading, "DEG") + " or " + OptionText(Option::kLevelNorth) +
+        ") or the gyroscope biases absorb up to that much");
   }
 }
 

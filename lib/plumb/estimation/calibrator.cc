@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
 #include "plumb/estimation/advice.h"
 #include "plumb/estimation/calibration_problem.h"
@@ -34,8 +35,10 @@ model::Model ModelForSession(const model::Model& requested, const ImuSeries& ser
     warnings.push_back("the input has no gyroscope: calibrating the accelerometer only");
   }
   if (site.known && model.has_effect("earth_rate")) {
-    throw Error("earth_rate is a candidate only without a site: with --lat/--lon Earth rate is "
-                "already in the model (from GeographicLib); drop it from the model");
+    throw Error("earth_rate is a candidate only without a site: with " +
+                OptionText(Option::kSite) +
+                " Earth rate is already in the model (from GeographicLib); drop it from the "
+                "model");
   }
   for (const auto& term : model.terms()) {
     const auto& info = term.effect->info();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "plumb/core/option_name.h"
 #include "plumb/core/typical_mems.h"
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/solve.h"
@@ -224,14 +225,16 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
     if (!s.chosen || !s.Estimated() || !s.walk_free) continue;
     const double ratio = s.walk->maxCoeff() / s.walk_typical;
     if (ratio <= kImplausibleWalk) continue;
-    char text[360];
+    char text[640];
     std::snprintf(text, sizeof text,
                   "%sthe estimated %s walk is %.0f times the typical MEMS walk: the differences "
                   "between poses it was read from are more likely an effect the model misses "
                   "than a walk, and a walk that large hides it from chi2; run 'plumb diagnose' "
-                  "(without --estimate-rw) or give the walk (--accel-rw/--gyro-rw)",
+                  "(without %s) or give the walk (%s/%s)",
                   out.implausible.empty() ? "" : "; ",
-                  s.sensor == model::Sensor::kAccel ? "accelerometer" : "gyroscope", ratio);
+                  s.sensor == model::Sensor::kAccel ? "accelerometer" : "gyroscope", ratio,
+                  OptionText(Option::kEstimateWalk).c_str(), OptionText(Option::kAccelWalk).c_str(),
+                  OptionText(Option::kGyroWalk).c_str());
     out.implausible += text;
   }
   return out;

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/typical_mems.h"
 
 namespace plumb::estimation {
@@ -206,19 +207,22 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
   // The session's holds can estimate what the still data leave to the typical sensor.
   const bool estimable = !options.estimate_walk && still_poses >= options.walk_min_poses &&
                          note.find(" typical") != std::string::npos;
-  char head[160], tail[320];
+  char head[160], tail[160];
   std::snprintf(head, sizeof head, "bias wander levels (Allan deviation of %.0f s of still data): ",
                 still_s);
   const std::string lead = measured.empty() ? "bias wander levels (no still data long enough for "
                                               "an Allan deviation): "
                                             : head;
   std::snprintf(tail, sizeof tail, "; instability: Gauss-Markov sigma, correlation time %.3g "
-                "s; override with --accel-rw/--gyro-rw/--accel-bi/--gyro-bi (a datasheet's "
-                "values)%s --noise-from a long still recording%s", n.instability_time_s,
-                estimable ? "," : " or",
-                estimable ? " or --estimate-rw (from the session's holds, once diagnose finds "
-                            "no missing effect)" : "");
-  out.notes.push_back(lead + note + tail);
+                "s; override with ", n.instability_time_s);
+  out.notes.push_back(
+      lead + note + tail + OptionText(Option::kAccelWalk) + "/" + OptionText(Option::kGyroWalk) +
+      "/" + OptionText(Option::kAccelInstability) + "/" + OptionText(Option::kGyroInstability) +
+      " (a datasheet's values)" + (estimable ? "," : " or") + " " +
+      OptionText(Option::kNoiseFrom) + " a long still recording" +
+      (estimable ? " or " + OptionText(Option::kEstimateWalk) +
+                       " (from the session's holds, once diagnose finds no missing effect)"
+                 : std::string()));
   return out;
 }
 

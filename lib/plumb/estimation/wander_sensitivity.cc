@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "plumb/core/option_name.h"
+
 namespace plumb::estimation {
 namespace {
 
@@ -79,15 +81,15 @@ std::optional<std::string> SigmaRestsOnTheTypicalWander(const CalibrationResult&
     if (same != d.end()) consider(c[i].text, c[i].sigma, same->sigma);
   }
   if (worst < kWorthSaying) return std::nullopt;
-  char text[640];
+  char text[768];
   std::snprintf(text, sizeof text,
                 "the sigmas rest on the typical MEMS bias wander, which this session cannot "
                 "measure (its still data do not resolve it and its holds are too few to "
                 "estimate it): were the wander at the largest level the still data allow (their "
                 "95 %% bound), the sigmas would be up to %.3g times larger (%s: %.3g -> %.3g). "
-                "Give the sensor's levels (a datasheet's, or --noise-from a long still "
-                "recording) for sigmas you can promise",
-                worst, what.c_str(), from, to);
+                "Give the sensor's levels (a datasheet's, or %s a long still recording) for "
+                "sigmas you can promise",
+                worst, what.c_str(), from, to, OptionText(Option::kNoiseFrom).c_str());
   return std::string(text);
 }
 

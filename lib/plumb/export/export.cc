@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
 
 namespace plumb::exporter {
@@ -58,11 +59,11 @@ void CheckDetermined(const std::string& format, const estimation::Calibration& c
     missing += (missing.empty() ? "" : ", ") + p.name;
   }
   if (missing.empty()) return;
-  throw Error("--export " + format + ": the session does not determine " + missing +
+  throw Error(OptionText(Option::kExport, format) + ": the session does not determine " + missing +
               ", which the firmware parameters come from; writing them would replace the "
               "vehicle's values with ones plumb held, not measured. Record more poses (six "
-              "faces or more, joined by turns), or give --export-undetermined to write them "
-              "anyway");
+              "faces or more, joined by turns), or give " + OptionText(Option::kExportUndetermined) +
+              " to write them anyway");
 }
 
 /// What the vehicle will do with the values, from the log's parameters: the boot-time gyro
@@ -82,12 +83,13 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
   const std::string offsets = ardupilot ? "INS_GYR*OFFS" : "CAL_GYRO" + std::to_string(set.imu) + "_*OFF";
   if (options.keep_gyro_offsets) {
     set.parameters.push_back({flag, 0.0, true});
-    set.notes.push_back(flag + " 0 (--keep-gyro-offsets): the firmware keeps these " + offsets +
+    set.notes.push_back(flag + " 0 (" + OptionText(Option::kKeepGyroOffsets) + "): the firmware keeps these " + offsets +
                         " instead of measuring new ones at rest after boot");
   } else if (!logged(flag) || *logged(flag) != 0.0) {
     set.notes.push_back("the firmware measures the gyro offsets at rest after boot while " + flag +
                         " is 1 (" + said(flag, "its default") + ") and they replace these " +
-                        offsets + ": write " + flag + " 0 (--keep-gyro-offsets) to keep plumb's");
+                        offsets + ": write " + flag + " 0 (" +
+                        OptionText(Option::kKeepGyroOffsets) + ") to keep plumb's");
   }
   if (ardupilot) {
     set.notes.push_back("AHRS_TRIM_X/Y/Z (the level: how the board sits in the frame) are left "
@@ -116,7 +118,9 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
   set.system_id = options.system_id.value_or(1);
   if (!ardupilot) {
     set.notes.push_back("vehicle (system) id " + std::to_string(set.system_id) +
-                        (options.system_id ? "" : " (the input does not say it; --sysid N gives it)") +
+                        (options.system_id ? ""
+                                           : " (the input does not say it; " +
+                                                 OptionText(Option::kSystemId, "N") + " gives it)") +
                         ": QGroundControl loads a .params file only onto that vehicle");
   }
 }

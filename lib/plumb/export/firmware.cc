@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
 #include "plumb/model/model.h"
 #include "plumb/signal/segment_stats.h"
@@ -102,8 +103,8 @@ FirmwareCorrection BestDiagonal(const estimation::Calibration& c,
   if (c.acc_unit != "m/s^2" || (c.has_gyro && c.gyr_unit != "rad/s")) {
     throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: firmware parameters act on SI sensor output, so "
-                "plumb cannot export them; give the sensor's scale (--acc-scale, --gyr-scale) "
-                "to calibrate in SI");
+                "plumb cannot export them; give the sensor's scale (" + OptionText(Option::kAccScale) +
+                ", " + OptionText(Option::kGyrScale) + ") to calibrate in SI");
   }
   FirmwareCorrection fw;
   fw.has_gyro = c.has_gyro;

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/signal/allan.h"
 #include "plumb/signal/axis_view.h"
 #include "plumb/signal/noise_terms.h"
@@ -85,12 +86,6 @@ SensorNoise Measure(const ImuSeries& series, signal::Sensor sensor, const Vec3& 
   return noise;
 }
 
-std::string Num(double value) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", value);
-  return buf;
-}
-
 /// Where the IEEE fit of the still data resolves N or K on an axis, it replaces the fallback.
 /// `slope_seen`: the fallback's own +1/2 test per axis.
 void UseIeeeTerms(const signal::StillNoise* noise, signal::Sensor sensor,
@@ -165,7 +160,8 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   if (c.acc_unit != "m/s^2" || (c.has_gyro && c.gyr_unit != "rad/s")) {
     throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: Kalibr's noise densities are in SI, so plumb cannot "
-                "export them; give the sensor's scale (--acc-scale, --gyr-scale)");
+                "export them; give the sensor's scale (" + OptionText(Option::kAccScale) + ", " +
+                OptionText(Option::kGyrScale) + ")");
   }
   const double dt_s = series.median_dt_s();
   if (!(dt_s > 0)) throw Error("Kalibr export: the session has no sample interval");
@@ -200,7 +196,7 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   }
   if (ieee) {
     imu.notes.push_back("IEEE noise terms fitted to the Allan deviation of " +
-                        Num(ieee->still_s) + " s of still data in " +
+                        Number(ieee->still_s) + " s of still data in " +
                         std::to_string(ieee->segments.size()) + " segment(s) (plumb allan)");
     imu.notes.push_back(SourceNote("accel", imu.accel));
     if (imu.has_gyro) imu.notes.push_back(SourceNote("gyro", imu.gyro));
@@ -212,7 +208,7 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   } else if (!resolved) {
     imu.notes.push_back("random walks not resolved by the IEEE fit are upper bounds (min over t "
                         "of ADEV(t) sqrt(3/t)): the longest still segment (" +
-                        Num(imu.longest_still_s) + " s) is too short to show the +1/2 slope");
+                        Number(imu.longest_still_s) + " s) is too short to show the +1/2 slope");
   }
   return imu;
 }
@@ -224,21 +220,21 @@ std::string KalibrYaml(const KalibrImu& imu) {
   const bool bound = !(imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved));
   const std::string walk_comment = bound ? "  # upper bound from a short session" : "";
   text += "rostopic: " + imu.rostopic + "\n";
-  text += "update_rate: " + Num(imu.update_rate_hz) + "  # Hz\n";
+  text += "update_rate: " + Number(imu.update_rate_hz) + "  # Hz\n";
   // Where the written (largest) value came from.
   const auto origin = [](const Vec3& v, const std::array<bool, 3>& ieee) {
     Eigen::Index axis = 0;
     v.maxCoeff(&axis);
     return std::string(ieee[axis] ? ", N of the IEEE noise fit" : "");
   };
-  text += "accelerometer_noise_density: " + Num(imu.accelerometer_noise_density()) +
+  text += "accelerometer_noise_density: " + Number(imu.accelerometer_noise_density()) +
           "  # m/s^2/sqrt(Hz)" + origin(imu.accel.white, imu.accel.white_from_ieee) + "\n";
-  text += "accelerometer_random_walk: " + Num(imu.accelerometer_random_walk()) +
+  text += "accelerometer_random_walk: " + Number(imu.accelerometer_random_walk()) +
           "  # m/s^3/sqrt(Hz)" + walk_comment + "\n";
   if (imu.has_gyro) {
-    text += "gyroscope_noise_density: " + Num(imu.gyroscope_noise_density()) +
+    text += "gyroscope_noise_density: " + Number(imu.gyroscope_noise_density()) +
             "  # rad/s/sqrt(Hz)" + origin(imu.gyro.white, imu.gyro.white_from_ieee) + "\n";
-    text += "gyroscope_random_walk: " + Num(imu.gyroscope_random_walk()) +
+    text += "gyroscope_random_walk: " + Number(imu.gyroscope_random_walk()) +
             "  # rad/s^2/sqrt(Hz)" + walk_comment + "\n";
   }
   return text;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/signal/high_pass.h"
 
 namespace plumb::paper {
@@ -105,7 +106,7 @@ PaperStaticResult CalibratePaperStatic(const ImuSeries& series, std::size_t begi
                     std::to_string(-options.accel_diagonal) + " are fixed, not estimated");
   if (series.has_gyro() && !site.known) {
     r.notes.push_back("no site: the gyroscope part (steps 5-7 need C_ecef^ned) is left out; "
-                      "give --lat --lon");
+                      "give " + OptionText(Option::kSite));
   } else if (series.has_gyro()) {
     r.has_gyro = true;
     r.gyro = Gyroscope(series, begin, end, hp, site, options);

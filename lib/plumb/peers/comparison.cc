@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
 
 namespace plumb::peers {
@@ -45,8 +48,9 @@ void CheckUnits(const Mat3& plumb, const Mat3& peer, const std::string& sensor,
       notes.push_back("WARNING: the " + sensor + " scales (matrix diagonals) differ by a factor " +
                       std::to_string(ratio) +
                       ": were plumb and the peer given data in different units? (plumb must read "
-                      "the peer's raw data without --acc-scale/--gyr-scale/--*-offset), or is "
-                      "plumb's estimate unobservable?");
+                      "the peer's raw data without " + OptionText(Option::kAccScale) + "/" +
+                      OptionText(Option::kGyrScale) + "/" + OptionText(Option::kAccOffset) + "/" +
+                      OptionText(Option::kGyrOffset) + "), or is plumb's estimate unobservable?");
       return;
     }
   }
@@ -70,7 +74,7 @@ std::string UnitMismatch(const std::string& plumb_unit, const std::string& peer_
   }
   if (apart) {
     return "every " + sensor + " scale differs by 180/pi: data in deg/s were read as rad/s on "
-           "one side (plumb converts deg/s with --gyr-unit deg/s)";
+           "one side (plumb converts deg/s with " + OptionText(Option::kGyrUnit, "deg/s") + ")";
   }
   return "";
 }
@@ -119,9 +123,10 @@ GravityNormComparison Costs(const PlumbResult& r, const ForwardCalibration& peer
   GravityNormComparison c;
   c.segments = static_cast<int>(r.segments.size());
   c.gravity_m_s2 = options.gravity_m_s2 > 0.0 ? options.gravity_m_s2 : r.gravity_m_s2;
-  c.gravity_source = options.gravity_m_s2 > 0.0 ? "--gravity" : "the result's site.gravity";
+  c.gravity_source =
+      options.gravity_m_s2 > 0.0 ? OptionText(Option::kGravity) : "the result's site.gravity";
   if (!(c.gravity_m_s2 > 0.0)) {
-    c.unavailable_reason = r.path + " has no site.gravity: give --gravity";
+    c.unavailable_reason = r.path + " has no site.gravity: give " + OptionText(Option::kGravity);
     return c;
   }
   if (r.segments.empty()) {
@@ -147,30 +152,25 @@ GravityNormComparison Costs(const PlumbResult& r, const ForwardCalibration& peer
   return c;
 }
 
-std::string Fmt(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, value);
-  return buffer;
-}
-
 std::string Cell(const std::string& text, std::size_t width) {
   return text.size() >= width ? text + " " : text + std::string(width - text.size(), ' ');
 }
 
-std::string OptionalCell(const std::optional<double>& v, const char* format) {
-  return v ? Fmt(format, *v) : "-";
+/// `v` with `decimals` digits after the point, "-" when absent.
+std::string OptionalCell(const std::optional<double>& v, int decimals) {
+  return v ? FixedText(*v, decimals) : "-";
 }
 
 std::string SigmaCell(const ComparisonRow& row) {
   if (!row.in_plumb_model) return "-";
   if (row.plumb_fixed) return "fixed";
   if (!row.plumb_sigma) return row.plumb_observable ? "-" : "unobs.";
-  return Fmt("%.3g", *row.plumb_sigma);
+  return Number(*row.plumb_sigma, 3);
 }
 
 std::string CostLine(const std::string& who, const ImuTkCost& c) {
-  return "    " + Cell(who, 8) + "cost " + Cell(Fmt("%.6g", c.cost), 13) + "rms " +
-         Cell(Fmt("%.4g", c.rms_m_s2), 11) + "max |r| " + Fmt("%.4g", c.max_abs_m_s2) + " m/s^2\n";
+  return "    " + Cell(who, 8) + "cost " + Cell(Number(c.cost), 13) + "rms " +
+         Cell(Number(c.rms_m_s2, 4), 11) + "max |r| " + Number(c.max_abs_m_s2, 4) + " m/s^2\n";
 }
 
 /// The largest |d/sigma| among rows whose name starts with `prefix`, as text.
@@ -180,7 +180,7 @@ std::string Largest(const std::vector<ComparisonRow>& rows, const std::string& p
     if (row.name.rfind(prefix, 0) != 0 || !row.z) continue;
     if (worst == nullptr || std::abs(*row.z) > std::abs(*worst->z)) worst = &row;
   }
-  return worst ? Fmt("%.3g", std::abs(*worst->z)) + " (" + worst->name + ")" : "-";
+  return worst ? Number(std::abs(*worst->z), 3) + " (" + worst->name + ")" : "-";
 }
 
 void WriteTable(const Comparison& c, std::ostream& os) {
@@ -188,13 +188,13 @@ void WriteTable(const Comparison& c, std::ostream& os) {
   const double scale = std::sqrt(std::max(1.0, std::isfinite(c.chi2_dof) ? c.chi2_dof : 1.0));
   os << Cell("parameter", 26) << Cell("unit", 18) << Cell("plumb", 15) << Cell("+- sigma", 11)
      << Cell(peer, 15) << Cell("plumb-" + peer, 14) << Cell("d/sigma", 9)
-     << "d/(sigma*" << Fmt("%.3g", scale) << ")\n";
+     << "d/(sigma*" << Number(scale, 3) << ")\n";
   for (const auto& row : c.rows) {
     os << Cell(row.name, 26) << Cell(row.in_plumb_model ? row.unit : "(not in model)", 18)
-       << Cell(row.in_plumb_model ? Fmt("%.9g", row.plumb_value) : "0", 15)
-       << Cell(SigmaCell(row), 11) << Cell(Fmt("%.9g", row.peer_value), 15)
-       << Cell(row.not_compared.empty() ? Fmt("%.4g", row.difference) : "not compared", 14)
-       << Cell(OptionalCell(row.z, "%.2f"), 9) << OptionalCell(row.z_scaled, "%.2f") << "\n";
+       << Cell(row.in_plumb_model ? Number(row.plumb_value, 9) : "0", 15)
+       << Cell(SigmaCell(row), 11) << Cell(Number(row.peer_value, 9), 15)
+       << Cell(row.not_compared.empty() ? Number(row.difference, 4) : "not compared", 14)
+       << Cell(OptionalCell(row.z, 2), 9) << OptionalCell(row.z_scaled, 2) << "\n";
   }
   os << "largest |d/sigma|: accel " << Largest(c.rows, "accel.") << ", gyro "
      << Largest(c.rows, "gyro") << "\n";
@@ -208,13 +208,13 @@ void WriteCosts(const Comparison& c, std::ostream& os) {
     os << ": not computed: " << k.unavailable_reason << "\n";
     return;
   }
-  os << ", g = " << Fmt("%.8g", k.gravity_m_s2) << " m/s^2 (" << k.gravity_source << ")\n";
+  os << ", g = " << Number(k.gravity_m_s2, 8) << " m/s^2 (" << k.gravity_source << ")\n";
   os << "  on plumb's " << k.segments << " still-segment means, one residual each:\n"
      << CostLine("plumb", k.plumb_means) << CostLine(peer, k.peer_means);
   if (k.has_sample_estimate) {
     os << "  expected as imu_tk computes it, on the first " << kImuTkSamplesPerInterval
        << " samples of each of the " << k.plumb_samples.terms << " segments longer than that ("
-       << Fmt("%.0f", k.plumb_samples.weight) << " residuals, sample noise included):\n"
+       << FixedText(k.plumb_samples.weight, 0) << " residuals, sample noise included):\n"
        << CostLine("plumb", k.plumb_samples) << CostLine(peer, k.peer_samples);
   }
   if (peer == "imu_tk") {
@@ -325,7 +325,7 @@ std::string ComparisonText(const Comparison& c) {
   for (const auto& s : c.peer.sources) sources += (sources.empty() ? "" : ", ") + s;
   os << " (" << sources << ")\n";
   os << "plumb: method " << c.method << ", model " << c.model << ", chi2/dof "
-     << Fmt("%.4g", c.chi2_dof) << " on " << c.dof << " dof\n";
+     << Number(c.chi2_dof, 4) << " on " << c.dof << " dof\n";
   for (const auto& n : c.peer.notes) os << "  " << n << "\n";
   for (const auto& n : c.notes) os << n << "\n";
   os << "forward form y = M x + b in the units of the data plumb was given; "

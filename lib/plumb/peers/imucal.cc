@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
 #include "plumb/document/json_fields.h"
 
@@ -112,8 +113,8 @@ ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string&
       "acc_cal - b_g); forward form F = s_a K_a R_a R, E = s_g K_g R_g R, G = (S_g / C_a) K_ga "
       "R, S_a b_a, S_g b_g, with R = R_peer_b, S (C) the SI value of one output (calibrated) "
       "unit, s = S / C: output " + cal.from_acc_unit + ", " + cal.from_gyr_unit +
-      " -> " + f.acc_unit + ", " + f.gyr_unit + " (plumb's units for data read with "
-      "--gyr-unit deg/s); calibrated " + cal.acc_unit + ", " + cal.gyr_unit + " -> m/s^2, rad/s");
+      " -> " + f.acc_unit + ", " + f.gyr_unit + " (plumb's units for data read with " +
+      OptionText(Option::kGyrUnit, "deg/s") + "); calibrated " + cal.acc_unit + ", " + cal.gyr_unit + " -> m/s^2, rad/s");
   if (frame == ImucalFrame::kPoses) {
     f.notes.push_back("compared in imucal's own frame, that of its six poses (R_peer_b = I): "
                       "plumb's F is full and determined, its frame also the poses'");

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/document/json_fields.h"
 #include "plumb/signal/chi_square.h"
 
@@ -113,7 +114,7 @@ json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 std::vector<TrueParameter> ReadSimulationTruth(const std::string& path) {
   const json root = detail::ParseJsonFile(path);
   const json& params = detail::Field(root, "parameters", path, "parameters",
-                                     "the true parameters that 'plumb simulate --truth-json' writes");
+                                     "the true parameters that " + OptionText(Option::kTruthJson) + " writes");
   if (!params.is_array()) throw InputError(path, detail::KeyPlace("parameters"), "expected a list");
   std::vector<TrueParameter> out;
   for (std::size_t i = 0; i < params.size(); ++i) {

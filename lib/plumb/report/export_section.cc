@@ -3,21 +3,17 @@
 #include <cmath>
 #include <cstdio>
 
+#include "plumb/core/error.h"
 #include "plumb/core/units.h"
 #include "plumb/report/html_report.h"
 
 namespace plumb::report {
 namespace {
 
-std::string G3(double value) {
-  if (!std::isfinite(value)) return "n/a";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", value);
-  return buf;
-}
+std::string G3(double value) { return std::isfinite(value) ? Number(value, 3) : "n/a"; }
 
 std::string Code(const std::string& text) { return "<code>" + HtmlEscape(text) + "</code>"; }
-std::string Num(const std::string& text) { return "<td class=\"num\">" + text + "</td>"; }
+std::string NumberCell(const std::string& text) { return "<td class=\"num\">" + text + "</td>"; }
 
 /// What the format is, in words.
 std::string FormatTitle(const std::string& format) {
@@ -33,9 +29,9 @@ std::string ErrorRow(const std::string& format, const std::string& sensor,
                      const exporter::AxisErrors& e, double factor, const std::string& unit,
                      const Mat3& per_input) {
   std::string row = "<tr><td>" + HtmlEscape(format) + "</td><td>" + HtmlEscape(sensor) + "</td>";
-  for (int i = 0; i < 3; ++i) row += Num(G3(e.rms[i] * factor));
-  for (int i = 0; i < 3; ++i) row += Num(G3(e.max_abs[i] * factor));
-  return row + "<td>" + HtmlEscape(unit) + "</td>" + Num(G3(per_input.cwiseAbs().maxCoeff() * 1e6)) +
+  for (int i = 0; i < 3; ++i) row += NumberCell(G3(e.rms[i] * factor));
+  for (int i = 0; i < 3; ++i) row += NumberCell(G3(e.max_abs[i] * factor));
+  return row + "<td>" + HtmlEscape(unit) + "</td>" + NumberCell(G3(per_input.cwiseAbs().maxCoeff() * 1e6)) +
          "</tr>\n";
 }
 

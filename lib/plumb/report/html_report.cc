@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "plumb/core/error.h"
 #include "plumb/estimation/uncertainty.h"
 #include "plumb/report/calibration_text.h"
 #include "plumb/report/export_section.h"
@@ -43,15 +44,13 @@ figure svg { display: block; max-width: 100%; height: auto; border: 1px solid #d
 figcaption { font-size: 0.92em; color: #444; }
 )css";
 
-std::string Fmt(double value, const char* format) {
-  if (!std::isfinite(value)) return "n/a";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, value);
-  return buf;
+/// `value` to `digits` significant digits, "n/a" when not finite.
+std::string Shown(double value, int digits) {
+  return std::isfinite(value) ? Number(value, digits) : "n/a";
 }
-std::string G6(double value) { return Fmt(value, "%.6g"); }
-std::string G3(double value) { return Fmt(value, "%.3g"); }
-std::string G2(double value) { return Fmt(value, "%.2g"); }
+std::string G6(double value) { return Shown(value, 6); }
+std::string G3(double value) { return Shown(value, 3); }
+std::string G2(double value) { return Shown(value, 2); }
 
 std::string Td(const std::string& html) { return "<td>" + html + "</td>"; }
 std::string TdNum(const std::string& html) { return "<td class=\"num\">" + html + "</td>"; }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
 #include "plumb/report/html_report.h"
 #include "plumb/report/version.h"
 
@@ -14,19 +16,10 @@ namespace {
 /// scale and cross terms come first in the base model; combinations when one pose).
 constexpr std::size_t kHeadline = 4;
 
-std::string Num(double v) {
-  if (!std::isfinite(v)) return "NaN";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
-}
+std::string CsvValue(double v) { return std::isfinite(v) ? Number(v, 10) : "NaN"; }
 
-std::string Short(double v, const char* format = "%.3g") {
-  if (!std::isfinite(v)) return "n/a";
-  char b[40];
-  std::snprintf(b, sizeof b, format, v);
-  return b;
-}
+/// `v` with 3 decimals ("%.3f"), "n/a" when not finite.
+std::string Short(double v) { return std::isfinite(v) ? FixedText(v, 3) : "n/a"; }
 
 /// The points along factor f: every other factor at the first point's value, sorted by f.
 std::vector<const study::PointSummary*> Along(const std::vector<study::PointSummary>& points,
@@ -56,8 +49,8 @@ std::string Safe(const std::string& name) {
 std::string NeesCells(double per_dof, int dof, double low, double high) {
   if (dof <= 0) return "<td class=\"num\">n/a</td><td></td>";
   const bool outside = per_dof > high || per_dof < low;
-  return "<td class=\"num" + std::string(outside ? " warn" : "") + "\">" + Short(per_dof, "%.3f") +
-         "</td><td class=\"num\">" + Short(low, "%.3f") + " .. " + Short(high, "%.3f") + "</td>";
+  return "<td class=\"num" + std::string(outside ? " warn" : "") + "\">" + Short(per_dof) +
+         "</td><td class=\"num\">" + Short(low) + " .. " + Short(high) + "</td>";
 }
 
 }  // namespace
@@ -77,8 +70,8 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
                                       [](const auto* p) { return std::isfinite(p->nees_per_dof); });
     std::string nees = "value,nees_per_dof,low,high\n";
     for (const auto* p : along) {
-      nees += Num(p->point.values[f]) + "," + Num(p->nees_per_dof) + "," + Num(p->nees_low) + "," +
-              Num(p->nees_high) + "\n";
+      nees += CsvValue(p->point.values[f]) + "," + CsvValue(p->nees_per_dof) + "," + CsvValue(p->nees_low) + "," +
+              CsvValue(p->nees_high) + "\n";
     }
     if (any_nees) job.data.push_back({"nees_" + safe + ".csv", nees});
     if (any_nees) job.script += "set output 'nees_" + safe + ".svg'\nset logscale y\nset xlabel " +
@@ -95,11 +88,11 @@ GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::Poin
     for (std::size_t i = 0; i < rows; ++i) err += ",rms" + std::to_string(i) + ",sigma" + std::to_string(i);
     err += "\n";
     for (const auto* p : along) {
-      err += Num(p->point.values[f]);
+      err += CsvValue(p->point.values[f]);
       for (std::size_t i = 0; i < rows; ++i) {
         const bool has = i < p->parameters.size();
-        err += "," + Num(has ? p->parameters[i].rms_error : NAN) + "," +
-               Num(has ? p->parameters[i].mean_sigma : NAN);
+        err += "," + CsvValue(has ? p->parameters[i].rms_error : NAN) + "," +
+               CsvValue(has ? p->parameters[i].mean_sigma : NAN);
       }
       err += "\n";
     }
@@ -155,12 +148,12 @@ std::string StudyPage(const study::Study& study, const std::vector<study::PointS
   for (const study::PointSummary& p : points) {
     const bool outside = p.nees_dof > 0 && (p.nees_per_dof > p.nees_high || p.nees_per_dof < p.nees_low);
     html += "<tr><td class=\"num\">" + std::to_string(p.point.index) + "</td>";
-    for (double v : p.point.values) html += "<td class=\"num\">" + Short(v, "%.6g") + "</td>";
+    for (double v : p.point.values) html += "<td class=\"num\">" + (std::isfinite(v) ? Number(v) : std::string("n/a")) + "</td>";
     html += "<td class=\"num\">" + std::to_string(p.runs) + "</td><td class=\"num\">" +
             std::to_string(p.failed) + "</td><td class=\"num\">" + std::to_string(p.flagged) +
             "</td><td class=\"num" + std::string(outside ? " warn" : "") + "\">" +
-            (p.nees_dof > 0 ? Short(p.nees_per_dof, "%.3f") : "n/a") + "</td><td class=\"num\">" +
-            (p.nees_dof > 0 ? Short(p.nees_low, "%.3f") + " .. " + Short(p.nees_high, "%.3f") : "") +
+            (p.nees_dof > 0 ? Short(p.nees_per_dof) : "n/a") + "</td><td class=\"num\">" +
+            (p.nees_dof > 0 ? Short(p.nees_low) + " .. " + Short(p.nees_high) : "") +
             "</td>" + NeesCells(p.nees_unflagged_per_dof, p.nees_unflagged_dof, p.nees_unflagged_low,
                                 p.nees_unflagged_high) +
             "</tr>\n";

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/elimination.h"
@@ -348,8 +349,8 @@ sim::Schedule TemplateSchedule(const nlohmann::json& doc, const std::string& pat
   std::vector<Hold> holds;
   const nlohmann::json* segments = doc.is_object() && doc.contains("segments") ? &doc.at("segments") : nullptr;
   if (segments == nullptr || !segments->is_array() || segments->size() < 2) {
-    throw InputError(path, "key 'segments'", "a session template needs the still segments of "
-                                             "'plumb calibrate --json' (2 or more)");
+    throw InputError(path, "key 'segments'", "a session template needs the still segments of " +
+                                             OptionText(Option::kCalibrationJson) + " (2 or more)");
   }
   for (std::size_t k = 0; k < segments->size(); ++k) {
     const nlohmann::json& seg = segments->at(k);

@@ -9,6 +9,7 @@
 
 #include "plumb/core/datasheet_level.h"
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 
 namespace plumb::study {
 namespace {
@@ -119,8 +120,8 @@ void ReadBase(const json& b, const std::string& path, Base& base) {
   }
   if ((base.schedule == "session") != !base.template_path.empty()) {
     throw InputError(path, "key 'base.template'",
-                     "the session schedule takes a template (a 'plumb calibrate --json' file), "
-                     "and only it");
+                     "the session schedule takes a template (a " +
+                         OptionText(Option::kCalibrationJson) + " file), and only it");
   }
   if (base.sensor != "typical" && base.sensor != "white") {
     throw InputError(path, "key 'base.sensor'", "expected typical or white");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/io/common/text_scan.h"
 
 namespace plumb::io {
@@ -293,8 +294,8 @@ class TableParser {
     if (!o_.allow_nan_rows) {
       throw InputError(file_, Where(line_no),
                        ColumnLabel(static_cast<std::size_t>(field_of_slot_[slot])) +
-                           ": NaN or infinite value; expected a finite number (to skip such rows: "
-                           "plumb --drop-nan, or TextTableOptions::allow_nan_rows)");
+                           ": NaN or infinite value; expected a finite number (to skip such rows: " +
+                           OptionText(Option::kDropNan) + ")");
     }
     if (skipped_++ == 0) first_skipped_line_ = line_no;
   }
