@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "plumb/core/error.h"
+#include "plumb/core/option_name.h"
 #include "plumb/correction/calibration_file.h"
 #include "plumb/peers/plumb_result.h"
 #include "plumb/report/json_report.h"
@@ -181,8 +182,8 @@ TEST(CalibrationDocument, BadDocumentsAreRefusedNamingTheFileAndTheKey) {
   doc = Small();
   doc.erase("model_reference");
   EXPECT_EQ(Refusal([&] { correction::ReadCalibrationFile(doc, "c.json"); }),
-            "c.json:key 'model_reference': missing: not a calibration written by 'plumb "
-            "calibrate --json'");
+            "c.json:key 'model_reference': missing: not a calibration written by " +
+                OptionText(Option::kCalibrationJson));
   doc = Small();
   doc.erase("accel");
   EXPECT_EQ(CompareRefusal(doc),
@@ -202,7 +203,8 @@ TEST(CalibrationDocument, BadDocumentsAreRefusedNamingTheFileAndTheKey) {
   EXPECT_EQ(Refusal([&] { correction::ReadCalibrationFile(doc, "c.json"); }), "");
   // Not an object.
   EXPECT_EQ(Refusal([] { ReadCalibrationDocument(json::array(), "c.json"); }),
-            "c.json: expected the JSON object that 'plumb calibrate --json' writes");
+            "c.json: expected the JSON object that " + OptionText(Option::kCalibrationJson) +
+                " writes");
 }
 
 }  // namespace

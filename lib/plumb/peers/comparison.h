@@ -40,7 +40,7 @@ struct GravityNormComparison {
   bool available = false;
   std::string unavailable_reason;  ///< why not, when not available
   double gravity_m_s2 = 0.0;       ///< g of the cost, m/s^2
-  std::string gravity_source;      ///< "--gravity" or "the result's site.gravity"
+  std::string gravity_source;      ///< the option giving g (OptionText) or "the result's site.gravity"
   int segments = 0;                ///< still segments in plumb's result
   ImuTkCost plumb_means;           ///< plumb's calibration, one residual per segment mean
   ImuTkCost peer_means;            ///< the peer's calibration, the same
