@@ -15,7 +15,7 @@ PlumbResult SmallPlumbResult() {
   PlumbResult r;
   r.path = "result.json";
   r.method = "generalized";
-  r.model = "base+gyro_bias_drift";
+  r.model_spec = "base+gyro_bias_drift";
   r.accel_matrix = 400.0 * Mat3::Identity();
   r.accel_bias = Vec3::Constant(32000.0);
   r.has_gyro = true;

@@ -36,7 +36,7 @@ TEST(PlumbResult, ReadsTheKeysAComparisonNeeds) {
   const TempFolder dir;
   const PlumbResult r = ReadPlumbResult(dir.Write("r.json", SmallResult().dump(2)));
   EXPECT_EQ(r.method, "generalized");
-  EXPECT_EQ(r.model, "base");
+  EXPECT_EQ(r.model_spec, "base");
   EXPECT_EQ(r.accel_matrix(0, 1), 0.1);
   EXPECT_EQ(r.accel_matrix(1, 2), 0.2);
   EXPECT_EQ(r.accel_bias, Vec3(1, 2, 3));

@@ -280,7 +280,7 @@ Comparison Compare(const PlumbResult& result, const ForwardCalibration& peer,
   Comparison c;
   c.result_path = result.path;
   c.method = result.method;
-  c.model = result.model;
+  c.model = result.model_spec;
   c.chi2_dof = result.chi2_dof;
   c.dof = result.dof;
   c.peer = peer;

@@ -26,34 +26,14 @@ using PlumbParameter = document::DocumentParameter;
 using PlumbCombination = document::DocumentCombination;
 using PlumbStillSegment = document::DocumentSegment;
 
-struct PlumbResult {
-  std::string path;    ///< the file read
-  std::string method;  ///< "generalized", ...
-  std::string model;   ///< model spec, e.g. "base"
-  Mat3 accel_matrix = Mat3::Identity();  ///< F, output units per m/s^2
+/// The document (every key the one reader read, as it read them) with "accel" required and
+/// both sensors' matrices at hand, as the comparisons use them.
+struct PlumbResult : document::CalibrationDocument {
+  Mat3 accel_matrix = Mat3::Identity();  ///< F, output units per m/s^2 (accel->matrix)
   Vec3 accel_bias = Vec3::Zero();        ///< b_a, output units
-  bool has_gyro = false;
-  Mat3 gyro_matrix = Mat3::Identity();   ///< E, output units per rad/s
+  bool has_gyro = false;                 ///< "gyro" given
+  Mat3 gyro_matrix = Mat3::Identity();   ///< E, output units per rad/s (gyro->matrix)
   Vec3 gyro_bias = Vec3::Zero();         ///< b_g, output units
-  std::vector<PlumbParameter> parameters;
-  std::vector<PlumbStillSegment> segments;  ///< empty when the file has no segment means
-  double gravity_m_s2 = 0.0;     ///< site.gravity, m/s^2; 0 when absent
-  std::string site_source;       ///< "gps", "flags" or "none"
-  double chi2_dof = 0.0;         ///< fit.chi2_dof; NaN when null
-  long dof = 0;                  ///< fit.dof
-  /// noise.accel: per-sample standard deviation of the accelerometer, output units; NaN when
-  /// absent or not three numbers.
-  Vec3 noise_accel = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-  std::vector<std::string> inputs;  ///< the data files plumb read
-  /// "covariance": the parameters it is over, in order, and the matrix (units of the
-  /// parameters squared); both empty when the file has none.
-  std::vector<std::string> covariance_names;
-  Eigen::MatrixXd covariance;
-  bool sigma_scaled_by_chi2 = false;  ///< covariance.sigma_scaled_by_chi2
-  /// "observability.determined", and their covariance ("covariance.determined.matrix", in
-  /// their order; empty when absent).
-  std::vector<PlumbCombination> determined;
-  Eigen::MatrixXd determined_covariance;
 };
 
 /// Reads the JSON document (document::ReadCalibrationDocumentFile). Throws plumb::InputError

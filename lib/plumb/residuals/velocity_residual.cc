@@ -12,7 +12,6 @@
 #include "plumb/core/so3.h"
 #include "plumb/model/effects/accel_linear.h"
 #include "plumb/model/effects/gyro_linear.h"
-#include "plumb/residuals/corrected_rates.h"
 #include "plumb/residuals/motion_residual.h"
 #include "plumb/residuals/strapdown.h"
 
@@ -22,7 +21,8 @@ VelocityResidual::VelocityResidual(const model::Model& model, SharedMotionSample
                                    const Vec3& g_n, const Vec3& omega_ie_n,
                                    const Vec3& sqrt_info, int accel_wander, int gyro_wander)
     : model_(&model), samples_(std::move(samples)), s_(*samples_), g_n_(g_n), omega_ie_n_(omega_ie_n),
-      sqrt_info_(sqrt_info), accel_wander_(accel_wander), gyro_wander_(gyro_wander) {}
+      sqrt_info_(sqrt_info), accel_wander_(accel_wander), gyro_wander_(gyro_wander),
+      columns_(model) {}
 
 namespace {
 
@@ -183,9 +183,11 @@ class LinearlyCorrected {
     Vec3 f, w;  ///< m/s^2 and rad/s, body frame
     double u;   ///< fraction of the motion, the wander line's weight
   };
-  LinearlyCorrected(const model::Model& model, const MotionSamples& s, const LinearStage& stage,
-                    const WanderLine& acc_wander, const WanderLine& gyr_wander)
-      : model_(model), stage_(stage), layout_(model), columns_(layout_.parameters),
+  /// `layout`: the model's columns (VelocityResidual's, made once).
+  LinearlyCorrected(const model::Model& model, const ModelColumns& layout, const MotionSamples& s,
+                    const LinearStage& stage, const WanderLine& acc_wander,
+                    const WanderLine& gyr_wander)
+      : model_(model), stage_(stage), layout_(layout), columns_(layout_.parameters),
         a_term_(model.BaseTerm(model::Sensor::kAccel)),
         g_term_(model.BaseTerm(model::Sensor::kGyro)) {
     const std::size_t n = s.size();
@@ -229,7 +231,7 @@ class LinearlyCorrected {
  private:
   const model::Model& model_;
   const LinearStage& stage_;
-  ModelColumns layout_;
+  const ModelColumns& layout_;
   VelocityColumns columns_;
   int a_term_, g_term_;
   std::vector<Sample> samples_;
@@ -241,7 +243,7 @@ void VelocityResidual::EvaluateLinear(double const* const* parameters, double* r
                                       double** jacobians) const {
   const LinearStage stage(*model_, parameters);
   double const* const* wander = parameters + 1 + model_->num_terms();
-  const LinearlyCorrected x(*model_, s_, stage, WanderEnds(wander, accel_wander_),
+  const LinearlyCorrected x(*model_, columns_, s_, stage, WanderEnds(wander, accel_wander_),
                             WanderEnds(wander + 2 * accel_wander_, gyro_wander_));
   const VelocityColumns& cols = x.columns();
   const std::size_t n = s_.size();

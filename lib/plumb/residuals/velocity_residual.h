@@ -46,6 +46,7 @@
 #include <memory>
 
 #include "plumb/model/model.h"
+#include "plumb/residuals/corrected_rates.h"
 #include "plumb/residuals/measurements.h"
 
 namespace plumb::residuals {
@@ -100,6 +101,7 @@ class VelocityResidual {
   const MotionSamples& s_;
   Vec3 g_n_, omega_ie_n_, sqrt_info_;
   int accel_wander_ = 0, gyro_wander_ = 0;  // wander processes; their block pairs follow the model's
+  ModelColumns columns_;  // where each model block sits among the P parameters
 };
 
 }  // namespace plumb::residuals
