@@ -1,5 +1,5 @@
 // An effect of one's own, added without touching the library (docs/extending.md, way (a)):
-// accel_scale_temperature.cc is compiled into this program and registered with one line at
+// accel_scale_temperature.h is included in this program and registered with one line at
 // the top of main(). Then
 //   - the invariant battery of every built-in effect (tests/support/effect_battery.h) runs on
 //     it;
@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include "accel_scale_temperature.h"
+#include "plumb/autodiff/differentiable_effect.h"
 #include "plumb/core/error.h"
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/estimation/calibrator.h"
@@ -36,12 +38,6 @@
 #include "plumb/report/diagnosis_text.h"
 #include "support/effect_battery.h"
 
-// The factory that PLUMB_DEFINE_EFFECT(accel_scale_temperature, ...) defines in
-// accel_scale_temperature.cc. (For a built-in effect the registration list generated from
-// effects.cmake declares it.)
-namespace plumb::model::effects {
-std::unique_ptr<Effect> Make_accel_scale_temperature(const std::string& option);
-}  // namespace plumb::model::effects
 
 namespace plumb {
 namespace {
@@ -67,8 +63,7 @@ TEST(AccelScaleTemperature, IsInTheRegistryAndInModelSpecs) {
   const auto params = m.ParameterNames();
   EXPECT_EQ(params.back(), "accel_scale_temperature.s.z");
   EXPECT_THROW(registry.Make("accel_scale_temperature", "2"), Error);  // takes no option
-  EXPECT_THROW(model::Registry::Global().Register("accel_scale_temperature",
-                                                  &model::effects::Make_accel_scale_temperature),
+  EXPECT_THROW(autodiff::RegisterEffect<model::AccelScaleTemperature>("accel_scale_temperature"),
                Error);  // a name is registered once
 }
 
@@ -256,8 +251,7 @@ TEST(ScaleTemperatureSession, DiagnoseRanksTheUserEffectFirst) {
 int main(int argc, char** argv) {
   // The one registration line of way (a): a program of your own adds its effect to the
   // process-wide catalogue before it parses a model spec.
-  plumb::model::Registry::Global().Register("accel_scale_temperature",
-                                            &plumb::model::effects::Make_accel_scale_temperature);
+  plumb::autodiff::RegisterEffect<plumb::model::AccelScaleTemperature>("accel_scale_temperature");
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
 }

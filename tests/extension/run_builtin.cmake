@@ -2,11 +2,12 @@
 # takes one new file in lib/plumb/model/effects/ and one line in effects/effects.cmake.
 #
 # A throwaway source tree gets verbatim copies of cmake/PlumbHelpers.cmake, lib/plumb/core,
-# lib/plumb/model, tests/model/effects_test.cc and tests/support/effect_battery.h, plus a
+# lib/plumb/model, lib/plumb/autodiff (the effects' Jet forms, generated from the same list),
+# tests/model/effects_test.cc and tests/support/effect_battery.h, plus a
 # small top-level project (PROJECT_TEMPLATE_DIR). Then exactly two edits are made:
 #   1. EFFECT_FILE is copied into lib/plumb/model/effects/;
 #   2. the line `accel_scale_temperature` is added to lib/plumb/model/effects/effects.cmake.
-# The tree is configured and built with the library's own lib/plumb/model/CMakeLists.txt,
+# The tree is configured and built with the library's own CMakeLists.txt of those modules,
 # and must then
 #   - list the effect in the generated registration list (effect_list.inc);
 #   - make it by name from Registry::Global() and parse it in a model spec (builtin_check);
@@ -29,6 +30,7 @@ endfunction()
 # The library as it is.
 file(COPY ${PLUMB_SOURCE_DIR}/cmake/PlumbHelpers.cmake DESTINATION ${src}/cmake)
 file(COPY ${PLUMB_SOURCE_DIR}/lib/plumb/core ${PLUMB_SOURCE_DIR}/lib/plumb/model
+          ${PLUMB_SOURCE_DIR}/lib/plumb/autodiff
      DESTINATION ${src}/lib/plumb)
 file(COPY ${PLUMB_SOURCE_DIR}/tests/model/effects_test.cc DESTINATION ${src}/tests/model)
 file(COPY ${PLUMB_SOURCE_DIR}/tests/support/effect_battery.h DESTINATION ${src}/tests/support)

@@ -3,9 +3,10 @@
 //
 //   ZeroParametersAreTheIdentity          an all-zero block changes no prediction;
 //   CorrectInvertsPredict                 Model::Correct undoes Model::Predict (1e-9 relative);
-//   JetPredictionAndDerivativeMatchDoubles  the Jet value equals the double one and the Jet
-//                                         derivative of every parameter matches a central
-//                                         difference (1e-6 relative);
+//   JetPredictionAndDerivativeMatchDoubles  the effect's Jet form (plumb::autodiff) gives the
+//                                         double value, and the Jet derivative of every
+//                                         parameter matches a central difference (1e-6
+//                                         relative);
 //   InfoIsComplete                        name, prefix, term, excitation, units, typical > 0,
 //                                         unique parameter names;
 //   EveryParameterChangesAnExcitedPrediction  no parameter is a silent no-op.
@@ -19,7 +20,8 @@
 //                            ::testing::Values(plumb::testing::EffectCase{"my_effect", ""}),
 //                            plumb::testing::EffectCaseName);
 //
-// The effect must be registered (Registry::Global()) before the tests run.
+// The effect must be registered (Registry::Global(), with its Jet form: a program's own effect
+// through plumb::autodiff::RegisterEffect) before the tests run.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -35,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/autodiff/differentiable_effect.h"
 #include "plumb/model/model.h"
 
 namespace plumb::testing {
@@ -99,27 +102,27 @@ inline Eigen::Matrix<double, 6, 1> Stack(const model::SensorOutput<double>& out)
   return y;
 }
 
-inline model::SensorInput<model::Jet> ToJet(const model::SensorInput<double>& in) {
-  model::SensorInput<model::Jet> j;
-  j.f_b = in.f_b.cast<model::Jet>();
-  j.omega_b = in.omega_b.cast<model::Jet>();
-  j.alpha_b = in.alpha_b.cast<model::Jet>();
-  j.dt_s = model::Jet(in.dt_s);
-  j.dtemp_c = model::Jet(in.dtemp_c);
-  j.R_b_n = in.R_b_n.cast<model::Jet>();
+inline model::SensorInput<autodiff::Jet> ToJet(const model::SensorInput<double>& in) {
+  model::SensorInput<autodiff::Jet> j;
+  j.f_b = in.f_b.cast<autodiff::Jet>();
+  j.omega_b = in.omega_b.cast<autodiff::Jet>();
+  j.alpha_b = in.alpha_b.cast<autodiff::Jet>();
+  j.dt_s = autodiff::Jet(in.dt_s);
+  j.dtemp_c = autodiff::Jet(in.dtemp_c);
+  j.R_b_n = in.R_b_n.cast<autodiff::Jet>();
   return j;
 }
 
 /// Jet-valued blocks equal to theta, with the infinitesimals seeded on parameters
 /// [first, first + kJetStride) of block `seeded`.
-inline std::vector<std::vector<model::Jet>> SeededJets(const model::ParameterBlocks& theta,
+inline std::vector<std::vector<autodiff::Jet>> SeededJets(const model::ParameterBlocks& theta,
                                                        std::size_t seeded, std::size_t first) {
-  std::vector<std::vector<model::Jet>> blocks;
+  std::vector<std::vector<autodiff::Jet>> blocks;
   for (std::size_t k = 0; k < theta.size(); ++k) {
-    std::vector<model::Jet> block;
+    std::vector<autodiff::Jet> block;
     for (std::size_t i = 0; i < theta[k].size(); ++i) {
-      model::Jet v(theta[k][i]);
-      if (k == seeded && i >= first && i < first + model::kJetStride) {
+      autodiff::Jet v(theta[k][i]);
+      if (k == seeded && i >= first && i < first + autodiff::kJetStride) {
         v.v[static_cast<int>(i - first)] = 1.0;
       }
       block.push_back(v);
@@ -129,12 +132,12 @@ inline std::vector<std::vector<model::Jet>> SeededJets(const model::ParameterBlo
   return blocks;
 }
 
-inline model::SensorOutput<model::Jet> PredictJet(
-    const model::Model& m, const std::vector<std::vector<model::Jet>>& blocks,
-    const model::SensorInput<model::Jet>& in) {
-  std::vector<const model::Jet*> ptr;
+inline model::SensorOutput<autodiff::Jet> PredictJet(
+    const model::Model& m, const std::vector<std::vector<autodiff::Jet>>& blocks,
+    const model::SensorInput<autodiff::Jet>& in) {
+  std::vector<const autodiff::Jet*> ptr;
   for (const auto& b : blocks) ptr.push_back(b.data());
-  return m.Predict<model::Jet>(ptr.data(), in);
+  return autodiff::DifferentiableModel(m).Predict(ptr.data(), in);
 }
 
 /// Index of the case's term in ModelWith(case).
@@ -172,9 +175,9 @@ TEST_P(EffectInvariants, JetPredictionAndDerivativeMatchDoubles) {
   const model::ParameterBlocks theta = RandomBlocks(m, 1.0, rng);
   const model::SensorInput<double> in = ExcitedInput();
   const auto y = Stack(m.Predict(theta, in));
-  for (std::size_t first = 0; first < theta[k].size(); first += model::kJetStride) {
+  for (std::size_t first = 0; first < theta[k].size(); first += autodiff::kJetStride) {
     const auto jet_out = PredictJet(m, SeededJets(theta, k, first), ToJet(in));
-    const std::size_t last = std::min(theta[k].size(), first + model::kJetStride);
+    const std::size_t last = std::min(theta[k].size(), first + autodiff::kJetStride);
     for (std::size_t i = first; i < last; ++i) {
       // Central difference with a step of 1e-3 of the typical size.
       const double h = 1e-3 * m.terms()[k].effect->info().parameters[i].typical;
@@ -184,7 +187,7 @@ TEST_P(EffectInvariants, JetPredictionAndDerivativeMatchDoubles) {
       const Eigen::Matrix<double, 6, 1> numeric =
           (Stack(m.Predict(plus, in)) - Stack(m.Predict(minus, in))) / (2 * h);
       for (int r = 0; r < 6; ++r) {
-        const model::Jet& yr = r < 3 ? jet_out.acc(r) : jet_out.gyr(r - 3);
+        const autodiff::Jet& yr = r < 3 ? jet_out.acc(r) : jet_out.gyr(r - 3);
         EXPECT_NEAR(yr.a, y(r), 1e-12 * (1.0 + std::abs(y(r)))) << "output " << r;
         const double analytic = yr.v[static_cast<int>(i - first)];
         EXPECT_NEAR(analytic, numeric(r), 1e-6 * (1.0 + std::abs(numeric(r))))

@@ -61,7 +61,7 @@ struct Predictor {
     for (const auto& b : fit.calibration.theta) blocks.push_back(b.data());
   }
   model::SensorOutput<double> operator()(const model::SensorInput<double>& in) const {
-    return model->Predict<double>(blocks.data(), in);
+    return model->Predict(blocks.data(), in);
   }
   const model::Model* model;
   std::vector<const double*> blocks;

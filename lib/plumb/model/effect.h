@@ -10,12 +10,18 @@
 // all-zero value means "no effect" (for the linear effects: F = I, b = 0), so every effect is
 // the identity at zero, as basalt's calib_bias.hpp is.
 //
+// An effect's term is a template on the scalar, as basalt's types are: the model evaluates it on
+// doubles (the simulator, the correction, the reports), and the fit's residuals on Ceres Jets
+// (plumb/autodiff/differentiable_effect.h instantiates the same Term for Jets). This module
+// itself knows no Jet and no Ceres.
+//
 // Writing an effect (worked example, see docs/extending.md and tests/model/effects_test.cc):
 //
-//   // lib/plumb/model/effects/accel_bias_drift.cc
+//   // lib/plumb/model/effects/accel_bias_drift.h
 //   class AccelBiasDrift : public EffectBase<AccelBiasDrift> {
 //    public:
-//     explicit AccelBiasDrift(const std::string& option) : EffectBase(MakeInfo(option)) {}
+//     explicit AccelBiasDrift(const std::string& option)
+//         : EffectBase(accel_bias_drift::Describe(option)) {}
 //     template <typename T>
 //     void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
 //       Eigen::Map<const Vec3T<T>> d_a(theta);   // m/s^3
@@ -25,10 +31,9 @@
 //   PLUMB_DEFINE_EFFECT(accel_bias_drift, ::plumb::model::AccelBiasDrift)
 //
 // and one line `accel_bias_drift` in lib/plumb/model/effects/effects.cmake. The effect then
-// appears in `plumb calibrate --model base+accel_bias_drift`, in the simulator and in diagnose.
+// appears in model specs ("base+accel_bias_drift"), in the simulator, in the fit and in
+// diagnose.
 #pragma once
-
-#include <ceres/jet.h>
 
 #include <memory>
 #include <string>
@@ -37,10 +42,6 @@
 #include "plumb/core/types.h"
 
 namespace plumb::model {
-
-/// Jet width used by every dynamic autodiff cost function in plumb (see residuals/).
-inline constexpr int kJetStride = 8;
-using Jet = ceres::Jet<double, kJetStride>;
 
 enum class Sensor { kAccel, kGyro };
 
@@ -131,7 +132,7 @@ struct SensorOutput {
 };
 
 /// Interface of an effect. Implement it through EffectBase<Derived> (CRTP) with one templated
-/// `Term<T>()`, which gives both the double and the Jet overloads.
+/// `Term<T>()`: the model calls it on doubles through Apply, and plumb::autodiff on Jets.
 class Effect {
  public:
   explicit Effect(EffectInfo info) : info_(std::move(info)) {}
@@ -145,13 +146,15 @@ class Effect {
   /// every pass (residuals/motion_residual.h), so the built-in ones do not.
   virtual void Apply(const double* theta, const SensorInput<double>& in,
                      SensorOutput<double>& out) const = 0;
-  virtual void Apply(const Jet* theta, const SensorInput<Jet>& in,
-                     SensorOutput<Jet>& out) const = 0;
 
  private:
   EffectInfo info_;
 };
 
+/// The base of every effect: `Derived` has
+///   template <typename T>
+///   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const;
+/// written once for every scalar (docs/extending.md says what that asks of the code).
 template <class Derived>
 class EffectBase : public Effect {
  public:
@@ -160,20 +163,23 @@ class EffectBase : public Effect {
              SensorOutput<double>& out) const final {
     static_cast<const Derived*>(this)->Term(theta, in, out);
   }
-  void Apply(const Jet* theta, const SensorInput<Jet>& in, SensorOutput<Jet>& out) const final {
-    static_cast<const Derived*>(this)->Term(theta, in, out);
-  }
 };
 
 using EffectFactory = std::unique_ptr<Effect> (*)(const std::string& option);
 
-/// Defines the factory that the generated registration list refers to. `option` is the text
-/// after ':' in a model spec (e.g. "2" in accel_temperature_bias:2), empty when absent.
-#define PLUMB_DEFINE_EFFECT(NAME, CLASS)                                          \
-  namespace plumb::model::effects {                                               \
-  std::unique_ptr<::plumb::model::Effect> Make_##NAME(const std::string& option) { \
-    return std::make_unique<CLASS>(option);                                       \
-  }                                                                               \
+/// The factory of effect class `E`: `option` is the text after ':' in a model spec (e.g. "2" in
+/// accel_temperature_bias:2), empty when absent.
+template <class E>
+std::unique_ptr<Effect> MakeEffect(const std::string& option) {
+  return std::make_unique<E>(option);
+}
+
+/// Names the class of a built-in effect for the registration lists generated from
+/// effects/effects.cmake: plumb::model::effects::NAME is CLASS. The model's catalogue
+/// (registry.cc) makes it by NAME, plumb::autodiff gives it its Jet form.
+#define PLUMB_DEFINE_EFFECT(NAME, CLASS) \
+  namespace plumb::model::effects {      \
+  using NAME = CLASS;                    \
   }
 
 /// Per-axis parameter helper: {"<stem>.x", "<stem>.y", "<stem>.z"}.

@@ -217,23 +217,21 @@ bool Model::AtLinearStage(const double* const* theta) const {
   return true;
 }
 
-template <typename T>
-SensorOutput<T> Model::Predict(const T* const* theta, const SensorInput<T>& in) const {
-  SensorOutput<T> out;
+SensorOutput<double> Model::Predict(const double* const* theta,
+                                    const SensorInput<double>& in) const {
+  SensorOutput<double> out;
   for (std::size_t i = 0; i < terms_.size(); ++i) terms_[i].effect->Apply(theta[i], in, out);
   return out;
 }
 
-template <typename T>
-std::pair<Vec3T<T>, Vec3T<T>> Model::Correct(const T* const* theta, const Vec3T<T>& y_a,
-                                             const Vec3T<T>& y_g, SensorInput<T> in,
-                                             const Mat3T<T>& F_inv, const Mat3T<T>& E_inv,
-                                             int steps) const {
+std::pair<Vec3, Vec3> Model::Correct(const double* const* theta, const Vec3& y_a,
+                                     const Vec3& y_g, SensorInput<double> in, const Mat3& F_inv,
+                                     const Mat3& E_inv, int steps) const {
   const bool gyro = has_gyro();
   in.f_b.setZero();
   in.omega_b.setZero();
   for (int it = 0; it < steps; ++it) {
-    const SensorOutput<T> out = Predict(theta, in);
+    const SensorOutput<double> out = Predict(theta, in);
     // Newton step with the linear part's Jacobian (exact when all terms are additive and
     // independent of the inputs; the others converge at the rate of their size).
     in.f_b += F_inv * (y_a - out.acc);
@@ -242,13 +240,12 @@ std::pair<Vec3T<T>, Vec3T<T>> Model::Correct(const T* const* theta, const Vec3T<
   return {in.f_b, in.omega_b};
 }
 
-template <typename T>
-std::pair<Vec3T<T>, Vec3T<T>> Model::Correct(const T* const* theta, const Vec3T<T>& y_a,
-                                             const Vec3T<T>& y_g, SensorInput<T> in,
-                                             int iterations) const {
+std::pair<Vec3, Vec3> Model::Correct(const double* const* theta, const Vec3& y_a,
+                                     const Vec3& y_g, SensorInput<double> in,
+                                     int iterations) const {
   // F and E are written by the linear stage whatever the inputs.
-  const SensorOutput<T> linear = Predict(theta, SensorInput<T>());
-  return Correct(theta, y_a, y_g, in, Mat3T<T>(linear.F.inverse()), Mat3T<T>(linear.E.inverse()),
+  const SensorOutput<double> linear = Predict(theta, SensorInput<double>());
+  return Correct(theta, y_a, y_g, in, Mat3(linear.F.inverse()), Mat3(linear.E.inverse()),
                  iterations + 1);
 }
 
@@ -277,14 +274,14 @@ SensorOutput<double> Model::Predict(const ParameterBlocks& theta,
                                     const SensorInput<double>& in) const {
   std::vector<const double*> ptr;
   for (const auto& b : theta) ptr.push_back(b.data());
-  return Predict<double>(ptr.data(), in);
+  return Predict(ptr.data(), in);
 }
 
 std::pair<Vec3, Vec3> Model::Correct(const ParameterBlocks& theta, const Vec3& y_a,
                                      const Vec3& y_g, const SensorInput<double>& in) const {
   std::vector<const double*> ptr;
   for (const auto& b : theta) ptr.push_back(b.data());
-  return Correct<double>(ptr.data(), y_a, y_g, in);
+  return Correct(ptr.data(), y_a, y_g, in);
 }
 
 std::vector<double> ReportedValues(const Model& model, const ParameterBlocks& theta) {
@@ -298,21 +295,5 @@ std::vector<double> ReportedValues(const Model& model, const ParameterBlocks& th
   }
   return values;
 }
-
-template SensorOutput<double> Model::Predict<double>(const double* const*,
-                                                     const SensorInput<double>&) const;
-template SensorOutput<Jet> Model::Predict<Jet>(const Jet* const*, const SensorInput<Jet>&) const;
-template std::pair<Vec3, Vec3> Model::Correct<double>(const double* const*, const Vec3&,
-                                                      const Vec3&, SensorInput<double>, int) const;
-template std::pair<Vec3T<Jet>, Vec3T<Jet>> Model::Correct<Jet>(const Jet* const*,
-                                                              const Vec3T<Jet>&,
-                                                              const Vec3T<Jet>&,
-                                                              SensorInput<Jet>, int) const;
-template std::pair<Vec3, Vec3> Model::Correct<double>(const double* const*, const Vec3&,
-                                                      const Vec3&, SensorInput<double>,
-                                                      const Mat3&, const Mat3&, int) const;
-template std::pair<Vec3T<Jet>, Vec3T<Jet>> Model::Correct<Jet>(
-    const Jet* const*, const Vec3T<Jet>&, const Vec3T<Jet>&, SensorInput<Jet>,
-    const Mat3T<Jet>&, const Mat3T<Jet>&, int) const;
 
 }  // namespace plumb::model

@@ -84,27 +84,22 @@ class Model {
   /// y_g = E omega + b_g, and its inverse and derivatives have closed forms.
   bool AtLinearStage(const double* const* theta) const;
 
-  /// Forward model: predicted outputs for the true inputs. `theta[i]` is block i.
-  /// Defined for T = double and T = Jet.
-  template <typename T>
-  SensorOutput<T> Predict(const T* const* theta, const SensorInput<T>& in) const;
+  /// Forward model: predicted outputs for the true inputs. `theta[i]` is block i. (On Jets:
+  /// plumb::autodiff::DifferentiableModel.)
+  SensorOutput<double> Predict(const double* const* theta, const SensorInput<double>& in) const;
 
   /// Inverse model: the true specific force and angular rate that produce measured y_a, y_g,
   /// by Newton iterations on the forward model started from the linear inverse. `in` supplies
   /// the other inputs (time, temperature, angular acceleration); its f_b and omega_b are
   /// ignored. Without gyroscope terms, omega_b is returned as zero.
-  template <typename T>
-  std::pair<Vec3T<T>, Vec3T<T>> Correct(const T* const* theta, const Vec3T<T>& y_a,
-                                        const Vec3T<T>& y_g, SensorInput<T> in,
-                                        int iterations = 3) const;
+  std::pair<Vec3, Vec3> Correct(const double* const* theta, const Vec3& y_a, const Vec3& y_g,
+                                SensorInput<double> in, int iterations = 3) const;
 
   /// The same with the inverses of the linear part given (F^-1, E^-1, which do not depend on
   /// the inputs) and `steps` Newton steps, for callers that correct many samples.
-  template <typename T>
-  std::pair<Vec3T<T>, Vec3T<T>> Correct(const T* const* theta, const Vec3T<T>& y_a,
-                                        const Vec3T<T>& y_g, SensorInput<T> in,
-                                        const Mat3T<T>& F_inv, const Mat3T<T>& E_inv,
-                                        int steps) const;
+  std::pair<Vec3, Vec3> Correct(const double* const* theta, const Vec3& y_a, const Vec3& y_g,
+                                SensorInput<double> in, const Mat3& F_inv, const Mat3& E_inv,
+                                int steps) const;
 
   /// The same on doubles, Newton steps until a step moves f_b and omega_b by at most
   /// `tolerance` times their size (or 1e-300), at most `max_steps`: the fixed point

@@ -4,7 +4,7 @@
 
 #include "plumb/core/error.h"
 
-// Declarations of the built-in factories, generated from effects/effects.cmake.
+// The built-in effects' headers, generated from effects/effects.cmake.
 #include "plumb/model/effect_list.inc"
 
 namespace plumb::model {
@@ -19,7 +19,7 @@ std::vector<ParameterInfo> AxisParameters(const std::string& stem, const std::st
 Registry& Registry::Global() {
   static Registry* registry = [] {
     auto* r = new Registry;
-#define PLUMB_EFFECT(NAME) r->Register(#NAME, &effects::Make_##NAME);
+#define PLUMB_EFFECT(NAME) r->Register(#NAME, &MakeEffect<effects::NAME>);
 #include "plumb/model/effect_list.inc"
 #undef PLUMB_EFFECT
     return r;

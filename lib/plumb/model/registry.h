@@ -1,8 +1,10 @@
 // plumb/model/registry.h — the effect catalogue by name.
 //
 // Built-in effects are listed once in lib/plumb/model/effects/effects.cmake (one line each);
-// CMake compiles effects/<name>.cc and generates the registration list from that line.
-// Programs linking plumb can add their own effects at run time with Register().
+// CMake generates the registration list from that line and the effect's header
+// effects/<name>.h. Programs linking plumb can add their own effects at run time: Register()
+// makes them known to models; plumb::autodiff::RegisterEffect<Class>(name) does that and gives
+// them the Jet form a fit needs.
 #pragma once
 
 #include <memory>

@@ -71,7 +71,7 @@ TermReads ProbeTermReads(const model::Effect& effect) {
   return TermReads{moved(increment(stage)), moved(increment(summed))};
 }
 
-using Jet = model::Jet;
+using autodiff::Jet;
 
 /// The model's terms on Jets at the samples of one interval, for the implicit derivative of the
 /// corrected rates (RateCorrection::ImplicitRateJacobians): theta as Jets, constants with up to
@@ -85,7 +85,7 @@ class TermJets {
  public:
   /// `parameter_of`: per parameter of the P, its (term, index); `at_zero`: the model's output
   /// at zero input (its F and E). Every argument must outlive the object.
-  TermJets(const model::Model& model, double const* const* theta,
+  TermJets(const autodiff::DifferentiableModel& model, double const* const* theta,
            const std::vector<std::pair<int, int>>& parameter_of, bool terms_split,
            const model::SensorOutput<double>& at_zero, const MotionSamples& samples,
            const std::vector<Vec3>& f, const std::vector<Vec3>& w)
@@ -93,7 +93,7 @@ class TermJets {
         F_(at_zero.F.cast<Jet>()), E_(at_zero.E.cast<Jet>()), s_(samples), f_(f), w_(w),
         blocks_(static_cast<std::size_t>(model.num_terms())), ptr_(blocks_.size()) {
     for (std::size_t t = 0; t < blocks_.size(); ++t) {
-      blocks_[t].resize(static_cast<std::size_t>(model.terms()[t].effect->info().size()));
+      blocks_[t].resize(static_cast<std::size_t>(model.term(static_cast<int>(t)).effect().info().size()));
       ptr_[t] = blocks_[t].data();
     }
   }
@@ -135,13 +135,13 @@ class TermJets {
       z_ = model::SensorOutput<Jet>();
     }
     for (int t : terms) {
-      model_.terms()[static_cast<std::size_t>(t)].effect->Apply(ptr_[static_cast<std::size_t>(t)], in_, z_);
+      model_.term(t).Apply(ptr_[static_cast<std::size_t>(t)], in_, z_);
     }
     return z_;
   }
 
  private:
-  const model::Model& model_;
+  const autodiff::DifferentiableModel& model_;
   double const* const* theta_;
   const std::vector<std::pair<int, int>>& parameter_of_;
   bool terms_split_;
@@ -205,7 +205,7 @@ ModelColumns::ModelColumns(const model::Model& model) {
 }
 
 RateCorrection::RateCorrection(const model::Model& model)
-    : model_(&model), columns_(model), accel_term_(model.BaseTerm(model::Sensor::kAccel)),
+    : model_(&model), differentiable_(model), columns_(model), accel_term_(model.BaseTerm(model::Sensor::kAccel)),
       gyro_term_(model.BaseTerm(model::Sensor::kGyro)) {
   for (int t = 0; t < model.num_terms(); ++t) {
     all_terms_.push_back(t);
@@ -294,10 +294,10 @@ RateJacobians RateCorrection::ImplicitRateJacobians(double const* const* theta,
                                                    const MotionSamples& samples,
                                                    const std::vector<Vec3>& f,
                                                    const std::vector<Vec3>& w) const {
-  constexpr int kStride = model::kJetStride;
+  constexpr int kStride = autodiff::kJetStride;
   static_assert(kStride >= 6, "one Jet pass differentiates the six inputs");
   const std::size_t n = samples.size();
-  TermJets jets(*model_, theta, columns_.parameter_of, terms_split_, at_zero, samples, f, w);
+  TermJets jets(differentiable_, theta, columns_.parameter_of, terms_split_, at_zero, samples, f, w);
   bool coupled = false;
   std::vector<Eigen::Matrix<double, 3, 6>> dw_dp = RateRowsOfInverse(
       *model_, terms_split_, terms_split_ ? catalogue_terms_ : all_terms_, at_zero, n, jets,
@@ -332,7 +332,7 @@ RateJacobians RateCorrection::ImplicitRateJacobians(double const* const* theta,
 
 std::vector<std::pair<std::vector<int>, std::vector<int>>> RateCorrection::JetPasses(
     bool coupled, bool linear_closed) const {
-  constexpr std::size_t kStride = model::kJetStride;
+  constexpr std::size_t kStride = autodiff::kJetStride;
   // The parameters that can move the rates: with the sensors uncoupled at every sample, D_x is
   // block diagonal and the accelerometer's terms (which write y_a alone) leave w alone: their
   // columns stay zero without a pass.

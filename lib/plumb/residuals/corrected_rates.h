@@ -9,13 +9,14 @@
 // satisfy y = Predict(theta, x), x = (f, w), so d w / d theta is implicit: with D_x = d Predict /
 // d x (6 x 6) and D_theta = d Predict / d theta, d x / d theta = -D_x^-1 D_theta (instead of Jets
 // through every Newton step). The linear stage's share of both is closed-form; the catalogue
-// terms' share comes from Jets (model::kJetStride parameters per pass), through the term that
+// terms' share comes from Jets (autodiff::kJetStride parameters per pass), through the term that
 // owns them alone where the terms only read the linear stage's F and E.
 #pragma once
 
 #include <utility>
 #include <vector>
 
+#include "plumb/autodiff/differentiable_effect.h"
 #include "plumb/model/model.h"
 #include "plumb/residuals/measurements.h"
 
@@ -118,7 +119,7 @@ class RateCorrection {
                                       const model::SensorOutput<double>& at_zero,
                                       const MotionSamples& samples, const std::vector<Vec3>& f,
                                       const std::vector<Vec3>& w) const;
-  /// The Jet passes of ImplicitRateJacobians: (parameters seeded, at most model::kJetStride of
+  /// The Jet passes of ImplicitRateJacobians: (parameters seeded, at most autodiff::kJetStride of
   /// the P; the terms applied), one per kJetStride parameters of a term that can move the
   /// rates (`coupled`: the sensors' inputs are coupled somewhere, so accelerometer terms can),
   /// through that term alone when the terms are split, and the linear stage's with the terms
@@ -127,6 +128,7 @@ class RateCorrection {
                                                                        bool linear_closed) const;
 
   const model::Model* model_;
+  autodiff::DifferentiableModel differentiable_;  // the model's terms on Jets
   ModelColumns columns_;
   int accel_term_ = -1, gyro_term_ = -1;  // the linear stage's terms (-1: none)
   // The model's terms: all, the linear stage's, the catalogue's; the linear stage's followed

@@ -9,7 +9,9 @@ StillResidual::StillResidual(const model::Model& model, model::Sensor sensor,
                              const Vec3& g_n, const Vec3& omega_ie_n, const Vec3& omega_eb_b,
                              std::vector<double> wander_weights)
     : model_(&model), sensor_(sensor), terms_(std::move(terms)), m_(measurement), g_n_(g_n),
-      omega_ie_n_(omega_ie_n), omega_eb_b_(omega_eb_b), wander_weights_(std::move(wander_weights)) {}
+      omega_ie_n_(omega_ie_n), omega_eb_b_(omega_eb_b), wander_weights_(std::move(wander_weights)) {
+  for (int t : terms_) effects_.emplace_back(*model.terms()[static_cast<std::size_t>(t)].effect);
+}
 
 std::vector<int> StillResidual::TermsOf(const model::Model& model, model::Sensor sensor) {
   std::vector<int> terms;
@@ -29,7 +31,7 @@ Vec3T<T> StillResidual::PredictT(T const* const* parameters) const {
       model::AtRest<T>(R_b_n, g_n_, omega_ie_n_, omega_eb_b_, T(m_.dt_s), T(m_.dtemp_c));
   model::SensorOutput<T> out;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
-    model_->terms()[static_cast<std::size_t>(terms_[i])].effect->Apply(parameters[i + 1], in, out);
+    effects_[i].Apply(parameters[i + 1], in, out);
   }
   return sensor_ == model::Sensor::kAccel ? out.acc : out.gyr;
 }
@@ -61,7 +63,7 @@ ceres::CostFunction* StillResidual::Create(const model::Model& model, model::Sen
   const std::size_t processes = wander_weights.size();
   auto* functor = new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n,
                                     omega_eb_b, std::move(wander_weights));
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, model::kJetStride>(functor);
+  auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, autodiff::kJetStride>(functor);
   cost->AddParameterBlock(4);
   for (int t : terms) cost->AddParameterBlock(model.terms()[static_cast<std::size_t>(t)].effect->info().size());
   for (std::size_t p = 0; p < 2 * processes; ++p) cost->AddParameterBlock(3);
@@ -70,6 +72,6 @@ ceres::CostFunction* StillResidual::Create(const model::Model& model, model::Sen
 }
 
 template bool StillResidual::operator()<double>(double const* const*, double*) const;
-template bool StillResidual::operator()<model::Jet>(model::Jet const* const*, model::Jet*) const;
+template bool StillResidual::operator()<autodiff::Jet>(autodiff::Jet const* const*, autodiff::Jet*) const;
 
 }  // namespace plumb::residuals

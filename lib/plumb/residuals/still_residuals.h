@@ -37,11 +37,11 @@
 #include <memory>
 #include <vector>
 
+#include "plumb/autodiff/differentiable_effect.h"
 #include "plumb/model/model.h"
 #include "plumb/residuals/measurements.h"
 
 namespace plumb::residuals {
-
 
 class StillResidual {
  public:
@@ -74,6 +74,7 @@ class StillResidual {
   const model::Model* model_;
   model::Sensor sensor_;
   std::vector<int> terms_;
+  std::vector<autodiff::DifferentiableEffect> effects_;  // the effects of terms_, on both scalars
   StillMeasurement m_;
   Vec3 g_n_, omega_ie_n_, omega_eb_b_;
   std::vector<double> wander_weights_;  // per wander process: w_p

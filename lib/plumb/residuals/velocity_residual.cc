@@ -149,7 +149,7 @@ Vec3 VelocityResidual::VelocityChange(double const* const* parameters) const {
     in.alpha_b = s_.alpha_b[i];
     in.dt_s = s_.dt_s[i];
     in.dtemp_c = s_.dtemp_c[i];
-    return model_->Correct<double>(theta, y_a, y_g, in, F_inv, E_inv, 3);
+    return model_->Correct(theta, y_a, y_g, in, F_inv, E_inv, 3);
   };
   const Vec3 dv = strapdown::IntegratedChange(s_.dt_s, R_b_n * omega_ie_n_, correct).second;
   const double T = s_.dt_s[n - 1] - s_.dt_s[0];

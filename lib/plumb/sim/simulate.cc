@@ -301,7 +301,7 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
       const Vec3 a_n = by_hand ? hand.Acceleration(turn, u, turn_s) : Vec3::Zero();
       const model::SensorInput<double> in = InputFor(motion, sim.site, t_s - sim.model.t_ref_s,
                                                      temp_c - sim.model.temp_ref_c, a_n);
-      model::SensorOutput<double> out = sim.model.Predict<double>(theta.data(), in);
+      model::SensorOutput<double> out = sim.model.Predict(theta.data(), in);
       if (by_hand) out.acc += hand.Vibration(turn, u);
       const Vec3 accel_white = noise.Draw();
       const Vec3 gyro_white = noise.Draw();

@@ -1,5 +1,5 @@
 // Part of the Extension.BuiltinTakesOneFileAndOneLine test (run_builtin.cmake): with
-// accel_scale_temperature.cc in lib/plumb/model/effects/ and its name in effects.cmake, the
+// accel_scale_temperature.h in lib/plumb/model/effects/ and its name in effects.cmake, the
 // library knows the effect by name with no Register() call in this program. Prints what it
 // checks; returns 1 on the first failure.
 #include <cmath>

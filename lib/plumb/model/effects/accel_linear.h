@@ -1,18 +1,28 @@
-// plumb/model/effects/accel_linear.h — the parameter block of the base accelerometer effect,
-// owned here: nothing outside accel_linear.{h,cc} indexes it by hand.
+// plumb/model/effects/accel_linear.h — the base accelerometer effect (SPEC section 2, the
+// paper's Equation (1)) and its parameter block, owned here: nothing outside this file indexes
+// it by hand.
 //
-//   y_a = F f_b + b_a      (SPEC section 2, the paper's Equation (1))
+//   y_a = F f_b + b_a,   F upper triangular (sensor and body x axes coincide, body y lies in
+//                        the sensor x-y plane), b_a the bias.
 //
 // Block layout (9 values, 12 with option "full"; all zero = F = I, no bias):
 //   [0..5]   F - I, upper triangle row-major: matrix.xx, matrix.xy, matrix.xz, matrix.yy,
 //            matrix.yz, matrix.zz (dimensionless; the diagonals are reported as 1 + value)
 //   [6..8]   b_a: bias.x, bias.y, bias.z (sensor output units; m/s^2 for SI input)
 //   [9..11]  option "full" only: matrix.yx, matrix.zx, matrix.zy (dimensionless)
+//
+// Option "full": F full 3x3, for a frame that the data defines by known attitudes (the
+// paper's benchmark platform, whose faces give the axes) rather than by the accelerometer
+// itself. Without known attitudes, a full F is not determined (a rotation of the frame changes
+// no prediction).
 #pragma once
 
+#include <string>
 #include <vector>
 
+#include "plumb/core/error.h"
 #include "plumb/core/types.h"
+#include "plumb/model/effect.h"
 
 namespace plumb::model::accel_linear {
 
@@ -70,4 +80,55 @@ inline void SetIsotropic(std::vector<double>& block, double scale, const Vec3& b
   for (int i = 0; i < 3; ++i) block[static_cast<std::size_t>(kBias + i)] = bias[i];
 }
 
+/// The catalogue entry of accel_linear (parameters, units, typical sizes); throws
+/// plumb::Error on an option other than "full".
+inline EffectInfo Describe(const std::string& option) {
+  if (!option.empty() && option != "full") {
+    throw Error("accel_linear's only option is 'full' (got '" + option + "')");
+  }
+  EffectInfo info;
+  info.name = "accel_linear";
+  info.prefix = "accel";
+  info.option = option;
+  info.sensor = Sensor::kAccel;
+  info.linear_stage = true;
+  info.term = option.empty() ? "y_a = F f_b + b_a, F upper triangular"
+                             : "y_a = F f_b + b_a, F full";
+  info.parameters = {{"matrix.xx", "1", 0.02, 1.0}, {"matrix.xy", "1", 0.01, 0.0},
+                     {"matrix.xz", "1", 0.01, 0.0}, {"matrix.yy", "1", 0.02, 1.0},
+                     {"matrix.yz", "1", 0.01, 0.0}, {"matrix.zz", "1", 0.02, 1.0}};
+  auto bias = AxisParameters("bias", "m/s^2", 0.2);
+  info.parameters.insert(info.parameters.end(), bias.begin(), bias.end());
+  if (option == "full") {
+    for (const char* name : {"matrix.yx", "matrix.zx", "matrix.zy"}) {
+      info.parameters.push_back({name, "1", 0.01, 0.0});
+    }
+  }
+  info.excitation.still_orientations = true;
+  return info;
+}
+
 }  // namespace plumb::model::accel_linear
+
+namespace plumb::model {
+
+class AccelLinear : public EffectBase<AccelLinear> {
+ public:
+  explicit AccelLinear(const std::string& option)
+      : EffectBase(accel_linear::Describe(option)), full_(option == "full") {}
+
+  template <typename T>
+  void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
+    const Mat3T<T> F = accel_linear::Matrix(theta, full_);
+    Eigen::Map<const Vec3T<T>> b_a(theta + accel_linear::kBias);
+    out.F = F;
+    out.acc = F * in.f_b + b_a;
+  }
+
+ private:
+  bool full_;
+};
+
+}  // namespace plumb::model
+
+PLUMB_DEFINE_EFFECT(accel_linear, ::plumb::model::AccelLinear)

@@ -1,5 +1,7 @@
-# The built-in effects, one per line. Adding an effect: write effects/<name>.cc (with
-# PLUMB_DEFINE_EFFECT(<name>, Class)) and add its name here. Nothing else changes.
+# The built-in effects, one per line. Adding an effect: write effects/<name>.h (its class, with
+# PLUMB_DEFINE_EFFECT(<name>, Class)) and add its name here. Nothing else changes: the model's
+# catalogue (registry.cc) and the effects' Jet forms (plumb::autodiff) are generated from this
+# list.
 set(PLUMB_EFFECTS
   accel_linear
   gyro_linear

@@ -1,7 +1,9 @@
-// plumb/model/effects/gyro_linear.h — the parameter block of the base gyroscope effect, owned
-// here: nothing outside gyro_linear.{h,cc} indexes it by hand.
+// plumb/model/effects/gyro_linear.h — the base gyroscope effect (SPEC section 2, the paper's
+// Equation (2)) and its parameter block, owned here: nothing outside this file indexes it by
+// hand.
 //
-//   y_g = E omega_b + b_g      (SPEC section 2, the paper's Equation (2))
+//   y_g = E omega_b + b_g,   E full 3x3 relative to the accelerometer-defined body frame
+//                            (3 scales + 6 misalignments), b_g the bias.
 //
 // Block layout (12 values; all zero = E = I, no bias):
 //   [0..8]   E - I row-major: matrix.xx, matrix.xy, ..., matrix.zz (dimensionless; the
@@ -11,9 +13,12 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
+#include "plumb/core/error.h"
 #include "plumb/core/types.h"
+#include "plumb/model/effect.h"
 
 namespace plumb::model::gyro_linear {
 
@@ -72,4 +77,53 @@ void SubtractSummedRateJacobian(const Mat3& E_inv, const std::array<Mat3, 3>& K_
   cols.template middleCols<3>(kBias) -= K_sum * E_inv;
 }
 
+/// The catalogue entry of gyro_linear (parameters, units, typical sizes); throws
+/// plumb::Error on an option other than "triangular".
+inline EffectInfo Describe(const std::string& option) {
+  if (!option.empty() && option != "triangular") {
+    throw Error("gyro_linear's only option is 'triangular' (got '" + option + "')");
+  }
+  EffectInfo info;
+  info.name = "gyro_linear";
+  info.prefix = "gyro";
+  info.option = option;
+  info.sensor = Sensor::kGyro;
+  info.linear_stage = true;
+  info.term = option.empty() ? "y_g = E omega_b + b_g, E full"
+                             : "y_g = E omega_b + b_g, E upper triangular";
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      info.parameters.push_back({std::string("matrix.") + kAxisName[r] + kAxisName[c], "1",
+                                 r == c ? 0.02 : 0.01, r == c ? 1.0 : 0.0});
+    }
+  }
+  auto bias = AxisParameters("bias", "rad/s", 0.02);
+  info.parameters.insert(info.parameters.end(), bias.begin(), bias.end());
+  if (option == "triangular") {
+    info.held = {MatrixIndex(1, 0), MatrixIndex(2, 0), MatrixIndex(2, 1)};
+  }
+  info.excitation.still_orientations = true;
+  info.excitation.rotation = true;
+  return info;
+}
+
 }  // namespace plumb::model::gyro_linear
+
+namespace plumb::model {
+
+class GyroLinear : public EffectBase<GyroLinear> {
+ public:
+  explicit GyroLinear(const std::string& option) : EffectBase(gyro_linear::Describe(option)) {}
+
+  template <typename T>
+  void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
+    const Mat3T<T> E = gyro_linear::Matrix(theta);
+    Eigen::Map<const Vec3T<T>> b_g(theta + gyro_linear::kBias);
+    out.E = E;
+    out.gyr = E * in.omega_b + b_g;
+  }
+};
+
+}  // namespace plumb::model
+
+PLUMB_DEFINE_EFFECT(gyro_linear, ::plumb::model::GyroLinear)

@@ -9,7 +9,7 @@
 //   [0..2] c1.x c1.y c1.z, [3..5] c2.* (order >= 2), [6..8] c3.* (order 3), in the sensor's
 //   output unit per degC^k. The term uses SensorInput::dtemp_c.
 //
-// INTERNAL to plumb::model (not installed): the two effects' sources share it.
+// The two effects (accel_temperature_bias.h, gyro_temperature_bias.h) differ only in their Spec.
 #pragma once
 
 #include <string>
@@ -28,6 +28,7 @@ struct Spec {
   double typical[3];        ///< typical c1, c2, c3 of a MEMS IMU on a small UAV
 };
 
+/// The order an option asks for; throws plumb::Error on another option.
 inline int ParseOrder(const Spec& spec, const std::string& option) {
   if (option.empty() || option == "1") return 1;
   if (option == "2") return 2;
@@ -36,7 +37,8 @@ inline int ParseOrder(const Spec& spec, const std::string& option) {
               " takes the polynomial order 1, 2 or 3 as its option (got '" + option + "')");
 }
 
-inline EffectInfo MakeInfo(const Spec& spec, const std::string& option) {
+/// The catalogue entry of the effect of `spec` with `option`.
+inline EffectInfo Describe(const Spec& spec, const std::string& option) {
   const int order = ParseOrder(spec, option);
   EffectInfo info;
   info.name = spec.name;
@@ -61,7 +63,7 @@ template <const Spec& kSpec>
 class TemperatureBias : public EffectBase<TemperatureBias<kSpec>> {
  public:
   explicit TemperatureBias(const std::string& option)
-      : EffectBase<TemperatureBias<kSpec>>(MakeInfo(kSpec, option)),
+      : EffectBase<TemperatureBias<kSpec>>(Describe(kSpec, option)),
         order_(ParseOrder(kSpec, option)) {}
 
   template <typename T>

@@ -13,13 +13,19 @@
 //   [3..5] r_z.x, r_z.y, r_z.z   lever arm of the z accelerometer
 // Residual signature: accelerometer residual during rotation that follows omega^2 and the
 // angular acceleration; nothing when still.
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace accel_size_effect {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of accel_size_effect (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) throw Error("accel_size_effect takes no option (got '" + option + "')");
   EffectInfo info;
   info.name = "accel_size_effect";
@@ -35,9 +41,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace accel_size_effect
+
 class AccelSizeEffect : public EffectBase<AccelSizeEffect> {
  public:
-  explicit AccelSizeEffect(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit AccelSizeEffect(const std::string& option) : EffectBase(accel_size_effect::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -55,7 +63,6 @@ class AccelSizeEffect : public EffectBase<AccelSizeEffect> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(accel_size_effect, ::plumb::model::AccelSizeEffect)

@@ -12,14 +12,20 @@
 // Parameter block (2 values, zero = no Earth rate): omega.north, omega.down in rad/s.
 // Residual signature: a still gyroscope residual fixed in the level frame, which turns with
 // the heading and flips with the pose.
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/core/units.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace earth_rate {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of earth_rate (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) throw Error("earth_rate takes no option (got '" + option + "')");
   EffectInfo info;
   info.name = "earth_rate";
@@ -33,9 +39,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace earth_rate
+
 class EarthRate : public EffectBase<EarthRate> {
  public:
-  explicit EarthRate(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit EarthRate(const std::string& option) : EffectBase(earth_rate::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -44,7 +52,6 @@ class EarthRate : public EffectBase<EarthRate> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(earth_rate, ::plumb::model::EarthRate)

@@ -4,13 +4,19 @@
 //
 // Parameter block (3 values, zero = no drift): d.x, d.y, d.z in rad/s^2.
 // Residual signature: gyroscope residual that trends with time.
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace gyro_bias_drift {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of gyro_bias_drift (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) throw Error("gyro_bias_drift takes no option (got '" + option + "')");
   EffectInfo info;
   info.name = "gyro_bias_drift";
@@ -23,9 +29,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace gyro_bias_drift
+
 class GyroBiasDrift : public EffectBase<GyroBiasDrift> {
  public:
-  explicit GyroBiasDrift(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit GyroBiasDrift(const std::string& option) : EffectBase(gyro_bias_drift::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -34,7 +42,6 @@ class GyroBiasDrift : public EffectBase<GyroBiasDrift> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(gyro_bias_drift, ::plumb::model::GyroBiasDrift)

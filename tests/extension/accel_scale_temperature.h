@@ -15,16 +15,23 @@
 // with the same-axis input (an axis up and the same axis down disagree in opposite
 // directions), where accel_temperature_bias moves the residual the same way in every pose.
 //
-// Two ways to add it (docs/extending.md): register it at run time in your own program, or
-// copy this file to lib/plumb/model/effects/ and add the line `accel_scale_temperature` to
+// Two ways to add it (docs/extending.md): register it at run time in your own program
+// (plumb::autodiff::RegisterEffect<plumb::model::AccelScaleTemperature>), or copy this file to
+// lib/plumb/model/effects/ and add the line `accel_scale_temperature` to
 // lib/plumb/model/effects/effects.cmake.
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace accel_scale_temperature {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of accel_scale_temperature (parameters, units, typical sizes); throws
+/// plumb::Error on an option (it takes none).
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) {
     throw Error("accel_scale_temperature takes no option (got '" + option + "')");
   }
@@ -40,9 +47,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace accel_scale_temperature
+
 class AccelScaleTemperature : public EffectBase<AccelScaleTemperature> {
  public:
-  explicit AccelScaleTemperature(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit AccelScaleTemperature(const std::string& option) : EffectBase(accel_scale_temperature::Describe(option)) {}
 
   // One template for double and Jet: every value that depends on theta or the input is a T.
   template <typename T>
@@ -53,7 +62,6 @@ class AccelScaleTemperature : public EffectBase<AccelScaleTemperature> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(accel_scale_temperature, ::plumb::model::AccelScaleTemperature)

@@ -7,13 +7,19 @@
 // Parameter block (3 values, zero = linear): k.x, k.y, k.z in 1/(rad/s).
 // Residual signature: the motion residual grows with the square of the rate (turns in
 // opposite directions disagree in the same direction).
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace gyro_scale_nonlinearity {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of gyro_scale_nonlinearity (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) {
     throw Error("gyro_scale_nonlinearity takes no option (got '" + option + "')");
   }
@@ -28,9 +34,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace gyro_scale_nonlinearity
+
 class GyroScaleNonlinearity : public EffectBase<GyroScaleNonlinearity> {
  public:
-  explicit GyroScaleNonlinearity(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit GyroScaleNonlinearity(const std::string& option) : EffectBase(gyro_scale_nonlinearity::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -40,7 +48,6 @@ class GyroScaleNonlinearity : public EffectBase<GyroScaleNonlinearity> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(gyro_scale_nonlinearity, ::plumb::model::GyroScaleNonlinearity)

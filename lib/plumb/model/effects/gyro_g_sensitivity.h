@@ -6,13 +6,19 @@
 // G.yy, G.yz, G.zx, G.zy, G.zz in rad/s per m/s^2 (row = gyroscope axis, column = axis of the
 // specific force).
 // Residual signature: the still gyroscope residual changes with the pose, i.e. with f_b.
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace gyro_g_sensitivity {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of gyro_g_sensitivity (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) throw Error("gyro_g_sensitivity takes no option (got '" + option + "')");
   EffectInfo info;
   info.name = "gyro_g_sensitivity";
@@ -30,9 +36,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace gyro_g_sensitivity
+
 class GyroGSensitivity : public EffectBase<GyroGSensitivity> {
  public:
-  explicit GyroGSensitivity(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit GyroGSensitivity(const std::string& option) : EffectBase(gyro_g_sensitivity::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -41,7 +49,6 @@ class GyroGSensitivity : public EffectBase<GyroGSensitivity> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(gyro_g_sensitivity, ::plumb::model::GyroGSensitivity)

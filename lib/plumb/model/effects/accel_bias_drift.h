@@ -4,13 +4,19 @@
 //
 // Parameter block (3 values, zero = no drift): d.x, d.y, d.z in m/s^3.
 // Residual signature: accelerometer residual that trends with time.
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace accel_bias_drift {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of accel_bias_drift (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) throw Error("accel_bias_drift takes no option (got '" + option + "')");
   EffectInfo info;
   info.name = "accel_bias_drift";
@@ -22,9 +28,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace accel_bias_drift
+
 class AccelBiasDrift : public EffectBase<AccelBiasDrift> {
  public:
-  explicit AccelBiasDrift(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit AccelBiasDrift(const std::string& option) : EffectBase(accel_bias_drift::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -33,7 +41,6 @@ class AccelBiasDrift : public EffectBase<AccelBiasDrift> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(accel_bias_drift, ::plumb::model::AccelBiasDrift)

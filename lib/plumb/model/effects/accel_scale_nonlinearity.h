@@ -9,13 +9,19 @@
 // Parameter block (3 values, zero = linear): k.x, k.y, k.z in 1/(m/s^2).
 // Residual signature: accelerometer residual that grows with the square of the same-axis input
 // (the still poses with that axis up and down disagree in the same direction).
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace accel_scale_nonlinearity {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of accel_scale_nonlinearity (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) {
     throw Error("accel_scale_nonlinearity takes no option (got '" + option + "')");
   }
@@ -30,9 +36,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace accel_scale_nonlinearity
+
 class AccelScaleNonlinearity : public EffectBase<AccelScaleNonlinearity> {
  public:
-  explicit AccelScaleNonlinearity(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit AccelScaleNonlinearity(const std::string& option) : EffectBase(accel_scale_nonlinearity::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -42,7 +50,6 @@ class AccelScaleNonlinearity : public EffectBase<AccelScaleNonlinearity> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(accel_scale_nonlinearity, ::plumb::model::AccelScaleNonlinearity)

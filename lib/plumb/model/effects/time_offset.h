@@ -8,13 +8,19 @@
 //
 // Parameter block (1 value, zero = synchronous): dt in s.
 // Residual signature: motion residual that follows the angular acceleration.
+#pragma once
+
+#include <string>
+
 #include "plumb/core/error.h"
 #include "plumb/model/effect.h"
 
 namespace plumb::model {
-namespace {
+namespace time_offset {
 
-EffectInfo MakeInfo(const std::string& option) {
+/// The catalogue entry of time_offset (parameters, units, typical sizes); throws
+/// plumb::Error on an option it does not take.
+inline EffectInfo Describe(const std::string& option) {
   if (!option.empty()) throw Error("time_offset takes no option (got '" + option + "')");
   EffectInfo info;
   info.name = "time_offset";
@@ -27,9 +33,11 @@ EffectInfo MakeInfo(const std::string& option) {
   return info;
 }
 
+}  // namespace time_offset
+
 class TimeOffset : public EffectBase<TimeOffset> {
  public:
-  explicit TimeOffset(const std::string& option) : EffectBase(MakeInfo(option)) {}
+  explicit TimeOffset(const std::string& option) : EffectBase(time_offset::Describe(option)) {}
 
   template <typename T>
   void Term(const T* theta, const SensorInput<T>& in, SensorOutput<T>& out) const {
@@ -38,7 +46,6 @@ class TimeOffset : public EffectBase<TimeOffset> {
   }
 };
 
-}  // namespace
 }  // namespace plumb::model
 
 PLUMB_DEFINE_EFFECT(time_offset, ::plumb::model::TimeOffset)

@@ -5,6 +5,8 @@
 // Option: the order, "1" (default), "2" or "3". Parameters c1.x ... c3.z in m/s^2/degC^k,
 // lowest order first (layout in temperature_bias.h).
 // Residual signature: accelerometer residual that follows the temperature.
+#pragma once
+
 #include "plumb/model/effects/temperature_bias.h"
 
 namespace plumb::model::temperature {
