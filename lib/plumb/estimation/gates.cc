@@ -20,7 +20,6 @@ namespace plumb::estimation {
 namespace {
 
 using gates_internal::Count;
-using gates_internal::kAxis;
 using gates_internal::Median;
 using gates_internal::SiAccel;
 using gates_internal::SiGyro;
@@ -130,7 +129,8 @@ std::optional<Gate> OnePose(const ImuSeries& series, const Calibration& cal,
   const auto rest = AtRest(fit.still);
   const int segments = static_cast<int>(rest.size());
   int free_accel = 0;
-  for (const auto& p : cal.parameters) free_accel += (!p.fixed && p.name.rfind("accel.", 0) == 0) ? 1 : 0;
+  const int accel_base = cal.model.BaseTerm(model::Sensor::kAccel);
+  for (const auto& p : cal.parameters) free_accel += (!p.fixed && p.place.term == accel_base) ? 1 : 0;
   const bool known = std::any_of(rest.begin(), rest.end(),
                                  [](const StillSegmentFit* s) { return s->attitude_known; });
   const int needed = known ? (free_accel + 2) / 3 : free_accel;
@@ -155,16 +155,16 @@ std::optional<Gate> OnePose(const ImuSeries& series, const Calibration& cal,
                   ". Record more poses, or give one segment per pose"};
 }
 
-/// Mean of the fitted diagonal entries prefix.matrix.xx/yy/zz that are free and observable;
-/// nullopt when none is.
-std::optional<double> FittedScale(const Calibration& cal, const std::string& prefix,
+/// Mean of the sensor's fitted diagonal entries of F or E (matrix.xx/yy/zz) that are free and
+/// observable; nullopt when none is.
+std::optional<double> FittedScale(const Calibration& cal, model::Sensor sensor,
                                   const Mat3& m, std::string* diagonal) {
   double sum = 0;
   int n = 0;
   for (int a = 0; a < 3; ++a) {
-    const std::string name = prefix + ".matrix." + kAxis[a] + kAxis[a];
+    const auto place = cal.model.MatrixEntry(sensor, a, a);
     const auto p = std::find_if(cal.parameters.begin(), cal.parameters.end(),
-                                [&](const ParameterEstimate& q) { return q.name == name; });
+                                [&](const ParameterEstimate& q) { return place && q.place == *place; });
     if (p == cal.parameters.end() || p->fixed || !p->observable) continue;
     sum += m(a, a);
     ++n;
@@ -221,7 +221,7 @@ std::optional<Gate> AccelUnit(const Calibration& cal, const std::vector<const St
                                     hint};
   }
   std::string diagonal;
-  const auto scale = FittedScale(cal, "accel", F, &diagonal);
+  const auto scale = FittedScale(cal, model::Sensor::kAccel, F, &diagonal);
   if (!usable || !scale) return std::nullopt;
   if (cal.acc_unit == "m/s^2" && std::abs(*scale - 1.0) > kMaxScaleError) {
     return Gate{"unit_or_rate", "the accelerometer's scale came out " + Number(*scale, 4) +
@@ -261,7 +261,7 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
                     OptionText(Option::kGyrScale) + ")"};
   }
   std::string diagonal;
-  const auto scale = FittedScale(cal, "gyro", cal.GyroMatrix(), &diagonal);
+  const auto scale = FittedScale(cal, model::Sensor::kGyro, cal.GyroMatrix(), &diagonal);
   if (!usable || !scale || std::abs(*scale - 1.0) <= kMaxScaleError) return std::nullopt;
   const std::string what = "the gyroscope's scale came out " + Number(*scale, 4) +
                            " (gyro.matrix diagonal " + diagonal + "), not about 1: ";
