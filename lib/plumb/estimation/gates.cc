@@ -88,7 +88,8 @@ Gate NotConverged(const FitReport& fit) {
                   " solves; " + why +
                   "); the values, sigmas and chi2 are not those of a minimum. Check the "
                   "segments and the input's units and rate (the other gates), or allow more "
-                  "iterations (" + OptionText(Option::kMaxIterations) + ")"};
+                  "iterations (" + OptionText(Option::kMaxIterations) + ")",
+              {Option::kMaxIterations}};
 }
 
 std::optional<Gate> Nonlinear(const FitReport& fit) {
@@ -206,6 +207,9 @@ std::optional<Gate> AccelUnit(const Calibration& cal, const std::vector<const St
   const int n = static_cast<int>(rest.size());
   if (cal.acc_unit == "m/s^2" && std::abs(norm / g - 1.0) > kMaxNormError) {
     const double ratio = norm / g;
+    const std::vector<Option> named =
+        std::abs(norm - 1.0) < 0.2 ? std::vector<Option>{Option::kAccUnit}
+                                   : std::vector<Option>{Option::kAccUnit, Option::kAccScale};
     const std::string hint =
         std::abs(norm - 1.0) < 0.2
             ? "the samples look like g, not m/s^2: give " + OptionText(Option::kAccUnit, "g")
@@ -218,7 +222,8 @@ std::optional<Gate> AccelUnit(const Calibration& cal, const std::vector<const St
     return Gate{"unit_or_rate", "the still accelerometer reads " + Number(norm, 4) +
                                     " m/s^2 (median norm over " + Count(n, "still segment") +
                                     ") where gravity is " + Number(g, 4) + " m/s^2: " +
-                                    hint};
+                                    hint,
+                named};
   }
   std::string diagonal;
   const auto scale = FittedScale(cal, model::Sensor::kAccel, F, &diagonal);
@@ -229,7 +234,8 @@ std::optional<Gate> AccelUnit(const Calibration& cal, const std::vector<const St
                                     "), more than " + Number(100 * kMaxScaleError, 4) +
                                     " % from 1: check the accelerometer's unit and scale (" +
                                     OptionText(Option::kAccUnit) + ", " +
-                                    OptionText(Option::kAccScale) + ")"};
+                                    OptionText(Option::kAccScale) + ")",
+                {Option::kAccUnit, Option::kAccScale}};
   }
   const double after = Median(corrected);
   if (std::isfinite(after) && std::abs(after / g - 1.0) > kMaxCorrectedNormError) {
@@ -258,7 +264,8 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
                     " rad/s: the samples look like deg/s or raw counts, not rad/s (give " +
                     OptionText(Option::kGyrUnit, "deg/s") + ", " +
                     OptionText(Option::kGyrUnit, "counts") + " or " +
-                    OptionText(Option::kGyrScale) + ")"};
+                    OptionText(Option::kGyrScale) + ")",
+                {Option::kGyrUnit, Option::kGyrScale}};
   }
   std::string diagonal;
   const auto scale = FittedScale(cal, model::Sensor::kGyro, cal.GyroMatrix(), &diagonal);
@@ -267,12 +274,14 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
                            " (gyro.matrix diagonal " + diagonal + "), not about 1: ";
   if (std::abs(*scale / units::kDegPerRad - 1.0) < 0.15) {
     return Gate{"unit_or_rate", what + "the samples look like deg/s, not rad/s: give " +
-                                    OptionText(Option::kGyrUnit, "deg/s")};
+                                    OptionText(Option::kGyrUnit, "deg/s"),
+                {Option::kGyrUnit}};
   }
   if (std::abs(*scale * units::kDegPerRad - 1.0) < 0.15) {
     return Gate{"unit_or_rate",
                 what + "the samples look like rad/s, given as deg/s: drop " +
-                    OptionText(Option::kGyrUnit, "deg/s")};
+                    OptionText(Option::kGyrUnit, "deg/s"),
+                {Option::kGyrUnit}};
   }
   const double dt = series.median_dt_s();
   return Gate{"unit_or_rate",
@@ -281,7 +290,8 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
                   "times are likely wrong by that factor: the samples are " + Number(dt, 4) +
                   " s apart (" + Number(1.0 / dt, 4) + " Hz), the turns say about " +
                   Number(*scale / dt, 4) + " Hz (check " + OptionText(Option::kRate) +
-                  ", or the time column's unit)"};
+                  ", or the time column's unit)",
+              {Option::kRate}};
 }
 
 /// The free parameters of the gyroscope's matrix (its linear stage's block before the bias,

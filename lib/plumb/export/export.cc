@@ -61,7 +61,8 @@ void CheckDetermined(const std::string& format, const estimation::Calibration& c
               ", which the firmware parameters come from; writing them would replace the "
               "vehicle's values with ones plumb held, not measured. Record more poses (six "
               "faces or more, joined by turns), or give " + OptionText(Option::kExportUndetermined) +
-              " to write them anyway");
+              " to write them anyway",
+              {Option::kExport, Option::kExportUndetermined});
 }
 
 /// What the vehicle will do with the values, from the log's parameters: the boot-time gyro

@@ -100,7 +100,8 @@ FirmwareCorrection BestDiagonal(const estimation::Calibration& c,
     throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: firmware parameters act on SI sensor output, so "
                 "plumb cannot export them; give the sensor's scale (" + OptionText(Option::kAccScale) +
-                ", " + OptionText(Option::kGyrScale) + ") to calibrate in SI");
+                ", " + OptionText(Option::kGyrScale) + ") to calibrate in SI",
+                {Option::kAccScale, Option::kGyrScale});
   }
   FirmwareCorrection fw;
   fw.has_gyro = c.has_gyro;

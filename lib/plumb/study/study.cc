@@ -121,7 +121,8 @@ void ReadBase(const json& b, const std::string& path, Base& base) {
   if ((base.schedule == "session") != !base.template_path.empty()) {
     throw InputError(path, "key 'base.template'",
                      "the session schedule takes a template (a " +
-                         OptionText(Option::kCalibrationJson) + " file), and only it");
+                         OptionText(Option::kCalibrationJson) + " file), and only it",
+                     {Option::kCalibrationJson});
   }
   if (base.sensor != "typical" && base.sensor != "white") {
     throw InputError(path, "key 'base.sensor'", "expected typical or white");
