@@ -190,11 +190,21 @@ void RegisterCalibrate(py::module_& m) {
           "fit",
           [](const PyResult& r) {
             py::dict fit = ToPython(r.document["fit"]);
-            fit["gates"] = ToPython(r.document["gates"]);
+            py::list gates;
+            for (const estimation::Gate& g : r.result.fit.gates) {
+              py::dict gate;
+              gate["name"] = g.name;
+              gate["message"] = g.message;
+              py::list options;
+              for (const Option o : g.options) options.append(SpellKeyword(o, ""));
+              gate["options"] = py::tuple(options);
+              gates.append(gate);
+            }
+            fit["gates"] = gates;
             return fit;
           },
           "chi2, dof, chi2_dof, RMS, convergence, verdict ... (the JSON's fit) and gates (the "
-          "checks failed: name, message).")
+          "checks failed: name, its stable code; message; options, the keywords it points to).")
       .def_property_readonly("site", [](const PyResult& r) { return ToPython(r.document["site"]); },
                              "The site used: lat_deg, lon_deg (degrees), height_m (m), gravity "
                              "(m/s^2), source.")

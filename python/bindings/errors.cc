@@ -1,6 +1,9 @@
 // plumb's errors as Python exceptions: plumb::Error -> plumb.Error (a subclass of Exception),
 // plumb::InputError -> plumb.InputError (with .file and .where), plumb::InsufficientDataError
 // -> plumb.InsufficientDataError, both subclasses of plumb.Error; the message is plumb's.
+// Every plumb.Error has .options, a tuple of the options its message points to as this module's
+// keywords (plumb::Error::options(); the library's name where no keyword takes it), and
+// .option, the first of them or None.
 // A JSON document of the wrong shape (nlohmann::json's exceptions) is a plumb.Error too.
 #include <nlohmann/json.hpp>
 
@@ -12,23 +15,36 @@ namespace plumb::python {
 void RegisterErrors(py::module_& m) {
   static py::exception<Error> error(m, "Error", PyExc_Exception);
   error.doc() = "plumb's error: the message names the file and the place (line, byte) and what "
-                "was expected.";
+                "was expected; .options lists the options it points to (keywords), .option the "
+                "first or None.";
   static py::exception<InputError> input_error(m, "InputError", error.ptr());
   input_error.doc() = "Bad input: .file and .where (e.g. 'line 12') say where.";
   static py::exception<InsufficientDataError> insufficient(m, "InsufficientDataError", error.ptr());
   insufficient.doc() = "The data cannot support the model: the message says what to record.";
+  // Errors raised without options (a JSON document of the wrong shape) read them from the class.
+  error.attr("option") = py::none();
+  error.attr("options") = py::tuple();
+  // The exception object of class `type` for `e`, with .options and .option.
+  static const auto make = [](PyObject* type, const Error& e) {
+    py::object value = py::reinterpret_borrow<py::object>(type)(e.what());
+    py::list options;
+    for (const Option o : e.options()) options.append(SpellKeyword(o, ""));
+    value.attr("option") = options.empty() ? py::none() : py::object(options[0]);
+    value.attr("options") = py::tuple(options);
+    return value;
+  };
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
-      py::object value = py::reinterpret_borrow<py::object>(input_error.ptr())(e.what());
+      py::object value = make(input_error.ptr(), e);
       value.attr("file") = e.file();
       value.attr("where") = e.where();
       PyErr_SetObject(input_error.ptr(), value.ptr());
     } catch (const InsufficientDataError& e) {
-      PyErr_SetString(insufficient.ptr(), e.what());
+      PyErr_SetObject(insufficient.ptr(), make(insufficient.ptr(), e).ptr());
     } catch (const Error& e) {
-      PyErr_SetString(error.ptr(), e.what());
+      PyErr_SetObject(error.ptr(), make(error.ptr(), e).ptr());
     } catch (const nlohmann::json::exception& e) {
       PyErr_SetString(error.ptr(), (std::string("JSON: ") + e.what()).c_str());
     }

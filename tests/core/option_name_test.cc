@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include "plumb/core/error.h"
+
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace plumb {
 namespace {
@@ -43,6 +46,23 @@ TEST(OptionName, EachFrontEndSpellsTheOptionsOfOneMessage) {
   EXPECT_EQ(Advice(), "give acc_unit=\"g\", or allow more iterations (max_iterations)");
   SetOptionSpeller(nullptr);
   EXPECT_EQ(OptionText(Option::kMaxIterations), LibraryName(Option::kMaxIterations));
+}
+
+// The options a message names travel with the error as data, whatever the front end's spelling.
+TEST(OptionName, ErrorsCarryTheOptionsTheirMessageNames) {
+  SetOptionSpeller(nullptr);
+  EXPECT_TRUE(Error("no option here").options().empty());
+  const Error e("give " + OptionText(Option::kAccScale) + ", " + OptionText(Option::kGyrScale),
+                {Option::kAccScale, Option::kGyrScale});
+  EXPECT_EQ(e.options(), (std::vector<Option>{Option::kAccScale, Option::kGyrScale}));
+  try {
+    throw InputError("a.csv", "line 2", "NaN (" + OptionText(Option::kDropNan) + ")",
+                     {Option::kDropNan});
+  } catch (const Error& caught) {  // as a front end catches it
+    EXPECT_EQ(caught.options(), std::vector<Option>{Option::kDropNan});
+    EXPECT_EQ(std::string(caught.what()), "a.csv:line 2: NaN (InputOptions::drop_nan_rows)");
+  }
+  EXPECT_EQ(InsufficientDataError("x", {Option::kSite}).options(), std::vector<Option>{Option::kSite});
 }
 
 TEST(OptionName, EveryOptionHasALibraryName) {

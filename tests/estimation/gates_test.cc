@@ -256,6 +256,8 @@ TEST(Gates, TheIterationLimitFailsNotConverged) {
   ASSERT_NE(g, nullptr) << Names(r.fit.gates);
   EXPECT_TRUE(Contains(g->message, "the solver did not converge: its last solve stopped after ")) << g->message;
   EXPECT_TRUE(Contains(g->message, "Termination: NO_CONVERGENCE")) << g->message;
+  // The option its advice names, as data (Gate::options).
+  EXPECT_EQ(g->options, std::vector<Option>{Option::kMaxIterations});
   const std::string verdict = report::FitVerdict(r.fit);
   EXPECT_FALSE(Contains(verdict, "consistent with the noise")) << verdict;
   EXPECT_TRUE(Contains(verdict, "the fit failed a gate (not_converged)")) << verdict;

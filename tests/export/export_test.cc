@@ -12,6 +12,7 @@
 #include "plumb/export/firmware.h"
 #include "plumb/export/formats.h"
 #include "plumb/export/kalibr.h"
+#include "plumb/model/effects/accel_linear.h"
 #include "plumb/model/model.h"
 
 namespace plumb::exporter {
@@ -336,6 +337,7 @@ TEST(PreviewExports, EveryFormatWithItsNumbersOrWhyNot) {
   // What Export() refuses is carried, not thrown.
   estimation::ParameterEstimate lost;
   lost.name = "accel.bias.x";
+  lost.place = {s.r.calibration.model.BaseTerm(model::Sensor::kAccel), model::accel_linear::kBias};
   lost.unit = "m/s^2";
   lost.observable = false;
   s.r.calibration.parameters = {lost};

@@ -101,11 +101,21 @@ class Errors(unittest.TestCase):
             plumb.open(path, columns="t,ax,ay,az")
         self.assertIn("(to skip such rows: drop_nan)", str(c.exception))
         self.assertNotIn("--", str(c.exception))
+        # ... and carry the option as data, as the keyword.
+        self.assertEqual(c.exception.options, ("drop_nan",))
+        self.assertEqual(c.exception.option, "drop_nan")
         s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
         fit = plumb.calibrate(s, max_iterations=1).fit
         gates = {g["name"]: g["message"] for g in fit["gates"]}
         self.assertIn("allow more iterations (max_iterations)", gates["not_converged"])
         self.assertNotIn("--", gates["not_converged"])
+        options = {g["name"]: g["options"] for g in fit["gates"]}
+        self.assertEqual(options["not_converged"], ("max_iterations",))
+        # An error whose message names no option carries none.
+        with self.assertRaises(plumb.InputError) as c:
+            plumb.open(out("missing.csv"))
+        self.assertEqual(c.exception.options, ())
+        self.assertIsNone(c.exception.option)
 
     def test_bad_calibration_file_names_it(self):
         path = out("not_a_calibration.json")

@@ -29,6 +29,8 @@ inline estimation::CalibrationResult MakeResult() {
   for (std::size_t i = 0; i < names.size(); ++i) {
     estimation::ParameterEstimate p;
     p.name = names[i];
+    const auto where = *r.calibration.model.FindParameter(names[i]);
+    p.place = {where.first, where.second};
     p.unit = "u" + std::to_string(i);
     p.value = 0.01 * static_cast<double>(i);
     p.sigma = 1e-3;

@@ -1,7 +1,7 @@
 // plumb/core/datasheet_level.h — the bias wander levels (estimation/options.h: the random
 // walk densities and the Gauss-Markov instability) as a datasheet states them, e.g. "4 deg/h"
-// or "40ug", turned into SI numbers: one parser for the command's --accel-rw, --gyro-rw,
-// --accel-bi, --gyro-bi, the Python module's keywords of the same names and a study file's
+// or "40ug", turned into SI numbers: one parser for the four levels as the command line and
+// the Python module take them (Option::kAccelWalk ... kGyroInstability) and a study file's
 // keys and factors of the same names (study/study.h). It needs only units.h and error.h, so it
 // sits in core, below every module that reads a level.
 #pragma once

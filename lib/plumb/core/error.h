@@ -2,7 +2,12 @@
 //
 // The library never prints and never calls exit(); it throws plumb::Error with a message that
 // names the file, the place (line or byte offset) and what was expected (SPEC section 8).
-// Only the command-line `main` catches it.
+// Only the front ends (the command's `main`, the Python module) catch it.
+//
+// A message that points the user to an option names it through OptionText (option_name.h),
+// spelled by the front end; the error also carries those options as data (options()), in the
+// order the message names them, so that a front end can act on them without reading the text
+// (Python: the exception's .options, its keywords). The kind of error is its class.
 #pragma once
 
 #include <cstddef>
@@ -11,6 +16,10 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
+
+#include "plumb/core/option_name.h"
 
 namespace plumb {
 
@@ -25,16 +34,26 @@ std::string Printable(std::string_view text, std::size_t max_chars);
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& what) : std::runtime_error(Printable(what, kMaxMessage)) {}
+  /// `options`: the options `what` names (through OptionText), in its order.
+  Error(const std::string& what, std::vector<Option> options)
+      : std::runtime_error(Printable(what, kMaxMessage)), options_(std::move(options)) {}
+
+  /// The options the message points the user to; empty when it names none.
+  const std::vector<Option>& options() const { return options_; }
 
   /// Longest message kept, bytes.
   static constexpr std::size_t kMaxMessage = 16000;
+
+ private:
+  std::vector<Option> options_;
 };
 
 /// Error about an input file. `where` is e.g. "line 12" or "byte 4096"; may be empty.
 class InputError : public Error {
  public:
-  InputError(const std::string& file, const std::string& where, const std::string& what)
-      : Error(file + (where.empty() ? "" : ":" + where) + ": " + what),
+  InputError(const std::string& file, const std::string& where, const std::string& what,
+             std::vector<Option> options = {})
+      : Error(file + (where.empty() ? "" : ":" + where) + ": " + what, std::move(options)),
         file_(file), where_(where) {}
   const std::string& file() const { return file_; }
   const std::string& where() const { return where_; }
@@ -48,7 +67,8 @@ class InputError : public Error {
 /// missing and what to record.
 class InsufficientDataError : public Error {
  public:
-  explicit InsufficientDataError(const std::string& what) : Error(what) {}
+  explicit InsufficientDataError(const std::string& what, std::vector<Option> options = {})
+      : Error(what, std::move(options)) {}
 };
 
 

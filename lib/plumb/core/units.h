@@ -20,11 +20,11 @@ inline constexpr double kDegPerRad = 180.0 / kPi;
 /// firmware units (mg, mG); not local gravity, which plumb takes from the site (geo::Site).
 inline constexpr double kStandardGravity = 9.80665;
 /// The gravity magnitudes found on Earth, m/s^2: 9.78 at the equator to 9.83 at the poles at
-/// sea level, down to about 9.75 at 10 km; a --gravity outside this range is a typing mistake.
+/// sea level, down to about 9.75 at 10 km; a fixed gravity outside this range is a typing mistake.
 inline constexpr double kMinEarthGravity = 9.7;
 inline constexpr double kMaxEarthGravity = 9.9;
 /// The highest sample rate of an IMU's output, Hz: MEMS parts output at most 32 kHz
-/// (ICM-42688-P); 1 MHz leaves room for any test rig, and a --rate beyond it is a typing
+/// (ICM-42688-P); 1 MHz leaves room for any test rig, and a sample rate beyond it is a typing
 /// mistake (1e300 Hz would make a still-detection window of 1e300 samples).
 inline constexpr double kMaxImuRate_hz = 1e6;
 /// m/s^2 per milli-g and per micro-g.

@@ -138,7 +138,8 @@ CorrectedSeries ApplyCalibration(const CalibrationFile& calibration, const ImuSe
                   ": the calibration has no covariance over its parameters to propagate (none "
                   "in the file, or its data determined only combinations of them: see its "
                   "'observability'); apply it without the uncertainty (" +
-                  OptionText(Option::kSigma) + ")");
+                  OptionText(Option::kSigma) + ")",
+                  {Option::kSigma});
     }
     Propagate(calibration, series, steps, out);
   }

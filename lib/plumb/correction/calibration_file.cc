@@ -38,10 +38,12 @@ CalibrationFile CalibrationFromDocument(const document::CalibrationDocument& d) 
   const std::string& path = d.path;
   CalibrationFile out;
   out.path = path;
-  if (!d.has_model) throw InputError(path, KeyPlace("model"), Missing());
+  if (!d.has_model) throw InputError(path, KeyPlace("model"), Missing(), {Option::kCalibrationJson});
   if (!d.model) throw InputError(path, KeyPlace("model"), d.model_problem);
   out.model = *d.model;
-  if (!d.reference) throw InputError(path, KeyPlace("model_reference"), Missing());
+  if (!d.reference) {
+    throw InputError(path, KeyPlace("model_reference"), Missing(), {Option::kCalibrationJson});
+  }
   out.model.t_ref_s = d.reference->t_ref_s;
   out.model.temp_ref_c = d.reference->temp_ref_c;
   // An accelerometer-only session's fit dropped the gyroscope terms of its spec.

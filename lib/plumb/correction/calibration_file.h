@@ -1,5 +1,5 @@
 // plumb/correction/calibration_file.h — a calibration read back from the JSON document
-// `plumb calibrate --json` writes (report/json_report.h, SPEC section 6): the model it fitted,
+// report::CalibrationJson writes (report/json_report.h, SPEC section 6): the model it fitted,
 // every parameter's value as its parameter blocks, the reference time and temperature, and
 // the covariance over the parameters it determined.
 //

@@ -415,7 +415,7 @@ Refit RefitWith(const ImuSeries& series, const std::vector<StillSegment>& segmen
   try {
     model::Model with = model;
     with.Add(cand.effect, cand.option);
-    // As the user's `--model SPEC+EFFECT` fits: velocity residuals on when the effect needs
+    // As the user's model SPEC+EFFECT fits: velocity residuals on when the effect needs
     // them, otherwise as in the user's fit (unset: when its model needs them).
     estimation::CalibrationOptions refit_options = options.calibration;
     if (cand.with_velocity) refit_options.accel_in_motion = true;

@@ -11,7 +11,7 @@
 // 3. Confirm the best significant ones by refitting the model plus that effect: the actual fall
 //    of chi^2, and the new parameters with their sigma.
 // 4. Advise like with like: a confirmed candidate is recommended only when its refit, made as
-//    the user would make it (`--model SPEC+EFFECT`, velocity residuals included when the effect
+//    the user would make it (the model SPEC+EFFECT, velocity residuals included when the effect
 //    needs them), has a lower chi^2/dof than the user's own fit (Diagnosis::fit). A candidate
 //    judged in the fit with velocity residuals (lever arms, time offset) is scored against that
 //    fit (Diagnosis::fit_with_velocity, shown beside the user's), but advised against the
@@ -28,7 +28,7 @@
 // And the bias wander (`bias_wander`, CandidateKind::kWander): when the fit's wander levels
 // were assumed (the typical sensor's, or the still data's bound) on a session with holds
 // enough to estimate them, the same model refitted with the levels estimated from the session
-// (estimation/walk_estimate.h, `--estimate-rw`). A sensor that wanders more than typical
+// (estimation/walk_estimate.h, CalibrationOptions::estimate_walk). A sensor that wanders more than typical
 // leaves a misfit between its holds that the score tests would otherwise pin on some catalogue
 // effect (a simulated sensor at 5 times the typical wander: g-sensitivity "advised", chi2/dof
 // 16.2 -> 12.9; the wander's refit: 0.85). Its LM is the refit's fall, one degree of freedom

@@ -324,7 +324,8 @@ void CheckSigmasAgree(const CalibrationDocument& d) {
 CalibrationDocument ReadCalibrationDocument(const json& root, const std::string& path,
                                             const ReadOptions& options) {
   if (!root.is_object()) {
-    throw InputError(path, "", "expected the JSON object that " + OptionText(Option::kCalibrationJson) + " writes");
+    throw InputError(path, "", "expected the JSON object that " + OptionText(Option::kCalibrationJson) + " writes",
+                     {Option::kCalibrationJson});
   }
   CalibrationDocument d;
   d.path = path;

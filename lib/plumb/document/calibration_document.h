@@ -1,5 +1,5 @@
 // plumb/document/calibration_document.h — the one reader of the calibration document that
-// `calibrate --json` writes (report/json_report.h, SPEC section 6; keys: calibration_keys.h).
+// report::CalibrationJson writes (report/json_report.h, SPEC section 6; keys: calibration_keys.h).
 // `plumb apply` and Python's load_calibration read it through correction/calibration_file.h,
 // `plumb compare` through peers/plumb_result.h: each takes what it needs from what this reads,
 // and every check of the document is made here, once.
@@ -99,7 +99,7 @@ struct CalibrationDocument {
 struct ReadOptions {
   /// Read "segments" as the fit's still segments (label, acc_mean, count: compare's NEES over
   /// still means). Off: "segments" is left unread, as apply leaves it: a simulation's truth
-  /// document (`simulate --truth-json`), which apply takes as a calibration, has segments of
+  /// document (Option::kTruthJson), which apply takes as a calibration, has segments of
   /// another shape (the schedule's poses).
   bool still_segments = true;
 };

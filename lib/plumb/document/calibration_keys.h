@@ -1,5 +1,5 @@
 // plumb/document/calibration_keys.h — the key names of the calibration document (SPEC section
-// 6: what `calibrate --json` writes), written once: the writer (report/json_report.cc) and the
+// 6: what report::CalibrationJson writes), written once: the writer (report/json_report.cc) and the
 // reader (calibration_document.h) both spell a key from here.
 #pragma once
 

@@ -17,11 +17,13 @@ std::string Undetermined(const Calibration& calibration,
                          const FitReport& fit) {
   bool accel_short = false, gyro_short = false;
   std::vector<std::string> lost;
+  const int accel_base = calibration.model.BaseTerm(model::Sensor::kAccel);
+  const int gyro_base = calibration.model.BaseTerm(model::Sensor::kGyro);
   for (const auto& p : calibration.parameters) {
     if (p.fixed || p.observable) continue;
     lost.push_back(p.name);
-    accel_short = accel_short || p.name.rfind("accel.", 0) == 0;
-    gyro_short = gyro_short || p.name.rfind("gyro.", 0) == 0;
+    accel_short = accel_short || p.place.term == accel_base;
+    gyro_short = gyro_short || (gyro_base >= 0 && p.place.term == gyro_base);
   }
   if (lost.empty()) return "";
   std::vector<std::string> advice;

@@ -20,7 +20,10 @@ namespace plumb::estimation {
 
 /// One scalar model parameter as reported.
 struct ParameterEstimate {
-  std::string name;   ///< e.g. "accel.bias.x", "gyro_g_sensitivity.G.xy"
+  std::string name;   ///< e.g. "accel.bias.x", "gyro_g_sensitivity.G.xy" (for display)
+  /// Where it lives in the model (Calibration::model): what it is is asked of the model
+  /// (model::Model::Role, SensorOf), not read from `name`.
+  model::ParameterPlace place;
   std::string unit;   ///< e.g. "m/s^2"
   double value = 0;   ///< reported value (nominal + block value), SI
   /// One standard deviation; NaN when not observable or held fixed.
@@ -60,7 +63,7 @@ struct Observability {
 /// process and axis.
 enum class LevelSource {
   kNone,       ///< no such process in the fit (a constant bias, or a level given as 0)
-  kGiven,      ///< given in the options (--accel-rw, --gyro-bi, ...)
+  kGiven,      ///< given in the options (CalibrationOptions::accel_walk_density, ...)
   kMeasured,   ///< resolved by the Allan deviation of still data
   kBounded,    ///< not resolved; the Allan deviation's upper bound, below the typical level
   kTypical,    ///< the typical MEMS level (core/typical_mems.h), within the data's bound

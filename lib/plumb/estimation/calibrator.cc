@@ -38,7 +38,8 @@ model::Model ModelForSession(const model::Model& requested, const ImuSeries& ser
     throw Error("earth_rate is a candidate only without a site: with " +
                 OptionText(Option::kSite) +
                 " Earth rate is already in the model (from GeographicLib); drop it from the "
-                "model");
+                "model",
+                {Option::kSite});
   }
   for (const auto& term : model.terms()) {
     const auto& info = term.effect->info();
@@ -177,7 +178,8 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   // What says not to trust it (gates.h).
   fit.gates = CheckGates(series, segments, cal, options.log_motion, fit);
   if (!fitted.implausible_walk.empty()) {
-    fit.gates.push_back(Gate{"implausible_walk", fitted.implausible_walk});
+    fit.gates.push_back(Gate{"implausible_walk", fitted.implausible_walk,
+                             {Option::kEstimateWalk, Option::kAccelWalk, Option::kGyroWalk}});
   }
 }
 

@@ -13,7 +13,9 @@ namespace {
 
 /// Unit of a reported parameter: the catalogue's SI unit, or, for the base effects on
 /// unscaled sensor output, that output's unit (bias) and unit per SI input (matrix).
-std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series) {
+std::string UnitOf(const model::Model& model, model::ParameterPlace place, const ImuSeries& series) {
+  const model::EffectInfo& info = model.terms()[static_cast<std::size_t>(place.term)].effect->info();
+  const int i = place.index;
   const std::string& si = info.parameters[static_cast<std::size_t>(i)].unit;
   const bool accel = info.sensor == model::Sensor::kAccel;
   const std::string& out = accel ? series.acc_unit : series.gyr_unit;
@@ -23,7 +25,7 @@ std::string UnitOf(const model::EffectInfo& info, int i, const ImuSeries& series
     // Additive terms are in output units: "rad/s per m/s^2" becomes "counts per m/s^2".
     return info.ScalesWithOutput(i) ? out + si.substr(in.size()) : si;
   }
-  const bool matrix = info.parameters[static_cast<std::size_t>(i)].name.rfind("matrix.", 0) == 0;
+  const bool matrix = model.Role(place) != model::ParameterRole::kBias;
   return matrix ? out + " per " + in : out;
 }
 
@@ -83,7 +85,8 @@ std::vector<ParameterEstimate> ReportParameters(const model::Model& model,
     for (int i = 0; i < info.size(); ++i, ++flat) {
       ParameterEstimate p;
       p.name = info.ParameterName(i);
-      p.unit = UnitOf(info, i, series);
+      p.place = {t, i};
+      p.unit = UnitOf(model, p.place, series);
       p.value = values[static_cast<std::size_t>(flat)];
       p.fixed = term.fixed[static_cast<std::size_t>(i)];
       const auto& index = columns.model_index;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "plumb/core/log_motion.h"
+#include "plumb/core/option_name.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/types.h"
 
@@ -82,8 +83,11 @@ struct ProbeJacobian {
 /// converge, a rank from segments of one pose, samples outside the sensor's range, a rate or
 /// unit the data contradict, a saturated axis. `name` is one of kGateNames (gates.h).
 struct Gate {
-  std::string name;     ///< e.g. "not_converged"
+  std::string name;     ///< its stable code (gates.h lists them), e.g. "not_converged"
   std::string message;  ///< what failed, in numbers, and what to do
+  /// The options the message points the user to (through OptionText), in its order: data for
+  /// a front end that acts on them instead of reading the message (not in the JSON).
+  std::vector<Option> options = {};
 };
 
 /// Whether chi^2 is as quadratic in the unknowns as the covariance assumes, a few sigma out

@@ -20,7 +20,6 @@ namespace plumb::estimation {
 namespace {
 
 using gates_internal::Count;
-using gates_internal::kAxis;
 using gates_internal::Median;
 using gates_internal::SiAccel;
 using gates_internal::SiGyro;
@@ -89,7 +88,8 @@ Gate NotConverged(const FitReport& fit) {
                   " solves; " + why +
                   "); the values, sigmas and chi2 are not those of a minimum. Check the "
                   "segments and the input's units and rate (the other gates), or allow more "
-                  "iterations (" + OptionText(Option::kMaxIterations) + ")"};
+                  "iterations (" + OptionText(Option::kMaxIterations) + ")",
+              {Option::kMaxIterations}};
 }
 
 std::optional<Gate> Nonlinear(const FitReport& fit) {
@@ -130,7 +130,8 @@ std::optional<Gate> OnePose(const ImuSeries& series, const Calibration& cal,
   const auto rest = AtRest(fit.still);
   const int segments = static_cast<int>(rest.size());
   int free_accel = 0;
-  for (const auto& p : cal.parameters) free_accel += (!p.fixed && p.name.rfind("accel.", 0) == 0) ? 1 : 0;
+  const int accel_base = cal.model.BaseTerm(model::Sensor::kAccel);
+  for (const auto& p : cal.parameters) free_accel += (!p.fixed && p.place.term == accel_base) ? 1 : 0;
   const bool known = std::any_of(rest.begin(), rest.end(),
                                  [](const StillSegmentFit* s) { return s->attitude_known; });
   const int needed = known ? (free_accel + 2) / 3 : free_accel;
@@ -155,16 +156,16 @@ std::optional<Gate> OnePose(const ImuSeries& series, const Calibration& cal,
                   ". Record more poses, or give one segment per pose"};
 }
 
-/// Mean of the fitted diagonal entries prefix.matrix.xx/yy/zz that are free and observable;
-/// nullopt when none is.
-std::optional<double> FittedScale(const Calibration& cal, const std::string& prefix,
+/// Mean of the sensor's fitted diagonal entries of F or E (matrix.xx/yy/zz) that are free and
+/// observable; nullopt when none is.
+std::optional<double> FittedScale(const Calibration& cal, model::Sensor sensor,
                                   const Mat3& m, std::string* diagonal) {
   double sum = 0;
   int n = 0;
   for (int a = 0; a < 3; ++a) {
-    const std::string name = prefix + ".matrix." + kAxis[a] + kAxis[a];
+    const auto place = cal.model.MatrixEntry(sensor, a, a);
     const auto p = std::find_if(cal.parameters.begin(), cal.parameters.end(),
-                                [&](const ParameterEstimate& q) { return q.name == name; });
+                                [&](const ParameterEstimate& q) { return place && q.place == *place; });
     if (p == cal.parameters.end() || p->fixed || !p->observable) continue;
     sum += m(a, a);
     ++n;
@@ -206,6 +207,9 @@ std::optional<Gate> AccelUnit(const Calibration& cal, const std::vector<const St
   const int n = static_cast<int>(rest.size());
   if (cal.acc_unit == "m/s^2" && std::abs(norm / g - 1.0) > kMaxNormError) {
     const double ratio = norm / g;
+    const std::vector<Option> named =
+        std::abs(norm - 1.0) < 0.2 ? std::vector<Option>{Option::kAccUnit}
+                                   : std::vector<Option>{Option::kAccUnit, Option::kAccScale};
     const std::string hint =
         std::abs(norm - 1.0) < 0.2
             ? "the samples look like g, not m/s^2: give " + OptionText(Option::kAccUnit, "g")
@@ -218,10 +222,11 @@ std::optional<Gate> AccelUnit(const Calibration& cal, const std::vector<const St
     return Gate{"unit_or_rate", "the still accelerometer reads " + Number(norm, 4) +
                                     " m/s^2 (median norm over " + Count(n, "still segment") +
                                     ") where gravity is " + Number(g, 4) + " m/s^2: " +
-                                    hint};
+                                    hint,
+                named};
   }
   std::string diagonal;
-  const auto scale = FittedScale(cal, "accel", F, &diagonal);
+  const auto scale = FittedScale(cal, model::Sensor::kAccel, F, &diagonal);
   if (!usable || !scale) return std::nullopt;
   if (cal.acc_unit == "m/s^2" && std::abs(*scale - 1.0) > kMaxScaleError) {
     return Gate{"unit_or_rate", "the accelerometer's scale came out " + Number(*scale, 4) +
@@ -229,7 +234,8 @@ std::optional<Gate> AccelUnit(const Calibration& cal, const std::vector<const St
                                     "), more than " + Number(100 * kMaxScaleError, 4) +
                                     " % from 1: check the accelerometer's unit and scale (" +
                                     OptionText(Option::kAccUnit) + ", " +
-                                    OptionText(Option::kAccScale) + ")"};
+                                    OptionText(Option::kAccScale) + ")",
+                {Option::kAccUnit, Option::kAccScale}};
   }
   const double after = Median(corrected);
   if (std::isfinite(after) && std::abs(after / g - 1.0) > kMaxCorrectedNormError) {
@@ -258,21 +264,24 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
                     " rad/s: the samples look like deg/s or raw counts, not rad/s (give " +
                     OptionText(Option::kGyrUnit, "deg/s") + ", " +
                     OptionText(Option::kGyrUnit, "counts") + " or " +
-                    OptionText(Option::kGyrScale) + ")"};
+                    OptionText(Option::kGyrScale) + ")",
+                {Option::kGyrUnit, Option::kGyrScale}};
   }
   std::string diagonal;
-  const auto scale = FittedScale(cal, "gyro", cal.GyroMatrix(), &diagonal);
+  const auto scale = FittedScale(cal, model::Sensor::kGyro, cal.GyroMatrix(), &diagonal);
   if (!usable || !scale || std::abs(*scale - 1.0) <= kMaxScaleError) return std::nullopt;
   const std::string what = "the gyroscope's scale came out " + Number(*scale, 4) +
                            " (gyro.matrix diagonal " + diagonal + "), not about 1: ";
   if (std::abs(*scale / units::kDegPerRad - 1.0) < 0.15) {
     return Gate{"unit_or_rate", what + "the samples look like deg/s, not rad/s: give " +
-                                    OptionText(Option::kGyrUnit, "deg/s")};
+                                    OptionText(Option::kGyrUnit, "deg/s"),
+                {Option::kGyrUnit}};
   }
   if (std::abs(*scale * units::kDegPerRad - 1.0) < 0.15) {
     return Gate{"unit_or_rate",
                 what + "the samples look like rad/s, given as deg/s: drop " +
-                    OptionText(Option::kGyrUnit, "deg/s")};
+                    OptionText(Option::kGyrUnit, "deg/s"),
+                {Option::kGyrUnit}};
   }
   const double dt = series.median_dt_s();
   return Gate{"unit_or_rate",
@@ -281,7 +290,8 @@ std::optional<Gate> GyroUnitOrRate(const ImuSeries& series, const Calibration& c
                   "times are likely wrong by that factor: the samples are " + Number(dt, 4) +
                   " s apart (" + Number(1.0 / dt, 4) + " Hz), the turns say about " +
                   Number(*scale / dt, 4) + " Hz (check " + OptionText(Option::kRate) +
-                  ", or the time column's unit)"};
+                  ", or the time column's unit)",
+              {Option::kRate}};
 }
 
 /// The free parameters of the gyroscope's matrix (its linear stage's block before the bias,

@@ -39,14 +39,14 @@
 //                  poses after it start a chain of their own), where that leaves the
 //                  gyroscope's matrix (scale and misalignment, which only turns determine)
 //                  undetermined or known only to more than kNotATurnMatrixSigma
-//   implausible_walk  a bias random walk estimated from the session (--estimate-rw) more than
+//   implausible_walk  a bias random walk estimated from the session (estimate_walk) more than
 //                  10 times the typical MEMS walk: more likely a missing effect seen between
 //                  the poses, which a walk that large hides from chi2 (walk_estimate.h)
 //
 // CheckSamples looks at the samples (before the fit: the fit itself may be garbage when they
 // are), CheckFit at the fitted calibration; Calibrate (calibrator.cc) runs both and puts the
 // failures in FitReport::gates. The library only reports: the command decides what a failed
-// gate does (exit 3 under --strict, no export unless forced).
+// gate does (the command's exit status 3 when strict, no export unless forced).
 #pragma once
 
 #include <string>

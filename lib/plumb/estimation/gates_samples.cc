@@ -163,7 +163,8 @@ std::optional<Gate> OutOfRange(const ImuSeries& series, const SampleScan& scan) 
                   " s (sample " + std::to_string(first) + "): " + sample +
                   ". A corrupt log (flipped bytes, a bad record) or a wrong unit: cut them out "
                   "(" + OptionText(Option::kTimeWindow) + ", " + OptionText(Option::kSegments) +
-                  ") or fix the input before trusting this fit"};
+                  ") or fix the input before trusting this fit",
+              {Option::kTimeWindow, Option::kSegments}};
 }
 
 /// out_of_range for the sensor's temperature: readings beyond kMinTemperatureC ..
@@ -184,7 +185,8 @@ std::optional<Gate> TemperatureOutOfRange(const ImuSeries& series) {
                   Exact(series.temp_c[first]) +
                   " degC. A corrupt log or a column that is not degC: cut them out "
                   "(" + OptionText(Option::kTimeWindow) +
-                  ") or fix the input before trusting a temperature model"};
+                  ") or fix the input before trusting a temperature model",
+              {Option::kTimeWindow}};
 }
 
 /// Runs of samples at one axis's extreme value outside the still segments.

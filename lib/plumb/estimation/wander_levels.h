@@ -30,7 +30,7 @@
 // Quantisation (IEEE Q) is the resolved Q of the longest still data, per axis, else 0.
 //
 // The still data: the session's own segments at rest (MeasureStillNoise) and any other still
-// recording of the same sensor analysed the same way (`plumb calibrate --noise-from`). A term
+// recording of the same sensor analysed the same way (CalibrationOptions::other_still_noise). A term
 // resolved by several is taken from the longest still data; the bound is the smallest.
 #pragma once
 

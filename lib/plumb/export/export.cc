@@ -38,15 +38,13 @@ json ParametersJson(const ParameterSet& set) {
 
 /// True for the plumb parameters that firmware values come from: the accelerometer matrix's
 /// diagonal (its scales) and biases, the gyroscope biases and the temperature terms.
-bool FeedsFirmware(const std::string& name) {
-  for (const char* exact : {"accel.matrix.xx", "accel.matrix.yy", "accel.matrix.zz"}) {
-    if (name == exact) return true;
+bool FeedsFirmware(const model::Model& model, const estimation::ParameterEstimate& p) {
+  switch (model.Role(p.place)) {
+    case model::ParameterRole::kScale: return model.SensorOf(p.place) == model::Sensor::kAccel;
+    case model::ParameterRole::kBias:
+    case model::ParameterRole::kTemperatureBias: return true;
+    default: return false;
   }
-  for (const char* prefix : {"accel.bias.", "gyro.bias.", "accel_temperature_bias.",
-                             "gyro_temperature_bias."}) {
-    if (name.rfind(prefix, 0) == 0) return true;
-  }
-  return false;
 }
 
 /// Refuses to write firmware values from parameters the session does not determine.
@@ -55,7 +53,7 @@ void CheckDetermined(const std::string& format, const estimation::Calibration& c
   if (options.allow_undetermined) return;
   std::string missing;
   for (const auto& p : c.parameters) {
-    if (p.fixed || p.observable || !FeedsFirmware(p.name)) continue;
+    if (p.fixed || p.observable || !FeedsFirmware(c.model, p)) continue;
     missing += (missing.empty() ? "" : ", ") + p.name;
   }
   if (missing.empty()) return;
@@ -63,7 +61,8 @@ void CheckDetermined(const std::string& format, const estimation::Calibration& c
               ", which the firmware parameters come from; writing them would replace the "
               "vehicle's values with ones plumb held, not measured. Record more poses (six "
               "faces or more, joined by turns), or give " + OptionText(Option::kExportUndetermined) +
-              " to write them anyway");
+              " to write them anyway",
+              {Option::kExport, Option::kExportUndetermined});
 }
 
 /// What the vehicle will do with the values, from the log's parameters: the boot-time gyro

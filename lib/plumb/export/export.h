@@ -1,5 +1,5 @@
 // plumb/export/export.h — one call per export format, for the command line: the file's text,
-// the report lines for the terminal and the JSON for `calibrate --json` ("export").
+// the report lines for the terminal and the JSON for the calibration document ("export").
 //
 // Formats:
 //   ardupilot  Mission Planner .param (formats.h), INS_* for the chosen IMU instance

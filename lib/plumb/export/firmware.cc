@@ -20,11 +20,11 @@ double Binomial(int k, int j) {
   return c;
 }
 
-/// The temperature polynomial of the model's term `name` (accel_temperature_bias or
-/// gyro_temperature_bias), about the model's reference temperature; false when absent.
-bool ModelThermal(const estimation::Calibration& c, const std::string& name,
+/// The temperature polynomial of the sensor's temperature bias term (Model::
+/// TemperatureBiasTerm), about the model's reference temperature; false when absent.
+bool ModelThermal(const estimation::Calibration& c, model::Sensor sensor,
                   TemperaturePolynomial& out) {
-  const int term = c.model.FindTerm(name);
+  const int term = c.model.TemperatureBiasTerm(sensor);
   if (term < 0) return false;
   const std::vector<double>& block = c.theta[static_cast<std::size_t>(term)];
   out = TemperaturePolynomial{};
@@ -34,10 +34,6 @@ bool ModelThermal(const estimation::Calibration& c, const std::string& name,
     out.c[k + 1] = Vec3(block[3 * k], block[3 * k + 1], block[3 * k + 2]);
   }
   return true;
-}
-
-bool IsTemperatureTerm(const std::string& name) {
-  return name == "accel_temperature_bias" || name == "gyro_temperature_bias";
 }
 
 std::string Fixed(double value, int decimals) {
@@ -104,7 +100,8 @@ FirmwareCorrection BestDiagonal(const estimation::Calibration& c,
     throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: firmware parameters act on SI sensor output, so "
                 "plumb cannot export them; give the sensor's scale (" + OptionText(Option::kAccScale) +
-                ", " + OptionText(Option::kGyrScale) + ") to calibrate in SI");
+                ", " + OptionText(Option::kGyrScale) + ") to calibrate in SI",
+                {Option::kAccScale, Option::kGyrScale});
   }
   FirmwareCorrection fw;
   fw.has_gyro = c.has_gyro;
@@ -112,12 +109,13 @@ FirmwareCorrection BestDiagonal(const estimation::Calibration& c,
   fw.accel.scale = F_inv.diagonal();
   fw.accel.offset = c.AccelBias();
   fw.gyro.offset = c.GyroBias();  // no gyro scale in either firmware: S = 1
-  const std::pair<const char*, DiagonalCorrection*> thermal[] = {
-      {"accel_temperature_bias", &fw.accel}, {"gyro_temperature_bias", &fw.gyro}};
-  for (const auto& [name, sensor] : thermal) {
-    if (!ModelThermal(c, name, sensor->thermal)) continue;
+  const std::pair<model::Sensor, DiagonalCorrection*> thermal[] = {
+      {model::Sensor::kAccel, &fw.accel}, {model::Sensor::kGyro, &fw.gyro}};
+  for (const auto& [which, sensor] : thermal) {
+    if (!ModelThermal(c, which, sensor->thermal)) continue;
     if (!range.known()) {
-      throw Error(std::string("the model has ") + name +
+      const int term = c.model.TemperatureBiasTerm(which);
+      throw Error("the model has " + c.model.terms()[static_cast<std::size_t>(term)].effect->info().name +
                   " but the session has no temperature: no range to export it over");
     }
     sensor->has_thermal = true;
@@ -172,7 +170,9 @@ ExportReport Evaluate(const estimation::Calibration& c, const ImuSeries& series,
   for (const model::ModelTerm& term : c.model.terms()) {
     const model::EffectInfo& info = term.effect->info();
     const std::size_t n = static_cast<std::size_t>(info.size());
-    const bool kept = info.linear_stage || (keeps_temperature && IsTemperatureTerm(info.name));
+    const int t = static_cast<int>(&term - c.model.terms().data());
+    const bool kept = info.linear_stage ||
+                      (keeps_temperature && t == c.model.TemperatureBiasTerm(info.sensor));
     if (!kept && n > 0 && !term.probe) {
       DroppedEffect d;
       d.effect = info.name;

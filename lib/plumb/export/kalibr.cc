@@ -161,7 +161,8 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
     throw Error("the session's samples are in " + c.acc_unit + " and " + c.gyr_unit +
                 ", not m/s^2 and rad/s: Kalibr's noise densities are in SI, so plumb cannot "
                 "export them; give the sensor's scale (" + OptionText(Option::kAccScale) + ", " +
-                OptionText(Option::kGyrScale) + ")");
+                OptionText(Option::kGyrScale) + ")",
+                {Option::kAccScale, Option::kGyrScale});
   }
   const double dt_s = series.median_dt_s();
   if (!(dt_s > 0)) throw Error("Kalibr export: the session has no sample interval");

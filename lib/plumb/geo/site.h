@@ -42,7 +42,7 @@ struct Site {
   static Site Unknown(double g = units::kStandardGravity);
 };
 
-/// The site a fit uses: `given` (the user's, e.g. --lat/--lon, source "flags") when set, else
+/// The site a fit uses: `given` (the user's latitude and longitude, source "flags") when set, else
 /// `from_log` (the log's GPS), else Site::Unknown. `gravity_m_s2`, when set, replaces the
 /// gravity magnitude (still pointing down); without a site it is Site::Unknown's gravity.
 Site ResolveSite(const std::optional<SiteInput>& given, const std::optional<SiteInput>& from_log,

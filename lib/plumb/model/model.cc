@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/model/effects/accel_linear.h"
+#include "plumb/model/effects/gyro_linear.h"
 #include "plumb/model/registry.h"
 
 namespace plumb::model {
@@ -204,6 +206,49 @@ void Model::Fix(const std::string& full_name, bool fixed) {
   const auto where = FindParameter(full_name);
   if (!where) throw Error("model '" + spec_ + "' has no parameter '" + full_name + "'");
   terms_[static_cast<std::size_t>(where->first)].fixed[static_cast<std::size_t>(where->second)] = fixed;
+}
+
+void Model::Fix(ParameterPlace place, bool fixed) {
+  if (place.term < 0 || place.term >= num_terms() ||
+      place.index < 0 || place.index >= terms_[static_cast<std::size_t>(place.term)].effect->info().size()) {
+    throw Error("model '" + spec_ + "' has no parameter " + std::to_string(place.index) +
+                " in term " + std::to_string(place.term));
+  }
+  terms_[static_cast<std::size_t>(place.term)].fixed[static_cast<std::size_t>(place.index)] = fixed;
+}
+
+Sensor Model::SensorOf(ParameterPlace place) const {
+  return terms_.at(static_cast<std::size_t>(place.term)).effect->info().sensor;
+}
+
+ParameterRole Model::Role(ParameterPlace place) const {
+  const Sensor sensor = SensorOf(place);
+  const int j = place.index;
+  if (place.term == BaseTerm(Sensor::kAccel)) {
+    return accel_linear::IsBias(j)       ? ParameterRole::kBias
+           : accel_linear::IsDiagonal(j) ? ParameterRole::kScale
+                                         : ParameterRole::kCrossAxis;
+  }
+  if (place.term == BaseTerm(Sensor::kGyro)) {
+    return gyro_linear::IsBias(j)       ? ParameterRole::kBias
+           : gyro_linear::IsDiagonal(j) ? ParameterRole::kScale
+                                        : ParameterRole::kCrossAxis;
+  }
+  if (place.term == TemperatureBiasTerm(sensor)) return ParameterRole::kTemperatureBias;
+  return ParameterRole::kOther;
+}
+
+std::optional<ParameterPlace> Model::MatrixEntry(Sensor sensor, int r, int c) const {
+  const int term = BaseTerm(sensor);
+  if (term < 0) return std::nullopt;
+  const int index = sensor == Sensor::kAccel ? accel_linear::MatrixIndex(r, c)
+                                             : gyro_linear::MatrixIndex(r, c);
+  if (index >= terms_[static_cast<std::size_t>(term)].effect->info().size()) return std::nullopt;
+  return ParameterPlace{term, index};
+}
+
+int Model::TemperatureBiasTerm(Sensor sensor) const {
+  return FindTerm(sensor == Sensor::kAccel ? "accel_temperature_bias" : "gyro_temperature_bias");
 }
 
 bool Model::AtLinearStage(const double* const* theta) const {

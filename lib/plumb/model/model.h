@@ -31,6 +31,25 @@ struct ModelTerm {
   bool probe = false;
 };
 
+/// What a parameter is, answered from the layout its effect owns (effects/accel_linear.h,
+/// effects/gyro_linear.h, the temperature polynomial's block): modules ask this instead of
+/// reading the parameter's name.
+enum class ParameterRole {
+  kScale,            ///< a diagonal entry of F or E (the base effects)
+  kCrossAxis,        ///< an off-diagonal entry of F or E
+  kBias,             ///< b_a or b_g
+  kTemperatureBias,  ///< a coefficient of accel_temperature_bias / gyro_temperature_bias
+  kOther,            ///< any other catalogue effect's parameter
+};
+
+/// Where a parameter lives: model term `term` (Model::terms()), value `index` of its block.
+struct ParameterPlace {
+  int term = -1;
+  int index = -1;
+  bool operator==(const ParameterPlace& o) const { return term == o.term && index == o.index; }
+  bool operator!=(const ParameterPlace& o) const { return !(*this == o); }
+};
+
 /// Parameter values of a model: one block per effect, in model order.
 using ParameterBlocks = std::vector<std::vector<double>>;
 
@@ -78,6 +97,19 @@ class Model {
   /// Holds a parameter fixed at its nominal value (the identity model: 1 on the diagonals of
   /// F and E, 0 elsewhere) in the fit (throws if the name is unknown).
   void Fix(const std::string& full_name, bool fixed = true);
+  /// The same for the parameter at `place` (throws if the model has no such parameter).
+  void Fix(ParameterPlace place, bool fixed = true);
+
+  /// The sensor whose output the parameter at `place` models, and what it is there.
+  Sensor SensorOf(ParameterPlace place) const;
+  ParameterRole Role(ParameterPlace place) const;
+  /// The place of entry (r, c) of F (kAccel) or E (kGyro) in the sensor's base term, or
+  /// nullopt when the model has no such term or its block no such entry (F's lower triangle
+  /// without accel_linear's option "full").
+  std::optional<ParameterPlace> MatrixEntry(Sensor sensor, int r, int c) const;
+  /// Index of the sensor's temperature bias polynomial term (accel_temperature_bias,
+  /// gyro_temperature_bias), or -1.
+  int TemperatureBiasTerm(Sensor sensor) const;
 
   /// True when every term but the linear stage's (EffectInfo::linear_stage) is at zero in
   /// `theta` (block i of term i): the model then acts as its linear stage, y = F f + b_a,

@@ -65,11 +65,12 @@ PaperBenchmarkBackend CalibratePaperBenchmarkOnBackend(const ImuSeries& series,
   return out;
 }
 
-const std::vector<std::string>& PaperStaticFixedParameters() {
-  static const std::vector<std::string> names = {"accel.matrix.xx", "accel.matrix.yy",
-                                                 "accel.matrix.xy", "gyro.matrix.xx",
-                                                 "gyro.matrix.yy", "gyro.matrix.xy"};
-  return names;
+const std::vector<MatrixEntryRef>& PaperStaticFixedEntries() {
+  using model::Sensor;
+  static const std::vector<MatrixEntryRef> entries = {
+      {Sensor::kAccel, 0, 0}, {Sensor::kAccel, 1, 1}, {Sensor::kAccel, 0, 1},
+      {Sensor::kGyro, 0, 0},  {Sensor::kGyro, 1, 1},  {Sensor::kGyro, 0, 1}};
+  return entries;
 }
 
 PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::size_t begin,
@@ -95,19 +96,21 @@ PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::s
   freed.t_ref_s = series.t_s.front();
   if (!site.known && freed.has_gyro()) freed.DropGyro();  // no Earth rate: nothing to fit
   model::Model fixed = freed;
-  for (const auto& name : PaperStaticFixedParameters()) {
-    if (fixed.FindParameter(name)) fixed.Fix(name);
+  for (const MatrixEntryRef& e : PaperStaticFixedEntries()) {
+    if (const auto place = fixed.MatrixEntry(e.sensor, e.row, e.col)) fixed.Fix(*place);
   }
 
   PaperStaticBackend out;
   out.fixed = estimation::Calibrate(series, segments, fixed, site, options);
   options.method = "paper-static (backend, the paper's constants freed)";
   out.freed = estimation::Calibrate(series, segments, freed, site, options);
-  for (const auto& name : PaperStaticFixedParameters()) {
-    const auto it = std::find_if(out.freed.calibration.parameters.begin(), out.freed.calibration.parameters.end(),
-                                 [&](const estimation::ParameterEstimate& p) { return p.name == name; });
-    if (it == out.freed.calibration.parameters.end()) continue;  // no gyroscope in the data
-    (it->observable ? out.fixed_observable : out.fixed_unobservable).push_back(name);
+  const estimation::Calibration& c = out.freed.calibration;
+  for (const MatrixEntryRef& e : PaperStaticFixedEntries()) {
+    const auto place = c.model.MatrixEntry(e.sensor, e.row, e.col);
+    if (!place) continue;  // no gyroscope in the data
+    const auto it = std::find_if(c.parameters.begin(), c.parameters.end(),
+                                 [&](const estimation::ParameterEstimate& p) { return p.place == *place; });
+    (it->observable ? out.fixed_observable : out.fixed_unobservable).push_back(it->name);
   }
   return out;
 }

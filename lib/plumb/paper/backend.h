@@ -70,8 +70,15 @@ struct PaperStaticBackend {
 PaperStaticBackend CalibratePaperStaticOnBackend(const ImuSeries& series, std::size_t begin,
                                                  std::size_t end, const geo::Site& site);
 
-/// Names of the parameters the paper's static procedure fixes (section 5: the first two
-/// diagonal elements of F and E, alpha and sigma).
-const std::vector<std::string>& PaperStaticFixedParameters();
+/// An entry (row, col) of F (model::Sensor::kAccel) or E (kGyro); a model places it with
+/// model::Model::MatrixEntry.
+struct MatrixEntryRef {
+  model::Sensor sensor;
+  int row, col;
+};
+
+/// The entries the paper's static procedure fixes (section 5: the first two diagonal elements
+/// of F and E, alpha = F_xy and sigma = E_xy), in that order.
+const std::vector<MatrixEntryRef>& PaperStaticFixedEntries();
 
 }  // namespace plumb::paper

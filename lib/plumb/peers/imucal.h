@@ -21,7 +21,7 @@
 // plumb does not know (imucal's "a.u.") is kept as it is (S = 1), with a note.
 //
 // The frame: against a plumb result whose F is full and determined (known faces define the
-// frame, as `--method paper-benchmark` has them), the comparison is made in the frame of the
+// frame, as the paper-benchmark method has them), the comparison is made in the frame of the
 // poses, imucal's own: R_peer_b = I (ImucalFrame::kPoses). Rotating it into the accelerometer-
 // defined frame there would set two answers in different frames side by side.
 //

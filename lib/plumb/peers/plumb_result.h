@@ -1,4 +1,4 @@
-// plumb/peers/plumb_result.h — reads back what `plumb calibrate --json` wrote
+// plumb/peers/plumb_result.h — reads back the calibration document (report::CalibrationJson)
 // (plumb/report/json_report.h), the part a comparison with another tool needs: the headline
 // keys of SPEC section 6, which every method's document has (a paper method's are its closed
 // form's answer). The document is read and checked by the one reader

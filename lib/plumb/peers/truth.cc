@@ -113,8 +113,13 @@ json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 std::vector<TrueParameter> ReadSimulationTruth(const std::string& path) {
   const json root = detail::ParseJsonFile(path);
-  const json& params = detail::Field(root, "parameters", path, "parameters",
-                                     "the true parameters that " + OptionText(Option::kTruthJson) + " writes");
+  if (!root.is_object() || !root.contains("parameters")) {
+    throw InputError(path, detail::KeyPlace("parameters"),
+                     "missing; expected the true parameters that " + OptionText(Option::kTruthJson) +
+                         " writes",
+                     {Option::kTruthJson});
+  }
+  const json& params = root.at("parameters");
   if (!params.is_array()) throw InputError(path, detail::KeyPlace("parameters"), "expected a list");
   std::vector<TrueParameter> out;
   for (std::size_t i = 0; i < params.size(); ++i) {

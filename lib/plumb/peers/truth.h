@@ -1,5 +1,5 @@
-// plumb/peers/truth.h — a calibration (what `plumb calibrate --json` wrote) against the truth
-// of a simulated session (`plumb simulate --truth-json`): the error of every parameter in
+// plumb/peers/truth.h — a calibration (its document, report::CalibrationJson) against the truth
+// of a simulated session (its truth document, Option::kTruthJson): the error of every parameter in
 // units of its sigma, and the normalised estimation error squared over the full covariance,
 //
 //   NEES = e^T C^-1 e,   e = estimate - truth over covariance.parameters, C = covariance.matrix
@@ -25,7 +25,7 @@ struct TrueParameter {
   double value = 0.0;
 };
 
-/// Reads "parameters" of `plumb simulate --truth-json`. Throws plumb::InputError naming `path`
+/// Reads "parameters" of a simulation's truth document. Throws plumb::InputError naming `path`
 /// and the key when the file is not such a document.
 std::vector<TrueParameter> ReadSimulationTruth(const std::string& path);
 

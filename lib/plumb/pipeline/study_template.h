@@ -1,5 +1,5 @@
 // plumb/pipeline/study_template.h — a sensitivity study's session template (schedule
-// "session": a calibrate --json document whose segments and site the study's runs repeat),
+// "session": a calibration document (SPEC section 6) whose segments and site the study's runs repeat),
 // read for the study as `plumb sweep` and the Python module's sweep_point read it.
 #pragma once
 

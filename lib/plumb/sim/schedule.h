@@ -151,8 +151,8 @@ struct ScheduleRequest {
   std::uint64_t seed = 1;  ///< multipose: the seed of the tilts and headings
 };
 
-/// How a front end names the request's fields in its errors (e.g. "--schedule", "--poses",
-/// "--turn" on the command line).
+/// How a front end names the request's fields in its errors (the command line its flags, the
+/// Python module its keywords).
 struct ScheduleOptionNames {
   std::string kind;   ///< the option that names the schedule
   std::string poses;  ///< ... the number of poses

@@ -350,7 +350,8 @@ sim::Schedule TemplateSchedule(const nlohmann::json& doc, const std::string& pat
   const nlohmann::json* segments = doc.is_object() && doc.contains("segments") ? &doc.at("segments") : nullptr;
   if (segments == nullptr || !segments->is_array() || segments->size() < 2) {
     throw InputError(path, "key 'segments'", "a session template needs the still segments of " +
-                                             OptionText(Option::kCalibrationJson) + " (2 or more)");
+                                             OptionText(Option::kCalibrationJson) + " (2 or more)",
+                     {Option::kCalibrationJson});
   }
   for (std::size_t k = 0; k < segments->size(); ++k) {
     const nlohmann::json& seg = segments->at(k);

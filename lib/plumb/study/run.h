@@ -26,8 +26,8 @@
 
 namespace plumb::study {
 
-/// The poses and timing of a real session (schedule "session"), from the `plumb calibrate
-/// --json` document `doc` read from `path`: each still segment's fitted attitude held for the
+/// The poses and timing of a real session (schedule "session"), from the calibration
+/// document `doc` (SPEC section 6) read from `path`: each still segment's fitted attitude held for the
 /// segment's length, joined by single-axis turns lasting the gap to the next segment (at least
 /// 0.5 s). The sample interval comes from the segments' mid times and sample indices. Throws
 /// plumb::InputError naming `path` when the document has fewer than 2 segments or a segment

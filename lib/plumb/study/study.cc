@@ -71,7 +71,7 @@ std::optional<WanderLevel> LevelOf(const std::string& name) {
 
 /// A value of the base field or factor `name` at `where`: a finite number (SI) or, for a bias
 /// wander level, also a datasheet's text such as "4 deg/h" or "40 ug", read by the parser of
-/// the command's --gyro-bi and the Python module's gyro_bi (core/datasheet_level.h), in SI.
+/// the front ends' bias instability option (core/datasheet_level.h), in SI.
 double Value(const json& v, const std::string& name, const std::string& path,
              const std::string& where) {
   const std::optional<WanderLevel> level = LevelOf(name);
@@ -121,7 +121,8 @@ void ReadBase(const json& b, const std::string& path, Base& base) {
   if ((base.schedule == "session") != !base.template_path.empty()) {
     throw InputError(path, "key 'base.template'",
                      "the session schedule takes a template (a " +
-                         OptionText(Option::kCalibrationJson) + " file), and only it");
+                         OptionText(Option::kCalibrationJson) + " file), and only it",
+                     {Option::kCalibrationJson});
   }
   if (base.sensor != "typical" && base.sensor != "white") {
     throw InputError(path, "key 'base.sensor'", "expected typical or white");

@@ -9,7 +9,7 @@
 //     "runs": 20,                         Monte Carlo runs per point, >= 1
 //     "design": "grid",                   "grid" | "one_at_a_time" | {"latin_hypercube": N}
 //     "base": { "schedule": "multipose",  "multipose" | "paper_static" | "paper_benchmark" |
-//                                         "session" (with "template": a calibrate --json file)
+//                                         "session" (with "template": a calibration document)
 //               "poses": 12, "still_s": 5, "turn_s": 2, "rate_hz": 100,
 //               "sensor": "typical",      "typical" (white, instability, walk, warming) | "white"
 //               "random_truth": 1,        scale of the random true parameters (sim/truth.h)
@@ -17,7 +17,7 @@
 //     "simulate": "base",                 the model simulated (default: the fitted one)
 //     "fit": { "method": "generalized", "model": "base", "constant_bias": false,
 //              "wander_levels": "from_data" },   or "given": the simulated sensor's levels
-//                                         are given to the fit (a datasheet, --noise-from)
+//                                         are given to the fit (a datasheet, other still data)
 //     "factors": [ {"name": "poses", "levels": [6, 9, 12]},
 //                  {"name": "still_s", "range": [2, 30]},      (a range: latin hypercube only)
 //                  {"name": "fit_lat_error_deg", "levels": [0], "sigma": 1} ] }
@@ -35,7 +35,7 @@
 //
 // Values are SI numbers. The bias wander levels (accel_rw, gyro_rw, accel_bi, gyro_bi: the base's
 // keys, and those factors' levels, range and sigma) may also be given as a datasheet states
-// them, as the command's --gyro-bi and the Python module's gyro_bi take them: "4 deg/h",
+// them, as the front ends' bias wander options take them: "4 deg/h",
 // "40 ug", "0.5 deg/h/sqrt(h)" (core/datasheet_level.h); ParseStudy turns them into SI, and a
 // unit the level does not take is an InputError naming the file and the key.
 #pragma once
@@ -78,7 +78,7 @@ struct Base {
   /// paper_static only: the true hold is tilted about body y by level_error_deg and turned
   /// from north by heading_error_deg, while the fit assumes level, x north.
   double level_error_deg = 0.0, heading_error_deg = 0.0;
-  /// schedule "session": the path of a `plumb calibrate --json` document whose still
+  /// schedule "session": the path of a calibration document (SPEC section 6) whose still
   /// segments (their fitted attitudes, lengths and the gaps between them) are the poses and
   /// timing (TemplateSchedule).
   std::string template_path;
@@ -105,7 +105,7 @@ struct Study {
   std::string fit_method = "generalized";
   bool constant_bias = false;
   /// The generalized fit is given the simulated sensor's bias walk and instability levels
-  /// (as --accel-rw, --gyro-rw, --accel-bi, --gyro-bi from a datasheet), instead of taking
+  /// (as CalibrationOptions' walk densities and instabilities from a datasheet), instead of taking
   /// them from the still data or the typical sensor (estimation/wander_levels.h).
   bool wander_levels_given = false;
   std::vector<Factor> factors;

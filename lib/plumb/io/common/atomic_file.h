@@ -71,7 +71,7 @@ class AtomicFileSet {
   std::vector<std::unique_ptr<AtomicFileWriter>> files_;
 };
 
-/// A folder written as a whole (`plumb report --out DIR`): its files go into a temporary
+/// A folder written as a whole (the report page's folder): its files go into a temporary
 /// sibling folder (`.<name>.tmp.<pid>.XXXXXX`), and Commit() puts that folder in place of the
 /// destination in one step (renameat2 RENAME_EXCHANGE with the old folder, which is then
 /// removed; a plain rename when there is none). Without Commit() (an error, an interruption)

@@ -227,7 +227,7 @@ struct RecordFilter {
   bool Decodes(std::string_view name) const { return decode && decode(name); }
 };
 
-/// The message of a time window (--from/--to, log times) that holds fewer than 2 samples of a
+/// The message of a time window (FlightLogSelection::from_s/to_s, log times) that holds fewer than 2 samples of a
 /// stream spanning [t_start_s, t_end_s]: both in log times, as `plumb info` shows them.
 std::string EmptyWindowMessage(const std::optional<double>& from_s,
                                const std::optional<double>& to_s, double t_start_s,

@@ -1,9 +1,9 @@
 // plumb/io/input/input_spec.h — the text forms a user writes to describe a text table (the
-// command line's --columns, --axis-map, --delimiter, --acc-scale, --acc-unit, and the Python
-// module's keywords of the same names), turned into the fields of InputOptions
+// column description, the axis map, the delimiter, the sensors' scales and units, as the command
+// line's flags and the Python module's keywords give them), turned into the fields of InputOptions
 // (open_inputs.h). One parser for every front end: each throws plumb::Error with a message
-// that quotes the text and names the option as the caller spells it (the command line
-// "--axis-map", the Python module "axis_map").
+// that quotes the text and names the option as the caller spells it (the command line its flag,
+// the Python module its keyword).
 #pragma once
 
 #include <array>
@@ -20,8 +20,8 @@ std::vector<std::string> SplitList(const std::string& text, char sep);
 /// How a front end names the column description and the sample rate in the errors of
 /// ParseTableColumns and ParseTwoTableColumns.
 struct ColumnOptionNames {
-  std::string columns;  ///< the column description, e.g. "--columns"
-  std::string rate;     ///< how to give a sample rate, e.g. "--rate HZ"
+  std::string columns;  ///< the column description, as the front end names it
+  std::string rate;     ///< how to give a sample rate, as the front end names it
 };
 
 /// A one-file table's columns by position, e.g. "t,ax,ay,az,gx,gy,gz" or "-,ax,ay,az": t (or

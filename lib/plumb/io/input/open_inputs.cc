@@ -150,7 +150,7 @@ InputKind KindOf(const InputFile& input, const InputOptions& o) {
 }
 
 /// The samples of a text session inside the time window [from_s, to_s] (the file's own times:
-/// its time column, or the clock --rate gives), as a flight log's reader keeps its window.
+/// its time column, or the clock InputOptions::rate_hz gives), as a flight log's reader keeps its window.
 /// Throws InputError naming the file when fewer than 2 samples are left.
 void KeepWindow(Session& s, const FlightLogSelection& window) {
   if (!window.from_s && !window.to_s) return;

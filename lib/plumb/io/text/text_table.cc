@@ -295,7 +295,8 @@ class TableParser {
       throw InputError(file_, Where(line_no),
                        ColumnLabel(static_cast<std::size_t>(field_of_slot_[slot])) +
                            ": NaN or infinite value; expected a finite number (to skip such rows: " +
-                           OptionText(Option::kDropNan) + ")");
+                           OptionText(Option::kDropNan) + ")",
+                       {Option::kDropNan});
     }
     if (skipped_++ == 0) first_skipped_line_ = line_no;
   }

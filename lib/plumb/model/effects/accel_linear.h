@@ -60,6 +60,17 @@ inline constexpr int MatrixCol(int j) {
   return j < 3 ? j : j < 5 ? j - 2 : j < kBias ? 2 : j == kLower + 2 ? 1 : 0;
 }
 
+/// Offset of F(r, c) - [r == c] in the block: the upper triangle at [0..5], the lower one at
+/// kLower.. (in a block with option "full" only). MatrixRow/MatrixCol's inverse.
+inline constexpr int MatrixIndex(int r, int c) {
+  if (r <= c) return r == 0 ? c : r == 1 ? c + 2 : 5;
+  return r == 1 ? kLower : c == 0 ? kLower + 1 : kLower + 2;
+}
+
+/// True when block value j is a bias (b_a), and when it is a diagonal entry of F (a scale).
+inline constexpr bool IsBias(int j) { return j >= kBias && j < kLower; }
+inline constexpr bool IsDiagonal(int j) { return !IsBias(j) && MatrixRow(j) == MatrixCol(j); }
+
 /// The corrected specific force of the base model is f = F^-1 (y_a - b_a), so
 ///   d f / d F_rc = -F^-1 e_r f_c,   d f / d b_a = -F^-1.
 /// Subtracts K d f / d block from the block's columns `cols` (3 x kSize, or kSizeFull with

@@ -28,6 +28,10 @@ inline constexpr int kBias = 9;   ///< offset of b_g
 /// Offset of E(r, c) - [r == c] in the block.
 inline constexpr int MatrixIndex(int r, int c) { return 3 * r + c; }
 
+/// True when block value j is a bias (b_g), and when it is a diagonal entry of E (a scale).
+inline constexpr bool IsBias(int j) { return j >= kBias && j < kSize; }
+inline constexpr bool IsDiagonal(int j) { return j < kBias && j / 3 == j % 3; }
+
 /// E from a block.
 template <typename T>
 Mat3T<T> Matrix(const T* block) {
