@@ -142,7 +142,7 @@ class AllanCommand : public Command {
       doc["inputs"] = inputs;
       doc["source"] = session.source;
       doc["still"]["method"] = a.whole ? "whole" : seg.report.method;
-      doc["warnings"] = session.warnings;
+      doc["warnings"] = Messages(session.warnings);
       WriteJsonOutput(a.json_path, doc);
     }
     return 0;

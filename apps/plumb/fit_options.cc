@@ -188,8 +188,8 @@ void PrintSession(const Session& session) {
   PrintWarnings(session.warnings);
 }
 
-void PrintWarnings(const std::vector<std::string>& warnings) {
-  for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
+void PrintWarnings(const std::vector<Notice>& warnings) {
+  for (const Notice& w : warnings) std::cerr << "warning: " << w.message << "\n";
 }
 
 estimation::CalibrationResult CalibrateWithProgress(const Session& session, const FitSetup& fit) {

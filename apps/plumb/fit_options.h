@@ -72,7 +72,7 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
 void PrintSession(const Session& session);
 
 /// Each of `warnings` as "warning: ..." on standard error (SPEC 6: warnings go to stderr).
-void PrintWarnings(const std::vector<std::string>& warnings);
+void PrintWarnings(const std::vector<Notice>& warnings);
 
 /// The files a fit reads besides its calibration: INPUT..., --acc/--gyr, --segments and
 /// --noise-from, into `roles`' inputs (file_roles.h).

@@ -126,8 +126,8 @@ nlohmann::json PaperDocument(const estimation::CalibrationResult& headline,
       "fit, observability and gates are those of the same procedure on the backend (\"" +
       headline.calibration.method + "\".backend): the closed form has no noise model, and it "
       "uses the same means without weighting them, so its own uncertainty is not smaller");
-  std::vector<std::string> warnings = session.warnings;
-  for (const auto& w : headline.fit.warnings) warnings.push_back(w);
+  std::vector<std::string> warnings = Messages(session.warnings);
+  for (const Notice& w : headline.fit.warnings) warnings.push_back(w.message);
   doc["warnings"] = warnings;
   doc["inputs"] = inputs;
   doc[headline.calibration.method] = detail;

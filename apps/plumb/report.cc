@@ -163,7 +163,7 @@ report::InputSummary Summarise(const Session& session, const InputArgs& args) {
   }
   in.acc_unit = s.acc_unit;
   in.gyr_unit = s.gyr_unit;
-  in.warnings = session.warnings;
+  in.warnings = Messages(session.warnings);
   return in;
 }
 

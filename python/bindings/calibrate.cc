@@ -36,7 +36,8 @@ support the model).)doc";
 struct PyResult {
   estimation::CalibrationResult result;
   segmentation::SegmentationResult segmentation;
-  std::vector<std::string> inputs, input_warnings;
+  std::vector<std::string> inputs;
+  std::vector<Notice> input_warnings;  ///< the session's, and gravity's override
   nlohmann::json document;  ///< report::CalibrationJson, made once
 };
 
@@ -210,6 +211,15 @@ void RegisterCalibrate(py::module_& m) {
                              "(m/s^2), source.")
       .def_property_readonly("warnings", [](const PyResult& r) { return ToPython(r.document["warnings"]); },
                              "What the user must know, in words.")
+      .def_property_readonly(
+          "notices",
+          [](const PyResult& r) {
+            py::list out = NoticesToPython(r.input_warnings);
+            for (const auto& d : NoticesToPython(r.result.fit.warnings)) out.append(d);
+            return out;
+          },
+          "The warnings as dicts, in their order: code (stable, e.g. 'site_unknown'), message "
+          "(as in warnings), options (the keywords it points to, as plumb.Error's .options).")
       .def("save", [](const PyResult& r, const std::string& path) { report::WriteJson(path, r.document); },
            py::arg("path"), "Write the calibrate --json document to path (atomically).")
       .def("__repr__", [](const PyResult& r) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/notice.h"
 #include "plumb/core/option_name.h"
 #include "plumb/core/session.h"
 #include "plumb/geo/site.h"
@@ -25,6 +26,11 @@ namespace plumb::python {
 std::string SpellKeyword(Option option, std::string_view value);
 
 namespace py = pybind11;
+
+/// `notices` (core/notice.h) as a list of dicts {code, message, options}, the options a tuple
+/// of this module's keywords (SpellKeyword), as plumb.Error's .options: the structured form of
+/// a `warnings` list, in its order.
+py::list NoticesToPython(const std::vector<Notice>& notices);
 
 void RegisterErrors(py::module_& m);
 void RegisterSession(py::module_& m);

@@ -3,7 +3,8 @@
 // -> plumb.InsufficientDataError, both subclasses of plumb.Error; the message is plumb's.
 // Every plumb.Error has .options, a tuple of the options its message points to as this module's
 // keywords (plumb::Error::options(); the library's name where no keyword takes it), and
-// .option, the first of them or None.
+// .option, the first of them or None. Warnings are rendered the same way (NoticesToPython): a
+// Session's and a Result's .notices, beside their .warnings.
 // A JSON document of the wrong shape (nlohmann::json's exceptions) is a plumb.Error too.
 #include <nlohmann/json.hpp>
 
@@ -11,6 +12,20 @@
 #include "plumb/core/error.h"
 
 namespace plumb::python {
+
+py::list NoticesToPython(const std::vector<Notice>& notices) {
+  py::list out;
+  for (const Notice& n : notices) {
+    py::list options;
+    for (const Option o : n.options) options.append(SpellKeyword(o, ""));
+    py::dict d;
+    d["code"] = n.code;
+    d["message"] = n.message;
+    d["options"] = py::tuple(options);
+    out.append(d);
+  }
+  return out;
+}
 
 void RegisterErrors(py::module_& m) {
   static py::exception<Error> error(m, "Error", PyExc_Exception);

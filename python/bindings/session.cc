@@ -227,8 +227,12 @@ void RegisterSession(py::module_& m) {
                              "The file name(s) it was read from.")
       .def_readonly("inputs", &PySession::inputs,
                     "The inputs as given to open() (a two-file input as 'acc,gyr').")
-      .def_property_readonly("warnings", [](const PySession& s) { return s.session.warnings; },
+      .def_property_readonly("warnings", [](const PySession& s) { return Messages(s.session.warnings); },
                              "What the reader skipped or repaired, in words.")
+      .def_property_readonly("notices",
+                             [](const PySession& s) { return NoticesToPython(s.session.warnings); },
+                             "The warnings as dicts: code (stable, e.g. 'nan_rows_skipped'), "
+                             "message (as in warnings), options (the keywords it points to).")
       .def_property_readonly("site", &SiteOf,
                              "Where the log says the IMU was (its GPS): dict lat_deg, lon_deg "
                              "(degrees), height_m (m), source; None when it does not say.")

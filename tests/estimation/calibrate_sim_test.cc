@@ -245,9 +245,14 @@ TEST(CalibrateSimulated, WithFewHoldsTheTypicalWalkIsAssumedAndSaid) {
   EXPECT_NEAR(o.result.calibration.noise.walk_acc[0], 1e-4, 5e-6);
   EXPECT_NEAR(o.result.calibration.noise.instability_acc[0], 4e-4, 2e-5);
   bool said = false;
-  for (const auto& w : o.result.fit.warnings) {
-    said = said || w.find("bias random walk not estimated (4 still segments, at least 6") !=
-                       std::string::npos;
+  for (const Notice& w : o.result.fit.warnings) {
+    if (w.message.find("bias random walk not estimated (4 still segments, at least 6") ==
+        std::string::npos) {
+      continue;
+    }
+    said = true;
+    EXPECT_EQ(w.code, "walk_not_estimated");
+    EXPECT_TRUE(w.options.empty());
   }
   EXPECT_TRUE(said);
 }
@@ -406,10 +411,10 @@ TEST(CalibrateSimulated, CovarianceIsHonestWithTurnsMadeByHand) {
 }
 
 /// The warnings of `result` that start with `prefix`.
-std::vector<std::string> WarningsStarting(const CalibrationResult& result, const std::string& prefix) {
-  std::vector<std::string> out;
-  for (const auto& w : result.fit.warnings) {
-    if (w.rfind(prefix, 0) == 0) out.push_back(w);
+std::vector<Notice> WarningsStarting(const CalibrationResult& result, const std::string& prefix) {
+  std::vector<Notice> out;
+  for (const Notice& w : result.fit.warnings) {
+    if (w.message.rfind(prefix, 0) == 0) out.push_back(w);
   }
   return out;
 }
@@ -433,10 +438,14 @@ TEST(CalibrateSimulated, SigmasRestingOnTheTypicalWanderAreSaid) {
   std::vector<StillSegment> segments = minute.truth_segments;
   for (auto& seg : segments) seg.known_R_n_b.reset();
   const CalibrationResult r = Calibrate(minute.session.series, segments, minute.model, minute.site, {});
-  const std::vector<std::string> said = WarningsStarting(r, prefix);
+  const std::vector<Notice> said = WarningsStarting(r, prefix);
   ASSERT_EQ(said.size(), 1u) << report::FullReport(r);
-  EXPECT_NE(said[0].find("were the wander at the largest level the still data allow (their 95 % "
-                         "bound), the sigmas would be up to "), std::string::npos) << said[0];
+  EXPECT_NE(said[0].message.find("were the wander at the largest level the still data allow "
+                                 "(their 95 % bound), the sigmas would be up to "),
+            std::string::npos)
+      << said[0].message;
+  EXPECT_EQ(said[0].code, "sigma_rests_on_wander");
+  EXPECT_EQ(said[0].options, std::vector<Option>{Option::kNoiseFrom});
   const Outcome holds = CalibrateMultiPose(9901, "base", 12, 5.0, Noise::kRealistic, Fit::kWander);
   EXPECT_TRUE(WarningsStarting(holds.result, prefix).empty()) << report::FullReport(holds.result);
 }

@@ -6,6 +6,8 @@
 #include <limits>
 #include <random>
 
+#include "plumb/core/notice.h"
+#include "plumb/core/option_name.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/gates.h"
 #include "plumb/estimation/uncertainty.h"
@@ -141,6 +143,46 @@ TEST(Gates, AGoodSessionPassesEveryGate) {
   EXPECT_EQ(r.fit.distinct_poses, 12);
   EXPECT_TRUE(Contains(report::FitVerdict(r.fit), "consistent with the noise"))
       << report::FitVerdict(r.fit);
+}
+
+/// The warning with `code`, or nullptr.
+const Notice* FindWarning(const std::vector<Notice>& warnings, const std::string& code) {
+  for (const Notice& w : warnings) {
+    if (w.code == code) return &w;
+  }
+  return nullptr;
+}
+
+// Issue 36 item 3: the fit's warnings carry their code and the options their advice names.
+TEST(FitWarnings, TheSiteAndTheHeadingAreSaidWithTheirCodeAndOptions) {
+  const sim::Simulation s = MultiPose(31);
+  const std::vector<StillSegment> segments = FreeAttitudes(s.truth_segments);
+  const CalibrationResult at_site = Calibrate(s.session.series, segments, s.model, s.site);
+  EXPECT_EQ(FindWarning(at_site.fit.warnings, "site_unknown"), nullptr);
+  const Notice* heading = FindWarning(at_site.fit.warnings, "heading_assumed");
+  ASSERT_NE(heading, nullptr) << report::FullReport(at_site);
+  EXPECT_TRUE(Contains(heading->message, "the heading of the first still pose is held at 0"))
+      << heading->message;
+  EXPECT_EQ(heading->options, (std::vector<Option>{Option::kHeading, Option::kLevelNorth}));
+
+  const CalibrationResult nowhere =
+      Calibrate(s.session.series, segments, s.model, geo::Site::Unknown());
+  EXPECT_EQ(FindWarning(nowhere.fit.warnings, "heading_assumed"), nullptr);
+  const Notice* site = FindWarning(nowhere.fit.warnings, "site_unknown");
+  ASSERT_NE(site, nullptr) << report::FullReport(nowhere);
+  EXPECT_TRUE(Contains(site->message, "no site given: gravity fixed at ")) << site->message;
+  EXPECT_TRUE(Contains(site->message, "(give " + OptionText(Option::kSite) + ")"))
+      << site->message;
+  EXPECT_EQ(site->options, std::vector<Option>{Option::kSite});
+
+  ImuSeries accel_only = s.session.series;
+  accel_only.gyr.clear();
+  const CalibrationResult no_gyro =
+      Calibrate(accel_only, segments, s.model, geo::Site::Unknown());
+  const Notice* gyro = FindWarning(no_gyro.fit.warnings, "no_gyroscope");
+  ASSERT_NE(gyro, nullptr) << report::FullReport(no_gyro);
+  EXPECT_EQ(gyro->message, "the input has no gyroscope: calibrating the accelerometer only");
+  EXPECT_TRUE(gyro->options.empty());
 }
 
 TEST(Gates, PiecesOfOnePoseAreOnePose) {

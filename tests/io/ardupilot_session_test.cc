@@ -43,7 +43,11 @@ TEST(ArdupilotSession, UndoesTheInsCorrectionAndReadsTheSite) {
     EXPECT_NEAR(raw.series.gyr[10][i], logged.series.gyr[10][i] + gyr, 1e-6);
   }
   bool said = false;
-  for (const auto& w : raw.warnings) said = said || w.find("reconstructed") != std::string::npos;
+  for (const auto& w : raw.warnings) {
+    if (w.message.find("reconstructed") == std::string::npos) continue;
+    said = true;
+    EXPECT_EQ(w.code, "correction_undone");
+  }
   EXPECT_TRUE(said);
   // The log's README: GPS at 51.64 N; the site comes from its 3D fixes.
   ASSERT_TRUE(raw.site.has_value());
@@ -215,7 +219,7 @@ TEST(ArdupilotSession, UndoRecoversRawSamplesForEveryRotation) {
     }
     bool tcal_said = false;
     for (const auto& w : s.warnings) {
-      tcal_said = tcal_said || w.find("INS_TCAL1 temperature calibration undone") !=
+      tcal_said = tcal_said || w.message.find("INS_TCAL1 temperature calibration undone") !=
                                    std::string::npos;
     }
     EXPECT_TRUE(tcal_said) << orientation;
@@ -234,8 +238,8 @@ TEST(ArdupilotSession, CustomOrientationIsNotUndoneAndSaysSo) {
   EXPECT_EQ(s.series.acc[0], Vec3f(1, 2, -9.8f));  // as logged
   bool said = false;
   for (const auto& w : s.warnings) {
-    said = said || (w.find("AHRS_ORIENTATION = 101 (CUSTOM)") != std::string::npos &&
-                    w.find("not undone") != std::string::npos);
+    said = said || (w.message.find("AHRS_ORIENTATION = 101 (CUSTOM)") != std::string::npos &&
+                    w.message.find("not undone") != std::string::npos);
   }
   EXPECT_TRUE(said);
   EXPECT_FALSE(DataflashImuStreams(log)[0].undoable);
@@ -252,7 +256,9 @@ TEST(ArdupilotSession, ACorrectionChangedDuringTheLogIsSaid) {
   const Session s = ArdupilotSession(log, FlightLogSelection{});
   bool said = false;
   for (const auto& w : s.warnings) {
-    said = said || (w.find("changed during the log (INS_ACCOFFS_X)") != std::string::npos);
+    if (w.message.find("changed during the log (INS_ACCOFFS_X)") == std::string::npos) continue;
+    said = true;
+    EXPECT_EQ(w.code, "correction_changed");
   }
   EXPECT_TRUE(said);
   const Session same = ArdupilotSession(
@@ -261,7 +267,7 @@ TEST(ArdupilotSession, ACorrectionChangedDuringTheLogIsSaid) {
         return ParseDataflashText(t.data(), t.size(), "steady.log");
       }(),
       FlightLogSelection{});
-  for (const auto& w : same.warnings) EXPECT_EQ(w.find("changed during the log"), std::string::npos);
+  for (const auto& w : same.warnings) EXPECT_EQ(w.message.find("changed during the log"), std::string::npos);
 }
 
 TEST(ArdupilotSession, ANonFiniteParameterIsNotUsedAndSaysWhatStays) {
@@ -293,7 +299,7 @@ TEST(ArdupilotSession, TemperatureCalibrationWithoutTemperatureIsSaid) {
   const Session s = ArdupilotSession(log, acc);
   bool said = false;
   for (const auto& w : s.warnings) {
-    said = said || w.find("INS_TCAL1_ENABLE = 1 but the stream has no temperature") !=
+    said = said || w.message.find("INS_TCAL1_ENABLE = 1 but the stream has no temperature") !=
                        std::string::npos;
   }
   EXPECT_TRUE(said);
@@ -320,7 +326,7 @@ TEST(ArdupilotSession, UndoesAhrsOrientationOfARealLog) {
   }
   bool said = false;
   for (const auto& w : raw.warnings) {
-    said = said || w.find("AHRS_ORIENTATION = 8 (ROLL_180) undone") != std::string::npos;
+    said = said || w.message.find("AHRS_ORIENTATION = 8 (ROLL_180) undone") != std::string::npos;
   }
   EXPECT_TRUE(said);
 }

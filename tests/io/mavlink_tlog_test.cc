@@ -516,7 +516,7 @@ TEST(MavlinkSession, ArdupilotRawImuIsMilliGAndTheCorrectionIsUndone) {
   EXPECT_NEAR(raw.series.gyr[0].x(), 0.1 + 0.125, 1e-6);
   EXPECT_NEAR(raw.series.gyr[0].z(), -0.2 - 0.5, 1e-6);
   bool reconstructed = false;
-  for (const auto& w : raw.warnings) reconstructed |= w.find("reconstructed") != std::string::npos;
+  for (const auto& w : raw.warnings) reconstructed |= w.message.find("reconstructed") != std::string::npos;
   EXPECT_TRUE(reconstructed);
   EXPECT_FALSE(raw.site.has_value());
 }
@@ -551,7 +551,7 @@ TEST(MavlinkSession, TheAutopilotIsTheSystemSendingMostImuFrames) {
   const Session s = TlogSession(log, FlightLogSelection{});
   EXPECT_EQ(s.series.size(), 10u);
   bool said = false;
-  for (const auto& w : s.warnings) said |= w.find("other system") != std::string::npos;
+  for (const auto& w : s.warnings) said |= w.message.find("other system") != std::string::npos;
   EXPECT_TRUE(said);
 }
 
@@ -644,8 +644,10 @@ TEST(MavlinkSession, BadTimesCostOneSampleEachAndAreSaid) {
       "RAW_IMU instance 0: dropped 2 sample(s) whose time did not increase past the last kept "
       "one, or ran ahead of the next (a reboot or a corrupted time); the first with time "
       "900000.000000 s";
-  EXPECT_NE(std::find(s.warnings.begin(), s.warnings.end(), said), s.warnings.end())
-      << ::testing::PrintToString(s.warnings);
+  const auto dropped = std::find_if(s.warnings.begin(), s.warnings.end(),
+                                    [&](const Notice& n) { return n.message == said; });
+  ASSERT_NE(dropped, s.warnings.end()) << ::testing::PrintToString(Messages(s.warnings));
+  EXPECT_EQ(dropped->code, "samples_out_of_order");
 }
 
 // --- the real log as a session ------------------------------------------------------------------

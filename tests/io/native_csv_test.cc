@@ -98,9 +98,10 @@ TEST(NativeCsv, ByteOrderMarkAndNanRowsOnRequest) {
   ASSERT_EQ(s.series.size(), 2u);
   EXPECT_EQ(s.series.t_s[1], 3.0);
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("skipped 1 rows with NaN or infinite values (first at line 3)"),
+  EXPECT_EQ(s.warnings[0].code, "nan_rows_skipped");
+  EXPECT_NE(s.warnings[0].message.find("skipped 1 rows with NaN or infinite values (first at line 3)"),
             std::string::npos)
-      << s.warnings[0];
+      << s.warnings[0].message;
   ExpectInputError([&] { ReadNativeCsv(path); }, path, "line 3", {"NaN or infinite"});
 }
 

@@ -177,7 +177,9 @@ TEST(OpenInputs, JoinsShiftingAnOverlappingClock) {
   EXPECT_DOUBLE_EQ(s.series.t_s[3], 0.2 + 1000.0);
   EXPECT_EQ(s.source, a + " " + b);
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("shifted by 1000.200000 s"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].message.find("shifted by 1000.200000 s"), std::string::npos)
+      << s.warnings[0].message;
+  EXPECT_EQ(s.warnings[0].code, "inputs_overlap");
 }
 
 TEST(OpenInputs, RefusesToJoinDifferentSensors) {

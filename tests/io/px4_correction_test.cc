@@ -72,13 +72,16 @@ TEST(Px4Correction, UndoInvertsTheForwardCorrection) {
   ImuSeries s;
   s.t_s = {0.0};
   s.acc = {(c->rotation * (m - c->offset).cwiseProduct(c->scale)).cast<float>()};  // logged
-  std::vector<std::string> warnings, left;
+  std::vector<Notice> warnings;
+  std::vector<std::string> left;
   UndoPx4Correction(p, sensors, "acc: ", &s, &warnings, &left);
   EXPECT_NEAR(s.acc[0].x(), m.x(), 1e-5);
   EXPECT_NEAR(s.acc[0].y(), m.y(), 1e-5);
   EXPECT_NEAR(s.acc[0].z(), m.z(), 1e-5);
   ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_EQ(warnings[0].rfind("acc: accelerometer reconstructed", 0), 0u) << warnings[0];
+  EXPECT_EQ(warnings[0].message.rfind("acc: accelerometer reconstructed", 0), 0u)
+      << warnings[0].message;
+  EXPECT_EQ(warnings[0].code, "correction_undone");
   EXPECT_TRUE(left.empty());
   EXPECT_EQ(Px4AppliedText(p, sensors), "CAL_ACC0_*, CAL_GYROn_*, board rotation");
   EXPECT_TRUE(Px4Undoable(p, sensors, false));

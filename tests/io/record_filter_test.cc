@@ -185,9 +185,9 @@ TEST(RecordFilter, DataflashImuDecodedKeepsTheTimeRuleAndInstances) {
                              "or a spike above the next record's: a corrupt or backwards time "
                              "stamp); the first with time 0.002001 s";
     EXPECT_EQ(std::count_if(s.warnings.begin(), s.warnings.end(),
-                            [&](const std::string& w) { return w.rfind(said, 0) == 0; }),
+                            [&](const Notice& w) { return w.message.rfind(said, 0) == 0; }),
               1)
-        << ::testing::PrintToString(s.warnings);
+        << ::testing::PrintToString(Messages(s.warnings));
   }
 }
 

@@ -87,8 +87,11 @@ TEST(TextTable, TimeFromTheSampleRate) {
   EXPECT_DOUBLE_EQ(s.series.t_s[0], 0.0);
   EXPECT_DOUBLE_EQ(s.series.t_s[1], 0.01);  // the dropped row keeps its time slot
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("skipped 1 rows"), std::string::npos) << s.warnings[0];
-  EXPECT_NE(s.warnings[0].find("line 2"), std::string::npos) << s.warnings[0];
+  EXPECT_NE(s.warnings[0].message.find("skipped 1 rows"), std::string::npos)
+      << s.warnings[0].message;
+  EXPECT_NE(s.warnings[0].message.find("line 2"), std::string::npos) << s.warnings[0].message;
+  EXPECT_EQ(s.warnings[0].code, "nan_rows_skipped");
+  EXPECT_TRUE(s.warnings[0].options.empty());
 }
 
 TEST(TextTable, AxisMapTurnsFluIntoFrd) {

@@ -498,8 +498,11 @@ TEST(ULogBuilt, SensorCombinedDecodedInThePassAsFromBodies) {
         "sensor_combined of IMU instance 0: left out 2 of 7 records by their time (not finite, "
         "not above the last kept one, or a spike above the next record's: a corrupt or "
         "backwards time stamp); the first with time 0.002000 s";
-    EXPECT_EQ(std::count(s->warnings.begin(), s->warnings.end(), dropped), 1)
-        << ::testing::PrintToString(s->warnings);
+    const std::vector<std::string> said = Messages(s->warnings);
+    EXPECT_EQ(std::count(said.begin(), said.end(), dropped), 1) << ::testing::PrintToString(said);
+    for (const Notice& n : s->warnings) {
+      if (n.message == dropped) EXPECT_EQ(n.code, "records_dropped");
+    }
   }
 }
 
@@ -525,13 +528,14 @@ TEST(ULogBuilt, OneStampFarAheadCostsOneSample) {
     ASSERT_EQ(info.size(), 1u);
     EXPECT_EQ(info[0].records, 100u);
     EXPECT_EQ(info[0].samples, 99u);
-    EXPECT_NE(std::find(s.warnings.begin(), s.warnings.end(),
+    const std::vector<std::string> said = Messages(s.warnings);
+    EXPECT_NE(std::find(said.begin(), said.end(),
                         "sensor_combined of IMU instance 0: left out 1 of 100 records by their time "
                         "(not finite, not above the last kept one, or a spike above the next "
                         "record's: a corrupt or backwards time stamp); the first with time "
                         "5000000000000.000000 s"),
-              s.warnings.end())
-        << ::testing::PrintToString(s.warnings);
+              said.end())
+        << ::testing::PrintToString(said);
   }
 }
 
@@ -586,7 +590,7 @@ TEST(ULogSession, SampleUlgStillPeriodAfterUndoingTheCalibration) {
   const Vec3 expected_gyro = r.transpose() * logged.series.gyr[10].cast<double>() + gyro_offset;
   EXPECT_LT((raw.series.gyr[10].cast<double>() - expected_gyro).norm(), 1e-6);
   bool said = false;
-  for (const auto& w : raw.warnings) said = said || w.find("reconstructed") != std::string::npos;
+  for (const auto& w : raw.warnings) said = said || w.message.find("reconstructed") != std::string::npos;
   EXPECT_TRUE(said);
   // sample.ulg subscribes vehicle_gps_position but logs no message of it: no site.
   EXPECT_FALSE(raw.site.has_value());
@@ -745,7 +749,7 @@ TEST(ULogSession, UndoesBoardRotationCalibrationAndThermalOffset) {
   }
   EXPECT_NEAR(logged.series.acc[0].x(), 0.2, 1e-6);  // delta_velocity / dt
   bool thermal_said = false;
-  for (const auto& m : s.warnings) thermal_said = thermal_said || m.find("TC_A0") != std::string::npos;
+  for (const auto& m : s.warnings) thermal_said = thermal_said || m.message.find("TC_A0") != std::string::npos;
   EXPECT_TRUE(thermal_said);
 }
 

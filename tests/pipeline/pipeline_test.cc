@@ -66,7 +66,7 @@ TEST(FitSetup, SegmentsGivenOrDetected) {
 
 TEST(FitSetup, RequestBecomesTheFitsInputs) {
   Session session = SixPoses();
-  session.warnings = {"from the reader"};
+  session.warnings = {Notice{"nan_rows_skipped", "from the reader", {}}};
   const segmentation::SegmentationResult seg = FindSegments(session.series, {});
   FitRequest request;
   request.model = model::Model::Parse("base");
@@ -89,8 +89,10 @@ TEST(FitSetup, RequestBecomesTheFitsInputs) {
   EXPECT_TRUE(fixed.site.known);
   EXPECT_EQ(fixed.site.g_n.z(), 9.8);
   ASSERT_EQ(fixed.input_warnings.size(), 2u);
-  EXPECT_EQ(fixed.input_warnings[1],
+  EXPECT_EQ(fixed.input_warnings[1].message,
             "gravity fixed at 9.800000 m/s^2 by GRAVITY instead of WGS84 normal gravity");
+  EXPECT_EQ(fixed.input_warnings[1].code, "gravity_fixed");
+  EXPECT_EQ(fixed.input_warnings[1].options, std::vector<Option>{Option::kGravity});
 }
 
 TEST(FitSetup, GateFailureCountsTheGates) {

@@ -117,6 +117,25 @@ class Errors(unittest.TestCase):
         self.assertEqual(c.exception.options, ())
         self.assertIsNone(c.exception.option)
 
+    def test_warnings_carry_a_code_and_their_options(self):
+        # The warnings stay strings; .notices gives each its stable code and its options, as
+        # keywords, in the same order.
+        path = out("nan_dropped.csv")
+        with open(path, "w") as f:
+            f.write("0,0,0,9.8\n0.01,nan,0,9.8\n0.02,0,0,9.8\n0.03,0,0,9.8\n")
+        s = plumb.open(path, columns="t,ax,ay,az", drop_nan=True)
+        self.assertTrue(all(isinstance(w, str) for w in s.warnings))
+        self.assertEqual([n["message"] for n in s.notices], s.warnings)
+        self.assertIn("nan_rows_skipped", [n["code"] for n in s.notices])
+        r = plumb.calibrate(plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100),
+                            max_iterations=1)
+        self.assertTrue(all(isinstance(w, str) for w in r.warnings))
+        self.assertEqual([n["message"] for n in r.notices], r.warnings)
+        site = [n for n in r.notices if n["code"] == "site_unknown"]
+        self.assertEqual(len(site), 1)
+        self.assertEqual(site[0]["options"], ("site=(lat_deg, lon_deg, height_m)",))
+        self.assertIn("(give site=(lat_deg, lon_deg, height_m))", site[0]["message"])
+
     def test_bad_calibration_file_names_it(self):
         path = out("not_a_calibration.json")
         with open(path, "w") as f:

@@ -204,7 +204,8 @@ TEST(JsonReport, AccelerometerOnlyResultHasNullGyro) {
 
 TEST(JsonReport, CalibrationJsonAddsSegmentationInputsAndReaderWarningsFirst) {
   const json doc =
-      CalibrationJson(MakeResult(), GivenSegmentation(), {"a.csv"}, {"a.csv: 3 rows dropped"});
+      CalibrationJson(MakeResult(), GivenSegmentation(), {"a.csv"},
+                      {Notice{"nan_rows_skipped", "a.csv: 3 rows dropped", {}}});
   EXPECT_EQ(doc["inputs"], json::array({"a.csv"}));
   EXPECT_EQ(doc["segmentation"]["method"], "given");
   EXPECT_EQ(doc["segmentation"]["segments"], 2);

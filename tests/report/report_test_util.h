@@ -86,7 +86,7 @@ inline estimation::CalibrationResult MakeResult() {
   r.fit.motion.push_back(m);
   r.calibration.noise.acc = Vec3(0.01, 0.01, 0.012);
   r.calibration.noise.gyr = Vec3(7e-4, 7e-4, 8e-4);
-  r.fit.warnings = {"no site given"};
+  r.fit.warnings = {Notice{"site_unknown", "no site given", {Option::kSite}}};
   return r;
 }
 

@@ -8,6 +8,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/core/log_motion.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/segment.h"
 
 namespace plumb {
@@ -26,7 +27,8 @@ struct Session {
   ImuSeries series;
   std::vector<StillSegment> given_segments;  ///< stated by the user; empty means detect
   std::optional<SiteInput> site;
-  std::vector<std::string> warnings;         ///< what the reader skipped or repaired
+  /// What the reader skipped, repaired or assumed (notice.h lists the codes).
+  std::vector<Notice> warnings;
   /// What a flight controller applied to these samples that the reader did not undo (e.g.
   /// "ArduPilot INS_ACC2OFFS/INS_ACC2SCAL"); empty when the samples are the sensor's own
   /// output, raw or fully reconstructed. Firmware parameters calibrated from samples that

@@ -84,28 +84,32 @@ void AddAdvice(const Calibration& calibration, const StillSet& still,
     if (options.on_insufficient == InsufficientData::kError) {
       throw InsufficientDataError(undetermined);
     }
-    fit.warnings.push_back(undetermined);
+    fit.warnings.push_back(Notice{"undetermined", undetermined, {}});
   }
   for (const NotATurn& m : fit.not_turns) fit.notes.push_back(NotATurnText(fit, m));
   if (const std::optional<std::string> turns = TurnsNotAtTheirNoise(calibration, options, fit)) {
-    fit.warnings.push_back(*turns);
+    fit.warnings.push_back(Notice{"turns_above_noise", *turns, {}});
   }
   if (!site.known) {
-    fit.warnings.push_back(
+    fit.warnings.push_back(Notice{
+        "site_unknown",
         "no site given: gravity fixed at " + std::to_string(site.gravity()) + " m/s^2" +
         (calibration.has_gyro ? " and Earth rate left out; the accelerometer scale and the "
                                 "gyroscope bias depend on it"
                               : "; the accelerometer scale depends on it") +
-        " (give " + OptionText(Option::kSite) + ")");
+        " (give " + OptionText(Option::kSite) + ")",
+        {Option::kSite}});
   }
   if (site.known && calibration.has_gyro && !still.AnyAttitudeKnown() &&
       !options.first_heading_deg) {
-    fit.warnings.push_back(
+    fit.warnings.push_back(Notice{
+        "heading_assumed",
         "the heading of the first still pose is held at 0 (x north) as the gauge; with a site, "
         "Earth rate (" + Number(site.omega_ie_n.head<2>().norm()) +
         " rad/s horizontal) is predicted for that heading: state it (" +
         OptionText(Option::kHeading, "DEG") + " or " + OptionText(Option::kLevelNorth) +
-        ") or the gyroscope biases absorb up to that much");
+        ") or the gyroscope biases absorb up to that much",
+        {Option::kHeading, Option::kLevelNorth}});
   }
 }
 

@@ -28,11 +28,12 @@ namespace {
 /// The model as this session can fit it: without gyroscope terms when the input has no
 /// gyroscope (said in `warnings`). Throws when an effect needs data the input lacks.
 model::Model ModelForSession(const model::Model& requested, const ImuSeries& series,
-                             const geo::Site& site, std::vector<std::string>& warnings) {
+                             const geo::Site& site, std::vector<Notice>& warnings) {
   model::Model model = requested;
   if (!series.has_gyro() && model.has_gyro()) {
     model.DropGyro();
-    warnings.push_back("the input has no gyroscope: calibrating the accelerometer only");
+    warnings.push_back(
+        Notice{"no_gyroscope", "the input has no gyroscope: calibrating the accelerometer only", {}});
   }
   if (site.known && model.has_effect("earth_rate")) {
     throw Error("earth_rate is a candidate only without a site: with " +
@@ -121,7 +122,7 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
           fitted.noise, fitted.wander_bounds, result.fit.still_segments, options)) {
     const CalibrationResult bound = Calibrate(series, segments, model_in, site, *at_bound);
     if (const std::optional<std::string> w = SigmaRestsOnTheTypicalWander(result, bound)) {
-      result.fit.warnings.push_back(*w);
+      result.fit.warnings.push_back(Notice{"sigma_rests_on_wander", *w, {Option::kNoiseFrom}});
     }
   }
   return result;

@@ -106,7 +106,7 @@ void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>&
                        const ObservabilityAnalysis& analysis,
                        const std::vector<Eigen::Index>& column_of,
                        const CalibrationOptions& options, Calibration& calibration,
-                       std::vector<std::string>& warnings) {
+                       std::vector<Notice>& warnings) {
   const auto n = static_cast<Eigen::Index>(calibration.parameters.size());
   calibration.covariance = Eigen::MatrixXd::Zero(n, n);
   // With the bias-wander states (more than kDenseUnknowns unknowns) the analysis's covariance,
@@ -118,8 +118,10 @@ void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>&
       CeresCovariance(fitted, calibration.model, fitted_blocks, calibration.covariance);
   if (!from_ceres) {
     if (options.use_ceres_covariance && dense && calibration.model.num_free_parameters() > 0) {
-      warnings.push_back("ceres::Covariance found the problem singular; sigmas are from "
-                         "the pseudo-inverse of the column-scaled Jacobian");
+      warnings.push_back(Notice{"covariance_singular",
+                                "ceres::Covariance found the problem singular; sigmas are from "
+                                "the pseudo-inverse of the column-scaled Jacobian",
+                                {}});
     }
     for (Eigen::Index a = 0; a < n; ++a) {
       for (Eigen::Index b = 0; b < n; ++b) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/estimation/calibration.h"
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/observability.h"
@@ -44,6 +45,6 @@ void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>&
                        const ObservabilityAnalysis& analysis,
                        const std::vector<Eigen::Index>& column_of,
                        const CalibrationOptions& options, Calibration& calibration,
-                       std::vector<std::string>& warnings);
+                       std::vector<Notice>& warnings);
 
 }  // namespace plumb::estimation

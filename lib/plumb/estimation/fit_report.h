@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "plumb/core/log_motion.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/option_name.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/types.h"
@@ -127,7 +128,7 @@ struct FitReport {
   std::vector<StillSegmentFit> still;  ///< per still segment used, in time order
   std::vector<MotionFit> motion;       ///< per motion interval integrated
   std::vector<NotATurn> not_turns;     ///< motion between poses left out of the fit
-  std::vector<std::string> warnings;   ///< what the user must know, in words
+  std::vector<Notice> warnings;        ///< what the user must know (codes: core/notice.h)
   std::vector<std::string> notes;      ///< how the fit was made, in words (e.g. the noise)
   /// Checks the fit failed (empty: all passed); a failed gate means the numbers above are
   /// not to be trusted as they stand (estimation/gates.h).

@@ -197,7 +197,7 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
                   "bias random walk not estimated (%zu still segments, at least %d are needed to "
                   "see it): the level from the still data or the typical MEMS sensor kept",
                   still.poses.size(), options.walk_min_poses);
-    out.warnings.emplace_back(text);
+    out.warnings.push_back(Notice{"walk_not_estimated", text, {}});
     return out;
   }
   for (int it = 0; it < kMaxIterations; ++it) {

@@ -49,6 +49,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/options.h"
@@ -63,7 +64,7 @@ struct WalkEstimate {
   NoiseModel noise;        ///< the noise model with the wander levels the session resolves
   int iterations = 0;      ///< fits made
   std::vector<std::string> notes;     ///< what was done, in words
-  std::vector<std::string> warnings;  ///< what was assumed for lack of data
+  std::vector<Notice> warnings;  ///< what was assumed for lack of data
   /// Non-empty when an estimated walk is implausibly large (the gate implausible_walk).
   std::string implausible;
 };

@@ -33,9 +33,12 @@ FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResu
   out.site = geo::ResolveSite(request.site, session.site, request.gravity_m_s2);
   out.input_warnings = session.warnings;
   if (request.gravity_m_s2 && out.site.known) {
-    out.input_warnings.push_back("gravity fixed at " + std::to_string(*request.gravity_m_s2) +
-                                 " m/s^2 by " + request.gravity_option +
-                                 " instead of WGS84 normal gravity");
+    out.input_warnings.push_back(Notice{"gravity_fixed",
+                                        "gravity fixed at " +
+                                            std::to_string(*request.gravity_m_s2) + " m/s^2 by " +
+                                            request.gravity_option +
+                                            " instead of WGS84 normal gravity",
+                                        {Option::kGravity}});
   }
   out.model = std::move(request.model);
   out.model.t_ref_s = session.series.t_s.front();

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/session.h"
 #include "plumb/estimation/options.h"
@@ -67,7 +68,7 @@ struct FitSetup {
   estimation::CalibrationOptions options;  ///< the request's
   /// The session's warnings, and the note that a fixed gravity overrides WGS84 gravity at a
   /// known site (a calibration document's input warnings).
-  std::vector<std::string> input_warnings;
+  std::vector<Notice> input_warnings;
 };
 
 /// The fit's inputs for `session` and its segmentation, from `request`.

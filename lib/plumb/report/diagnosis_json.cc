@@ -132,7 +132,7 @@ nlohmann::json DiagnosisJson(const diagnostics::Diagnosis& d,
   }
   doc["compare"] = ToJson(ra);
   doc["site"] = fit["site"];
-  doc["warnings"] = d.fit.fit.warnings;
+  doc["warnings"] = Messages(d.fit.fit.warnings);
   doc["gates"] = GatesJson(d.fit.fit);  // the user's fit's, as calibrate's JSON has them
   return doc;
 }

@@ -538,7 +538,7 @@ std::string WorstSection(const diagnostics::ResidualAnalysis& a) {
 std::string TailSection(const estimation::CalibrationResult& r, const PageExtras& extras) {
   std::string out;
   if (!r.fit.warnings.empty()) {
-    out += "<h2 id=\"warnings\">Warnings</h2>\n" + HtmlList(r.fit.warnings, "warn");
+    out += "<h2 id=\"warnings\">Warnings</h2>\n" + HtmlList(Messages(r.fit.warnings), "warn");
   }
   if (!extras.files.empty()) {
     out += "<h2 id=\"files\">Files</h2>\n<p>Written beside this page in its folder, for other "

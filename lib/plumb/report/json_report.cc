@@ -402,7 +402,7 @@ json ToJson(const estimation::CalibrationResult& r) {
     if (m.flown) j["log_motion"] = LogMotionJson(*m.flown);
     doc["not_turns"].push_back(j);
   }
-  doc["warnings"] = r.fit.warnings;
+  doc["warnings"] = Messages(r.fit.warnings);  // the messages; the codes are not in SPEC 6
   if (!r.fit.notes.empty()) doc["notes"] = r.fit.notes;
   return doc;
 }
@@ -426,12 +426,12 @@ json ToJson(const segmentation::SegmentationResult& s) {
 json CalibrationJson(const estimation::CalibrationResult& result,
                      const segmentation::SegmentationResult& segmentation,
                      const std::vector<std::string>& inputs,
-                     const std::vector<std::string>& input_warnings) {
+                     const std::vector<Notice>& input_warnings) {
   json doc = ToJson(result);
   doc["segmentation"] = ToJson(segmentation);
   doc[keys::kInputs] = inputs;
-  std::vector<std::string> warnings = input_warnings;
-  warnings.insert(warnings.end(), result.fit.warnings.begin(), result.fit.warnings.end());
+  std::vector<std::string> warnings = Messages(input_warnings);
+  for (const Notice& w : result.fit.warnings) warnings.push_back(w.message);
   doc["warnings"] = warnings;
   return doc;
 }

@@ -48,6 +48,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/notice.h"
 #include "plumb/core/types.h"
 #include "plumb/estimation/result.h"
 #include "plumb/segmentation/still_detector.h"
@@ -97,7 +98,7 @@ nlohmann::json ToJson(const segmentation::SegmentationResult& segmentation);
 nlohmann::json CalibrationJson(const estimation::CalibrationResult& result,
                                const segmentation::SegmentationResult& segmentation,
                                const std::vector<std::string>& inputs,
-                               const std::vector<std::string>& input_warnings);
+                               const std::vector<Notice>& input_warnings);
 
 /// `document` as every JSON file plumb writes holds it: indented by 2, newline-terminated,
 /// invalid UTF-8 in strings replaced (the text WriteJson writes, the Python module's to_json).

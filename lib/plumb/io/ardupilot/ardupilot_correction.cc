@@ -5,12 +5,18 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "plumb/core/units.h"
 
 namespace plumb::io {
 namespace {
+
+/// Adds `message` to `warnings` under `code` (core/notice.h lists the codes).
+void Say(std::vector<Notice>* warnings, const char* code, std::string message) {
+  warnings->push_back(Notice{code, std::move(message), {}});
+}
 
 /// One entry of ArduPilot's Rotation enum: name and Euler angles, degrees.
 struct RotationEntry {
@@ -160,57 +166,64 @@ std::string Format(double v) {
 
 
 /// Step 1 of the undo: board = R_board^T logged.
-void UndoRotation(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<std::string>* warnings) {
+void UndoRotation(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<Notice>* warnings) {
   if (c.orientation == 0) return;
   const Mat3 Rt = c.R_board->transpose();
   for (auto& a : series->acc) a = (Rt * a.cast<double>()).cast<float>();
   for (auto& g : series->gyr) g = (Rt * g.cast<double>()).cast<float>();
-  warnings->push_back(who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
-                        ArdupilotRotationName(c.orientation) +
-                        ") undone: board = R^T logged, R = " + Format(*c.R_board));
+  Say(warnings, "correction_undone",
+      who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
+          ArdupilotRotationName(c.orientation) + ") undone: board = R^T logged, R = " +
+          Format(*c.R_board));
 }
 
 /// Step 2: offsets and scales.
-void UndoOffsets(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<std::string>* warnings) {
+void UndoOffsets(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<Notice>* warnings) {
   const std::string acc = Prefix("ACC", c.instance);
   const std::string gyr = Prefix("GYR", c.instance);
   if (c.acc_offset && c.acc_scale) {
     for (auto& a : series->acc) {
       a = (a.cast<double>().cwiseQuotient(*c.acc_scale) + *c.acc_offset).cast<float>();
     }
-    warnings->push_back(who + "accelerometer reconstructed as logged ./ " + acc + "SCAL (" +
-                          Format(*c.acc_scale) + ") + " + acc + "OFFS (" +
-                          Format(*c.acc_offset) + ") m/s^2");
+    Say(warnings, "correction_undone",
+        who + "accelerometer reconstructed as logged ./ " + acc + "SCAL (" +
+            Format(*c.acc_scale) + ") + " + acc + "OFFS (" + Format(*c.acc_offset) + ") m/s^2");
   } else {
-    warnings->push_back(who + "no " + acc + "OFFS/" + acc +
-                          "SCAL in the log: accelerometer offsets/scales not undone");
+    Say(warnings, "correction_not_undone",
+        who + "no " + acc + "OFFS/" + acc +
+            "SCAL in the log: accelerometer offsets/scales not undone");
   }
   if (!series->has_gyro()) return;
   if (c.gyr_offset) {
     for (auto& g : series->gyr) g = (g.cast<double>() + *c.gyr_offset).cast<float>();
-    warnings->push_back(who + "gyroscope reconstructed as logged + " + gyr + "OFFS (" +
-                          Format(*c.gyr_offset) + ") rad/s");
+    Say(warnings, "correction_undone",
+        who + "gyroscope reconstructed as logged + " + gyr + "OFFS (" + Format(*c.gyr_offset) +
+            ") rad/s");
   } else {
-    warnings->push_back(who + "no " + gyr + "OFFS in the log: gyroscope offsets not undone");
+    Say(warnings, "correction_not_undone",
+        who + "no " + gyr + "OFFS in the log: gyroscope offsets not undone");
   }
 }
 
 /// Step 3: the temperature calibration.
-void UndoTempCal(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<std::string>* warnings) {
+void UndoTempCal(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<Notice>* warnings) {
   const std::string tcal = "INS_TCAL" + std::to_string(c.instance + 1);
   if (c.tcal_enable == 2) {
-    warnings->push_back(who + tcal + "_ENABLE = 2 (learning): ArduPilot applied no "
-                                "temperature correction, nothing to undo");
+    Say(warnings, "correction_not_undone",
+        who + tcal + "_ENABLE = 2 (learning): ArduPilot applied no temperature correction, "
+                     "nothing to undo");
   }
   if (c.tcal_enable != 1) return;
   if (!c.tcal) {
-    warnings->push_back(who + tcal + "_ENABLE = 1 but its TMIN/TMAX/ACC*/GYR* parameters "
-                                "are not all in the log: temperature calibration not undone");
+    Say(warnings, "correction_not_undone",
+        who + tcal + "_ENABLE = 1 but its TMIN/TMAX/ACC*/GYR* parameters are not all in the "
+                     "log: temperature calibration not undone");
     return;
   }
   if (!series->has_temperature()) {
-    warnings->push_back(who + tcal + "_ENABLE = 1 but the stream has no temperature: "
-                                "temperature calibration not undone");
+    Say(warnings, "correction_not_undone",
+        who + tcal + "_ENABLE = 1 but the stream has no temperature: temperature calibration "
+                     "not undone");
     return;
   }
   const ArdupilotTempCal& t = *c.tcal;
@@ -224,7 +237,7 @@ void UndoTempCal(const ArdupilotCorrection& c, const std::string& who, ImuSeries
                            .cast<float>();
     }
   }
-  warnings->push_back(
+  Say(warnings, "correction_undone",
       who + tcal + " temperature calibration undone: sensor = corrected + P(clamp(T) - 35) - "
             "P(clamp(T_cal) - 35), P(d) = (c1 + (c2 + c3 d) d) d * 1e-6, clamp to [" +
       Format(t.t_min_degc) + ", " + Format(t.t_max_degc) + "] degC, T from the stream; "
@@ -308,25 +321,27 @@ ArdupilotCorrection ArdupilotCorrectionFor(const std::map<std::string, double>& 
   return c;
 }
 
-std::vector<std::string> UndoArdupilotCorrection(const ArdupilotCorrection& c, bool undo,
-                                                 const std::string& who, ImuSeries* series,
-                                                 std::vector<std::string>* left) {
-  std::vector<std::string> lines;
-  std::vector<std::string>* warnings = &lines;
+std::vector<Notice> UndoArdupilotCorrection(const ArdupilotCorrection& c, bool undo,
+                                            const std::string& who, ImuSeries* series,
+                                            std::vector<std::string>* left) {
+  std::vector<Notice> lines;
+  std::vector<Notice>* warnings = &lines;
   const std::string applied = c.Describe(true, series->has_gyro());
   auto leave = [&](const std::string& what) {
     if (left != nullptr) left->push_back(who + "ArduPilot " + what);
   };
   if (!undo) {
-    warnings->push_back(who + "samples taken as logged (ArduPilot applied " + applied + ")");
+    Say(warnings, "correction_kept",
+        who + "samples taken as logged (ArduPilot applied " + applied + ")");
     leave(applied);
     return lines;
   }
   if (!c.R_board) {
-    warnings->push_back(who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
-                          ArdupilotRotationName(c.orientation) +
-                          ") is not a rotation plumb knows: ArduPilot's correction (" + applied +
-                          ") is not undone, samples taken as logged");
+    Say(warnings, "correction_not_undone",
+        who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
+            ArdupilotRotationName(c.orientation) +
+            ") is not a rotation plumb knows: ArduPilot's correction (" + applied +
+            ") is not undone, samples taken as logged");
     leave(applied);
     return lines;
   }

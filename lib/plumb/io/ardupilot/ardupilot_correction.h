@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/types.h"
 
 namespace plumb::io {
@@ -93,8 +94,8 @@ ArdupilotCorrection ArdupilotCorrectionFor(const std::map<std::string, double>& 
 /// line per part of the correction that stays in the samples (not undone, or its parameters
 /// missing or not finite); see Session::firmware_left. Shared by every reader of ArduPilot
 /// data (DataFlash .bin/.log, MAVLink .tlog).
-std::vector<std::string> UndoArdupilotCorrection(const ArdupilotCorrection& c, bool undo,
-                                                 const std::string& who, ImuSeries* series,
-                                                 std::vector<std::string>* left = nullptr);
+std::vector<Notice> UndoArdupilotCorrection(const ArdupilotCorrection& c, bool undo,
+                                            const std::string& who, ImuSeries* series,
+                                            std::vector<std::string>* left = nullptr);
 
 }  // namespace plumb::io

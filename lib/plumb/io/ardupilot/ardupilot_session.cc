@@ -23,7 +23,7 @@ namespace {
 /// PARM records: the undo uses the last value for every sample, so samples logged before a
 /// recalibration are reconstructed with the later values.
 void WarnCorrectionChanges(const DataflashLog& log, const std::string& who,
-                           std::vector<std::string>* warnings) {
+                           std::vector<Notice>* warnings) {
   const DataflashType* parm = log.Find("PARM");
   if (parm == nullptr) return;
   const int name_col = parm->ColumnIndex("Name");
@@ -44,8 +44,11 @@ void WarnCorrectionChanges(const DataflashLog& log, const std::string& who,
     if (seen.size() > 1) changed += (changed.empty() ? "" : ", ") + name;
   }
   if (!changed.empty()) {
-    warnings->push_back(who + "parameters of ArduPilot's correction changed during the log (" +
-                        changed + "): the last values are used for every sample");
+    warnings->push_back(Notice{"correction_changed",
+                               who + "parameters of ArduPilot's correction changed during the "
+                                     "log (" + changed + "): the last values are used for "
+                                     "every sample",
+                               {}});
   }
 }
 
@@ -146,15 +149,19 @@ Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& sele
   const int instance = info.instance;
   const std::string label = stream + " of IMU instance " + std::to_string(instance);
   s.source = log.source + " " + stream + " (IMU instance " + std::to_string(instance) + ")";
-  for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
-  if (auto w = DroppedRecordsWarning(info)) s.warnings.push_back(log.source + ": " + *w);
+  for (const auto& w : log.warnings.Describe()) {
+    s.warnings.push_back(Notice{"log_damaged", log.source + ": " + w, {}});
+  }
+  if (auto w = DroppedRecordsWarning(info)) {
+    s.warnings.push_back(Notice{"records_dropped", log.source + ": " + *w, {}});
+  }
   if (s.series.size() < 2) {
     throw InputError(log.source, label,
                      EmptyWindowMessage(selection.from_s, selection.to_s,
                                         info.t_start_s, info.t_end_s));
   }
   const ArdupilotCorrection correction = ArdupilotCorrectionFor(log.params, instance);
-  const std::vector<std::string> undone =
+  const std::vector<Notice> undone =
       UndoArdupilotCorrection(correction, selection.undo_correction, label + ": ", &s.series,
                               &s.firmware_left);
   s.warnings.insert(s.warnings.end(), undone.begin(), undone.end());

@@ -208,16 +208,22 @@ void Append(Session& joined, Session next) {
   double shift = 0.0;
   if (!a.empty() && !b.empty() && b.t_s.front() <= a.t_s.back()) {
     shift = a.t_s.back() + kJoinGap_s - b.t_s.front();
-    joined.warnings.push_back(next.source +
-                              ": its times overlap the previous input's; shifted by " +
-                              std::to_string(shift) + " s (no motion assumed between files)");
+    joined.warnings.push_back(Notice{"inputs_overlap",
+                                     next.source +
+                                         ": its times overlap the previous input's; shifted by " +
+                                         std::to_string(shift) +
+                                         " s (no motion assumed between files)",
+                                     {}});
   }
   for (double t : b.t_s) a.t_s.push_back(t + shift);
   a.acc.insert(a.acc.end(), b.acc.begin(), b.acc.end());
   a.gyr.insert(a.gyr.end(), b.gyr.begin(), b.gyr.end());
   a.temp_c.insert(a.temp_c.end(), b.temp_c.begin(), b.temp_c.end());
   joined.source += " " + next.source;
-  for (auto& w : next.warnings) joined.warnings.push_back(next.source + ": " + w);
+  for (Notice& w : next.warnings) {
+    w.message = next.source + ": " + w.message;  // the input's own notice, its code kept
+    joined.warnings.push_back(std::move(w));
+  }
   for (auto& l : next.firmware_left) joined.firmware_left.push_back(next.source + ": " + l);
   if (!joined.site) joined.site = next.site;
   if (joined.log_params.empty()) joined.log_params = std::move(next.log_params);
@@ -232,13 +238,17 @@ namespace {
 void UseUniformClock(Session& s) {
   const signal::TimeBase base = signal::AnalyseTimeBase(s.series.t_s);
   if (base.kind == signal::ClockKind::kTooShort) {
-    s.warnings.push_back(s.source + ": too few samples (" + std::to_string(base.samples) +
-                         ") to fit a uniform clock; the stamps are kept");
+    s.warnings.push_back(Notice{"clock_kept",
+                                s.source + ": too few samples (" + std::to_string(base.samples) +
+                                    ") to fit a uniform clock; the stamps are kept",
+                                {}});
     return;
   }
   if (base.kind == signal::ClockKind::kIrregular) {
-    s.warnings.push_back(s.source + ": no uniform clock fits these stamps (irregular intervals, "
-                         "e.g. telemetry); the stamps are kept");
+    s.warnings.push_back(Notice{"clock_kept",
+                                s.source + ": no uniform clock fits these stamps (irregular "
+                                           "intervals, e.g. telemetry); the stamps are kept",
+                                {}});
     return;
   }
   signal::ApplyUniformClock(base, s.series.t_s);
@@ -247,7 +257,7 @@ void UseUniformClock(Session& s) {
        << " Hz clock fitted through the stamps (jitter RMS " << std::setprecision(3)
        << base.jitter_rms_s * 1e3 << " ms removed; " << base.dropped
        << " dropped samples kept as gaps)";
-  s.warnings.push_back(note.str());
+  s.warnings.push_back(Notice{"clock_uniform", note.str(), {}});
 }
 
 }  // namespace

@@ -483,31 +483,39 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
   s.log_params = params;
   s.system_id = v.system_id;
   for (const auto& w : log.warnings.Describe(log.message_counts)) {
-    s.warnings.push_back(log.source + ": " + w);
+    s.warnings.push_back(Notice{"log_damaged", log.source + ": " + w, {}});
   }
   if (v.other_sources > 0) {
-    s.warnings.push_back(std::to_string(v.other_sources) +
-                         " other system/component(s) sent IMU messages; using system " +
-                         std::to_string(v.system_id) + " component " +
-                         std::to_string(v.component_id) + " (most IMU frames)");
+    s.warnings.push_back(Notice{"other_senders",
+                                std::to_string(v.other_sources) +
+                                    " other system/component(s) sent IMU messages; using "
+                                    "system " + std::to_string(v.system_id) + " component " +
+                                    std::to_string(v.component_id) + " (most IMU frames)",
+                                {}});
   }
   const std::string who = info.name + " instance " + std::to_string(d.instance) + ": ";
-  s.warnings.push_back(who + "from system " + std::to_string(v.system_id) + " component " +
-                       std::to_string(v.component_id) + " (" + AutopilotName(v.autopilot) +
-                       "), " + units.text);
-  s.warnings.push_back(who + (d.used_log_time
-                                  ? "message times all zero: times from the tlog (unix s)"
-                                  : "times from the message's own time stamps (s)"));
+  s.warnings.push_back(Notice{"sample_source",
+                              who + "from system " + std::to_string(v.system_id) +
+                                  " component " + std::to_string(v.component_id) + " (" +
+                                  AutopilotName(v.autopilot) + "), " + units.text,
+                              {}});
+  s.warnings.push_back(
+      Notice{"sample_times",
+             who + (d.used_log_time ? "message times all zero: times from the tlog (unix s)"
+                                    : "times from the message's own time stamps (s)"),
+             {}});
 
   LeftOutTimes dropped;
   s.series = WindowedSeries(d, selection, units, info.has_temperature, &dropped);
   ImuSeries& out = s.series;
   if (dropped.count > 0) {
-    s.warnings.push_back(
+    s.warnings.push_back(Notice{
+        "samples_out_of_order",
         who + "dropped " + std::to_string(dropped.count) +
-        " sample(s) whose time did not increase past the last kept one, or ran ahead of the "
-        "next (a reboot or a corrupted time); the first with time " +
-        LeftOutTimeText(*dropped.first_t_s));
+            " sample(s) whose time did not increase past the last kept one, or ran ahead of the "
+            "next (a reboot or a corrupted time); the first with time " +
+            LeftOutTimeText(*dropped.first_t_s),
+        {}});
   }
   if (out.size() < 2) {
     throw InputError(log.source, info.name + " instance " + std::to_string(d.instance),
@@ -517,16 +525,18 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
 
   // ArduPilot's correction, undone (ardupilot_correction.h has the equations).
   if (ardupilot) {
-    const std::vector<std::string> undo =
+    const std::vector<Notice> undo =
         UndoArdupilotCorrection(ArdupilotCorrectionFor(params, d.instance),
                                 selection.undo_correction, who, &out, &s.firmware_left);
     s.warnings.insert(s.warnings.end(), undo.begin(), undo.end());
   } else if (!info.applied.empty()) {
-    s.warnings.push_back(who + "calibrated by " + AutopilotName(v.autopilot) +
-                         " in a way the tlog does not state: samples taken as sent");
+    s.warnings.push_back(Notice{"correction_kept",
+                                who + "calibrated by " + AutopilotName(v.autopilot) +
+                                    " in a way the tlog does not state: samples taken as sent",
+                                {}});
     s.firmware_left.push_back(who + info.applied);
   } else {
-    s.warnings.push_back(who + "raw sensor output as sent");
+    s.warnings.push_back(Notice{"raw_sensor", who + "raw sensor output as sent", {}});
   }
   s.site = SiteFromTlog(log);
   s.log_motion = StreamMotion(log, d);

@@ -14,6 +14,11 @@
 namespace plumb::io {
 namespace {
 
+/// Adds `message` to `warnings` under `code` (core/notice.h lists the codes).
+void Say(std::vector<Notice>* warnings, const char* code, std::string message) {
+  warnings->push_back(Notice{code, std::move(message), {}});
+}
+
 constexpr int kMaxCalSlots = 4;  // CAL_ACC0..CAL_ACC3, TC_A0..TC_A3
 
 using Params = std::map<std::string, double>;
@@ -76,14 +81,14 @@ std::optional<Px4Calibration> CalibrationOf(const Params& params, const Px4Senso
 
 /// Undoes the correction of one sensor (accelerometer when `acc`), with its warnings.
 void UndoSensor(const Params& params, const Px4Sensors& sensors, bool acc,
-                const std::string& who, ImuSeries* series, std::vector<std::string>* warnings,
+                const std::string& who, ImuSeries* series, std::vector<Notice>* warnings,
                 std::vector<std::string>* left) {
   const std::string what = acc ? "accelerometer" : "gyroscope";
   std::string why;
   const auto c = CalibrationOf(params, sensors, acc, &why);
   if (!c) {
-    warnings->push_back(who + what + " taken as logged (calibrated by PX4; not undone: " + why +
-                        ")");
+    Say(warnings, "correction_kept",
+        who + what + " taken as logged (calibrated by PX4; not undone: " + why + ")");
     left->push_back(who + "PX4 " + what + " calibration (" + why + ")");
     return;
   }
@@ -98,8 +103,9 @@ void UndoSensor(const Params& params, const Px4Sensors& sensors, bool acc,
     temp = thermal ? sensors.temperature(acc, c->device_id) : std::nullopt;
     if (!thermal || !temp) {
       if (thermal) tc_why = "no temperature of device " + Integer(c->device_id) + " in the log";
-      warnings->push_back(who + tc + " = 1: PX4's thermal " + what +
-                          " correction is in the samples and NOT undone (" + tc_why + ")");
+      Say(warnings, "correction_not_undone",
+          who + tc + " = 1: PX4's thermal " + what +
+              " correction is in the samples and NOT undone (" + tc_why + ")");
       left->push_back(who + "PX4 thermal " + what + " correction (" + tc_why + ")");
       thermal.reset();
     } else {
@@ -114,11 +120,11 @@ void UndoSensor(const Params& params, const Px4Sensors& sensors, bool acc,
   }
   UndoPx4Calibration(*c, thermal, temp, series->t_s, acc ? &series->acc : &series->gyr);
   const std::string unit = acc ? " m/s^2" : " rad/s";
-  warnings->push_back(who + what + " reconstructed as R^T logged ./ " + c->prefix +
-                      "_*SCALE (" + Format(c->scale) + ") + " + c->prefix + "_*OFF (" +
-                      Format(c->offset) + ")" + unit + thermal_text + ", R from " +
-                      c->rotation_text + "; " + c->prefix + " chosen by device id " +
-                      Integer(c->device_id) + " from " + c->id_source);
+  Say(warnings, "correction_undone",
+      who + what + " reconstructed as R^T logged ./ " + c->prefix + "_*SCALE (" +
+          Format(c->scale) + ") + " + c->prefix + "_*OFF (" + Format(c->offset) + ")" + unit +
+          thermal_text + ", R from " + c->rotation_text + "; " + c->prefix +
+          " chosen by device id " + Integer(c->device_id) + " from " + c->id_source);
 }
 
 }  // namespace
@@ -261,7 +267,7 @@ bool Px4Undoable(const Params& params, const Px4Sensors& sensors, bool gyro) {
 }
 
 void UndoPx4Correction(const Params& params, const Px4Sensors& sensors, const std::string& who,
-                       ImuSeries* series, std::vector<std::string>* warnings,
+                       ImuSeries* series, std::vector<Notice>* warnings,
                        std::vector<std::string>* left) {
   UndoSensor(params, sensors, true, who, series, warnings, left);
   if (series->has_gyro()) UndoSensor(params, sensors, false, who, series, warnings, left);

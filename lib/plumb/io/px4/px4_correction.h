@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/types.h"
 
 namespace plumb::io {
@@ -124,6 +125,6 @@ bool Px4Undoable(const std::map<std::string, double>& params, const Px4Sensors& 
 /// per correction left in the samples (see Session::firmware_left).
 void UndoPx4Correction(const std::map<std::string, double>& params, const Px4Sensors& sensors,
                        const std::string& who, ImuSeries* series,
-                       std::vector<std::string>* warnings, std::vector<std::string>* left);
+                       std::vector<Notice>* warnings, std::vector<std::string>* left);
 
 }  // namespace plumb::io

@@ -361,8 +361,11 @@ void WarnParamChanges(const ULog& log, Session* s) {
     }
   }
   if (changes > 0) {
-    s->warnings.push_back(std::to_string(changes) + " calibration parameter change(s) during " +
-                          "the log (first: " + first + "); the initial values were used");
+    s->warnings.push_back(Notice{"correction_changed",
+                                 std::to_string(changes) +
+                                     " calibration parameter change(s) during the log (first: " +
+                                     first + "); the initial values were used",
+                                 {}});
   }
 }
 
@@ -541,12 +544,14 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   }
   std::vector<ImuStreamInfo> infos;
   std::vector<ImuSeries> all;
-  std::vector<std::vector<std::string>> notes(sources.size());
+  std::vector<std::vector<Notice>> notes(sources.size());
   for (std::size_t i = 0; i < sources.size(); ++i) {
-    Extracted e = Extract(sources[i], &notes[i]);
+    std::vector<std::string> unpaired;  // a gyro topic not paired with the accelerometer's
+    Extracted e = Extract(sources[i], &unpaired);
+    AddNotices(notes[i], "gyro_unpaired", std::move(unpaired));
     infos.push_back(Describe(log, sources[i], e.series, e.left_out));
     if (auto w = DroppedRecordsWarning(infos.back())) {
-      notes[i].push_back(std::move(*w));
+      notes[i].push_back(Notice{"records_dropped", std::move(*w), {}});
     }
     all.push_back(std::move(e.series));
   }
@@ -565,11 +570,15 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   if (const auto id = log.params.find("MAV_SYS_ID"); id != log.params.end()) {
     s.system_id = static_cast<int>(id->second);
   }
-  for (const auto& w : log.warnings.Describe()) s.warnings.push_back(log.source + ": " + w);
+  for (const auto& w : log.warnings.Describe()) {
+    s.warnings.push_back(Notice{"log_damaged", log.source + ": " + w, {}});
+  }
   if (log.dropouts > 0) {
-    s.warnings.push_back(log.source + ": " + std::to_string(log.dropouts) +
-                         " logging dropout(s), " + std::to_string(log.dropout_total_ms) +
-                         " ms in total");
+    s.warnings.push_back(Notice{"records_dropped",
+                                log.source + ": " + std::to_string(log.dropouts) +
+                                    " logging dropout(s), " +
+                                    std::to_string(log.dropout_total_ms) + " ms in total",
+                                {}});
   }
   for (auto& n : notes[chosen]) s.warnings.push_back(std::move(n));
   const ImuSeries& whole = all[chosen];
@@ -593,10 +602,13 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   }
   const std::string who = Who(*src);
   if (src->kind == StreamKind::kSensorAccel) {
-    s.warnings.push_back(who + "raw driver output (not calibrated by PX4), taken as logged");
+    s.warnings.push_back(Notice{
+        "raw_sensor", who + "raw driver output (not calibrated by PX4), taken as logged", {}});
   } else if (!selection.undo_correction) {
-    s.warnings.push_back(who + "samples taken as logged (calibrated by PX4 with " +
-                         infos[chosen].applied + ")");
+    s.warnings.push_back(Notice{"correction_kept",
+                                who + "samples taken as logged (calibrated by PX4 with " +
+                                    infos[chosen].applied + ")",
+                                {}});
     s.firmware_left.push_back(who + "PX4 " + infos[chosen].applied);
   } else {
     UndoPx4Correction(log.params, SensorsOf(log, *src), who, &s.series, &s.warnings,

@@ -163,9 +163,12 @@ class TableParser {
   Session Finish(const std::string& source) {
     session_.source = source;
     if (skipped_ > 0) {
-      session_.warnings.push_back(source + ": skipped " + std::to_string(skipped_) +
-                                  " rows with NaN or infinite values (first at line " +
-                                  std::to_string(first_skipped_line_) + ")");
+      session_.warnings.push_back(
+          Notice{"nan_rows_skipped",
+                 source + ": skipped " + std::to_string(skipped_) +
+                     " rows with NaN or infinite values (first at line " +
+                     std::to_string(first_skipped_line_) + ")",
+                 {}});
     }
     return std::move(session_);
   }
