@@ -59,7 +59,7 @@ DifferentiableEffect::DifferentiableEffect(const model::Effect& effect)
   }
 }
 
-DifferentiableModel::DifferentiableModel(const model::Model& model) : model_(&model) {
+DifferentiableModel::DifferentiableModel(const model::Model& model) {
   terms_.reserve(model.terms().size());
   for (const auto& term : model.terms()) terms_.emplace_back(*term.effect);
 }

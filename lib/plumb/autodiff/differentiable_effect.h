@@ -82,7 +82,6 @@ class DifferentiableModel {
  public:
   explicit DifferentiableModel(const model::Model& model);
 
-  const model::Model& model() const { return *model_; }
   const DifferentiableEffect& term(int i) const { return terms_[static_cast<std::size_t>(i)]; }
   int num_terms() const { return static_cast<int>(terms_.size()); }
 
@@ -95,7 +94,6 @@ class DifferentiableModel {
   }
 
  private:
-  const model::Model* model_;
   std::vector<DifferentiableEffect> terms_;
 };
 

@@ -81,6 +81,11 @@ inline std::vector<std::string> Messages(const std::vector<Notice>& notices) {
   return out;
 }
 
+/// `message` as a notice with `code` that names no option (the readers' correction notes).
+inline void AddNotice(std::vector<Notice>& to, std::string code, std::string message) {
+  to.push_back(Notice{std::move(code), std::move(message), {}});
+}
+
 /// Each of `messages` as a notice with `code` (a reader's lines of one kind).
 inline void AddNotices(std::vector<Notice>& to, const std::string& code,
                        std::vector<std::string> messages) {

@@ -13,11 +13,6 @@
 namespace plumb::io {
 namespace {
 
-/// Adds `message` to `warnings` under `code` (core/notice.h lists the codes).
-void Say(std::vector<Notice>* warnings, const char* code, std::string message) {
-  warnings->push_back(Notice{code, std::move(message), {}});
-}
-
 /// One entry of ArduPilot's Rotation enum: name and Euler angles, degrees.
 struct RotationEntry {
   const char* name;
@@ -171,7 +166,7 @@ void UndoRotation(const ArdupilotCorrection& c, const std::string& who, ImuSerie
   const Mat3 Rt = c.R_board->transpose();
   for (auto& a : series->acc) a = (Rt * a.cast<double>()).cast<float>();
   for (auto& g : series->gyr) g = (Rt * g.cast<double>()).cast<float>();
-  Say(warnings, "correction_undone",
+  AddNotice(*warnings, "correction_undone",
       who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
           ArdupilotRotationName(c.orientation) + ") undone: board = R^T logged, R = " +
           Format(*c.R_board));
@@ -185,22 +180,22 @@ void UndoOffsets(const ArdupilotCorrection& c, const std::string& who, ImuSeries
     for (auto& a : series->acc) {
       a = (a.cast<double>().cwiseQuotient(*c.acc_scale) + *c.acc_offset).cast<float>();
     }
-    Say(warnings, "correction_undone",
+    AddNotice(*warnings, "correction_undone",
         who + "accelerometer reconstructed as logged ./ " + acc + "SCAL (" +
             Format(*c.acc_scale) + ") + " + acc + "OFFS (" + Format(*c.acc_offset) + ") m/s^2");
   } else {
-    Say(warnings, "correction_not_undone",
+    AddNotice(*warnings, "correction_not_undone",
         who + "no " + acc + "OFFS/" + acc +
             "SCAL in the log: accelerometer offsets/scales not undone");
   }
   if (!series->has_gyro()) return;
   if (c.gyr_offset) {
     for (auto& g : series->gyr) g = (g.cast<double>() + *c.gyr_offset).cast<float>();
-    Say(warnings, "correction_undone",
+    AddNotice(*warnings, "correction_undone",
         who + "gyroscope reconstructed as logged + " + gyr + "OFFS (" + Format(*c.gyr_offset) +
             ") rad/s");
   } else {
-    Say(warnings, "correction_not_undone",
+    AddNotice(*warnings, "correction_not_undone",
         who + "no " + gyr + "OFFS in the log: gyroscope offsets not undone");
   }
 }
@@ -209,19 +204,19 @@ void UndoOffsets(const ArdupilotCorrection& c, const std::string& who, ImuSeries
 void UndoTempCal(const ArdupilotCorrection& c, const std::string& who, ImuSeries* series, std::vector<Notice>* warnings) {
   const std::string tcal = "INS_TCAL" + std::to_string(c.instance + 1);
   if (c.tcal_enable == 2) {
-    Say(warnings, "correction_not_undone",
+    AddNotice(*warnings, "correction_not_undone",
         who + tcal + "_ENABLE = 2 (learning): ArduPilot applied no temperature correction, "
                      "nothing to undo");
   }
   if (c.tcal_enable != 1) return;
   if (!c.tcal) {
-    Say(warnings, "correction_not_undone",
+    AddNotice(*warnings, "correction_not_undone",
         who + tcal + "_ENABLE = 1 but its TMIN/TMAX/ACC*/GYR* parameters are not all in the "
                      "log: temperature calibration not undone");
     return;
   }
   if (!series->has_temperature()) {
-    Say(warnings, "correction_not_undone",
+    AddNotice(*warnings, "correction_not_undone",
         who + tcal + "_ENABLE = 1 but the stream has no temperature: temperature calibration "
                      "not undone");
     return;
@@ -237,7 +232,7 @@ void UndoTempCal(const ArdupilotCorrection& c, const std::string& who, ImuSeries
                            .cast<float>();
     }
   }
-  Say(warnings, "correction_undone",
+  AddNotice(*warnings, "correction_undone",
       who + tcal + " temperature calibration undone: sensor = corrected + P(clamp(T) - 35) - "
             "P(clamp(T_cal) - 35), P(d) = (c1 + (c2 + c3 d) d) d * 1e-6, clamp to [" +
       Format(t.t_min_degc) + ", " + Format(t.t_max_degc) + "] degC, T from the stream; "
@@ -331,13 +326,13 @@ std::vector<Notice> UndoArdupilotCorrection(const ArdupilotCorrection& c, bool u
     if (left != nullptr) left->push_back(who + "ArduPilot " + what);
   };
   if (!undo) {
-    Say(warnings, "correction_kept",
+    AddNotice(*warnings, "correction_kept",
         who + "samples taken as logged (ArduPilot applied " + applied + ")");
     leave(applied);
     return lines;
   }
   if (!c.R_board) {
-    Say(warnings, "correction_not_undone",
+    AddNotice(*warnings, "correction_not_undone",
         who + "AHRS_ORIENTATION = " + std::to_string(c.orientation) + " (" +
             ArdupilotRotationName(c.orientation) +
             ") is not a rotation plumb knows: ArduPilot's correction (" + applied +

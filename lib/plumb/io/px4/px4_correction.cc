@@ -14,11 +14,6 @@
 namespace plumb::io {
 namespace {
 
-/// Adds `message` to `warnings` under `code` (core/notice.h lists the codes).
-void Say(std::vector<Notice>* warnings, const char* code, std::string message) {
-  warnings->push_back(Notice{code, std::move(message), {}});
-}
-
 constexpr int kMaxCalSlots = 4;  // CAL_ACC0..CAL_ACC3, TC_A0..TC_A3
 
 using Params = std::map<std::string, double>;
@@ -87,7 +82,7 @@ void UndoSensor(const Params& params, const Px4Sensors& sensors, bool acc,
   std::string why;
   const auto c = CalibrationOf(params, sensors, acc, &why);
   if (!c) {
-    Say(warnings, "correction_kept",
+    AddNotice(*warnings, "correction_kept",
         who + what + " taken as logged (calibrated by PX4; not undone: " + why + ")");
     left->push_back(who + "PX4 " + what + " calibration (" + why + ")");
     return;
@@ -103,7 +98,7 @@ void UndoSensor(const Params& params, const Px4Sensors& sensors, bool acc,
     temp = thermal ? sensors.temperature(acc, c->device_id) : std::nullopt;
     if (!thermal || !temp) {
       if (thermal) tc_why = "no temperature of device " + Integer(c->device_id) + " in the log";
-      Say(warnings, "correction_not_undone",
+      AddNotice(*warnings, "correction_not_undone",
           who + tc + " = 1: PX4's thermal " + what +
               " correction is in the samples and NOT undone (" + tc_why + ")");
       left->push_back(who + "PX4 thermal " + what + " correction (" + tc_why + ")");
@@ -120,7 +115,7 @@ void UndoSensor(const Params& params, const Px4Sensors& sensors, bool acc,
   }
   UndoPx4Calibration(*c, thermal, temp, series->t_s, acc ? &series->acc : &series->gyr);
   const std::string unit = acc ? " m/s^2" : " rad/s";
-  Say(warnings, "correction_undone",
+  AddNotice(*warnings, "correction_undone",
       who + what + " reconstructed as R^T logged ./ " + c->prefix + "_*SCALE (" +
           Format(c->scale) + ") + " + c->prefix + "_*OFF (" + Format(c->offset) + ")" + unit +
           thermal_text + ", R from " + c->rotation_text + "; " + c->prefix +
