@@ -167,7 +167,6 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
   request.level_north = fit.level_north;
   request.site = site_args.given_site();
   request.gravity_m_s2 = site_args.fixed_gravity();
-  request.gravity_option = "--gravity";
   estimation::CalibrationOptions& o = request.options;
   o = fit.options;
   if (fit.heading != nullptr && fit.heading->count() > 0) o.first_heading_deg = fit.heading_deg;

@@ -180,8 +180,8 @@ class InfoCommand : public Command {
     nlohmann::json messages = nlohmann::json::object();
     for (const auto& [name, count] : summary.messages) messages[name] = count;
     doc["messages"] = messages;
-    doc["warnings"] = summary.warnings;
-    for (const auto& w : summary.warnings) std::cerr << "warning: " << w << "\n";
+    doc["warnings"] = Messages(summary.warnings);
+    for (const Notice& w : summary.warnings) std::cerr << "warning: " << w.message << "\n";
     if (!a.json_path.empty()) {
       WriteJsonOutput(a.json_path, doc);
     }

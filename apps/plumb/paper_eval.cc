@@ -383,7 +383,7 @@ nlohmann::json PaperJson(const PaperInputs& in, const PaperResults& r) {
   doc["reconstruction"] = {{"rms_f_difference", report::Vector(r.rec.rms_f_difference)},
                            {"rms_omega_difference", report::Vector(r.rec.rms_omega_difference)},
                            {"notes", r.rec.notes}};
-  doc["notes"] = {{"benchmark", r.b.notes}, {"static", r.s.notes}};
+  doc["notes"] = {{"benchmark", Messages(r.b.notes)}, {"static", Messages(r.s.notes)}};
   return doc;
 }
 

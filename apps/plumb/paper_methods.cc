@@ -41,9 +41,9 @@ void PrintVector(const std::string& name, const Vec3& v) {
   std::cout << "  " << name << " " << Row(v.transpose()) << "\n";
 }
 
-void Finish(const nlohmann::json& doc, const std::vector<std::string>& notes,
+void Finish(const nlohmann::json& doc, const std::vector<Notice>& notes,
             const std::string& json_path) {
-  for (const auto& n : notes) std::cout << "note: " << n << "\n";
+  for (const Notice& n : notes) std::cout << "note: " << n.message << "\n";
   if (!json_path.empty()) {
     WriteJsonOutput(json_path, doc);
   }
@@ -104,7 +104,7 @@ estimation::CalibrationResult ClosedFormHeadline(estimation::CalibrationResult r
 /// form's answer (ClosedFormHeadline), marked where they are the backend's ("source"), with
 /// the method's own detail (`detail`, its "backend" among them) under the method's name.
 nlohmann::json PaperDocument(const estimation::CalibrationResult& headline,
-                             const nlohmann::json& detail, const std::vector<std::string>& notes,
+                             const nlohmann::json& detail, const std::vector<Notice>& notes,
                              const Session& session, const std::vector<std::string>& inputs) {
   nlohmann::json doc = report::ToJson(headline);
   const std::string source = "backend";
@@ -120,7 +120,7 @@ nlohmann::json PaperDocument(const estimation::CalibrationResult& headline,
     }
   }
   doc.erase("motion");
-  doc["notes"] = notes;
+  doc["notes"] = Messages(notes);
   doc["notes"].push_back(
       "accel, gyro, effects and parameters values are the closed form's; sigma, covariance, "
       "fit, observability and gates are those of the same procedure on the backend (\"" +
@@ -179,7 +179,7 @@ int RunPaperBenchmark(const Session& session, const std::vector<StillSegment>& s
                 {"t0_s", r.t0_s}, {"coupling", ToJson(r.gyro_coupling_paper)},
                 {"total_angle_rad", ToJson(r.total_angle_rad)}}}};
   detail["gravity"] = r.gravity_m_s2;
-  detail["notes"] = r.notes;
+  detail["notes"] = Messages(r.notes);
 
   std::cout << "\nThe same procedure on the backend (the faces' tilts known, headings estimated; "
                "turns at their known mean rate; model "
@@ -242,7 +242,7 @@ int RunPaperStatic(const Session& session, std::size_t begin, std::size_t end,
         {"matrix", ToJson(r.gyro.E_paper)}};
   }
   detail["samples"] = {begin, end};
-  detail["notes"] = r.notes;
+  detail["notes"] = Messages(r.notes);
 
   std::cout << "\nThe same procedure on the backend (one segment, attitude known level x north; "
                "the paper's constants held):\n";

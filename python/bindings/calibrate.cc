@@ -136,7 +136,6 @@ FitInputs PrepareFit(const PySession& s, const std::string& model_spec, const py
   pipeline::FitRequest request;
   request.site = SiteFromPython(site);
   request.gravity_m_s2 = k.Take<double>("gravity");
-  request.gravity_option = "gravity=";
   request.model = model::Model::Parse(model_spec);
   request.temp_ref_c = k.Take<double>("temp_ref", request.temp_ref_c);
   estimation::CalibrationOptions& o = request.options;

@@ -223,7 +223,7 @@ TEST(Gates, MotionLeftOutAsNoTurnIsNamedAndGatedWhereTheGyroscopeNeedsIt) {
   const std::string note = "between '" + segments[4].label + "' and '" + segments[5].label +
                            "' is left out of the fit, not a turn: longer than 8 s";
   EXPECT_EQ(std::count_if(one.fit.notes.begin(), one.fit.notes.end(),
-                          [&](const std::string& n) { return Contains(n, note); }),
+                          [&](const Notice& n) { return n.code == "not_a_turn" && Contains(n.message, note); }),
             1)
       << report::FullReport(one);
   // Every turn longer than allowed: no turn determines the gyroscope's matrix.
@@ -273,7 +273,7 @@ TEST(Gates, WhereTheLogSaysTheVehicleFlewNothingIsStillAndNothingATurn) {
                            "' is left out of the fit, not a turn: the log says the vehicle was "
                            "airborne ";
   EXPECT_EQ(std::count_if(r.fit.notes.begin(), r.fit.notes.end(),
-                          [&](const std::string& n) { return Contains(n, note); }),
+                          [&](const Notice& n) { return n.code == "not_a_turn" && Contains(n.message, note); }),
             1)
       << report::FullReport(r);
   const Gate* g = Find(r.fit.gates, "not_still");

@@ -49,7 +49,13 @@ TEST(WanderLevels, WithoutStillDataTheTypicalSensorIsAssumedAndSaid) {
   EXPECT_NEAR(out.noise.instability_gyr[2], typical_mems::kGyroInstability, 1e-12);
   EXPECT_EQ(out.noise.from.walk_acc[1], LevelSource::kTypical);
   ASSERT_EQ(out.notes.size(), 1U);
-  EXPECT_NE(out.notes[0].find("no still data long enough"), std::string::npos) << out.notes[0];
+  EXPECT_EQ(out.notes[0].code, "wander_levels");
+  EXPECT_NE(out.notes[0].message.find("no still data long enough"), std::string::npos)
+      << out.notes[0].message;
+  // The note points to the options that give the levels, in the order it names them.
+  EXPECT_EQ(out.notes[0].options,
+            (std::vector<Option>{Option::kAccelWalk, Option::kGyroWalk, Option::kAccelInstability,
+                                 Option::kGyroInstability, Option::kNoiseFrom}));
 }
 
 TEST(WanderLevels, GivenLevelsAreKept) {
@@ -88,7 +94,7 @@ TEST(WanderLevels, ARecordThatCoversTheSessionGivesItsFittedLevels) {
     EXPECT_EQ(out.noise.from.walk_acc[static_cast<std::size_t>(i)], LevelSource::kMeasured);
     EXPECT_NEAR(out.noise.walk_acc[i] / walk, 1.0, 0.35) << i;
   }
-  EXPECT_NE(out.notes[0].find("accel walk"), std::string::npos) << out.notes[0];
+  EXPECT_NE(out.notes[0].message.find("accel walk"), std::string::npos) << out.notes[0].message;
 }
 
 TEST(WanderLevels, ResolvedQuantisationIsUsed) {
@@ -99,7 +105,7 @@ TEST(WanderLevels, ResolvedQuantisationIsUsed) {
       AssignWanderLevels(NoiseModel{}, {&still}, StartingValues{}, true, 300.0, {});
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(out.noise.quantisation_acc[i] / 2e-4, 1.0, 0.2) << i;
   EXPECT_TRUE(out.noise.quantisation_gyr.isZero());
-  EXPECT_NE(out.notes[0].find("accel quantisation"), std::string::npos) << out.notes[0];
+  EXPECT_NE(out.notes[0].message.find("accel quantisation"), std::string::npos) << out.notes[0].message;
 }
 
 }  // namespace

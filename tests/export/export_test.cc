@@ -262,6 +262,19 @@ TEST(VehicleState, TheFilesSayAndKeepWhatTheFirmwareWouldReplace) {
   EXPECT_NE(plain.text.find("are not written (the input does not record them)"), std::string::npos);
   EXPECT_NE(plain.text.find("\n1\t1\tCAL_ACC0_XOFF"), std::string::npos);
   EXPECT_NE(plain.text.find("ExportOptions::system_id = N gives it"), std::string::npos);
+  // The advice carries its code and the option it points to, for a program to act on.
+  const auto note = [](const ExportOutput& out, const std::string& code) -> const Notice* {
+    for (const Notice& n : out.parameters->notes) {
+      if (n.code == code) return &n;
+    }
+    return nullptr;
+  };
+  ASSERT_NE(note(said, "gyro_offsets_replaced"), nullptr);
+  EXPECT_EQ(note(said, "gyro_offsets_replaced")->options, std::vector<Option>{Option::kKeepGyroOffsets});
+  ASSERT_NE(note(kept, "gyro_offsets_kept"), nullptr);
+  ASSERT_NE(note(plain, "system_id"), nullptr);
+  EXPECT_EQ(note(plain, "system_id")->options, std::vector<Option>{Option::kSystemId});
+  EXPECT_TRUE(note(px4, "system_id")->options.empty());  // given: nothing to point to
 }
 
 TEST(Evaluate, OffDiagonalTermMatchesTheHandComputation) {
@@ -459,7 +472,10 @@ TEST(Kalibr, ShortSegmentsFallBackToTheAutocorrelationTime) {
   const json j = ToJson(imu);
   EXPECT_EQ(j["accel"]["noise_density_source"][0], "fallback");
   bool said = false;
-  for (const auto& note : imu.notes) said = said || note.find("no IEEE noise terms") == 0;
+  for (const Notice& note : imu.notes) {
+    said = said || (note.code == "noise_terms_unresolved" &&
+                     note.message.find("no IEEE noise terms") == 0);
+  }
   EXPECT_TRUE(said);
 }
 

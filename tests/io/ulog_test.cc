@@ -644,7 +644,8 @@ TEST(ULogSession, SmallLogStreamsSiteAndRawSensorAccel) {
   EXPECT_EQ(summary.params, params);
   EXPECT_TRUE(summary.site.has_value());
   EXPECT_EQ(summary.messages, log.MessageCounts());
-  EXPECT_EQ(summary.warnings.size(), 1u);  // one dropout
+  ASSERT_EQ(summary.warnings.size(), 1u);  // one dropout
+  EXPECT_EQ(summary.warnings[0].code, "records_dropped");
 }
 
 // vehicle_imu: mean specific force = delta_velocity / dt, checked against the raw fields.

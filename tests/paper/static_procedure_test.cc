@@ -80,7 +80,10 @@ TEST(PaperStatic, EquatorIsRefusedAndNoSiteLeavesTheGyroscopeOut) {
   EXPECT_FALSE(no_site.has_gyro);
   EXPECT_NEAR(no_site.accel.bias.x(), 0.10, 2e-3);
   bool said = false;
-  for (const auto& n : no_site.notes) said = said || n.find("no site") != std::string::npos;
+  for (const Notice& n : no_site.notes) {
+    said = said || (n.code == "site_unknown" && n.options == std::vector<Option>{Option::kSite} &&
+                    n.message.find("no site") != std::string::npos);
+  }
   EXPECT_TRUE(said);
   EXPECT_THROW(CalibratePaperStatic(series, 5, 6, s.site, PaperStaticOptions{}), Error);
 }

@@ -119,7 +119,7 @@ TEST(Comparison, CostsAreImuTksOnTheSegmentMeans) {
   CompareOptions options;
   options.gravity_m_s2 = 9.9;
   const Comparison other_g = Compare(r, p, options);
-  EXPECT_EQ(other_g.cost.gravity_source, "CompareOptions::gravity_m_s2");
+  EXPECT_EQ(other_g.cost.gravity_source, "FitRequest/CompareOptions::gravity_m_s2");
   EXPECT_NEAR(other_g.cost.plumb_means.rms_m_s2, 0.1, 1e-12);
 }
 
@@ -139,7 +139,10 @@ TEST(Comparison, ScalesOfDifferentUnitsAreFlagged) {
   p.accel_matrix = Mat3::Identity();  // a peer given m/s^2 against plumb's counts
   const Comparison c = Compare(r, p);
   ASSERT_EQ(c.notes.size(), 1u);
-  EXPECT_NE(c.notes[0].find("accelerometer scales"), std::string::npos) << c.notes[0];
+  EXPECT_EQ(c.notes[0].code, "scales_differ");
+  EXPECT_NE(c.notes[0].message.find("accelerometer scales"), std::string::npos) << c.notes[0].message;
+  EXPECT_EQ(c.notes[0].options, (std::vector<Option>{Option::kAccScale, Option::kGyrScale,
+                                                     Option::kAccOffset, Option::kGyrOffset}));
 }
 
 TEST(Comparison, TextAndJsonCarryTheRows) {

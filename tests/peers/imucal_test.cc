@@ -91,7 +91,8 @@ TEST(Imucal, UnknownOutputUnitIsKeptWithANote) {
   EXPECT_NEAR(f.gyro_matrix(0, 0), 16.0 / kDeg, 1e-9);
   EXPECT_EQ(f.gyro_bias, Vec3(1, 2, 3));
   ASSERT_FALSE(f.notes.empty());
-  EXPECT_NE(f.notes.front().find("'a.u.'"), std::string::npos) << f.notes.front();
+  EXPECT_EQ(f.notes.front().code, "unit_kept");
+  EXPECT_NE(f.notes.front().message.find("'a.u.'"), std::string::npos) << f.notes.front().message;
 }
 
 TEST(Imucal, ReflectedAccelerometerIsRefused) {

@@ -84,13 +84,13 @@ TEST(FitSetup, RequestBecomesTheFitsInputs) {
 
   request.site = SiteInput{45.0, 5.0, 200.0, "flags"};
   request.gravity_m_s2 = 9.8;
-  request.gravity_option = "GRAVITY";
   const FitSetup fixed = PrepareFit(session, seg, request);
   EXPECT_TRUE(fixed.site.known);
   EXPECT_EQ(fixed.site.g_n.z(), 9.8);
   ASSERT_EQ(fixed.input_warnings.size(), 2u);
   EXPECT_EQ(fixed.input_warnings[1].message,
-            "gravity fixed at 9.800000 m/s^2 by GRAVITY instead of WGS84 normal gravity");
+            "gravity fixed at 9.800000 m/s^2 by FitRequest/CompareOptions::gravity_m_s2 instead "
+            "of WGS84 normal gravity");
   EXPECT_EQ(fixed.input_warnings[1].code, "gravity_fixed");
   EXPECT_EQ(fixed.input_warnings[1].options, std::vector<Option>{Option::kGravity});
 }

@@ -185,7 +185,8 @@ TEST(HtmlReport, ShowsWhatEachExportWritesAndLeaves) {
   report.gyro_still.rms = Vec3(0, 1e-5, 0);  // 2.06 deg/h
   report.accel_per_input(0, 1) = 0.01;  // 10000 ppm
   report.dropped = {{"gyro_g_sensitivity", {"gyro_g_sensitivity.G.xx"}, {1e-4}, {"rad/s/(m/s^2)"}, true}};
-  report.notes = {"a note in the file", "a note for the page only"};
+  report.notes = {Notice{"device_id", "a note in the file", {}},
+                  Notice{"board_frame", "a note for the page only", {}}};
   ardupilot.report = report;
   parts.extras.exports = {{"ardupilot", ardupilot, ""},
                           {"px4", std::nullopt, "the session does not determine accel.bias.x"}};

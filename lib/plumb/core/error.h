@@ -7,7 +7,11 @@
 // A message that points the user to an option names it through OptionText (option_name.h),
 // spelled by the front end; the error also carries those options as data (options()), in the
 // order the message names them, so that a front end can act on them without reading the text
-// (Python: the exception's .options, its keywords). The kind of error is its class.
+// (Python: the exception's .options, its keywords). The kind of error is its class, its code:
+// Error (a request the library cannot carry out), InputError (a file, with its place) and
+// InsufficientDataError (the data cannot support the model), raised in Python as plumb.Error,
+// plumb.InputError and plumb.InsufficientDataError. A program acts on the class and the
+// options; the message, which names the file and the place, is for the user.
 #pragma once
 
 #include <cstddef>

@@ -7,7 +7,8 @@
 // The codes, one per situation, snake_case and stable (a message's words may change, its code
 // does not). Beside each, where it is made.
 //
-// The session's warnings (Session::warnings: what a reader skipped, repaired or assumed):
+// The session's warnings (Session::warnings: what a reader skipped, repaired or assumed; a
+// log's summary, FlightLogSummary::warnings, has log_damaged and records_dropped):
 //   nan_rows_skipped        io/text/text_table.cc: rows with NaN or infinite values skipped
 //   log_damaged             io/*/*_session.cc: what a log reader skipped or found malformed
 //                           (bytes, records, messages, checksums), from its counts
@@ -45,6 +46,18 @@
 //   walk_not_estimated      estimation/walk_estimate.cc: too few holds to estimate the walk
 //   sigma_rests_on_wander   estimation/wander_sensitivity.cc, calibrator.cc: the sigmas rest on
 //                           the typical MEMS wander (kNoiseFrom)
+//
+// The fit's notes (estimation::FitReport::notes: how the fit was made):
+//   allan_too_short         estimation/wander_levels.cc: no Allan deviation of the still data
+//   wander_levels           estimation/wander_levels.cc: the wander levels and where they came
+//                           from (kAccelWalk, kGyroWalk, kAccelInstability, kGyroInstability,
+//                           kNoiseFrom, and kEstimateWalk when the session can estimate them)
+//   walk_estimated          estimation/walk_estimate.cc: the levels the session's holds resolved
+//   not_a_turn              estimation/advice.cc: motion between poses left out of the fit
+//
+// Elsewhere, each beside the struct that holds them: the exports' notes (export/export.h),
+// a comparison's and a peer's (peers/comparison.h, peers/forward_calibration.h), the paper's
+// methods' (paper/benchmark.h, paper/static_procedure.h).
 #pragma once
 
 #include <string>

@@ -25,7 +25,7 @@ std::string LibraryName(Option option) {
     case Option::kSite: return "FitRequest::site";
     case Option::kHeading: return "CalibrationOptions::first_heading_deg";
     case Option::kLevelNorth: return "FitRequest::level_north";
-    case Option::kGravity: return "CompareOptions::gravity_m_s2";
+    case Option::kGravity: return "FitRequest/CompareOptions::gravity_m_s2";
     case Option::kMaxIterations: return "CalibrationOptions::max_iterations";
     case Option::kEstimateWalk: return "CalibrationOptions::estimate_walk";
     case Option::kAccelWalk: return "CalibrationOptions::accel_walk_density";

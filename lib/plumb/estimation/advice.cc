@@ -86,7 +86,7 @@ void AddAdvice(const Calibration& calibration, const StillSet& still,
     }
     fit.warnings.push_back(Notice{"undetermined", undetermined, {}});
   }
-  for (const NotATurn& m : fit.not_turns) fit.notes.push_back(NotATurnText(fit, m));
+  for (const NotATurn& m : fit.not_turns) AddNotice(fit.notes, "not_a_turn", NotATurnText(fit, m));
   if (const std::optional<std::string> turns = TurnsNotAtTheirNoise(calibration, options, fit)) {
     fit.warnings.push_back(Notice{"turns_above_noise", *turns, {}});
   }

@@ -129,7 +129,7 @@ struct FitReport {
   std::vector<MotionFit> motion;       ///< per motion interval integrated
   std::vector<NotATurn> not_turns;     ///< motion between poses left out of the fit
   std::vector<Notice> warnings;        ///< what the user must know (codes: core/notice.h)
-  std::vector<std::string> notes;      ///< how the fit was made, in words (e.g. the noise)
+  std::vector<Notice> notes;           ///< how the fit was made (e.g. the noise; codes: notice.h)
   /// Checks the fit failed (empty: all passed); a failed gate means the numbers above are
   /// not to be trusted as they stand (estimation/gates.h).
   std::vector<Gate> gates;

@@ -219,7 +219,7 @@ WalkEstimate ResolveWander(const ImuSeries& series, const model::Model& model,
     }
     note += std::string(note.back() == ':' ? " " : "; ") + Describe(s, marginal);
   }
-  out.notes.push_back(note);
+  AddNotice(out.notes, "walk_estimated", note);
   // A walk far above any MEMS sensor's is more likely a missing effect seen between the poses.
   for (const SensorWander& s : sensors) {
     if (!s.chosen || !s.Estimated() || !s.walk_free) continue;

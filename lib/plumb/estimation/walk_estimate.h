@@ -63,7 +63,7 @@ namespace plumb::estimation {
 struct WalkEstimate {
   NoiseModel noise;        ///< the noise model with the wander levels the session resolves
   int iterations = 0;      ///< fits made
-  std::vector<std::string> notes;     ///< what was done, in words
+  std::vector<Notice> notes;     ///< what was done (code walk_estimated)
   std::vector<Notice> warnings;  ///< what was assumed for lack of data
   /// Non-empty when an estimated walk is implausibly large (the gate implausible_walk).
   std::string implausible;

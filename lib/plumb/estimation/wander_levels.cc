@@ -215,14 +215,21 @@ WanderLevels AssignWanderLevels(const NoiseModel& noise,
                                             : head;
   std::snprintf(tail, sizeof tail, "; instability: Gauss-Markov sigma, correlation time %.3g "
                 "s; override with ", n.instability_time_s);
-  out.notes.push_back(
+  std::vector<Option> pointed = {Option::kAccelWalk, Option::kGyroWalk,
+                                 Option::kAccelInstability, Option::kGyroInstability,
+                                 Option::kNoiseFrom};
+  if (estimable) pointed.push_back(Option::kEstimateWalk);
+  out.notes.push_back(Notice{
+      "wander_levels",
       lead + note + tail + OptionText(Option::kAccelWalk) + "/" + OptionText(Option::kGyroWalk) +
-      "/" + OptionText(Option::kAccelInstability) + "/" + OptionText(Option::kGyroInstability) +
-      " (a datasheet's values)" + (estimable ? "," : " or") + " " +
-      OptionText(Option::kNoiseFrom) + " a long still recording" +
-      (estimable ? " or " + OptionText(Option::kEstimateWalk) +
-                       " (from the session's holds, once diagnose finds no missing effect)"
-                 : std::string()));
+          "/" + OptionText(Option::kAccelInstability) + "/" +
+          OptionText(Option::kGyroInstability) + " (a datasheet's values)" +
+          (estimable ? "," : " or") + " " + OptionText(Option::kNoiseFrom) +
+          " a long still recording" +
+          (estimable ? " or " + OptionText(Option::kEstimateWalk) +
+                           " (from the session's holds, once diagnose finds no missing effect)"
+                     : std::string()),
+      std::move(pointed)});
   return out;
 }
 
@@ -238,14 +245,15 @@ signal::StillNoiseOptions WanderNoiseOptions(double instability_time_s) {
 
 std::optional<signal::StillNoise> MeasureStillNoise(const ImuSeries& series, const StillSet& set,
                                                     double instability_time_s,
-                                                    std::vector<std::string>& notes,
+                                                    std::vector<Notice>& notes,
                                                     const JobRunner& run_jobs) {
   try {
     return signal::AnalyseStillNoise(series, set.AtRestSegments(),
                                       WanderNoiseOptions(instability_time_s), run_jobs);
   } catch (const InsufficientDataError& e) {
-    notes.push_back(std::string("the still data are too short for an Allan deviation (") +
-                    e.what() + ")");
+    AddNotice(notes, "allan_too_short",
+              std::string("the still data are too short for an Allan deviation (") + e.what() +
+                  ")");
   }
   return std::nullopt;
 }

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/options.h"
@@ -60,7 +61,7 @@ struct WanderBounds {
 struct WanderLevels {
   NoiseModel noise;                ///< with every wander level set
   WanderBounds bounds;             ///< the still data's bounds on them
-  std::vector<std::string> notes;  ///< the levels and where they came from, in words
+  std::vector<Notice> notes;  ///< the levels and where they came from (code wander_levels)
 };
 
 /// Sets the wander levels that `noise` (stage 2) leaves unset because the options do not give
@@ -78,10 +79,10 @@ signal::StillNoiseOptions WanderNoiseOptions(double instability_time_s);
 
 /// The noise terms of the session's segments at rest (signal::AnalyseStillNoise with
 /// WanderNoiseOptions), or nullopt when they are too short for an Allan deviation (the reason
-/// appended to `notes`). The axes are analysed at once through `run_jobs` when it is given.
+/// appended to `notes`, code allan_too_short). The axes are analysed at once through `run_jobs` when it is given.
 std::optional<signal::StillNoise> MeasureStillNoise(const ImuSeries& series, const StillSet& set,
                                                     double instability_time_s,
-                                                    std::vector<std::string>& notes,
+                                                    std::vector<Notice>& notes,
                                                     const JobRunner& run_jobs = {});
 
 }  // namespace plumb::estimation

@@ -82,16 +82,22 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
   const std::string offsets = ardupilot ? "INS_GYR*OFFS" : "CAL_GYRO" + std::to_string(set.imu) + "_*OFF";
   if (options.keep_gyro_offsets) {
     set.parameters.push_back({flag, 0.0, true});
-    set.notes.push_back(flag + " 0 (" + OptionText(Option::kKeepGyroOffsets) + "): the firmware keeps these " + offsets +
-                        " instead of measuring new ones at rest after boot");
+    set.notes.push_back(Notice{"gyro_offsets_kept",
+                               flag + " 0 (" + OptionText(Option::kKeepGyroOffsets) +
+                                   "): the firmware keeps these " + offsets +
+                                   " instead of measuring new ones at rest after boot",
+                               {Option::kKeepGyroOffsets}});
   } else if (!logged(flag) || *logged(flag) != 0.0) {
-    set.notes.push_back("the firmware measures the gyro offsets at rest after boot while " + flag +
-                        " is 1 (" + said(flag, "its default") + ") and they replace these " +
-                        offsets + ": write " + flag + " 0 (" +
-                        OptionText(Option::kKeepGyroOffsets) + ") to keep plumb's");
+    set.notes.push_back(Notice{"gyro_offsets_replaced",
+                               "the firmware measures the gyro offsets at rest after boot while " +
+                                   flag + " is 1 (" + said(flag, "its default") +
+                                   ") and they replace these " + offsets + ": write " + flag +
+                                   " 0 (" + OptionText(Option::kKeepGyroOffsets) +
+                                   ") to keep plumb's",
+                               {Option::kKeepGyroOffsets}});
   }
   if (ardupilot) {
-    set.notes.push_back("AHRS_TRIM_X/Y/Z (the level: how the board sits in the frame) are left "
+    AddNotice(set.notes, "level_kept", "AHRS_TRIM_X/Y/Z (the level: how the board sits in the frame) are left "
                         "as they are: plumb calibrates the sensor, not its mounting");
   } else {
     const std::string i = std::to_string(set.imu);
@@ -99,7 +105,7 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
     for (const auto& [cal, tc] : ids) {
       const auto id = logged(std::string(cal) + i + "_ID");
       if (!id || *id == 0.0) {
-        set.notes.push_back(std::string(cal) + i + "_ID and " + tc + i +
+        AddNotice(set.notes, "device_id_unknown", std::string(cal) + i + "_ID and " + tc + i +
                             "_ID are not written (the input does not record them): the "
                             "vehicle's device ids stay");
         continue;
@@ -109,18 +115,21 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
         return p.name.rfind(std::string(tc) + i + "_", 0) == 0;
       });
       if (thermal) set.parameters.push_back({std::string(tc) + i + "_ID", *id, true});
-      set.notes.push_back(std::string(cal) + i + "_ID" + (thermal ? " and " + std::string(tc) + i + "_ID" : "") +
+      AddNotice(set.notes, "device_id", std::string(cal) + i + "_ID" + (thermal ? " and " + std::string(tc) + i + "_ID" : "") +
                           " " + std::to_string(std::lround(*id)) +
                           ": the device id the log records (the firmware applies these values only to it)");
     }
   }
   set.system_id = options.system_id.value_or(1);
   if (!ardupilot) {
-    set.notes.push_back("vehicle (system) id " + std::to_string(set.system_id) +
-                        (options.system_id ? ""
-                                           : " (the input does not say it; " +
-                                                 OptionText(Option::kSystemId, "N") + " gives it)") +
-                        ": QGroundControl loads a .params file only onto that vehicle");
+    set.notes.push_back(Notice{
+        "system_id",
+        "vehicle (system) id " + std::to_string(set.system_id) +
+            (options.system_id ? ""
+                               : " (the input does not say it; " +
+                                     OptionText(Option::kSystemId, "N") + " gives it)") +
+            ": QGroundControl loads a .params file only onto that vehicle",
+        options.system_id ? std::vector<Option>{} : std::vector<Option>{Option::kSystemId}});
   }
 }
 
@@ -147,8 +156,9 @@ ExportOutput Firmware(const std::string& format, const estimation::Calibration& 
   }
   ExportReport report = Evaluate(c, series, still, applied, format, /*keeps_temperature=*/true);
   report.notes.insert(report.notes.end(), set.notes.begin(), set.notes.end());
-  report.notes.push_back("axes as plumb calibrated them (the log's board frame); the firmware "
-                         "applies its board rotation after this correction");
+  AddNotice(report.notes, "board_frame",
+            "axes as plumb calibrated them (the log's board frame); the firmware applies its "
+            "board rotation after this correction");
   out.lines = report.Lines();
   out.json = ToJson(report);
   out.json["imu"] = options.imu;
@@ -202,7 +212,7 @@ ExportOutput Kalibr(const estimation::Calibration& c, const ImuSeries& series,
   };
   detail("accel", imu.accel);
   if (imu.has_gyro) detail("gyro", imu.gyro);
-  for (const std::string& note : imu.notes) out.lines.push_back("  note: " + note);
+  for (const Notice& note : imu.notes) out.lines.push_back("  note: " + note.message);
   out.json = ToJson(imu);
   out.kalibr = imu;
   return out;
@@ -277,7 +287,7 @@ json ToJson(const ExportReport& rep) {
                        {"seen_at_rest", d.seen_at_rest}});
   }
   out["dropped"] = dropped;
-  out["notes"] = rep.notes;
+  out["notes"] = Messages(rep.notes);
   return out;
 }
 
@@ -305,7 +315,7 @@ json ToJson(const KalibrImu& imu) {
               {"accelerometer_random_walk", Num(imu.accelerometer_random_walk())},
               {"longest_still_s", Num(imu.longest_still_s)},
               {"accel", sensor(imu.accel)},
-              {"notes", imu.notes}};
+              {"notes", Messages(imu.notes)}};
   if (imu.has_gyro) {
     out["gyroscope_noise_density"] = Num(imu.gyroscope_noise_density());
     out["gyroscope_random_walk"] = Num(imu.gyroscope_random_walk());

@@ -8,6 +8,27 @@
 //   json       the three above as one JSON document (parameters, reports, noise)
 // Every firmware format is evaluated from the parameter values it writes (read back through
 // ArdupilotCorrection / Px4Correction), so the reported error is that of the file.
+//
+// The notes' codes (core/notice.h; ParameterSet, ExportReport and KalibrImu notes), beside
+// each where it is made:
+//   parameters_written      formats.cc: which parameters, for which instance, and their equation
+//   thermal_kept            formats.cc: no temperature term; the vehicle's thermal parameters stay
+//   thermal_model           formats.cc: the firmware's temperature polynomial written
+//   gyro_offsets_kept       export.cc: the firmware keeps the offsets (kKeepGyroOffsets given)
+//   gyro_offsets_replaced   export.cc: the firmware measures new offsets at boot
+//                           (kKeepGyroOffsets keeps plumb's)
+//   level_kept              export.cc: ArduPilot's AHRS_TRIM left as it is
+//   device_id_unknown       export.cc: no device id in the input; the vehicle's stay
+//   device_id               export.cc: the device id the log records, written
+//   system_id               export.cc: the PX4 vehicle id written (kSystemId when not given)
+//   board_frame             export.cc: the axes are the log's board frame
+//   no_still_segment        firmware.cc, kalibr.cc: nothing at rest to measure on
+//   undetermined            firmware.cc: directions the session does not determine
+//   noise_model_only        kalibr.cc: imu.yaml holds the noise model only
+//   noise_terms_unresolved  kalibr.cc: the still data give no IEEE noise terms
+//   noise_terms_fitted      kalibr.cc: the IEEE terms and the data they come from
+//   noise_terms_source      kalibr.cc: which value each axis takes, per sensor
+//   walk_upper_bound        kalibr.cc: walks written as upper bounds
 #pragma once
 
 #include <map>

@@ -187,9 +187,11 @@ ExportReport Evaluate(const estimation::Calibration& c, const ImuSeries& series,
     }
     first += n;
   }
-  if (rep.accel_still.segments == 0) rep.notes.push_back("no still segment to measure the error on");
+  if (rep.accel_still.segments == 0) {
+    AddNotice(rep.notes, "no_still_segment", "no still segment to measure the error on");
+  }
   if (!c.observability.unobservable.empty()) {
-    rep.notes.push_back(std::to_string(c.observability.unobservable.size()) +
+    AddNotice(rep.notes, "undetermined", std::to_string(c.observability.unobservable.size()) +
                         " direction(s) of the parameters are not determined by this session (see "
                         "the observability report): the exported values are one of many that "
                         "fit it equally, right for poses like the session's only");
@@ -227,7 +229,7 @@ std::vector<std::string> ExportReport::Lines() const {
     if (!d.seen_at_rest) text += " (acts in motion only: not in the still-segment error)";
     lines.push_back(text);
   }
-  for (const std::string& note : notes) lines.push_back("  note: " + note);
+  for (const Notice& note : notes) lines.push_back("  note: " + note.message);
   return lines;
 }
 

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/types.h"
 #include "plumb/estimation/calibration.h"
 #include "plumb/estimation/fit_report.h"
@@ -116,7 +117,7 @@ struct ExportReport {
   Mat3 accel_per_input = Mat3::Zero();
   Mat3 gyro_per_input = Mat3::Zero();
   std::vector<DroppedEffect> dropped;  ///< effects the target cannot carry
-  std::vector<std::string> notes;      ///< what else the user must know, in words
+  std::vector<Notice> notes;  ///< what else the user must know (codes: export.h)
 
   /// The report for a terminal, one line each (numbers in SI and in mg, deg/h, ppm).
   std::vector<std::string> Lines() const;

@@ -164,12 +164,12 @@ ParameterSet ArdupilotParameters(const FirmwareCorrection& fw, int imu) {
     gyr = ToArdupilot(fw.gyro, cal_gyr);
     AddVector(set, ArduStem("GYR", "OFFS", imu), gyr.offset);
   }
-  set.notes.push_back("ArduPilot parameters from plumb for IMU instance " + std::to_string(imu) +
+  AddNotice(set.notes, "parameters_written", "ArduPilot parameters from plumb for IMU instance " + std::to_string(imu) +
                       " (" + ArduStem("ACC", "", imu) + "...): acc = (acc_sensor - tcal(T) - " +
                       ArduStem("ACC", "OFFS", imu) + ") .* " + ArduStem("ACC", "SCAL", imu) +
                       ", gyr = gyr_sensor - tcal(T) - " + ArduStem("GYR", "OFFS", imu));
   if (!thermal) {
-    set.notes.push_back("no temperature term in plumb's model: INS_TCAL" +
+    AddNotice(set.notes, "thermal_kept", "no temperature term in plumb's model: INS_TCAL" +
                         std::to_string(imu + 1) + "_* left as on the vehicle");
     return set;
   }
@@ -186,7 +186,7 @@ ParameterSet ArdupilotParameters(const FirmwareCorrection& fw, int imu) {
   if (fw.has_gyro && fw.gyro.has_thermal) {
     set.parameters.push_back({"INS_GYR" + n + "_CALTEMP", cal_gyr, false});
   }
-  set.notes.push_back("tcal(T) = p(clamp(T) - 35) - p(clamp(CALTEMP) - 35), p(d) = (C1 + (C2 + "
+  AddNotice(set.notes, "thermal_model", "tcal(T) = p(clamp(T) - 35) - p(clamp(CALTEMP) - 35), p(d) = (C1 + (C2 + "
                       "C3 d) d) d * 1e-6 (AP_InertialSensor_tempcal.cpp); valid for samples "
                       "with no temperature correction left in them (INS_TCAL" + n +
                       "_ENABLE = 0 in the log, or its correction undone by plumb)");
@@ -236,7 +236,7 @@ ParameterSet Px4Parameters(const FirmwareCorrection& fw, int imu) {
       set.parameters.push_back({"CAL_GYRO" + i + "_" + kAxes[a] + "OFF", fw.gyro.offset[a], false});
     }
   }
-  set.notes.push_back("PX4 parameters from plumb for instance " + i +
+  AddNotice(set.notes, "parameters_written", "PX4 parameters from plumb for instance " + i +
                       ": acc = (acc_sensor - thermal - CAL_ACC" + i + "_OFF) .* CAL_ACC" + i +
                       "_SCALE, gyr = gyr_sensor - thermal - CAL_GYRO" + i + "_OFF");
 
@@ -290,7 +290,7 @@ FirmwareCorrection Px4Correction(const std::map<std::string, double>& v, int imu
 
 std::string ArdupilotParamFile(const ParameterSet& set) {
   std::string text;
-  for (const std::string& note : set.notes) text += "# " + note + "\n";
+  for (const Notice& note : set.notes) text += "# " + note.message + "\n";
   for (const Parameter& p : set.parameters) {
     text += p.name + "," + (p.integer ? std::to_string(std::lround(p.value)) : Number(p.value)) + "\n";
   }
@@ -316,7 +316,7 @@ std::map<std::string, double> ReadArdupilotParamFile(const std::string& text,
 
 std::string Px4ParamsFile(const ParameterSet& set) {
   std::string text;
-  for (const std::string& note : set.notes) text += "# " + note + "\n";
+  for (const Notice& note : set.notes) text += "# " + note.message + "\n";
   text += "#\n# Vehicle-Id Component-Id Name Value Type\n";
   for (const Parameter& p : set.parameters) {
     text += std::to_string(set.system_id) + "\t1\t" + p.name + "\t" +

@@ -43,7 +43,7 @@ struct ParameterSet {
   std::string target;  ///< "ardupilot" or "px4"
   int imu = 0;         ///< IMU instance, 0-based
   std::vector<Parameter> parameters;
-  std::vector<std::string> notes;  ///< written as comments at the top of the file
+  std::vector<Notice> notes;  ///< written as comments at the top of the file (codes: export.h)
   int system_id = 1;  ///< the vehicle's MAVLink system id (QGroundControl's first column)
 
   /// Name -> value.

@@ -179,7 +179,7 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
     imu.gyro = Measure(series, signal::Sensor::kGyro, c.noise.gyr, c.noise.tau_gyr, dt_s, seg,
                        gyro_slope);
   }
-  imu.notes.push_back("Kalibr's imu.yaml holds the noise model only: plumb's scale, "
+  AddNotice(imu.notes, "noise_model_only", "Kalibr's imu.yaml holds the noise model only: plumb's scale, "
                       "misalignment, biases and effects are not in it (Kalibr estimates its own "
                       "IMU intrinsics)");
   // The IEEE terms of the still data (every still segment that does not turn, pooled).
@@ -189,25 +189,25 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   try {
     if (seg) ieee = signal::AnalyseStillNoise(series, segments);
   } catch (const InsufficientDataError& e) {
-    imu.notes.push_back(std::string("no IEEE noise terms: ") + e.what());
+    AddNotice(imu.notes, "noise_terms_unresolved", std::string("no IEEE noise terms: ") + e.what());
   }
   UseIeeeTerms(ieee ? &*ieee : nullptr, signal::Sensor::kAccel, accel_slope, imu.accel);
   if (imu.has_gyro) {
     UseIeeeTerms(ieee ? &*ieee : nullptr, signal::Sensor::kGyro, gyro_slope, imu.gyro);
   }
   if (ieee) {
-    imu.notes.push_back("IEEE noise terms fitted to the Allan deviation of " +
+    AddNotice(imu.notes, "noise_terms_fitted", "IEEE noise terms fitted to the Allan deviation of " +
                         Number(ieee->still_s) + " s of still data in " +
                         std::to_string(ieee->segments.size()) + " segment(s) (plumb allan)");
-    imu.notes.push_back(SourceNote("accel", imu.accel));
-    if (imu.has_gyro) imu.notes.push_back(SourceNote("gyro", imu.gyro));
+    AddNotice(imu.notes, "noise_terms_source", SourceNote("accel", imu.accel));
+    if (imu.has_gyro) AddNotice(imu.notes, "noise_terms_source", SourceNote("gyro", imu.gyro));
   }
   const bool resolved = imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved);
   if (!seg) {
-    imu.notes.push_back("no still segment: random walks unknown, written as 0");
+    AddNotice(imu.notes, "no_still_segment", "no still segment: random walks unknown, written as 0");
     imu.accel.walk = imu.gyro.walk = Vec3::Zero();
   } else if (!resolved) {
-    imu.notes.push_back("random walks not resolved by the IEEE fit are upper bounds (min over t "
+    AddNotice(imu.notes, "walk_upper_bound", "random walks not resolved by the IEEE fit are upper bounds (min over t "
                         "of ADEV(t) sqrt(3/t)): the longest still segment (" +
                         Number(imu.longest_still_s) + " s) is too short to show the +1/2 slope");
   }
@@ -217,7 +217,7 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
 std::string KalibrYaml(const KalibrImu& imu) {
   std::string text = "# Kalibr IMU noise model from plumb (white noise densities and bias random "
                      "walks of the session)\n";
-  for (const std::string& note : imu.notes) text += "# " + note + "\n";
+  for (const Notice& note : imu.notes) text += "# " + note.message + "\n";
   const bool bound = !(imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved));
   const std::string walk_comment = bound ? "  # upper bound from a short session" : "";
   text += "rostopic: " + imu.rostopic + "\n";

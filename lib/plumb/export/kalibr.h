@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/estimation/calibration.h"
 #include "plumb/estimation/fit_report.h"
 #include "plumb/export/firmware.h"
@@ -69,7 +70,7 @@ struct KalibrImu {
   SensorNoise accel, gyro;
   bool has_gyro = false;
   double longest_still_s = 0;      ///< length of the segment the Allan deviation used, s
-  std::vector<std::string> notes;  ///< what the file cannot carry and how K was found
+  std::vector<Notice> notes;  ///< what the file cannot carry and how K was found (codes: export.h)
 
   double accelerometer_noise_density() const { return accel.white.maxCoeff(); }
   double accelerometer_random_walk() const { return accel.walk.maxCoeff(); }

@@ -94,7 +94,7 @@ void GyroscopeBias(double max_tilt_rad, PaperBenchmarkResult& r) {
       if (pose.axis == 2 && !pose.parallel && pose.tilt_rad <= max_tilt_rad) xy.push_back(i);
     }
     if (!xy.empty()) {
-      r.notes.push_back("no still period with z parallel to gravity (down) for the x and y "
+      AddNotice(r.notes, "gyro_bias_from_up", "no still period with z parallel to gravity (down) for the x and y "
                         "gyroscope bias; used those with z antiparallel (up)");
     }
   }
@@ -108,7 +108,7 @@ void GyroscopeBias(double max_tilt_rad, PaperBenchmarkResult& r) {
     FitBiasLine(r.still, periods, axis, r.t0_s, r.gyro_bias_b0[axis], r.gyro_bias_b1[axis]);
   }
   if (xy.size() < 2 || r.z_perpendicular_index.size() < 2) {
-    r.notes.push_back("only one still period of a kind for the gyroscope bias: b1 = 0 there");
+    AddNotice(r.notes, "gyro_bias_drift_zero", "only one still period of a kind for the gyroscope bias: b1 = 0 there");
   }
   r.b_g = r.gyro_bias_b0;
   r.gyro_bias_drift = r.gyro_bias_b1;
@@ -152,7 +152,7 @@ void GyroscopeCoupling(const ImuSeries& series, const std::vector<MotionRange>& 
     const double along = turn.integral[turn.axis];
     turn.nominal_angle_rad = std::round(along / kHalfPi) * kHalfPi;
     if (turn.nominal_angle_rad == 0.0) {
-      r.notes.push_back("'" + m.label + "' turned less than 45 deg: not used");
+      AddNotice(r.notes, "turn_too_small", "'" + m.label + "' turned less than 45 deg: not used");
       continue;
     }
     r.turns.push_back(turn);

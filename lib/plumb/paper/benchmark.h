@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/types.h"
 #include "plumb/core/units.h"
@@ -121,7 +122,9 @@ struct PaperBenchmarkResult {
   std::vector<int> z_parallel_index;       ///< still[] used for the x and y gyroscope bias
   std::vector<int> z_perpendicular_index;  ///< still[] used for the z gyroscope bias
   std::vector<TurnPeriod> turns;           ///< turns used for the gyroscope coupling
-  std::vector<std::string> notes;          ///< choices made, for the report
+  /// Choices made, for the report (codes: gyro_bias_from_up, the x and y gyroscope bias from
+  /// z up; gyro_bias_drift_zero, b1 = 0 for want of a second period; turn_too_small).
+  std::vector<Notice> notes;
 };
 
 /// Runs the benchmark procedure. `still` are the still periods (detected or given, labels kept);

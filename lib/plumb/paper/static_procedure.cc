@@ -102,17 +102,19 @@ PaperStaticResult CalibratePaperStatic(const ImuSeries& series, std::size_t begi
   r.accel = Accelerometer(series, begin, end, hp, options.accel_diagonal);
   r.F = -r.accel.F_paper;
   r.b_a = r.accel.bias;
-  r.notes.push_back("F is in the frame of the level, x-north pose; alpha = 0 and F_xx = F_yy = " +
+  AddNotice(r.notes, "accel_entries_fixed", "F is in the frame of the level, x-north pose; alpha = 0 and F_xx = F_yy = " +
                     std::to_string(-options.accel_diagonal) + " are fixed, not estimated");
   if (series.has_gyro() && !site.known) {
-    r.notes.push_back("no site: the gyroscope part (steps 5-7 need C_ecef^ned) is left out; "
-                      "give " + OptionText(Option::kSite));
+    r.notes.push_back(Notice{"site_unknown",
+                             "no site: the gyroscope part (steps 5-7 need C_ecef^ned) is left "
+                             "out; give " + OptionText(Option::kSite),
+                             {Option::kSite}});
   } else if (series.has_gyro()) {
     r.has_gyro = true;
     r.gyro = Gyroscope(series, begin, end, hp, site, options);
     r.E = r.gyro.E_paper;
     r.b_g = r.gyro.bias;
-    r.notes.push_back("sigma = 0 and E_xx = E_yy = " + Number(options.gyro_diagonal) +
+    AddNotice(r.notes, "gyro_entries_fixed", "sigma = 0 and E_xx = E_yy = " + Number(options.gyro_diagonal) +
                       " are fixed; tau, xi, nu come from Earth rate alone");
   }
   return r;

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/notice.h"
 #include "plumb/core/types.h"
 #include "plumb/core/units.h"
 #include "plumb/geo/site.h"
@@ -85,7 +86,9 @@ struct PaperStaticResult {
   Vec3 b_g = Vec3::Zero();    ///< gyro.bias
   double rate_hz = 0.0;       ///< sample rate the filter was designed for (1 / median dt), Hz
   std::size_t count = 0;      ///< samples used
-  std::vector<std::string> notes;
+  /// What was fixed or left out (codes: accel_entries_fixed, gyro_entries_fixed, site_unknown
+  /// with kSite).
+  std::vector<Notice> notes;
 };
 
 /// Runs the static procedure on samples [begin, end) of the series (the still, level, x-north

@@ -41,16 +41,19 @@ ComparisonRow MakeRow(const NamedValue& peer, const PlumbParameter* plumb, doubl
 
 /// A note when the diagonal scales differ by more than a factor 2: different units.
 void CheckUnits(const Mat3& plumb, const Mat3& peer, const std::string& sensor,
-                std::vector<std::string>& notes) {
+                std::vector<Notice>& notes) {
   for (int i = 0; i < 3; ++i) {
     const double ratio = plumb(i, i) / peer(i, i);
     if (!(std::abs(ratio) > 0.5 && std::abs(ratio) < 2.0)) {
-      notes.push_back("WARNING: the " + sensor + " scales (matrix diagonals) differ by a factor " +
-                      std::to_string(ratio) +
-                      ": were plumb and the peer given data in different units? (plumb must read "
-                      "the peer's raw data without " + OptionText(Option::kAccScale) + "/" +
-                      OptionText(Option::kGyrScale) + "/" + OptionText(Option::kAccOffset) + "/" +
-                      OptionText(Option::kGyrOffset) + "), or is plumb's estimate unobservable?");
+      notes.push_back(Notice{
+          "scales_differ",
+          "WARNING: the " + sensor + " scales (matrix diagonals) differ by a factor " +
+              std::to_string(ratio) +
+              ": were plumb and the peer given data in different units? (plumb must read the "
+              "peer's raw data without " + OptionText(Option::kAccScale) + "/" +
+              OptionText(Option::kGyrScale) + "/" + OptionText(Option::kAccOffset) + "/" +
+              OptionText(Option::kGyrOffset) + "), or is plumb's estimate unobservable?",
+          {Option::kAccScale, Option::kGyrScale, Option::kAccOffset, Option::kGyrOffset}});
       return;
     }
   }
@@ -58,13 +61,16 @@ void CheckUnits(const Mat3& plumb, const Mat3& peer, const std::string& sensor,
 
 bool IsSi(const std::string& unit) { return unit == "m/s^2" || unit == "rad/s"; }
 
-/// Why the rows of a sensor cannot be compared for units, or "": plumb's outputs in SI and the
-/// peer's not (or the reverse), or every scale 180/pi apart (deg/s data read as rad/s).
-std::string UnitMismatch(const std::string& plumb_unit, const std::string& peer_unit,
+/// Why the rows of a sensor cannot be compared for units (code units_differ), or nullopt:
+/// plumb's outputs in SI and the peer's not (or the reverse), or every scale 180/pi apart
+/// (deg/s data read as rad/s).
+std::optional<Notice> UnitMismatch(const std::string& plumb_unit, const std::string& peer_unit,
                          const Mat3& plumb, const Mat3& peer, const std::string& sensor) {
   if (!plumb_unit.empty() && !peer_unit.empty() && IsSi(plumb_unit) != IsSi(peer_unit)) {
-    return "plumb's " + sensor + " outputs are in " + plumb_unit + ", the peer's in " +
-           peer_unit + ": give both the same data in the same units";
+    return Notice{"units_differ",
+                  "plumb's " + sensor + " outputs are in " + plumb_unit + ", the peer's in " +
+                      peer_unit + ": give both the same data in the same units",
+                  {}};
   }
   const double deg = 180.0 / units::kPi;
   bool apart = true;
@@ -73,19 +79,24 @@ std::string UnitMismatch(const std::string& plumb_unit, const std::string& peer_
     apart = apart && (std::abs(ratio / deg - 1.0) < 0.1 || std::abs(ratio * deg - 1.0) < 0.1);
   }
   if (apart) {
-    return "every " + sensor + " scale differs by 180/pi: data in deg/s were read as rad/s on "
-           "one side (plumb converts deg/s with " + OptionText(Option::kGyrUnit, "deg/s") + ")";
+    return Notice{"units_differ",
+                  "every " + sensor + " scale differs by 180/pi: data in deg/s were read as "
+                  "rad/s on one side (plumb converts deg/s with " +
+                      OptionText(Option::kGyrUnit, "deg/s") + ")",
+                  {Option::kGyrUnit}};
   }
-  return "";
+  return std::nullopt;
 }
 
-/// Why the gyroscope matrices cannot be compared for their sign, or "".
-std::string SignMismatch(const Mat3& plumb, const Mat3& peer, const std::string& peer_name) {
+/// Why the gyroscope matrices cannot be compared for their sign (code gyro_sign_differs), or
+/// nullopt.
+std::optional<Notice> SignMismatch(const Mat3& plumb, const Mat3& peer,
+                                   const std::string& peer_name) {
   std::string axes;
   for (int i = 0; i < 3; ++i) {
     if ((plumb(i, i) > 0.0) != (peer(i, i) > 0.0)) axes += kAxisName[i];
   }
-  if (axes.empty()) return "";
+  if (axes.empty()) return std::nullopt;
   std::string why = "the gyroscope matrix's diagonal has the opposite sign in plumb and " +
                     peer_name + " on axes " + axes +
                     ": the two take the rate with opposite signs there";
@@ -93,19 +104,19 @@ std::string SignMismatch(const Mat3& plumb, const Mat3& peer, const std::string&
     why += " (imucal takes its turns as clockwise, expected_angle -360: turns made the other "
            "way give a negative R_g diagonal; recompute with expected_angle +360)";
   }
-  return why;
+  return Notice{"gyro_sign_differs", why, {}};
 }
 
 void MarkNotCompared(std::vector<ComparisonRow>& rows, const std::vector<std::string>& prefixes,
-                     const std::string& why, std::vector<std::string>& notes) {
-  if (why.empty()) return;
+                     const std::optional<Notice>& why, std::vector<Notice>& notes) {
+  if (!why) return;
   std::string which;
   for (const auto& p : prefixes) which += (which.empty() ? "" : ", ") + p + "*";
-  notes.push_back("not compared: " + which + ": " + why);
+  notes.push_back(Notice{why->code, "not compared: " + which + ": " + why->message, why->options});
   for (ComparisonRow& row : rows) {
     for (const auto& p : prefixes) {
       if (row.name.rfind(p, 0) != 0) continue;
-      row.not_compared = why;
+      row.not_compared = why->message;
       row.difference = 0.0;
       row.z.reset();
       row.z_scaled.reset();
@@ -245,7 +256,7 @@ json CostJson(const ImuTkCost& c) {
 json PeerJson(const ForwardCalibration& p) {
   json out{{"name", p.peer},
            {"sources", p.sources},
-           {"notes", p.notes},
+           {"notes", Messages(p.notes)},
            {"R_peer_b", Mat(p.R_peer_b)},
            {"units", {{"accel", p.acc_unit}, {"gyro", p.gyr_unit}}},
            {"accel", {{"matrix", Mat(p.accel_matrix)}, {"bias", Vec(p.accel_bias)}}}};
@@ -297,18 +308,19 @@ Comparison Compare(const PlumbResult& result, const ForwardCalibration& peer,
                                      [&](const NamedValue& v) { return v.name == p.name; });
     if (!matched) c.plumb_only.push_back(p.name);
   }
-  const std::string acc_units = UnitMismatch(BiasUnit(result, "accel.bias.x"), peer.acc_unit,
+  const std::optional<Notice> acc_units = UnitMismatch(BiasUnit(result, "accel.bias.x"), peer.acc_unit,
                                              result.accel_matrix, peer.accel_matrix,
                                              "accelerometer");
   MarkNotCompared(c.rows, {"accel."}, acc_units, c.notes);
-  if (acc_units.empty()) {
+  if (!acc_units) {
     CheckUnits(result.accel_matrix, peer.accel_matrix, "accelerometer", c.notes);
   }
   if (result.has_gyro && peer.has_gyro) {
-    const std::string gyr_units = UnitMismatch(BiasUnit(result, "gyro.bias.x"), peer.gyr_unit,
-                                               result.gyro_matrix, peer.gyro_matrix, "gyroscope");
+    const std::optional<Notice> gyr_units =
+        UnitMismatch(BiasUnit(result, "gyro.bias.x"), peer.gyr_unit, result.gyro_matrix,
+                     peer.gyro_matrix, "gyroscope");
     MarkNotCompared(c.rows, {"gyro.", "gyro_g_sensitivity."}, gyr_units, c.notes);
-    if (gyr_units.empty()) {
+    if (!gyr_units) {
       MarkNotCompared(c.rows, {"gyro.matrix."},
                       SignMismatch(result.gyro_matrix, peer.gyro_matrix, peer.peer), c.notes);
       CheckUnits(result.gyro_matrix, peer.gyro_matrix, "gyroscope", c.notes);
@@ -326,8 +338,8 @@ std::string ComparisonText(const Comparison& c) {
   os << " (" << sources << ")\n";
   os << "plumb: method " << c.method << ", model " << c.model << ", chi2/dof "
      << Number(c.chi2_dof, 4) << " on " << c.dof << " dof\n";
-  for (const auto& n : c.peer.notes) os << "  " << n << "\n";
-  for (const auto& n : c.notes) os << n << "\n";
+  for (const Notice& n : c.peer.notes) os << "  " << n.message << "\n";
+  for (const Notice& n : c.notes) os << n.message << "\n";
   os << "forward form y = M x + b in the units of the data plumb was given; "
      << "d = plumb - " << c.peer.peer << ", sigma = plumb's\n\n";
   WriteTable(c, os);
@@ -362,7 +374,7 @@ json ComparisonJson(const Comparison& c) {
               {"rows", rows},
               {"plumb_only", c.plumb_only},
               {"gravity_norm_cost", CostsJson(c.cost)},
-              {"notes", c.notes}};
+              {"notes", Messages(c.notes)}};
 }
 
 }  // namespace plumb::peers

@@ -58,7 +58,9 @@ struct Comparison {
   std::vector<ComparisonRow> rows;
   std::vector<std::string> plumb_only;  ///< plumb's parameters the peer has no value for
   GravityNormComparison cost;
-  std::vector<std::string> notes;       ///< warnings, and why rows are not compared
+  /// Warnings, and why rows are not compared (codes: scales_differ, units_differ,
+  /// gyro_sign_differs; core/notice.h).
+  std::vector<Notice> notes;
 };
 
 struct CompareOptions {

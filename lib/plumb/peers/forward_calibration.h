@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/notice.h"
 #include "plumb/core/types.h"
 
 namespace plumb::peers {
@@ -39,8 +40,11 @@ struct ForwardCalibration {
   /// were converted to SI, the peer's own unit when kept ("a.u."), "" when the peer does not
   /// say (imu_tk: the data's as given).
   std::string acc_unit, gyr_unit;
-  /// How the peer's numbers were converted, and anything a reader must know about them.
-  std::vector<std::string> notes;
+  /// How the peer's numbers were converted, and anything a reader must know about them (codes:
+  /// peer_form, the peer's equation and plumb's forward form of it; peer_frame, the frame
+  /// compared in; peer_convention, what the peer assumes; unit_kept, an output unit plumb
+  /// does not convert).
+  std::vector<Notice> notes;
 };
 
 /// One named forward parameter, named as in plumb's JSON (`accel.matrix.xy`, `gyro.bias.z`,

@@ -210,12 +210,14 @@ ForwardCalibration ImuTkToForward(const ImuTkCalibration& calibration,
   f.has_gyro = true;
   f.gyro_matrix = InverseOf(calibration.gyro.T * calibration.gyro.K, "imu_tk gyroscope");
   f.gyro_bias = calibration.gyro.B;
-  f.notes.push_back(
+  AddNotice(
+      f.notes, "peer_form",
       "imu_tk applies calibrated = T K (raw - B); forward form F = (T_a K_a)^-1, b_a = B_a, "
       "E = (T_g K_g)^-1, b_g = B_g, in raw units per m/s^2 and per rad/s");
   const Mat3& T_a = calibration.acc.T;
   if (T_a(1, 0) != 0.0 || T_a(2, 0) != 0.0 || T_a(2, 1) != 0.0) {
-    f.notes.push_back(
+    AddNotice(
+        f.notes, "peer_frame",
         "imu_tk's accelerometer T is not upper triangular: its frame is not the "
         "accelerometer-defined one and the lower entries of F were dropped");
   }

@@ -33,7 +33,7 @@ std::string Text(const json& root, const std::string& key, const std::string& fa
 double OutputScale(const std::string& unit, const std::string& what, ForwardCalibration& f) {
   const double si = SiPerUnit(unit);
   if (si > 0.0) return si;
-  f.notes.push_back(what + " output unit '" + unit +
+  AddNotice(f.notes, "unit_kept", what + " output unit '" + unit +
                     "' is not one plumb converts: values kept in that unit (give plumb the "
                     "same raw data without unit conversion)");
   return 1.0;
@@ -108,24 +108,28 @@ ForwardCalibration ImucalToForward(const ImucalFerraris& cal, const std::string&
   f.gyro_bias = out_g * cal.b_g;
   f.has_g_sensitivity = true;
   f.g_sensitivity = (out_g / cal_a) * cal.K_ga * f.R_peer_b;
-  f.notes.push_back(
+  f.notes.push_back(Notice{
+      "peer_form",
       "imucal applies acc_cal = R_a^-1 K_a^-1 (acc - b_a), gyr_cal = R_g^-1 K_g^-1 (gyr - K_ga "
       "acc_cal - b_g); forward form F = s_a K_a R_a R, E = s_g K_g R_g R, G = (S_g / C_a) K_ga "
       "R, S_a b_a, S_g b_g, with R = R_peer_b, S (C) the SI value of one output (calibrated) "
-      "unit, s = S / C: output " + cal.from_acc_unit + ", " + cal.from_gyr_unit +
-      " -> " + f.acc_unit + ", " + f.gyr_unit + " (plumb's units for data read with " +
-      OptionText(Option::kGyrUnit, "deg/s") + "); calibrated " + cal.acc_unit + ", " + cal.gyr_unit + " -> m/s^2, rad/s");
+      "unit, s = S / C: output " + cal.from_acc_unit + ", " + cal.from_gyr_unit + " -> " +
+          f.acc_unit + ", " + f.gyr_unit + " (plumb's units for data read with " +
+          OptionText(Option::kGyrUnit, "deg/s") + "); calibrated " + cal.acc_unit + ", " +
+          cal.gyr_unit + " -> m/s^2, rad/s",
+      {Option::kGyrUnit}});
   if (frame == ImucalFrame::kPoses) {
-    f.notes.push_back("compared in imucal's own frame, that of its six poses (R_peer_b = I): "
+    AddNotice(f.notes, "peer_frame", "compared in imucal's own frame, that of its six poses (R_peer_b = I): "
                       "plumb's F is full and determined, its frame also the poses'");
   } else {
     const double angle_deg =
         std::acos(std::clamp((f.R_peer_b.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / units::kPi;
-    f.notes.push_back("imucal's frame (its six poses) is turned by " +
+    AddNotice(f.notes, "peer_frame", "imucal's frame (its six poses) is turned by " +
                       Number(angle_deg) +
                       " deg from plumb's accelerometer-defined frame (R_peer_b)");
   }
-  f.notes.push_back(
+  AddNotice(
+      f.notes, "peer_convention",
       "imucal's gyroscope bias is the mean of its six static poses, Earth rate included; its "
       "turns are taken as clockwise (expected_angle -360), a right-handed rate like plumb's");
   return f;

@@ -36,7 +36,7 @@ FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResu
     out.input_warnings.push_back(Notice{"gravity_fixed",
                                         "gravity fixed at " +
                                             std::to_string(*request.gravity_m_s2) + " m/s^2 by " +
-                                            request.gravity_option +
+                                            OptionText(Option::kGravity) +
                                             " instead of WGS84 normal gravity",
                                         {Option::kGravity}});
   }

@@ -51,9 +51,6 @@ struct FitRequest {
   std::optional<SiteInput> site;
   /// A fixed gravity magnitude instead of WGS84 normal gravity, m/s^2.
   std::optional<double> gravity_m_s2;
-  /// How the front end names the fixed-gravity option, in the warning that it overrides WGS84
-  /// gravity at a known site (the command line spells it OptionText(Option::kGravity) does).
-  std::string gravity_option = "the fixed gravity";
   /// The fit's options as given (heading, strictness, iteration limit, bias wander, other
   /// still recordings' noise); passed on unchanged.
   estimation::CalibrationOptions options;

@@ -140,7 +140,7 @@ std::string FullReport(const estimation::CalibrationResult& result) {
       os << "\n";
     }
   }
-  for (const auto& n : fit.notes) os << "note: " << n << "\n";
+  for (const Notice& n : fit.notes) os << "note: " << n.message << "\n";
   return os.str();
 }
 

@@ -80,8 +80,8 @@ std::string FirmwareDetails(const exporter::ExportReport& r, const std::string& 
   std::string out;
   if (!dropped.empty()) out += "<p>Effects it has no parameter for (dropped):</p>\n" + HtmlList(dropped);
   std::vector<std::string> notes;  // those the file does not carry as comments
-  for (const std::string& note : r.notes) {
-    if (text.find("# " + note + "\n") == std::string::npos) notes.push_back(note);
+  for (const Notice& note : r.notes) {
+    if (text.find("# " + note.message + "\n") == std::string::npos) notes.push_back(note.message);
   }
   if (!notes.empty()) out += HtmlList(notes);
   return out;

@@ -403,7 +403,7 @@ json ToJson(const estimation::CalibrationResult& r) {
     doc["not_turns"].push_back(j);
   }
   doc["warnings"] = Messages(r.fit.warnings);  // the messages; the codes are not in SPEC 6
-  if (!r.fit.notes.empty()) doc["notes"] = r.fit.notes;
+  if (!r.fit.notes.empty()) doc["notes"] = Messages(r.fit.notes);
   return doc;
 }
 

@@ -76,7 +76,9 @@ struct FlightLogSummary {
   std::vector<LogMotion> motion;
   std::map<std::string, double> params;  ///< the calibration parameters in force (firmware names)
   std::vector<std::pair<std::string, std::size_t>> messages;  ///< (message, count), log order
-  std::vector<std::string> warnings;   ///< what the reader skipped or repaired, with counts
+  /// What the reader skipped or repaired, with counts (codes log_damaged, records_dropped:
+  /// core/notice.h).
+  std::vector<Notice> warnings;
 };
 
 /// The first and last sample times over the streams with samples, s ({0, 0} without any).

@@ -39,7 +39,7 @@ FlightLogSummary DataflashSummary(const DataflashLog& log, FlightLogFormat forma
     if (IsArdupilotCalibrationParameter(name)) out.params[name] = value;
   }
   out.messages = log.MessageCounts();
-  out.warnings = log.warnings.Describe();
+  AddNotices(out.warnings, "log_damaged", log.warnings.Describe());
   return out;
 }
 

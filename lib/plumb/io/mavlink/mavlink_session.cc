@@ -573,7 +573,7 @@ FlightLogSummary TlogSummary(const MavlinkLog& log) {
     }
   }
   out.messages = log.MessageCounts();
-  out.warnings = log.warnings.Describe(log.message_counts);
+  AddNotices(out.warnings, "log_damaged", log.warnings.Describe(log.message_counts));
   return out;
 }
 

@@ -636,10 +636,11 @@ FlightLogSummary ULogSummary(const ULog& log) {
   out.motion = ULogMotion(log, LogSpan(out.imus).second);
   out.params = ULogParams(log);
   out.messages = log.MessageCounts();
-  out.warnings = log.warnings.Describe();
+  AddNotices(out.warnings, "log_damaged", log.warnings.Describe());
   if (log.dropouts > 0) {
-    out.warnings.push_back(std::to_string(log.dropouts) + " logging dropout(s), " +
-                           std::to_string(log.dropout_total_ms) + " ms in total");
+    AddNotice(out.warnings, "records_dropped",
+              std::to_string(log.dropouts) + " logging dropout(s), " +
+                  std::to_string(log.dropout_total_ms) + " ms in total");
   }
   return out;
 }
