@@ -17,4 +17,10 @@ std::string SignificantText(double value, int digits) {
   return buf;
 }
 
+std::string FormattedText(const char* format, double value) {
+  char buf[352];
+  std::snprintf(buf, sizeof buf, format, value);
+  return buf;
+}
+
 }  // namespace plumb

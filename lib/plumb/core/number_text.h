@@ -13,4 +13,9 @@ std::string FixedText(double value, int decimals);
 /// `value` to `digits` significant digits ("%.*g"): 1.07e+03, 0.0004.
 std::string SignificantText(double value, int digits);
 
+/// `value` through the one printf conversion of `format` ("%.3f", "%+.2e", "%8.4g", and text
+/// around it: "%.1f s"): the forms a report's columns take. `format` is a literal of the
+/// caller's with exactly one conversion of a double.
+std::string FormattedText(const char* format, double value);
+
 }  // namespace plumb

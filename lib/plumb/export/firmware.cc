@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "plumb/core/number_text.h"
 #include "plumb/core/error.h"
 #include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
@@ -36,22 +37,11 @@ bool ModelThermal(const estimation::Calibration& c, model::Sensor sensor,
   return true;
 }
 
-std::string Fixed(double value, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
-  return buf;
-}
-
-std::string Sci(double value) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.3g", value);
-  return buf;
-}
 
 /// "x 0.12 y 0.03 z 0.40 mg" style triple.
 std::string Triple(const Vec3& v, double factor, int decimals) {
-  return "x " + Fixed(v.x() * factor, decimals) + "  y " + Fixed(v.y() * factor, decimals) +
-         "  z " + Fixed(v.z() * factor, decimals);
+  return "x " + FixedText(v.x() * factor, decimals) + "  y " + FixedText(v.y() * factor, decimals) +
+         "  z " + FixedText(v.z() * factor, decimals);
 }
 
 }  // namespace
@@ -216,15 +206,15 @@ std::vector<std::string> ExportReport::Lines() const {
                     Triple(gyro_still.max_abs, 1.0, 7) + " rad/s");
   }
   lines.push_back("  not representable: accel up to " +
-                  Fixed(accel_per_input.cwiseAbs().maxCoeff() * 1e6, 0) +
+                  FixedText(accel_per_input.cwiseAbs().maxCoeff() * 1e6, 0) +
                   " ppm of the input (diagonal scale and offset only)" +
-                  (has_gyro ? ", gyro up to " + Fixed(gyro_per_input.cwiseAbs().maxCoeff() * 1e6, 0) +
+                  (has_gyro ? ", gyro up to " + FixedText(gyro_per_input.cwiseAbs().maxCoeff() * 1e6, 0) +
                                   " ppm of the rate (no gyro scale or misalignment)"
                             : std::string()));
   for (const DroppedEffect& d : dropped) {
     std::string text = "  dropped " + d.effect + ":";
     for (std::size_t i = 0; i < d.names.size(); ++i) {
-      text += " " + d.names[i] + " " + Sci(d.values[i]) + (i + 1 < d.names.size() ? "," : "");
+      text += " " + d.names[i] + " " + SignificantText(d.values[i], 3) + (i + 1 < d.names.size() ? "," : "");
     }
     if (!d.seen_at_rest) text += " (acts in motion only: not in the still-segment error)";
     lines.push_back(text);

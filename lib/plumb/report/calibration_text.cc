@@ -4,19 +4,14 @@
 #include <cstdio>
 #include <sstream>
 
+#include "plumb/core/number_text.h"
 #include "plumb/estimation/uncertainty.h"
 
 namespace plumb::report {
 namespace {
 
-std::string Format(const char* fmt, double a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, a);
-  return buf;
-}
-
 std::string Vec(const Vec3& v, const char* fmt = "%.4g") {
-  return "(" + Format(fmt, v.x()) + ", " + Format(fmt, v.y()) + ", " + Format(fmt, v.z()) + ")";
+  return "(" + FormattedText(fmt, v.x()) + ", " + FormattedText(fmt, v.y()) + ", " + FormattedText(fmt, v.z()) + ")";
 }
 
 /// `text` right-aligned in 12 columns.
@@ -32,15 +27,15 @@ std::string OverDispersionNote(const estimation::FitReport& fit) {
   if (!estimation::Chi2AboveBand(fit)) return "";
   const double scale = estimation::SigmaScale(fit);
   const double upper = estimation::Chi2BandUpper(fit.dof);
-  return "chi2/dof " + Format("%.4g", fit.chi2_dof()) + " is above its band (up to " +
-         Format("%.3g", upper) +
+  return "chi2/dof " + FormattedText("%.4g", fit.chi2_dof()) + " is above its band (up to " +
+         FormattedText("%.3g", upper) +
          "): the residuals exceed the noise the fit was whitened with, so the formal sigma "
          "(from that noise) is too small; 'scaled' is sigma * sqrt(chi2/dof) = sigma * " +
-         Format("%.4g", scale) +
+         FormattedText("%.4g", scale) +
          ". The JSON's sigma and covariance are the scaled ones (sigma_formal beside); the "
          "exported files carry values only\n" +
          (estimation::MisfitBeyondNoise(fit)
-              ? "chi2/dof is more than " + Format("%.0f", estimation::kMisfitFactor) +
+              ? "chi2/dof is more than " + FormattedText("%.0f", estimation::kMisfitFactor) +
                     " times its band: the misfit is a missing effect or bad segments, not "
                     "noise, and even the scaled sigma assumes it is random: do not trust these "
                     "parameters to their sigma (another session of the same sensor can differ "
@@ -54,8 +49,8 @@ std::string BriefReport(const estimation::CalibrationResult& result) {
   std::ostringstream os;
   os << "method " << c.method << ", model " << c.model.spec() << ": " << fit.still_segments
      << " still segments, " << fit.motion_segments << " motion intervals\n";
-  os << "chi2 " << Format("%.6g", fit.chi2) << " on " << fit.dof << " dof, chi2/dof "
-     << Format("%.4g", fit.chi2_dof()) << "; rank " << c.observability.rank << " of "
+  os << "chi2 " << FormattedText("%.6g", fit.chi2) << " on " << fit.dof << " dof, chi2/dof "
+     << FormattedText("%.4g", fit.chi2_dof()) << "; rank " << c.observability.rank << " of "
      << c.observability.num_unknowns << " unknowns"
      << (c.observability.wander_states > 0
              ? " (and " + std::to_string(c.observability.wander_states) + " bias-wander states)"
@@ -71,19 +66,19 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   const estimation::FitReport& fit = result.fit;
   std::ostringstream os;
   os << BriefReport(result);
-  os << "site: " << (c.site.known ? Format("%.6f", c.site.lat_deg) + " deg, " +
-                                      Format("%.6f", c.site.lon_deg) + " deg, " +
-                                      Format("%.1f", c.site.height_m) + " m (" + c.site.source + ")"
+  os << "site: " << (c.site.known ? FormattedText("%.6f", c.site.lat_deg) + " deg, " +
+                                      FormattedText("%.6f", c.site.lon_deg) + " deg, " +
+                                      FormattedText("%.1f", c.site.height_m) + " m (" + c.site.source + ")"
                                 : std::string("none"))
-     << ", gravity " << Format("%.6f", c.site.gravity()) << " m/s^2\n";
+     << ", gravity " << FormattedText("%.6f", c.site.gravity()) << " m/s^2\n";
   os << "residual RMS per axis: accel " << Vec(fit.rms_acc) << " " << c.acc_unit;
   if (c.has_gyro) os << ", gyro " << Vec(fit.rms_gyr) << " " << c.gyr_unit;
   if (fit.motion_segments > 0) os << ", motion " << Vec(fit.rms_motion) << " rad";
   os << "\nnoise per sample: accel " << Vec(c.noise.acc) << " " << c.acc_unit << " (tau "
-     << Format("%.2f", c.noise.tau_acc) << " samples)";
+     << FormattedText("%.2f", c.noise.tau_acc) << " samples)";
   if (c.has_gyro) {
     os << ", gyro " << Vec(c.noise.gyr) << " " << c.gyr_unit << " (tau "
-       << Format("%.2f", c.noise.tau_gyr) << " samples)";
+       << FormattedText("%.2f", c.noise.tau_gyr) << " samples)";
   }
   os << "\n";
   const bool acc_walk = c.noise.walk_acc.minCoeff() > 0, gyr_walk = c.noise.walk_gyr.minCoeff() > 0;
@@ -99,7 +94,7 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   const bool acc_bi = c.noise.instability_acc.minCoeff() > 0;
   const bool gyr_bi = c.noise.instability_gyr.minCoeff() > 0;
   if (acc_bi || gyr_bi) {
-    os << "bias instability in the fit (Gauss-Markov, tau " << Format("%.3g", c.noise.instability_time_s)
+    os << "bias instability in the fit (Gauss-Markov, tau " << FormattedText("%.3g", c.noise.instability_time_s)
        << " s):";
     if (acc_bi) os << " accel " << Vec(c.noise.instability_acc) << " " << c.acc_unit;
     if (gyr_bi) os << (acc_bi ? "," : "") << " gyro " << Vec(c.noise.instability_gyr) << " " << c.gyr_unit;
@@ -121,8 +116,8 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   os << line;
   for (const auto& p : c.parameters) {
     const bool none = p.fixed || !p.observable;
-    std::string sigma = p.fixed ? "fixed" : !p.observable ? "unobservable" : Format("%.3g", p.sigma);
-    const std::string extra = !scaled ? "" : " " + Pad(none ? "" : Format("%.3g", scale * p.sigma));
+    std::string sigma = p.fixed ? "fixed" : !p.observable ? "unobservable" : FormattedText("%.3g", p.sigma);
+    const std::string extra = !scaled ? "" : " " + Pad(none ? "" : FormattedText("%.3g", scale * p.sigma));
     std::snprintf(line, sizeof line, "%-34s %15.8g %12s%s  %s\n", p.name.c_str(), p.value,
                   sigma.c_str(), extra.c_str(), p.unit.c_str());
     os << line;
@@ -134,9 +129,9 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   if (!c.observability.determined.empty()) {
     os << "determined combinations:\n";
     for (const auto& d : c.observability.determined) {
-      os << "  " << d.text << " = " << Format("%.8g", d.value) << " +- "
-         << Format("%.3g", d.sigma);
-      if (scaled) os << " (scaled " << Format("%.3g", scale * d.sigma) << ")";
+      os << "  " << d.text << " = " << FormattedText("%.8g", d.value) << " +- "
+         << FormattedText("%.3g", d.sigma);
+      if (scaled) os << " (scaled " << FormattedText("%.3g", scale * d.sigma) << ")";
       os << "\n";
     }
   }

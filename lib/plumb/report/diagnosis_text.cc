@@ -6,16 +6,12 @@
 #include <sstream>
 #include <vector>
 
+#include "plumb/core/number_text.h"
 #include "plumb/estimation/uncertainty.h"
 
 namespace plumb::report {
 namespace {
 
-std::string Fixed(double v, int precision) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(precision) << v;
-  return out.str();
-}
 
 }  // namespace
 
@@ -35,9 +31,9 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
       continue;
     }
     if (c.kind == diagnostics::CandidateKind::kWander && c.recommended && advised != nullptr) {
-      out << "not advised yet: " << name << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
-          << Fixed(c.refit->fit.chi2_dof(), 3) << "): " << advised->effect
-          << "'s refit explains the holds better (" << Fixed(advised->refit->fit.chi2_dof(), 3)
+      out << "not advised yet: " << name << " (its refit: chi2/dof " << FixedText(user, 3) << " -> "
+          << FixedText(c.refit->fit.chi2_dof(), 3) << "): " << advised->effect
+          << "'s refit explains the holds better (" << FixedText(advised->refit->fit.chi2_dof(), 3)
           << "); the wander would absorb what an effect explains: add the effect, then "
              "diagnose again\n";
       continue;
@@ -45,7 +41,7 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
     if (c.kind == diagnostics::CandidateKind::kWander && !c.refit->fit.gates.empty()) {
       const std::string& gate = c.refit->fit.gates.front().name;
       out << "not advised: " << name << " is significant, but its refit fails the gate " << gate
-          << " (chi2/dof " << Fixed(user, 3) << " -> " << Fixed(c.refit->fit.chi2_dof(), 3)
+          << " (chi2/dof " << FixedText(user, 3) << " -> " << FixedText(c.refit->fit.chi2_dof(), 3)
           << "): "
           << (gate == "implausible_walk"
                   ? "the holds disagree by more than any MEMS sensor wanders, so what they show "
@@ -57,14 +53,14 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
     const estimation::TurnVelocityFit turns = estimation::VelocityFit(c.refit->fit);
     if (c.with_velocity && turns.above_band() && c.refit->fit.chi2_dof() < user) {
       out << "not advised: " << name << " is significant and its refit lowers your fit's chi2/dof ("
-          << Fixed(user, 3) << " -> " << Fixed(c.refit->fit.chi2_dof(), 3)
-          << "), but leaves the turns' velocity residuals at chi2 " << Fixed(turns.per_residual(), 2)
-          << " per residual, above their band (" << Fixed(estimation::Chi2BandUpper(turns.residuals), 2)
+          << FixedText(user, 3) << " -> " << FixedText(c.refit->fit.chi2_dof(), 3)
+          << "), but leaves the turns' velocity residuals at chi2 " << FixedText(turns.per_residual(), 2)
+          << " per residual, above their band (" << FixedText(estimation::Chi2BandUpper(turns.residuals), 2)
           << "): the accelerometer during the turns carries more than this effect explains\n";
       continue;
     }
     out << "not advised: " << name << " is significant, but the refit with it has chi2/dof "
-        << Fixed(c.refit->fit.chi2_dof(), 3) << ", not below your fit's " << Fixed(user, 3);
+        << FixedText(c.refit->fit.chi2_dof(), 3) << ", not below your fit's " << FixedText(user, 3);
     if (c.refit->fit.velocity_segments > d.fit.fit.velocity_segments) {
       out << " (the refit adds the velocity residuals of the turns, which this session does not"
              " fit to their noise)";
@@ -72,18 +68,18 @@ std::string AdviceText(const diagnostics::Diagnosis& d) {
     out << "\n";
   }
   if (advised != nullptr && advised->kind == diagnostics::CandidateKind::kTimeBase) {
-    out << "best: " << advised->effect << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
-        << Fixed(advised->refit->fit.chi2_dof(), 3)
+    out << "best: " << advised->effect << " (its refit: chi2/dof " << FixedText(user, 3) << " -> "
+        << FixedText(advised->refit->fit.chi2_dof(), 3)
         << ": the stamps are a host's arrival clock) -> refit with --clock uniform\n";
   } else if (advised != nullptr && advised->kind == diagnostics::CandidateKind::kWander) {
-    out << "best: " << advised->effect << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
-        << Fixed(advised->refit->fit.chi2_dof(), 3)
+    out << "best: " << advised->effect << " (its refit: chi2/dof " << FixedText(user, 3) << " -> "
+        << FixedText(advised->refit->fit.chi2_dof(), 3)
         << ": the holds show the bias wandering more than the levels your fit assumed) -> refit "
            "with --estimate-rw\n";
   } else if (advised != nullptr) {
     out << "best: " << advised->effect << (advised->option.empty() ? "" : ":" + advised->option)
-        << " (its refit: chi2/dof " << Fixed(user, 3) << " -> "
-        << Fixed(advised->refit->fit.chi2_dof(), 3) << ") -> refit with --model "
+        << " (its refit: chi2/dof " << FixedText(user, 3) << " -> "
+        << FixedText(advised->refit->fit.chi2_dof(), 3) << ") -> refit with --model "
         << diagnostics::NextModelSpec(d).value_or("") << "\n";
   } else if (significant == 0) {
     out << "no candidate is significant: nothing in the catalogue is missing at this level\n";
@@ -102,15 +98,15 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
   using diagnostics::Candidate;
   std::ostringstream out;
   const auto& f = d.fit.fit;
-  out << "model " << d.fit.calibration.model.spec() << ": chi2 " << Fixed(f.chi2, 1) << " on " << f.dof
-      << " dof, chi2/dof " << Fixed(f.chi2_dof(), 3) << "\n";
+  out << "model " << d.fit.calibration.model.spec() << ": chi2 " << FixedText(f.chi2, 1) << " on " << f.dof
+      << " dof, chi2/dof " << FixedText(f.chi2_dof(), 3) << "\n";
   if (d.fit_with_velocity && d.fit_with_velocity->fit.velocity_segments > f.velocity_segments) {
     // Like with like: the candidates that need velocity residuals are scored in this fit, so
     // it stands beside the user's.
     const auto& v = d.fit_with_velocity->fit;
     out << "  with velocity residuals (the accelerometer during the turns), where the candidates"
            " marked * are scored: chi2 "
-        << Fixed(v.chi2, 1) << " on " << v.dof << " dof, chi2/dof " << Fixed(v.chi2_dof(), 3)
+        << FixedText(v.chi2, 1) << " on " << v.dof << " dof, chi2/dof " << FixedText(v.chi2_dof(), 3)
         << "\n";
   }
   out << "candidates (score test at the current fit; significant at " << d.significance
@@ -123,10 +119,10 @@ std::string DiagnosisText(const diagnostics::Diagnosis& d) {
     const std::string name =
         c.effect + (c.option.empty() ? "" : ":" + c.option) + (c.with_velocity ? " *" : "");
     out << "  " << std::left << std::setw(26) << name << std::right << std::setw(11)
-        << Fixed(c.lm, 1) << std::setw(5) << c.dof << std::setw(11) << Fixed(c.evidence, 1)
+        << FixedText(c.lm, 1) << std::setw(5) << c.dof << std::setw(11) << FixedText(c.evidence, 1)
         << std::setw(13) << (c.significant ? "yes" : "no") << std::setw(13)
-        << (c.refit_drop ? Fixed(*c.refit_drop, 1) : std::string("-")) << std::setw(16)
-        << (c.refit ? Fixed(c.refit->fit.chi2_dof(), 3) : std::string("-"));
+        << (c.refit_drop ? FixedText(*c.refit_drop, 1) : std::string("-")) << std::setw(16)
+        << (c.refit ? FixedText(c.refit->fit.chi2_dof(), 3) : std::string("-"));
     for (const auto& other : c.indistinguishable_from) out << "  (same as " << other << " here)";
     if (c.kind == diagnostics::CandidateKind::kTimeBase) {
       out << "  (the times from the uniform clock fitted through the stamps; LM is the refit's"

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "plumb/core/number_text.h"
 #include "plumb/core/error.h"
 #include "plumb/report/inline_svg.h"
 
@@ -33,12 +34,6 @@ void Cells(std::ostringstream& os, const Vec3& v, bool present) {
   for (int i = 0; i < 3; ++i) os << "," << (present ? Cell(v[i]) : std::string());
 }
 
-std::string Fixed(double value, const char* format) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, value);
-  return buf;
-}
-
 /// `plot` clauses of three columns (x, y, z) of `file` starting at `first_column`, against
 /// column `x_column`, in the axis colours.
 std::string AxisClauses(const std::string& file, int x_column, int first_column,
@@ -54,7 +49,7 @@ std::string AxisClauses(const std::string& file, int x_column, int first_column,
 
 /// The +-band lines of whitened residuals.
 std::string BandClauses() {
-  const std::string band = Fixed(kWhitenedBand, "%g");
+  const std::string band = FormattedText("%g", kWhitenedBand);
   return ", " + band + " with lines dt 2 lc rgb 'gray40' notitle, -" + band +
          " with lines dt 2 lc rgb 'gray40' notitle";
 }
@@ -110,7 +105,7 @@ void SeriesFigure(const ImuSeries& series, const std::vector<StillSegment>& segm
   plan.job.outputs.push_back("series.svg");
   plan.figures.push_back(
       {"series.svg", "Input time series",
-       "The samples against time since the first one (" + Fixed(t0, "%.6g") + " s in the log), " +
+       "The samples against time since the first one (" + FormattedText("%.6g", t0) + " s in the log), " +
            (stride > 1 ? "one sample in " + std::to_string(stride) + " drawn; " : std::string()) +
            "shaded: the " + std::to_string(segments.size()) +
            " still segments the fit used. Accelerometer in " + series.acc_unit +
@@ -156,7 +151,7 @@ void ResidualFigure(const diagnostics::ResidualAnalysis& a, const FigureOptions&
   if (panels == 0) return;
   std::ostringstream gp;
   // The y range reaches at least the +-band lines so that both are always drawn.
-  const std::string reach = Fixed(kWhitenedBand + 0.5, "%g");
+  const std::string reach = FormattedText("%g", kWhitenedBand + 0.5);
   gp << Begin(o, "residuals.svg", panels) << "set xlabel 'time since the first sample (s)'\n"
      << "set yrange [*<-" << reach << ":" << reach << "<*]\n";
   const std::string style = "linespoints pt 7 ps 0.6";
@@ -246,7 +241,7 @@ void AllanFigure(const ImuSeries& series, const estimation::CalibrationResult& f
                  " using 1:3 with lines dt 2 lc rgb '" + colour + "' title '" +
                  kAxisName[al.axis] + " white'";
       ratios += (ratios.empty() ? "" : ", ") + std::string(diagnostics::ResidualKindName(kind)) +
-                " " + kAxisName[al.axis] + " " + Fixed(al.ratio, "%.2g");
+                " " + kAxisName[al.axis] + " " + FormattedText("%.2g", al.ratio);
     }
     if (clauses.empty()) continue;
     ++panels;
@@ -329,9 +324,9 @@ void AddStillNoiseFigure(const signal::StillNoise& noise, const FigureOptions& o
   const double confidence = noise.axes.front().adev.confidence;
   plan.figures.push_back(
       {"noise.svg", "Allan deviation of the still data and the IEEE noise model",
-       "Overlapping Allan deviation of the raw samples over " + Fixed(noise.still_s, "%.4g") +
+       "Overlapping Allan deviation of the raw samples over " + FormattedText("%.4g", noise.still_s) +
            " s of still data in " + std::to_string(noise.segments.size()) +
-           " segment(s), per axis (points, with " + Fixed(100.0 * confidence, "%.3g") +
+           " segment(s), per axis (points, with " + FormattedText("%.3g", 100.0 * confidence) +
            " % chi-square intervals for the noise type the fit finds at each tau), and the "
            "fitted model 3Q^2/tau^2 + N^2/tau + 0.44 B^2 + K^2 tau/3 (line, over the fitted "
            "taus). Slopes -1, -1/2, 0, +1/2: quantisation, white noise, bias instability, "

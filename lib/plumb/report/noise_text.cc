@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "plumb/core/number_text.h"
 #include "plumb/core/units.h"
 #include "plumb/report/json_report.h"
 
@@ -20,11 +21,9 @@ constexpr NoiseTermKind kTableOrder[] = {NoiseTermKind::kWhite, NoiseTermKind::k
                                          NoiseTermKind::kRandomWalk,
                                          NoiseTermKind::kQuantisation, NoiseTermKind::kRamp};
 
+/// FormattedText, or "n/a" for a value not finite (a term the fit did not resolve).
 std::string Format(const char* format, double value) {
-  if (!std::isfinite(value)) return "n/a";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, value);
-  return buf;
+  return std::isfinite(value) ? FormattedText(format, value) : "n/a";
 }
 
 std::string Pad(const std::string& text, std::size_t width) {

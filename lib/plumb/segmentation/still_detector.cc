@@ -64,9 +64,9 @@ SegmentationResult DetectStillSegments(const ImuSeries& series,
   if (series.size() < geometry.window()) {
     throw InsufficientDataError(
         "still detection: the series has " + std::to_string(series.size()) + " samples (" +
-        Format("%.3g", series.duration_s()) + " s), fewer than one " +
+        FormattedText("%.3g", series.duration_s()) + " s), fewer than one " +
         std::to_string(geometry.window()) + "-sample window of " +
-        Format("%.3g", options.window_s) + " s; record longer still periods");
+        FormattedText("%.3g", options.window_s) + " s; record longer still periods");
   }
   const bool use_gyro = options.use_gyro && series.has_gyro();
   const BlockMoments blocks(series, geometry.block, use_gyro);
@@ -137,9 +137,9 @@ SegmentationResult DetectStillSegments(const ImuSeries& series,
   }
   report.notes.push_back(
       "found " + std::to_string(result.segments.size()) + " still segments totalling " +
-      Format("%.1f", still_s) + " s of " + Format("%.1f", series.duration_s() + dt_s) + " s; " +
+      FormattedText("%.1f", still_s) + " s of " + FormattedText("%.1f", series.duration_s() + dt_s) + " s; " +
       std::to_string(report.rejected_short) + " still runs shorter than " +
-      Format("%.3g", options.min_still_s) + " s after trimming " + Format("%.3g", options.edge_s) +
+      FormattedText("%.3g", options.min_still_s) + " s after trimming " + FormattedText("%.3g", options.edge_s) +
       " s at each end dropped");
   if (use_gyro) NoteGyroRejections(series, found, options, dt_s, result);
   if (options.init_still_s > 0.0) NoteInitialCoverage(found, noise, report);

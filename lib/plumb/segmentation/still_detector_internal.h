@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/number_text.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/types.h"
 #include "plumb/segmentation/block_moments.h"
@@ -115,8 +116,6 @@ std::vector<Run> JoinSamePose(const ImuSeries& series, const BlockMoments& block
 
 // still_notes.cc
 
-/// `value` printed with the printf `format` (one double conversion).
-std::string Format(const char* format, double value);
 /// "(x, y, z)", each printed with `format`.
 std::string FormatVec(const Vec3& v, const char* format = "%.4g");
 /// "t0-t1 s": the run's first and last sample times, from the series' start.

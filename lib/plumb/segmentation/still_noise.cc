@@ -303,7 +303,7 @@ NoiseEstimate InitialNoise(const ImuSeries& series, const BlockMoments& blocks,
   const Run period{0, end / geometry.block * geometry.block};
   if (period.size() < geometry.window()) {
     throw InsufficientDataError(
-        "still detection: the initial still period of " + Format("%.3g", options.init_still_s) +
+        "still detection: the initial still period of " + FormattedText("%.3g", options.init_still_s) +
         " s holds " + std::to_string(end) + " samples, fewer than one " +
         std::to_string(geometry.window()) + "-sample window");
   }
@@ -343,9 +343,9 @@ NoiseEstimate AutomaticNoise(const ImuSeries& series, const BlockMoments& blocks
   NoiseEstimate noise = EstimateNoise(series, blocks, runs, "auto");
 
   std::string note = "noise pooled over " + std::to_string(runs.size()) + " still runs (" +
-                     Format("%.1f", static_cast<double>(noise.samples) * dt_s) +
+                     FormattedText("%.1f", static_cast<double>(noise.samples) * dt_s) +
                      " s) found by a first pass seeded by the quietest " +
-                     Format("%.3g", static_cast<double>(stretch.size()) * dt_s) + " s stretch " +
+                     FormattedText("%.3g", static_cast<double>(stretch.size()) * dt_s) + " s stretch " +
                      TimeRange(series, stretch) + " (init_still_s = 0: automatic)";
   if (runs.size() < first_pass_runs) {
     note += "; " + std::to_string(first_pass_runs - runs.size()) +

@@ -23,20 +23,14 @@ bool Overlaps(const std::vector<StillSegment>& segments, Run run) {
 
 }  // namespace
 
-std::string Format(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, value);
-  return buffer;
-}
-
 std::string FormatVec(const Vec3& v, const char* format) {
-  return "(" + Format(format, v.x()) + ", " + Format(format, v.y()) + ", " + Format(format, v.z()) +
+  return "(" + FormattedText(format, v.x()) + ", " + FormattedText(format, v.y()) + ", " + FormattedText(format, v.z()) +
          ")";
 }
 
 std::string TimeRange(const ImuSeries& series, Run run) {
   // Log times, as `plumb info` shows them, so a stretch named here can be found in the log.
-  return Format("%.2f", series.t_s[run.begin]) + "-" + Format("%.2f", series.t_s[run.end - 1]) +
+  return FormattedText("%.2f", series.t_s[run.begin]) + "-" + FormattedText("%.2f", series.t_s[run.end - 1]) +
          " s";
 }
 
@@ -54,18 +48,18 @@ std::string NoiseNote(const NoiseEstimate& noise, const StillDetectorOptions& op
 std::string ThresholdNote(const DetectionDetail& d, const StillDetectorOptions& options,
                           double dt_s) {
   std::string note =
-      "window " + Format("%.3g", static_cast<double>(d.window_samples) * dt_s) + " s (" +
-      std::to_string(d.window_samples) + " samples at dt " + Format("%.4g", dt_s) +
+      "window " + FormattedText("%.3g", static_cast<double>(d.window_samples) * dt_s) + " s (" +
+      std::to_string(d.window_samples) + " samples at dt " + FormattedText("%.4g", dt_s) +
       " s, tested every " + std::to_string(d.block_samples) + " samples); false alarm " +
-      Format("%.3g", options.false_alarm) +
-      " per window length; thresholds: accel variance ratio " + Format("%.3f", d.acc_threshold) +
-      " (chi^2 dof " + Format("%.0f", d.acc_dof) + ")";
+      FormattedText("%.3g", options.false_alarm) +
+      " per window length; thresholds: accel variance ratio " + FormattedText("%.3f", d.acc_threshold) +
+      " (chi^2 dof " + FormattedText("%.0f", d.acc_dof) + ")";
   if (d.gyr_threshold > 0.0) {
-    note += ", gyro variance ratio " + Format("%.3f", d.gyr_threshold) + " (chi^2 dof " +
-            Format("%.0f", d.gyr_dof) + ")";
+    note += ", gyro variance ratio " + FormattedText("%.3f", d.gyr_threshold) + " (chi^2 dof " +
+            FormattedText("%.0f", d.gyr_dof) + ")";
   }
   if (d.rate_threshold > 0.0) {
-    note += ", gyro mean rate chi^2(3) " + Format("%.2f", d.rate_threshold) +
+    note += ", gyro mean rate chi^2(3) " + FormattedText("%.2f", d.rate_threshold) +
             " with allowance " + FormatVec(d.rate_allowance) + " " + options.gyr_unit;
   }
   return note;
