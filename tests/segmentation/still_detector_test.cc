@@ -196,6 +196,24 @@ TEST(StillDetector, TimeGapSplitsAStillPeriod) {
   EXPECT_EQ(result.detail.failed_gap, 17U);  // the 17 windows holding the block with the gap
 }
 
+TEST(StillDetector, ShortDropoutsDoNotSplitAStillPeriod) {
+  // A host that drops samples in short bursts (ardrone_imu.bag's first seconds: 40 % of the
+  // samples missing, in gaps of 0.12-0.18 s): no gap can hide a change of pose, so the period
+  // stays whole although its windows span far more time than their samples would at the rate.
+  const ImuSeries full = testing::MakeSession({Still(20.0)}, {});
+  ImuSeries series;
+  for (std::size_t i = 0; i < full.size(); ++i) {
+    if (i % 20 >= 12 && i < full.size() - 200) continue;  // 8 of every 20 samples: 0.09 s gaps
+    series.t_s.push_back(full.t_s[i]);
+    series.acc.push_back(full.acc[i]);
+    series.gyr.push_back(full.gyr[i]);
+  }
+  const SegmentationResult result = DetectStillSegments(series);
+  ASSERT_EQ(result.segments.size(), 1U);
+  EXPECT_EQ(result.detail.failed_gap, 0U);
+  EXPECT_LT(series.t_s[result.segments[0].begin], 1.0);
+}
+
 TEST(StillDetector, NonFiniteSamplesAreNeverStill) {
   ImuSeries series = testing::MakeSession({Still(20.0)}, {});
   const float nan = std::numeric_limits<float>::quiet_NaN();

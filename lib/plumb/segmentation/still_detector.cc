@@ -93,7 +93,7 @@ SegmentationResult DetectStillSegments(const ImuSeries& series,
 
   // 2. The window tests over the whole series.
   DetectionDetail& detail = result.detail;
-  const WindowTests tests = MakeTests(noise, blocks, options, geometry, dt_s, detail);
+  const WindowTests tests = MakeTests(noise, blocks, options, geometry, detail);
   const Classification found = Classify(series, blocks, tests);
   report.threshold = detail.acc_threshold;
   detail.windows = found.windows;

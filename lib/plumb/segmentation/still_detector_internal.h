@@ -46,7 +46,11 @@ struct Geometry {
 /// Everything a window test needs, derived from the noise estimate and the options.
 struct WindowTests {
   Geometry geometry;
-  double max_span_s = 0.0;         ///< longest time span of a window without a gap
+  /// Longest interval between two consecutive samples a still window may hold, s: half a
+  /// window. Motion could hide in a longer gap; shorter ones (a host dropping samples one by
+  /// one or in short bursts) cannot hide a change of pose, which the window's variance and
+  /// mean-rate tests would see before and after it.
+  double max_gap_s = 0.0;
   double inverse_n = 0.0;          ///< 1 / samples per window
   Vec3 acc_weight = Vec3::Zero();  ///< 1 / (3 sigma^2 (n - 1)), on the scatter sums
   double acc_threshold = 0.0;
@@ -92,7 +96,7 @@ Vec3 RateAllowance(const NoiseEstimate& noise, const StillDetectorOptions& optio
 
 /// The window tests; `with_rate_test` false leaves out the mean-rate test (first pass).
 WindowTests MakeTests(const NoiseEstimate& noise, const BlockMoments& blocks,
-                      const StillDetectorOptions& options, Geometry geometry, double dt_s,
+                      const StillDetectorOptions& options, Geometry geometry,
                       DetectionDetail& detail, bool with_rate_test = true);
 
 /// Noise from the first init_still_s seconds, rounded down to whole blocks.

@@ -254,14 +254,14 @@ Vec3 RateAllowance(const NoiseEstimate& noise, const StillDetectorOptions& optio
 
 /// The window tests; `with_rate_test` false leaves out the mean-rate test (first pass).
 WindowTests MakeTests(const NoiseEstimate& noise, const BlockMoments& blocks,
-                      const StillDetectorOptions& options, Geometry geometry, double dt_s,
+                      const StillDetectorOptions& options, Geometry geometry,
                       DetectionDetail& detail, bool with_rate_test) {
   WindowTests tests;
   tests.geometry = geometry;
   const auto n = static_cast<double>(geometry.window());
   const auto n0 = static_cast<double>(noise.samples);
   tests.inverse_n = 1.0 / n;
-  tests.max_span_s = (n - 1.0) * dt_s + 0.5 * options.window_s;
+  tests.max_gap_s = 0.5 * options.window_s;
   tests.gyro_variance = noise.has_gyro && options.gyro_variance_test;
   tests.rate = noise.has_gyro && with_rate_test;
   const double num_tests = 1.0 + (tests.rate ? 1.0 : 0.0) + (tests.gyro_variance ? 1.0 : 0.0);
@@ -332,7 +332,7 @@ NoiseEstimate AutomaticNoise(const ImuSeries& series, const BlockMoments& blocks
   strict.false_alarm = std::min(options.false_alarm, kProvisionalFalseAlarm);
   DetectionDetail unused;
   const WindowTests first_pass =
-      MakeTests(seed, blocks, strict, geometry, dt_s, unused, /*with_rate_test=*/false);
+      MakeTests(seed, blocks, strict, geometry, unused, /*with_rate_test=*/false);
   std::vector<Run> runs;
   for (const Run& run : Classify(series, blocks, first_pass).runs) {
     if (run.size() >= geometry.window()) runs.push_back(run);

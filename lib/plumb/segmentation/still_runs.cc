@@ -40,6 +40,36 @@ class RunBuilder {
   bool in_run_ = false;
 };
 
+/// The longest interval between consecutive samples of each full block of `b` samples:
+/// `inside` the block, and `before` it (from the previous block's last sample to its first; 0
+/// for the first block). A window's longest interval is the largest `inside` of its blocks
+/// and `before` of all but its first (LongestInterval).
+struct BlockIntervals {
+  std::vector<double> inside;
+  std::vector<double> before;
+
+  BlockIntervals(const std::vector<double>& t_s, std::size_t b, std::size_t full)
+      : inside(full, 0.0), before(full, 0.0) {
+    for (std::size_t j = 0; j < full; ++j) {
+      const std::size_t first = j * b;
+      if (j > 0) before[j] = t_s[first] - t_s[first - 1];
+      for (std::size_t i = first + 1; i < first + b; ++i) {
+        inside[j] = std::max(inside[j], t_s[i] - t_s[i - 1]);
+      }
+    }
+  }
+
+  /// The longest interval between consecutive samples of the window of `m` blocks from
+  /// block `first_block`.
+  double LongestInterval(std::size_t first_block, std::size_t m) const {
+    double longest = inside[first_block];
+    for (std::size_t j = first_block + 1; j < first_block + m; ++j) {
+      longest = std::max({longest, inside[j], before[j]});
+    }
+    return longest;
+  }
+};
+
 }  // namespace
 
 /// The most samples a still-detection window holds: more than any recording has (a day at
@@ -77,6 +107,7 @@ Classification Classify(const ImuSeries& series, const BlockMoments& blocks,
   std::size_t nonfinite = 0;  // non-finite blocks in the window
   RunBuilder all_tests;
   RunBuilder acc_tests;
+  const BlockIntervals intervals(series.t_s, b, full);
   for (std::size_t c = k; c + k < full; ++c) {
     const std::size_t first_block = c - k;
     if (first_block % kResyncInterval == 0) {
@@ -102,7 +133,7 @@ Classification Classify(const ImuSeries& series, const BlockMoments& blocks,
       continue;
     }
     bool still = true;
-    if (series.t_s[(c + k + 1) * b - 1] - series.t_s[first_block * b] > tests.max_span_s) {
+    if (intervals.LongestInterval(first_block, m) > tests.max_gap_s) {
       ++out.failed_gap;
       still = false;
     }
