@@ -101,6 +101,11 @@ void Parser::Damaged(std::size_t at, const std::string& why) {
 
 void Parser::Run() {
   std::size_t pos = detail::kRosBagMagicSize;
+  if (pos == size_) {
+    throw InputError(bag_->source, "byte " + std::to_string(pos),
+                     "expected the bag header record (op 0x03) after \"#ROSBAG V2.0\"; the file "
+                     "ends there");
+  }
   bool first = true;
   Record r;
   while (pos < size_) {
@@ -124,6 +129,11 @@ void Parser::Run() {
     }
     TopRecord(r, pos);
     pos = r.end;
+  }
+  // Every record whole, but the bag header points past the end: cut at a record boundary.
+  if (!bag_->warnings.cut_at && bag_->index_pos > size_) {
+    bag_->warnings.cut_at = size_;
+    bag_->warnings.index_past_end = bag_->index_pos;
   }
   Finish();
 }
@@ -327,7 +337,10 @@ bool RosBagWarnings::any() const {
 std::vector<std::string> RosBagWarnings::Describe() const {
   std::vector<std::string> out;
   const auto n = [](std::size_t v) { return std::to_string(v); };
-  if (cut_at) {
+  if (cut_at && index_past_end) {
+    out.push_back("cut short: the bag header puts the index at byte " + n(index_past_end) +
+                  ", past the end of the file (" + n(*cut_at) + " bytes); every record in it was read");
+  } else if (cut_at) {
     out.push_back("cut short: the record at byte " + n(*cut_at) +
                   " runs past the end of the file; the records before it were read" +
                   (cut_messages_kept ? ", and " + n(cut_messages_kept) +

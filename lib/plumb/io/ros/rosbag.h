@@ -97,6 +97,9 @@ struct RosBagWarnings {
   /// Set when a record runs past the end of the file: its offset.
   std::optional<std::size_t> cut_at;
   std::size_t cut_messages_kept = 0;     ///< messages of a cut chunk kept (whole records)
+  /// Set when every record is whole but the bag header's index_pos lies past the end (the
+  /// file cut at a record boundary; cut_at is then the file size): that index_pos.
+  std::uint64_t index_past_end = 0;
   std::size_t bad_records = 0;           ///< records whose header does not parse, skipped
   std::size_t first_bad_record = 0;
   std::size_t damaged_chunks = 0;        ///< chunks not decoded to their end
