@@ -252,6 +252,19 @@ TEST(RosBag, CorruptLengthsAreCountedNeverFatal) {
     ASSERT_EQ(b.warnings.md5_notes.size(), 1u);
     EXPECT_EQ(b.imu_topics[0].samples.size(), 5u);
   }
+  {  // A chunk stating more than 1 GiB: skipped, counted, the next chunk read.
+    std::string records = ImuRecords(0, "/imu", 10);
+    std::string chunk_record = RosChunkRecord("lz4", records);
+    const std::string field = test::RosField("size", test::Bytes(std::uint32_t(records.size())));
+    const std::size_t at = chunk_record.find(field);
+    const std::uint32_t huge = 0xfffffff0u;
+    std::memcpy(&chunk_record[at + 9], &huge, 4);
+    const RosBag b = Parse(RosBagStart() + chunk_record +
+                           RosChunkRecord("none", ImuRecords(1, "/imu", 5, 10)));
+    EXPECT_EQ(b.warnings.damaged_chunks, 1u);
+    EXPECT_NE(b.warnings.first_damage.find("more than plumb reads"), std::string::npos);
+    EXPECT_EQ(b.imu_topics.at(0).samples.size(), 5u);
+  }
   {  // A damaged compressed stream: counted.
     std::string chunk_record = RosChunkRecord("bz2", ImuRecords(0, "/imu", 50));
     chunk_record[chunk_record.size() / 2] ^= 0x55;

@@ -163,6 +163,11 @@ void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
     Damaged(at, "chunk without its 'size' field");
     return;
   }
+  if (r.fields.size > detail::kRosMaxChunkBytes) {
+    Damaged(at, "chunk stating " + std::to_string(r.fields.size) +
+                    " bytes uncompressed, more than plumb reads (1 GiB)");
+    return;
+  }
   std::string why;
   const std::uint8_t* records = r.data;
   std::size_t n = r.data_len;

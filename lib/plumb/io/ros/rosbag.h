@@ -41,7 +41,8 @@
 //    (counted); inside a chunk, a record whose length runs past the chunk's end ends that
 //    chunk (counted), and reading goes on with the next record of the file. A chunk that does
 //    not decompress, of an unknown compression, or whose data exceeds its stated size keeps
-//    the records decoded before the fault (counted).
+//    the records decoded before the fault (counted); one stating more than 1 GiB uncompressed
+//    is skipped (counted). The output buffer grows as data comes out, never ahead of it.
 //  * A file without the magic, of another bag version (1.2), or whose first record is not a
 //    bag header is refused: plumb::InputError naming the file and the byte.
 //  * Values are kept as logged: SI (m/s^2, rad/s) in the message's frame (REP-103: x forward,

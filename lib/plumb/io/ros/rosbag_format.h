@@ -22,6 +22,11 @@ inline constexpr std::size_t kRosBagMagicSize = sizeof(kRosBagMagic) - 1;
 inline constexpr char kRosBagPrefix[] = "#ROSBAG V";
 inline constexpr std::size_t kRosBagPrefixSize = sizeof(kRosBagPrefix) - 1;
 
+/// The largest uncompressed chunk read, bytes (1 GiB): rosbag closes a chunk past 768 KiB
+/// (its default chunk threshold) or after one large message, so a larger stated size is a
+/// damaged field or a decompression bomb, not a bag; such a chunk is skipped (counted).
+inline constexpr std::uint32_t kRosMaxChunkBytes = std::uint32_t{1} << 30;
+
 /// The record ops.
 enum RosOp : std::uint8_t {
   kOpMessageData = 0x02,
