@@ -9,11 +9,15 @@
 // written once into a temporary file removed at exit; the page cache holds it, so this measures
 // the reader, not the disk. Counters: MB/s of bag, imu_msgs (IMU messages decoded per read) and
 // msgs/s.
-// BM_Bunzip2/<bag> decompresses the same file's bz2 chunks with libbz2 alone
-// (BZ2_bzBuffToBuffDecompress into one buffer): the floor under BM_ReadRosBag of a bz2 bag.
+// BM_ReadRosBag/<bag>_lz4 reads the same bag with each chunk recompressed as an LZ4 frame (as
+// `rosbag record --lz4` writes them).
+// BM_Bunzip2/<bag> and BM_Lz4/<bag>_lz4 decompress the same file's chunks with libbz2 alone
+// (BZ2_bzBuffToBuffDecompress) or liblz4 alone (LZ4F_decompress) into one buffer: the floor
+// under BM_ReadRosBag of a compressed bag.
 // Skipped with the reason when the shared data is absent.
 #include <benchmark/benchmark.h>
 #include <bzlib.h>
+#include <lz4frame.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -68,13 +72,55 @@ std::vector<TopRecord> Records(const std::vector<char>& bytes) {
   return out;
 }
 
-/// A temporary file holding the bag `relative` with its connections and chunks repeated up to
-/// about `target` bytes; removed at exit.
+/// `bytes` (a whole bag 2.0) with every bz2 or uncompressed chunk recompressed as an LZ4 frame.
+std::vector<char> AsLz4(const std::vector<char>& bytes) {
+  std::vector<char> out;
+  std::size_t copied = 0;
+  for (const TopRecord& r : Records(bytes)) {
+    if (r.op != plumb::io::detail::kOpChunk) continue;
+    out.insert(out.end(), bytes.begin() + static_cast<long>(copied),
+               bytes.begin() + static_cast<long>(r.begin));
+    std::vector<char> plain(r.size);
+    if (r.compression == "bz2") {
+      unsigned n = r.size;
+      BZ2_bzBuffToBuffDecompress(plain.data(), &n, const_cast<char*>(bytes.data() + r.data_begin),
+                                 static_cast<unsigned>(r.end - r.data_begin), 0, 0);
+    } else {
+      std::copy(bytes.begin() + static_cast<long>(r.data_begin),
+                bytes.begin() + static_cast<long>(r.end), plain.begin());
+    }
+    std::vector<char> packed(LZ4F_compressFrameBound(plain.size(), nullptr));
+    packed.resize(LZ4F_compressFrame(packed.data(), packed.size(), plain.data(), plain.size(),
+                                     nullptr));
+    const auto field = [](const std::string& name, const std::string& value) {
+      const auto len = static_cast<std::uint32_t>(name.size() + 1 + value.size());
+      return std::string(reinterpret_cast<const char*>(&len), 4) + name + "=" + value;
+    };
+    const std::uint32_t size = r.size;
+    const std::string header = field("op", std::string(1, '\x05')) + field("compression", "lz4") +
+                               field("size", std::string(reinterpret_cast<const char*>(&size), 4));
+    const auto header_len = static_cast<std::uint32_t>(header.size());
+    const auto data_len = static_cast<std::uint32_t>(packed.size());
+    out.insert(out.end(), reinterpret_cast<const char*>(&header_len),
+               reinterpret_cast<const char*>(&header_len) + 4);
+    out.insert(out.end(), header.begin(), header.end());
+    out.insert(out.end(), reinterpret_cast<const char*>(&data_len),
+               reinterpret_cast<const char*>(&data_len) + 4);
+    out.insert(out.end(), packed.begin(), packed.end());
+    copied = r.end;
+  }
+  out.insert(out.end(), bytes.begin() + static_cast<long>(copied), bytes.end());
+  return out;
+}
+
+/// A temporary file holding the bag `relative` (its chunks as LZ4 frames when `lz4`) with its
+/// connections and chunks repeated up to about `target` bytes; removed at exit.
 class RepeatedBag {
  public:
-  RepeatedBag(const std::string& source, std::size_t target) {
+  RepeatedBag(const std::string& source, std::size_t target, bool lz4) {
     std::ifstream in(source, std::ios::binary);
-    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+    if (lz4) bytes = AsLz4(bytes);
     const std::vector<TopRecord> records = Records(bytes);
     std::size_t body_begin = records.at(0).end;  // after the bag header
     std::size_t body_end = body_begin;
@@ -86,7 +132,8 @@ class RepeatedBag {
       }
     }
     path_ = (std::filesystem::temp_directory_path() /
-             ("plumb_bench_" + std::filesystem::path(source).filename().string()))
+             ("plumb_bench_" + std::string(lz4 ? "lz4_" : "") +
+              std::filesystem::path(source).filename().string()))
                 .string();
     std::ofstream out(path_, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(body_begin));
@@ -102,13 +149,14 @@ class RepeatedBag {
   std::string path_;
 };
 
-/// The repeated copy of `relative` (under ../shared/data), made once; nullptr when absent.
-const RepeatedBag* Repeated(const std::string& relative, std::size_t target) {
+/// The repeated copy of `relative` (under ../shared/data; its chunks as LZ4 frames when `lz4`),
+/// made once; nullptr when absent.
+const RepeatedBag* Repeated(const std::string& relative, std::size_t target, bool lz4 = false) {
   static std::map<std::string, std::unique_ptr<RepeatedBag>> made;
   const std::string source = std::string(PLUMB_SHARED_DATA_DIR) + "/" + relative;
   if (!std::filesystem::exists(source)) return nullptr;
-  auto& slot = made[relative];
-  if (!slot) slot = std::make_unique<RepeatedBag>(source, target);
+  auto& slot = made[relative + (lz4 ? " lz4" : "")];
+  if (!slot) slot = std::make_unique<RepeatedBag>(source, target, lz4);
   return slot.get();
 }
 
@@ -122,8 +170,9 @@ void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t message
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
 }
 
-void BM_ReadRosBag(benchmark::State& state, const std::string& relative, std::size_t target) {
-  const RepeatedBag* bag = Repeated(relative, target);
+void BM_ReadRosBag(benchmark::State& state, const std::string& relative, std::size_t target,
+                   bool lz4 = false) {
+  const RepeatedBag* bag = Repeated(relative, target, lz4);
   if (bag == nullptr) {
     state.SkipWithError(("shared data absent: " + relative).c_str());
     return;
@@ -147,6 +196,10 @@ BENCHMARK_CAPTURE(BM_ReadRosBag, ardrone_imu_bz2, std::string("ros/ardrone_imu.b
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ReadRosBag, phidgets_imu_upside_down_bz2,
                   std::string("ros/phidgets_imu_upside_down.bag"), kTargetBz2Bytes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRosBag, ardrone_imu_lz4, std::string("ros/ardrone_imu.bag"),
+                  kTargetBytes, true)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -178,6 +231,41 @@ BENCHMARK_CAPTURE(BM_Bunzip2, ardrone_imu_bz2, std::string("ros/ardrone_imu.bag"
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Bunzip2, phidgets_imu_upside_down_bz2,
                   std::string("ros/phidgets_imu_upside_down.bag"), kTargetBz2Bytes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_Lz4(benchmark::State& state, const std::string& relative, std::size_t target) {
+  const RepeatedBag* bag = Repeated(relative, target, true);
+  if (bag == nullptr) {
+    state.SkipWithError(("shared data absent: " + relative).c_str());
+    return;
+  }
+  std::ifstream in(bag->path(), std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  const std::vector<TopRecord> records = Records(bytes);
+  std::vector<char> out;
+  LZ4F_dctx* ctx = nullptr;
+  LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION);
+  for (auto _ : state) {
+    for (const TopRecord& r : records) {
+      if (r.op != plumb::io::detail::kOpChunk || r.compression != "lz4") continue;
+      out.resize(r.size);
+      std::size_t out_size = out.size();
+      std::size_t in_size = r.end - r.data_begin;
+      const std::size_t rc = LZ4F_decompress(ctx, out.data(), &out_size,
+                                             bytes.data() + r.data_begin, &in_size, nullptr);
+      if (LZ4F_isError(rc) || rc != 0 || out_size != r.size) {
+        state.SkipWithError("lz4 decompression failed");
+        LZ4F_freeDecompressionContext(ctx);
+        return;
+      }
+      benchmark::DoNotOptimize(out.data());
+    }
+  }
+  LZ4F_freeDecompressionContext(ctx);
+  SetCounters(state, bytes.size(), 0);
+}
+BENCHMARK_CAPTURE(BM_Lz4, ardrone_imu_lz4, std::string("ros/ardrone_imu.bag"), kTargetBytes)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

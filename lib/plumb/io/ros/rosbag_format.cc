@@ -32,12 +32,13 @@ bool ForEachField(const std::uint8_t* p, std::size_t n, std::string* why, Field&
       return false;
     }
     const auto* begin = reinterpret_cast<const char*>(p + pos);
-    const void* eq = std::memchr(begin, '=', len);
-    if (eq == nullptr) {
+    // The names are a few letters: a loop beats a call of memchr per field.
+    std::size_t name_len = 0;
+    while (name_len < len && begin[name_len] != '=') ++name_len;
+    if (name_len == len) {
       *why = "a field without '='";
       return false;
     }
-    const auto name_len = static_cast<std::size_t>(static_cast<const char*>(eq) - begin);
     if (!field(std::string_view(begin, name_len),
                std::string_view(begin + name_len + 1, len - name_len - 1))) {
       *why = "field '" + std::string(begin, name_len) + "' of the wrong size (" +
@@ -103,12 +104,18 @@ namespace {
 bool Grow(std::vector<std::uint8_t>* out, std::size_t used, std::size_t cap) {
   if (used >= cap) return false;
   const std::size_t want = std::min<std::size_t>(cap, std::max<std::size_t>(used * 2, 1 << 16));
-  out->resize(want);
+  if (want > out->size()) out->resize(want);
   return true;
 }
 
+/// At least `bytes` in `out`: a buffer reused chunk after chunk only grows (never shrunk, so
+/// never zero-filled again).
+void Reserve(std::vector<std::uint8_t>* out, std::size_t bytes) {
+  if (out->size() < bytes) out->resize(bytes);
+}
+
 bool Bz2(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
-         std::vector<std::uint8_t>* out, std::string* why) {
+         std::vector<std::uint8_t>* out, std::size_t* out_size, std::string* why) {
   bz_stream s{};
   if (BZ2_bzDecompressInit(&s, 0, 0) != BZ_OK) {
     *why = "bz2 could not start";
@@ -117,13 +124,14 @@ bool Bz2(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
   std::size_t used = 0;
   std::size_t fed = 0;
   int rc = BZ_OK;
-  out->resize(std::min<std::size_t>(std::size_t{declared} + 1, std::max<std::size_t>(n * 4, 1 << 16)));
+  Reserve(out, std::min<std::size_t>(std::size_t{declared} + 1, std::max<std::size_t>(n * 4, 1 << 16)));
   while (true) {
     const std::size_t give = std::min<std::size_t>(n - fed, std::numeric_limits<unsigned>::max());
     s.next_in = const_cast<char*>(reinterpret_cast<const char*>(in + fed));
     s.avail_in = static_cast<unsigned>(give);
     s.next_out = reinterpret_cast<char*>(out->data() + used);
-    s.avail_out = static_cast<unsigned>(std::min<std::size_t>(out->size() - used,
+    const std::size_t room = std::min<std::size_t>(out->size(), std::size_t{declared} + 1);
+    s.avail_out = static_cast<unsigned>(std::min<std::size_t>(room - used,
                                                               std::numeric_limits<unsigned>::max()));
     const unsigned out_before = s.avail_out;
     rc = BZ2_bzDecompress(&s);
@@ -141,7 +149,7 @@ bool Bz2(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
     if (fed == n) break;  // input ended before the stream did
   }
   BZ2_bzDecompressEnd(&s);
-  out->resize(used);
+  *out_size = used;
   if (rc == BZ_STREAM_END) {
     if (used == declared) return true;
     *why = "bz2 data of " + std::to_string(used) + " bytes, not the chunk's size " +
@@ -159,7 +167,7 @@ bool Bz2(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
 }
 
 bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
-         std::vector<std::uint8_t>* out, std::string* why) {
+         std::vector<std::uint8_t>* out, std::size_t* out_size, std::string* why) {
   LZ4F_dctx* ctx = nullptr;
   if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) {
     *why = "lz4 could not start";
@@ -169,14 +177,16 @@ bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
   std::size_t fed = 0;
   std::size_t hint = 1;
   bool ok = true;
-  out->resize(std::min<std::size_t>(std::size_t{declared} + 1, std::max<std::size_t>(n * 4, 1 << 16)));
+  Reserve(out, std::min<std::size_t>(std::size_t{declared} + 1, std::max<std::size_t>(n * 4, 1 << 16)));
   while (hint != 0) {
-    if (used == out->size() && !Grow(out, used, std::size_t{declared} + 1)) {
+    const std::size_t room = std::min<std::size_t>(out->size(), std::size_t{declared} + 1);
+    if (used == room && !Grow(out, used, std::size_t{declared} + 1)) {
       *why = "lz4 data longer than the chunk's size " + std::to_string(declared);
       ok = false;
       break;
     }
-    std::size_t out_size = out->size() - used;
+    std::size_t out_size =
+        std::min<std::size_t>(out->size(), std::size_t{declared} + 1) - used;
     std::size_t in_size = n - fed;
     hint = LZ4F_decompress(ctx, out->data() + used, &out_size, in + fed, &in_size, nullptr);
     if (LZ4F_isError(hint)) {
@@ -195,7 +205,7 @@ bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
     }
   }
   LZ4F_freeDecompressionContext(ctx);
-  out->resize(used);
+  *out_size = used;
   if (ok && used != declared) {
     *why = "lz4 data of " + std::to_string(used) + " bytes, not the chunk's size " +
            std::to_string(declared);
@@ -208,11 +218,14 @@ bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
 
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
                      std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
-                     std::string* why) {
+                     std::size_t* out_size, std::string* why) {
   why->clear();
+  *out_size = 0;
   if (compression == "none") {
     const std::size_t take = std::min<std::size_t>(n, declared);
-    out->assign(in, in + take);
+    Reserve(out, take);
+    std::copy(in, in + take, out->begin());
+    *out_size = take;
     if (n == declared) return true;
     *why = cut ? "chunk cut by the end of the file after " + std::to_string(n) + " of its " +
                      std::to_string(declared) + " bytes"
@@ -220,9 +233,8 @@ bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::
                      std::to_string(declared);
     return false;
   }
-  if (compression == "bz2") return Bz2(in, n, declared, cut, out, why);
-  if (compression == "lz4") return Lz4(in, n, declared, cut, out, why);
-  out->clear();
+  if (compression == "bz2") return Bz2(in, n, declared, cut, out, out_size, why);
+  if (compression == "lz4") return Lz4(in, n, declared, cut, out, out_size, why);
   *why = "unknown compression '" + std::string(compression.substr(0, 32)) + "'";
   return false;
 }

@@ -64,15 +64,16 @@ bool ParseRecordFields(const std::uint8_t* p, std::size_t n, RosRecordFields* ou
 bool ParseConnectionData(const std::uint8_t* p, std::size_t n, RosConnection* c,
                          std::string* why);
 
-/// Decompresses a chunk's data [in, in + n) of `compression` ("none", "bz2", "lz4") into
-/// `out` (resized to what came out), growing it as needed but never past `declared` bytes.
-/// True when the data decompressed to its end and to exactly `declared` bytes; false with
-/// `why` otherwise, `out` then holding what came out before the fault (the records there are
-/// still whole: a caller reads them). `cut`: the data was cut by the end of the file (the
-/// fault expected; `why` says where it ended).
+/// Decompresses a chunk's data [in, in + n) of `compression` ("none", "bz2", "lz4") into the
+/// first `*out_size` bytes of `out`, a buffer reused from chunk to chunk: grown as data comes
+/// out (never ahead of it, never past `declared` + 1 bytes), never shrunk. True when the data
+/// decompressed to its end and to exactly `declared` bytes; false with `why` otherwise, `out`
+/// then holding what came out before the fault (the records there are still whole: a caller
+/// reads them). `cut`: the data was cut by the end of the file (the fault expected; `why` says
+/// where it ended).
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
                      std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
-                     std::string* why);
+                     std::size_t* out_size, std::string* why);
 
 /// One decoded sensor_msgs/Imu message.
 struct RosImuMessage {
