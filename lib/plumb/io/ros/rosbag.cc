@@ -29,8 +29,10 @@ struct Pending {
 
 class Parser {
  public:
-  Parser(const std::uint8_t* data, std::size_t size, RosBag* bag)
-      : data_(data), size_(size), bag_(bag) {}
+  /// `file`: the mapped file the bytes are, whose pages the parser releases behind it as it
+  /// goes (LogFile::Release), or nullptr.
+  Parser(const std::uint8_t* data, std::size_t size, RosBag* bag, const LogFile* file)
+      : data_(data), size_(size), bag_(bag), file_(file) {}
 
   void Run();
 
@@ -70,6 +72,8 @@ class Parser {
   const std::uint8_t* data_;
   std::size_t size_;
   RosBag* bag_;
+  const LogFile* file_;
+  std::size_t released_ = 0;  ///< the file is released up to here
   /// A connection as a message finds it: its record, and its index in imu_topics (-1: not IMU).
   struct Slot {
     RosConnection* conn = nullptr;  ///< nullptr: not defined (yet)
@@ -154,6 +158,10 @@ void Parser::Run() {
     }
     TopRecord(r, pos);
     pos = r.end;
+    if (file_ != nullptr && pos >= released_ + LogFile::kReleaseStep) {
+      file_->Release(released_, pos);
+      released_ = pos;
+    }
   }
   // Every record whole, but the bag header points past the end: cut at a record boundary.
   if (!bag_->warnings.cut_at && bag_->index_pos > size_) {
@@ -421,7 +429,11 @@ std::vector<std::pair<std::string, std::size_t>> RosBag::MessageCounts() const {
   return out;
 }
 
-RosBag ParseRosBag(const std::uint8_t* data, std::size_t size, const std::string& source) {
+namespace {
+
+/// ParseRosBag, releasing the pages of `file` (or nullptr) behind the parser.
+RosBag ParseRosBagFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
+                       const LogFile* file) {
   RosBag bag;
   bag.source = source;
   bag.size_bytes = size;
@@ -438,14 +450,20 @@ RosBag ParseRosBag(const std::uint8_t* data, std::size_t size, const std::string
                      "ROS bag of another version (\"" + std::string(text, line) +
                          "\"); plumb reads ROS 1 bags of version 2.0");
   }
-  Parser(data, size, &bag).Run();
+  Parser(data, size, &bag, file).Run();
   return bag;
+}
+
+}  // namespace
+
+RosBag ParseRosBag(const std::uint8_t* data, std::size_t size, const std::string& source) {
+  return ParseRosBagFrom(data, size, source, nullptr);
 }
 
 RosBag ReadRosBag(const std::string& path) {
   const LogFile file(path, "ROS bag");
   try {
-    RosBag bag = ParseRosBag(file.data(), file.size(), path);
+    RosBag bag = ParseRosBagFrom(file.data(), file.size(), path, &file);
     file.ThrowIfCut();
     return bag;
   } catch (const Error&) {
