@@ -144,6 +144,11 @@ TEST(RosBag, MixedCompressionAndOtherTopics) {
   EXPECT_EQ(RosBagSession(b, pick).series.size(), 10u);
   pick.stream = "/c";
   EXPECT_THROW(RosBagSession(b, pick), InputError);
+  FlightLogSelection by_instance;  // --imu 1: the second IMU topic
+  by_instance.imu = 1;
+  EXPECT_EQ(RosBagSession(b, by_instance).source, "t.bag (/b)");
+  by_instance.imu = 2;
+  EXPECT_THROW(RosBagSession(b, by_instance), InputError);
 }
 
 TEST(RosBag, ConnectionsOnlyAfterTheChunks) {

@@ -72,6 +72,15 @@ std::size_t Choose(const RosBag& bag, const FlightLogSelection& selection) {
                          TopicList(bag),
                      {Option::kTopic});
   }
+  if (selection.imu > 0) {  // an instance other than the default: the IMU topic of that index
+    if (static_cast<std::size_t>(selection.imu) < topics.size()) {
+      return static_cast<std::size_t>(selection.imu);
+    }
+    throw InputError(bag.source, "",
+                     "no IMU instance " + std::to_string(selection.imu) + "; its IMU topics: " +
+                         TopicList(bag),
+                     {Option::kTopic});
+  }
   if (topics.size() == 1) return 0;
   if (topics.empty()) {
     throw InputError(bag.source, "", "no sensor_msgs/Imu topic in the bag");

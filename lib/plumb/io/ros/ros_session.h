@@ -27,7 +27,9 @@ namespace plumb::io {
 /// Every IMU stream of `bag` (see the file comment), on header stamps.
 std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag);
 
-/// The session of one topic: selection.stream (the topic), else the bag's only IMU topic;
+/// The session of one topic: selection.stream (the topic), else the IMU topic of instance
+/// selection.imu when it is above 0 (the default 0 does not pick among several), else the bag's
+/// only IMU topic;
 /// windowed to [from_s, to_s] on the chosen clock. Throws plumb::InputError naming the bag when
 /// the topic is absent (listing the IMU topics), when several IMU topics and none is named
 /// (pointing to Option::kTopic), when the topic gives no linear_acceleration, or when the
