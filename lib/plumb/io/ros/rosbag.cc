@@ -154,6 +154,7 @@ void Parser::Run() {
           r.fields.op == detail::kOpChunk && r.data != nullptr) {
         Chunk(r, pos, true);
       }
+      bag_->warnings.messages_read = bag_->messages;
       break;
     }
     TopRecord(r, pos);
@@ -163,10 +164,12 @@ void Parser::Run() {
       released_ = pos;
     }
   }
-  // Every record whole, but the bag header points past the end: cut at a record boundary.
-  if (!bag_->warnings.cut_at && bag_->index_pos > size_) {
+  // Every record whole, but the bag header puts the index at the end or past it: cut at a
+  // record boundary.
+  if (!bag_->warnings.cut_at && bag_->index_pos != 0 && bag_->index_pos >= size_) {
     bag_->warnings.cut_at = size_;
     bag_->warnings.index_past_end = bag_->index_pos;
+    bag_->warnings.messages_read = bag_->messages;
   }
   Finish();
 }
@@ -376,12 +379,14 @@ std::vector<std::string> RosBagWarnings::Describe() const {
   const auto n = [](std::size_t v) { return std::to_string(v); };
   if (cut_at && index_past_end) {
     out.push_back("cut short: the bag header puts the index at byte " + n(index_past_end) +
-                  ", past the end of the file (" + n(*cut_at) + " bytes); every record in it was read");
+                  ", not before the end of the file (" + n(*cut_at) + " bytes); its " +
+                  n(messages_read) + " messages were read");
   } else if (cut_at) {
     out.push_back("cut short: the record at byte " + n(*cut_at) +
-                  " runs past the end of the file; the records before it were read" +
-                  (cut_messages_kept ? ", and " + n(cut_messages_kept) +
-                                           " message(s) of that cut chunk that were whole"
+                  " runs past the end of the file; the " + n(messages_read) +
+                  " messages before the cut were read" +
+                  (cut_messages_kept ? " (" + n(cut_messages_kept) +
+                                           " of them whole in that cut chunk)"
                                      : std::string()));
   }
   if (damaged_chunks) {

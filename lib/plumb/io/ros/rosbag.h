@@ -98,6 +98,7 @@ struct RosBagWarnings {
   /// Set when a record runs past the end of the file: its offset.
   std::optional<std::size_t> cut_at;
   std::size_t cut_messages_kept = 0;     ///< messages of a cut chunk kept (whole records)
+  std::size_t messages_read = 0;         ///< with cut_at: the messages read (all topics)
   /// Set when every record is whole but the bag header's index_pos lies past the end (the
   /// file cut at a record boundary; cut_at is then the file size): that index_pos.
   std::uint64_t index_past_end = 0;
