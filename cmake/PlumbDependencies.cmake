@@ -15,6 +15,13 @@ if(NOT TARGET plumb_yaml::yaml-cpp)
   set_target_properties(plumb_yaml::yaml-cpp PROPERTIES INTERFACE_LINK_LIBRARIES yaml-cpp)
 endif()
 
+# libbz2 and liblz4 (C libraries): the bz2 and lz4 chunks of ROS bags (io/ros), found as plain
+# libraries (Debian ships no CMake package for liblz4) and linked privately by io_ros.
+find_path(PLUMB_BZ2_INCLUDE_DIR bzlib.h REQUIRED)
+find_library(PLUMB_BZ2_LIBRARY bz2 REQUIRED)
+find_path(PLUMB_LZ4_INCLUDE_DIR lz4frame.h REQUIRED)
+find_library(PLUMB_LZ4_LIBRARY lz4 REQUIRED)
+
 # Debian ships GeographicLib with a Find module only; wrap it in an imported target.
 if(NOT TARGET GeographicLib::GeographicLib)
   list(APPEND CMAKE_MODULE_PATH /usr/share/cmake/geographiclib)

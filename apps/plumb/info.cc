@@ -1,5 +1,5 @@
 // plumb info LOG [--json FILE] — what is inside a flight log (ArduPilot DataFlash .bin or text
-// .log, MAVLink .tlog, PX4 ULog .ulg, recognised by content): each IMU stream with its sample
+// .log, MAVLink .tlog, PX4 ULog .ulg, ROS 1 bag; recognised by content): each IMU stream with its sample
 // count, rate, time span, temperature range, what the firmware applied and whether plumb can
 // undo it, its still periods, the site from the GPS, the calibration parameters in force, the
 // message counts and what the reader skipped (issue 5).
@@ -76,7 +76,7 @@ class InfoCommand : public Command {
  public:
   explicit InfoCommand(CLI::App& parent) {
     app_ = parent.add_subcommand(
-        "info", "What is inside a flight log (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg): IMU "
+        "info", "What is inside a flight log (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg, ROS bag): IMU "
                 "streams, still periods, the site from GPS, the calibration parameters in force");
     app_->footer("Example (the streams, still periods and firmware calibration of a PX4 log):\n  plumb info ../shared/data/px4/sample.ulg --json info.json");
     app_->add_option("LOG", args_.log_path, "The log file")->required()->type_name("LOG");
@@ -142,8 +142,10 @@ class InfoCommand : public Command {
         doc["imus"].push_back(j);
         continue;
       }
-      std::cout << "\n    applied by the firmware: "
-                << (imu.applied.empty() ? "nothing (raw sensor output)" : imu.applied)
+      const bool bag = summary.format == "ros1-bag";
+      std::cout << (bag ? "\n    applied by the driver: " : "\n    applied by the firmware: ")
+                << (bag ? "a bag does not say (taken as logged)"
+                        : imu.applied.empty() ? "nothing (raw sensor output)" : imu.applied)
                 << (imu.applied.empty() ? "" : imu.undoable ? " (plumb undoes it)"
                                                             : " (plumb cannot undo it all)")
                 << "\n";
@@ -180,6 +182,11 @@ class InfoCommand : public Command {
     nlohmann::json messages = nlohmann::json::object();
     for (const auto& [name, count] : summary.messages) messages[name] = count;
     doc["messages"] = messages;
+    if (summary.format == "ros1-bag") {  // a bag's topics and their types
+      for (const auto& [name, count] : summary.messages) {
+        std::cout << "topic " << name << ": " << count << " messages\n";
+      }
+    }
     doc["warnings"] = Messages(summary.warnings);
     for (const Notice& w : summary.warnings) std::cerr << "warning: " << w.message << "\n";
     if (!a.json_path.empty()) {

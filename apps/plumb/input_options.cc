@@ -73,7 +73,9 @@ io::InputOptions MakeInputOptions(const InputArgs& a, const std::vector<std::str
   o.time_unit_s = a.time_unit_s;
   o.rate_hz = a.rate_hz;
   o.drop_nan_rows = a.drop_nan;
-  o.clock = a.clock == "uniform" ? io::Clock::kUniform : io::Clock::kStamps;
+  o.clock = a.clock == "uniform"   ? io::Clock::kUniform
+            : a.clock == "receive" ? io::Clock::kReceive
+                                   : io::Clock::kStamps;
   o.acc.unit = a.acc_unit == "g"        ? io::AccUnit::kStandardGravity
                : a.acc_unit == "counts" ? io::AccUnit::kCounts
                                         : io::AccUnit::kMetersPerSecond2;
@@ -83,7 +85,13 @@ io::InputOptions MakeInputOptions(const InputArgs& a, const std::vector<std::str
   o.acc.offset = a.acc_offset;
   o.gyr.offset = a.gyr_offset;
   o.flight_log.imu = a.imu;
-  o.flight_log.stream = a.stream;
+  // --topic names a ROS bag's topic, --stream a log's message or topic: the library keeps
+  // either in FlightLogSelection::stream (a bag's streams are its topics).
+  if (!a.topic.empty() && !a.stream.empty() && a.topic != a.stream) {
+    throw UsageError("--topic " + a.topic + " and --stream " + a.stream +
+                     " name different streams; give one");
+  }
+  o.flight_log.stream = a.topic.empty() ? a.stream : a.topic;
   if (a.from != nullptr && a.from->count() > 0) o.flight_log.from_s = a.from_s;
   if (a.to != nullptr && a.to->count() > 0) o.flight_log.to_s = a.to_s;
   o.flight_log.undo_correction = !a.as_logged;
@@ -135,12 +143,12 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
   app->add_option("INPUT", a.inputs,
                   "Input files: plumb's native CSV, a text table (see --columns), an "
                   "accelerometer and a gyroscope table as acc.txt,gyr.txt, or a flight log: "
-                  "ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg "
-                  "(recognised by their first bytes)")
+                  "ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg, ROS 1 "
+                  ".bag (recognised by their first bytes)")
       ->type_name("FILE...");
   auto* logs = app->add_option_group(
-      "Flight logs", "Reading an ArduPilot .bin/.log, MAVLink .tlog or PX4 .ulg log "
-                     "(`plumb info LOG` lists its IMU streams)");
+      "Flight logs", "Reading an ArduPilot .bin/.log, MAVLink .tlog or PX4 .ulg log, or a ROS "
+                     "bag (`plumb info LOG` lists its IMU streams)");
   logs->add_option("--imu", a.imu, "IMU instance of the log, 0-based (IMU = 0, IMU2 = 1, ...)")
       ->check(NonNegative)
       ->capture_default_str();
@@ -149,6 +157,10 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
                    "e.g. IMU, ACC+GYR, ISBD_ACC, SCALED_IMU2, sensor_combined, vehicle_imu, "
                    "sensor_accel; default: the one with accelerometer and gyroscope at the "
                    "highest rate")
+      ->type_name("NAME");
+  logs->add_option("--topic", a.topic,
+                   "sensor_msgs/Imu topic of a ROS bag, as `plumb info` names it (e.g. "
+                   "/imu/data_raw); default: the bag's only IMU topic")
       ->type_name("NAME");
   a.from = logs->add_option("--from", a.from_s,
                             "Use the samples from this time on, s (a log's time, a table's "
@@ -164,8 +176,10 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
                   "Which clock the times follow: stamps (as read), or uniform (the sample "
                   "clock fitted through each input's stamps, keeping the gaps where samples "
                   "were dropped: for stamps a host wrote on arrival; `plumb info` and "
-                  "`plumb diagnose` say which the stamps are)")
-      ->check(CLI::IsMember({"stamps", "uniform"}))
+                  "`plumb diagnose` say which the stamps are), or receive (a ROS bag's record "
+                  "times, when the recorder received each message, instead of the header "
+                  "stamps)")
+      ->check(CLI::IsMember({"stamps", "uniform", "receive"}))
       ->capture_default_str();
   app->add_option("--acc", a.acc_file,
                   "Accelerometer table of the two-file form (imu_tk's `t x y z`), with --gyr")

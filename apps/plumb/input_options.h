@@ -49,10 +49,11 @@ struct InputArgs {
   std::string gyr_unit = "rad/s";  ///< rad/s | deg/s
   std::string axis_map = "1,2,3";  ///< body axis i = sign * sensor axis |m_i|, e.g. 1,-2,-3
   bool drop_nan = false;           ///< drop rows with NaN/inf instead of failing
-  std::string clock = "stamps";    ///< --clock: stamps | uniform (io::Clock)
-  // Flight logs (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg):
+  std::string clock = "stamps";    ///< --clock: stamps | uniform | receive (io::Clock)
+  // Flight logs (ArduPilot .bin/.log, MAVLink .tlog, PX4 .ulg) and ROS bags:
   int imu = 0;                     ///< --imu: IMU instance, 0-based, >= 0
   std::string stream;              ///< --stream: message/topic name; empty = the default
+  std::string topic;               ///< --topic: a ROS bag's sensor_msgs/Imu topic; empty = the only one
   double from_s = 0.0, to_s = 0.0; ///< --from / --to: time window in log time, s
   CLI::Option* from = nullptr;
   CLI::Option* to = nullptr;

@@ -34,6 +34,8 @@ const char* Flag(Option option) {
     case Option::kSystemId: return "--sysid";
     case Option::kCalibrationJson: return "'plumb calibrate --json'";
     case Option::kTruthJson: return "'plumb simulate --truth-json'";
+    case Option::kTopic: return "--topic";
+    case Option::kClock: return "--clock";
   }
   return "";
 }

@@ -31,6 +31,8 @@ const char* Keyword(Option option) {
     case Option::kGyroInstability: return "gyro_bi";
     case Option::kSigma: return "sigma";
     case Option::kCalibrationJson: return "Result.save";
+    case Option::kTopic: return "topic";
+    case Option::kClock: return "clock";
     case Option::kNoiseFrom:
     case Option::kExport:
     case Option::kExportUndetermined:

@@ -88,14 +88,23 @@ io::InputOptions Options(Keywords& k) {
   o.flight_log.imu = k.Take<int>("imu", 0);
   if (o.flight_log.imu < 0) throw Error("open: imu must be >= 0");
   o.flight_log.stream = k.Take<std::string>("stream", "");
+  // A ROS bag's topic: the library keeps it as the stream (a bag's streams are its topics).
+  if (auto topic = k.Take<std::string>("topic")) {
+    if (!o.flight_log.stream.empty() && *topic != o.flight_log.stream) {
+      throw Error("open: topic and stream name different streams; give one");
+    }
+    o.flight_log.stream = *topic;
+  }
   if (auto from = k.Take<double>("from_s")) o.flight_log.from_s = *from;
   if (auto to = k.Take<double>("to_s")) o.flight_log.to_s = *to;
   o.flight_log.undo_correction = !k.Take<bool>("as_logged", false);
   const std::string clock = k.Take<std::string>("clock", "stamps");
-  if (clock != "stamps" && clock != "uniform") {
-    throw Error("open: clock must be 'stamps' or 'uniform', not '" + clock + "'");
+  if (clock != "stamps" && clock != "uniform" && clock != "receive") {
+    throw Error("open: clock must be 'stamps', 'uniform' or 'receive', not '" + clock + "'");
   }
-  o.clock = clock == "uniform" ? io::Clock::kUniform : io::Clock::kStamps;
+  o.clock = clock == "uniform"   ? io::Clock::kUniform
+            : clock == "receive" ? io::Clock::kReceive
+                                 : io::Clock::kStamps;
   o.not_native_hint = "describe the table, e.g. columns='t,ax,ay,az,gx,gy,gz' (by position; "
                       "'-' skips a column, no 't' needs rate=HZ), with skip_lines, header, "
                       "acc_unit='g', gyr_unit='deg/s', acc_scale, acc_offset";

@@ -1,6 +1,6 @@
 // The bad-input battery: every command that reads a file runs on empty, garbage, truncated,
 // byte-flipped and NaN versions of each kind of input plumb reads (native CSV; ArduPilot .bin
-// and text .log, PX4 .ulg and MAVLink .tlog from ../shared/data when present; calibration,
+// and text .log, PX4 .ulg, MAVLink .tlog and a ROS bag from ../shared/data when present; calibration,
 // truth and study JSON). For every run: the process exits by itself with a code below 128 (no
 // abort, no signal), a failure's message names the damaged file and holds no NUL or raw
 // binary byte, and no input file is changed. The damage is drawn from fixed seeds, so every
@@ -188,6 +188,20 @@ TEST_F(BadInput, MavlinkTlog) {
   const std::string good = SharedLog("mavlink/plane385_disarmed.tlog");
   if (good.empty()) GTEST_SKIP() << "shared data absent: " << PLUMB_SHARED_DATA_DIR;
   Battery(good, "tlog", 5);
+}
+
+TEST_F(BadInput, RosBag) {
+  const std::string good = SharedLog("ros/ardrone_imu.bag");
+  if (good.empty()) GTEST_SKIP() << "shared data absent: " << PLUMB_SHARED_DATA_DIR;
+  // Besides the battery: the magic and then garbage, another bag version, and the bag with its
+  // first chunk's stated size made wrong (bytes 4129..: the ardrone bag's first chunk header).
+  std::string garbage(4096, '\x5a');
+  std::string wrong_size = good;
+  const std::size_t size_field = wrong_size.find("size=", 4096 + 13);
+  if (size_field != std::string::npos) wrong_size[size_field + 6] ^= 0x40;
+  Battery(good, "bag", 6,
+          {{"after_magic", "#ROSBAG V2.0\n" + garbage}, {"version12", "#ROSBAG V1.2\n" + garbage},
+           {"wrong_size", wrong_size}});
 }
 
 TEST_F(BadInput, CalibrationTruthAndStudyFiles) {

@@ -66,7 +66,7 @@ TEST(OptionName, ErrorsCarryTheOptionsTheirMessageNames) {
 }
 
 TEST(OptionName, EveryOptionHasALibraryName) {
-  for (int k = 0; k <= static_cast<int>(Option::kTruthJson); ++k) {
+  for (int k = 0; k <= static_cast<int>(Option::kClock); ++k) {
     const std::string name = LibraryName(static_cast<Option>(k));
     EXPECT_NE(name, "an option") << k;
     EXPECT_EQ(name.find("--"), std::string::npos) << name;

@@ -114,6 +114,20 @@ class CliEqual(unittest.TestCase):
         with self.assertRaises(plumb.Error):
             plumb.open(out("clock_host.csv"), clock="host")
 
+    def test_ros_bag_is_the_commands(self):
+        # A ROS bag's topic and its record times (--topic, --clock receive): the same fit.
+        bag = os.path.join(os.environ.get("PLUMB_SHARED_DATA_DIR", ""), "ros", "ardrone_imu.bag")
+        if not os.path.exists(bag):
+            self.skipTest("shared data absent: " + bag)
+        run("calibrate", bag, "--topic", "/ardrone/imu", "--clock", "receive", "--json",
+            out("bag_cal.json"))
+        session = plumb.open(bag, topic="/ardrone/imu", clock="receive")
+        with open(out("bag_cal.json")) as f:
+            self.assertEqual(plumb.calibrate(session).to_json(), in_python_words(f.read()))
+        with self.assertRaises(plumb.Error) as raised:
+            plumb.open(bag, topic="/nope")
+        self.assertEqual(raised.exception.options, ("topic",))
+
     def test_datasheet_units_are_the_commands(self):
         # The bias wander levels in a datasheet's units, parsed by the command's parser.
         levels = {"gyro_bi": "4 deg/h", "accel_rw": "10 ug/sqrt(h)"}

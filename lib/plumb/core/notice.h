@@ -18,8 +18,10 @@
 //   gyro_unpaired           io/px4/px4_session.cc: a gyroscope topic too few accelerometer
 //                           samples pair with (accelerometer only)
 //   other_senders           io/mavlink/mavlink_session.cc: other systems sent IMU messages
-//   sample_source           io/mavlink/mavlink_session.cc: the system, component and units
-//   sample_times            io/mavlink/mavlink_session.cc: which clock gave the times
+//   sample_source           io/mavlink/mavlink_session.cc: the system, component and units;
+//                           io/ros/ros_session.cc: a bag topic's frame, units, what is unused
+//   sample_times            io/mavlink/mavlink_session.cc, io/ros/ros_session.cc: which clock
+//                           gave the times
 //   raw_sensor              io/px4, io/mavlink: the samples are the sensor's raw output
 //   correction_kept         io/*: a flight controller's correction taken as logged
 //   correction_undone       io/*: a correction taken out of the samples, with its values

@@ -40,6 +40,8 @@ std::string LibraryName(Option option) {
     case Option::kSystemId: return "ExportOptions::system_id";
     case Option::kCalibrationJson: return "report::CalibrationJson";
     case Option::kTruthJson: return "the plumb command's simulate";
+    case Option::kTopic: return "FlightLogSelection::stream (a ROS bag's topic)";
+    case Option::kClock: return "InputOptions::clock";
   }
   return "an option";
 }

@@ -44,6 +44,8 @@ enum class Option {
   kSystemId,            ///< ExportOptions::system_id
   kCalibrationJson,     ///< report::CalibrationJson, the calibration's JSON document
   kTruthJson,           ///< the truth file of the command `plumb simulate` (no library call)
+  kTopic,               ///< FlightLogSelection::stream, a ROS bag's sensor_msgs/Imu topic
+  kClock,               ///< InputOptions::clock, which clock the times follow
 };
 
 /// The option's library name: the C++ field or argument, e.g. "CalibrationOptions::max_iterations".

@@ -1,9 +1,10 @@
 // plumb/io/common/flight_log.h — what every flight-log reader offers, whatever the format.
 //
-// A flight log (ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg) holds one
-// or more IMU streams: a message or topic carrying accelerometer and/or gyroscope samples of
-// one sensor instance (ArduPilot IMU/IMU2/ACC/GYR/ISBD, MAVLink RAW_IMU/SCALED_IMU2/HIGHRES_IMU,
-// PX4 sensor_combined/sensor_accel/vehicle_imu). Each format's reader lists its streams as
+// A flight log (ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg, ROS 1
+// .bag) holds one or more IMU streams: a message or topic carrying accelerometer and/or
+// gyroscope samples of one sensor instance (ArduPilot IMU/IMU2/ACC/GYR/ISBD, MAVLink
+// RAW_IMU/SCALED_IMU2/HIGHRES_IMU, PX4 sensor_combined/sensor_accel/vehicle_imu, a ROS bag's
+// sensor_msgs/Imu topics). Each format's reader lists its streams as
 // ImuStreamInfo and turns one of them into a Session from a FlightLogSelection, undoing what the
 // firmware applied before logging when the log says what that was.
 //
@@ -56,8 +57,12 @@ std::optional<std::string> DroppedRecordsWarning(const ImuStreamInfo& info);
 struct FlightLogSelection {
   int imu = 0;                   ///< sensor instance, 0-based, >= 0
   /// Stream (message or topic) name; empty means the reader's default stream for `imu` (the
-  /// one carrying both accelerometer and gyroscope at the highest rate).
+  /// one carrying both accelerometer and gyroscope at the highest rate). For a ROS bag, the
+  /// topic (Option::kTopic); empty: the bag's only sensor_msgs/Imu topic.
   std::string stream;
+  /// A ROS bag's record times (when the recorder received each message) instead of the
+  /// messages' header stamps (Clock::kReceive); only bags have them.
+  bool receive_time = false;
   std::optional<double> from_s;  ///< keep samples at or after this log time, s
   std::optional<double> to_s;    ///< keep samples at or before this log time, s
   bool undo_correction = true;   ///< recover the sensor's own output from the log's parameters
@@ -66,7 +71,7 @@ struct FlightLogSelection {
 /// A flight log's contents as `plumb info` shows them.
 struct FlightLogSummary {
   std::string source;                  ///< file name
-  std::string format;                  ///< "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog"
+  std::string format;                  ///< "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog", "ros1-bag"
   std::string format_detail;           ///< e.g. "MAVLink v1+v2, 41230 frames", "ULog version 1"
   std::size_t size_bytes = 0;          ///< file size, bytes
   std::vector<ImuStreamInfo> imus;     ///< every IMU stream

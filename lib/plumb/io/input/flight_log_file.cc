@@ -11,6 +11,7 @@
 #include "plumb/io/ardupilot/ardupilot_session.h"
 #include "plumb/io/mavlink/mavlink_session.h"
 #include "plumb/io/px4/px4_session.h"
+#include "plumb/io/ros/ros_session.h"
 #include "plumb/io/common/stream_spool.h"
 
 namespace plumb::io {
@@ -48,6 +49,7 @@ FlightLogSummary DataflashSummary(const DataflashLog& log, FlightLogFormat forma
 FlightLogFormat SniffFlightLog(const std::string& path) {
   if (LooksLikeDataflash(path)) return FlightLogFormat::kDataflashBinary;
   if (LooksLikeULog(path)) return FlightLogFormat::kPx4ULog;
+  if (LooksLikeRosBag(path)) return FlightLogFormat::kRosBag;
   if (LooksLikeTlog(path)) return FlightLogFormat::kMavlinkTlog;
   if (LooksLikeDataflashText(path)) return FlightLogFormat::kDataflashText;
   return FlightLogFormat::kNone;
@@ -63,6 +65,8 @@ const char* FlightLogFormatName(FlightLogFormat format) {
       return "mavlink-tlog";
     case FlightLogFormat::kPx4ULog:
       return "px4-ulog";
+    case FlightLogFormat::kRosBag:
+      return "ros1-bag";
     case FlightLogFormat::kNone:
       break;
   }
@@ -104,10 +108,13 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
     case FlightLogFormat::kPx4ULog:
       out.log_ = ReadULog(path, Px4SessionTopics(), InParts(run_jobs));
       break;
+    case FlightLogFormat::kRosBag:
+      out.log_ = ReadRosBag(path);
+      break;
     case FlightLogFormat::kNone:
       throw InputError(path, "byte 0",
                        "not a flight log plumb reads (ArduPilot DataFlash .bin or text .log, "
-                       "MAVLink .tlog, PX4 ULog .ulg)");
+                       "MAVLink .tlog, PX4 ULog .ulg, ROS 1 bag .bag)");
   }
   return out;
 }
@@ -121,6 +128,8 @@ FlightLogSummary FlightLog::Summary() const {
       return TlogSummary(std::get<MavlinkLog>(log_));
     case FlightLogFormat::kPx4ULog:
       return ULogSummary(std::get<ULog>(log_));
+    case FlightLogFormat::kRosBag:
+      return RosBagSummary(std::get<RosBag>(log_));
     case FlightLogFormat::kNone:
       break;
   }
@@ -128,6 +137,12 @@ FlightLogSummary FlightLog::Summary() const {
 }
 
 Session FlightLog::Select(const FlightLogSelection& selection) const {
+  if (selection.receive_time && format_ != FlightLogFormat::kRosBag) {
+    throw InputError(source_, "",
+                     std::string(FlightLogFormatName(format_)) + " has no receive times (" +
+                         OptionText(Option::kClock, "receive") + " is for ROS bags)",
+                     {Option::kClock});
+  }
   switch (format_) {
     case FlightLogFormat::kDataflashBinary:
     case FlightLogFormat::kDataflashText:
@@ -136,6 +151,8 @@ Session FlightLog::Select(const FlightLogSelection& selection) const {
       return TlogSession(std::get<MavlinkLog>(log_), selection);
     case FlightLogFormat::kPx4ULog:
       return ULogSession(std::get<ULog>(log_), selection);
+    case FlightLogFormat::kRosBag:
+      return RosBagSession(std::get<RosBag>(log_), selection);
     case FlightLogFormat::kNone:
       break;
   }

@@ -1,4 +1,4 @@
-// plumb/io/input/flight_log_file.h — any flight log plumb reads, opened by content: the format is
+// plumb/io/input/flight_log_file.h — any flight log plumb reads (a ROS bag included), opened by content: the format is
 // recognised from the file's first bytes (not its name), the log decoded once, and then its
 // summary (`plumb info`) and any number of sessions (calibrate, diagnose, report) come from it.
 //
@@ -16,6 +16,7 @@
 #include "plumb/io/common/flight_log.h"
 #include "plumb/io/mavlink/mavlink_tlog.h"
 #include "plumb/io/px4/ulog.h"
+#include "plumb/io/ros/rosbag.h"
 
 namespace plumb::io {
 
@@ -26,13 +27,15 @@ enum class FlightLogFormat {
   kDataflashText,    ///< ArduPilot text log .log ("FMT, ..." lines)
   kMavlinkTlog,      ///< MAVLink telemetry log .tlog (time-stamped v1/v2 frames)
   kPx4ULog,          ///< PX4 ULog .ulg ("ULog" magic)
+  kRosBag,           ///< ROS 1 bag .bag ("#ROSBAG V" line; version 2.0 is read)
 };
 
 /// The format of the file at `path`, from its first bytes; kNone when it is none of them or
 /// cannot be read.
 FlightLogFormat SniffFlightLog(const std::string& path);
 
-/// "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog" ("none" for kNone).
+/// "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog", "ros1-bag" ("none" for
+/// kNone).
 const char* FlightLogFormatName(FlightLogFormat format);
 
 /// A decoded flight log of any supported format.
@@ -61,7 +64,7 @@ class FlightLog {
   FlightLog() = default;
   FlightLogFormat format_ = FlightLogFormat::kNone;
   std::string source_;
-  std::variant<DataflashLog, MavlinkLog, ULog> log_;
+  std::variant<DataflashLog, MavlinkLog, ULog, RosBag> log_;
 };
 
 }  // namespace plumb::io

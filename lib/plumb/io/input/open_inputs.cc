@@ -187,8 +187,11 @@ Session Read(const InputFile& input, InputKind kind, const InputOptions& o) {
       }
       return windowed(
           ReadSplitTables(input.path, input.gyr_path, TableOptions(o, true), o.run_jobs));
-    case InputKind::kFlightLog:
-      return FlightLog::Open(input.path, o.run_jobs).Select(o.flight_log);
+    case InputKind::kFlightLog: {
+      FlightLogSelection selection = o.flight_log;
+      if (o.clock == Clock::kReceive) selection.receive_time = true;
+      return FlightLog::Open(input.path, o.run_jobs).Select(selection);
+    }
     case InputKind::kTextTable:
       return windowed(ReadTextTable(input.path, TableOptions(o, false)));
     case InputKind::kNativeCsv:
@@ -274,6 +277,12 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const InputKind kind = KindOf(inputs[i], options);
     if (options.before_read) options.before_read(i, kind);
+    if (options.clock == Clock::kReceive && kind != InputKind::kFlightLog) {
+      throw InputError(inputs[i].path, "",
+                       "a table has no receive times (" + OptionText(Option::kClock, "receive") +
+                           " is for ROS bags)",
+                       {Option::kClock});
+    }
     Session s = Read(inputs[i], kind, options);
     if (options.clock == Clock::kUniform) UseUniformClock(s);
     if (options.acc.unit == AccUnit::kCounts) s.series.acc_unit = "counts";
@@ -321,6 +330,7 @@ double KeptFraction(const std::string& path, FlightLogFormat format) {
         }
         break;
       case FlightLogFormat::kMavlinkTlog:
+      case FlightLogFormat::kRosBag:
       case FlightLogFormat::kNone:
         return 1.0;
     }
@@ -345,6 +355,7 @@ std::uint64_t EstimateReadMemory(const std::string& path) {
       factor = kKeptMemoryFactor * KeptFraction(path, format);
       break;
     case FlightLogFormat::kMavlinkTlog: factor = kTlogMemoryFactor; break;
+    case FlightLogFormat::kRosBag: factor = kRosBagMemoryFactor; break;
     case FlightLogFormat::kNone: break;
   }
   return kReadMemoryBaseBytes + SpooledBytes(path) +

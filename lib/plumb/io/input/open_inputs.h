@@ -15,7 +15,8 @@
 //   const Session x = OpenInputs({{"xsens_acc.mat", "xsens_gyro.mat"}}, o);  // two-file form
 //
 // Each input is one of (InputKind):
-//   flight log    an ArduPilot DataFlash .bin or text .log, a MAVLink .tlog or a PX4 ULog .ulg,
+//   flight log    an ArduPilot DataFlash .bin or text .log, a MAVLink .tlog, a PX4 ULog .ulg or
+//                 a ROS 1 bag .bag,
 //                 recognised by its first bytes (flight_log_file.h); `flight_log` selects the
 //                 stream, the time window and whether the firmware's correction is undone;
 //   native CSV    plumb's own format (native_csv.h), recognised by its header
@@ -71,7 +72,10 @@ enum class Clock {
   kStamps,  ///< the times as the input states them
   /// The uniform sample clock fitted through each input's stamps (signal/time_base.h), the
   /// gaps kept where samples were dropped: for stamps a host wrote on arrival.
-  kUniform
+  kUniform,
+  /// A ROS bag's record times, when the recorder received each message, instead of the
+  /// messages' header stamps (FlightLogSelection::receive_time); any other input is refused.
+  kReceive
 };
 
 enum class InputKind {
@@ -210,7 +214,7 @@ Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& opt
 ///   .log: kKeptMemoryFactor, times the share of the file that the session's reader keeps (the
 ///   bodies of its IMU, parameter and GPS messages, measured on the first
 ///   kEstimatePrefixBytes: FlightLog reads with ArdupilotSessionRecords / Px4SessionTopics);
-///   MAVLink .tlog kTlogMemoryFactor; text tables and CSV
+///   MAVLink .tlog kTlogMemoryFactor; ROS bags kRosBagMemoryFactor; text tables and CSV
 ///   kTableMemoryFactor (about 50 bytes per decoded sample). Calibrated on the peak RSS of
 ///   `plumb info` / `plumb calibrate` on ~450 MB inputs (docs/performance.md, "Memory"),
 ///   rounded up. A stream held in memory (StreamSpool) is estimated from its copy, whose
@@ -229,6 +233,11 @@ inline constexpr double kSplitKeptMemoryFactor = 3.5;
 /// Memory per byte of a .tlog (its frames are kept as decoded messages; read in two parts, the
 /// second part's messages are held until joined: 140 MB peak for a 150 MB .tlog).
 inline constexpr double kTlogMemoryFactor = 0.85;
+/// Memory per byte of a ROS bag: the decoded samples (36 bytes and an 8-byte receive time per
+/// sensor_msgs/Imu message of about 370 bytes in the file's records, 3-4 times as many per byte
+/// of a bz2 bag) and the session's copies of them; the mapped file's pages are released as
+/// the reader passes them (62 MB peak for `plumb info` on a 150 MB uncompressed bag).
+inline constexpr double kRosBagMemoryFactor = 1.0;
 /// Memory per byte of a text table or CSV.
 inline constexpr double kTableMemoryFactor = 0.8;
 

@@ -1,0 +1,44 @@
+// plumb/io/ros/ros_session.h — a ROS 1 bag (rosbag.h) as plumb IMU streams and Sessions.
+//
+// IMU streams: one per sensor_msgs/Imu topic, named by the topic ("/imu/data_raw"), instance =
+// its index among the bag's IMU topics (order of first connection). accel =
+// linear_acceleration (m/s^2), gyro = angular_velocity (rad/s), as logged: the message's own
+// frame (REP-103 asks for x forward, y left, z up: FLU), not turned into FRD. plumb calibrates
+// the sensor's axes as the log gives them, as it does for every log (the ArduPilot and PX4
+// readers take their firmware's FRD as logged too); the session's sample_source warning says
+// the frame. Whatever the driver applied before publishing stays in the samples (a bag does
+// not say what). orientation and the covariances are not used; a topic whose every
+// angular_velocity_covariance[0] is -1 ("not given") is accelerometer-only.
+//
+// Time: header.stamp (sec + nsec * 1e-9, s since the unix epoch, as a .tlog's times), or with
+// FlightLogSelection::receive_time the record time (when the recorder received the message).
+// Samples whose time does not increase are left out (KeepIncreasingTimes, counted in a
+// records_dropped warning).
+#pragma once
+
+#include <vector>
+
+#include "plumb/core/session.h"
+#include "plumb/io/common/flight_log.h"
+#include "plumb/io/ros/rosbag.h"
+
+namespace plumb::io {
+
+/// Every IMU stream of `bag` (see the file comment), on header stamps.
+std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag);
+
+/// The session of one topic: selection.stream (the topic), else the IMU topic of instance
+/// selection.imu when it is above 0 (the default 0 does not pick among several), else the bag's
+/// only IMU topic;
+/// windowed to [from_s, to_s] on the chosen clock. Throws plumb::InputError naming the bag when
+/// the topic is absent (listing the IMU topics), when several IMU topics and none is named
+/// (pointing to Option::kTopic), when the topic gives no linear_acceleration, or when the
+/// window holds fewer than 2 samples.
+Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection);
+
+/// The bag as `plumb info` shows it: format "ros1-bag", format_detail "ROS bag 2.0, N chunks
+/// (bz2 4), K connections, indexed", the IMU streams, message counts per "topic (type)" and
+/// the reader's warnings.
+FlightLogSummary RosBagSummary(const RosBag& bag);
+
+}  // namespace plumb::io

@@ -1,0 +1,260 @@
+// plumb/io/ros/rosbag_format.cc — see rosbag_format.h.
+#include "plumb/io/ros/rosbag_format.h"
+
+#include <bzlib.h>
+#include <lz4frame.h>
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include "plumb/io/common/log_common.h"
+
+namespace plumb::io::detail {
+namespace {
+
+/// Calls `field(name, value)` for each "name=value" field of [p, p + n). False, with `why`,
+/// when a length runs past the end or a field has no '='.
+template <typename Field>
+bool ForEachField(const std::uint8_t* p, std::size_t n, std::string* why, Field&& field) {
+  std::size_t pos = 0;
+  while (pos < n) {
+    if (n - pos < 4) {
+      *why = "a field length cut by the end of the header (" + std::to_string(n - pos) +
+             " bytes left)";
+      return false;
+    }
+    const std::uint32_t len = LoadLittleEndian<std::uint32_t>(p + pos);
+    pos += 4;
+    if (len > n - pos) {
+      *why = "a field of " + std::to_string(len) + " bytes where " + std::to_string(n - pos) +
+             " remain";
+      return false;
+    }
+    const auto* begin = reinterpret_cast<const char*>(p + pos);
+    // The names are a few letters: a loop beats a call of memchr per field.
+    std::size_t name_len = 0;
+    while (name_len < len && begin[name_len] != '=') ++name_len;
+    if (name_len == len) {
+      *why = "a field without '='";
+      return false;
+    }
+    if (!field(std::string_view(begin, name_len),
+               std::string_view(begin + name_len + 1, len - name_len - 1))) {
+      *why = "field '" + std::string(begin, name_len) + "' of the wrong size (" +
+             std::to_string(len - name_len - 1) + " bytes)";
+      return false;
+    }
+    pos += len;
+  }
+  return true;
+}
+
+template <typename T>
+bool Load(std::string_view value, T* out) {
+  if (value.size() != sizeof(T)) return false;
+  *out = LoadLittleEndian<T>(reinterpret_cast<const std::uint8_t*>(value.data()));
+  return true;
+}
+
+}  // namespace
+
+bool ParseRecordFields(const std::uint8_t* p, std::size_t n, RosRecordFields* out,
+                       std::string* why) {
+  *out = RosRecordFields{};
+  return ForEachField(p, n, why, [out](std::string_view name, std::string_view value) {
+    if (name == "op") return out->has_op = Load(value, &out->op);
+    if (name == "conn") return out->has_conn = Load(value, &out->conn);
+    if (name == "time") {
+      std::uint64_t t = 0;
+      if (!Load(value, &t)) return false;
+      out->sec = static_cast<std::uint32_t>(t & 0xffffffffu);
+      out->nsec = static_cast<std::uint32_t>(t >> 32);
+      return out->has_time = true;
+    }
+    if (name == "topic") {
+      out->topic = value;
+      return out->has_topic = true;
+    }
+    if (name == "compression") {
+      out->compression = value;
+      return true;
+    }
+    if (name == "size") return out->has_size = Load(value, &out->size);
+    if (name == "index_pos") return Load(value, &out->index_pos);
+    return true;
+  });
+}
+
+bool ParseConnectionData(const std::uint8_t* p, std::size_t n, RosConnection* c,
+                         std::string* why) {
+  return ForEachField(p, n, why, [c](std::string_view name, std::string_view value) {
+    if (name == "type") c->type = std::string(value);
+    if (name == "md5sum") c->md5sum = std::string(value);
+    if (name == "callerid") c->callerid = std::string(value);
+    if (name == "latching") c->latching = value == "1";
+    return true;
+  });
+}
+
+namespace {
+
+/// Room for more output: doubles `out` up to `cap` bytes (a chunk's size and one byte, to see
+/// data longer than stated). False when it is there already.
+bool Grow(std::vector<std::uint8_t>* out, std::size_t used, std::size_t cap) {
+  if (used >= cap) return false;
+  const std::size_t want = std::min<std::size_t>(cap, std::max<std::size_t>(used * 2, 1 << 16));
+  if (want > out->size()) out->resize(want);
+  return true;
+}
+
+/// At least `bytes` in `out`: a buffer reused chunk after chunk only grows (never shrunk, so
+/// never zero-filled again).
+void Reserve(std::vector<std::uint8_t>* out, std::size_t bytes) {
+  if (out->size() < bytes) out->resize(bytes);
+}
+
+bool Bz2(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
+         std::vector<std::uint8_t>* out, std::size_t* out_size, std::string* why) {
+  bz_stream s{};
+  if (BZ2_bzDecompressInit(&s, 0, 0) != BZ_OK) {
+    *why = "bz2 could not start";
+    return false;
+  }
+  std::size_t used = 0;
+  std::size_t fed = 0;
+  int rc = BZ_OK;
+  Reserve(out, std::min<std::size_t>(std::size_t{declared} + 1, std::max<std::size_t>(n * 4, 1 << 16)));
+  while (true) {
+    const std::size_t give = std::min<std::size_t>(n - fed, std::numeric_limits<unsigned>::max());
+    s.next_in = const_cast<char*>(reinterpret_cast<const char*>(in + fed));
+    s.avail_in = static_cast<unsigned>(give);
+    s.next_out = reinterpret_cast<char*>(out->data() + used);
+    const std::size_t room = std::min<std::size_t>(out->size(), std::size_t{declared} + 1);
+    s.avail_out = static_cast<unsigned>(std::min<std::size_t>(room - used,
+                                                              std::numeric_limits<unsigned>::max()));
+    const unsigned out_before = s.avail_out;
+    rc = BZ2_bzDecompress(&s);
+    fed += give - s.avail_in;
+    used += out_before - s.avail_out;
+    if (rc == BZ_STREAM_END || rc != BZ_OK) break;
+    if (s.avail_out == 0) {
+      if (!Grow(out, used, std::size_t{declared} + 1)) {
+        rc = BZ_DATA_ERROR_MAGIC;  // more than declared
+        *why = "bz2 data longer than the chunk's size " + std::to_string(declared);
+        break;
+      }
+      continue;
+    }
+    if (fed == n) break;  // input ended before the stream did
+  }
+  BZ2_bzDecompressEnd(&s);
+  *out_size = used;
+  if (rc == BZ_STREAM_END) {
+    if (used == declared) return true;
+    *why = "bz2 data of " + std::to_string(used) + " bytes, not the chunk's size " +
+           std::to_string(declared);
+    return false;
+  }
+  if (why->empty()) {
+    *why = rc == BZ_OK ? (cut ? "bz2 data cut by the end of the file after " + std::to_string(used) +
+                                    " bytes"
+                              : "bz2 data ended before its stream did")
+                       : "bz2 data corrupt (error " + std::to_string(rc) + ") after " +
+                             std::to_string(used) + " bytes";
+  }
+  return false;
+}
+
+bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
+         std::vector<std::uint8_t>* out, std::size_t* out_size, std::string* why) {
+  LZ4F_dctx* ctx = nullptr;
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) {
+    *why = "lz4 could not start";
+    return false;
+  }
+  std::size_t used = 0;
+  std::size_t fed = 0;
+  std::size_t hint = 1;
+  bool ok = true;
+  Reserve(out, std::min<std::size_t>(std::size_t{declared} + 1, std::max<std::size_t>(n * 4, 1 << 16)));
+  while (hint != 0) {
+    const std::size_t room = std::min<std::size_t>(out->size(), std::size_t{declared} + 1);
+    if (used == room && !Grow(out, used, std::size_t{declared} + 1)) {
+      *why = "lz4 data longer than the chunk's size " + std::to_string(declared);
+      ok = false;
+      break;
+    }
+    std::size_t out_size =
+        std::min<std::size_t>(out->size(), std::size_t{declared} + 1) - used;
+    std::size_t in_size = n - fed;
+    hint = LZ4F_decompress(ctx, out->data() + used, &out_size, in + fed, &in_size, nullptr);
+    if (LZ4F_isError(hint)) {
+      *why = std::string("lz4 data corrupt (") + LZ4F_getErrorName(hint) + ") after " +
+             std::to_string(used) + " bytes";
+      ok = false;
+      break;
+    }
+    fed += in_size;
+    used += out_size;
+    if (hint != 0 && fed == n && out_size == 0) {
+      *why = cut ? "lz4 data cut by the end of the file after " + std::to_string(used) + " bytes"
+                 : "lz4 data ended before its frame did";
+      ok = false;
+      break;
+    }
+  }
+  LZ4F_freeDecompressionContext(ctx);
+  *out_size = used;
+  if (ok && used != declared) {
+    *why = "lz4 data of " + std::to_string(used) + " bytes, not the chunk's size " +
+           std::to_string(declared);
+    ok = false;
+  }
+  return ok;
+}
+
+}  // namespace
+
+bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
+                     std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
+                     std::size_t* out_size, std::string* why) {
+  why->clear();
+  *out_size = 0;
+  if (compression == "none") {
+    const std::size_t take = std::min<std::size_t>(n, declared);
+    Reserve(out, take);
+    std::copy(in, in + take, out->begin());
+    *out_size = take;
+    if (n == declared) return true;
+    *why = cut ? "chunk cut by the end of the file after " + std::to_string(n) + " of its " +
+                     std::to_string(declared) + " bytes"
+               : "uncompressed chunk of " + std::to_string(n) + " bytes, not its size " +
+                     std::to_string(declared);
+    return false;
+  }
+  if (compression == "bz2") return Bz2(in, n, declared, cut, out, out_size, why);
+  if (compression == "lz4") return Lz4(in, n, declared, cut, out, out_size, why);
+  *why = "unknown compression '" + std::string(compression.substr(0, 32)) + "'";
+  return false;
+}
+
+bool DecodeRosImu(const std::uint8_t* p, std::size_t n, RosImuMessage* out) {
+  if (n < 16) return false;
+  out->sec = LoadLittleEndian<std::uint32_t>(p + 4);
+  out->nsec = LoadLittleEndian<std::uint32_t>(p + 8);
+  const std::uint32_t len = LoadLittleEndian<std::uint32_t>(p + 12);
+  if (len > n - 16 || n - 16 - len != kRosImuFixedBytes) return false;
+  out->frame_id = std::string_view(reinterpret_cast<const char*>(p + 16), len);
+  const std::uint8_t* d = p + 16 + len;
+  const auto f = [d](int i) { return LoadLittleEndian<double>(d + 8 * i); };
+  for (int i = 0; i < 4; ++i) out->orientation[i] = f(i);
+  out->orientation_cov0 = f(4);
+  out->gyr = Vec3(f(13), f(14), f(15));
+  out->gyr_cov0 = f(16);
+  out->acc = Vec3(f(25), f(26), f(27));
+  out->acc_cov0 = f(28);
+  return true;
+}
+
+}  // namespace plumb::io::detail

@@ -1,0 +1,98 @@
+// plumb/io/ros/rosbag_format.h — the pieces of a ROS 1 bag 2.0 (rosbag.h has the format): a
+// record header's fields, a connection's data, a chunk's decompression and the
+// sensor_msgs/Imu serialization. Internal to the reader; every length is checked against the
+// bytes that hold it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "plumb/core/types.h"
+#include "plumb/io/ros/rosbag.h"
+
+namespace plumb::io::detail {
+
+/// The bag's first line.
+inline constexpr char kRosBagMagic[] = "#ROSBAG V2.0\n";
+inline constexpr std::size_t kRosBagMagicSize = sizeof(kRosBagMagic) - 1;
+/// What every bag's first line starts with, whatever its version.
+inline constexpr char kRosBagPrefix[] = "#ROSBAG V";
+inline constexpr std::size_t kRosBagPrefixSize = sizeof(kRosBagPrefix) - 1;
+
+/// The largest uncompressed chunk read, bytes (1 GiB): rosbag closes a chunk past 768 KiB
+/// (its default chunk threshold) or after one large message, so a larger stated size is a
+/// damaged field or a decompression bomb, not a bag; such a chunk is skipped (counted).
+inline constexpr std::uint32_t kRosMaxChunkBytes = std::uint32_t{1} << 30;
+
+/// The record ops.
+enum RosOp : std::uint8_t {
+  kOpMessageData = 0x02,
+  kOpBagHeader = 0x03,
+  kOpIndexData = 0x04,
+  kOpChunk = 0x05,
+  kOpChunkInfo = 0x06,
+  kOpConnection = 0x07,
+};
+
+/// The fields of a record header the reader uses (others are read past).
+struct RosRecordFields {
+  bool has_op = false;
+  std::uint8_t op = 0;
+  bool has_conn = false;
+  std::uint32_t conn = 0;
+  bool has_time = false;
+  std::uint32_t sec = 0;
+  std::uint32_t nsec = 0;
+  std::string_view topic;
+  bool has_topic = false;
+  std::string_view compression;
+  bool has_size = false;
+  std::uint32_t size = 0;   ///< a chunk's uncompressed size
+  std::uint64_t index_pos = 0;
+};
+
+/// Parses the header [p, p + n) into `out`. False when a field's length runs past the header,
+/// a field has no '=', or a known field has the wrong size; `why` then says which.
+bool ParseRecordFields(const std::uint8_t* p, std::size_t n, RosRecordFields* out,
+                       std::string* why);
+
+/// Parses a connection record's data (type, md5sum, callerid, latching) into `c`. False, with
+/// `why`, when a field's length runs past the data or has no '='.
+bool ParseConnectionData(const std::uint8_t* p, std::size_t n, RosConnection* c,
+                         std::string* why);
+
+/// Decompresses a chunk's data [in, in + n) of `compression` ("none", "bz2", "lz4") into the
+/// first `*out_size` bytes of `out`, a buffer reused from chunk to chunk: grown as data comes
+/// out (never ahead of it, never past `declared` + 1 bytes), never shrunk. True when the data
+/// decompressed to its end and to exactly `declared` bytes; false with `why` otherwise, `out`
+/// then holding what came out before the fault (the records there are still whole: a caller
+/// reads them). `cut`: the data was cut by the end of the file (the fault expected; `why` says
+/// where it ended).
+bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
+                     std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
+                     std::size_t* out_size, std::string* why);
+
+/// One decoded sensor_msgs/Imu message.
+struct RosImuMessage {
+  std::uint32_t sec = 0;
+  std::uint32_t nsec = 0;
+  std::string_view frame_id;
+  double orientation[4] = {};       ///< x y z w
+  double orientation_cov0 = 0.0;
+  Vec3 gyr = Vec3::Zero();          ///< angular_velocity, rad/s
+  double gyr_cov0 = 0.0;
+  Vec3 acc = Vec3::Zero();          ///< linear_acceleration, m/s^2
+  double acc_cov0 = 0.0;
+};
+
+/// Bytes of a sensor_msgs/Imu message past its frame_id.
+inline constexpr std::size_t kRosImuFixedBytes = 37 * 8;
+
+/// Decodes a sensor_msgs/Imu message [p, p + n). False when its size is not 16 + frame_id
+/// length + kRosImuFixedBytes.
+bool DecodeRosImu(const std::uint8_t* p, std::size_t n, RosImuMessage* out);
+
+}  // namespace plumb::io::detail

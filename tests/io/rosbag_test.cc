@@ -1,0 +1,366 @@
+// The ROS 1 bag reader (io/ros) on small bags written here (rosbag_builder.h): chunks of each
+// compression, with and without an index, connections after the chunks, bags cut short at
+// every byte, corrupt lengths, and the session's topic, clock and frame.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "io/rosbag_builder.h"
+#include "plumb/core/error.h"
+#include "plumb/io/input/flight_log_file.h"
+#include "plumb/io/input/open_inputs.h"
+#include "plumb/io/ros/ros_session.h"
+#include "plumb/io/ros/rosbag.h"
+
+namespace plumb::io {
+namespace {
+
+using test::RosBagStart;
+using test::RosChunkRecord;
+using test::RosConnectionRecord;
+using test::RosImuMessage;
+using test::RosMessageRecord;
+
+constexpr std::uint32_t kSec = 1360242236;
+
+/// The records of `n` IMU messages of connection `conn` at 100 Hz, the connection first.
+std::string ImuRecords(std::uint32_t conn, const std::string& topic, int n, int from = 0,
+                       bool with_connection = true) {
+  std::string out = with_connection ? RosConnectionRecord(conn, topic) : "";
+  for (int i = from; i < from + n; ++i) {
+    const std::uint32_t nsec = static_cast<std::uint32_t>(i) * 10000000u;
+    const std::array<double, 3> acc = {0.1 * i, -0.2, 9.8 + 0.001 * i};
+    const std::array<double, 3> gyr = {0.01, 0.002 * i, -0.03};
+    out += RosMessageRecord(conn, kSec + 1, nsec + 5000,
+                            RosImuMessage(static_cast<std::uint32_t>(i), kSec, nsec, "/imu", acc, gyr));
+  }
+  return out;
+}
+
+/// A bag of 3 chunks of 40 messages each, compressed with `compression`, indexed or not.
+std::string ThreeChunks(const std::string& compression, bool indexed) {
+  std::string bag = RosBagStart();
+  const std::size_t first_chunk = bag.size();
+  bag += RosChunkRecord(compression, ImuRecords(0, "/imu/data_raw", 40));
+  bag += RosChunkRecord(compression, ImuRecords(0, "/imu/data_raw", 40, 40, false));
+  bag += RosChunkRecord(compression, ImuRecords(0, "/imu/data_raw", 40, 80, false));
+  if (indexed) {
+    bag += RosConnectionRecord(0, "/imu/data_raw");
+    bag += test::RosIndexRecords(0, first_chunk);
+  }
+  return bag;
+}
+
+/// The offsets where the top-level records of `bag` start, and its size.
+std::vector<std::size_t> RecordStarts(const std::string& bag) {
+  std::vector<std::size_t> out;
+  std::size_t pos = 13;
+  while (pos + 4 <= bag.size()) {
+    out.push_back(pos);
+    std::uint32_t header = 0, data = 0;
+    std::memcpy(&header, &bag[pos], 4);
+    std::memcpy(&data, &bag[pos + 4 + header], 4);
+    pos += 8 + header + data;
+  }
+  out.push_back(bag.size());
+  return out;
+}
+
+RosBag Parse(const std::string& bytes) {
+  return ParseRosBag(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "t.bag");
+}
+
+TEST(RosBag, ReadsEveryCompressionAlike) {
+  const RosBag none = Parse(ThreeChunks("none", true));
+  ASSERT_EQ(none.imu_topics.size(), 1u);
+  const RosImuTopic& t = none.imu_topics[0];
+  EXPECT_EQ(t.topic, "/imu/data_raw");
+  EXPECT_EQ(t.frame_id, "/imu");
+  ASSERT_EQ(t.samples.size(), 120u);
+  EXPECT_DOUBLE_EQ(t.samples.t_s[0], kSec);
+  EXPECT_DOUBLE_EQ(t.samples.t_s[119], kSec + 1.19);
+  EXPECT_DOUBLE_EQ(t.receive_s[0], kSec + 1 + 5e-6);
+  EXPECT_FLOAT_EQ(t.samples.acc[119].x(), static_cast<float>(0.1 * 119));
+  EXPECT_FLOAT_EQ(t.samples.acc[7].z(), static_cast<float>(9.8 + 0.007));
+  EXPECT_FLOAT_EQ(t.samples.gyr[9].y(), static_cast<float>(0.018));
+  EXPECT_EQ(t.orientation_not_given, 120u);
+  EXPECT_FALSE(none.warnings.any()) << none.warnings.Describe()[0];
+  EXPECT_EQ(none.chunks, 3u);
+  EXPECT_EQ(none.chunk_infos, 1u);
+  EXPECT_EQ(none.connections.size(), 1u);
+  EXPECT_EQ(none.connections.at(0).callerid, "/test_node");
+  for (const char* c : {"bz2", "lz4"}) {
+    for (const bool indexed : {true, false}) {
+      const RosBag other = Parse(ThreeChunks(c, indexed));
+      ASSERT_EQ(other.imu_topics.size(), 1u) << c;
+      EXPECT_EQ(other.imu_topics[0].samples.t_s, t.samples.t_s) << c;
+      EXPECT_EQ(other.imu_topics[0].samples.acc, t.samples.acc) << c;
+      EXPECT_EQ(other.imu_topics[0].samples.gyr, t.samples.gyr) << c;
+      EXPECT_EQ(other.imu_topics[0].receive_s, t.receive_s) << c;
+      EXPECT_EQ(other.compression.at(c), 3u);
+      EXPECT_EQ(other.chunk_infos, indexed ? 1u : 0u);
+      EXPECT_FALSE(other.warnings.any()) << c;
+    }
+  }
+}
+
+TEST(RosBag, MixedCompressionAndOtherTopics) {
+  std::string bag = RosBagStart();
+  bag += RosChunkRecord("bz2", ImuRecords(0, "/a", 10) +
+                                   RosConnectionRecord(1, "/mag", "sensor_msgs/MagneticField",
+                                                       "2f3b0b43eed0c9501de0fa3ff89a45aa") +
+                                   RosMessageRecord(1, kSec, 0, std::string(100, 'x')));
+  bag += RosChunkRecord("lz4", ImuRecords(2, "/b", 10));
+  bag += RosChunkRecord("none", ImuRecords(0, "/a", 10, 10, false));
+  const RosBag b = Parse(bag);
+  ASSERT_EQ(b.imu_topics.size(), 2u);
+  EXPECT_EQ(b.Find("/a")->samples.size(), 20u);
+  EXPECT_EQ(b.Find("/b")->samples.size(), 10u);
+  const auto counts = b.MessageCounts();
+  ASSERT_EQ(counts.size(), 3u);
+  EXPECT_EQ(counts[1].first, "/mag (sensor_msgs/MagneticField)");
+  EXPECT_EQ(counts[1].second, 1u);
+  const FlightLogSummary summary = RosBagSummary(b);
+  EXPECT_EQ(summary.format, "ros1-bag");
+  ASSERT_EQ(summary.imus.size(), 2u);
+  EXPECT_EQ(summary.imus[1].name, "/b");
+  EXPECT_EQ(summary.imus[1].instance, 1);
+  EXPECT_NEAR(summary.imus[0].rate_hz, 100.0, 1e-3);  // unix times: 2.4e-7 s steps
+  EXPECT_NE(summary.format_detail.find("no index"), std::string::npos) << summary.format_detail;
+  // Two IMU topics and none named: an error listing them and naming the option.
+  try {
+    RosBagSession(b, FlightLogSelection{});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/a (20 messages), /b (10 messages)"), std::string::npos)
+        << e.what();
+    EXPECT_EQ(e.options(), std::vector<Option>{Option::kTopic});
+  }
+  FlightLogSelection pick;
+  pick.stream = "/b";
+  EXPECT_EQ(RosBagSession(b, pick).series.size(), 10u);
+  pick.stream = "/c";
+  EXPECT_THROW(RosBagSession(b, pick), InputError);
+  FlightLogSelection by_instance;  // --imu 1: the second IMU topic
+  by_instance.imu = 1;
+  EXPECT_EQ(RosBagSession(b, by_instance).source, "t.bag (/b)");
+  by_instance.imu = 2;
+  EXPECT_THROW(RosBagSession(b, by_instance), InputError);
+}
+
+TEST(RosBag, ConnectionsOnlyAfterTheChunks) {
+  // A writer that puts connections in the index section only: messages kept aside, decoded.
+  std::string bag = RosBagStart();
+  bag += RosChunkRecord("none", ImuRecords(4, "/imu", 30, 0, false));
+  bag += RosConnectionRecord(4, "/imu");
+  const RosBag b = Parse(bag);
+  ASSERT_EQ(b.imu_topics.size(), 1u);
+  EXPECT_EQ(b.imu_topics[0].samples.size(), 30u);
+  EXPECT_EQ(b.warnings.orphan_messages, 0u);
+  // Without the connection at all: counted, not decoded.
+  std::string orphan = RosBagStart();
+  orphan += RosChunkRecord("none", ImuRecords(4, "/imu", 30, 0, false));
+  const RosBag o = Parse(orphan);
+  EXPECT_TRUE(o.imu_topics.empty());
+  EXPECT_EQ(o.warnings.orphan_messages, 30u);
+}
+
+TEST(RosBag, CutShortAtEveryByteKeepsAPrefix) {
+  for (const char* c : {"none", "bz2", "lz4"}) {
+    const std::string whole = ThreeChunks(c, true);
+    const RosBag full = Parse(whole);
+    const std::vector<double>& all = full.imu_topics[0].samples.t_s;
+    const std::size_t header_end = RosBagStart().size();
+    const std::vector<std::size_t> starts = RecordStarts(whole);
+    std::size_t last_count = 0;
+    for (std::size_t cut = 13; cut < whole.size(); ++cut) {
+      const std::string part = whole.substr(0, cut);
+      if (cut < header_end) {
+        EXPECT_THROW(Parse(part), InputError) << c << " cut " << cut;
+        continue;
+      }
+      RosBag b;
+      ASSERT_NO_THROW(b = Parse(part)) << c << " cut " << cut;
+      const std::size_t n = b.imu_topics.empty() ? 0 : b.imu_topics[0].samples.size();
+      ASSERT_LE(n, all.size());
+      if (n > 0) {
+        EXPECT_TRUE(std::equal(b.imu_topics[0].samples.t_s.begin(),
+                               b.imu_topics[0].samples.t_s.end(), all.begin()));
+      }
+      EXPECT_GE(n, last_count) << c << " cut " << cut;  // more file, never fewer samples
+      last_count = n;
+      // Cut inside a record: said (at a record boundary the bag looks whole, its header's
+      // index_pos being 0 here).
+      const bool boundary = std::find(starts.begin(), starts.end(), cut) != starts.end();
+      EXPECT_EQ(b.warnings.cut_at.has_value(), !boundary) << c << " cut " << cut;
+    }
+  }
+  // An uncompressed chunk cut in the middle keeps its whole messages and says so.
+  const std::string whole = ThreeChunks("none", false);
+  const RosBag b = Parse(whole.substr(0, whole.size() - 1000));
+  EXPECT_GT(b.warnings.cut_messages_kept, 0u);
+  const std::string text = b.warnings.Describe()[0];
+  EXPECT_NE(text.find("cut short: the record at byte "), std::string::npos) << text;
+}
+
+TEST(RosBag, CorruptLengthsAreCountedNeverFatal) {
+  const std::string whole = ThreeChunks("none", false);
+  const std::size_t chunk = RosBagStart().size();
+  {  // The first chunk's header length past the end of the file: cut there.
+    std::string bad = whole;
+    const std::uint32_t huge = 0x7fffffff;
+    std::memcpy(&bad[chunk], &huge, 4);
+    const RosBag b = Parse(bad);
+    EXPECT_EQ(b.warnings.cut_at, chunk);
+    EXPECT_TRUE(b.imu_topics.empty() || b.imu_topics[0].samples.empty());
+  }
+  {  // A field length inside the chunk's header past the header: record skipped, rest read.
+    std::string bad = whole;
+    const std::uint32_t huge = 0x10000;
+    std::memcpy(&bad[chunk + 4], &huge, 4);
+    const RosBag b = Parse(bad);
+    EXPECT_EQ(b.warnings.bad_records, 1u);
+    EXPECT_EQ(b.warnings.first_bad_record, chunk);
+  }
+  {  // A chunk's size that does not match its data: damaged, its whole records read.
+    std::string records = ImuRecords(0, "/imu", 10);
+    std::string chunk_record = RosChunkRecord("bz2", records);
+    const std::string field = test::RosField("size", test::Bytes(std::uint32_t(records.size())));
+    const std::size_t at = chunk_record.find(field);
+    const std::uint32_t wrong = static_cast<std::uint32_t>(records.size() - 400);
+    std::memcpy(&chunk_record[at + 9], &wrong, 4);
+    const RosBag b = Parse(RosBagStart() + chunk_record + RosChunkRecord("none", ImuRecords(0, "/imu", 5, 10, false)));
+    EXPECT_EQ(b.warnings.damaged_chunks, 1u);
+    ASSERT_EQ(b.imu_topics.size(), 1u);
+    EXPECT_GE(b.imu_topics[0].samples.size(), 5u + 8u);
+  }
+  {  // An IMU message one byte short, another with a frame_id length past its end.
+    std::string msg = RosImuMessage(0, kSec, 0, "imu", {0, 0, 9.8}, {0, 0, 0});
+    std::string shorter = msg.substr(0, msg.size() - 1);
+    std::string long_id = msg;
+    const std::uint32_t len = 0xffffff00;
+    std::memcpy(&long_id[12], &len, 4);
+    const RosBag b = Parse(RosBagStart() + RosChunkRecord("none", RosConnectionRecord(0, "/i") +
+                                                                       RosMessageRecord(0, kSec, 0, shorter) +
+                                                                       RosMessageRecord(0, kSec, 0, long_id) +
+                                                                       RosMessageRecord(0, kSec, 1, msg)));
+    EXPECT_EQ(b.warnings.malformed_imu, 2u);
+    EXPECT_EQ(b.imu_topics[0].samples.size(), 1u);
+  }
+  {  // Another md5sum: said, decoded where the size fits.
+    const RosBag b = Parse(RosBagStart() +
+                           RosChunkRecord("none", RosConnectionRecord(0, "/i", "sensor_msgs/Imu", "0123") +
+                                                      ImuRecords(0, "/i", 5, 0, false)));
+    ASSERT_EQ(b.warnings.md5_notes.size(), 1u);
+    EXPECT_EQ(b.imu_topics[0].samples.size(), 5u);
+  }
+  {  // A chunk stating more than 1 GiB: skipped, counted, the next chunk read.
+    std::string records = ImuRecords(0, "/imu", 10);
+    std::string chunk_record = RosChunkRecord("lz4", records);
+    const std::string field = test::RosField("size", test::Bytes(std::uint32_t(records.size())));
+    const std::size_t at = chunk_record.find(field);
+    const std::uint32_t huge = 0xfffffff0u;
+    std::memcpy(&chunk_record[at + 9], &huge, 4);
+    const RosBag b = Parse(RosBagStart() + chunk_record +
+                           RosChunkRecord("none", ImuRecords(1, "/imu", 5, 10)));
+    EXPECT_EQ(b.warnings.damaged_chunks, 1u);
+    EXPECT_NE(b.warnings.first_damage.find("more than plumb reads"), std::string::npos);
+    EXPECT_EQ(b.imu_topics.at(0).samples.size(), 5u);
+  }
+  {  // A damaged compressed stream: counted.
+    std::string chunk_record = RosChunkRecord("bz2", ImuRecords(0, "/imu", 50));
+    chunk_record[chunk_record.size() / 2] ^= 0x55;
+    RosBag b;
+    ASSERT_NO_THROW(b = Parse(RosBagStart() + chunk_record));
+    EXPECT_EQ(b.warnings.damaged_chunks, 1u);
+  }
+}
+
+TEST(RosBag, RefusesWhatIsNotABag20) {
+  try {
+    Parse("#ROSBAG V1.2\n" + std::string(100, '\0'));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "byte 0");
+    EXPECT_NE(std::string(e.what()).find("version 2.0"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(Parse("ULog"), InputError);
+  try {  // The first record is not the bag header.
+    Parse("#ROSBAG V2.0\n" + RosConnectionRecord(0, "/imu"));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where(), "byte 13");
+  }
+}
+
+TEST(RosBag, SessionClockFrameAndGyroNotGiven) {
+  std::string records = RosConnectionRecord(0, "/imu");
+  for (int i = 0; i < 20; ++i) {
+    records += RosMessageRecord(0, kSec + 100, static_cast<std::uint32_t>(i) * 20000000u,
+                                RosImuMessage(i, kSec, static_cast<std::uint32_t>(i) * 10000000u,
+                                              "/imu", {0, 0, 9.8}, {0.1, 0, 0}, -1.0, 0.0, true));
+  }
+  const RosBag b = Parse(RosBagStart() + RosChunkRecord("lz4", records));
+  FlightLogSelection pick;
+  const Session s = RosBagSession(b, pick);
+  EXPECT_EQ(s.series.size(), 20u);
+  EXPECT_FALSE(s.series.has_gyro());  // every angular_velocity_covariance[0] is -1
+  EXPECT_NEAR(s.series.t_s[1] - s.series.t_s[0], 0.01, 1e-6);
+  const auto has = [&](const std::string& code, const std::string& text) {
+    return std::any_of(s.warnings.begin(), s.warnings.end(), [&](const Notice& n) {
+      return n.code == code && n.message.find(text) != std::string::npos;
+    });
+  };
+  EXPECT_TRUE(has("sample_source", "REP-103"));
+  EXPECT_TRUE(has("sample_source", "20 message(s) with an all-zero orientation"));
+  EXPECT_TRUE(has("sample_source", "accelerometer only"));
+  EXPECT_TRUE(has("sample_times", "header stamps"));
+  pick.receive_time = true;
+  const Session r = RosBagSession(b, pick);
+  EXPECT_NEAR(r.series.t_s[1] - r.series.t_s[0], 0.02, 1e-6);
+  EXPECT_DOUBLE_EQ(r.series.t_s[0], kSec + 100.0);
+  pick.from_s = kSec + 100.1;
+  pick.to_s = kSec + 100.2;
+  EXPECT_EQ(RosBagSession(b, pick).series.size(), 6u);
+  pick.from_s = kSec + 500.0;
+  EXPECT_THROW(RosBagSession(b, pick), InputError);
+}
+
+TEST(RosBag, FlightLogAndOpenInputsReadABagFile) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "plumb_rosbag_test.bag").string();
+  {
+    std::ofstream out(path, std::ios::binary);
+    const std::string bytes = ThreeChunks("bz2", true);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  EXPECT_EQ(SniffFlightLog(path), FlightLogFormat::kRosBag);
+  const FlightLog log = FlightLog::Open(path);
+  EXPECT_EQ(log.Summary().format, "ros1-bag");
+  EXPECT_EQ(log.Summary().imus.at(0).samples, 120u);
+  InputOptions o;
+  EXPECT_EQ(OpenInputs({path}, o).series.size(), 120u);
+  o.clock = Clock::kReceive;
+  EXPECT_DOUBLE_EQ(OpenInputs({path}, o).series.t_s[0], kSec + 1 + 5e-6);
+  std::filesystem::remove(path);
+  // Receive times are a bag's only.
+  const std::string csv =
+      (std::filesystem::temp_directory_path() / "plumb_rosbag_test.csv").string();
+  {
+    std::ofstream out(csv);
+    out << "time_s,acc_x,acc_y,acc_z\n0,0,0,9.8\n0.01,0,0,9.8\n0.02,0,0,9.8\n";
+  }
+  try {
+    OpenInputs({csv}, o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.options(), std::vector<Option>{Option::kClock});
+  }
+  std::filesystem::remove(csv);
+}
+
+}  // namespace
+}  // namespace plumb::io
