@@ -4,9 +4,10 @@
 // Per factor with two or more values along it (the other factors at the first point's values):
 //   nees_FACTOR.svg     the NEES per degree of freedom (all runs, and the runs no gate flagged)
 //                       with its 95 % band, against the factor
-//   error_FACTOR_N.svg  for every parameter the study scores (the N-th row of the first point
-//                       along the factor: the fitted model's parameters, or on one pose the
-//                       combinations the data determine), the signed mean error (estimate -
+//   error_FACTOR_N.svg  for every parameter the study scores (N: the row's place among the rows
+//                       of the points along the factor, first seen first; the fitted model's
+//                       parameters a run determined, or on one pose the combinations the
+//                       data determine), the signed mean error (estimate -
 //                       truth) over the runs with its spread (+- 1 standard deviation over the
 //                       runs, as error bars), and +- the mean sigma the fit reported, against
 //                       the factor; the y axis in the parameter's unit
