@@ -87,7 +87,7 @@ TEST(StudyPage, EveryScoredParameterGetsASignedErrorFigureAgainstEveryFactor) {
   ASSERT_EQ(plan.job.outputs.size(), plan.figures.size());
   for (std::size_t f = 0; f < 2; ++f) {
     for (const auto& row : kRows) {
-      const std::string title = "set title '" + row.name + " against " + s.factors[f].name + "'";
+      const std::string title = "set title '" + row.name + "'";
       EXPECT_TRUE(Contains(plan.job.script, title)) << title;
       const bool found = std::any_of(plan.figures.begin(), plan.figures.end(), [&](const auto& fig) {
         return fig.factor == f && fig.parameter == row.name && fig.unit == row.unit;
@@ -141,7 +141,7 @@ TEST(StudyPage, OnePoseDrawsTheDeterminedCombinations) {
   EXPECT_EQ(drawn, (std::vector<std::string>{"accel.bias.x - 9.78 accel.matrix.xz",
                                              "gyro.bias.y + 7.243e-05 gyro.matrix.yx"}));
   EXPECT_TRUE(Contains(plan.job.script,
-                       "set title 'accel.bias.x - 9.78 accel.matrix.xz against fit_gravity_m_s2'"));
+                       "set title 'accel.bias.x - 9.78 accel.matrix.xz'\nplot"));
 }
 
 TEST(StudyPage, ThePageGroupsTheDrawnFiguresByFactor) {

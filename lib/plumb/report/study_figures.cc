@@ -145,7 +145,7 @@ std::string NeesScript(const std::string& csv_name, const std::string& csv, cons
 
 /// The error figure's script for row `i`, "" when no point has its mean error.
 std::string ErrorScript(const std::string& csv_name, const std::string& csv, const std::string& svg,
-                        const std::string& name, const Axis& axis, std::size_t i,
+                        const Axis& axis, std::size_t i,
                         const std::string& row, const std::string& unit) {
   const std::size_t mean = 7 + 3 * i, sd = mean + 1, sigma = mean + 2;
   if (!AnyValue(csv, mean)) return "";
@@ -153,7 +153,7 @@ std::string ErrorScript(const std::string& csv_name, const std::string& csv, con
   std::string s = "set output '" + svg + "'\n" + axis.setup + "unset logscale y\nset autoscale y\nset xlabel " +
                   GnuplotQuote(axis.label) + "\nset ylabel " +
                   GnuplotQuote(WithUnit("error, estimate - truth", unit.empty() ? "dimensionless" : unit)) +
-                  "\nset title " + GnuplotQuote(row + " against " + name) + "\nplot 0 with lines lc rgb '#9e9e9e' title 'zero error'";
+                  "\nset title " + GnuplotQuote(row) + "\nplot 0 with lines lc rgb '#9e9e9e' title 'zero error'";
   if (AnyValue(csv, sd)) {
     s += ", '" + csv_name + "' using 1:" + m + ":" + d + " with yerrorbars ps 0 lw 2 lc rgb '" + kSpreadColour +
          "' title 'spread: mean +- 1 sd over runs'";
@@ -223,7 +223,7 @@ StudyFigurePlan PlanStudyFigures(const study::Study& study,
     }
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const std::string svg = "error_" + safe + "_" + std::to_string(i) + ".svg";
-      const std::string script = ErrorScript(csv_name, csv, svg, name, axis, i, rows[i], units[i]);
+      const std::string script = ErrorScript(csv_name, csv, svg, axis, i, rows[i], units[i]);
       if (script.empty()) continue;  // not determined along this factor
       job.script += script;
       job.outputs.push_back(svg);
