@@ -196,7 +196,7 @@ StudyFigurePlan PlanStudyFigures(const study::Study& study,
   GnuplotJob& job = plan.job;
   job.script_name = "study.gp";
   job.log_name = "study.log";
-  job.script = SvgTerminal(560, 380) + "set datafile separator ','\nset grid\nset key below\n";
+  job.script = SvgTerminal(560, 380) + "set datafile separator ','\nset grid\nset key below samplen 2\n";
   for (std::size_t f = 0; f < study.factors.size(); ++f) {
     const auto along = PointsAlong(points, f);
     if (along.size() < 2) continue;
