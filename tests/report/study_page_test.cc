@@ -142,6 +142,23 @@ TEST(StudyPage, OnePoseDrawsTheDeterminedCombinations) {
                                              "gyro.bias.y + 7.243e-05 gyro.matrix.yx"}));
   EXPECT_TRUE(Contains(plan.job.script,
                        "set title 'accel.bias.x - 9.78 accel.matrix.xz'\nplot"));
+  // A combination's other coefficients follow the factor (the fit's gravity: 9.807 instead of
+  // 9.78): still one row, matched by its leading parameter, and its name says so.
+  auto moved = Points(s, rows);
+  moved[1].parameters[2].name = "accel.bias.x - 9.807 accel.matrix.xz";
+  const StudyFigurePlan vary = PlanStudyFigures(s, moved);
+  drawn.clear();
+  for (const auto& fig : vary.figures) {
+    if (fig.factor == 0 && !fig.parameter.empty()) drawn.push_back(fig.parameter);
+  }
+  EXPECT_EQ(drawn, (std::vector<std::string>{
+                       "accel.bias.x - 9.78 accel.matrix.xz (coefficients vary)",
+                       "gyro.bias.y + 7.243e-05 gyro.matrix.yx"}));
+  const auto csv = std::find_if(vary.job.data.begin(), vary.job.data.end(), [](const GnuplotFile& d) {
+    return d.name == "study_fit_gravity_m_s2.csv";
+  });
+  ASSERT_NE(csv, vary.job.data.end());
+  EXPECT_TRUE(Contains(csv->content, "\n1,9.80665,1.1,0.2,2.4,,,,,,,,0.039,1e-05,4e-05,")) << csv->content;
 }
 
 TEST(StudyPage, ThePageGroupsTheDrawnFiguresByFactor) {

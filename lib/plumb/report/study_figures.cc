@@ -13,6 +13,8 @@ constexpr const char* kMeanColour = "#1565c0";
 constexpr const char* kSpreadColour = "#64b5f6";
 constexpr const char* kSigmaColour = "#c62828";
 constexpr const char* kBandColour = "#2e7d32";
+/// Appended to a combination's name when its coefficients change along the factor.
+constexpr const char* kVaries = " (coefficients vary)";
 
 /// A CSV field: empty when not finite (gnuplot skips it).
 std::string Field(double v) { return std::isfinite(v) ? Number(v, 10) : ""; }
@@ -33,10 +35,19 @@ std::string UnitOfFactor(const std::string& name, const std::vector<study::Point
   return "";
 }
 
-/// The row named `name` of point `p`, or null.
-const study::ParameterSummary* Row(const study::PointSummary& p, const std::string& name) {
+/// What a row is along a factor: a parameter's name, or for a determined combination its
+/// leading parameter's (the text's first term, coefficient 1) marked as a combination: its
+/// other coefficients may change with the factor ("accel.bias.z - 9.78 accel.matrix.zz" at
+/// WGS84's gravity, "accel.bias.z - 9.807 accel.matrix.zz" at 9.80665).
+std::string RowKey(const std::string& name) {
+  const std::size_t space = name.find(' ');
+  return space == std::string::npos ? name : name.substr(0, space) + " (combination)";
+}
+
+/// The row of point `p` whose RowKey is `key`, or null.
+const study::ParameterSummary* Row(const study::PointSummary& p, const std::string& key) {
   for (const study::ParameterSummary& r : p.parameters) {
-    if (r.name == name) return &r;
+    if (RowKey(r.name) == key) return &r;
   }
   return nullptr;
 }
@@ -202,13 +213,20 @@ StudyFigurePlan PlanStudyFigures(const study::Study& study,
     if (along.size() < 2) continue;
     const std::string name = study.factors[f].name, safe = Safe(name);
     const Axis axis = FactorAxis(name, UnitOfFactor(name, points), along, f);
-    // Every row of every point along the factor, first seen first (the first point's order).
-    std::vector<std::string> rows, units;
+    // Every row of every point along the factor (by RowKey), first seen first (the first
+    // point's order), named by its first text; a combination whose text changes along the
+    // factor says so.
+    std::vector<std::string> rows, names, units;
     for (const auto* p : along) {
       for (const study::ParameterSummary& r : p->parameters) {
-        if (std::find(rows.begin(), rows.end(), r.name) == rows.end()) {
-          rows.push_back(r.name);
+        const auto at = std::find(rows.begin(), rows.end(), RowKey(r.name));
+        if (at == rows.end()) {
+          rows.push_back(RowKey(r.name));
+          names.push_back(r.name);
           units.push_back(r.unit);
+        } else if (names[at - rows.begin()] != r.name &&
+                   names[at - rows.begin()].find(kVaries) == std::string::npos) {
+          names[at - rows.begin()] += kVaries;
         }
       }
     }
@@ -223,11 +241,11 @@ StudyFigurePlan PlanStudyFigures(const study::Study& study,
     }
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const std::string svg = "error_" + safe + "_" + std::to_string(i) + ".svg";
-      const std::string script = ErrorScript(csv_name, csv, svg, axis, i, rows[i], units[i]);
+      const std::string script = ErrorScript(csv_name, csv, svg, axis, i, names[i], units[i]);
       if (script.empty()) continue;  // not determined along this factor
       job.script += script;
       job.outputs.push_back(svg);
-      plan.figures.push_back({svg, f, rows[i], units[i]});
+      plan.figures.push_back({svg, f, names[i], units[i]});
     }
     if (plan.figures.size() > drawn) job.data.push_back({csv_name, csv});
   }

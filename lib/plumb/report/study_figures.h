@@ -7,7 +7,9 @@
 //   error_FACTOR_N.svg  for every parameter the study scores (N: the row's place among the rows
 //                       of the points along the factor, first seen first; the fitted model's
 //                       parameters a run determined, or on one pose the combinations the
-//                       data determine), the signed mean error (estimate -
+//                       data determine, matched along the factor by their leading
+//                       parameter: the other coefficients may change with it, and the name
+//                       then says "(coefficients vary)"), the signed mean error (estimate -
 //                       truth) over the runs with its spread (+- 1 standard deviation over the
 //                       runs, as error bars), and +- the mean sigma the fit reported, against
 //                       the factor; the y axis in the parameter's unit
