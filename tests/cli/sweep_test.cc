@@ -52,10 +52,10 @@ TEST(SweepCli, ShardsMergeIntoTheUnshardedResultByteForByte) {
   // The page and its figures (gnuplot is part of the set-up).
   const std::string page = ReadAll(at("whole/index.html"));
   EXPECT_TRUE(Contains(page, "<h1>plumb sweep: t</h1>")) << page;
-  EXPECT_TRUE(Contains(page, "<figure>\n<svg")) << page;  // inside the page, own ids
+  EXPECT_TRUE(Contains(page, "<figure id=\"fig-error_poses_0\">\n<svg")) << page;  // inside the page, own ids
   EXPECT_TRUE(Contains(page, "id='nees_poses-gpDot'")) << page;
-  EXPECT_TRUE(Contains(page, "id='error_poses-gpDot'")) << page;
-  EXPECT_FALSE(fs::exists(dir.path() / "whole/error_poses.svg"));
+  EXPECT_TRUE(Contains(page, "id='error_poses_0-gpDot'")) << page;
+  EXPECT_FALSE(fs::exists(dir.path() / "whole/error_poses_0.svg"));
   const std::string csv = ReadAll(at("whole/results.csv"));
   EXPECT_TRUE(Contains(csv, "point,poses,parameter,unit,runs,failed,flagged,mean_error")) << csv;
   EXPECT_TRUE(Contains(csv, "\n2,15,gyro.bias.z,rad/s,3,0,")) << csv;

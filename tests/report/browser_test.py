@@ -52,6 +52,40 @@ def run(args, **kw):
     return subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **kw)
 
 
+STUDY = ('{"name": "one pose", "seed": 5, "runs": 2, "design": "one_at_a_time",'
+         ' "base": {"schedule": "paper_static", "still_s": 10, "rate_hz": 100, "sensor": "typical",'
+         ' "lat_deg": 6.67, "lon_deg": -1.57, "height_m": 250}, "fit": {"method": "generalized"},'
+         ' "factors": [{"name": "level_error_deg", "levels": [0, 1]},'
+         ' {"name": "fit_gravity_m_s2", "levels": [0, 9.80665]}]}')
+
+
+def study_page(args, verdict):
+    """Part 3 of the module comment."""
+    study = args.out / "study.json"
+    study.write_text(STUDY)
+    folder = args.out / "study"
+    r = run([args.plumb, "sweep", str(study), "--out", str(folder), "--jobs", "1"])
+    verdict("plumb sweep writes the study's page", r.returncode == 0, r.stdout)
+    if r.returncode != 0:
+        return
+    alone = args.out / "study_alone"
+    alone.mkdir()
+    shutil.copy(folder / "index.html", alone / "index.html")
+    html = (alone / "index.html").read_text()
+    for factor in ("level_error_deg", "fit_gravity_m_s2"):
+        for n in range(6):  # the rows of the raw parameters, undetermined, are not drawn
+            verdict("an error figure of combination %d against %s" % (n, factor),
+                    ('<figure id="fig-error_%s_%d">' % (factor, 21 + n)) in html, "")
+    verdict("the y axes have units", html.count("error, estimate - truth (m/s^2)") == 6 and
+            html.count("error, estimate - truth (rad/s)") == 6, "")
+    verdict("the gravity factor is drawn by level", "fit_gravity_m_s2 (m/s^2), by level" in html
+            and "WGS84<" in html, "")
+    r = run([sys.executable, args.checker, str(alone / "index.html"), "--min-figures", "14",
+             "--screenshot", str(args.out / "study.png")])
+    verdict("the study's page alone: no console error, no request, 14 figures of non-zero size",
+            r.returncode == 0, r.stdout)
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--plumb", required=True)
@@ -107,6 +141,7 @@ def main():
                 "size", r.returncode == 0, r.stdout)
         verdict("the screenshot is a PNG (%s)" % shot,
                 shot.is_file() and shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", "")
+    study_page(args, verdict)
     print("%d passed, %d failed" % (passed, failed))
     return 0 if failed == 0 else 1
 

@@ -12,36 +12,70 @@
 namespace plumb::report {
 namespace {
 
-/// Rows drawn against each factor: the first four of the point's rows (the accelerometer's
-/// scale and cross terms come first in the base model; combinations when one pose).
-constexpr std::size_t kHeadline = 4;
-
-std::string CsvValue(double v) { return std::isfinite(v) ? Number(v, 10) : "NaN"; }
-
 /// `v` with 3 decimals ("%.3f"), "n/a" when not finite.
 std::string Short(double v) { return std::isfinite(v) ? FixedText(v, 3) : "n/a"; }
-
-/// The points along factor f: every other factor at the first point's value, sorted by f.
-std::vector<const study::PointSummary*> Along(const std::vector<study::PointSummary>& points,
-                                              std::size_t f) {
-  std::vector<const study::PointSummary*> out;
-  if (points.empty()) return out;
-  const std::vector<double>& base = points.front().point.values;
-  for (const study::PointSummary& p : points) {
-    bool others = true;
-    for (std::size_t g = 0; g < base.size(); ++g) others = others && (g == f || p.point.values[g] == base[g]);
-    if (others) out.push_back(&p);
-  }
-  std::sort(out.begin(), out.end(), [f](const auto* a, const auto* b) {
-    return a->point.values[f] < b->point.values[f];
-  });
-  return out;
-}
 
 std::string Safe(const std::string& name) {
   std::string out;
   for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
   return out;
+}
+
+/// A factor's value in the points table: its level's name (study::FactorLevelName) or number.
+std::string LevelText(const std::string& factor, double v) {
+  const std::string level = study::FactorLevelName(factor, v);
+  if (!level.empty()) return level;
+  return std::isfinite(v) ? Number(v) : std::string("n/a");
+}
+
+constexpr const char* kFigureStyle =
+    ".figs { display: flex; flex-wrap: wrap; gap: 0.8em; }\n"
+    ".figs figure { margin: 0.4em 0; flex: 1 1 460px; max-width: 640px; }\n"
+    "nav.toc li { margin: 0.15em 0; }\n";
+
+/// The figures section: what the figures show, a table of contents (a line per factor with a
+/// link per parameter), then a section per factor with its figures, captioned.
+std::string FiguresSection(const study::Study& study, const std::vector<study::PointSummary>& points,
+                           const std::vector<InlineFigure>& figures) {
+  const StudyFigurePlan plan = PlanStudyFigures(study, points);
+  auto svg_of = [&](const std::string& file) -> const InlineFigure* {
+    for (const InlineFigure& f : figures) {
+      if (f.file == file) return &f;
+    }
+    return nullptr;
+  };
+  std::string toc, sections;
+  for (std::size_t f = 0; f < study.factors.size(); ++f) {
+    const std::string& name = study.factors[f].name;
+    std::string links, body;
+    for (const StudyFigure& fig : plan.figures) {
+      const InlineFigure* drawn = fig.factor == f ? svg_of(fig.file) : nullptr;
+      if (drawn == nullptr) continue;
+      const std::string id = "fig-" + fig.file.substr(0, fig.file.size() - 4);
+      const std::string caption =
+          fig.parameter.empty() ? "NEES per degree of freedom, with its 95 % band"
+                                : "error of " + WithUnit(fig.parameter, fig.unit) +
+                                      ": mean over the runs, +- 1 sd, and +- the mean sigma";
+      links += std::string(links.empty() ? "" : ", ") + "<a href=\"#" + id + "\">" +
+               HtmlEscape(fig.parameter.empty() ? "NEES" : fig.parameter) + "</a>";
+      body += "<figure id=\"" + id + "\">\n" + drawn->svg + "\n<figcaption>" + HtmlEscape(caption) +
+              "</figcaption></figure>\n";
+    }
+    if (body.empty()) continue;
+    const std::string unit = study::FactorUnit(name);
+    const std::string heading = WithUnit(name, unit);
+    toc += "<li><a href=\"#factor-" + Safe(name) + "\">" + HtmlEscape(heading) + "</a>: " + links + "</li>\n";
+    sections += "<section id=\"factor-" + Safe(name) + "\">\n<h3>Against " + HtmlEscape(heading) +
+                "</h3>\n<div class=\"figs\">\n" + body + "</div>\n</section>\n";
+  }
+  if (sections.empty()) return "";
+  return "<p>Against each factor, the other factors at the first point's values: the NEES per "
+         "degree of freedom with its 95 % band, and for every parameter the study scores (on one "
+         "pose, the combinations the data determine) the signed error, estimate - truth, in the "
+         "parameter's unit: its mean over the runs (points), +- 1 standard deviation over the runs "
+         "(bars), and +- the mean sigma the fit reported (dashed). A mean outside the dashed lines "
+         "is a bias the sigma does not cover. A factor whose value names a case (gravity 0: WGS84's) "
+         "is drawn by level.</p>\n<nav class=\"toc\"><ul>\n" + toc + "</ul></nav>\n" + sections;
 }
 
 /// Two table cells: a NEES per dof (marked when outside its band, "n/a" without runs) and
@@ -56,99 +90,30 @@ std::string NeesCells(double per_dof, int dof, double low, double high) {
 }  // namespace
 
 GnuplotJob StudyFigures(const study::Study& study, const std::vector<study::PointSummary>& points) {
-  GnuplotJob job;
-  job.script_name = "study.gp";
-  job.log_name = "study.log";
-  job.script = SvgTerminal(800, 480) + "set datafile separator ','\nset grid\nset key outside right\n";
-  for (std::size_t f = 0; f < study.factors.size(); ++f) {
-    const auto along = Along(points, f);
-    if (along.size() < 2) continue;
-    const std::string name = study.factors[f].name, safe = Safe(name);
-    // NEES per degree of freedom with its band (none for closed forms: no sigma). gnuplot
-    // stops at a plot with no defined point, so such series are left out.
-    const bool any_nees = std::any_of(along.begin(), along.end(),
-                                      [](const auto* p) { return std::isfinite(p->nees_per_dof); });
-    std::string nees = "value,nees_per_dof,low,high\n";
-    for (const auto* p : along) {
-      nees += CsvValue(p->point.values[f]) + "," + CsvValue(p->nees_per_dof) + "," + CsvValue(p->nees_low) + "," +
-              CsvValue(p->nees_high) + "\n";
-    }
-    if (any_nees) job.data.push_back({"nees_" + safe + ".csv", nees});
-    if (any_nees) job.script += "set output 'nees_" + safe + ".svg'\nset logscale y\nset xlabel " +
-                  GnuplotQuote(name) + "\nset ylabel 'NEES / dof'\nset title " +
-                  GnuplotQuote("NEES per degree of freedom against " + name + " (95 % band)") +
-                  "\nplot 'nees_" + safe + ".csv' every ::1 using 1:3 with lines dt 2 lc rgb '#2e7d32' title 'band', " +
-                  "'' every ::1 using 1:4 with lines dt 2 lc rgb '#2e7d32' notitle, " +
-                  "'' every ::1 using 1:2 with linespoints pt 7 lc rgb '#1565c0' title 'NEES / dof'\n";
-    if (any_nees) job.outputs.push_back("nees_" + safe + ".svg");
-    // RMS error and mean sigma of the headline rows.
-    const std::size_t rows = std::min(kHeadline, along.front()->parameters.size());
-    if (rows == 0) continue;
-    std::string err = "value";
-    for (std::size_t i = 0; i < rows; ++i) err += ",rms" + std::to_string(i) + ",sigma" + std::to_string(i);
-    err += "\n";
-    for (const auto* p : along) {
-      err += CsvValue(p->point.values[f]);
-      for (std::size_t i = 0; i < rows; ++i) {
-        const bool has = i < p->parameters.size();
-        err += "," + CsvValue(has ? p->parameters[i].rms_error : NAN) + "," +
-               CsvValue(has ? p->parameters[i].mean_sigma : NAN);
-      }
-      err += "\n";
-    }
-    job.data.push_back({"error_" + safe + ".csv", err});
-    job.script += "set output 'error_" + safe + ".svg'\nset ylabel 'RMS error (points), mean sigma (dashed)'\nset title " +
-                  GnuplotQuote("error and sigma against " + name) + "\nplot ";
-    auto defined = [&](std::size_t i, bool sigma) {
-      return std::any_of(along.begin(), along.end(), [&](const auto* p) {
-        return i < p->parameters.size() &&
-               std::isfinite(sigma ? p->parameters[i].mean_sigma : p->parameters[i].rms_error);
-      });
-    };
-    std::string plots;
-    for (std::size_t i = 0; i < rows; ++i) {
-      const std::string label = along.front()->parameters[i].name;
-      const std::string col = std::to_string(2 + 2 * i);
-      const std::string sig = std::to_string(3 + 2 * i);
-      const std::string lc = " lc " + std::to_string(i + 1);
-      if (defined(i, false)) {
-        plots += std::string(plots.empty() ? "" : ", ") + "'error_" + safe + ".csv' every ::1 using 1:" +
-                 col + " with points pt 7" + lc + " title " + GnuplotQuote(label);
-      }
-      if (defined(i, true)) {
-        plots += std::string(plots.empty() ? "" : ", ") + "'error_" + safe + ".csv' every ::1 using 1:" +
-                 sig + " with lines dt 2" + lc + " notitle";
-      }
-    }
-    if (plots.empty()) {  // nothing determined along this factor
-      job.data.pop_back();
-      job.script.resize(job.script.rfind("set output 'error_"));
-      continue;
-    }
-    job.script += plots;
-    job.script += "\nunset logscale y\n";
-    job.outputs.push_back("error_" + safe + ".svg");
-  }
-  return job;
+  return PlanStudyFigures(study, points).job;
 }
 
 std::string StudyPage(const study::Study& study, const std::vector<study::PointSummary>& points,
                       const std::vector<InlineFigure>& figures, const std::string& figure_note) {
   std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"generator\" content=\"plumb sweep\"><title>plumb sweep: " +
-                     HtmlEscape(study.name) + "</title><style>" + PageStyle() +
+                     HtmlEscape(study.name) + "</title><style>" + PageStyle() + kFigureStyle +
                      "</style></head><body>\n<h1>plumb sweep: " + HtmlEscape(study.name) + "</h1>\n";
   html += "<p class=\"muted\">plumb " + HtmlEscape(Version()) + "; " + std::to_string(points.size()) +
           " points x " + std::to_string(study.runs) + " runs, seed " + std::to_string(study.seed) +
           ", method " + HtmlEscape(study.fit_method) + ", fitted model " + HtmlEscape(study.fit_model) +
           ". The numbers are in results.csv and results.json beside this page.</p>\n";
   html += "<h2>Points</h2>\n<table><tr><th>point</th>";
-  for (const study::Factor& f : study.factors) html += "<th>" + HtmlEscape(f.name) + "</th>";
+  for (const study::Factor& f : study.factors) {
+    html += "<th>" + HtmlEscape(WithUnit(f.name, study::FactorUnit(f.name))) + "</th>";
+  }
   html += "<th>runs</th><th>failed</th><th>flagged</th><th>NEES / dof</th><th>95 % band</th>"
           "<th>NEES / dof, runs not flagged</th><th>95 % band</th></tr>\n";
   for (const study::PointSummary& p : points) {
     const bool outside = p.nees_dof > 0 && (p.nees_per_dof > p.nees_high || p.nees_per_dof < p.nees_low);
     html += "<tr><td class=\"num\">" + std::to_string(p.point.index) + "</td>";
-    for (double v : p.point.values) html += "<td class=\"num\">" + (std::isfinite(v) ? Number(v) : std::string("n/a")) + "</td>";
+    for (std::size_t f = 0; f < p.point.values.size() && f < study.factors.size(); ++f) {
+      html += "<td class=\"num\">" + LevelText(study.factors[f].name, p.point.values[f]) + "</td>";
+    }
     html += "<td class=\"num\">" + std::to_string(p.runs) + "</td><td class=\"num\">" +
             std::to_string(p.failed) + "</td><td class=\"num\">" + std::to_string(p.flagged) +
             "</td><td class=\"num" + std::string(outside ? " warn" : "") + "\">" +
@@ -160,7 +125,7 @@ std::string StudyPage(const study::Study& study, const std::vector<study::PointS
   }
   html += "</table>\n<h2>Figures</h2>\n";
   if (!figure_note.empty()) html += "<p class=\"warn\">No figures: " + HtmlEscape(figure_note) + "</p>\n";
-  for (const InlineFigure& fig : figures) html += "<figure>\n" + fig.svg + "\n</figure>\n";
+  html += FiguresSection(study, points, figures);
   return html + "</body></html>\n";
 }
 

@@ -99,9 +99,23 @@ void SetNees(const Eigen::VectorXd& e, const Eigen::MatrixXd& C, RunOutcome& out
   }
 }
 
+/// The unit of a determined combination: its leading parameter's (the one of coefficient 1,
+/// "accel.bias.z" of "accel.bias.z - 9.78 accel.matrix.zz"; the other terms carry their
+/// coefficient's unit), "" when there is none.
+std::string CombinationUnit(const estimation::Combination& c,
+                            const std::vector<estimation::ParameterEstimate>& params) {
+  for (std::size_t i = 0; i < c.names.size() && i < c.coefficients.size(); ++i) {
+    if (c.coefficients[i] != 1.0) continue;
+    for (const auto& p : params) {
+      if (p.name == c.names[i]) return p.unit;
+    }
+  }
+  return "";
+}
+
 /// Where the data determine no parameter alone (one pose), the combinations they determine
-/// (estimation::Observability::determined) are scored instead, each a row named by its text,
-/// and the NEES is over their covariance.
+/// (estimation::Observability::determined) are scored instead, each a row named by its text
+/// in its leading parameter's unit, and the NEES is over their covariance.
 void Combinations(const estimation::CalibrationResult& result, const Truth& truth_of,
                   RunOutcome& out) {
   const auto& obs = result.calibration.observability;
@@ -114,7 +128,7 @@ void Combinations(const estimation::CalibrationResult& result, const Truth& trut
     for (std::size_t i = 0; i < c.names.size(); ++i) truth += c.coefficients[i] * truth_of(c.names[i]);
     e[k] = c.value - truth;
     out.names.push_back(c.text);
-    out.units.push_back("");
+    out.units.push_back(CombinationUnit(c, result.calibration.parameters));
     out.error.push_back(e[k]);
     out.sigma.push_back(c.sigma);
   }

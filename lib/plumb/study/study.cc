@@ -212,6 +212,25 @@ const std::vector<std::string>& FactorNames() {
   return kNames;
 }
 
+std::string FactorUnit(const std::string& name) {
+  static const std::vector<std::pair<std::string, std::string>> kUnits = {
+      {"poses", "poses"}, {"still_s", "s"}, {"turn_s", "s"}, {"rate_hz", "Hz"},
+      {"accel_noise", "m/s^2/sqrt(Hz)"}, {"gyro_noise", "rad/s/sqrt(Hz)"},
+      {"accel_rw", "m/s^3/sqrt(Hz)"}, {"gyro_rw", "rad/s^2/sqrt(Hz)"}, {"accel_bi", "m/s^2"},
+      {"gyro_bi", "rad/s"}, {"bi_time_s", "s"}, {"temperature_rise_c", "degC"},
+      {"lat_deg", "deg"}, {"height_m", "m"}, {"fit_lat_error_deg", "deg"},
+      {"fit_gravity_m_s2", "m/s^2"}, {"level_error_deg", "deg"}, {"heading_error_deg", "deg"},
+      {"hand_vibration", "m/s^2"}, {"hand_translation_m", "m"}};
+  for (const auto& [factor, unit] : kUnits) {
+    if (factor == name) return unit;
+  }
+  return "";
+}
+
+std::string FactorLevelName(const std::string& name, double value) {
+  return name == "fit_gravity_m_s2" && value == 0.0 ? "WGS84" : "";
+}
+
 Study ParseStudy(const json& doc, const std::string& path) {
   if (!doc.is_object()) throw InputError(path, "", "expected a study object");
   Study s;

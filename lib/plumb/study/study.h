@@ -118,6 +118,16 @@ struct Study {
 /// The factor names a study may use besides truth.PARAMETER.
 const std::vector<std::string>& FactorNames();
 
+/// The unit of factor `name`'s values (FactorNames): "s", "Hz", "m/s^2/sqrt(Hz)", "deg", ...;
+/// "poses" for poses; "" for truth.PARAMETER (its unit is the parameter's, which the model
+/// gives) and an unknown name.
+std::string FactorUnit(const std::string& name);
+
+/// The name a factor's value stands for when it is not a quantity: "WGS84" for
+/// fit_gravity_m_s2 = 0 (the fit uses WGS84's gravity at the site); "" otherwise. A factor
+/// with such a value is a category, not a scale: drawn and listed by its levels' names.
+std::string FactorLevelName(const std::string& name, double value);
+
 /// Reads a study from its JSON (file comment), the wander levels given with a unit in SI.
 /// Throws plumb::InputError naming `path` and the key for anything out of place (an unknown
 /// factor, a range in a grid, runs < 1, a unit a level does not take, ...).
