@@ -47,8 +47,32 @@ TEST(RosBagCli, InfoListsTopicsCountsRatesAndStillPeriods) {
   EXPECT_EQ(doc["imus"][0]["name"], "/ardrone/imu");
   EXPECT_EQ(doc["imus"][0]["samples"], 4308);
   EXPECT_GT(doc["imus"][0]["rate_hz"].get<double>(), 45.0);
-  EXPECT_GE(doc["imus"][0]["still"].size(), 2u);  // README: still at 24-35 s and 42-55 s
+  // README: still at 0-6 s, 24-35 s (touched near 29 s: two periods), 42-55 s and 90-93 s.
+  // The first seconds lose 40 % of their samples in gaps of 0.12-0.18 s (the recorder's host):
+  // that pose is found all the same. The last pose, 2.7 s before the bag ends, is too short
+  // for a window of 1 s and the 2 s kept.
+  const json& still = doc["imus"][0]["still"];
+  ASSERT_EQ(still.size(), 4u) << still.dump();
+  const double t0 = doc["imus"][0]["t_start_s"].get<double>();
+  EXPECT_LT(still[0]["t_start_s"].get<double>() - t0, 1.0) << still.dump();
+  EXPECT_GT(still[0]["t_end_s"].get<double>() - t0, 5.0) << still.dump();
   EXPECT_EQ(doc["messages"]["/ardrone/mag (sensor_msgs/MagneticField)"], 4308);
+}
+
+TEST(RosBagCli, APhidgetsOnAVibratingTurntableHasNoStillPeriod) {
+  // Between its turns about z the Phidgets bag's IMU scatters 15-30 times its quiet noise
+  // (0.06-0.1 m/s^2 against 0.004 in the first second) and still turns at about 0.8 deg/s
+  // about z: no stretch of 2 s is still, and info says so rather than taking them as poses.
+  const std::string bag = Bag("phidgets_imu_upside_down.bag");
+  SKIP_IF_ABSENT(bag);
+  TempDir dir;
+  const std::string out = dir.File("info.json");
+  const ToolRun run = Plumb({"info", bag, "--json", out}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "still: no still period of 2 s or more")) << run.out;
+  const json doc = ReadJson(out);
+  EXPECT_TRUE(doc["imus"][0]["still"].empty());
+  EXPECT_EQ(doc["imus"][0]["samples"], 13964);
 }
 
 TEST(RosBagCli, CalibrateNamesWhatTheDataCannotDetermine) {
