@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "support/program_on_path.h"
 #include "run_tool.h"
 
 namespace plumb::cli {
@@ -27,17 +28,7 @@ const std::string kSession = std::string(PLUMB_SOURCE_DIR) + "/data/mikoff/imu0.
 /// How scripts/demo reads it: six columns, no time, 100 Hz.
 const std::vector<std::string> kLayout = {"--columns", "ax,ay,az,gx,gy,gz", "--rate", "100"};
 
-bool GnuplotOnPath() {
-  const char* path = std::getenv("PATH");
-  std::stringstream dirs(path ? path : "");
-  std::string dir;
-  while (std::getline(dirs, dir, ':')) {
-    if (!dir.empty() && ::access((std::filesystem::path(dir) / "gnuplot").c_str(), X_OK) == 0) {
-      return true;
-    }
-  }
-  return false;
-}
+bool GnuplotOnPath() { return plumb::testing::ProgramOnPath("gnuplot"); }
 
 std::uintmax_t SizeOf(const std::string& path) {
   std::error_code ec;

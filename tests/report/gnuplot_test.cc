@@ -1,5 +1,6 @@
 // Figures through gnuplot: the plan of plumb report's figures (which ones, their data), and
 // running gnuplot as a child process, with and without gnuplot on the PATH.
+#include "support/program_on_path.h"
 #include "plumb/report/gnuplot.h"
 
 #include <gtest/gtest.h>
@@ -23,17 +24,7 @@ bool Contains(const std::string& text, const std::string& part) {
 }
 
 /// True when an executable `gnuplot` is on the PATH.
-bool GnuplotOnPath() {
-  const char* path = std::getenv("PATH");
-  std::stringstream dirs(path ? path : "");
-  std::string dir;
-  while (std::getline(dirs, dir, ':')) {
-    if (!dir.empty() && ::access((std::filesystem::path(dir) / "gnuplot").c_str(), X_OK) == 0) {
-      return true;
-    }
-  }
-  return false;
-}
+bool GnuplotOnPath() { return plumb::testing::ProgramOnPath("gnuplot"); }
 
 /// A line, drawn to line.svg.
 GnuplotJob LineJob() {

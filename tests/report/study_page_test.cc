@@ -3,6 +3,7 @@
 // runs, the mean sigma) with units on both axes and a legend for every line; a factor whose
 // value names a case (gravity 0: WGS84) drawn by level; on one pose the determined
 // combinations drawn instead of the raw parameters. Hand-made point summaries: no fit is run.
+#include "support/program_on_path.h"
 #include "plumb/report/study_page.h"
 
 #include <gtest/gtest.h>
@@ -23,17 +24,7 @@ bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-bool GnuplotOnPath() {
-  const char* path = std::getenv("PATH");
-  std::stringstream dirs(path ? path : "");
-  std::string dir;
-  while (std::getline(dirs, dir, ':')) {
-    if (!dir.empty() && ::access((std::filesystem::path(dir) / "gnuplot").c_str(), X_OK) == 0) {
-      return true;
-    }
-  }
-  return false;
-}
+bool GnuplotOnPath() { return plumb::testing::ProgramOnPath("gnuplot"); }
 
 study::Study MakeStudy() {
   return study::ParseStudy(nlohmann::json::parse(R"({"name": "g", "seed": 1, "runs": 3,

@@ -326,6 +326,22 @@ LeftOutTimes KeepIncreasingTimes(ImuSeries& s) {
   return out;
 }
 
+ImuStreamInfo StreamInfoOf(const ImuSeries& s, const LeftOutTimes& left_out) {
+  ImuStreamInfo info;
+  info.samples = s.size();
+  info.records = s.size() + left_out.count;
+  info.first_left_out_t_s = left_out.first_t_s;
+  if (!s.empty()) {
+    info.t_start_s = s.t_s.front();
+    info.t_end_s = s.t_s.back();
+  }
+  const double span = info.t_end_s - info.t_start_s;
+  if (s.size() >= 2 && span > 0.0) info.rate_hz = static_cast<double>(s.size() - 1) / span;
+  info.has_accel = true;
+  info.has_gyro = s.has_gyro();
+  return info;
+}
+
 std::optional<std::string> DroppedRecordsWarning(const ImuStreamInfo& info) {
   const std::optional<double>& first_t_s = info.first_left_out_t_s;
   if (info.records <= info.samples) return std::nullopt;

@@ -17,6 +17,7 @@
 #include "plumb/core/log_motion.h"
 #include "plumb/core/session.h"
 #include "plumb/core/types.h"
+#include "plumb/io/common/flight_log.h"
 #include "plumb/io/common/mapping_guard.h"
 
 namespace plumb::io {
@@ -143,6 +144,11 @@ struct LeftOutTimes {
 /// only "above the last kept" was asked), so one bad stamp costs one sample. The rule of
 /// ImuFromDataflash. Returns what was left out.
 LeftOutTimes KeepIncreasingTimes(ImuSeries& s);
+
+/// An IMU stream's counts, first and last times and rate from its samples `s` and what
+/// KeepIncreasingTimes left out of them (records = samples + left out); the reader fills in
+/// the name, the instance, a temperature and what the firmware applied.
+ImuStreamInfo StreamInfoOf(const ImuSeries& s, const LeftOutTimes& left_out);
 
 /// A left-out record's time as warnings say it: "5000000000000.000000 s", or "not a number".
 std::string LeftOutTimeText(double t_s);

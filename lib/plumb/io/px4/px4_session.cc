@@ -392,20 +392,9 @@ const StreamSource* Select(const std::vector<StreamSource>& sources,
 
 ImuStreamInfo Describe(const ULog& log, const StreamSource& src, const ImuSeries& s,
                        const LeftOutTimes& left_out) {
-  ImuStreamInfo info;
+  ImuStreamInfo info = StreamInfoOf(s, left_out);
   info.name = KindName(src.kind);
   info.instance = src.instance;
-  info.samples = s.size();
-  info.records = s.size() + left_out.count;
-  info.first_left_out_t_s = left_out.first_t_s;
-  if (!s.empty()) {
-    info.t_start_s = s.t_s.front();
-    info.t_end_s = s.t_s.back();
-  }
-  const double span = info.t_end_s - info.t_start_s;
-  if (s.size() >= 2 && span > 0.0) info.rate_hz = static_cast<double>(s.size() - 1) / span;
-  info.has_accel = true;
-  info.has_gyro = s.has_gyro();
   info.has_temperature = s.has_temperature();
   if (src.kind != StreamKind::kSensorAccel) {
     const Px4Sensors sensors = SensorsOf(log, src);
