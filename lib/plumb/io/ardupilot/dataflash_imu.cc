@@ -412,22 +412,6 @@ std::optional<StreamRef> Select(const DataflashLog& log, const FlightLogSelectio
   return std::nullopt;
 }
 
-ImuSeries Window(const ImuSeries& all, const FlightLogSelection& selection) {
-  ImuSeries out;
-  out.acc_unit = all.acc_unit;
-  out.gyr_unit = all.gyr_unit;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    const double t = all.t_s[i];
-    if (selection.from_s && t < *selection.from_s) continue;
-    if (selection.to_s && t > *selection.to_s) continue;
-    out.t_s.push_back(t);
-    out.acc.push_back(all.acc[i]);
-    if (all.has_gyro()) out.gyr.push_back(all.gyr[i]);
-    if (all.has_temperature()) out.temp_c.push_back(all.temp_c[i]);
-  }
-  return out;
-}
-
 std::string StreamLabel(const FlightLogSelection& selection) {
   return (selection.stream.empty() ? std::string("default stream") : selection.stream) +
          " of IMU instance " + std::to_string(selection.imu);
@@ -476,7 +460,7 @@ ImuSeries DataflashStream(const DataflashLog& log, const FlightLogSelection& sel
                                          std::to_string(ref->instance) + " has no samples");
   }
   if (info != nullptr) *info = Describe(log, *ref, all);
-  ImuSeries s = Window(all, selection);
+  ImuSeries s = WindowOf(all, selection);
   if (s.empty()) {
     throw InputError(log.source, "", "no samples of " + ref->name + " of IMU instance " +
                                          std::to_string(ref->instance) +

@@ -326,6 +326,22 @@ LeftOutTimes KeepIncreasingTimes(ImuSeries& s) {
   return out;
 }
 
+ImuSeries WindowOf(const ImuSeries& all, const FlightLogSelection& selection) {
+  ImuSeries out;
+  out.acc_unit = all.acc_unit;
+  out.gyr_unit = all.gyr_unit;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const double t = all.t_s[i];
+    if (selection.from_s && t < *selection.from_s) continue;
+    if (selection.to_s && t > *selection.to_s) continue;
+    out.t_s.push_back(t);
+    out.acc.push_back(all.acc[i]);
+    if (all.has_gyro()) out.gyr.push_back(all.gyr[i]);
+    if (all.has_temperature()) out.temp_c.push_back(all.temp_c[i]);
+  }
+  return out;
+}
+
 ImuStreamInfo StreamInfoOf(const ImuSeries& s, const LeftOutTimes& left_out) {
   ImuStreamInfo info;
   info.samples = s.size();

@@ -150,6 +150,10 @@ LeftOutTimes KeepIncreasingTimes(ImuSeries& s);
 /// the name, the instance, a temperature and what the firmware applied.
 ImuStreamInfo StreamInfoOf(const ImuSeries& s, const LeftOutTimes& left_out);
 
+/// The samples of `all` within the selection's [from_s, to_s] (each bound optional), with
+/// their gyroscope, temperature and units: the session a reader hands out.
+ImuSeries WindowOf(const ImuSeries& all, const FlightLogSelection& selection);
+
 /// A left-out record's time as warnings say it: "5000000000000.000000 s", or "not a number".
 std::string LeftOutTimeText(double t_s);
 

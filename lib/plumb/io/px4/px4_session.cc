@@ -572,17 +572,8 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
   for (auto& n : notes[chosen]) s.warnings.push_back(std::move(n));
   const ImuSeries& whole = all[chosen];
 
-  ImuSeries& out = s.series;
-  for (std::size_t i = 0; i < whole.size(); ++i) {
-    const double t = whole.t_s[i];
-    if (selection.from_s && t < *selection.from_s) continue;
-    if (selection.to_s && t > *selection.to_s) continue;
-    out.t_s.push_back(t);
-    out.acc.push_back(whole.acc[i]);
-    if (whole.has_gyro()) out.gyr.push_back(whole.gyr[i]);
-    if (whole.has_temperature()) out.temp_c.push_back(whole.temp_c[i]);
-  }
-  if (out.size() < 2) {
+  s.series = WindowOf(whole, selection);
+  if (s.series.size() < 2) {
     throw InputError(log.source, std::string(KindName(src->kind)) + " instance " +
                                      std::to_string(src->instance),
                      EmptyWindowMessage(selection.from_s, selection.to_s,

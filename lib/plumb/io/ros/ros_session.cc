@@ -150,16 +150,8 @@ Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection) {
   if (auto w = DroppedRecordsWarning(info)) AddNotice(s.warnings, "records_dropped", *w);
   SayWhat(t, selection.receive_time, &s.warnings);
   const ImuSeries& whole = e.series;
-  ImuSeries& out = s.series;
-  for (std::size_t i = 0; i < whole.size(); ++i) {
-    const double time = whole.t_s[i];
-    if (selection.from_s && time < *selection.from_s) continue;
-    if (selection.to_s && time > *selection.to_s) continue;
-    out.t_s.push_back(time);
-    out.acc.push_back(whole.acc[i]);
-    if (whole.has_gyro()) out.gyr.push_back(whole.gyr[i]);
-  }
-  if (out.size() < 2) {
+  s.series = WindowOf(whole, selection);
+  if (s.series.size() < 2) {
     throw InputError(bag.source, t.topic,
                      EmptyWindowMessage(selection.from_s, selection.to_s,
                                         whole.empty() ? 0.0 : whole.t_s.front(),
