@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace plumb::estimation {
 namespace {
 
@@ -34,6 +36,33 @@ TEST(Observability, OneLevelPoseDeterminesTheMeasuredCombination) {
   EXPECT_EQ(c.text, "accel.bias.z - 9.78 accel.matrix.zz");
   EXPECT_NEAR(c.value, 0.05 - 9.78 * 1.002, 1e-12);
   EXPECT_NEAR(c.sigma, 0.01, 1e-12);  // the one measurement's sigma
+}
+
+/// Two biases seen through one unknown attitude: y1 = a + theta, y2 = b + theta (sigma 1). The
+/// null direction moves a, b and theta together; a - b = y1 - y2 is determined.
+ObservabilityInput TwoBiasesThroughOneAttitude() {
+  ObservabilityInput in;
+  in.J.resize(2, 3);
+  in.J << 1, 0, 1,
+          0, 1, 1;
+  in.names = {"a", "b", "theta"};
+  in.values = {0.3, 0.1, std::nan("")};
+  in.is_model = {true, true, false};
+  return in;
+}
+
+TEST(Observability, ADirectionThroughAnAttitudeStillDeterminesWhatItLeaves) {
+  const auto a = AnalyseObservability(TwoBiasesThroughOneAttitude());
+  EXPECT_EQ(a.summary.rank, 2);
+  ASSERT_EQ(a.summary.unobservable.size(), 1u);
+  EXPECT_EQ(a.summary.unobservable[0], "1 a - 1 theta + 1 b");
+  ASSERT_EQ(a.summary.determined.size(), 1u);
+  const auto& c = a.summary.determined[0];
+  EXPECT_EQ(c.text, "-a + b");
+  EXPECT_NEAR(c.value, 0.1 - 0.3, 1e-12);
+  EXPECT_NEAR(c.sigma, std::sqrt(2.0), 1e-12);  // y2 - y1
+  // The determined combination is orthogonal to the null direction's model part.
+  EXPECT_NEAR(c.coefficients[0] + c.coefficients[1], 0.0, 1e-12);
 }
 
 TEST(Observability, FullRankCovarianceIsTheInverseNormalMatrix) {

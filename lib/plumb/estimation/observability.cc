@@ -38,92 +38,118 @@ std::string FormatNumber(double v) {
   return buf;
 }
 
+/// Model parameters joined by null directions: one group per connected set, with the null
+/// directions (rows of B) that touch it.
+struct NullGroup {
+  std::vector<int> parameters;  ///< columns of B that are model parameters, ascending
+  std::vector<int> rows;        ///< rows of B whose model part touches them
+};
+
+/// The groups of the model parameters that null directions touch. A direction that also moves
+/// attitudes (a gravity direction with the level's accelerometer biases, say) joins its model
+/// parameters like one over model parameters alone: within a group, the combinations the data
+/// determines are those orthogonal to the model part of every direction.
+std::vector<NullGroup> GroupsJoinedByNullDirections(const Eigen::MatrixXd& B,
+                                                    const std::vector<bool>& is_model) {
+  const auto n_all = static_cast<int>(is_model.size());
+  std::vector<int> root(static_cast<std::size_t>(n_all));
+  std::iota(root.begin(), root.end(), 0);
+  const auto find = [&root](int j) {
+    while (root[static_cast<std::size_t>(j)] != j) j = root[static_cast<std::size_t>(j)];
+    return j;
+  };
+  std::vector<bool> touched(static_cast<std::size_t>(n_all), false);
+  std::vector<int> first_of_row(static_cast<std::size_t>(B.rows()), -1);
+  for (Eigen::Index r = 0; r < B.rows(); ++r) {
+    for (int j = 0; j < n_all; ++j) {
+      if (B(r, j) == 0.0 || !is_model[static_cast<std::size_t>(j)]) continue;
+      touched[static_cast<std::size_t>(j)] = true;
+      int& first = first_of_row[static_cast<std::size_t>(r)];
+      if (first < 0) first = j;
+      else root[static_cast<std::size_t>(find(j))] = find(first);
+    }
+  }
+  std::vector<NullGroup> groups;
+  std::vector<int> group_of_root(static_cast<std::size_t>(n_all), -1);
+  for (int j = 0; j < n_all; ++j) {
+    if (!touched[static_cast<std::size_t>(j)]) continue;
+    int& g = group_of_root[static_cast<std::size_t>(find(j))];
+    if (g < 0) {
+      g = static_cast<int>(groups.size());
+      groups.emplace_back();
+    }
+    groups[static_cast<std::size_t>(g)].parameters.push_back(j);
+  }
+  for (Eigen::Index r = 0; r < B.rows(); ++r) {
+    const int first = first_of_row[static_cast<std::size_t>(r)];
+    if (first < 0) continue;
+    const int g = group_of_root[static_cast<std::size_t>(find(first))];
+    groups[static_cast<std::size_t>(g)].rows.push_back(static_cast<int>(r));
+  }
+  return groups;
+}
+
+/// The combinations of a group's parameters orthogonal to the model part of its null
+/// directions (the left null space of that part), in row-echelon form with biases leading, as
+/// vectors over J's n columns.
+std::vector<Eigen::VectorXd> DeterminedInGroup(const Eigen::MatrixXd& B, const NullGroup& group,
+                                               Eigen::Index n) {
+  const auto size = static_cast<Eigen::Index>(group.parameters.size());
+  Eigen::MatrixXd directions(size, static_cast<Eigen::Index>(group.rows.size()));  // |S| x k_g
+  for (Eigen::Index a = 0; a < size; ++a) {
+    for (std::size_t b = 0; b < group.rows.size(); ++b) {
+      directions(a, static_cast<Eigen::Index>(b)) =
+          B(group.rows[b], group.parameters[static_cast<std::size_t>(a)]);
+    }
+  }
+  // Rows with a model pivot have independent model parts (B is in row-echelon form with the
+  // model parameters first), so the directions span k_g dimensions.
+  const Eigen::Index free_dim = size - directions.cols();
+  if (free_dim <= 0) return {};
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(directions.transpose(), Eigen::ComputeFullV);
+  std::vector<int> reversed(static_cast<std::size_t>(size));
+  std::iota(reversed.rbegin(), reversed.rend(), 0);  // pivots from the end: biases before matrices
+  const Eigen::MatrixXd echelon = Rref(svd.matrixV().rightCols(free_dim).transpose(), reversed);
+  std::vector<Eigen::VectorXd> out;
+  for (Eigen::Index r = 0; r < echelon.rows(); ++r) {
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index a = 0; a < size; ++a) c[group.parameters[static_cast<std::size_t>(a)]] = echelon(r, a);
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
 /// Within each group of model parameters joined by null directions (rows of B, k x n_all, over
-/// names then the eliminated unknowns) that involve model parameters only, the combinations
-/// orthogonal to them (the ones the data determines), with value and sigma, into `out`.
+/// J's columns then the eliminated unknowns), the combinations the data determines, with value
+/// and sigma, into `out`.
 void AddDeterminedCombinations(const Eigen::MatrixXd& B, const std::vector<bool>& is_model,
                                const ObservabilityInput& in, ObservabilityAnalysis& out) {
   const Eigen::Index n = in.J.cols();
-  const auto n_all = static_cast<Eigen::Index>(is_model.size());
-  std::vector<int> group(static_cast<std::size_t>(n_all), -1);
-  std::vector<std::vector<int>> rows_of_group;
-  for (Eigen::Index r = 0; r < B.rows(); ++r) {
-    std::vector<int> support;
-    bool model_only = true;
-    for (int j = 0; j < n_all; ++j) {
-      if (B(r, j) != 0.0) {
-        support.push_back(j);
-        model_only = model_only && is_model[static_cast<std::size_t>(j)];
+  std::vector<Eigen::VectorXd> determined;  // over J's n columns
+  for (const NullGroup& group : GroupsJoinedByNullDirections(B, is_model)) {
+    std::vector<std::string> names;
+    for (int j : group.parameters) names.push_back(in.names[static_cast<std::size_t>(j)]);
+    for (Eigen::VectorXd& c_full : DeterminedInGroup(B, group, n)) {
+      Eigen::VectorXd c(static_cast<Eigen::Index>(group.parameters.size()));
+      double value = 0.0;
+      for (std::size_t a = 0; a < group.parameters.size(); ++a) {
+        const auto j = static_cast<std::size_t>(group.parameters[a]);
+        c[static_cast<Eigen::Index>(a)] = c_full[group.parameters[a]];
+        value += c_full[group.parameters[a]] * in.values[j];
       }
-    }
-    if (!model_only || support.size() < 2) continue;
-    // Merge with any existing group touching this support.
-    int g = -1;
-    for (int j : support) {
-      if (group[static_cast<std::size_t>(j)] >= 0) g = group[static_cast<std::size_t>(j)];
-    }
-    if (g < 0) {
-      g = static_cast<int>(rows_of_group.size());
-      rows_of_group.emplace_back();
-    }
-    for (int j : support) {
-      const int old = group[static_cast<std::size_t>(j)];
-      if (old >= 0 && old != g) {
-        for (int& gg : group) gg = gg == old ? g : gg;
-        rows_of_group[static_cast<std::size_t>(g)].insert(rows_of_group[static_cast<std::size_t>(g)].end(),
-            rows_of_group[static_cast<std::size_t>(old)].begin(), rows_of_group[static_cast<std::size_t>(old)].end());
-        rows_of_group[static_cast<std::size_t>(old)].clear();
-      }
-      group[static_cast<std::size_t>(j)] = g;
-    }
-    rows_of_group[static_cast<std::size_t>(g)].push_back(static_cast<int>(r));
-  }
-  std::vector<Eigen::VectorXd> determined_vectors;  // over all n unknowns
-  for (std::size_t g = 0; g < rows_of_group.size(); ++g) {
-    if (rows_of_group[g].empty()) continue;
-    std::vector<int> support;  // model parameters only: all among J's columns
-    for (int j = 0; j < n; ++j) {
-      if (group[static_cast<std::size_t>(j)] == static_cast<int>(g)) support.push_back(j);
-    }
-    Eigen::MatrixXd Ng(support.size(), rows_of_group[g].size());  // |S| x k_g
-    for (std::size_t a = 0; a < support.size(); ++a) {
-      for (std::size_t b = 0; b < rows_of_group[g].size(); ++b) {
-        Ng(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
-            B(rows_of_group[g][b], support[a]);
-      }
-    }
-    // Combinations c with c^T Ng = 0: the left null space of Ng.
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd_g(Ng.transpose(), Eigen::ComputeFullV);
-    const Eigen::Index kg = Ng.cols();
-    const Eigen::Index free_dim = static_cast<Eigen::Index>(support.size()) - kg;
-    if (free_dim <= 0) continue;
-    const Eigen::MatrixXd Cbasis = svd_g.matrixV().rightCols(free_dim);  // |S| x free
-    std::vector<int> rev(support.size());
-    std::iota(rev.rbegin(), rev.rend(), 0);  // pivots from the end: biases before matrices
-    const Eigen::MatrixXd Cr = Rref(Cbasis.transpose(), rev);
-    std::vector<std::string> group_names;
-    Eigen::VectorXd values(static_cast<Eigen::Index>(support.size()));
-    for (std::size_t a = 0; a < support.size(); ++a) {
-      group_names.push_back(in.names[static_cast<std::size_t>(support[a])]);
-      values[static_cast<Eigen::Index>(a)] = in.values[static_cast<std::size_t>(support[a])];
-    }
-    for (Eigen::Index r = 0; r < Cr.rows(); ++r) {
-      const Eigen::VectorXd c = Cr.row(r).transpose();
-      Eigen::VectorXd c_full = Eigen::VectorXd::Zero(n);
-      for (std::size_t a = 0; a < support.size(); ++a) c_full[support[a]] = c[static_cast<Eigen::Index>(a)];
       Combination comb;
-      comb.text = FormatCombination(c, group_names, false);
-      comb.value = c.dot(values);
+      comb.text = FormatCombination(c, names, false);
+      comb.value = value;
       comb.sigma = std::sqrt(std::max(0.0, c_full.dot(out.covariance * c_full)));
-      comb.names = group_names;
+      comb.names = names;
       comb.coefficients.assign(c.data(), c.data() + c.size());
       out.summary.determined.push_back(comb);
-      determined_vectors.push_back(c_full);
+      determined.push_back(std::move(c_full));
     }
   }
-  Eigen::MatrixXd combos(n, static_cast<Eigen::Index>(determined_vectors.size()));
-  for (std::size_t j = 0; j < determined_vectors.size(); ++j) {
-    combos.col(static_cast<Eigen::Index>(j)) = determined_vectors[j];
+  Eigen::MatrixXd combos(n, static_cast<Eigen::Index>(determined.size()));
+  for (std::size_t j = 0; j < determined.size(); ++j) {
+    combos.col(static_cast<Eigen::Index>(j)) = determined[j];
   }
   out.summary.determined_covariance = combos.transpose() * out.covariance * combos;
 }
