@@ -99,12 +99,21 @@ void RegisterDiagnose(py::module_& m) {
       .def_property_readonly("fit", [](const PyDiagnosis& d) { return ToPython(d.document["fit"]); },
                              "The diagnosed model's fit: chi2, dof, ...")
       .def("__repr__", &Repr)
-      .def(py::pickle([](const PyDiagnosis& d) { return py::make_tuple(1, d.document.dump()); },
-                      [](const py::tuple& t) {
-                        auto out = std::make_shared<PyDiagnosis>();
-                        out->document = nlohmann::json::parse(t[1].cast<std::string>());
-                        return out;
-                      }));
+      .def(py::pickle(
+          [](const PyDiagnosis& d) {
+            // CBOR keeps every number as it is (NaN included), so that to_json() is unchanged.
+            const auto bytes = nlohmann::json::to_cbor(d.document);
+            return py::make_tuple(1, py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 2 || t[0].cast<int>() != 1) {
+              throw Error("Diagnosis: a pickled state of another version of plumb");
+            }
+            auto out = std::make_shared<PyDiagnosis>();
+            const std::string cbor = t[1].cast<std::string>();
+            out->document = nlohmann::json::from_cbor(cbor.begin(), cbor.end());
+            return out;
+          }));
   m.def("diagnose", &Diagnose, py::arg("session"), py::arg("model") = "base",
         py::arg("site") = py::none(), kDiagnoseDoc);
 }
