@@ -19,8 +19,26 @@ option(PLUMB_BUILD_PYTHON "Build the Python module plumb (pybind11, numpy)" ${_p
 if(PLUMB_BUILD_PYTHON)
   find_package(Python3 3.8 REQUIRED COMPONENTS Interpreter Development.Module NumPy)
   find_package(pybind11 2.6 CONFIG REQUIRED)
-  # Where `cmake --install` puts the package plumb/, relative to the prefix: a folder Debian's
-  # python3 searches under /usr/local (site.getsitepackages()).
-  set(PLUMB_PYTHON_INSTALL_DIR "lib/python3/dist-packages" CACHE STRING
+  # Where `cmake --install` puts the package plumb/, relative to the prefix, asked of the
+  # interpreter: its 'posix_local' scheme on Debian (/usr/local/lib/python3.X/dist-packages,
+  # which Debian's python3 searches; relative, lib/python3.X/dist-packages), else its
+  # 'posix_prefix' (lib/python3.X/site-packages). -DPLUMB_PYTHON_INSTALL_DIR=... chooses another
+  # (tests/python/test_install.py checks it is on python3's sys.path for PREFIX=/usr/local).
+  execute_process(
+    COMMAND ${Python3_EXECUTABLE} -c [=[
+import os, sysconfig
+scheme = "posix_local" if "posix_local" in sysconfig.get_scheme_names() else "posix_prefix"
+path = os.path.relpath(sysconfig.get_path("platlib", scheme, vars={"base": "/P", "platbase": "/P"}), "/P")
+print(path[len("local/"):] if path.startswith("local/") else path, end="")
+]=]
+    OUTPUT_VARIABLE _plumb_python_dir RESULT_VARIABLE _plumb_python_rc)
+  if(NOT _plumb_python_rc EQUAL 0 OR _plumb_python_dir STREQUAL "")
+    set(_plumb_python_dir "lib/python3/dist-packages")
+  endif()
+  # A build folder configured before kept the old default, which Debian's python3 does not search.
+  if(PLUMB_PYTHON_INSTALL_DIR STREQUAL "lib/python3/dist-packages")
+    unset(PLUMB_PYTHON_INSTALL_DIR CACHE)
+  endif()
+  set(PLUMB_PYTHON_INSTALL_DIR "${_plumb_python_dir}" CACHE STRING
       "Install folder of the Python package plumb, relative to CMAKE_INSTALL_PREFIX")
 endif()

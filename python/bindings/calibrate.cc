@@ -7,6 +7,7 @@
 #include "plumb/core/datasheet_level.h"
 #include "plumb/core/error.h"
 #include "plumb/estimation/calibrator.h"
+#include "plumb/correction/calibration_file.h"
 #include "plumb/estimation/uncertainty.h"
 #include "plumb/report/json_report.h"
 
@@ -29,17 +30,32 @@ Keywords (the command's options, '-' as '_'):
   constant_bias (bool): the bias wander, each level a number in SI or a text with a datasheet's
   unit as the command takes it ('4 deg/h', '40 ug', '0.3 deg/h/sqrt(h)', '10 ug/sqrt(h)');
   white_turns (bool: the turns' velocity residuals weighted by the white noise alone).
-Returns a Result. Raises plumb.Error (plumb.InsufficientDataError when the data cannot
+Returns a Result; the fit's warnings (and gravity's) are also emitted as plumb.PlumbWarning
+(warnings module). Raises plumb.Error (plumb.InsufficientDataError when the data cannot
 support the model).)doc";
 
-/// The fitted calibration and what the document says beside it.
+/// A calibration and how its fit went, as Python reads them: plain data made once from the
+/// fit (so that a pickle of it restores it exactly), the calibration ready to apply.
 struct PyResult {
-  estimation::CalibrationResult result;
-  segmentation::SegmentationResult segmentation;
-  std::vector<std::string> inputs;
-  std::vector<Notice> input_warnings;  ///< the session's, and gravity's override
   nlohmann::json document;  ///< report::CalibrationJson, made once
+  std::string model;        ///< the fitted model's spec
+  /// Every parameter, in model order (`place` not kept).
+  std::vector<estimation::ParameterEstimate> parameters;
+  double sigma_scale = 1.0;  ///< estimation::SigmaScale
+  double chi2_dof = 0.0;
+  estimation::NamedCovariance covariance;  ///< formal, of the free observable parameters
+  std::vector<estimation::Gate> gates;
+  std::vector<Notice> notices;  ///< the input warnings (the session's, gravity's), the fit's
+  Eigen::MatrixXd null_space;   ///< Observability::null_space
+  std::vector<std::string> null_space_names;
+  std::shared_ptr<PyCalibration> calibration;  ///< from the document, as load_calibration
 };
+
+/// The calibration of `document` as load_calibration reads it from the file Result.save
+/// writes: the document's text parsed again, so that it applies bit for bit alike.
+std::shared_ptr<PyCalibration> CalibrationOf(const nlohmann::json& document) {
+  return CalibrationOfText(report::JsonText(document), "<plumb.Result>");
+}
 
 pipeline::SegmentRequest Segments(Keywords& k) {
   pipeline::SegmentRequest r;
@@ -87,13 +103,24 @@ void WanderOptions(Keywords& k, estimation::CalibrationOptions& o) {
 
 py::dict Parameters(const PyResult& r) {
   py::module_ ns = py::module_::import("types");
-  const double scale = estimation::SigmaScale(r.result.fit);
   py::dict out;
-  for (const auto& p : r.result.calibration.parameters) {
+  for (const auto& p : r.parameters) {
     out[p.name.c_str()] = ns.attr("SimpleNamespace")(
-        py::arg("value") = p.value, py::arg("sigma") = p.sigma * scale,
+        py::arg("value") = p.value, py::arg("sigma") = p.sigma * r.sigma_scale,
         py::arg("sigma_formal") = p.sigma, py::arg("unit") = p.unit,
         py::arg("observable") = p.observable, py::arg("fixed") = p.fixed);
+  }
+  return out;
+}
+
+/// The value (`sigma` false) or the reported sigma of every parameter of parameter_names.
+py::array_t<double> Aligned(const PyResult& r, bool sigma) {
+  py::array_t<double> out(static_cast<py::ssize_t>(r.covariance.names.size()));
+  for (std::size_t i = 0; i < r.covariance.names.size(); ++i) {
+    for (const auto& p : r.parameters) {
+      if (p.name != r.covariance.names[i]) continue;
+      out.mutable_at(static_cast<py::ssize_t>(i)) = sigma ? p.sigma * r.sigma_scale : p.value;
+    }
   }
   return out;
 }
@@ -111,19 +138,93 @@ std::shared_ptr<PyResult> Calibrate(const PySession& s, const std::string& model
   Keywords k("calibrate", kwargs);
   FitInputs fit = PrepareFit(s, model, site, k, true);
   k.Finish();
-  auto out = std::make_shared<PyResult>();
+  estimation::CalibrationResult result;
   {
     py::gil_scoped_release release;
-    out->result = pipeline::CalibrateSession(s.session, fit.setup);
+    result = pipeline::CalibrateSession(s.session, fit.setup);
   }
-  if (fit.strict && !out->result.fit.gates.empty()) {
-    throw Error(pipeline::GateFailure(out->result.fit, s.session.source) + " under strict=True");
+  if (fit.strict && !result.fit.gates.empty()) {
+    throw Error(pipeline::GateFailure(result.fit, s.session.source) + " under strict=True");
   }
-  out->segmentation = std::move(fit.segmentation);
-  out->inputs = s.inputs;
-  out->input_warnings = fit.setup.input_warnings;
-  out->document = report::CalibrationJson(out->result, out->segmentation, out->inputs,
-                                          out->input_warnings);
+  auto out = std::make_shared<PyResult>();
+  out->document = report::CalibrationJson(result, fit.segmentation, s.inputs,
+                                          fit.setup.input_warnings);
+  out->model = result.calibration.model.spec();
+  out->parameters = result.calibration.parameters;
+  out->sigma_scale = estimation::SigmaScale(result.fit);
+  out->chi2_dof = result.fit.chi2_dof();
+  out->covariance = estimation::ParameterCovariance(result.calibration);
+  out->gates = result.fit.gates;
+  out->notices = fit.setup.input_warnings;
+  out->notices.insert(out->notices.end(), result.fit.warnings.begin(), result.fit.warnings.end());
+  out->null_space = result.calibration.observability.null_space;
+  out->null_space_names = result.calibration.observability.null_space_names;
+  out->calibration = CalibrationOf(out->document);
+  // The warnings the session did not already give when it was opened.
+  Warn(std::vector<Notice>(out->notices.begin() + static_cast<std::ptrdiff_t>(s.session.warnings.size()),
+                           out->notices.end()));
+  return out;
+}
+
+py::tuple ResultState(const PyResult& r) {
+  py::list parameters;
+  for (const auto& p : r.parameters) {
+    parameters.append(py::make_tuple(p.name, p.unit, p.value, p.sigma, p.observable, p.fixed));
+  }
+  py::list gates;
+  for (const auto& g : r.gates) {
+    py::list options;
+    for (const Option o : g.options) options.append(static_cast<int>(o));
+    gates.append(py::make_tuple(g.name, g.message, options));
+  }
+  const auto bytes = nlohmann::json::to_cbor(r.document);
+  return py::make_tuple(1, py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+                        r.model, parameters, r.sigma_scale, r.chi2_dof, r.covariance.names,
+                        Matrix(r.covariance.matrix), gates, NoticesState(r.notices),
+                        Matrix(r.null_space), r.null_space_names);
+}
+
+Eigen::MatrixXd MatrixOf(const py::handle& array) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(array);
+  if (!a || a.ndim() != 2) throw Error("Result state: not a matrix");
+  Eigen::MatrixXd out(a.shape(0), a.shape(1));
+  for (Eigen::Index i = 0; i < out.rows(); ++i) {
+    for (Eigen::Index j = 0; j < out.cols(); ++j) out(i, j) = a.at(i, j);
+  }
+  return out;
+}
+
+std::shared_ptr<PyResult> ResultOfState(const py::tuple& t) {
+  if (t.size() != 12 || t[0].cast<int>() != 1) throw Error("Result: a pickled state of another version of plumb");
+  auto out = std::make_shared<PyResult>();
+  const std::string cbor = t[1].cast<std::string>();
+  out->document = nlohmann::json::from_cbor(cbor.begin(), cbor.end());
+  out->model = t[2].cast<std::string>();
+  for (const auto& item : t[3]) {
+    const py::tuple p = item.cast<py::tuple>();
+    estimation::ParameterEstimate e;
+    e.name = p[0].cast<std::string>();
+    e.unit = p[1].cast<std::string>();
+    e.value = p[2].cast<double>();
+    e.sigma = p[3].cast<double>();
+    e.observable = p[4].cast<bool>();
+    e.fixed = p[5].cast<bool>();
+    out->parameters.push_back(std::move(e));
+  }
+  out->sigma_scale = t[4].cast<double>();
+  out->chi2_dof = t[5].cast<double>();
+  out->covariance.names = t[6].cast<std::vector<std::string>>();
+  out->covariance.matrix = MatrixOf(t[7]);
+  for (const auto& item : t[8]) {
+    const py::tuple g = item.cast<py::tuple>();
+    std::vector<Option> options;
+    for (const auto& o : g[2]) options.push_back(static_cast<Option>(o.cast<int>()));
+    out->gates.push_back(estimation::Gate{g[0].cast<std::string>(), g[1].cast<std::string>(), options});
+  }
+  out->notices = NoticesOfState(t[9]);
+  out->null_space = MatrixOf(t[10]);
+  out->null_space_names = t[11].cast<std::vector<std::string>>();
+  out->calibration = CalibrationOf(out->document);
   return out;
 }
 
@@ -159,7 +260,7 @@ void RegisterCalibrate(py::module_& m) {
       "A calibration and how its fit went: what `plumb calibrate --json` writes, as Python "
       "objects. SI units (sensor units for counts).");
   DocumentMethods(result, "calibrate")
-      .def_property_readonly("model", [](const PyResult& r) { return r.result.calibration.model.spec(); },
+      .def_property_readonly("model", [](const PyResult& r) { return r.model; },
                              "The fitted model's spec.")
       .def_property_readonly("parameters", &Parameters,
                              "name -> (value, sigma, sigma_formal, unit, observable, fixed): "
@@ -169,18 +270,34 @@ void RegisterCalibrate(py::module_& m) {
       .def_property_readonly(
           "covariance",
           [](const PyResult& r) {
-            const double scale = estimation::SigmaScale(r.result.fit);
-            return Matrix(scale * scale *
-                          estimation::ParameterCovariance(r.result.calibration).matrix);
+            return Matrix(r.sigma_scale * r.sigma_scale * r.covariance.matrix);
           },
           "Covariance of the free, observable parameters (numpy, units of parameter_names "
           "squared), as the JSON's covariance.matrix: scaled by chi2/dof when above its band.")
       .def_property_readonly(
           "parameter_names",
-          [](const PyResult& r) { return estimation::ParameterCovariance(r.result.calibration).names; },
-          "The rows and columns of covariance, in model order.")
+          [](const PyResult& r) { return r.covariance.names; },
+          "The free, observable parameters, in model order: the rows and columns of covariance, "
+          "the entries of values and sigmas.")
+      .def_property_readonly("values", [](const PyResult& r) { return Aligned(r, false); },
+                             "The values of parameter_names (numpy float64), SI (their unit).")
+      .def_property_readonly("sigmas", [](const PyResult& r) { return Aligned(r, true); },
+                             "The reported sigmas of parameter_names (numpy float64; scaled as "
+                             "parameters' sigma): the square root of covariance's diagonal.")
+      .def_property_readonly("null_space", [](const PyResult& r) { return Matrix(r.null_space); },
+                             "The unobservable directions (numpy, k x len(null_space_names)): "
+                             "row i is observability['unobservable'][i] as numbers (reduced "
+                             "row-echelon form, SI), moving the unknowns along it changes no "
+                             "prediction; 0 rows when everything is observable.")
+      .def_property_readonly("null_space_names", [](const PyResult& r) { return r.null_space_names; },
+                             "The columns of null_space: the fit's free unknowns (the model's "
+                             "free parameters, then the poses' attitudes ...).")
+      .def_property_readonly("calibration", [](const PyResult& r) { return r.calibration; },
+                             "The calibration, ready to apply (result.calibration.apply(acc, "
+                             "gyr)): a Calibration as load_calibration reads from the file save "
+                             "writes, giving the same numbers bit for bit.")
       .def_property_readonly(
-          "sigma_scale", [](const PyResult& r) { return estimation::SigmaScale(r.result.fit); },
+          "sigma_scale", [](const PyResult& r) { return r.sigma_scale; },
           "The factor on every reported sigma: sqrt(chi2/dof) above its band, else 1.")
       .def_property_readonly("observability",
                              [](const PyResult& r) { return ToPython(r.document["observability"]); },
@@ -191,7 +308,7 @@ void RegisterCalibrate(py::module_& m) {
           [](const PyResult& r) {
             py::dict fit = ToPython(r.document["fit"]);
             py::list gates;
-            for (const estimation::Gate& g : r.result.fit.gates) {
+            for (const estimation::Gate& g : r.gates) {
               py::dict gate;
               gate["name"] = g.name;
               gate["message"] = g.message;
@@ -212,19 +329,16 @@ void RegisterCalibrate(py::module_& m) {
                              "What the user must know, in words.")
       .def_property_readonly(
           "notices",
-          [](const PyResult& r) {
-            py::list out = NoticesToPython(r.input_warnings);
-            for (const auto& d : NoticesToPython(r.result.fit.warnings)) out.append(d);
-            return out;
-          },
+          [](const PyResult& r) { return NoticesToPython(r.notices); },
           "The warnings as dicts, in their order: code (stable, e.g. 'site_unknown'), message "
           "(as in warnings), options (the keywords it points to, as plumb.Error's .options).")
       .def("save", [](const PyResult& r, const std::string& path) { report::WriteJson(path, r.document); },
            py::arg("path"), "Write the calibrate --json document to path (atomically).")
       .def("__repr__", [](const PyResult& r) {
-        return "<plumb.Result " + r.result.calibration.model.spec() + ": chi2/dof " +
-               Number(r.result.fit.chi2_dof()) + ">";
-      });
+        return "<plumb.Result " + r.model + ": chi2/dof " + Number(r.chi2_dof) + ">";
+      })
+      .def(py::pickle([](const PyResult& r) { return ResultState(r); },
+                      [](const py::tuple& t) { return ResultOfState(t); }));
   m.def("calibrate", &Calibrate, py::arg("session"), py::arg("model") = "base",
         py::arg("site") = py::none(), kCalibrateDoc);
 }

@@ -7,14 +7,17 @@
 #include <pybind11/pybind11.h>
 
 #include <nlohmann/json.hpp>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "plumb/core/error.h"
 #include "plumb/core/notice.h"
 #include "plumb/core/option_name.h"
 #include "plumb/core/session.h"
+#include "plumb/correction/calibration_file.h"
 #include "plumb/geo/site.h"
 #include "plumb/report/json_report.h"
 
@@ -24,6 +27,9 @@ namespace plumb::python {
 /// value in capitals, a placeholder, unquoted: heading=DEG); an option the module does not
 /// take keeps the library's name. The module's init installs it (plumb::SetOptionSpeller).
 std::string SpellKeyword(Option option, std::string_view value);
+/// `option` as a message names it (the speller the module's init installs): SpellKeyword, a
+/// switch as the keyword set ("drop_nan=True", as the command's "--drop-nan").
+std::string SpellKeywordInText(Option option, std::string_view value);
 
 namespace py = pybind11;
 
@@ -31,6 +37,18 @@ namespace py = pybind11;
 /// of this module's keywords (SpellKeyword), as plumb.Error's .options: the structured form of
 /// a `warnings` list, in its order.
 py::list NoticesToPython(const std::vector<Notice>& notices);
+
+/// Each of `notices` emitted through Python's warnings module as a plumb.PlumbWarning (with
+/// .code and .options), at the Python line that called the module; raises (an
+/// error_already_set) where a warnings filter turns them into errors.
+void Warn(const std::vector<Notice>& notices);
+
+/// An input file that is not there: raised as plumb.MissingFileError, which is both a
+/// plumb.InputError and Python's FileNotFoundError (errno ENOENT, filename).
+class MissingFile : public InputError {
+ public:
+  explicit MissingFile(const std::string& path);
+};
 
 void RegisterErrors(py::module_& m);
 void RegisterSession(py::module_& m);
@@ -46,6 +64,24 @@ struct PySession {
   Session session;
   std::vector<std::string> inputs;
 };
+
+/// A calibration ready to apply, and the JSON text it was read from (its pickled state).
+struct PyCalibration {
+  correction::CalibrationFile file;
+  std::string text;
+};
+/// The calibration in the JSON document `text` (a `plumb calibrate --json` document), named
+/// `name` in messages, read as load_calibration reads a file.
+std::shared_ptr<PyCalibration> CalibrationOfText(const std::string& text, const std::string& name);
+
+/// A session's state for pickle (a dict of copies: the arrays, units, source, inputs,
+/// warnings, site, segments, the log's parameters and motion) and the session it restores,
+/// equal in every field.
+py::dict SessionState(const PySession& session);
+std::shared_ptr<PySession> SessionOfState(const py::dict& state);
+/// Notices as picklable tuples (code, message, [option as int]) and back.
+py::list NoticesState(const std::vector<Notice>& notices);
+std::vector<Notice> NoticesOfState(const py::handle& state);
 
 /// The keyword arguments of one call, taken one by one by name; Finish() refuses the ones no
 /// Take asked for (plumb::Error naming them and the accepted names), so that a misspelt

@@ -22,7 +22,7 @@ session: a Session; model: the spec diagnosed ('base'); site: as in calibrate().
 Keywords: significance (0.01: the test's level), confirm (3: refit the best N significant
 candidates), candidates (list of effect names, default: the catalogue); segments, init_still,
 window, min_still, false_alarm, still_accel_only, gravity, heading (deg), temp_ref (degC).
-Returns a Diagnosis.)doc";
+Returns a Diagnosis; the diagnosed fit's warnings are also emitted as plumb.PlumbWarning.)doc";
 
 struct PyDiagnosis {
   nlohmann::json document;  ///< report::DiagnosisJson
@@ -54,7 +54,30 @@ std::shared_ptr<PyDiagnosis> Diagnose(const PySession& s, const std::string& mod
       diagnostics::AnalyseResiduals(s.session.series, d.fit, ra_options);
   out->document = report::DiagnosisJson(d, ra);
   out->document["time_base"] = report::TimeBaseJson(signal::AnalyseTimeBase(s.session.series.t_s));
+  py::gil_scoped_acquire acquire;
+  Warn(std::vector<Notice>(fit.setup.input_warnings.begin() +
+                               static_cast<std::ptrdiff_t>(s.session.warnings.size()),
+                           fit.setup.input_warnings.end()));
+  Warn(d.fit.fit.warnings);
   return out;
+}
+
+/// "<plumb.Diagnosis base: chi2/dof 1.29, 12 candidates, 0 significant; recommendation:
+/// none>".
+std::string Repr(const PyDiagnosis& d) {
+  const nlohmann::json& doc = d.document;
+  std::size_t significant = 0;
+  const nlohmann::json candidates = doc.value("candidates", nlohmann::json::array());
+  for (const auto& c : candidates) significant += c.value("significant", false) ? 1 : 0;
+  const nlohmann::json& fit = doc.contains("fit") ? doc["fit"] : nlohmann::json::object();
+  const nlohmann::json chi2_dof = fit.value("chi2_dof", nlohmann::json());
+  const nlohmann::json recommendation = doc.value("recommendation", nlohmann::json());
+  return "<plumb.Diagnosis " + doc.value("model", std::string("?")) + ": chi2/dof " +
+         (chi2_dof.is_number() ? Number(chi2_dof.get<double>()) : std::string("n/a")) + ", " +
+         std::to_string(candidates.size()) + " candidates, " + std::to_string(significant) +
+         " significant; recommendation: " +
+         (recommendation.is_string() ? recommendation.get<std::string>() : std::string("none")) +
+         ">";
 }
 
 }  // namespace
@@ -74,7 +97,23 @@ void RegisterDiagnose(py::module_& m) {
                              "The model spec to fit next (the best recommended candidate added), "
                              "or None when no candidate lowers the fit's chi2/dof")
       .def_property_readonly("fit", [](const PyDiagnosis& d) { return ToPython(d.document["fit"]); },
-                             "The diagnosed model's fit: chi2, dof, ...");
+                             "The diagnosed model's fit: chi2, dof, ...")
+      .def("__repr__", &Repr)
+      .def(py::pickle(
+          [](const PyDiagnosis& d) {
+            // CBOR keeps every number as it is (NaN included), so that to_json() is unchanged.
+            const auto bytes = nlohmann::json::to_cbor(d.document);
+            return py::make_tuple(1, py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+          },
+          [](const py::tuple& t) {
+            if (t.size() != 2 || t[0].cast<int>() != 1) {
+              throw Error("Diagnosis: a pickled state of another version of plumb");
+            }
+            auto out = std::make_shared<PyDiagnosis>();
+            const std::string cbor = t[1].cast<std::string>();
+            out->document = nlohmann::json::from_cbor(cbor.begin(), cbor.end());
+            return out;
+          }));
   m.def("diagnose", &Diagnose, py::arg("session"), py::arg("model") = "base",
         py::arg("site") = py::none(), kDiagnoseDoc);
 }

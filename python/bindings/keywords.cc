@@ -60,6 +60,14 @@ std::string SpellKeyword(Option option, std::string_view value) {
   return std::string(keyword) + "=" + (Placeholder(value) ? text : "\"" + text + "\"");
 }
 
+std::string SpellKeywordInText(Option option, std::string_view value) {
+  // A switch reads as the keyword set: drop_nan=True, as the command's --drop-nan.
+  const bool flag = option == Option::kDropNan || option == Option::kLevelNorth ||
+                    option == Option::kEstimateWalk || option == Option::kSigma;
+  if (flag && value.empty()) return std::string(Keyword(option)) + "=True";
+  return SpellKeyword(option, value);
+}
+
 Keywords::Keywords(std::string function, const py::kwargs& kwargs)
     : function_(std::move(function)), kwargs_(kwargs) {}
 

@@ -14,7 +14,7 @@ PYBIND11_MODULE(_plumb, m) {
     google::InitGoogleLogging("plumb");
   }
   // The library's messages name options as this module's keywords (acc_unit="g").
-  plumb::SetOptionSpeller(&plumb::python::SpellKeyword);
+  plumb::SetOptionSpeller(&plumb::python::SpellKeywordInText);
   m.doc() = "plumb: calibrate an IMU's accelerometer and gyroscope from real logs, with honest "
             "uncertainty (the library behind the plumb command). SI units throughout: s, m/s^2, "
             "rad/s, degC.";

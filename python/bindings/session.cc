@@ -4,12 +4,16 @@
 // as numpy arrays over its own storage (no copy; read-only).
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <type_traits>
 
 #include "common.h"
 #include "plumb/core/error.h"
+#include "plumb/io/input/array_session.h"
 #include "plumb/io/input/input_spec.h"
 #include "plumb/io/input/open_inputs.h"
 
@@ -32,8 +36,25 @@ Keywords are the command line's input options (`plumb calibrate --help`), '-' as
   time window, s), as_logged (bool: keep the firmware's correction); clock='stamps'|'uniform'
   (the times as read, or the uniform sample clock fitted through each input's stamps, for
   stamps a host wrote on arrival: `plumb diagnose` says which they are).
-Returns a Session. Raises plumb.InputError naming the file and place for bad input,
-plumb.Error for options that do not fit.)doc";
+Returns a Session; what the reader skipped or repaired is also emitted as a
+plumb.PlumbWarning (warnings module). Raises plumb.MissingFileError (a FileNotFoundError and a
+plumb.InputError) for a file that is not there, plumb.InputError naming the file and place for
+bad input, plumb.Error (a ValueError) for options that do not fit.)doc";
+
+const char* const kFromArraysDoc = R"doc(A session from samples in memory, as open() makes one from
+a file: checked (shapes, finite values, strictly increasing times), in SI as plumb keeps them
+(float64 times, float32 samples), ready for calibrate() and diagnose() (which find the still
+segments, as for a file).
+
+time: N sample times, s (float64; any origin).
+acc: N x 3 accelerometer output in acc_unit; gyr: N x 3 gyroscope output in gyr_unit, or None
+     (accelerometer only); temp: N temperatures, degC, or None.
+acc_unit: 'm/s^2', 'g' or 'counts'; gyr_unit: 'rad/s', 'deg/s' or 'counts' (as open()'s):
+     the samples are converted to m/s^2 and rad/s (counts kept as they are).
+drop_nan: skip rows with NaN or infinite values (said in .warnings) instead of raising.
+source: the session's name in messages and documents ('arrays').
+Raises plumb.InputError naming the argument and the row (0-based): 'arrays:acc row 3: NaN or
+infinite value ...', 'arrays:time row 7: time 0.06 s is before the previous row's ...'.)doc";
 
 /// The inputs as OpenInputs takes them, and as a calibration document names them.
 void Inputs(const py::object& path, std::vector<io::InputFile>& files,
@@ -141,8 +162,82 @@ std::shared_ptr<PySession> Open(const py::object& path, const py::kwargs& kwargs
   Keywords k("open", kwargs);
   const io::InputOptions options = Options(k);
   k.Finish();
-  py::gil_scoped_release release;
-  out->session = io::OpenInputs(files, options);
+  // A file that is not there is Python's FileNotFoundError too (plumb.MissingFileError).
+  for (const io::InputFile& f : files) {
+    for (const std::string& p : {f.path, f.gyr_path}) {
+      if (!p.empty() && p != "-" && !std::filesystem::exists(p)) throw MissingFile(p);
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    out->session = io::OpenInputs(files, options);
+  }
+  Warn(out->session.warnings);
+  return out;
+}
+
+/// `array` as a C-contiguous float64 array of `cols` columns (0: a vector), checked: a
+/// plumb.InputError naming `name` and the shape expected.
+py::array_t<double, py::array::c_style | py::array::forcecast> Column(const py::object& array,
+                                                                     const char* name,
+                                                                     std::size_t cols,
+                                                                     const std::string& source) {
+  py::array_t<double, py::array::c_style | py::array::forcecast> a;
+  try {
+    a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(array);
+  } catch (const py::error_already_set&) {
+  }
+  const bool ok = a && (cols == 0 ? a.ndim() == 1 : a.ndim() == 2 && a.shape(1) == 3);
+  if (!ok) {
+    std::string shape = "not an array of numbers";
+    if (a) {
+      shape = "shape (";
+      for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
+      shape += a.ndim() == 1 ? ",)" : ")";
+    }
+    throw InputError(source, "", std::string(name) + " must be " +
+                                            (cols == 0 ? "N numbers (shape (N,))" : "N x 3 numbers (shape (N, 3))") +
+                                            ", got " + shape);
+  }
+  return a;
+}
+
+std::shared_ptr<PySession> FromArrays(const py::object& time, const py::object& acc,
+                                      const py::object& gyr, const py::object& temp,
+                                      const std::string& acc_unit, const std::string& gyr_unit,
+                                      bool drop_nan, const std::string& source) {
+  const auto t = Column(time, "time", 0, source);
+  const auto a = Column(acc, "acc", 3, source);
+  std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> g, c;
+  if (!gyr.is_none()) g = Column(gyr, "gyr", 3, source);
+  if (!temp.is_none()) c = Column(temp, "temp", 0, source);
+  const auto n = static_cast<std::size_t>(t.shape(0));
+  const auto rows = [&](const char* name, py::ssize_t count) {
+    if (static_cast<std::size_t>(count) != n) {
+      throw InputError(source, "", std::string(name) + " has " + std::to_string(count) +
+                                       " rows, time " + std::to_string(n) + "; give as many");
+    }
+  };
+  rows("acc", a.shape(0));
+  if (g) rows("gyr", g->shape(0));
+  if (c) rows("temp", c->shape(0));
+  io::ArraySamples samples;
+  samples.n = n;
+  samples.time = t.data();
+  samples.acc = a.data();
+  samples.gyr = g ? g->data() : nullptr;
+  samples.temp = c ? c->data() : nullptr;
+  samples.acc_unit = io::ParseAccUnit(acc_unit, "from_arrays: acc_unit");
+  samples.gyr_unit = io::ParseGyrUnit(gyr_unit, "from_arrays: gyr_unit");
+  samples.drop_nan_rows = drop_nan;
+  samples.source = source;
+  auto out = std::make_shared<PySession>();
+  {
+    py::gil_scoped_release release;
+    out->session = io::SessionFromArrays(samples, io::ArrayNames{});
+  }
+  out->inputs = {source};
+  Warn(out->session.warnings);
   return out;
 }
 
@@ -152,6 +247,24 @@ py::array Temperature(const py::object& self) {
   py::array_t<float> nan(static_cast<py::ssize_t>(s.size()));
   std::fill(nan.mutable_data(), nan.mutable_data() + s.size(), std::numeric_limits<float>::quiet_NaN());
   return std::move(nan);
+}
+
+py::object Temp(const py::object& self) {
+  const ImuSeries& s = self.cast<const PySession&>().session.series;
+  if (!s.has_temperature()) return py::none();
+  return View(s.temp_c.data(), s.size(), 0, sizeof(float), self);
+}
+
+/// The getter `get` under the old name `old`, which warns (DeprecationWarning) that `now` is
+/// its name.
+template <typename Get>
+auto Deprecated(const char* old, const char* now, Get get) {
+  return [old, now, get](const py::object& self) -> py::object {
+    const std::string text = std::string("Session.") + old + " is deprecated; use Session." +
+                             now + " (removed in the next release)";
+    if (PyErr_WarnEx(PyExc_DeprecationWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+    return get(self);
+  };
 }
 
 py::object SiteOf(const PySession& s) {
@@ -199,7 +312,150 @@ auto SeriesView(Column ImuSeries::*column, std::size_t cols) {
   };
 }
 
+/// A copy of `v` (rows of `cols` T; 0: a vector) as a numpy array that owns its data.
+template <typename T>
+py::array_t<T> Copy(const T* data, std::size_t rows, std::size_t cols) {
+  std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(rows)};
+  if (cols > 0) shape.push_back(static_cast<py::ssize_t>(cols));
+  py::array_t<T> out(shape);
+  if (rows > 0) std::memcpy(out.mutable_data(), data, rows * std::max<std::size_t>(cols, 1) * sizeof(T));
+  return out;
+}
+
+/// `array` (what Copy made) into `out`, `cols` T per item.
+template <typename T, typename Item>
+void Fill(const py::handle& array, std::size_t cols, std::vector<Item>& out) {
+  const auto a = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(array);
+  if (!a) throw Error("Session state: not an array");
+  out.resize(static_cast<std::size_t>(a.shape(0)));
+  if (!out.empty()) std::memcpy(static_cast<void*>(out.data()), a.data(), out.size() * cols * sizeof(T));
+}
+
+py::list OptionsOf(const std::vector<Option>& options) {
+  py::list out;
+  for (const Option o : options) out.append(static_cast<int>(o));
+  return out;
+}
+
+std::vector<Option> OptionsFrom(const py::handle& list) {
+  std::vector<Option> out;
+  for (const auto& o : list) out.push_back(static_cast<Option>(o.cast<int>()));
+  return out;
+}
+
 }  // namespace
+
+py::list NoticesState(const std::vector<Notice>& notices) {
+  py::list out;
+  for (const Notice& n : notices) out.append(py::make_tuple(n.code, n.message, OptionsOf(n.options)));
+  return out;
+}
+
+std::vector<Notice> NoticesOfState(const py::handle& state) {
+  std::vector<Notice> out;
+  for (const auto& item : state) {
+    const py::tuple t = item.cast<py::tuple>();
+    out.push_back(Notice{t[0].cast<std::string>(), t[1].cast<std::string>(), OptionsFrom(t[2])});
+  }
+  return out;
+}
+
+py::dict SessionState(const PySession& p) {
+  const Session& s = p.session;
+  const ImuSeries& x = s.series;
+  py::dict d;
+  d["version"] = 1;
+  d["time"] = Copy(x.t_s.data(), x.size(), 0);
+  d["acc"] = Copy(x.acc.empty() ? nullptr : x.acc[0].data(), x.acc.size(), 3);
+  d["gyr"] = Copy(x.gyr.empty() ? nullptr : x.gyr[0].data(), x.gyr.size(), 3);
+  d["temp"] = Copy(x.temp_c.data(), x.temp_c.size(), 0);
+  d["acc_unit"] = x.acc_unit;
+  d["gyr_unit"] = x.gyr_unit;
+  d["source"] = s.source;
+  d["inputs"] = p.inputs;
+  d["warnings"] = NoticesState(s.warnings);
+  d["site"] = s.site ? py::object(py::make_tuple(s.site->lat_deg, s.site->lon_deg,
+                                                  s.site->height_m, s.site->source))
+                     : py::object(py::none());
+  py::list segments;
+  for (const StillSegment& g : s.given_segments) {
+    const py::object q = g.known_R_n_b ? py::object(py::make_tuple(g.known_R_n_b->w(), g.known_R_n_b->x(),
+                                                                   g.known_R_n_b->y(), g.known_R_n_b->z()))
+                                       : py::object(py::none());
+    const py::object w = g.known_omega_eb_b
+                             ? py::object(py::make_tuple((*g.known_omega_eb_b)[0], (*g.known_omega_eb_b)[1],
+                                                         (*g.known_omega_eb_b)[2]))
+                             : py::object(py::none());
+    segments.append(py::make_tuple(g.begin, g.end, g.label, q, g.heading_free, w));
+  }
+  d["given_segments"] = segments;
+  d["firmware_left"] = s.firmware_left;
+  d["log_params"] = s.log_params;
+  d["system_id"] = s.system_id ? py::object(py::int_(*s.system_id)) : py::object(py::none());
+  py::list motion;
+  for (const LogMotion& m : s.log_motion) {
+    motion.append(py::make_tuple(m.t_begin_s, m.t_end_s, static_cast<int>(m.evidence), m.source,
+                                 m.max_ground_speed_m_s, m.max_climb_m_s, m.ground_distance_m));
+  }
+  d["log_motion"] = motion;
+  return d;
+}
+
+std::shared_ptr<PySession> SessionOfState(const py::dict& d) {
+  if (!d.contains("version") || d["version"].cast<int>() != 1) {
+    throw Error("Session: a pickled state of another version of plumb");
+  }
+  auto out = std::make_shared<PySession>();
+  Session& s = out->session;
+  ImuSeries& x = s.series;
+  Fill<double>(d["time"], 1, x.t_s);
+  Fill<float>(d["acc"], 3, x.acc);
+  Fill<float>(d["gyr"], 3, x.gyr);
+  Fill<float>(d["temp"], 1, x.temp_c);
+  x.acc_unit = d["acc_unit"].cast<std::string>();
+  x.gyr_unit = d["gyr_unit"].cast<std::string>();
+  s.source = d["source"].cast<std::string>();
+  out->inputs = d["inputs"].cast<std::vector<std::string>>();
+  s.warnings = NoticesOfState(d["warnings"]);
+  if (!d["site"].is_none()) {
+    const py::tuple t = d["site"].cast<py::tuple>();
+    s.site = SiteInput{t[0].cast<double>(), t[1].cast<double>(), t[2].cast<double>(),
+                       t[3].cast<std::string>()};
+  }
+  for (const auto& item : d["given_segments"]) {
+    const py::tuple t = item.cast<py::tuple>();
+    StillSegment g;
+    g.begin = t[0].cast<std::size_t>();
+    g.end = t[1].cast<std::size_t>();
+    g.label = t[2].cast<std::string>();
+    if (!t[3].is_none()) {
+      const auto q = t[3].cast<std::vector<double>>();
+      g.known_R_n_b = Quat(q[0], q[1], q[2], q[3]);
+    }
+    g.heading_free = t[4].cast<bool>();
+    if (!t[5].is_none()) {
+      const auto w = t[5].cast<std::vector<double>>();
+      g.known_omega_eb_b = Vec3(w[0], w[1], w[2]);
+    }
+    s.given_segments.push_back(std::move(g));
+  }
+  s.firmware_left = d["firmware_left"].cast<std::vector<std::string>>();
+  s.log_params = d["log_params"].cast<std::map<std::string, double>>();
+  if (!d["system_id"].is_none()) s.system_id = d["system_id"].cast<int>();
+  for (const auto& item : d["log_motion"]) {
+    const py::tuple t = item.cast<py::tuple>();
+    LogMotion m;
+    m.t_begin_s = t[0].cast<double>();
+    m.t_end_s = t[1].cast<double>();
+    m.evidence = static_cast<LogMotion::Evidence>(t[2].cast<int>());
+    m.source = t[3].cast<std::string>();
+    m.max_ground_speed_m_s = t[4].cast<double>();
+    m.max_climb_m_s = t[5].cast<double>();
+    m.ground_distance_m = t[6].cast<double>();
+    s.log_motion.push_back(std::move(m));
+  }
+  return out;
+}
 
 void RegisterSession(py::module_& m) {
   py::class_<PySession, std::shared_ptr<PySession>>(
@@ -208,15 +464,23 @@ void RegisterSession(py::module_& m) {
       "copy) and what the reader said. Body frame FRD.")
       .def_property_readonly("time", SeriesView(&ImuSeries::t_s, 0),
                              "Sample times, s (float64, N), strictly increasing; any origin.")
-      .def_property_readonly("specific_force", SeriesView(&ImuSeries::acc, 3),
+      .def_property_readonly("acc", SeriesView(&ImuSeries::acc, 3),
                              "Accelerometer output, m/s^2 (float32, N x 3; in acc_unit when the "
-                             "input was counts), as stored by plumb.")
-      .def_property_readonly("rate", SeriesView(&ImuSeries::gyr, 3),
+                             "input was counts), as stored by plumb: what apply(acc, ...) takes.")
+      .def_property_readonly("gyr", SeriesView(&ImuSeries::gyr, 3),
                              "Gyroscope output, rad/s (float32, N x 3; 0 x 3 without a "
                              "gyroscope; in gyr_unit when the input was counts).")
-      .def_property_readonly("temperature", &Temperature,
-                             "Sensor temperature, degC (float32, N); NaN when the input has "
-                             "none (then a new array, not a view).")
+      .def_property_readonly("temp", &Temp,
+                             "Sensor temperature, degC (float32, N); None when the input has "
+                             "none.")
+      .def_property_readonly("specific_force", Deprecated("specific_force", "acc", SeriesView(&ImuSeries::acc, 3)),
+                             "Deprecated: session.acc (the accelerometer's output).")
+      .def_property_readonly("rate", Deprecated("rate", "gyr", SeriesView(&ImuSeries::gyr, 3)),
+                             "Deprecated: session.gyr (the gyroscope's output; rate= of open() "
+                             "is the sample rate in Hz).")
+      .def_property_readonly("temperature", Deprecated("temperature", "temp", &Temperature),
+                             "Deprecated: session.temp (this one NaN, not None, without "
+                             "temperatures).")
       .def_property_readonly("has_gyro",
                              [](const PySession& s) { return s.session.series.has_gyro(); },
                              "Whether the session has gyroscope samples.")
@@ -228,14 +492,15 @@ void RegisterSession(py::module_& m) {
                              "First to last sample, s.")
       .def_property_readonly("acc_unit",
                              [](const PySession& s) { return s.session.series.acc_unit; },
-                             "Unit of specific_force: 'm/s^2', or 'counts' for unscaled output.")
+                             "Unit of acc: 'm/s^2', or 'counts' for unscaled output.")
       .def_property_readonly("gyr_unit",
                              [](const PySession& s) { return s.session.series.gyr_unit; },
-                             "Unit of rate: 'rad/s', or 'counts' for unscaled output.")
+                             "Unit of gyr: 'rad/s', or 'counts' for unscaled output.")
       .def_property_readonly("source", [](const PySession& s) { return s.session.source; },
-                             "The file name(s) it was read from.")
+                             "The file name(s) it was read from; from_arrays' source.")
       .def_readonly("inputs", &PySession::inputs,
-                    "The inputs as given to open() (a two-file input as 'acc,gyr').")
+                    "The inputs as given to open() (a two-file input as 'acc,gyr'); "
+                    "[source] for from_arrays.")
       .def_property_readonly("warnings", [](const PySession& s) { return Messages(s.session.warnings); },
                              "What the reader skipped or repaired, in words.")
       .def_property_readonly("notices",
@@ -259,6 +524,12 @@ void RegisterSession(py::module_& m) {
                              "segments there fail not_still; motion there is no turn.")
       .def("__len__", [](const PySession& s) { return s.session.series.size(); },
            "Number of samples.")
+      .def_static("from_arrays", &FromArrays, py::arg("time"), py::arg("acc"),
+                  py::arg("gyr") = py::none(), py::arg("temp") = py::none(), py::kw_only(),
+                  py::arg("acc_unit") = "m/s^2", py::arg("gyr_unit") = "rad/s",
+                  py::arg("drop_nan") = false, py::arg("source") = "arrays", kFromArraysDoc)
+      .def(py::pickle([](const PySession& s) { return SessionState(s); },
+                      [](const py::dict& state) { return SessionOfState(state); }))
       .def("__repr__", [](const PySession& s) {
         return "<plumb.Session " + s.session.source + ": " +
                std::to_string(s.session.series.size()) + " samples, " +

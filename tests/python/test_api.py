@@ -99,7 +99,7 @@ class Errors(unittest.TestCase):
             f.write("0,0,0,9.8\n0.01,nan,0,9.8\n")
         with self.assertRaises(plumb.InputError) as c:
             plumb.open(path, columns="t,ax,ay,az")
-        self.assertIn("(to skip such rows: drop_nan)", str(c.exception))
+        self.assertIn("(to skip such rows: drop_nan=True)", str(c.exception))
         self.assertNotIn("--", str(c.exception))
         # ... and carry the option as data, as the keyword.
         self.assertEqual(c.exception.options, ("drop_nan",))
@@ -180,16 +180,16 @@ class VehicleMotion(unittest.TestCase):
 class Arrays(unittest.TestCase):
     def test_session_arrays_are_views_of_one_storage(self):
         s = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100)
-        a, b = s.specific_force, s.specific_force
+        a, b = s.acc, s.acc
         self.assertTrue(np.shares_memory(a, b))
         self.assertFalse(a.flags.owndata)
         self.assertFalse(a.flags.writeable)
         self.assertEqual(a.shape, (len(s), 3))
         self.assertTrue(np.shares_memory(s.time, s.time))
-        self.assertTrue(np.shares_memory(s.rate, s.rate))
+        self.assertTrue(np.shares_memory(s.gyr, s.gyr))
 
     def test_a_view_keeps_its_session_alive(self):
-        f = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100).specific_force
+        f = plumb.open(SESSION, columns="ax,ay,az,gx,gy,gz", rate=100).acc
         first = f[0].copy()
         gc.collect()
         junk = [np.ones(1000) for _ in range(1000)]
@@ -201,12 +201,12 @@ class Arrays(unittest.TestCase):
         plumb.calibrate(s).save(out("cal_arrays.json"))
         cal = plumb.load_calibration(out("cal_arrays.json"))
         f, w = cal.apply(s)
-        f2, w2 = cal.apply(s.specific_force, s.rate, time=s.time)
+        f2, w2 = cal.apply(s.acc, s.gyr, time=s.time)
         np.testing.assert_array_equal(f, f2)
         np.testing.assert_array_equal(w, w2)
         self.assertEqual(f.shape, (len(s), 3))
         # The base model has no time or angular-acceleration effect: times are not needed.
-        f3, _ = cal.apply(s.specific_force, s.rate)
+        f3, _ = cal.apply(s.acc, s.gyr)
         np.testing.assert_array_equal(f, f3)
 
 

@@ -33,14 +33,14 @@ def run(*args):
 # The options the library's messages name (core/option_name.h), as the command spells them and
 # as this module does (python/bindings/keywords.cc): the documents are equal once these are.
 SPELLINGS = [("(give --lat --lon --height)", "(give site=(lat_deg, lon_deg, height_m))"),
-             ("(--heading DEG or --level-north)", "(heading=DEG or level_north)"),
+             ("(--heading DEG or --level-north)", "(heading=DEG or level_north=True)"),
              ("override with --accel-rw/--gyro-rw/--accel-bi/--gyro-bi",
               "override with accel_rw/gyro_rw/accel_bi/gyro_bi"),
              (" --noise-from a long still recording",
               " CalibrationOptions::other_still_noise a long still recording"),
-             ("or --estimate-rw (from the session's holds", "or estimate_rw (from the session's holds"),
+             ("or --estimate-rw (from the session's holds", "or estimate_rw=True (from the session's holds"),
              ("(without --estimate-rw) or give the walk (--accel-rw/--gyro-rw)",
-              "(without estimate_rw) or give the walk (accel_rw/gyro_rw)"),
+              "(without estimate_rw=True) or give the walk (accel_rw/gyro_rw)"),
              ("or --noise-from a long still recording) for sigmas",
               "or CalibrationOptions::other_still_noise a long still recording) for sigmas"),
              ("iterations (--max-iterations)", "iterations (max_iterations)")]
@@ -172,8 +172,8 @@ class CliEqual(unittest.TestCase):
         np.testing.assert_array_equal(printed(fs), table[:, 7:10])
         np.testing.assert_array_equal(printed(ws), table[:, 10:13])
         # The same samples given as arrays (float64, the session's values) and times.
-        f2, w2 = calibration.apply(self.session.specific_force.astype(np.float64),
-                                   self.session.rate.astype(np.float64),
+        f2, w2 = calibration.apply(self.session.acc.astype(np.float64),
+                                   self.session.gyr.astype(np.float64),
                                    time=self.session.time)
         np.testing.assert_array_equal(f2, f)
         np.testing.assert_array_equal(w2, w)
@@ -184,9 +184,9 @@ class CliEqual(unittest.TestCase):
         sim = plumb.simulate(random_truth=1, poses=6, site=(51.64, -1.2, 100), seed=3)
         written = plumb.open(out("sim.csv"))
         np.testing.assert_array_equal(sim.session.time, written.time)
-        np.testing.assert_array_equal(sim.session.specific_force, written.specific_force)
-        np.testing.assert_array_equal(sim.session.rate, written.rate)
-        np.testing.assert_array_equal(sim.session.temperature, written.temperature)
+        np.testing.assert_array_equal(sim.session.acc, written.acc)
+        np.testing.assert_array_equal(sim.session.gyr, written.gyr)
+        np.testing.assert_array_equal(sim.session.temp, written.temp)
 
     def test_sweep_point_is_the_commands_point_file(self):
         study = {"name": "python test", "seed": 5, "runs": 2, "design": "grid",

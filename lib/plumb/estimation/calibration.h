@@ -51,6 +51,11 @@ struct Observability {
   /// Null-space directions, each "a p1 + b p2 ...": moving the parameters along it changes
   /// no prediction.
   std::vector<std::string> unobservable;
+  /// The same directions as numbers: one row per entry of `unobservable` (reduced row-echelon
+  /// form, original units), one column per unknown named in `null_space_names` (the model's
+  /// free parameters, the attitudes, the eliminated unknowns); 0 rows when all is observable.
+  Eigen::MatrixXd null_space;
+  std::vector<std::string> null_space_names;
   /// Combinations of unobservable parameters that the data does determine.
   std::vector<Combination> determined;
   /// Their covariance, c_i^T C c_j, in `determined` order (its diagonal: their sigma squared).

@@ -255,6 +255,8 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
   for (Eigen::Index r = 0; r < B.rows(); ++r) {
     out.summary.unobservable.push_back(FormatCombination(B.row(r).transpose(), names, true));
   }
+  out.summary.null_space = B;
+  out.summary.null_space_names = names;
 
   AddDeterminedCombinations(B, is_model, in, out);
   return out;

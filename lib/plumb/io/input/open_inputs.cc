@@ -99,14 +99,6 @@ Session ReadNative(const std::string& path, bool insist, const std::string& hint
   return ReadNativeCsv(path);
 }
 
-double UnitFactor(AccUnit unit) {
-  return unit == AccUnit::kStandardGravity ? units::kStandardGravity : 1.0;
-}
-
-double UnitFactor(GyrUnit unit) {
-  return unit == GyrUnit::kDegreesPerSecond ? units::kRadPerDeg : 1.0;
-}
-
 /// The text-table options of a one-file table, or of each file of the two-file form.
 TextTableOptions TableOptions(const InputOptions& o, bool two_files) {
   TextTableOptions t;
@@ -264,6 +256,14 @@ void UseUniformClock(Session& s) {
 }
 
 }  // namespace
+
+double UnitFactor(AccUnit unit) {
+  return unit == AccUnit::kStandardGravity ? units::kStandardGravity : 1.0;
+}
+
+double UnitFactor(GyrUnit unit) {
+  return unit == GyrUnit::kDegreesPerSecond ? units::kRadPerDeg : 1.0;
+}
 
 Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& options) {
   if (inputs.empty()) throw Error("OpenInputs: no input");

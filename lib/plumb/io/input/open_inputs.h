@@ -114,6 +114,11 @@ enum class GyrUnit {
   kCounts,            ///< unscaled sensor counts (factor 1; the session's gyr_unit "counts")
 };
 
+/// SI units per unit: units::kStandardGravity m/s^2 per g, units::kRadPerDeg rad/s per deg/s,
+/// 1 for m/s^2, rad/s and counts (a value in `unit` times this is in SI, or stays counts).
+double UnitFactor(AccUnit unit);
+double UnitFactor(GyrUnit unit);
+
 /// Conversion of one sensor's table values to SI: (value - offset) * scale * unit factor.
 template <typename Unit>
 struct SensorScaling {
