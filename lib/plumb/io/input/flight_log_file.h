@@ -34,8 +34,8 @@ enum class FlightLogFormat {
   kRos2Db3,          ///< ROS 2 sqlite3 bag .db3 ("SQLite format 3\0", tables topics, messages)
 };
 
-/// True for the ROS bag formats (kRosBag, kRos2Mcap, kRos2Db3): sensor_msgs/Imu topics,
-/// --topic, --clock receive.
+/// True for the ROS bag formats (kRosBag, kRos2Mcap, kRos2Db3): sensor_msgs/Imu topics picked
+/// by name (Option::kTopic), receive times (Clock::kReceive).
 bool IsRosBag(FlightLogFormat format);
 
 /// The format of the file at `path`, from its first bytes; kNone when it is none of them or
