@@ -15,12 +15,17 @@ if(NOT TARGET plumb_yaml::yaml-cpp)
   set_target_properties(plumb_yaml::yaml-cpp PROPERTIES INTERFACE_LINK_LIBRARIES yaml-cpp)
 endif()
 
-# libbz2 and liblz4 (C libraries): the bz2 and lz4 chunks of ROS bags (io/ros), found as plain
-# libraries (Debian ships no CMake package for liblz4) and linked privately by io_ros.
+# libbz2, liblz4 and libzstd (C libraries): the bz2 and lz4 chunks of ROS 1 bags and the zstd
+# and lz4 chunks of MCAP files (io/ros), found as plain libraries (Debian ships no CMake
+# package for liblz4) and linked privately by io_ros. libsqlite3: ROS 2 .db3 bags (io/ros).
 find_path(PLUMB_BZ2_INCLUDE_DIR bzlib.h REQUIRED)
 find_library(PLUMB_BZ2_LIBRARY bz2 REQUIRED)
 find_path(PLUMB_LZ4_INCLUDE_DIR lz4frame.h REQUIRED)
 find_library(PLUMB_LZ4_LIBRARY lz4 REQUIRED)
+find_path(PLUMB_ZSTD_INCLUDE_DIR zstd.h REQUIRED)
+find_library(PLUMB_ZSTD_LIBRARY zstd REQUIRED)
+find_path(PLUMB_SQLITE3_INCLUDE_DIR sqlite3.h REQUIRED)
+find_library(PLUMB_SQLITE3_LIBRARY sqlite3 REQUIRED)
 
 # Debian ships GeographicLib with a Find module only; wrap it in an imported target.
 if(NOT TARGET GeographicLib::GeographicLib)

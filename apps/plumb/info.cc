@@ -1,5 +1,5 @@
 // plumb info LOG [--json FILE] — what is inside a flight log (ArduPilot DataFlash .bin or text
-// .log, MAVLink .tlog, PX4 ULog .ulg, ROS 1 bag; recognised by content): each IMU stream with its sample
+// .log, MAVLink .tlog, PX4 ULog .ulg, ROS 1 or 2 bag; recognised by content): each IMU stream with its sample
 // count, rate, time span, temperature range, what the firmware applied and whether plumb can
 // undo it, its still periods, the site from the GPS, the calibration parameters in force, the
 // message counts and what the reader skipped (issue 5).
@@ -14,6 +14,7 @@
 #include "plumb/core/number_text.h"
 #include "plumb/io/common/stream_spool.h"
 #include "plumb/io/input/flight_log_file.h"
+#include "plumb/io/ros/ros_session.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/time_base_text.h"
 #include "plumb/signal/time_base.h"
@@ -142,7 +143,7 @@ class InfoCommand : public Command {
         doc["imus"].push_back(j);
         continue;
       }
-      const bool bag = summary.format == "ros1-bag";
+      const bool bag = io::IsRosBag(summary.format);
       std::cout << (bag ? "\n    applied by the driver: " : "\n    applied by the firmware: ")
                 << (bag ? "a bag does not say (taken as logged)"
                         : imu.applied.empty() ? "nothing (raw sensor output)" : imu.applied)
@@ -182,7 +183,7 @@ class InfoCommand : public Command {
     nlohmann::json messages = nlohmann::json::object();
     for (const auto& [name, count] : summary.messages) messages[name] = count;
     doc["messages"] = messages;
-    if (summary.format == "ros1-bag") {  // a bag's topics and their types
+    if (io::IsRosBag(summary.format)) {  // a bag's topics and their types
       for (const auto& [name, count] : summary.messages) {
         std::cout << "topic " << name << ": " << count << " messages\n";
       }

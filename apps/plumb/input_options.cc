@@ -144,7 +144,7 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
                   "Input files: plumb's native CSV, a text table (see --columns), an "
                   "accelerometer and a gyroscope table as acc.txt,gyr.txt, or a flight log: "
                   "ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg, ROS 1 "
-                  ".bag (recognised by their first bytes)")
+                  ".bag, ROS 2 .mcap or .db3 (recognised by their first bytes)")
       ->type_name("FILE...");
   auto* logs = app->add_option_group(
       "Flight logs", "Reading an ArduPilot .bin/.log, MAVLink .tlog or PX4 .ulg log, or a ROS "

@@ -204,6 +204,27 @@ TEST_F(BadInput, RosBag) {
            {"wrong_size", wrong_size}});
 }
 
+// ROS 2 bags: the small MCAP (zstd chunks) and .db3 seeds of tests/fuzz (60 messages of a real
+// recording, written by an independent writer), through the battery; besides: the magic and
+// then garbage, another MCAP version, and the SQLite header and then garbage.
+TEST_F(BadInput, Ros2Mcap) {
+  const std::string good =
+      ReadAll(std::string(PLUMB_SOURCE_DIR) + "/tests/fuzz/seeds/mcap/phidgets_60_zstd.mcap");
+  ASSERT_FALSE(good.empty());
+  const std::string garbage(4096, '\x5a');
+  Battery(good, "mcap", 7,
+          {{"after_magic", std::string("\x89MCAP0\r\n", 8) + garbage},
+           {"version1", std::string("\x89MCAP1\r\n", 8) + garbage}});
+}
+
+TEST_F(BadInput, Ros2Db3) {
+  const std::string good =
+      ReadAll(std::string(PLUMB_SOURCE_DIR) + "/tests/fuzz/seeds/db3/phidgets_60.db3");
+  ASSERT_FALSE(good.empty());
+  const std::string garbage(4096, '\x5a');
+  Battery(good, "db3", 8, {{"after_header", std::string("SQLite format 3\0", 16) + garbage}});
+}
+
 TEST_F(BadInput, CalibrationTruthAndStudyFiles) {
   // JSON files other commands read: a calibration (apply, compare), a truth (compare --truth),
   // a study (sweep); damaged, and with a NaN where a number belongs.

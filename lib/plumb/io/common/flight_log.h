@@ -1,7 +1,7 @@
 // plumb/io/common/flight_log.h — what every flight-log reader offers, whatever the format.
 //
 // A flight log (ArduPilot DataFlash .bin or text .log, MAVLink .tlog, PX4 ULog .ulg, ROS 1
-// .bag) holds one or more IMU streams: a message or topic carrying accelerometer and/or
+// .bag, ROS 2 .mcap or .db3) holds one or more IMU streams: a message or topic carrying accelerometer and/or
 // gyroscope samples of one sensor instance (ArduPilot IMU/IMU2/ACC/GYR/ISBD, MAVLink
 // RAW_IMU/SCALED_IMU2/HIGHRES_IMU, PX4 sensor_combined/sensor_accel/vehicle_imu, a ROS bag's
 // sensor_msgs/Imu topics). Each format's reader lists its streams as
@@ -71,7 +71,7 @@ struct FlightLogSelection {
 /// A flight log's contents as `plumb info` shows them.
 struct FlightLogSummary {
   std::string source;                  ///< file name
-  std::string format;                  ///< "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog", "ros1-bag"
+  std::string format;                  ///< "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog", "ros1-bag", "ros2-mcap", "ros2-db3"
   std::string format_detail;           ///< e.g. "MAVLink v1+v2, 41230 frames", "ULog version 1"
   std::size_t size_bytes = 0;          ///< file size, bytes
   std::vector<ImuStreamInfo> imus;     ///< every IMU stream

@@ -50,6 +50,8 @@ FlightLogFormat SniffFlightLog(const std::string& path) {
   if (LooksLikeDataflash(path)) return FlightLogFormat::kDataflashBinary;
   if (LooksLikeULog(path)) return FlightLogFormat::kPx4ULog;
   if (LooksLikeRosBag(path)) return FlightLogFormat::kRosBag;
+  if (LooksLikeMcap(path)) return FlightLogFormat::kRos2Mcap;
+  if (LooksLikeDb3(path)) return FlightLogFormat::kRos2Db3;
   if (LooksLikeTlog(path)) return FlightLogFormat::kMavlinkTlog;
   if (LooksLikeDataflashText(path)) return FlightLogFormat::kDataflashText;
   return FlightLogFormat::kNone;
@@ -66,11 +68,20 @@ const char* FlightLogFormatName(FlightLogFormat format) {
     case FlightLogFormat::kPx4ULog:
       return "px4-ulog";
     case FlightLogFormat::kRosBag:
-      return "ros1-bag";
+      return RosBagFormatName(RosBagKind::kRos1);
+    case FlightLogFormat::kRos2Mcap:
+      return RosBagFormatName(RosBagKind::kMcap);
+    case FlightLogFormat::kRos2Db3:
+      return RosBagFormatName(RosBagKind::kSqlite3);
     case FlightLogFormat::kNone:
       break;
   }
   return "none";
+}
+
+bool IsRosBag(FlightLogFormat format) {
+  return format == FlightLogFormat::kRosBag || format == FlightLogFormat::kRos2Mcap ||
+         format == FlightLogFormat::kRos2Db3;
 }
 
 namespace {
@@ -111,10 +122,16 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
     case FlightLogFormat::kRosBag:
       out.log_ = ReadRosBag(path);
       break;
+    case FlightLogFormat::kRos2Mcap:
+      out.log_ = ReadMcap(path);
+      break;
+    case FlightLogFormat::kRos2Db3:
+      out.log_ = ReadDb3(path);
+      break;
     case FlightLogFormat::kNone:
       throw InputError(path, "byte 0",
                        "not a flight log plumb reads (ArduPilot DataFlash .bin or text .log, "
-                       "MAVLink .tlog, PX4 ULog .ulg, ROS 1 bag .bag)");
+                       "MAVLink .tlog, PX4 ULog .ulg, ROS 1 bag .bag, ROS 2 bag .mcap or .db3)");
   }
   return out;
 }
@@ -129,6 +146,8 @@ FlightLogSummary FlightLog::Summary() const {
     case FlightLogFormat::kPx4ULog:
       return ULogSummary(std::get<ULog>(log_));
     case FlightLogFormat::kRosBag:
+    case FlightLogFormat::kRos2Mcap:
+    case FlightLogFormat::kRos2Db3:
       return RosBagSummary(std::get<RosBag>(log_));
     case FlightLogFormat::kNone:
       break;
@@ -137,7 +156,7 @@ FlightLogSummary FlightLog::Summary() const {
 }
 
 Session FlightLog::Select(const FlightLogSelection& selection) const {
-  if (selection.receive_time && format_ != FlightLogFormat::kRosBag) {
+  if (selection.receive_time && !IsRosBag(format_)) {
     throw InputError(source_, "",
                      std::string(FlightLogFormatName(format_)) + " has no receive times (" +
                          OptionText(Option::kClock, "receive") + " is for ROS bags)",
@@ -152,6 +171,8 @@ Session FlightLog::Select(const FlightLogSelection& selection) const {
     case FlightLogFormat::kPx4ULog:
       return ULogSession(std::get<ULog>(log_), selection);
     case FlightLogFormat::kRosBag:
+    case FlightLogFormat::kRos2Mcap:
+    case FlightLogFormat::kRos2Db3:
       return RosBagSession(std::get<RosBag>(log_), selection);
     case FlightLogFormat::kNone:
       break;

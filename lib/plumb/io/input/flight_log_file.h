@@ -1,4 +1,4 @@
-// plumb/io/input/flight_log_file.h — any flight log plumb reads (a ROS bag included), opened by content: the format is
+// plumb/io/input/flight_log_file.h — any flight log plumb reads (ROS 1 and 2 bags included), opened by content: the format is
 // recognised from the file's first bytes (not its name), the log decoded once, and then its
 // summary (`plumb info`) and any number of sessions (calibrate, diagnose, report) come from it.
 //
@@ -16,6 +16,8 @@
 #include "plumb/io/common/flight_log.h"
 #include "plumb/io/mavlink/mavlink_tlog.h"
 #include "plumb/io/px4/ulog.h"
+#include "plumb/io/ros/db3.h"
+#include "plumb/io/ros/mcap.h"
 #include "plumb/io/ros/rosbag.h"
 
 namespace plumb::io {
@@ -28,13 +30,20 @@ enum class FlightLogFormat {
   kMavlinkTlog,      ///< MAVLink telemetry log .tlog (time-stamped v1/v2 frames)
   kPx4ULog,          ///< PX4 ULog .ulg ("ULog" magic)
   kRosBag,           ///< ROS 1 bag .bag ("#ROSBAG V" line; version 2.0 is read)
+  kRos2Mcap,         ///< ROS 2 bag in MCAP .mcap (0x89 "MCAP" magic; version 0 is read)
+  kRos2Db3,          ///< ROS 2 sqlite3 bag .db3 ("SQLite format 3\0", tables topics, messages)
 };
+
+/// True for the ROS bag formats (kRosBag, kRos2Mcap, kRos2Db3): sensor_msgs/Imu topics picked
+/// by name (Option::kTopic), receive times (Clock::kReceive).
+bool IsRosBag(FlightLogFormat format);
 
 /// The format of the file at `path`, from its first bytes; kNone when it is none of them or
 /// cannot be read.
 FlightLogFormat SniffFlightLog(const std::string& path);
 
-/// "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog", "ros1-bag" ("none" for
+/// "ardupilot-dataflash", "ardupilot-text", "mavlink-tlog", "px4-ulog", "ros1-bag", "ros2-mcap",
+/// "ros2-db3" ("none" for
 /// kNone).
 const char* FlightLogFormatName(FlightLogFormat format);
 

@@ -331,6 +331,8 @@ double KeptFraction(const std::string& path, FlightLogFormat format) {
         break;
       case FlightLogFormat::kMavlinkTlog:
       case FlightLogFormat::kRosBag:
+      case FlightLogFormat::kRos2Mcap:
+      case FlightLogFormat::kRos2Db3:
       case FlightLogFormat::kNone:
         return 1.0;
     }
@@ -355,7 +357,9 @@ std::uint64_t EstimateReadMemory(const std::string& path) {
       factor = kKeptMemoryFactor * KeptFraction(path, format);
       break;
     case FlightLogFormat::kMavlinkTlog: factor = kTlogMemoryFactor; break;
-    case FlightLogFormat::kRosBag: factor = kRosBagMemoryFactor; break;
+    case FlightLogFormat::kRosBag:
+    case FlightLogFormat::kRos2Mcap:
+    case FlightLogFormat::kRos2Db3: factor = kRosBagMemoryFactor; break;
     case FlightLogFormat::kNone: break;
   }
   return kReadMemoryBaseBytes + SpooledBytes(path) +

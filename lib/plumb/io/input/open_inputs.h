@@ -15,8 +15,8 @@
 //   const Session x = OpenInputs({{"xsens_acc.mat", "xsens_gyro.mat"}}, o);  // two-file form
 //
 // Each input is one of (InputKind):
-//   flight log    an ArduPilot DataFlash .bin or text .log, a MAVLink .tlog, a PX4 ULog .ulg or
-//                 a ROS 1 bag .bag,
+//   flight log    an ArduPilot DataFlash .bin or text .log, a MAVLink .tlog, a PX4 ULog .ulg, a
+//                 ROS 1 bag .bag or a ROS 2 bag (.mcap, .db3),
 //                 recognised by its first bytes (flight_log_file.h); `flight_log` selects the
 //                 stream, the time window and whether the firmware's correction is undone;
 //   native CSV    plumb's own format (native_csv.h), recognised by its header

@@ -110,17 +110,37 @@ void SayWhat(const RosImuTopic& t, bool receive_time, std::vector<Notice>* out) 
 }
 
 std::string FormatDetail(const RosBag& bag) {
+  const auto n = [](std::size_t v) { return std::to_string(v); };
+  if (bag.kind == RosBagKind::kSqlite3) {
+    return "ROS 2 sqlite3 bag, " + n(bag.connections.size()) + " topics";
+  }
   std::string chunks;
   for (const auto& [compression, count] : bag.compression) {
-    chunks += (chunks.empty() ? "" : ", ") + compression + " " + std::to_string(count);
+    chunks += (chunks.empty() ? "" : ", ") + compression + " " + n(count);
   }
-  return "ROS bag 2.0, " + std::to_string(bag.chunks) + " chunks" +
-         (chunks.empty() ? "" : " (" + chunks + ")") + ", " +
-         std::to_string(bag.connections.size()) + " connections, " +
+  const std::string chunk_text =
+      n(bag.chunks) + " chunks" + (chunks.empty() ? "" : " (" + chunks + ")");
+  if (bag.kind == RosBagKind::kMcap) {
+    return "MCAP, " + chunk_text + ", " + n(bag.connections.size()) + " channels";
+  }
+  return "ROS bag 2.0, " + chunk_text + ", " + n(bag.connections.size()) + " connections, " +
          (bag.chunk_infos > 0 ? "indexed" : "no index (read linearly)");
 }
 
 }  // namespace
+
+const char* RosBagFormatName(RosBagKind kind) {
+  switch (kind) {
+    case RosBagKind::kMcap: return "ros2-mcap";
+    case RosBagKind::kSqlite3: return "ros2-db3";
+    case RosBagKind::kRos1: break;
+  }
+  return "ros1-bag";
+}
+
+bool IsRosBag(const std::string& format) {
+  return format == "ros1-bag" || format == "ros2-mcap" || format == "ros2-db3";
+}
 
 std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag) {
   std::vector<ImuStreamInfo> out;
@@ -163,7 +183,7 @@ Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection) {
 FlightLogSummary RosBagSummary(const RosBag& bag) {
   FlightLogSummary out;
   out.source = bag.source;
-  out.format = "ros1-bag";
+  out.format = RosBagFormatName(bag.kind);
   out.format_detail = FormatDetail(bag);
   out.size_bytes = bag.size_bytes;
   out.imus = RosBagImuStreams(bag);

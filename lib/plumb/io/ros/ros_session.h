@@ -1,4 +1,5 @@
-// plumb/io/ros/ros_session.h — a ROS 1 bag (rosbag.h) as plumb IMU streams and Sessions.
+// plumb/io/ros/ros_session.h — a ROS bag (ROS 1 .bag: rosbag.h; ROS 2 MCAP: mcap.h; ROS 2
+// sqlite3 .db3: db3.h; all read into a RosBag) as plumb IMU streams and Sessions.
 //
 // IMU streams: one per sensor_msgs/Imu topic, named by the topic ("/imu/data_raw"), instance =
 // its index among the bag's IMU topics (order of first connection). accel =
@@ -11,11 +12,13 @@
 // angular_velocity_covariance[0] is -1 ("not given") is accelerometer-only.
 //
 // Time: header.stamp (sec + nsec * 1e-9, s since the unix epoch, as a .tlog's times), or with
-// FlightLogSelection::receive_time the record time (when the recorder received the message).
+// FlightLogSelection::receive_time the record time (when the recorder received the message:
+// ROS 1 the record's time, MCAP the message's log_time, .db3 the messages table's timestamp).
 // Samples whose time does not increase are left out (KeepIncreasingTimes, counted in a
 // records_dropped warning).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "plumb/core/session.h"
@@ -23,6 +26,12 @@
 #include "plumb/io/ros/rosbag.h"
 
 namespace plumb::io {
+
+/// "ros1-bag", "ros2-mcap", "ros2-db3": the format names of FlightLogSummary::format.
+const char* RosBagFormatName(RosBagKind kind);
+
+/// True when `format` (FlightLogSummary::format) is one of a ROS bag's (RosBagFormatName).
+bool IsRosBag(const std::string& format);
 
 /// Every IMU stream of `bag` (see the file comment), on header stamps.
 std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag);
@@ -36,9 +45,10 @@ std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag);
 /// window holds fewer than 2 samples.
 Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection);
 
-/// The bag as `plumb info` shows it: format "ros1-bag", format_detail "ROS bag 2.0, N chunks
-/// (bz2 4), K connections, indexed", the IMU streams, message counts per "topic (type)" and
-/// the reader's warnings.
+/// The bag as `plumb info` shows it: format RosBagFormatName(bag.kind), format_detail "ROS bag
+/// 2.0, N chunks (bz2 4), K connections, indexed", "MCAP, N chunks (zstd N), K channels" or
+/// "ROS 2 sqlite3 bag, K topics", the IMU streams, message counts per "topic (type)" and the
+/// reader's warnings.
 FlightLogSummary RosBagSummary(const RosBag& bag);
 
 }  // namespace plumb::io

@@ -9,6 +9,7 @@
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/common/stream_spool.h"
+#include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/rosbag_format.h"
 
 namespace plumb::io {
@@ -273,14 +274,8 @@ void Parser::Connection(const Record& r, std::size_t at) {
   c.topic = std::string(r.fields.topic);
   int topic = -1;
   if (c.type == kImuType) {
+    topic = detail::ImuTopicIndex(bag_, c.topic);
     auto& topics = bag_->imu_topics;
-    const auto it = std::find_if(topics.begin(), topics.end(),
-                                 [&](const RosImuTopic& t) { return t.topic == c.topic; });
-    topic = static_cast<int>(it - topics.begin());
-    if (it == topics.end()) {
-      topics.emplace_back();
-      topics.back().topic = c.topic;
-    }
     if (c.md5sum != kRosImuMd5) {
       topics[static_cast<std::size_t>(topic)].md5_differs = true;
       w.md5_notes.push_back("connection " + std::to_string(c.id) + " (" + c.topic +
@@ -320,18 +315,7 @@ void Parser::Decode(int topic, std::uint32_t sec, std::uint32_t nsec, const std:
     if (bag_->warnings.malformed_imu++ == 0) bag_->warnings.first_malformed_imu = at;
     return;
   }
-  if (t.samples.empty()) t.frame_id = std::string(m.frame_id.substr(0, 256));
-  t.samples.t_s.push_back(static_cast<double>(m.sec) + static_cast<double>(m.nsec) * 1e-9);
-  t.receive_s.push_back(static_cast<double>(sec) + static_cast<double>(nsec) * 1e-9);
-  t.samples.acc.push_back(SaturatedFloat(m.acc));
-  t.samples.gyr.push_back(SaturatedFloat(m.gyr));
-  if (m.acc_cov0 == -1.0) ++t.acc_not_given;
-  if (m.gyr_cov0 == -1.0) ++t.gyr_not_given;
-  if (m.orientation_cov0 == -1.0) ++t.orientation_not_given;
-  if (m.orientation[0] == 0.0 && m.orientation[1] == 0.0 && m.orientation[2] == 0.0 &&
-      m.orientation[3] == 0.0) {
-    ++t.orientation_zero;
-  }
+  detail::AppendImu(&t, m, sec, nsec);
 }
 
 void Parser::Finish() {
@@ -371,7 +355,7 @@ void Parser::Finish() {
 
 bool RosBagWarnings::any() const {
   return cut_at || bad_records || damaged_chunks || unknown_ops || orphan_messages ||
-         malformed_imu || !md5_notes.empty();
+         malformed_imu || !md5_notes.empty() || !notes.empty();
 }
 
 std::vector<std::string> RosBagWarnings::Describe() const {
@@ -403,12 +387,16 @@ std::vector<std::string> RosBagWarnings::Describe() const {
     out.push_back(n(orphan_messages) + " message(s) of a connection the bag never defines, " +
                   "skipped (first in the record at byte " + n(first_orphan) + ")");
   }
-  if (malformed_imu) {
+  if (malformed_imu && !first_malformed_why.empty()) {
+    out.push_back(n(malformed_imu) + " sensor_msgs/Imu message(s) that do not decode, skipped " +
+                  "(first: " + first_malformed_why + ")");
+  } else if (malformed_imu) {
     out.push_back(n(malformed_imu) + " sensor_msgs/Imu message(s) whose size is not 16 + " +
                   "frame_id + 296 bytes, skipped (first in the record at byte " +
                   n(first_malformed_imu) + ")");
   }
   for (const std::string& m : md5_notes) out.push_back(m);
+  for (const std::string& m : notes) out.push_back(m);
   return out;
 }
 

@@ -112,24 +112,42 @@ struct RosBagWarnings {
   std::size_t first_orphan = 0;          ///< file offset of the first (its chunk's)
   std::size_t malformed_imu = 0;         ///< sensor_msgs/Imu messages whose size does not fit
   std::size_t first_malformed_imu = 0;   ///< file offset of the first (its chunk's)
+  /// ROS 2 (CDR): where the first did not decode ("message at byte N: byte K: ..."); empty
+  /// for ROS 1, whose messages are judged by size.
+  std::string first_malformed_why;
   std::vector<std::string> md5_notes;    ///< IMU connections with another md5sum
+  /// Other lines, one per finding (ROS 2 readers: an IMU topic of another serialization, a
+  /// file that ends without its footer, a table that stopped reading).
+  std::vector<std::string> notes;
 
   bool any() const;
   /// One readable line per non-zero count.
   std::vector<std::string> Describe() const;
 };
 
-/// A decoded ROS 1 bag.
+/// The file formats a RosBag is read from.
+enum class RosBagKind {
+  kRos1,     ///< ROS 1 .bag (this file), format "ros1-bag"
+  kMcap,     ///< ROS 2 MCAP .mcap (mcap.h), format "ros2-mcap"
+  kSqlite3,  ///< ROS 2 sqlite3 .db3 (db3.h), format "ros2-db3"
+};
+
+/// A decoded ROS bag: ROS 1 (this file's reader), or ROS 2 (mcap.h, db3.h: the same
+/// intermediate, so that one session builder, ros_session.h, serves them all).
 struct RosBag {
+  RosBagKind kind = RosBagKind::kRos1;
   std::string source;               ///< file name (or the name given to ParseRosBag)
   std::size_t size_bytes = 0;
   std::uint64_t index_pos = 0;      ///< the bag header's; 0: never indexed
-  std::size_t chunks = 0;           ///< chunk records read
+  /// Chunk records read (MCAP: Chunk records; .db3: 0).
+  std::size_t chunks = 0;
   std::map<std::string, std::size_t> compression;  ///< chunks by compression
-  std::size_t chunk_infos = 0;      ///< chunk info records (the index) seen
-  std::map<std::uint32_t, RosConnection> connections;  ///< by conn id
+  std::size_t chunk_infos = 0;      ///< chunk info records (the index) seen (MCAP: ChunkIndex)
+  /// By conn id (MCAP: the channels by channel id, type its schema's name; .db3: the topics
+  /// table by id).
+  std::map<std::uint32_t, RosConnection> connections;
   std::vector<RosImuTopic> imu_topics;  ///< sensor_msgs/Imu topics, in order of first connection
-  std::size_t messages = 0;         ///< message data records read
+  std::size_t messages = 0;         ///< message data records read (all topics)
   RosBagWarnings warnings;
 
   /// The IMU topic called `topic`, or nullptr.

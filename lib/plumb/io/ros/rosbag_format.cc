@@ -3,6 +3,7 @@
 
 #include <bzlib.h>
 #include <lz4frame.h>
+#include <zstd.h>
 
 #include <algorithm>
 #include <cstring>
@@ -214,6 +215,53 @@ bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
   return ok;
 }
 
+bool Zstd(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
+          std::vector<std::uint8_t>* out, std::size_t* out_size, std::string* why) {
+  ZSTD_DStream* ctx = ZSTD_createDStream();
+  if (ctx == nullptr) {
+    *why = "zstd could not start";
+    return false;
+  }
+  std::size_t used = 0;
+  bool ok = true;
+  ZSTD_inBuffer src{in, n, 0};
+  std::size_t hint = 1;
+  Reserve(out, std::min<std::size_t>(std::size_t{declared} + 1, std::max<std::size_t>(n * 4, 1 << 16)));
+  while (hint != 0) {
+    const std::size_t room = std::min<std::size_t>(out->size(), std::size_t{declared} + 1);
+    if (used == room && !Grow(out, used, std::size_t{declared} + 1)) {
+      *why = "zstd data longer than the chunk's size " + std::to_string(declared);
+      ok = false;
+      break;
+    }
+    ZSTD_outBuffer dst{out->data(), std::min<std::size_t>(out->size(), std::size_t{declared} + 1), used};
+    const std::size_t in_before = src.pos;
+    hint = ZSTD_decompressStream(ctx, &dst, &src);
+    const bool progress = dst.pos != used || src.pos != in_before;
+    used = dst.pos;
+    if (ZSTD_isError(hint)) {
+      *why = std::string("zstd data corrupt (") + ZSTD_getErrorName(hint) + ") after " +
+             std::to_string(used) + " bytes";
+      ok = false;
+      break;
+    }
+    if (hint != 0 && src.pos == n && !progress) {
+      *why = cut ? "zstd data cut by the end of the file after " + std::to_string(used) + " bytes"
+                 : "zstd data ended before its frame did";
+      ok = false;
+      break;
+    }
+  }
+  ZSTD_freeDStream(ctx);
+  *out_size = used;
+  if (ok && used != declared) {
+    *why = "zstd data of " + std::to_string(used) + " bytes, not the chunk's size " +
+           std::to_string(declared);
+    ok = false;
+  }
+  return ok;
+}
+
 }  // namespace
 
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
@@ -235,6 +283,7 @@ bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::
   }
   if (compression == "bz2") return Bz2(in, n, declared, cut, out, out_size, why);
   if (compression == "lz4") return Lz4(in, n, declared, cut, out, out_size, why);
+  if (compression == "zstd") return Zstd(in, n, declared, cut, out, out_size, why);
   *why = "unknown compression '" + std::string(compression.substr(0, 32)) + "'";
   return false;
 }

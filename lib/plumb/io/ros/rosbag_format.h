@@ -1,6 +1,6 @@
 // plumb/io/ros/rosbag_format.h — the pieces of a ROS 1 bag 2.0 (rosbag.h has the format): a
 // record header's fields, a connection's data, a chunk's decompression and the
-// sensor_msgs/Imu serialization. Internal to the reader; every length is checked against the
+// sensor_msgs/Imu serialization (ROS 1's; the MCAP reader shares the chunks' decompression). Internal to the reader; every length is checked against the
 // bytes that hold it.
 #pragma once
 
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "plumb/core/types.h"
+#include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/rosbag.h"
 
 namespace plumb::io::detail {
@@ -64,7 +65,8 @@ bool ParseRecordFields(const std::uint8_t* p, std::size_t n, RosRecordFields* ou
 bool ParseConnectionData(const std::uint8_t* p, std::size_t n, RosConnection* c,
                          std::string* why);
 
-/// Decompresses a chunk's data [in, in + n) of `compression` ("none", "bz2", "lz4") into the
+/// Decompresses a chunk's data [in, in + n) of `compression` ("none", "bz2", "lz4" (the LZ4
+/// frame format), "zstd" (MCAP's; a zstd frame), as liblz4 and libzstd decode them) into the
 /// first `*out_size` bytes of `out`, a buffer reused from chunk to chunk: grown as data comes
 /// out (never ahead of it, never past `declared` + 1 bytes), never shrunk. True when the data
 /// decompressed to its end and to exactly `declared` bytes; false with `why` otherwise, `out`
@@ -74,19 +76,6 @@ bool ParseConnectionData(const std::uint8_t* p, std::size_t n, RosConnection* c,
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
                      std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
                      std::size_t* out_size, std::string* why);
-
-/// One decoded sensor_msgs/Imu message.
-struct RosImuMessage {
-  std::uint32_t sec = 0;
-  std::uint32_t nsec = 0;
-  std::string_view frame_id;
-  double orientation[4] = {};       ///< x y z w
-  double orientation_cov0 = 0.0;
-  Vec3 gyr = Vec3::Zero();          ///< angular_velocity, rad/s
-  double gyr_cov0 = 0.0;
-  Vec3 acc = Vec3::Zero();          ///< linear_acceleration, m/s^2
-  double acc_cov0 = 0.0;
-};
 
 /// Bytes of a sensor_msgs/Imu message past its frame_id.
 inline constexpr std::size_t kRosImuFixedBytes = 37 * 8;

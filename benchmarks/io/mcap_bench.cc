@@ -1,0 +1,231 @@
+// Reading speed of the ROS 2 MCAP reader (SPEC section 7: at least 1 GB/s uncompressed, near
+// the decompressor's own speed compressed).
+//
+// BM_ReadMcap/<copy> reads a large MCAP file end to end (ReadMcap: every record, every chunk
+// decompressed, every sensor_msgs/msg/Imu message decoded from CDR, as `plumb info` and
+// `plumb calibrate` read it). The file is made from the MCAP copies of
+// ../shared/data/ros/ardrone_imu.bag that tests/io/ros2_fixtures/make-fixtures writes with
+// @mcap/core into build/ros2_fixtures (uncompressed, zstd, lz4 chunks of 256 KiB): its magic and
+// Header, then its data section (Schema, Channel, Chunk and MessageIndex records, up to
+// DataEnd) again and again up to about kTargetBytes, then a Footer; written once into a
+// temporary file removed at exit, held by the page cache (this measures the reader, not the
+// disk). Counters: MB/s of file, imu_msgs (IMU messages decoded per read) and msgs/s.
+// BM_McapZstd/<copy> and BM_McapLz4/<copy> decompress the same file's chunks with libzstd alone
+// (ZSTD_decompressDCtx) or liblz4 alone (LZ4F_decompress) into one buffer: the floor under
+// BM_ReadMcap of a compressed file.
+// Skipped with the reason when the fixtures cannot be made (data, node or the npm packages
+// absent).
+#include <benchmark/benchmark.h>
+#include <lz4frame.h>
+#include <zstd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "plumb/io/common/log_common.h"
+#include "plumb/io/ros/mcap.h"
+
+namespace {
+
+constexpr std::size_t kTargetBytes = 150u * 1000u * 1000u;
+constexpr std::size_t kMagic = 8;
+
+/// A top-level record: where it is and its opcode; a chunk's compression, uncompressed size and
+/// where its compressed records are.
+struct TopRecord {
+  std::uint8_t op = 0;
+  std::size_t begin = 0, end = 0;
+  std::string compression;
+  std::uint64_t size = 0;
+  std::size_t data_begin = 0, data_end = 0;
+};
+
+std::vector<TopRecord> Records(const std::vector<char>& bytes) {
+  using plumb::io::LoadLittleEndian;
+  std::vector<TopRecord> out;
+  const auto* p = reinterpret_cast<const std::uint8_t*>(bytes.data());
+  std::size_t pos = kMagic;
+  while (pos + 9 <= bytes.size()) {
+    TopRecord r;
+    r.op = p[pos];
+    r.begin = pos;
+    r.end = pos + 9 + LoadLittleEndian<std::uint64_t>(p + pos + 1);
+    if (r.op == 0x06) {
+      const std::uint8_t* c = p + pos + 9;
+      r.size = LoadLittleEndian<std::uint64_t>(c + 16);
+      const auto len = LoadLittleEndian<std::uint32_t>(c + 28);
+      r.compression.assign(reinterpret_cast<const char*>(c + 32), len);
+      r.data_begin = pos + 9 + 32 + len + 8;
+      r.data_end = r.end;
+    }
+    out.push_back(r);
+    if (r.op == 0x02) break;  // Footer
+    pos = r.end;
+  }
+  return out;
+}
+
+/// Runs make-fixtures once; "" when the fixtures are there, else why not.
+std::string MakeFixtures(const std::string& prefix) {
+  static const std::string why = [&] {
+    const std::string bag = std::string(PLUMB_SHARED_DATA_DIR) + "/ros/ardrone_imu.bag";
+    const std::string command = std::string(PLUMB_SOURCE_DIR) +
+                                "/tests/io/ros2_fixtures/make-fixtures '" + bag + "' '" + prefix +
+                                "' 2>&1";
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr) return std::string("cannot run make-fixtures");
+    char buffer[4096];
+    std::string out;
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) out.append(buffer, n);
+    return ::pclose(pipe) == 0 ? std::string() : "ROS 2 fixtures absent: " + out;
+  }();
+  return why;
+}
+
+/// A temporary file holding the MCAP `source`'s data section repeated up to about `target`
+/// bytes; removed at exit.
+class RepeatedMcap {
+ public:
+  RepeatedMcap(const std::string& source, std::size_t target) {
+    std::ifstream in(source, std::ios::binary);
+    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+    const std::vector<TopRecord> records = Records(bytes);
+    const std::size_t body_begin = records.at(0).end;  // after the Header
+    std::size_t body_end = body_begin;
+    for (const TopRecord& r : records) {
+      if (r.op == 0x0F) break;  // DataEnd
+      body_end = r.end;
+    }
+    path_ = (std::filesystem::temp_directory_path() /
+             ("plumb_bench_" + std::filesystem::path(source).filename().string()))
+                .string();
+    std::ofstream out(path_, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(body_begin));
+    const std::size_t copies = std::max<std::size_t>(1, target / (body_end - body_begin));
+    for (std::size_t k = 0; k < copies; ++k) {
+      out.write(bytes.data() + body_begin, static_cast<std::streamsize>(body_end - body_begin));
+    }
+    const char footer[] = {0x02, 20, 0, 0, 0, 0, 0, 0, 0};
+    out.write(footer, sizeof footer);
+    out.write(std::string(20, '\0').data(), 20);
+    out.write(bytes.data(), kMagic);
+  }
+  ~RepeatedMcap() { std::remove(path_.c_str()); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+/// The repeated copy of fixture `name` ("ardrone_imu_zstd.mcap"), made once; nullptr with
+/// `why` when the fixtures are absent.
+const RepeatedMcap* Repeated(const std::string& name, std::string* why) {
+  static std::map<std::string, std::unique_ptr<RepeatedMcap>> made;
+  const std::string dir = std::string(PLUMB_BINARY_DIR) + "/ros2_fixtures";
+  *why = MakeFixtures(dir + "/ardrone_imu");
+  if (!why->empty()) return nullptr;
+  auto& slot = made[name];
+  if (!slot) slot = std::make_unique<RepeatedMcap>(dir + "/" + name, kTargetBytes);
+  return slot.get();
+}
+
+void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t messages) {
+  const double iterations = static_cast<double>(state.iterations());
+  state.counters["MB/s"] = benchmark::Counter(iterations * static_cast<double>(bytes) / 1e6,
+                                              benchmark::Counter::kIsRate);
+  state.counters["msgs/s"] =
+      benchmark::Counter(iterations * static_cast<double>(messages), benchmark::Counter::kIsRate);
+  state.counters["imu_msgs"] = static_cast<double>(messages);
+  state.counters["MB"] = static_cast<double>(bytes) / 1e6;
+}
+
+void BM_ReadMcap(benchmark::State& state, const std::string& name) {
+  std::string why;
+  const RepeatedMcap* file = Repeated(name, &why);
+  if (file == nullptr) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  std::size_t messages = 0;
+  for (auto _ : state) {
+    const plumb::io::RosBag read = plumb::io::ReadMcap(file->path());
+    messages = 0;
+    for (const plumb::io::RosImuTopic& t : read.imu_topics) messages += t.samples.size();
+    benchmark::DoNotOptimize(messages);
+  }
+  SetCounters(state, std::filesystem::file_size(file->path()), messages);
+}
+BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_uncompressed, std::string("ardrone_imu.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_zstd, std::string("ardrone_imu_zstd.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_lz4, std::string("ardrone_imu_lz4.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// Decompresses every chunk of the repeated `name` with `decompress` (false: failed).
+template <typename Decompress>
+void DecompressChunks(benchmark::State& state, const std::string& name, Decompress decompress) {
+  std::string why;
+  const RepeatedMcap* file = Repeated(name, &why);
+  if (file == nullptr) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  std::ifstream in(file->path(), std::ios::binary);
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  const std::vector<TopRecord> records = Records(bytes);
+  std::vector<char> out;
+  for (auto _ : state) {
+    for (const TopRecord& r : records) {
+      if (r.op != 0x06) continue;
+      out.resize(r.size);
+      if (!decompress(bytes.data() + r.data_begin, r.data_end - r.data_begin, &out)) {
+        state.SkipWithError("decompression failed");
+        return;
+      }
+      benchmark::DoNotOptimize(out.data());
+    }
+  }
+  SetCounters(state, bytes.size(), 0);
+}
+
+void BM_McapZstd(benchmark::State& state, const std::string& name) {
+  ZSTD_DCtx* ctx = ZSTD_createDCtx();
+  DecompressChunks(state, name, [ctx](const char* in, std::size_t n, std::vector<char>* out) {
+    const std::size_t rc = ZSTD_decompressDCtx(ctx, out->data(), out->size(), in, n);
+    return !ZSTD_isError(rc) && rc == out->size();
+  });
+  ZSTD_freeDCtx(ctx);
+}
+BENCHMARK_CAPTURE(BM_McapZstd, ardrone_imu_zstd, std::string("ardrone_imu_zstd.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_McapLz4(benchmark::State& state, const std::string& name) {
+  LZ4F_dctx* ctx = nullptr;
+  LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION);
+  DecompressChunks(state, name, [ctx](const char* in, std::size_t n, std::vector<char>* out) {
+    std::size_t out_size = out->size();
+    std::size_t in_size = n;
+    const std::size_t rc = LZ4F_decompress(ctx, out->data(), &out_size, in, &in_size, nullptr);
+    return !LZ4F_isError(rc) && rc == 0 && out_size == out->size();
+  });
+  LZ4F_freeDecompressionContext(ctx);
+}
+BENCHMARK_CAPTURE(BM_McapLz4, ardrone_imu_lz4, std::string("ardrone_imu_lz4.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace

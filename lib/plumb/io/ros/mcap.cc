@@ -1,0 +1,392 @@
+// plumb/io/ros/mcap.cc — see mcap.h for the format and the decoding contract: the one pass
+// over an MCAP file's records and chunks, and the reader's entry points.
+#include "plumb/io/ros/mcap.h"
+
+#include <algorithm>
+#include <fstream>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "plumb/core/error.h"
+#include "plumb/io/common/log_common.h"
+#include "plumb/io/common/stream_spool.h"
+#include "plumb/io/ros/ros_imu.h"
+#include "plumb/io/ros/rosbag_format.h"
+
+namespace plumb::io {
+namespace {
+
+constexpr std::uint8_t kMagic[] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
+constexpr std::size_t kMagicSize = sizeof(kMagic);
+constexpr std::size_t kPrefixSize = 5;  // 0x89 "MCAP", whatever the version
+constexpr const char* kImuSchema = "sensor_msgs/msg/Imu";
+
+enum McapOp : std::uint8_t {
+  kOpHeader = 0x01,
+  kOpFooter = 0x02,
+  kOpSchema = 0x03,
+  kOpChannel = 0x04,
+  kOpMessage = 0x05,
+  kOpChunk = 0x06,
+  kOpChunkIndex = 0x08,
+};
+
+/// Reads a record's fields from [p, p + n), every length checked; ok() false once one ran past.
+class Fields {
+ public:
+  Fields(const std::uint8_t* p, std::size_t n) : p_(p), n_(n) {}
+  bool ok() const { return ok_; }
+  std::size_t pos() const { return pos_; }
+  template <typename T>
+  T Get() {
+    if (!ok_ || n_ - pos_ < sizeof(T)) {
+      ok_ = false;
+      return T{};
+    }
+    const T v = LoadLittleEndian<T>(p_ + pos_);
+    pos_ += sizeof(T);
+    return v;
+  }
+  /// `count` bytes (as far as they go when `partial`: a cut chunk's records).
+  std::string_view Bytes(std::uint64_t count, bool partial = false) {
+    if (!ok_) return {};
+    if (count > n_ - pos_) {
+      if (!partial) {
+        ok_ = false;
+        return {};
+      }
+      count = n_ - pos_;
+    }
+    const std::string_view v(reinterpret_cast<const char*>(p_ + pos_), count);
+    pos_ += count;
+    return v;
+  }
+  std::string_view String() { return Bytes(Get<std::uint32_t>()); }
+
+ private:
+  const std::uint8_t* p_;
+  std::size_t n_;
+  std::size_t pos_ = 0;
+  bool ok_ = true;
+};
+
+const std::uint8_t* Bytes(std::string_view v) {
+  return reinterpret_cast<const std::uint8_t*>(v.data());
+}
+
+class Parser {
+ public:
+  Parser(const std::uint8_t* data, std::size_t size, RosBag* bag, const LogFile* file)
+      : data_(data), size_(size), bag_(bag), file_(file) {}
+
+  void Run();
+
+ private:
+  struct Record {
+    std::uint8_t op = 0;
+    const std::uint8_t* body = nullptr;
+    std::size_t len = 0;  ///< the content there is (all of it unless cut)
+    std::size_t end = 0;  ///< offset past the record in its range
+  };
+  /// The record at `pos` of [base, base + n). False when it runs past n (`r->len` then holds
+  /// what is there of it; `r->body` nullptr when not even its opcode and length are).
+  static bool Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r);
+  void TopRecord(const Record& r, std::size_t at);
+  void Chunk(const Record& r, std::size_t at, bool cut);
+  /// The records of a chunk's data [p, p + n); `at`: the chunk's file offset. Returns the
+  /// messages read; `past_end` says what ran past the data's end ("" when none).
+  std::size_t ChunkRecords(const std::uint8_t* p, std::size_t n, std::size_t at,
+                           std::string* past_end);
+  void Schema(const Record& r, std::size_t at);
+  void Channel(const Record& r, std::size_t at);
+  void Message(const Record& r, std::size_t at);
+  void BadRecord(std::size_t at) {
+    if (bag_->warnings.bad_records++ == 0) bag_->warnings.first_bad_record = at;
+  }
+  void Damaged(std::size_t at, const std::string& why) {
+    RosBagWarnings& w = bag_->warnings;
+    if (w.damaged_chunks++ == 0) {
+      w.first_damaged_chunk = at;
+      w.first_damage = why;
+    }
+  }
+
+  const std::uint8_t* data_;
+  std::size_t size_;
+  RosBag* bag_;
+  const LogFile* file_;
+  std::size_t released_ = 0;
+  bool footer_ = false;
+  struct SchemaInfo {
+    std::string name;
+  };
+  std::unordered_map<std::uint16_t, SchemaInfo> schemas_;
+  /// A channel as a message finds it (by id: channel ids are 16-bit).
+  struct Slot {
+    RosConnection* conn = nullptr;  ///< nullptr: not defined (yet)
+    int topic = -1;                 ///< index in imu_topics, -1: not decoded
+  };
+  std::vector<Slot> slots_;
+  std::vector<std::uint8_t> chunk_;  ///< a decompressed chunk, reused
+};
+
+bool Parser::Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r) {
+  r->body = nullptr;
+  r->len = 0;
+  if (n - pos < 9) return false;
+  r->op = base[pos];
+  const std::uint64_t len = LoadLittleEndian<std::uint64_t>(base + pos + 1);
+  r->body = base + pos + 9;
+  r->len = static_cast<std::size_t>(std::min<std::uint64_t>(len, n - pos - 9));
+  r->end = pos + 9 + r->len;
+  return len <= n - pos - 9;
+}
+
+void Parser::Run() {
+  std::size_t pos = kMagicSize;
+  Record r;
+  const bool first_whole = Frame(data_, size_, pos, &r);
+  if (r.body == nullptr || r.op != kOpHeader) {
+    throw InputError(bag_->source, "byte " + std::to_string(pos),
+                     "expected the MCAP Header record (opcode 0x01) after the magic" +
+                         std::string(r.body == nullptr ? "; the file ends there" : ""));
+  }
+  if (!first_whole) {
+    throw InputError(bag_->source, "byte " + std::to_string(pos),
+                     "the MCAP Header record runs past the end of the file");
+  }
+  while (pos < size_ && !footer_) {
+    if (!Frame(data_, size_, pos, &r)) {
+      bag_->warnings.cut_at = pos;
+      if (r.body != nullptr && r.op == kOpChunk) Chunk(r, pos, true);
+      bag_->warnings.messages_read = bag_->messages;
+      return;
+    }
+    TopRecord(r, pos);
+    pos = r.end;
+    if (file_ != nullptr && pos >= released_ + LogFile::kReleaseStep) {
+      file_->Release(released_, pos);
+      released_ = pos;
+    }
+  }
+  if (!footer_) {
+    bag_->warnings.notes.push_back(
+        "cut short: the file ends at byte " + std::to_string(size_) +
+        " without its Footer record (at a record boundary); the " +
+        std::to_string(bag_->messages) + " messages before were read");
+  }
+}
+
+void Parser::TopRecord(const Record& r, std::size_t at) {
+  switch (r.op) {
+    case kOpFooter: footer_ = true; break;
+    case kOpSchema: Schema(r, at); break;
+    case kOpChannel: Channel(r, at); break;
+    case kOpMessage: Message(r, at); break;
+    case kOpChunk: Chunk(r, at, false); break;
+    case kOpChunkIndex: ++bag_->chunk_infos; break;
+    default: break;  // the index, attachments, metadata, statistics; unknown opcodes
+  }
+}
+
+void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
+  Fields f(r.body, r.len);
+  f.Get<std::uint64_t>();  // message_start_time
+  f.Get<std::uint64_t>();  // message_end_time
+  const std::uint64_t size = f.Get<std::uint64_t>();
+  f.Get<std::uint32_t>();  // uncompressed_crc (not checked: the records' lengths are)
+  const std::string compression(f.String().substr(0, 32));
+  const std::uint64_t records_len = f.Get<std::uint64_t>();
+  const std::string_view records = f.Bytes(records_len, cut);
+  if (!f.ok()) {
+    if (!cut) BadRecord(at);
+    return;
+  }
+  ++bag_->chunks;
+  ++bag_->compression[compression.empty() ? "none" : compression];
+  if (size > detail::kRosMaxChunkBytes) {
+    Damaged(at, "chunk stating " + std::to_string(size) +
+                    " bytes uncompressed, more than plumb reads (1 GiB)");
+    return;
+  }
+  const auto declared = static_cast<std::uint32_t>(size);
+  std::string why;
+  const std::uint8_t* p = Bytes(records);
+  std::size_t n = records.size();
+  bool whole = true;
+  if (!compression.empty()) {
+    whole = detail::DecompressChunk(compression, p, n, declared, cut, &chunk_, &n, &why);
+    p = chunk_.data();
+  } else if (n != declared) {
+    whole = false;
+    why = cut ? "chunk cut by the end of the file after " + std::to_string(n) + " of its " +
+                    std::to_string(declared) + " bytes"
+              : "uncompressed chunk of " + std::to_string(n) + " bytes, not its size " +
+                    std::to_string(declared);
+    n = std::min<std::size_t>(n, declared);
+  }
+  std::string past_end;
+  const std::size_t kept = ChunkRecords(p, n, at, &past_end);
+  if (cut) {
+    bag_->warnings.cut_messages_kept = kept;
+  } else if (!whole) {
+    Damaged(at, why);
+  } else if (!past_end.empty()) {
+    Damaged(at, past_end);
+  }
+}
+
+std::size_t Parser::ChunkRecords(const std::uint8_t* p, std::size_t n, std::size_t at,
+                                 std::string* past_end) {
+  std::size_t pos = 0;
+  std::size_t messages = 0;
+  Record r;
+  while (pos < n) {
+    if (!Frame(p, n, pos, &r)) {
+      *past_end = "a record at offset " + std::to_string(pos) + " of the chunk's " +
+                  std::to_string(n) + " bytes runs past its end";
+      break;
+    }
+    switch (r.op) {
+      case kOpSchema: Schema(r, at); break;
+      case kOpChannel: Channel(r, at); break;
+      case kOpMessage:
+        Message(r, at);
+        ++messages;
+        break;
+      default: break;
+    }
+    pos = r.end;
+  }
+  return messages;
+}
+
+void Parser::Schema(const Record& r, std::size_t at) {
+  Fields f(r.body, r.len);
+  const auto id = f.Get<std::uint16_t>();
+  const std::string_view name = f.String();
+  f.String();  // encoding
+  f.Bytes(f.Get<std::uint32_t>());
+  if (!f.ok()) {
+    BadRecord(at);
+    return;
+  }
+  if (id == 0) return;  // invalid by the spec: ignored
+  schemas_.emplace(id, SchemaInfo{std::string(name.substr(0, 256))});
+}
+
+void Parser::Channel(const Record& r, std::size_t at) {
+  Fields f(r.body, r.len);
+  const auto id = f.Get<std::uint16_t>();
+  const auto schema_id = f.Get<std::uint16_t>();
+  const std::string_view topic = f.String();
+  const std::string_view encoding = f.String();
+  if (!f.ok()) {
+    BadRecord(at);
+    return;
+  }
+  if (bag_->connections.count(id) != 0) return;  // repeated in the summary
+  RosConnection c;
+  c.id = id;
+  c.topic = std::string(topic.substr(0, 1024));
+  const auto schema = schemas_.find(schema_id);
+  c.type = schema == schemas_.end() ? std::string() : schema->second.name;
+  int imu = -1;
+  if (c.type == kImuSchema) {
+    if (encoding == "cdr") {
+      imu = detail::ImuTopicIndex(bag_, c.topic);
+    } else {
+      bag_->warnings.notes.push_back(
+          "channel " + std::to_string(id) + " (" + c.topic + "): sensor_msgs/msg/Imu in '" +
+          std::string(encoding.substr(0, 32)) + "', not CDR; its messages are not decoded");
+    }
+  }
+  RosConnection& stored = bag_->connections.emplace(id, std::move(c)).first->second;
+  if (id >= slots_.size()) slots_.resize(std::size_t{id} + 1);
+  slots_[id] = Slot{&stored, imu};
+}
+
+void Parser::Message(const Record& r, std::size_t at) {
+  RosBagWarnings& w = bag_->warnings;
+  if (r.len < 22) {
+    BadRecord(at);
+    return;
+  }
+  const auto channel = LoadLittleEndian<std::uint16_t>(r.body);
+  const auto log_time = LoadLittleEndian<std::uint64_t>(r.body + 6);
+  ++bag_->messages;
+  if (channel >= slots_.size() || slots_[channel].conn == nullptr) {
+    if (w.orphan_messages++ == 0) w.first_orphan = at;
+    return;
+  }
+  const Slot& slot = slots_[channel];
+  ++slot.conn->messages;
+  if (slot.topic < 0) return;
+  RosImuTopic& t = bag_->imu_topics[static_cast<std::size_t>(slot.topic)];
+  detail::RosImuMessage m;
+  std::string why;
+  if (!detail::DecodeCdrImu(r.body + 22, r.len - 22, &m, &why)) {
+    ++t.malformed;
+    if (w.malformed_imu++ == 0) {
+      w.first_malformed_imu = at;
+      w.first_malformed_why = "the message " + std::to_string(t.samples.size() + t.malformed - 1) +
+                              " of " + t.topic + ", in the record at byte " +
+                              std::to_string(at) + ", " + why;
+    }
+    return;
+  }
+  std::int64_t sec = 0;
+  std::uint32_t nsec = 0;
+  detail::SplitNanoseconds(static_cast<std::int64_t>(log_time), &sec, &nsec);
+  detail::AppendImu(&t, m, sec, nsec);
+}
+
+/// ParseMcap, releasing the pages of `file` (or nullptr) behind the parser.
+RosBag ParseFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
+                 const LogFile* file) {
+  RosBag bag;
+  bag.kind = RosBagKind::kMcap;
+  bag.source = source;
+  bag.size_bytes = size;
+  if (size < kPrefixSize || !std::equal(data, data + kPrefixSize, kMagic)) {
+    throw InputError(source, "byte 0", "not an MCAP file (no 0x89 \"MCAP\" magic)");
+  }
+  if (size < kMagicSize || !std::equal(data, data + kMagicSize, kMagic)) {
+    throw InputError(source, "byte 5",
+                     size < kMagicSize ? "MCAP magic cut short"
+                                       : "MCAP of another version ('" +
+                                             std::string(1, static_cast<char>(data[5])) +
+                                             "'); plumb reads version 0");
+  }
+  Parser(data, size, &bag, file).Run();
+  return bag;
+}
+
+}  // namespace
+
+RosBag ParseMcap(const std::uint8_t* data, std::size_t size, const std::string& source) {
+  return ParseFrom(data, size, source, nullptr);
+}
+
+RosBag ReadMcap(const std::string& path) {
+  const LogFile file(path, "MCAP file");
+  try {
+    RosBag bag = ParseFrom(file.data(), file.size(), path, &file);
+    file.ThrowIfCut();
+    return bag;
+  } catch (const Error&) {
+    file.ThrowIfCut();
+    throw;
+  }
+}
+
+bool LooksLikeMcap(const std::string& path) {
+  std::ifstream in(OpenPath(path), std::ios::binary);
+  char head[kPrefixSize] = {};
+  in.read(head, sizeof(head));
+  return in.gcount() == static_cast<std::streamsize>(sizeof(head)) &&
+         std::equal(head, head + sizeof(head), reinterpret_cast<const char*>(kMagic));
+}
+
+}  // namespace plumb::io

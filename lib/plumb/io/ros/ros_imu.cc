@@ -1,0 +1,124 @@
+// plumb/io/ros/ros_imu.cc — see ros_imu.h.
+#include "plumb/io/ros/ros_imu.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "plumb/io/common/log_common.h"
+
+namespace plumb::io::detail {
+namespace {
+
+/// Reads CDR primitives of one byte order from [p, p + n), aligned relative to p.
+class CdrCursor {
+ public:
+  CdrCursor(const std::uint8_t* p, std::size_t n, bool little) : p_(p), n_(n), little_(little) {}
+
+  std::size_t pos() const { return pos_; }
+
+  /// Aligns to `size` and checks that `size` * `count` bytes follow. False when they do not.
+  bool Need(std::size_t size, std::size_t count) {
+    const std::size_t aligned = (pos_ + size - 1) / size * size;
+    if (aligned > n_ || (n_ - aligned) / size < count) return false;
+    pos_ = aligned;
+    return true;
+  }
+  template <typename T>
+  T Read() {  // after Need(sizeof(T), ...)
+    std::uint8_t b[sizeof(T)];
+    std::memcpy(b, p_ + pos_, sizeof(T));
+    if (!little_) std::reverse(b, b + sizeof(T));
+    pos_ += sizeof(T);
+    return LoadLittleEndian<T>(b);
+  }
+  const std::uint8_t* here() const { return p_ + pos_; }
+  void Skip(std::size_t bytes) { pos_ += bytes; }
+
+ private:
+  const std::uint8_t* p_;
+  std::size_t n_;
+  bool little_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace
+
+bool DecodeCdrImu(const std::uint8_t* p, std::size_t n, RosImuMessage* out, std::string* why) {
+  if (n < 4) {
+    *why = "byte 0: " + std::to_string(n) + " bytes, less than the CDR encapsulation header";
+    return false;
+  }
+  if (p[0] != 0x00 || (p[1] != 0x00 && p[1] != 0x01)) {
+    *why = "byte 0: encapsulation " + std::to_string(p[0]) + " " + std::to_string(p[1]) +
+           " is not plain CDR (0 1 little endian, 0 0 big endian)";
+    return false;
+  }
+  CdrCursor c(p + 4, n - 4, p[1] == 0x01);
+  const auto at = [&c](const std::string& what) {
+    return "byte " + std::to_string(4 + c.pos()) + ": the message ends in " + what;
+  };
+  if (!c.Need(4, 3)) {
+    *why = at("its header");
+    return false;
+  }
+  out->sec = c.Read<std::int32_t>();
+  out->nsec = c.Read<std::uint32_t>();
+  const std::uint32_t len = c.Read<std::uint32_t>();
+  if (!c.Need(1, len)) {
+    *why = at("header.frame_id (length " + std::to_string(len) + ")");
+    return false;
+  }
+  if (len == 0 || c.here()[len - 1] != 0) {
+    *why = "byte " + std::to_string(4 + c.pos()) + ": header.frame_id of length " +
+           std::to_string(len) + " without its terminating NUL";
+    return false;
+  }
+  out->frame_id = std::string_view(reinterpret_cast<const char*>(c.here()), len - 1);
+  c.Skip(len);
+  constexpr std::size_t kDoubles = 4 + 9 + 3 + 9 + 3 + 9;
+  if (!c.Need(8, kDoubles)) {
+    *why = at("its orientation, velocities or covariances (" +
+              std::to_string(kDoubles * 8) + " bytes from there)");
+    return false;
+  }
+  double d[kDoubles];
+  for (double& v : d) v = c.Read<double>();
+  for (int i = 0; i < 4; ++i) out->orientation[i] = d[i];
+  out->orientation_cov0 = d[4];
+  out->gyr = Vec3(d[13], d[14], d[15]);
+  out->gyr_cov0 = d[16];
+  out->acc = Vec3(d[25], d[26], d[27]);
+  out->acc_cov0 = d[28];
+  return true;
+}
+
+int ImuTopicIndex(RosBag* bag, const std::string& topic) {
+  auto& topics = bag->imu_topics;
+  const auto it = std::find_if(topics.begin(), topics.end(),
+                               [&](const RosImuTopic& t) { return t.topic == topic; });
+  const int index = static_cast<int>(it - topics.begin());
+  if (it == topics.end()) {
+    topics.emplace_back();
+    topics.back().topic = topic;
+  }
+  return index;
+}
+
+void AppendImu(RosImuTopic* t, const RosImuMessage& m, std::int64_t receive_sec,
+               std::uint32_t receive_nsec) {
+  if (t->samples.empty()) t->frame_id = std::string(m.frame_id.substr(0, 256));
+  t->samples.t_s.push_back(static_cast<double>(m.sec) + static_cast<double>(m.nsec) * 1e-9);
+  t->receive_s.push_back(static_cast<double>(receive_sec) +
+                         static_cast<double>(receive_nsec) * 1e-9);
+  t->samples.acc.push_back(SaturatedFloat(m.acc));
+  t->samples.gyr.push_back(SaturatedFloat(m.gyr));
+  if (m.acc_cov0 == -1.0) ++t->acc_not_given;
+  if (m.gyr_cov0 == -1.0) ++t->gyr_not_given;
+  if (m.orientation_cov0 == -1.0) ++t->orientation_not_given;
+  if (m.orientation[0] == 0.0 && m.orientation[1] == 0.0 && m.orientation[2] == 0.0 &&
+      m.orientation[3] == 0.0) {
+    ++t->orientation_zero;
+  }
+}
+
+}  // namespace plumb::io::detail
