@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "support/ros2_fixtures.h"
 #include "run_tool.h"
 
 namespace plumb::cli {
@@ -22,29 +23,11 @@ using testing::ReadJson;
 using testing::TempDir;
 using testing::ToolRun;
 
-const std::string kBag = std::string(PLUMB_SHARED_DATA_DIR) + "/ros/ardrone_imu.bag";
-const std::string kPrefix = std::string(PLUMB_ROS2_FIXTURES_DIR) + "/ardrone_imu";
-
-/// Makes the fixtures once per process; "" when made, else why not.
-std::string MakeFixtures() {
-  static const std::string why = [] {
-    if (!std::filesystem::exists(kBag)) return "shared data absent: " + kBag;
-    const std::string command = std::string(PLUMB_SOURCE_DIR) +
-                                "/tests/io/ros2_fixtures/make-fixtures '" + kBag + "' '" +
-                                kPrefix + "' 2>&1";
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr) return std::string("cannot run ") + command;
-    std::string out;
-    char buffer[4096];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) out.append(buffer, n);
-    return ::pclose(pipe) == 0 ? std::string() : "the fixtures were not made: " + out;
-  }();
-  return why;
-}
+const std::string& kBag = plumb::testing::Ros2FixturesSourceBag();
+const std::string& kPrefix = plumb::testing::Ros2FixturesPrefix();
 
 TEST(Ros2BagCli, InfoListsTheSameTopicCountRateAndStillPeriodsAsTheBag) {
-  if (const std::string why = MakeFixtures(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = plumb::testing::MakeRos2Fixtures(); !why.empty()) GTEST_SKIP() << why;
   TempDir dir;
   const ToolRun ros1 = Plumb({"info", kBag, "--json", dir.File("bag.json")}, dir);
   ASSERT_EQ(ros1.exit_code, 0) << ros1.err;
@@ -80,7 +63,7 @@ TEST(Ros2BagCli, InfoListsTheSameTopicCountRateAndStillPeriodsAsTheBag) {
 }
 
 TEST(Ros2BagCli, CalibrateOnTheReceiveClock) {
-  if (const std::string why = MakeFixtures(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = plumb::testing::MakeRos2Fixtures(); !why.empty()) GTEST_SKIP() << why;
   TempDir dir;
   const ToolRun run = Plumb({"calibrate", kPrefix + "_zstd.mcap", "--topic", "/ardrone/imu",
                              "--clock", "receive"}, dir);

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 namespace plumb::estimation {
 namespace {
@@ -63,6 +65,12 @@ TEST(Observability, ADirectionThroughAnAttitudeStillDeterminesWhatItLeaves) {
   EXPECT_NEAR(c.sigma, std::sqrt(2.0), 1e-12);  // y2 - y1
   // The determined combination is orthogonal to the null direction's model part.
   EXPECT_NEAR(c.coefficients[0] + c.coefficients[1], 0.0, 1e-12);
+  // The direction as numbers, over every unknown: the data does not see it.
+  ASSERT_EQ(a.summary.null_space.rows(), 1);
+  ASSERT_EQ(a.summary.null_space.cols(), 3);
+  EXPECT_EQ(a.summary.null_space_names, (std::vector<std::string>{"a", "b", "theta"}));
+  EXPECT_LT((TwoBiasesThroughOneAttitude().J * a.summary.null_space.row(0).transpose()).norm(),
+            1e-12);
 }
 
 TEST(Observability, FullRankCovarianceIsTheInverseNormalMatrix) {

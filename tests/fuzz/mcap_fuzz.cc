@@ -5,26 +5,11 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "plumb/core/error.h"
 #include "plumb/io/ros/mcap.h"
-#include "plumb/io/ros/ros_session.h"
 
-#include "select_every_stream.h"
+#include "exercise_ros_bag.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  try {
-    const plumb::io::RosBag bag = plumb::io::ParseMcap(data, size, "fuzz");
-    (void)bag.warnings.Describe();
-    (void)bag.MessageCounts();
-    (void)plumb::io::RosBagSummary(bag);
-    for (const bool receive : {false, true}) {
-      plumb::fuzz::SelectEveryStream(
-          plumb::io::RosBagImuStreams(bag), [&](plumb::io::FlightLogSelection selection) {
-            selection.receive_time = receive;
-            (void)plumb::io::RosBagSession(bag, selection);
-          });
-    }
-  } catch (const plumb::Error&) {
-  }
+  plumb::fuzz::ExerciseRosBag(data, size, plumb::io::ParseMcap);
   return 0;
 }

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <string>
 
+#include "support/ros2_fixtures.h"
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/db3.h"
 #include "plumb/io/ros/mcap.h"
@@ -20,32 +21,11 @@
 namespace plumb::io {
 namespace {
 
-const std::string kBag = std::string(PLUMB_SHARED_DATA_DIR) + "/ros/ardrone_imu.bag";
-const std::string kPrefix = std::string(PLUMB_ROS2_FIXTURES_DIR) + "/ardrone_imu";
-
-/// Makes the fixtures (once per process; the script keeps fresh ones); "" when made, else why
-/// not.
-std::string MakeFixtures() {
-  static const std::string why = [] {
-    if (!std::filesystem::exists(kBag)) return "shared data absent: " + kBag;
-    const std::string command = std::string(PLUMB_SOURCE_DIR) +
-                                "/tests/io/ros2_fixtures/make-fixtures '" + kBag + "' '" +
-                                kPrefix + "' 2>&1";
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr) return std::string("cannot run ") + command;
-    std::string out;
-    char buffer[4096];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) out.append(buffer, n);
-    const int status = ::pclose(pipe);
-    if (status == 0) return std::string();
-    return "the fixtures were not made (" + command + "): " + out;
-  }();
-  return why;
-}
+const std::string& kBag = plumb::testing::Ros2FixturesSourceBag();
+const std::string& kPrefix = plumb::testing::Ros2FixturesPrefix();
 
 #define NEED_FIXTURES()                                   \
-  if (const std::string why = MakeFixtures(); !why.empty()) \
+  if (const std::string why = plumb::testing::MakeRos2Fixtures(); !why.empty()) \
   GTEST_SKIP() << why
 
 void ExpectSameTopic(const RosImuTopic& a, const RosImuTopic& b) {

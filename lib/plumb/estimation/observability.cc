@@ -91,7 +91,7 @@ std::vector<NullGroup> GroupsJoinedByNullDirections(const Eigen::MatrixXd& B,
 
 /// The combinations of a group's parameters orthogonal to the model part of its null
 /// directions (the left null space of that part), in row-echelon form with biases leading, as
-/// vectors over J's n columns.
+/// vectors over J's n columns, in the order of their leading parameters.
 std::vector<Eigen::VectorXd> DeterminedInGroup(const Eigen::MatrixXd& B, const NullGroup& group,
                                                Eigen::Index n) {
   const auto size = static_cast<Eigen::Index>(group.parameters.size());
@@ -111,7 +111,7 @@ std::vector<Eigen::VectorXd> DeterminedInGroup(const Eigen::MatrixXd& B, const N
   std::iota(reversed.rbegin(), reversed.rend(), 0);  // pivots from the end: biases before matrices
   const Eigen::MatrixXd echelon = Rref(svd.matrixV().rightCols(free_dim).transpose(), reversed);
   std::vector<Eigen::VectorXd> out;
-  for (Eigen::Index r = 0; r < echelon.rows(); ++r) {
+  for (Eigen::Index r = echelon.rows() - 1; r >= 0; --r) {  // in the parameters' order
     Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
     for (Eigen::Index a = 0; a < size; ++a) c[group.parameters[static_cast<std::size_t>(a)]] = echelon(r, a);
     out.push_back(std::move(c));

@@ -210,28 +210,14 @@ void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
                     " bytes uncompressed, more than plumb reads (1 GiB)");
     return;
   }
-  const auto declared = static_cast<std::uint32_t>(size);
-  std::string why;
-  const std::uint8_t* p = Bytes(records);
-  std::size_t n = records.size();
-  bool whole = true;
-  if (!compression.empty()) {
-    whole = detail::DecompressChunk(compression, p, n, declared, cut, &chunk_, &n, &why);
-    p = chunk_.data();
-  } else if (n != declared) {
-    whole = false;
-    why = cut ? "chunk cut by the end of the file after " + std::to_string(n) + " of its " +
-                    std::to_string(declared) + " bytes"
-              : "uncompressed chunk of " + std::to_string(n) + " bytes, not its size " +
-                    std::to_string(declared);
-    n = std::min<std::size_t>(n, declared);
-  }
+  const detail::ChunkBody body = detail::OpenChunk(
+      compression, Bytes(records), records.size(), static_cast<std::uint32_t>(size), cut, &chunk_);
   std::string past_end;
-  const std::size_t kept = ChunkRecords(p, n, at, &past_end);
+  const std::size_t kept = ChunkRecords(body.data, body.size, at, &past_end);
   if (cut) {
     bag_->warnings.cut_messages_kept = kept;
-  } else if (!whole) {
-    Damaged(at, why);
+  } else if (!body.whole) {
+    Damaged(at, body.why);
   } else if (!past_end.empty()) {
     Damaged(at, past_end);
   }

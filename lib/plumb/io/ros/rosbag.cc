@@ -205,28 +205,14 @@ void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
                     " bytes uncompressed, more than plumb reads (1 GiB)");
     return;
   }
-  std::string why;
-  const std::uint8_t* records = r.data;
-  std::size_t n = r.data_len;
-  bool whole = true;
-  if (compression != "none" && !compression.empty()) {
-    whole = detail::DecompressChunk(compression, r.data, r.data_len, r.fields.size, cut, &chunk_,
-                                    &n, &why);
-    records = chunk_.data();
-  } else if (n != r.fields.size) {
-    whole = false;
-    why = cut ? "chunk cut by the end of the file after " + std::to_string(n) + " of its " +
-                    std::to_string(r.fields.size) + " bytes"
-              : "uncompressed chunk of " + std::to_string(n) + " bytes, not its size " +
-                    std::to_string(r.fields.size);
-    n = std::min<std::size_t>(n, r.fields.size);
-  }
+  const detail::ChunkBody body =
+      detail::OpenChunk(compression, r.data, r.data_len, r.fields.size, cut, &chunk_);
   std::string past_end;
-  const std::size_t kept = ChunkRecords(records, n, at, &past_end);
+  const std::size_t kept = ChunkRecords(body.data, body.size, at, &past_end);
   if (cut) {
     bag_->warnings.cut_messages_kept = kept;
-  } else if (!whole) {
-    Damaged(at, why);
+  } else if (!body.whole) {
+    Damaged(at, body.why);
   } else if (!past_end.empty()) {
     Damaged(at, past_end);
   }

@@ -264,6 +264,23 @@ bool Zstd(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cu
 
 }  // namespace
 
+ChunkBody OpenChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
+                    std::uint32_t declared, bool cut, std::vector<std::uint8_t>* buffer) {
+  ChunkBody body{in, n, true, {}};
+  if (compression != "none" && !compression.empty()) {
+    body.whole = DecompressChunk(compression, in, n, declared, cut, buffer, &body.size, &body.why);
+    body.data = buffer->data();
+  } else if (n != declared) {
+    body.whole = false;
+    body.why = cut ? "chunk cut by the end of the file after " + std::to_string(n) + " of its " +
+                         std::to_string(declared) + " bytes"
+                   : "uncompressed chunk of " + std::to_string(n) + " bytes, not its size " +
+                         std::to_string(declared);
+    body.size = std::min<std::size_t>(n, declared);
+  }
+  return body;
+}
+
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
                      std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
                      std::size_t* out_size, std::string* why) {

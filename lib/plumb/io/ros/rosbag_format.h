@@ -77,6 +77,20 @@ bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::
                      std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
                      std::size_t* out_size, std::string* why);
 
+/// A chunk's records as a reader walks them.
+struct ChunkBody {
+  const std::uint8_t* data = nullptr;
+  std::size_t size = 0;
+  bool whole = true;  ///< all `declared` bytes are there; else `why` says what is not
+  std::string why;
+};
+
+/// The records of a chunk whose data is [in, in + n): as stored for `compression` "none" or
+/// empty (cut to `declared` bytes), else decompressed into `buffer` (DecompressChunk). The ROS 1
+/// and MCAP readers' chunks alike.
+ChunkBody OpenChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
+                    std::uint32_t declared, bool cut, std::vector<std::uint8_t>* buffer);
+
 /// Bytes of a sensor_msgs/Imu message past its frame_id.
 inline constexpr std::size_t kRosImuFixedBytes = 37 * 8;
 
