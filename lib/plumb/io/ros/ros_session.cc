@@ -139,7 +139,10 @@ const char* RosBagFormatName(RosBagKind kind) {
 }
 
 bool IsRosBag(const std::string& format) {
-  return format == "ros1-bag" || format == "ros2-mcap" || format == "ros2-db3";
+  for (const RosBagKind kind : {RosBagKind::kRos1, RosBagKind::kMcap, RosBagKind::kSqlite3}) {
+    if (format == RosBagFormatName(kind)) return true;
+  }
+  return false;
 }
 
 std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag) {
