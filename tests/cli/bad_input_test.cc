@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -215,6 +216,38 @@ TEST_F(BadInput, Ros2Mcap) {
   Battery(good, "mcap", 7,
           {{"after_magic", std::string("\x89MCAP0\r\n", 8) + garbage},
            {"version1", std::string("\x89MCAP1\r\n", 8) + garbage}});
+}
+
+/// `mcap` with one bit flipped in the middle of its first chunk's records (opcode 0x06 after
+/// the magic; uncompressed, so the messages still decode); `chunk_at` the chunk's offset.
+std::string FlipInFirstChunk(std::string mcap, std::size_t* chunk_at) {
+  std::size_t at = 8;
+  std::uint64_t len = 0;
+  while (at + 9 <= mcap.size()) {
+    std::memcpy(&len, mcap.data() + at + 1, sizeof len);
+    if (mcap[at] == 0x06) break;
+    at += 9 + static_cast<std::size_t>(len);
+  }
+  mcap[at + 9 + static_cast<std::size_t>(len) * 3 / 4] ^= 0x04;
+  *chunk_at = at;
+  return mcap;
+}
+
+// A chunk not matching its CRC-32 (stated by @mcap/core): exit 1, the message naming the file,
+// the chunk's byte offset and the CRC; and through the battery.
+TEST_F(BadInput, Ros2McapChunkCrc) {
+  std::size_t at = 0;
+  const std::string flipped = FlipInFirstChunk(
+      ReadAll(std::string(PLUMB_SOURCE_DIR) + "/tests/fuzz/seeds/mcap/phidgets_60.mcap"), &at);
+  const std::string path = dir_.File("crc.mcap");
+  Write(path, flipped);
+  const ToolRun run = Plumb({"info", path}, dir_);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_TRUE(Contains(run.err, path + ":byte " + std::to_string(at) + ": ")) << run.err;
+  EXPECT_TRUE(Contains(run.err, "uncompressed_crc")) << run.err;
+  fs::remove(path);
+  Battery(ReadAll(std::string(PLUMB_SOURCE_DIR) + "/tests/fuzz/seeds/mcap/phidgets_60.mcap"),
+          "mcap", 9, {{"crc", flipped}});
 }
 
 TEST_F(BadInput, Ros2Db3) {

@@ -8,10 +8,13 @@
 #include <sqlite3.h>
 #include <zstd.h>
 
+#include <boost/crc.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -99,8 +102,17 @@ inline std::string McapMessage(std::uint16_t channel, std::uint64_t log_time_ns,
                               Le(log_time_ns) + data);
 }
 
-/// A Chunk record of `records`, compressed with `compression` ("", "zstd", "lz4").
-inline std::string McapChunk(const std::string& records, const std::string& compression) {
+/// The CRC-32 of `bytes` (Boost.CRC's: another implementation than the reader's libdeflate).
+inline std::uint32_t Crc32(const std::string& bytes) {
+  boost::crc_32_type crc;
+  crc.process_bytes(bytes.data(), bytes.size());
+  return static_cast<std::uint32_t>(crc.checksum());
+}
+
+/// A Chunk record of `records`, compressed with `compression` ("", "zstd", "lz4"), stating the
+/// records' CRC-32 when `with_crc` (else 0, "not given").
+inline std::string McapChunk(const std::string& records, const std::string& compression,
+                             bool with_crc = false) {
   std::string data = records;
   if (compression == "zstd") {
     data.resize(ZSTD_compressBound(records.size()));
@@ -113,7 +125,8 @@ inline std::string McapChunk(const std::string& records, const std::string& comp
   }
   return McapRecord(0x06, Le(std::uint64_t{0}) + Le(std::uint64_t{0}) +
                               Le(static_cast<std::uint64_t>(records.size())) +
-                              Le(std::uint32_t{0}) + McapString(compression) +
+                              Le(with_crc ? Crc32(records) : std::uint32_t{0}) +
+                              McapString(compression) +
                               Le(static_cast<std::uint64_t>(data.size())) + data);
 }
 
@@ -130,33 +143,32 @@ struct Db3Message {
   std::int64_t timestamp;
   std::string data;
 };
-inline void WriteDb3(const std::string& path, const std::vector<Db3Topic>& topics,
-                     const std::vector<Db3Message>& messages, bool with_tables = true) {
-  std::remove(path.c_str());
-  sqlite3* db = nullptr;
-  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) throw std::runtime_error("WriteDb3: open");
-  const auto exec = [db](const std::string& sql) {
-    if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) {
-      throw std::runtime_error("WriteDb3: " + std::string(sqlite3_errmsg(db)));
-    }
-  };
-  if (!with_tables) {
-    exec("CREATE TABLE other(x INTEGER)");
-    sqlite3_close(db);
-    return;
+inline void Db3Exec(sqlite3* db, const std::string& sql) {
+  if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) {
+    throw std::runtime_error("WriteDb3: " + std::string(sqlite3_errmsg(db)));
   }
-  exec("CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, "
-       "serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL)");
-  exec("CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp "
-       "INTEGER NOT NULL, data BLOB NOT NULL)");
+}
+
+/// rosbag2's two tables and `topics`.
+inline void Db3Tables(sqlite3* db, const std::vector<Db3Topic>& topics) {
+  Db3Exec(db, "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT "
+              "NULL, serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL)");
+  Db3Exec(db, "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, "
+              "timestamp INTEGER NOT NULL, data BLOB NOT NULL)");
   for (const Db3Topic& t : topics) {
-    exec("INSERT INTO topics VALUES (" + std::to_string(t.id) + ", '" + t.name + "', '" + t.type +
-         "', '" + t.format + "', '')");
+    Db3Exec(db, "INSERT INTO topics VALUES (" + std::to_string(t.id) + ", '" + t.name + "', '" +
+                    t.type + "', '" + t.format + "', '')");
   }
+}
+
+/// `messages` [begin, end) inserted, one transaction each (as a recorder writes them).
+inline void Db3Insert(sqlite3* db, const std::vector<Db3Message>& messages, std::size_t begin,
+                      std::size_t end) {
   sqlite3_stmt* s = nullptr;
   sqlite3_prepare_v2(db, "INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)", -1,
                      &s, nullptr);
-  for (const Db3Message& m : messages) {
+  for (std::size_t i = begin; i < end && i < messages.size(); ++i) {
+    const Db3Message& m = messages[i];
     sqlite3_bind_int(s, 1, m.topic_id);
     sqlite3_bind_int64(s, 2, m.timestamp);
     sqlite3_bind_blob(s, 3, m.data.data(), static_cast<int>(m.data.size()), SQLITE_TRANSIENT);
@@ -164,7 +176,46 @@ inline void WriteDb3(const std::string& path, const std::vector<Db3Topic>& topic
     sqlite3_reset(s);
   }
   sqlite3_finalize(s);
+}
+
+inline void WriteDb3(const std::string& path, const std::vector<Db3Topic>& topics,
+                     const std::vector<Db3Message>& messages, bool with_tables = true) {
+  std::remove(path.c_str());
+  sqlite3* db = nullptr;
+  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) throw std::runtime_error("WriteDb3: open");
+  if (!with_tables) {
+    Db3Exec(db, "CREATE TABLE other(x INTEGER)");
+    sqlite3_close(db);
+    return;
+  }
+  Db3Tables(db, topics);
+  Db3Insert(db, messages, 0, messages.size());
   sqlite3_close(db);
+}
+
+/// The bag `path` and its `path`-wal as a recorder in WAL mode leaves them when it dies: the
+/// tables and the first `checkpointed` messages checkpointed into the bag (none, with the
+/// tables too, when 0), the others only in the -wal file. Written in `scratch` (a file name
+/// in another folder) and copied while its connection is open (closing it would checkpoint).
+inline void WriteUnclosedDb3(const std::string& path, const std::string& scratch,
+                             const std::vector<Db3Topic>& topics,
+                             const std::vector<Db3Message>& messages, std::size_t checkpointed) {
+  std::remove(scratch.c_str());
+  sqlite3* db = nullptr;
+  if (sqlite3_open(scratch.c_str(), &db) != SQLITE_OK) throw std::runtime_error("open");
+  Db3Exec(db, "PRAGMA journal_mode=WAL");
+  Db3Exec(db, "PRAGMA wal_autocheckpoint=0");
+  Db3Tables(db, topics);
+  if (checkpointed > 0) {
+    Db3Insert(db, messages, 0, checkpointed);
+    Db3Exec(db, "PRAGMA wal_checkpoint(TRUNCATE)");
+  }
+  Db3Insert(db, messages, checkpointed, messages.size());
+  std::filesystem::copy_file(scratch, path, std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::copy_file(scratch + "-wal", path + "-wal",
+                             std::filesystem::copy_options::overwrite_existing);
+  sqlite3_close(db);
+  std::remove(scratch.c_str());
 }
 
 }  // namespace plumb::test

@@ -7,11 +7,16 @@
 // python3-rosbag are absent.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "support/ros2_fixtures.h"
+#include "plumb/core/error.h"
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/db3.h"
 #include "plumb/io/ros/mcap.h"
@@ -101,6 +106,36 @@ TEST(Ros2RealData, FormatDetailsNameTheChunksAndTopics) {
             std::string::npos);
   EXPECT_EQ(FlightLog::Open(kPrefix + ".db3").Summary().format_detail,
             "ROS 2 sqlite3 bag, 2 topics");
+}
+
+// @mcap/core states every chunk's CRC-32: the copies above pass plumb's check; one bit flipped in
+// the middle of the uncompressed copy's first chunk (a byte that still decodes) is refused.
+TEST(Ros2RealData, AByteFlippedInAChunkIsRefusedByItsCrc) {
+  NEED_FIXTURES();
+  std::ifstream in(kPrefix + ".mcap", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  std::size_t at = 8;  // the first Chunk record (opcode 0x06), after the magic
+  while (at + 9 <= bytes.size() && bytes[at] != 0x06) {
+    std::uint64_t len = 0;
+    std::memcpy(&len, bytes.data() + at + 1, sizeof len);
+    at += 9 + static_cast<std::size_t>(len);
+  }
+  ASSERT_LT(at + 9, bytes.size());
+  std::uint64_t len = 0;
+  std::memcpy(&len, bytes.data() + at + 1, sizeof len);
+  bytes[at + 9 + static_cast<std::size_t>(len) / 2] ^= 0x10;
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "plumb_ros2_real_flipped.mcap").string();
+  std::ofstream(path, std::ios::binary) << bytes;
+  try {
+    ReadMcap(path);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_EQ(e.where(), "byte " + std::to_string(at));
+    EXPECT_NE(std::string(e.what()).find("uncompressed_crc"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
 }
 
 }  // namespace

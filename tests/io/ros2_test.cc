@@ -5,9 +5,13 @@
 // it; and FlightLog recognising both by content.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <string>
+#include <vector>
 
 #include "io/ros2_builder.h"
 #include "plumb/core/error.h"
@@ -168,6 +172,36 @@ TEST(McapReader, UnknownCompressionIsADamagedChunk) {
   EXPECT_EQ(bag.compression.at("bogus"), 1u);
   ASSERT_EQ(bag.imu_topics.size(), 1u);
   EXPECT_EQ(bag.imu_topics[0].samples.size(), 5u);
+}
+
+TEST(McapReader, ChunksStatingTheirCrcAreChecked) {
+  for (const char* c : {"", "zstd", "lz4"}) {
+    const RosBag bag = Parse(Mcap(McapChunk(ImuRecords(40), c, true) +
+                                  McapChunk(ImuRecords(40, 40, false), c, true)));
+    EXPECT_FALSE(bag.warnings.any()) << c;
+    EXPECT_EQ(bag.imu_topics.at(0).samples.size(), 80u) << c;
+  }
+}
+
+TEST(McapReader, AChunkNotMatchingItsCrcIsAnInputErrorNamingTheChunk) {
+  const std::string first = McapChunk(ImuRecords(40), "", true);
+  const std::string second = McapChunk(ImuRecords(40, 40, false), "", true);
+  std::string bytes = Mcap(first + second);
+  const std::size_t at = bytes.find(second);
+  ASSERT_NE(at, std::string::npos);
+  bytes[at + second.size() - 40] ^= 0x01;  // a bit of a double of the chunk's last message
+  try {
+    Parse(bytes);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "t.mcap");
+    EXPECT_EQ(e.where(), "byte " + std::to_string(at));
+    EXPECT_NE(std::string(e.what()).find("uncompressed_crc"), std::string::npos) << e.what();
+  }
+  // A compressed chunk whose stated CRC is wrong: the same.
+  std::string zstd = McapChunk(ImuRecords(40), "zstd", true);
+  zstd[9 + 24] ^= 0x01;  // uncompressed_crc's first byte
+  EXPECT_THROW(Parse(Mcap(zstd)), InputError);
 }
 
 TEST(McapReader, NoFooterIsSaid) {
@@ -345,6 +379,62 @@ TEST(Db3Reader, NeverWritesBesideTheInput) {
   }
   EXPECT_EQ(files, 1u);  // no -journal, -wal or -shm
   std::filesystem::remove_all(dir);
+}
+
+/// The names of the files in `dir`.
+std::vector<std::string> FilesIn(const std::filesystem::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    out.push_back(e.path().filename().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A recorder killed in WAL mode: its last messages (or, checkpointed 0, everything, the tables
+// too) only in bag.db3-wal. Every message is read, with a warning naming the -wal file; the
+// two files stay as they were, nothing is written beside them, and the temporary folder plumb
+// reads them in is left as it was (TMPDIR pointed at an empty folder of the test's).
+TEST(Db3Reader, MessagesLeftInTheWalFileAreReadWithoutWritingBesideTheInput) {
+  const std::filesystem::path dir = TempPath("wal");
+  const std::filesystem::path tmp = TempPath("wal_tmp");
+  const std::filesystem::path scratch = TempPath("wal_scratch");
+  const RosBag reference = Parse(Mcap(ImuRecords(40)));
+  const char* old_tmp = std::getenv("TMPDIR");
+  const std::string saved = old_tmp == nullptr ? "" : old_tmp;
+  for (const std::size_t checkpointed : {std::size_t{30}, std::size_t{0}}) {
+    SCOPED_TRACE(checkpointed);
+    for (const auto& d : {dir, tmp, scratch}) {
+      std::filesystem::remove_all(d);
+      std::filesystem::create_directories(d);
+    }
+    const std::string path = (dir / "bag.db3").string();
+    test::WriteUnclosedDb3(path, (scratch / "x.db3").string(),
+                           {{1, "/imu", "sensor_msgs/msg/Imu"},
+                            {2, "/mag", "sensor_msgs/msg/MagneticField"}},
+                           Db3Imu(40), checkpointed);
+    ASSERT_GT(std::filesystem::file_size(path + "-wal"), 32u);
+    const std::string bag_bytes = FileBytes(path), wal_bytes = FileBytes(path + "-wal");
+    for (const std::string& f : {path, path + "-wal"}) {
+      std::filesystem::permissions(f, std::filesystem::perms::owner_read);
+    }
+    ::setenv("TMPDIR", tmp.c_str(), 1);
+    EXPECT_EQ(SniffFlightLog(path), FlightLogFormat::kRos2Db3);
+    const RosBag bag = ReadDb3(path);
+    EXPECT_EQ(FlightLog::Open(path).Summary().imus.at(0).samples, 40u);
+    if (old_tmp == nullptr) ::unsetenv("TMPDIR"); else ::setenv("TMPDIR", saved.c_str(), 1);
+    ASSERT_EQ(bag.imu_topics.size(), 1u);
+    EXPECT_EQ(bag.imu_topics[0].samples.t_s, reference.imu_topics.at(0).samples.t_s);
+    EXPECT_EQ(bag.messages, 80u);
+    const std::vector<std::string> said = bag.warnings.Describe();
+    ASSERT_EQ(said.size(), 1u) << said.front();
+    EXPECT_NE(said[0].find(path + "-wal"), std::string::npos) << said[0];
+    EXPECT_EQ(FilesIn(dir), (std::vector<std::string>{"bag.db3", "bag.db3-wal"}));
+    EXPECT_EQ(FileBytes(path), bag_bytes);
+    EXPECT_EQ(FileBytes(path + "-wal"), wal_bytes);
+    EXPECT_TRUE(FilesIn(tmp).empty());
+  }
+  for (const auto& d : {dir, tmp, scratch}) std::filesystem::remove_all(d);
 }
 
 TEST(Db3Reader, AnSqliteFileWithoutTheTablesIsNotABag) {

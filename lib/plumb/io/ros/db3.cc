@@ -3,10 +3,15 @@
 
 #include <sqlite3.h>
 
+#include <stdlib.h>  // mkdtemp
+
 #include <cctype>
+#include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <memory>
+#include <system_error>
 #include <unordered_map>
 
 #include "plumb/core/error.h"
@@ -29,9 +34,9 @@ struct FinalizeStatement {
 };
 using Statement = std::unique_ptr<sqlite3_stmt, FinalizeStatement>;
 
-/// `path` as an SQLite URI naming the file read-only and immutable (every byte outside the
-/// unreserved set and '/' percent-encoded).
-std::string ImmutableUri(const std::string& path) {
+/// `path` as an SQLite URI (every byte outside the unreserved set and '/' percent-encoded) with
+/// `query` ("mode=ro&immutable=1").
+std::string Uri(const std::string& path, const char* query) {
   std::string uri = "file:";
   for (const unsigned char c : path) {
     if (std::isalnum(c) || c == '/' || c == '-' || c == '.' || c == '_' || c == '~') {
@@ -43,13 +48,63 @@ std::string ImmutableUri(const std::string& path) {
       uri += kHex[c & 15];
     }
   }
-  return uri + "?mode=ro&immutable=1";
+  return uri + "?" + query;
 }
 
-Db OpenFile(const std::string& path, std::string* why) {
+/// The size of the -wal file beside `file` when it holds frames (more than its 32-byte header),
+/// else 0.
+std::uintmax_t WalBytes(const std::string& file) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(file + "-wal", ec);
+  return !ec && size > 32 ? size : 0;
+}
+
+/// A folder plumb makes in the temporary directory holding a copy of a bag and of its -wal
+/// file, where sqlite3 reads them as a live database (the -wal's frames replayed, its -shm
+/// made there); the copies, what sqlite3 made beside them and the folder are removed with it,
+/// nothing else.
+class WalCopy {
+ public:
+  WalCopy(const std::string& file, const std::string& source) {
+    std::string pattern = (std::filesystem::temp_directory_path() / "plumb-db3-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) {
+      throw InputError(source, "", "cannot make a temporary folder to read its -wal file in: " +
+                                       std::string(std::strerror(errno)));
+    }
+    dir_ = pattern;
+    db_ = dir_ + "/bag.db3";
+    std::error_code ec;
+    std::filesystem::copy_file(file, db_, ec);
+    if (!ec) std::filesystem::copy_file(file + "-wal", db_ + "-wal", ec);
+    if (ec) {
+      Remove();
+      throw InputError(source, "", "cannot copy it and its -wal file to a temporary folder: " +
+                                       ec.message());
+    }
+  }
+  ~WalCopy() { Remove(); }
+  WalCopy(const WalCopy&) = delete;
+  WalCopy& operator=(const WalCopy&) = delete;
+  const std::string& db() const { return db_; }
+
+ private:
+  void Remove() const {
+    std::error_code ec;
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"}) {
+      std::filesystem::remove(db_ + suffix, ec);
+    }
+    std::filesystem::remove(dir_, ec);  // only when empty
+  }
+  std::string dir_, db_;
+};
+
+/// Opens `path` read-only: immutable (no lock, nothing written beside it) unless `live`, for a
+/// WalCopy's database (its -wal read, its -shm made in plumb's own folder).
+Db OpenFile(const std::string& path, std::string* why, bool live = false) {
   sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(ImmutableUri(path).c_str(), &db,
-                                 SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
+  const std::string uri = Uri(path, live ? "mode=ro" : "mode=ro&immutable=1");
+  const int rc =
+      sqlite3_open_v2(uri.c_str(), &db, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
   Db out(db);
   if (rc != SQLITE_OK) {
     *why = std::string("sqlite3 cannot open it: ") + (db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
@@ -188,6 +243,24 @@ RosBag ReadFrom(sqlite3* db, const std::string& source, std::size_t size) {
   return bag;
 }
 
+/// A bag with a -wal file of `wal` bytes beside it (a recorder that did not close it): read
+/// from a WalCopy, so that the messages not yet checkpointed into the bag are read too.
+RosBag ReadWithWal(const std::string& file, const std::string& path, std::size_t size,
+                   std::uintmax_t wal) {
+  const WalCopy copy(file, path);
+  std::string why;
+  Db db = OpenFile(copy.db(), &why, true);
+  if (!db) throw InputError(path, "", why + " (a copy of it with its -wal file)");
+  RosBag bag = ReadFrom(db.get(), path, size);
+  db.reset();  // closed before the copy is removed
+  bag.warnings.notes.push_back(
+      "its -wal file (" + path + "-wal, " + std::to_string(wal) +
+      " bytes) was not checkpointed into it (the recording was not closed): read with it, "
+      "from a copy of both in a temporary folder; the " +
+      std::to_string(bag.messages) + " messages are the bag's and the -wal file's");
+  return bag;
+}
+
 bool HasSqliteHeader(const std::uint8_t* data, std::size_t size) {
   return size >= kSqliteHeaderSize &&
          std::memcmp(data, kSqliteHeader, kSqliteHeaderSize) == 0;
@@ -216,10 +289,14 @@ RosBag ReadDb3(const std::string& path) {
   if (!HasSqliteHeader(head, static_cast<std::size_t>(in.gcount()))) {
     throw InputError(path, "byte 0", "not an SQLite 3 database (no \"SQLite format 3\" header)");
   }
-  std::string why;
-  const Db db = OpenFile(file, &why);
-  if (!db) throw InputError(path, "", why);
-  return ReadFrom(db.get(), path, size);
+  const std::uintmax_t wal = WalBytes(file);
+  if (wal == 0) {
+    std::string why;
+    const Db db = OpenFile(file, &why);
+    if (!db) throw InputError(path, "", why);
+    return ReadFrom(db.get(), path, size);
+  }
+  return ReadWithWal(file, path, size, wal);
 }
 
 bool LooksLikeDb3(const std::string& path) {
@@ -230,6 +307,7 @@ bool LooksLikeDb3(const std::string& path) {
     in.read(reinterpret_cast<char*>(head), sizeof(head));
     if (!HasSqliteHeader(head, static_cast<std::size_t>(in.gcount()))) return false;
   }
+  if (WalBytes(file) != 0) return true;  // its tables may be in the -wal file only
   std::string why;
   const Db db = OpenFile(file, &why);
   if (!db) return false;

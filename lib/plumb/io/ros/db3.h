@@ -9,8 +9,15 @@
 // Decoding contract:
 //  * The database is opened read-only and immutable (SQLITE_OPEN_READONLY, the URI parameter
 //    immutable=1): sqlite3 then never writes a -journal, -wal or -shm file beside it nor takes
-//    a lock, and the input is never modified. (A bag whose recorder died before checkpointing
-//    its -wal file has its last messages there; immutable reading does not see them.)
+//    a lock, and the input is never modified.
+//  * A bag whose recorder did not close it (killed, crashed, power lost) may have messages in
+//    its -wal file (name.db3-wal beside it) not yet checkpointed into it; immutable reading
+//    would not see them. When that file holds frames (more than its 32-byte header), the bag
+//    and its -wal file are copied into a folder plumb makes in the temporary directory and
+//    read there as a live database (read-only; sqlite3 makes its -shm file there), the copies
+//    and the folder removed after: every message is read, nothing is written beside the
+//    input, and a warning names the -wal file. LooksLikeDb3 takes such a bag for one without
+//    looking for its tables (they may be in the -wal file only).
 //  * The topics are read from `topics` (RosBag::connections by id, type as given); a topic is
 //    an IMU topic when its type is "sensor_msgs/msg/Imu" and its serialization_format "cdr".
 //    The messages are read in the order of their id (the order recorded), each IMU message

@@ -3,6 +3,7 @@
 #include "plumb/io/ros/mcap.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <string_view>
 #include <unordered_map>
@@ -94,6 +95,8 @@ class Parser {
   static bool Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r);
   void TopRecord(const Record& r, std::size_t at);
   void Chunk(const Record& r, std::size_t at, bool cut);
+  /// Throws InputError naming the chunk at `at` when its records' CRC-32 is not `crc`.
+  void CheckCrc(const detail::ChunkBody& body, std::uint32_t crc, std::size_t at) const;
   /// The records of a chunk's data [p, p + n); `at`: the chunk's file offset. Returns the
   /// messages read; `past_end` says what ran past the data's end ("" when none).
   std::size_t ChunkRecords(const std::uint8_t* p, std::size_t n, std::size_t at,
@@ -128,7 +131,7 @@ class Parser {
     int topic = -1;                 ///< index in imu_topics, -1: not decoded
   };
   std::vector<Slot> slots_;
-  std::vector<std::uint8_t> chunk_;  ///< a decompressed chunk, reused
+  detail::ChunkBuffers chunk_;  ///< a decompressed chunk and the decompressors, reused
 };
 
 bool Parser::Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r) {
@@ -190,12 +193,23 @@ void Parser::TopRecord(const Record& r, std::size_t at) {
   }
 }
 
+void Parser::CheckCrc(const detail::ChunkBody& body, std::uint32_t crc, std::size_t at) const {
+  const std::uint32_t computed = detail::Crc32(body.data, body.size);
+  if (computed == crc) return;
+  char what[160];
+  std::snprintf(what, sizeof what,
+                "the chunk's %zu bytes of records do not match its uncompressed_crc (stated "
+                "%08x, computed %08x): the file is damaged there",
+                body.size, static_cast<unsigned>(crc), static_cast<unsigned>(computed));
+  throw InputError(bag_->source, "byte " + std::to_string(at), what);
+}
+
 void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
   Fields f(r.body, r.len);
   f.Get<std::uint64_t>();  // message_start_time
   f.Get<std::uint64_t>();  // message_end_time
   const std::uint64_t size = f.Get<std::uint64_t>();
-  f.Get<std::uint32_t>();  // uncompressed_crc (not checked: the records' lengths are)
+  const auto crc = f.Get<std::uint32_t>();  // uncompressed_crc, 0: not given
   const std::string compression(f.String().substr(0, 32));
   const std::uint64_t records_len = f.Get<std::uint64_t>();
   const std::string_view records = f.Bytes(records_len, cut);
@@ -212,6 +226,7 @@ void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
   }
   const detail::ChunkBody body = detail::OpenChunk(
       compression, Bytes(records), records.size(), static_cast<std::uint32_t>(size), cut, &chunk_);
+  if (!cut && body.whole && crc != 0) CheckCrc(body, crc, at);
   std::string past_end;
   const std::size_t kept = ChunkRecords(body.data, body.size, at, &past_end);
   if (cut) {

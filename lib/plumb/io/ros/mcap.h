@@ -35,6 +35,11 @@
 //    chunk (counted). A chunk that does not decompress, of an unknown compression, of another
 //    size than stated, or stating more than 1 GiB, keeps the records decoded before the fault
 //    (counted). A message of a channel not defined before it is counted as an orphan.
+//  * A chunk stating its uncompressed_crc (not 0) whose records, whole and decompressed, have
+//    another CRC-32 is refused: plumb::InputError naming the file and the chunk's byte offset
+//    (a damaged byte there could be a wrong value in a message that still decodes). A chunk cut
+//    by the end of the file or not decompressed to its size is not checked (the damage is
+//    said as above).
 //  * A file without the magic, of another MCAP version, or whose first record is not a Header
 //    is refused: plumb::InputError naming the file and the byte.
 //  * Values as logged (FLU, SI), times as the ROS 1 reader's: header.stamp, and log_time as the

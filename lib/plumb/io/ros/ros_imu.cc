@@ -25,10 +25,17 @@ class CdrCursor {
   }
   template <typename T>
   T Read() {  // after Need(sizeof(T), ...)
-    std::uint8_t b[sizeof(T)];
-    std::memcpy(b, p_ + pos_, sizeof(T));
-    if (!little_) std::reverse(b, b + sizeof(T));
+    const T v = At<T>(0);
     pos_ += sizeof(T);
+    return v;
+  }
+  /// The T `offset` bytes on (within what Need checked), the cursor left where it is.
+  template <typename T>
+  T At(std::size_t offset) const {
+    if (little_) return LoadLittleEndian<T>(p_ + pos_ + offset);
+    std::uint8_t b[sizeof(T)];
+    std::memcpy(b, p_ + pos_ + offset, sizeof(T));
+    std::reverse(b, b + sizeof(T));
     return LoadLittleEndian<T>(b);
   }
   const std::uint8_t* here() const { return p_ + pos_; }
@@ -81,14 +88,14 @@ bool DecodeCdrImu(const std::uint8_t* p, std::size_t n, RosImuMessage* out, std:
               std::to_string(kDoubles * 8) + " bytes from there)");
     return false;
   }
-  double d[kDoubles];
-  for (double& v : d) v = c.Read<double>();
-  for (int i = 0; i < 4; ++i) out->orientation[i] = d[i];
-  out->orientation_cov0 = d[4];
-  out->gyr = Vec3(d[13], d[14], d[15]);
-  out->gyr_cov0 = d[16];
-  out->acc = Vec3(d[25], d[26], d[27]);
-  out->acc_cov0 = d[28];
+  // Only the 13 doubles used are read (the other covariances' 25 are not).
+  const auto d = [&c](std::size_t i) { return c.At<double>(8 * i); };
+  for (std::size_t i = 0; i < 4; ++i) out->orientation[i] = d(i);
+  out->orientation_cov0 = d(4);
+  out->gyr = Vec3(d(13), d(14), d(15));
+  out->gyr_cov0 = d(16);
+  out->acc = Vec3(d(25), d(26), d(27));
+  out->acc_cov0 = d(28);
   return true;
 }
 

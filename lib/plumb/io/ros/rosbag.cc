@@ -93,7 +93,7 @@ class Parser {
   std::vector<Slot> slots_;
   std::unordered_map<std::uint32_t, Slot> sparse_slots_;
   std::vector<Pending> pending_;
-  std::vector<std::uint8_t> chunk_;  ///< a decompressed chunk, reused
+  detail::ChunkBuffers chunk_;  ///< a decompressed chunk and the decompressors, reused
 };
 
 bool Parser::Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r) {

@@ -2,6 +2,7 @@
 #include "plumb/io/ros/rosbag_format.h"
 
 #include <bzlib.h>
+#include <libdeflate.h>
 #include <lz4frame.h>
 #include <zstd.h>
 
@@ -168,12 +169,16 @@ bool Bz2(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
 }
 
 bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
-         std::vector<std::uint8_t>* out, std::size_t* out_size, std::string* why) {
-  LZ4F_dctx* ctx = nullptr;
-  if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) {
+         ChunkBuffers* buffers, std::size_t* out_size, std::string* why) {
+  if (buffers->lz4 == nullptr &&
+      LZ4F_isError(LZ4F_createDecompressionContext(&buffers->lz4, LZ4F_VERSION))) {
+    buffers->lz4 = nullptr;
     *why = "lz4 could not start";
     return false;
   }
+  LZ4F_dctx* ctx = buffers->lz4;
+  LZ4F_resetDecompressionContext(ctx);  // a frame left part way by the last chunk
+  std::vector<std::uint8_t>* out = &buffers->out;
   std::size_t used = 0;
   std::size_t fed = 0;
   std::size_t hint = 1;
@@ -205,7 +210,6 @@ bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
       break;
     }
   }
-  LZ4F_freeDecompressionContext(ctx);
   *out_size = used;
   if (ok && used != declared) {
     *why = "lz4 data of " + std::to_string(used) + " bytes, not the chunk's size " +
@@ -215,13 +219,18 @@ bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
   return ok;
 }
 
+/// Once the buffer holds the chunk's size (from the second chunk on), libzstd decodes the frame
+/// straight into it in one pass (its content size known); else through its window.
 bool Zstd(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
-          std::vector<std::uint8_t>* out, std::size_t* out_size, std::string* why) {
-  ZSTD_DStream* ctx = ZSTD_createDStream();
+          ChunkBuffers* buffers, std::size_t* out_size, std::string* why) {
+  if (buffers->zstd == nullptr) buffers->zstd = ZSTD_createDCtx();
+  ZSTD_DCtx* ctx = buffers->zstd;
   if (ctx == nullptr) {
     *why = "zstd could not start";
     return false;
   }
+  ZSTD_DCtx_reset(ctx, ZSTD_reset_session_only);  // a frame left part way by the last chunk
+  std::vector<std::uint8_t>* out = &buffers->out;
   std::size_t used = 0;
   bool ok = true;
   ZSTD_inBuffer src{in, n, 0};
@@ -252,7 +261,6 @@ bool Zstd(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cu
       break;
     }
   }
-  ZSTD_freeDStream(ctx);
   *out_size = used;
   if (ok && used != declared) {
     *why = "zstd data of " + std::to_string(used) + " bytes, not the chunk's size " +
@@ -264,12 +272,22 @@ bool Zstd(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cu
 
 }  // namespace
 
+ChunkBuffers::~ChunkBuffers() {
+  ZSTD_freeDCtx(zstd);
+  if (lz4 != nullptr) LZ4F_freeDecompressionContext(lz4);
+}
+
+std::uint32_t Crc32(const std::uint8_t* p, std::size_t n) {
+  return libdeflate_crc32(0, p, n);
+}
+
 ChunkBody OpenChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
-                    std::uint32_t declared, bool cut, std::vector<std::uint8_t>* buffer) {
+                    std::uint32_t declared, bool cut, ChunkBuffers* buffers) {
   ChunkBody body{in, n, true, {}};
   if (compression != "none" && !compression.empty()) {
-    body.whole = DecompressChunk(compression, in, n, declared, cut, buffer, &body.size, &body.why);
-    body.data = buffer->data();
+    body.whole =
+        DecompressChunk(compression, in, n, declared, cut, buffers, &body.size, &body.why);
+    body.data = buffers->out.data();
   } else if (n != declared) {
     body.whole = false;
     body.why = cut ? "chunk cut by the end of the file after " + std::to_string(n) + " of its " +
@@ -282,8 +300,9 @@ ChunkBody OpenChunk(std::string_view compression, const std::uint8_t* in, std::s
 }
 
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
-                     std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
+                     std::uint32_t declared, bool cut, ChunkBuffers* buffers,
                      std::size_t* out_size, std::string* why) {
+  std::vector<std::uint8_t>* out = &buffers->out;
   why->clear();
   *out_size = 0;
   if (compression == "none") {
@@ -299,8 +318,8 @@ bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::
     return false;
   }
   if (compression == "bz2") return Bz2(in, n, declared, cut, out, out_size, why);
-  if (compression == "lz4") return Lz4(in, n, declared, cut, out, out_size, why);
-  if (compression == "zstd") return Zstd(in, n, declared, cut, out, out_size, why);
+  if (compression == "lz4") return Lz4(in, n, declared, cut, buffers, out_size, why);
+  if (compression == "zstd") return Zstd(in, n, declared, cut, buffers, out_size, why);
   *why = "unknown compression '" + std::string(compression.substr(0, 32)) + "'";
   return false;
 }

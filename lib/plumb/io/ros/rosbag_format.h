@@ -1,7 +1,7 @@
 // plumb/io/ros/rosbag_format.h — the pieces of a ROS 1 bag 2.0 (rosbag.h has the format): a
 // record header's fields, a connection's data, a chunk's decompression and the
-// sensor_msgs/Imu serialization (ROS 1's; the MCAP reader shares the chunks' decompression). Internal to the reader; every length is checked against the
-// bytes that hold it.
+// sensor_msgs/Imu serialization (ROS 1's; the MCAP reader shares the chunks' decompression).
+// Internal to the reader; every length is checked against the bytes that hold it.
 #pragma once
 
 #include <cstddef>
@@ -13,6 +13,9 @@
 #include "plumb/core/types.h"
 #include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/rosbag.h"
+
+struct ZSTD_DCtx_s;  // zstd.h's ZSTD_DCtx
+struct LZ4F_dctx_s;  // lz4frame.h's LZ4F_dctx
 
 namespace plumb::io::detail {
 
@@ -65,16 +68,32 @@ bool ParseRecordFields(const std::uint8_t* p, std::size_t n, RosRecordFields* ou
 bool ParseConnectionData(const std::uint8_t* p, std::size_t n, RosConnection* c,
                          std::string* why);
 
+/// What a reader keeps from chunk to chunk: the buffer the chunks decompress into (grown as
+/// data comes out, never shrunk) and libzstd's and liblz4's decompression contexts (made at
+/// their first chunk, reused: a context's making and its tables' setting up cost as much as a
+/// small chunk's decompression).
+class ChunkBuffers {
+ public:
+  ChunkBuffers() = default;
+  ~ChunkBuffers();
+  ChunkBuffers(const ChunkBuffers&) = delete;
+  ChunkBuffers& operator=(const ChunkBuffers&) = delete;
+
+  std::vector<std::uint8_t> out;
+  ZSTD_DCtx_s* zstd = nullptr;
+  LZ4F_dctx_s* lz4 = nullptr;
+};
+
 /// Decompresses a chunk's data [in, in + n) of `compression` ("none", "bz2", "lz4" (the LZ4
 /// frame format), "zstd" (MCAP's; a zstd frame), as liblz4 and libzstd decode them) into the
-/// first `*out_size` bytes of `out`, a buffer reused from chunk to chunk: grown as data comes
+/// first `*out_size` bytes of `buffers->out`, reused from chunk to chunk: grown as data comes
 /// out (never ahead of it, never past `declared` + 1 bytes), never shrunk. True when the data
-/// decompressed to its end and to exactly `declared` bytes; false with `why` otherwise, `out`
-/// then holding what came out before the fault (the records there are still whole: a caller
-/// reads them). `cut`: the data was cut by the end of the file (the fault expected; `why` says
-/// where it ended).
+/// decompressed to its end and to exactly `declared` bytes; false with `why` otherwise, the
+/// buffer then holding what came out before the fault (the records there are still whole: a
+/// caller reads them). `cut`: the data was cut by the end of the file (the fault expected;
+/// `why` says where it ended).
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
-                     std::uint32_t declared, bool cut, std::vector<std::uint8_t>* out,
+                     std::uint32_t declared, bool cut, ChunkBuffers* buffers,
                      std::size_t* out_size, std::string* why);
 
 /// A chunk's records as a reader walks them.
@@ -86,10 +105,13 @@ struct ChunkBody {
 };
 
 /// The records of a chunk whose data is [in, in + n): as stored for `compression` "none" or
-/// empty (cut to `declared` bytes), else decompressed into `buffer` (DecompressChunk). The ROS 1
-/// and MCAP readers' chunks alike.
+/// empty (cut to `declared` bytes), else decompressed into `buffers` (DecompressChunk). The
+/// ROS 1 and MCAP readers' chunks alike.
 ChunkBody OpenChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
-                    std::uint32_t declared, bool cut, std::vector<std::uint8_t>* buffer);
+                    std::uint32_t declared, bool cut, ChunkBuffers* buffers);
+
+/// The CRC-32 (ISO-HDLC: zlib's, gzip's, MCAP's) of [p, p + n), by libdeflate.
+std::uint32_t Crc32(const std::uint8_t* p, std::size_t n);
 
 /// Bytes of a sensor_msgs/Imu message past its frame_id.
 inline constexpr std::size_t kRosImuFixedBytes = 37 * 8;
