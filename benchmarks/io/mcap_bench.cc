@@ -36,6 +36,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -239,18 +240,33 @@ BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_zstd_decompressed,
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-/// Decompresses every chunk of the repeated `name` with `decompress` (false: failed).
-template <typename Decompress>
-void DecompressChunks(benchmark::State& state, const std::string& name, Decompress decompress) {
+/// The bytes of the repeated `name` and its top-level records (nullopt, the state skipped,
+/// when it cannot be made).
+struct McapBytes {
+  std::vector<char> bytes;
+  std::vector<TopRecord> records;
+};
+std::optional<McapBytes> LoadMcap(benchmark::State& state, const std::string& name) {
   std::string why;
   const std::string* file = Repeated(name, &why);
   if (file == nullptr) {
     state.SkipWithError(why.c_str());
-    return;
+    return std::nullopt;
   }
   std::ifstream in(*file, std::ios::binary);
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
-  const std::vector<TopRecord> records = Records(bytes);
+  McapBytes out;
+  out.bytes.assign(std::istreambuf_iterator<char>(in), {});
+  out.records = Records(out.bytes);
+  return out;
+}
+
+/// Decompresses every chunk of the repeated `name` with `decompress` (false: failed).
+template <typename Decompress>
+void DecompressChunks(benchmark::State& state, const std::string& name, Decompress decompress) {
+  const std::optional<McapBytes> mcap = LoadMcap(state, name);
+  if (!mcap) return;
+  const std::vector<char>& bytes = mcap->bytes;
+  const std::vector<TopRecord>& records = mcap->records;
   // One buffer for all (as the reader's, never resized per chunk: resizing a vector per chunk
   // made liblz4 alone 3 to 5 times slower), each chunk given its size and one byte as room.
   std::size_t largest = 0;
@@ -299,16 +315,11 @@ BENCHMARK_CAPTURE(BM_McapLz4, ardrone_imu_lz4, std::string("ardrone_imu_lz4.mcap
     ->UseRealTime();
 
 void BM_McapCrc32(benchmark::State& state, const std::string& name) {
-  std::string why;
-  const std::string* file = Repeated(name, &why);
-  if (file == nullptr) {
-    state.SkipWithError(why.c_str());
-    return;
-  }
-  std::ifstream in(*file, std::ios::binary);
-  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  const std::optional<McapBytes> mcap = LoadMcap(state, name);
+  if (!mcap) return;
+  const std::vector<char>& bytes = mcap->bytes;
   const auto* p = reinterpret_cast<const std::uint8_t*>(bytes.data());
-  const std::vector<TopRecord> records = Records(bytes);
+  const std::vector<TopRecord>& records = mcap->records;
   std::size_t checked = 0;
   for (auto _ : state) {
     checked = 0;

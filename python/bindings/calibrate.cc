@@ -301,7 +301,8 @@ void RegisterCalibrate(py::module_& m) {
           "The factor on every reported sigma: sqrt(chi2/dof) above its band, else 1.")
       .def_property_readonly("observability",
                              [](const PyResult& r) { return ToPython(r.document["observability"]); },
-                             "rank, unobservable directions, determined combinations (value, "
+                             "rank, unobservable directions, weakly determined combinations "
+                             "(held where the fit starts), determined combinations (value, "
                              "sigma): the JSON's observability.")
       .def_property_readonly(
           "fit",

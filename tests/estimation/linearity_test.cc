@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <iostream>
 
@@ -60,15 +62,21 @@ TEST(Linearity, WellSpreadPosesWithFreeAttitudesStayQuadratic) {
   }
 }
 
-TEST(Linearity, SixFacesWithFreeAttitudesFailTheNonlinearGate) {
+// Six faces with free attitudes lie in a curved valley of near-equal fits (the nonlinear gate
+// fired on every seed, chi2 rising hundreds of times what the covariance said): the
+// combinations that valley runs along are the ones the data determine no better than their
+// typical spread, so the fit holds them where it starts, and what is left is quadratic.
+TEST(Linearity, SixFacesWithFreeAttitudesHoldTheirCurvedValley) {
   for (std::uint64_t seed : {1U, 2U, 3U}) {
     const sim::Simulation s = Session(6, seed, false);
     const CalibrationResult r = Calibrate(s.session.series, s.truth_segments, s.model, s.site, {});
     ASSERT_TRUE(r.fit.converged);
-    EXPECT_GT(r.fit.linearity.worst_ratio, 100.0) << "seed " << seed;
-    ASSERT_TRUE(HasGate(r.fit, "nonlinear")) << "seed " << seed;
-    std::cout << "6 poses, seed " << seed << ": worst ratio " << r.fit.linearity.worst_ratio
-              << " along " << r.fit.linearity.worst_direction << "\n";
+    EXPECT_FALSE(r.calibration.observability.weakly_determined.empty()) << "seed " << seed;
+    EXPECT_LT(r.fit.linearity.worst_ratio, 1.5) << "seed " << seed;
+    EXPECT_FALSE(HasGate(r.fit, "nonlinear")) << "seed " << seed;
+    std::cout << "6 poses, seed " << seed << ": "
+              << r.calibration.observability.weakly_determined.size()
+              << " weak combinations held, worst ratio " << r.fit.linearity.worst_ratio << "\n";
   }
 }
 
@@ -83,8 +91,11 @@ TEST(Linearity, TheCheckLeavesTheSolutionAsItWas) {
   EXPECT_FALSE(HasGate(without.fit, "nonlinear"));
   ASSERT_EQ(with.calibration.parameters.size(), without.calibration.parameters.size());
   for (std::size_t i = 0; i < with.calibration.parameters.size(); ++i) {
-    EXPECT_EQ(with.calibration.parameters[i].value, without.calibration.parameters[i].value);
-    EXPECT_EQ(with.calibration.parameters[i].sigma, without.calibration.parameters[i].sigma);
+    const auto& a = with.calibration.parameters[i];
+    const auto& b = without.calibration.parameters[i];
+    EXPECT_EQ(a.value, b.value);
+    if (std::isnan(a.sigma)) EXPECT_TRUE(std::isnan(b.sigma)) << a.name;
+    else EXPECT_EQ(a.sigma, b.sigma) << a.name;
   }
   EXPECT_EQ(with.fit.chi2, without.fit.chi2);
   ASSERT_EQ(with.fit.still.size(), without.fit.still.size());

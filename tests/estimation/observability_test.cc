@@ -98,6 +98,53 @@ TEST(Observability, RankDecisionIgnoresUnits) {
   EXPECT_EQ(AnalyseObservability(in).summary.rank, 2);
 }
 
+// Two parameters of typical size 1 whose sum the data determine to 0.1 and (with weight 0.02)
+// whose difference only to 50, over three times its typical size: the difference is weakly
+// determined (kWeakSpread), the sum is what the data determine, and neither parameter alone is
+// (each sigma is 25).
+ObservabilityInput SumAndDifference(double difference_weight) {
+  ObservabilityInput in;
+  in.J.resize(2, 2);
+  in.J << 10, 10, difference_weight, -difference_weight;
+  in.names = {"a", "b"};
+  in.values = {0.5, 0.25};
+  in.is_model = {true, true};
+  in.typical = {1.0, 1.0};
+  return in;
+}
+
+TEST(Observability, ACombinationKnownWorseThanItsTypicalSpreadIsWeak) {
+  const auto a = AnalyseObservability(SumAndDifference(0.02));
+  EXPECT_TRUE(a.summary.unobservable.empty());
+  ASSERT_EQ(a.summary.weakly_determined.size(), 1u);
+  const Combination& w = a.summary.weakly_determined[0];
+  EXPECT_EQ(w.text, "a - b");
+  EXPECT_DOUBLE_EQ(w.value, 0.25);
+  // var(a - b) = 2 / (2 0.02^2) = 2500; its typical spread sqrt(1 + 1).
+  EXPECT_NEAR(w.sigma, 50.0, 1e-9);
+  EXPECT_NEAR(w.typical, std::sqrt(2.0), 1e-12);
+  ASSERT_EQ(a.weak.size(), 1u);
+  EXPECT_NEAR(std::abs(a.weak[0][0] + a.weak[0][1]), 0.0, 1e-12);  // along a - b
+  EXPECT_EQ(a.summary.rank, 1);
+  EXPECT_FALSE(a.observable[0]);
+  EXPECT_FALSE(a.observable[1]);
+  ASSERT_EQ(a.summary.determined.size(), 1u);
+  EXPECT_EQ(a.summary.determined[0].text, "a + b");
+  EXPECT_NEAR(a.summary.determined[0].sigma, 0.1, 1e-12);  // sqrt(2 / 200)
+}
+
+TEST(Observability, ACombinationKnownWithinItsTypicalSpreadIsDetermined) {
+  // sigma(a - b) = 1 / 0.4 = 2.5 < 3 sqrt(2): determined, like every parameter.
+  const auto a = AnalyseObservability(SumAndDifference(0.4));
+  EXPECT_TRUE(a.summary.weakly_determined.empty());
+  EXPECT_TRUE(a.observable[0] && a.observable[1]);
+  EXPECT_EQ(a.summary.rank, 2);
+  // Without typical sizes no weak combination is sought.
+  ObservabilityInput untyped = SumAndDifference(0.02);
+  untyped.typical.clear();
+  EXPECT_TRUE(AnalyseObservability(untyped).summary.weakly_determined.empty());
+}
+
 TEST(Observability, FormatCombinationDropsNegligibleTerms) {
   Eigen::VectorXd c(3);
   c << 1.0, -2.5, 1e-15;

@@ -130,7 +130,7 @@ std::vector<RealSession> Sessions() {
       // ChanghyeonKim93: host-stamped clock (issue 34 item 3); far above the noise.
       {"changhyeonkim93_good1",
        Concat({"shared:multipose/changhyeonkim93/imu_good1.txt"}, kChk), "time_base",
-       velocity, {"nonlinear"}, {"one_pose", "not_converged", "not_still"}, 3.0, 1e9, "host_arrival"},
+       velocity, {}, {"one_pose", "not_converged", "not_still"}, 3.0, 1e9, "host_arrival"},
       {"changhyeonkim93_good2",
        Concat({"shared:multipose/changhyeonkim93/imu_good2.txt"}, kChk), "time_base", velocity,
        {}, {"one_pose", "not_converged", "not_still"}, 20.0, 1e9, "host_arrival"},
@@ -144,10 +144,12 @@ std::vector<RealSession> Sessions() {
        "gyro_scale_nonlinearity", velocity, {}, {"one_pose", "not_converged", "not_still"},
        10.0, 40.0},
       // The same sessions on the uniform clock fitted through their stamps (--clock uniform):
-      // chi2/dof 9.2 -> 5.4 and 109 -> 44 (ClockUniformAtLeastHalvesImuGood2).
+      // chi2/dof 10.9 -> 5.2 and 109 -> 44 (ClockUniformAtLeastHalvesImuGood2). imu_good1's
+      // misalignments are weakly determined (held where the fit starts): its curved valley,
+      // which failed the nonlinear gate, is gone.
       {"changhyeonkim93_good1_uniform",
        Concat({"shared:multipose/changhyeonkim93/imu_good1.txt", "--clock", "uniform"}, kChk),
-       "earth_rate", velocity, {"nonlinear"}, {"one_pose", "not_converged", "not_still"}, 3.0, 7.0},
+       "earth_rate", velocity, {}, {"one_pose", "not_converged", "not_still"}, 3.0, 7.0},
       {"changhyeonkim93_good2_uniform",
        Concat({"shared:multipose/changhyeonkim93/imu_good2.txt", "--clock", "uniform"}, kChk),
        "gyro_g_sensitivity", velocity, {}, {"one_pose", "not_converged", "not_still"}, 20.0, 55.0},
@@ -440,10 +442,11 @@ std::pair<int, int> PairsBeyond3Sigma(const json& a, const json& b) {
 }
 
 // Issue 34 item 7: one sensor's sessions agree within 3 combined sigma, or the output says
-// why. ChanghyeonKim93's two sessions of one IMU: on the host's stamps 4 of 21 parameters
-// disagree; on the uniform clock 1 (gyro.matrix.xz, 3.3 sigma), and each fit says why its
-// sigmas are not to be taken as they stand (chi2/dof far above its band, or imu_good1's
-// nonlinear gate).
+// why. ChanghyeonKim93's two sessions of one IMU: at most 1 of 21 parameters disagrees on
+// either clock (on the uniform clock gyro.matrix.xz, 3.5 sigma; imu_good1's misalignments are
+// weakly determined, and their sigmas cover the hold of that combination), each fit says why
+// its sigmas are not to be taken as they stand (chi2/dof above its band: the scaled sigma),
+// and the uniform clock halves chi2/dof of both (the host's stamps jitter).
 TEST(RealityAgreement, OneSensorsSessionsAgreeOnTheUniformClock) {
   const std::string dir_data = std::string(PLUMB_SHARED_DATA_DIR) + "/multipose/changhyeonkim93";
   if (!std::filesystem::exists(dir_data)) GTEST_SKIP() << "shared data absent: " << dir_data;
@@ -459,7 +462,7 @@ TEST(RealityAgreement, OneSensorsSessionsAgreeOnTheUniformClock) {
                                 dir);
       ASSERT_EQ(run.exit_code, 0) << run.err;
       // Each says its sigmas are not to be taken as they stand: the misfit, or a gate.
-      EXPECT_TRUE(Contains(run.out, "do not trust these parameters to their sigma") ||
+      EXPECT_TRUE(Contains(run.out, "is above its band") ||
                   Contains(run.out, "not to be trusted as it stands"))
           << run.out;
       fits[session + "_" + clock] = ReadJson(out);
@@ -471,7 +474,14 @@ TEST(RealityAgreement, OneSensorsSessionsAgreeOnTheUniformClock) {
   EXPECT_EQ(n, 21);
   EXPECT_EQ(m, 21);
   EXPECT_LE(uniform, 1) << "of " << m << " beyond 3 sigma on the uniform clock";
-  EXPECT_LT(uniform, stamps) << "the uniform clock should bring the sessions together";
+  EXPECT_LE(stamps, 1) << "of " << n << " beyond 3 sigma on the host's stamps";
+  for (const std::string session : {"imu_good1", "imu_good2"}) {
+    const double on_stamps = fits[session + "_stamps"]["fit"]["chi2"].get<double>() /
+                             fits[session + "_stamps"]["fit"]["dof"].get<double>();
+    const double on_uniform = fits[session + "_uniform"]["fit"]["chi2"].get<double>() /
+                              fits[session + "_uniform"]["fit"]["dof"].get<double>();
+    EXPECT_LT(on_uniform, 0.6 * on_stamps) << session;
+  }
 }
 
 std::string SessionName(const ::testing::TestParamInfo<RealSession>& info) {

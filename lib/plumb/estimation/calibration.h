@@ -37,6 +37,9 @@ struct Combination {
   std::string text;  ///< e.g. "accel.bias.z - 9.78 accel.matrix.zz"
   double value = 0;
   double sigma = 0;
+  /// For a weakly determined combination: its typical spread among MEMS IMUs (sigma exceeds
+  /// it; estimation/observability.h kWeakSpread); 0 otherwise.
+  double typical = 0;
   /// The combination as numbers: sum_i coefficients[i] * value of parameter names[i].
   std::vector<std::string> names;
   std::vector<double> coefficients;
@@ -56,6 +59,10 @@ struct Observability {
   /// free parameters, the attitudes, the eliminated unknowns); 0 rows when all is observable.
   Eigen::MatrixXd null_space;
   std::vector<std::string> null_space_names;
+  /// Combinations the data determine no better than their typical spread among MEMS IMUs,
+  /// held at their start values in the fit (value: there; sigma: the data's; typical: the
+  /// spread). Their parameters are not reported as determined.
+  std::vector<Combination> weakly_determined;
   /// Combinations of unobservable parameters that the data does determine.
   std::vector<Combination> determined;
   /// Their covariance, c_i^T C c_j, in `determined` order (its diagonal: their sigma squared).

@@ -7,6 +7,7 @@
 #include "plumb/core/error.h"
 #include "plumb/estimation/turn_noise.h"
 #include "plumb/residuals/bias_walk_residual.h"
+#include "plumb/residuals/held_combination.h"
 #include "plumb/residuals/manifolds.h"
 #include "plumb/residuals/motion_residual.h"
 #include "plumb/residuals/still_residuals.h"
@@ -46,6 +47,17 @@ Eigen::SparseMatrix<double> Sparse(const ceres::CRSMatrix& crs) {
       crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
       crs.cols.data(), crs.values.data());
   return Eigen::SparseMatrix<double>(rows);
+}
+
+/// The typical size of parameter i of `info` in its column's unit: the catalogue's (SI), times
+/// the output's sensitivity (the mean diagonal of F or E: about 1 on SI output, and what the
+/// data show whatever the input's unit says, as on imu_tk's counts read as SI) where the
+/// parameter is in output units (the linear stage, and EffectInfo::ScalesWithOutput's
+/// additive terms).
+double TypicalSize(const model::EffectInfo& info, int i, const Mat3& F, const Mat3& E) {
+  const double typical = info.parameters[static_cast<std::size_t>(i)].typical;
+  if (!info.linear_stage && !info.ScalesWithOutput(i)) return typical;
+  return typical * (info.sensor == model::Sensor::kAccel ? F : E).diagonal().cwiseAbs().mean();
 }
 
 }  // namespace
@@ -377,8 +389,7 @@ void CalibrationProblem::AddWanderFactors(BuiltProblem& built, std::size_t p) {
   }
 }
 
-BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
-                                       bool free_probes) {
+BuiltProblem CalibrationProblem::Build(const Gauge& gauge, bool free_probes) {
   BuiltProblem built;
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -388,15 +399,41 @@ BuiltProblem CalibrationProblem::Build(const std::vector<ParameterIndex>& held,
   }
   built.problem = std::make_unique<ceres::Problem>(problem_options);
   if (built.evaluation) built.evaluation->SetProblem(built.problem.get());
-  AddParameterBlocks(built, held, free_probes);
+  AddParameterBlocks(built, gauge.parameters, free_probes);
   AddResiduals(built);
   for (std::size_t p = 0; p < wander_.size(); ++p) AddWanderFactors(built, p);
+  AddHeldCombinations(built, gauge.combinations);
   return built;
+}
+
+void CalibrationProblem::AddHeldCombinations(BuiltProblem& built,
+                                             const std::vector<Gauge::Combination>& held) {
+  for (const Gauge::Combination& c : held) {
+    std::vector<int> terms_of_block;  // the model terms whose blocks the residual takes
+    std::vector<residuals::HeldTerm> terms;
+    for (const auto& [place, coefficient] : c.terms) {
+      auto at = std::find(terms_of_block.begin(), terms_of_block.end(), place.first);
+      if (at == terms_of_block.end()) at = terms_of_block.insert(terms_of_block.end(), place.first);
+      terms.push_back({static_cast<int>(at - terms_of_block.begin()), place.second, coefficient,
+                       block(place.first)[place.second]});
+    }
+    std::vector<int> sizes;
+    std::vector<double*> blocks;
+    for (int t : terms_of_block) {
+      sizes.push_back(block_size(t));
+      blocks.push_back(block(t));
+    }
+    built.held.push_back(built.problem->AddResidualBlock(
+        new residuals::HeldCombination(sizes, std::move(terms), kHeldCombinationWidth * c.sigma),
+        nullptr, blocks));
+  }
 }
 
 UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
                                            const std::vector<ParameterIndex>& held) {
   UnknownColumns out;
+  const std::vector<const double*> blocks = ModelBlocks();
+  const auto linear = model_.Predict(blocks.data(), model::SensorInput<double>());
   for (int t = 0; t < model_.num_terms(); ++t) {
     double* values = block(t);
     if (problem.IsParameterBlockConstant(values)) continue;
@@ -410,6 +447,7 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
       }
       out.names.push_back(info.ParameterName(i));
       out.values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal + values[i]);
+      out.typical.push_back(TypicalSize(info, i, linear.F, linear.E));
       out.is_model.push_back(true);
       out.model_index.emplace_back(t, i);
     }
@@ -424,6 +462,7 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
     for (int i = first; i < first + dims; ++i) {
       out.names.push_back("attitude[" + std::to_string(k) + "]." + kTangentName[i]);
       out.values.push_back(std::nan(""));
+      out.typical.push_back(0.0);
       out.is_model.push_back(false);
       out.model_index.emplace_back(-1, static_cast<int>(k));
     }
@@ -441,6 +480,7 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
               (w.sensor == model::Sensor::kGyro ? "gyro." : "accel.") +
               (end ? "end." : "start.") + kAxisName[i]);
           out.values.push_back(std::nan(""));
+          out.typical.push_back(0.0);
           out.is_model.push_back(false);
           out.model_index.emplace_back(-1, static_cast<int>(k));
         }

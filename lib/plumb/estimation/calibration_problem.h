@@ -49,6 +49,29 @@
 
 namespace plumb::estimation {
 
+/// A (term, index) pair naming one scalar model parameter.
+using ParameterIndex = std::pair<int, int>;
+
+/// What a fit holds where it starts besides the model's fixed parameters (solve.h): one
+/// parameter per null direction (its pivot), and the weakly determined combinations
+/// (observability.h kWeakSpread), each as terms and the data's sigma of it.
+struct Gauge {
+  struct Combination {
+    std::vector<std::pair<ParameterIndex, double>> terms;  ///< parameter, coefficient
+    double sigma = 0.0;  ///< the data's sigma of the combination, its unit
+  };
+  std::vector<ParameterIndex> parameters;
+  std::vector<Combination> combinations;
+
+  bool empty() const { return parameters.empty() && combinations.empty(); }
+};
+
+/// A held combination's residual is the combination's move from its start over this share of
+/// the data's sigma of it: the data cannot move it measurably (a pull of one sigma moves it
+/// by 1e-6 of its sigma), and a thousand to one keeps the normal equations well within double
+/// precision.
+inline constexpr double kHeldCombinationWidth = 1e-3;
+
 /// A ceres::Problem built from the current values, with its residual blocks per still pose
 /// and motion interval (null where absent) and the manifolds it uses.
 struct BuiltProblem {
@@ -62,6 +85,7 @@ struct BuiltProblem {
   std::vector<ceres::ResidualBlockId> velocity;  ///< per motion interval, when used
   std::vector<ceres::ResidualBlockId> walk;      ///< bias-wander factors, when the bias wanders
   std::vector<std::size_t> walk_process;         ///< per wander factor: its process (Wander order)
+  std::vector<ceres::ResidualBlockId> held;      ///< per held combination (Gauge)
 };
 
 /// The free unknowns of a built problem as Jacobian columns, in order: model parameters
@@ -72,13 +96,13 @@ struct UnknownColumns {
   std::vector<std::string> names;       ///< per column, e.g. "accel.bias.x", "attitude[3].down"
   std::vector<double> values;           ///< per column: reported value (NaN for attitudes)
   std::vector<bool> is_model;           ///< per column: model parameter (else attitude)
+  /// Per column: a model parameter's typical size (model::ParameterInfo::typical) in the
+  /// column's unit (times the output's sensitivity where the output is not SI); 0 otherwise.
+  std::vector<double> typical;
   std::vector<std::pair<int, int>> model_index;  ///< per column: (term, index) or (-1, pose)
   /// Columns [first_wander, size) are the bias-wander states (none: first_wander == size).
   std::size_t first_wander = 0;
 };
-
-/// A (term, index) pair naming one scalar model parameter.
-using ParameterIndex = std::pair<int, int>;
 
 class CalibrationProblem {
  public:
@@ -98,10 +122,11 @@ class CalibrationProblem {
   /// so that chi^2 does not depend on the starting values).
   void SetMotionWeightsFromSolution();
 
-  /// A problem on the current values. `held`: parameters held at their values besides the
-  /// model's fixed ones; `free_probes`: the probe terms' blocks are left free (for their
-  /// Jacobian columns only).
-  BuiltProblem Build(const std::vector<ParameterIndex>& held, bool free_probes = false);
+  /// A problem on the current values. `gauge`: parameters held at their values besides the
+  /// model's fixed ones, and combinations held where they are (residuals::HeldCombination,
+  /// after every other residual); `free_probes`: the probe terms' blocks are left free (for
+  /// their Jacobian columns only).
+  BuiltProblem Build(const Gauge& gauge, bool free_probes = false);
 
   /// The free unknowns of `problem` (built by Build with `held` held) as columns.
   UnknownColumns Columns(const ceres::Problem& problem,
@@ -150,6 +175,7 @@ class CalibrationProblem {
   void AddParameterBlocks(BuiltProblem& built, const std::vector<ParameterIndex>& held,
                           bool free_probes);
   void AddResiduals(BuiltProblem& built);
+  void AddHeldCombinations(BuiltProblem& built, const std::vector<Gauge::Combination>& held);
   double* block(int term) { return values_.data() + block_offset_[static_cast<std::size_t>(term)]; }
   const double* block(int term) const {
     return values_.data() + block_offset_[static_cast<std::size_t>(term)];

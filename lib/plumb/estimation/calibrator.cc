@@ -158,7 +158,7 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   fit.motion_segments = static_cast<int>(problem.still().motions.size());
   for (const MotionInterval& m : problem.still().not_turns) {
     fit.not_turns.push_back({m.from, m.from + 1, series.t_s[m.first], series.t_s[m.last],
-                             options.max_motion_s, m.flown});
+                             options.max_motion_s, m.flown, m.gap, options.max_turn_gap_s});
   }
   problem.ReportResiduals(solution.all_free, fit);
   // Counted once: the advice, the one_pose gate and the JSON all say this number.
@@ -171,8 +171,8 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   }
   if (options.check_linearity) {
     // The analysis's Jacobian is the fitted problem's when no parameter is held.
-    const bool same = solution.held_parameters.empty();
-    fit.linearity = CheckLinearity(problem, solution.fitted(), solution.held_parameters,
+    const bool same = solution.gauge.empty();
+    fit.linearity = CheckLinearity(problem, solution.fitted(), solution.gauge.parameters,
                                    kLinearityStepSigmas, same ? &at.jacobian : nullptr, at.cost,
                                    same ? at.eliminated.get() : nullptr, options.run_jobs);
   }

@@ -113,11 +113,14 @@ void ComputeCovariance(ceres::Problem& fitted, const std::vector<const double*>&
   // the wander eliminated by Eigen's sparse Cholesky (solve.h): ceres::Covariance would need
   // SuiteSparseQR, whose BLAS kernels make the last bits depend on the heap layout.
   const bool dense = fitted.NumParameters() <= kDenseUnknowns;
+  // With weak combinations held the fitted problem's covariance would be the one conditional
+  // on them, too small for the parameters their hold at a guess moves: the analysis's is not.
+  const bool weak = !analysis.weak.empty();
   const bool from_ceres =
-      options.use_ceres_covariance && dense &&
+      options.use_ceres_covariance && dense && !weak &&
       CeresCovariance(fitted, calibration.model, fitted_blocks, calibration.covariance);
   if (!from_ceres) {
-    if (options.use_ceres_covariance && dense && calibration.model.num_free_parameters() > 0) {
+    if (options.use_ceres_covariance && dense && !weak && calibration.model.num_free_parameters() > 0) {
       warnings.push_back(Notice{"covariance_singular",
                                 "ceres::Covariance found the problem singular; sigmas are from "
                                 "the pseudo-inverse of the column-scaled Jacobian",

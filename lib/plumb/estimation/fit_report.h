@@ -50,6 +50,12 @@ struct MotionFit {
 
 /// Motion between two still segments that the fit leaves out, not a turn: longer than
 /// CalibrationOptions::max_motion_s (estimation/still_set.h).
+/// A stretch of time with no sample: from t_s (the last sample before it), length_s long.
+struct SampleGap {
+  double t_s = 0.0;
+  double length_s = 0.0;
+};
+
 struct NotATurn {
   std::size_t from = 0, to = 0;  ///< still segment indices
   double t_begin_s = 0.0, t_end_s = 0.0;
@@ -57,6 +63,10 @@ struct NotATurn {
   /// What the log says the vehicle did in it, when that is why it is left out (else its
   /// length, beyond limit_s).
   std::optional<LogMotion> flown;
+  /// The longest gap in its samples, when that is why it is left out (longer than
+  /// gap_limit_s, CalibrationOptions::max_turn_gap_s).
+  std::optional<SampleGap> gap;
+  double gap_limit_s = 0.0;
 };
 
 /// The whitened problem at the optimum with the columns of the model's probe terms

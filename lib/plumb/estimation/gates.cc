@@ -342,6 +342,12 @@ std::string NotATurnText(const FitReport& fit, const NotATurn& m) {
            ", a flight or a vehicle carried, whose vibration and translation logged samples "
            "do not resolve";
   }
+  if (m.gap) {
+    return motion + "its samples stop for " + Number(m.gap->length_s, 3) + " s at " +
+           Tenth(m.gap->t_s) + " s, longer than " + Number(m.gap_limit_s, 3) +
+           " s: the turn the samples miss (a dropout of the link or the logger) cannot be "
+           "integrated";
+  }
   return motion + "longer than " + Number(m.limit_s, 4) +
          " s, more than a MEMS gyroscope integrates to its noise (a flight, a vehicle carried)";
 }

@@ -45,7 +45,7 @@ inline constexpr double kLinearityStepSigmas = 2.0;
 inline constexpr int kLinearityDirections = 6;
 
 /// The check of the file comment on `problem` (built by `calibration` with `held` held, at
-/// its solution: Solution::fitted() and held_parameters), with steps of `step_sigmas` sigma; the
+/// its solution: Solution::fitted() and its gauge's parameters), with steps of `step_sigmas` sigma; the
 /// problem's values are not touched. Not checked
 /// (LinearityReport::checked false) without free model parameters or when the reduced normal
 /// matrix is not positive definite (the observability analysis then says why).

@@ -30,6 +30,11 @@ struct CalibrationOptions {
   /// Motion intervals longer than this are not integrated, s (> 0): the attitude before and
   /// after are then treated as unrelated and each chain gets its own heading gauge.
   double max_motion_s = 120.0;
+  /// Motion intervals whose samples stop for longer than this, s (> 0), are not integrated
+  /// either: the integration holds the last rate across a gap, and a hand's turn changes its
+  /// rate within tenths of a second, so over a longer gap the turn the samples miss (a dropout
+  /// of the link or the logger) would enter the fit as a misfit of degrees.
+  double max_turn_gap_s = 0.5;
   /// Where the log says the vehicle flew or moved (Session::log_motion, core/log_motion.h), on
   /// the samples' clock: a motion interval one covers (LogMotion::Covers: more than its edges)
   /// is no turn and is left out like one longer than max_motion_s; a still segment one covers

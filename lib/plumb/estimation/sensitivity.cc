@@ -27,7 +27,7 @@ Eigen::VectorXd ResidualsUnder(const ImuSeries& series, const std::vector<StillS
                              fitted.noise, fitted.start, options);
   problem.TakeValues(*fitted.problem);
   problem.SetMotionWeightsFromSolution();
-  BuiltProblem built = problem.Build(fitted.solution.held_parameters);
+  BuiltProblem built = problem.Build(fitted.solution.gauge);
   double cost = 0.0;
   std::vector<double> r;
   built.problem->Evaluate(ceres::Problem::EvaluateOptions{}, &cost, &r, nullptr, nullptr);
@@ -44,7 +44,7 @@ Sensitivities SensitivityAt(const ImuSeries& series, const std::vector<StillSegm
   if (changes.empty()) return out;  // nothing to differentiate: no Jacobian, no factorisation
   CalibrationProblem& problem = *fitted.problem;
   ceres::Problem& at = fitted.solution.fitted();
-  const UnknownColumns columns = problem.Columns(at, fitted.solution.held_parameters);
+  const UnknownColumns columns = problem.Columns(at, fitted.solution.gauge.parameters);
   const Eigen::SparseMatrix<double> J = problem.SparseJacobian(at, columns, nullptr, nullptr);
   const Eigen::SparseMatrix<double> normal = Eigen::SparseMatrix<double>(J.transpose()) * J;
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);

@@ -55,12 +55,15 @@ AnalysedSolution AnalyseAt(CalibrationProblem& calibration, ceres::Problem& prob
   in.names = columns.names;
   in.values = columns.values;
   in.is_model = columns.is_model;
+  in.typical = columns.typical;
   in.rank_tolerance = options.rank_tolerance;
   const auto n = static_cast<Eigen::Index>(columns.names.size());
   const auto first_wander = static_cast<Eigen::Index>(columns.first_wander);
   const Eigen::Index n_m = LeadingModelColumns(columns.is_model);
   if (how.dense || (n_m == n && !how.keep_jacobian)) {
     in.J = calibration.Jacobian(problem, columns, &out.cost, &out.residuals);
+    in.chi2 = 2.0 * out.cost;
+    in.observations = static_cast<int>(out.residuals.size());
     out.analysis = AnalyseObservability(in);
     if (how.dense) out.dense_jacobian = std::move(in.J);
     return out;
@@ -68,6 +71,8 @@ AnalysedSolution AnalyseAt(CalibrationProblem& calibration, ceres::Problem& prob
   Eigen::SparseMatrix<double> J_local;
   Eigen::SparseMatrix<double>& J = how.keep_jacobian ? out.jacobian : J_local;
   J = calibration.SparseJacobian(problem, columns, &out.cost, &out.residuals);
+  in.chi2 = 2.0 * out.cost;
+  in.observations = static_cast<int>(out.residuals.size());
   // The attitudes and wander states eliminated together when the data determine the attitudes
   // clearly (the cost is then linear in the poses), else the wander states alone; kept for
   // the caller (`eliminated`) in the first case.
@@ -90,6 +95,8 @@ AnalysedSolution AnalyseAt(CalibrationProblem& calibration, ceres::Problem& prob
   in.names.resize(static_cast<std::size_t>(kept));
   in.values.resize(static_cast<std::size_t>(kept));
   in.is_model.resize(static_cast<std::size_t>(kept));
+  in.typical.resize(static_cast<std::size_t>(kept));
+  in.wander_outside = static_cast<int>(n - first_wander);
   const Eigen::Index n_attitudes = first_wander - kept;
   if (n_attitudes > 0) {
     in.eliminated_names.assign(columns.names.begin() + kept, columns.names.begin() + first_wander);
@@ -128,10 +135,38 @@ AnalysedSolution AnalyseSolution(CalibrationProblem& calibration, ceres::Problem
   return AnalyseAt(calibration, problem, options, how);
 }
 
+namespace {
+
+/// What to hold, from an analysis: the null directions' pivots that are model parameters, and
+/// the weak combinations with the data's sigma of each.
+Gauge GaugeOf(const AnalysedSolution& at) {
+  Gauge gauge;
+  const std::vector<ParameterIndex>& index = at.columns.model_index;
+  for (int c : at.analysis.pivots) {
+    if (index[static_cast<std::size_t>(c)].first >= 0) gauge.parameters.push_back(index[static_cast<std::size_t>(c)]);
+  }
+  for (const Eigen::VectorXd& c : at.analysis.weak) {
+    Gauge::Combination held;
+    for (Eigen::Index j = 0; j < c.size(); ++j) {
+      if (c[j] != 0.0) held.terms.emplace_back(index[static_cast<std::size_t>(j)], c[j]);
+    }
+    held.sigma = std::sqrt(c.dot(at.analysis.covariance * c));
+    gauge.combinations.push_back(std::move(held));
+  }
+  return gauge;
+}
+
+bool SameShape(const Gauge& a, const Gauge& b) {
+  return a.parameters.size() == b.parameters.size() &&
+         a.combinations.size() == b.combinations.size();
+}
+
+}  // namespace
+
 // Solves with every unknown free (with motion: roughly, then again with the motion weights
-// of that solution) and analyses the solution. Where the analysis finds null directions, their
-// pivots are held and the fit is made again from the starting values (the fit's account then
-// has the first solve and this one).
+// of that solution) and analyses the solution. Where the analysis finds null directions or
+// weak combinations, they are held and the fit is made again from the starting values, and
+// analysed again while the gauge changes shape (the fit's account then has every solve).
 Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOptions& options,
                         FitReport& fit) {
   Solution out;
@@ -147,19 +182,24 @@ Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOption
     Record(Solve(*out.all_free.problem, SolveStage::kRefine, options), refined);
   }
   out.analysed = AnalyseSolution(calibration, *out.all_free.problem, options);
-  for (int c : out.analysed->analysis.pivots) {
-    const ParameterIndex& index = out.analysed->columns.model_index[static_cast<std::size_t>(c)];
-    if (index.first >= 0) out.held_parameters.push_back(index);
-  }
-  if (out.held_parameters.empty()) {
+  Gauge gauge = GaugeOf(*out.analysed);
+  if (gauge.empty()) {
     fit = std::move(refined);
     return out;
   }
-  out.analysed.reset();
-  calibration.RestoreValues();
-  out.all_free = calibration.Build({});
-  out.held = calibration.Build(out.held_parameters);
-  Record(Solve(*out.held.problem, SolveStage::kFromStart, options), fit);
+  for (int round = 0; round < kGaugeRounds; ++round) {
+    out.analysed.reset();
+    calibration.RestoreValues();
+    out.gauge = std::move(gauge);
+    out.all_free = calibration.Build({});
+    out.held = calibration.Build(out.gauge);
+    Record(Solve(*out.held.problem, SolveStage::kFromStart, options), fit);
+    // Without weak combinations the null directions are the free fit's: nothing to redo.
+    if (out.gauge.combinations.empty()) break;
+    out.analysed = AnalyseSolution(calibration, *out.all_free.problem, options);
+    gauge = GaugeOf(*out.analysed);
+    if (SameShape(gauge, out.gauge)) break;
+  }
   return out;
 }
 

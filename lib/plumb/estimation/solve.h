@@ -5,7 +5,10 @@
 // solver could wander along them (or exploit ones that are observable only at the level of
 // rounding), so the fit is redone from the starting values with one parameter per null
 // direction (its row-echelon pivot, e.g. accel.matrix.zz for "9.78 accel.bias.z + 1
-// accel.matrix.zz") held at its start value. With motion intervals, the motion residuals'
+// accel.matrix.zz") held at its start value, and every weakly determined combination
+// (observability.h kWeakSpread) held where it starts (residuals::HeldCombination). The weak
+// combinations depend on where the analysis linearises, so the held fit is analysed again and
+// redone while its gauge changes shape (at most kGaugeRounds fits). With motion intervals, the motion residuals'
 // whitening is set again from the first solution's E and F before the final solve, so chi^2
 // does not depend on the starting values.
 //
@@ -26,6 +29,11 @@
 #include "plumb/estimation/options.h"
 
 namespace plumb::estimation {
+
+/// The held fits SolveWithGauge makes at most: the first from the free fit's analysis, then
+/// again while the analysis at the held fit's solution finds a gauge of another shape (more or
+/// fewer null directions or weak combinations). Two settle every session we have.
+inline constexpr int kGaugeRounds = 3;
 
 /// Above this many parameters (ambient, all blocks) the solve uses a sparse Cholesky
 /// factorisation instead of dense QR.
@@ -116,13 +124,13 @@ AnalysedSolution AnalyseSolution(CalibrationProblem& calibration, ceres::Problem
 /// The solved problem.
 struct Solution {
   BuiltProblem all_free;  ///< every free unknown: for the analysis and the residuals
-  BuiltProblem held;      ///< with the null directions' pivots held (empty when there are none)
-  std::vector<ParameterIndex> held_parameters;  ///< those pivots
-  /// all_free analysed at the solution, when nothing is held (the analysis that found no null
-  /// direction to hold); empty otherwise.
+  BuiltProblem held;      ///< with the gauge held (empty when there is none)
+  Gauge gauge;            ///< the null directions' pivots and the weak combinations held
+  /// all_free analysed at the solution, when the fit's last analysis was made there (nothing
+  /// held, or a gauge analysed again at its solution); empty otherwise.
   std::optional<AnalysedSolution> analysed;
   /// The problem the fit and its covariance were made on.
-  ceres::Problem& fitted() { return held_parameters.empty() ? *all_free.problem : *held.problem; }
+  ceres::Problem& fitted() { return gauge.empty() ? *all_free.problem : *held.problem; }
 };
 
 /// Stage 5 (file comment): solves `calibration` in place.

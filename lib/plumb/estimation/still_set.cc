@@ -6,6 +6,19 @@
 #include "plumb/core/error.h"
 
 namespace plumb::estimation {
+namespace {
+
+/// The longest stretch without a sample in samples [first, last] of `series`.
+SampleGap LongestGap(const ImuSeries& series, std::size_t first, std::size_t last) {
+  SampleGap out;
+  for (std::size_t i = first; i < last; ++i) {
+    const double length = series.t_s[i + 1] - series.t_s[i];
+    if (length > out.length_s) out = {series.t_s[i], length};
+  }
+  return out;
+}
+
+}  // namespace
 
 std::vector<Vec3> StillSet::AtRestMeans(bool gyro) const {
   std::vector<Vec3> out;
@@ -78,14 +91,19 @@ StillSet MakeStillSet(const ImuSeries& series, const std::vector<StillSegment>& 
           return m.Covers(series.t_s[first], series.t_s[last]);
         });
     if (flown != options.log_motion.end()) {
-      set.not_turns.push_back({k, first, last, *flown});
+      set.not_turns.push_back({k, first, last, *flown, std::nullopt});
       continue;
     }
     if (gap > options.max_motion_s) {
-      set.not_turns.push_back({k, first, last, std::nullopt});
+      set.not_turns.push_back({k, first, last, std::nullopt, std::nullopt});
       continue;
     }
-    set.motions.push_back({k, first, last, std::nullopt});
+    if (const SampleGap dropout = LongestGap(series, first, last);
+        dropout.length_s > options.max_turn_gap_s) {
+      set.not_turns.push_back({k, first, last, std::nullopt, dropout});
+      continue;
+    }
+    set.motions.push_back({k, first, last, std::nullopt, std::nullopt});
   }
   set.joined_to_previous.assign(set.poses.size(), false);
   for (const auto& m : set.motions) set.joined_to_previous[m.from + 1] = true;

@@ -15,6 +15,7 @@
 #include "plumb/core/imu_series.h"
 #include "plumb/core/segment.h"
 #include "plumb/core/types.h"
+#include "plumb/estimation/fit_report.h"
 #include "plumb/estimation/options.h"
 #include "plumb/residuals/measurements.h"
 #include "plumb/signal/segment_stats.h"
@@ -44,8 +45,10 @@ struct MotionInterval {
   std::size_t from = 0;
   std::size_t first = 0, last = 0;
   /// For a motion left out (StillSet::not_turns): what the log says the vehicle did in it, when
-  /// that is the reason; empty when the motion is left out for its length.
+  /// that is the reason; empty when the motion is left out for its length or a gap.
   std::optional<LogMotion> flown;
+  /// For a motion left out for a gap in its samples: the longest one.
+  std::optional<SampleGap> gap;
 };
 
 struct StillSet {

@@ -126,6 +126,17 @@ std::string FullReport(const estimation::CalibrationResult& result) {
     os << "\nunobservable directions (moving along them changes no prediction):\n";
     for (const auto& u : c.observability.unobservable) os << "  " << u << "\n";
   }
+  if (!c.observability.weakly_determined.empty()) {
+    os << "\nweakly determined combinations (the data place them no better than three times a MEMS "
+          "IMU's typical size: each held where the fit starts; a parameter it moves keeps the "
+          "data's sigma, which covers the hold, or is unobservable where that sigma exceeds three "
+          "typical sizes):\n";
+    for (const auto& w : c.observability.weakly_determined) {
+      os << "  " << w.text << ": held at " << FormattedText("%.4g", w.value) << "; the data's sigma "
+         << FormattedText("%.3g", w.sigma) << " (formal), typical size " << FormattedText("%.3g", w.typical)
+         << "\n";
+    }
+  }
   if (!c.observability.determined.empty()) {
     os << "determined combinations:\n";
     for (const auto& d : c.observability.determined) {

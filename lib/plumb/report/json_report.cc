@@ -149,10 +149,20 @@ json ObservabilityJson(const estimation::Observability& o, double sigma_scale) {
                           {keys::kSigma, Number(sigma_scale * d.sigma)},
                           {"sigma_formal", Number(d.sigma)}});
   }
+  json weak = json::array();
+  for (const auto& w : o.weakly_determined) {
+    weak.push_back({{keys::kCombination, w.text},
+                    {keys::kParameters, w.names},
+                    {keys::kCoefficients, w.coefficients},
+                    {"held_at", Number(w.value)},
+                    {"sigma_data", Number(w.sigma)},
+                    {"typical", Number(w.typical)}});
+  }
   return json{{"rank", o.rank},
               {"unknowns", o.num_unknowns},
               {"wander_states", o.wander_states},
               {"unobservable", o.unobservable},
+              {"weakly_determined", weak},
               {keys::kDetermined, determined}};
 }
 
@@ -398,8 +408,13 @@ json ToJson(const estimation::CalibrationResult& r) {
               {"t_begin_s", Number(m.t_begin_s)},
               {"t_end_s", Number(m.t_end_s)},
               {"limit_s", Number(m.limit_s)},
-              {"reason", m.flown ? "log_says_flown" : "too_long"}};
+              {"reason", m.flown ? "log_says_flown" : m.gap ? "gap_in_samples" : "too_long"}};
     if (m.flown) j["log_motion"] = LogMotionJson(*m.flown);
+    if (m.gap) {
+      j["gap"] = {{"t_s", Number(m.gap->t_s)},
+                  {"length_s", Number(m.gap->length_s)},
+                  {"limit_s", Number(m.gap_limit_s)}};
+    }
     doc["not_turns"].push_back(j);
   }
   doc["warnings"] = Messages(r.fit.warnings);  // the messages; the codes are not in SPEC 6

@@ -111,6 +111,8 @@ std::string CalibrationSummary(const estimation::CalibrationResult& r, const std
   os << FitVerdict(r.fit);
   const std::size_t lost = r.calibration.observability.unobservable.size();
   if (lost > 0) os << "; " << lost << " unobservable direction" << (lost > 1 ? "s" : "");
+  const std::size_t weak = r.calibration.observability.weakly_determined.size();
+  if (weak > 0) os << "; " << weak << " weakly determined combination" << (weak > 1 ? "s" : "") << " held";
   os << "\n" << GateLines(r.fit, source) << "\n" << FullReport(r);
   return os.str();
 }
