@@ -46,7 +46,9 @@ struct Combination {
 };
 
 struct Observability {
-  int rank = 0;            ///< numerical rank of the column-scaled whitened Jacobian
+  /// Numerical rank of the column-scaled whitened Jacobian, less the weakly determined
+  /// combinations held (observability.h kWeakSpread).
+  int rank = 0;
   int num_unknowns = 0;    ///< free tangent-space unknowns (model parameters and attitudes)
   /// Bias-wander states besides them (always determined: each has its Markov factor), which
   /// the degrees of freedom also subtract.
