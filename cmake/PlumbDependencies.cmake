@@ -19,7 +19,7 @@ endif()
 # and lz4 chunks of MCAP files (io/ros), found as plain libraries (Debian ships no CMake
 # package for liblz4) and linked privately by io_ros. libsqlite3: ROS 2 .db3 bags (io/ros).
 # libdeflate: the CRC-32 of an MCAP chunk's records (libdeflate_crc32, carry-less multiplication:
-# about 4 times zlib 1.2.13's crc32, so that the check costs a few percent of a read).
+# about 3 times zlib 1.2.13's crc32; its cost in a read is in docs/performance.md).
 find_path(PLUMB_BZ2_INCLUDE_DIR bzlib.h REQUIRED)
 find_library(PLUMB_BZ2_LIBRARY bz2 REQUIRED)
 find_path(PLUMB_LZ4_INCLUDE_DIR lz4frame.h REQUIRED)

@@ -194,10 +194,10 @@ void AddDeterminedCombinations(const Eigen::MatrixXd& B, const std::vector<bool>
 
 /// A combination c^T x of the model parameters (c over J's columns, zero off the model's)
 /// that the data determine no better than its typical spread (kWeakSpread).
+/// Its typical spread, sqrt(sum c_i^2 typical_i^2), is 1 (c = T^-1 c~, |c~| = 1).
 struct WeakCombination {
   Eigen::VectorXd c;
   double sigma = 0.0;    ///< the data's sigma of c^T x
-  double typical = 0.0;  ///< its typical spread, sqrt(sum c_i^2 typical_i^2)
 };
 
 /// The model columns of `in` (J's columns that are model parameters).
@@ -252,7 +252,6 @@ std::vector<WeakCombination> WeakCombinations(const ObservabilityInput& in,
     w.c = Eigen::VectorXd::Zero(in.J.cols());
     for (Eigen::Index a = 0; a < n_m; ++a) w.c[model[static_cast<std::size_t>(a)]] = unit[a] / T[a];
     w.sigma = std::sqrt(variance);
-    w.typical = 1.0;
     out.push_back(std::move(w));
   }
   return out;
@@ -310,7 +309,7 @@ Combination DescribeWeak(const WeakCombination& w, const ObservabilityInput& in)
   }
   out.text = FormatCombination(shown, out.names, false);
   out.sigma = w.sigma * std::abs(scale);
-  out.typical = w.typical * std::abs(scale);
+  out.typical = std::abs(scale);  // the unit typical spread, rescaled
   return out;
 }
 
