@@ -62,7 +62,7 @@ AnalysedSolution AnalyseAt(CalibrationProblem& calibration, ceres::Problem& prob
   const Eigen::Index n_m = LeadingModelColumns(columns.is_model);
   if (how.dense || (n_m == n && !how.keep_jacobian)) {
     in.J = calibration.Jacobian(problem, columns, &out.cost, &out.residuals);
-    in.chi2 = 2.0 * out.cost;
+    in.chi2 = how.formal_sigmas ? 0.0 : 2.0 * out.cost;
     in.observations = static_cast<int>(out.residuals.size());
     out.analysis = AnalyseObservability(in);
     if (how.dense) out.dense_jacobian = std::move(in.J);
@@ -71,7 +71,7 @@ AnalysedSolution AnalyseAt(CalibrationProblem& calibration, ceres::Problem& prob
   Eigen::SparseMatrix<double> J_local;
   Eigen::SparseMatrix<double>& J = how.keep_jacobian ? out.jacobian : J_local;
   J = calibration.SparseJacobian(problem, columns, &out.cost, &out.residuals);
-  in.chi2 = 2.0 * out.cost;
+  in.chi2 = how.formal_sigmas ? 0.0 : 2.0 * out.cost;
   in.observations = static_cast<int>(out.residuals.size());
   // The attitudes and wander states eliminated together when the data determine the attitudes
   // clearly (the cost is then linear in the poses), else the wander states alone; kept for
@@ -161,12 +161,42 @@ bool SameShape(const Gauge& a, const Gauge& b) {
          a.combinations.size() == b.combinations.size();
 }
 
+/// The gauge read at the starting values (the values saved before the free fit), on the noise
+/// model's sigmas; the calibration's values are left at the start.
+Gauge GaugeAtStart(CalibrationProblem& calibration, const CalibrationOptions& options) {
+  calibration.RestoreValues();
+  const BuiltProblem start = calibration.Build({});
+  AnalysisOptions how;
+  how.formal_sigmas = true;
+  return GaugeOf(AnalyseAt(calibration, *start.problem, options, how));
+}
+
+/// The held fits from `gauge`, each from the starting values: again while the analysis at the
+/// solution finds a gauge of another shape (at most kGaugeRounds). Leaves `out` as the last.
+void HeldFits(CalibrationProblem& calibration, const CalibrationOptions& options, Gauge gauge,
+              Solution& out, FitReport& fit) {
+  for (int round = 0; round < kGaugeRounds; ++round) {
+    out.analysed.reset();
+    calibration.RestoreValues();
+    out.gauge = std::move(gauge);
+    out.all_free = calibration.Build({});
+    out.held = calibration.Build(out.gauge);
+    Record(Solve(*out.held.problem, SolveStage::kFromStart, options), fit);
+    // Without weak combinations the null directions are the free fit's: nothing to redo.
+    if (out.gauge.combinations.empty()) break;
+    out.analysed = AnalyseSolution(calibration, *out.all_free.problem, options);
+    gauge = GaugeOf(*out.analysed);
+    if (SameShape(gauge, out.gauge)) break;
+  }
+}
+
 }  // namespace
 
 // Solves with every unknown free (with motion: roughly, then again with the motion weights
 // of that solution) and analyses the solution. Where the analysis finds null directions or
 // weak combinations, they are held and the fit is made again from the starting values, and
-// analysed again while the gauge changes shape (the fit's account then has every solve).
+// analysed again while the gauge changes shape (the fit's account then has every solve). Held
+// fits that do not converge are made again from the gauge at the starting values.
 Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOptions& options,
                         FitReport& fit) {
   Solution out;
@@ -187,19 +217,8 @@ Solution SolveWithGauge(CalibrationProblem& calibration, const CalibrationOption
     fit = std::move(refined);
     return out;
   }
-  for (int round = 0; round < kGaugeRounds; ++round) {
-    out.analysed.reset();
-    calibration.RestoreValues();
-    out.gauge = std::move(gauge);
-    out.all_free = calibration.Build({});
-    out.held = calibration.Build(out.gauge);
-    Record(Solve(*out.held.problem, SolveStage::kFromStart, options), fit);
-    // Without weak combinations the null directions are the free fit's: nothing to redo.
-    if (out.gauge.combinations.empty()) break;
-    out.analysed = AnalyseSolution(calibration, *out.all_free.problem, options);
-    gauge = GaugeOf(*out.analysed);
-    if (SameShape(gauge, out.gauge)) break;
-  }
+  HeldFits(calibration, options, std::move(gauge), out, fit);
+  if (!fit.converged) HeldFits(calibration, options, GaugeAtStart(calibration, options), out, fit);
   return out;
 }
 

@@ -8,9 +8,13 @@
 // accel.matrix.zz") held at its start value, and every weakly determined combination
 // (observability.h kWeakSpread) held where it starts (residuals::HeldCombination). The weak
 // combinations depend on where the analysis linearises, so the held fit is analysed again and
-// redone while its gauge changes shape (at most kGaugeRounds fits). With motion intervals, the motion residuals'
-// whitening is set again from the first solution's E and F before the final solve, so chi^2
-// does not depend on the starting values.
+// redone while its gauge changes shape (at most kGaugeRounds fits). The free fit can wander far
+// along what the data do not determine (one turn sampled at 3 Hz took a gyroscope scale to 1e7),
+// and a gauge read there need not hold at the start: when the held fits do not converge, the
+// gauge is read again at the starting values, on the noise model's sigmas, and the held fits are
+// made again from it. With motion intervals, the motion residuals' whitening is set again from
+// the first solution's E and F before the final solve, so chi^2 does not depend on the starting
+// values.
 //
 // INTERNAL to plumb::estimation (not installed): it exposes Ceres's problem.
 #pragma once
@@ -104,6 +108,10 @@ struct AnalysisOptions {
   /// Without `dense`: keep the whitened sparse Jacobian and, when the analysis made one, the
   /// elimination of every column after the model's, for other checks at the same point.
   bool keep_jacobian = false;
+  /// Judge the weak combinations on the sigmas the noise model gives, not scaled by the misfit
+  /// (observability.h kWeakSpread): at the starting values the misfit says only that no fit
+  /// has been made yet.
+  bool formal_sigmas = false;
 };
 
 /// The observability analysis of `problem` at the current values (see AnalysisOptions).
