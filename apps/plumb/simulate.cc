@@ -45,6 +45,7 @@ struct SimulateArgs {
   double t0_s = 0.0;                     ///< time of the first sample, s
   SiteArgs site;
   std::uint64_t seed = 1;    ///< seed of the noise, the poses and random truth
+  int imus = 1;              ///< --imus: IMUs on the board (RandomBoard places IMU 1..)
   std::string truth_json;    ///< --truth-json FILE
   std::string segments_out;  ///< --segments-out FILE
 };
@@ -75,20 +76,49 @@ sim::TemperatureProfile ParseTemperature(const std::string& spec) {
                    spec + "')");
 }
 
-nlohmann::json TruthJson(const sim::Simulation& s, const SimulateArgs& a) {
-  using nlohmann::json;
-  const auto names = s.model.ParameterNames();
-  const auto values = model::ReportedValues(s.model, s.truth);
-  json params = json::array();
+/// The true parameters of `model` at `truth`, names prefixed with `prefix` ("imu1." for IMU 1).
+nlohmann::json TrueParameters(const model::Model& model, const model::ParameterBlocks& truth,
+                              const std::string& prefix) {
+  const auto names = model.ParameterNames();
+  const auto values = model::ReportedValues(model, truth);
+  nlohmann::json params = nlohmann::json::array();
   int flat = 0;
-  for (const auto& term : s.model.terms()) {
+  for (const auto& term : model.terms()) {
     const auto& info = term.effect->info();
     for (int i = 0; i < info.size(); ++i, ++flat) {
-      params.push_back({{"name", names[static_cast<std::size_t>(flat)]},
+      params.push_back({{"name", prefix + names[static_cast<std::size_t>(flat)]},
                         {"value", report::Number(values[static_cast<std::size_t>(flat)])},
                         {"unit", info.parameters[static_cast<std::size_t>(i)].unit}});
     }
   }
+  return params;
+}
+
+/// One IMU of the board as SPEC 6's "imus" entries describe it (IMU 0: the identity).
+nlohmann::json BoardImuJson(int instance, const model::Model& model,
+                            const model::ParameterBlocks& truth, const Quat& R_b_i,
+                            const Vec3& lever_arm_m, double time_offset_s) {
+  using nlohmann::json;
+  const Mat3 R = R_b_i.toRotationMatrix();
+  const Eigen::AngleAxisd v(R_b_i);
+  const Vec3 vector = v.angle() * v.axis();
+  auto triple = [](const Vec3& x) {
+    return json::array({report::Number(x.x()), report::Number(x.y()), report::Number(x.z())});
+  };
+  json matrix = json::array();
+  for (int r = 0; r < 3; ++r) matrix.push_back(triple(R.row(r).transpose()));
+  const std::string prefix = instance == 0 ? "" : "imu" + std::to_string(instance) + ".";
+  return json{{"instance", instance},
+              {"model", model.spec()},
+              {"parameters", TrueParameters(model, truth, prefix)},
+              {"rotation", {{"matrix", matrix}, {"vector", triple(vector)}}},
+              {"lever_arm", {{"value", triple(lever_arm_m)}}},
+              {"time_offset", {{"value", report::Number(time_offset_s)}}}};
+}
+
+nlohmann::json TruthJson(const sim::Simulation& s, const SimulateArgs& a) {
+  using nlohmann::json;
+  const json params = TrueParameters(s.model, s.truth, "");
   json segments = json::array();
   for (std::size_t k = 0; k < s.truth_segments.size(); ++k) {
     const auto& seg = s.truth_segments[k];
@@ -105,7 +135,7 @@ nlohmann::json TruthJson(const sim::Simulation& s, const SimulateArgs& a) {
             {"height_m", s.site.known ? report::Number(s.site.height_m) : json(nullptr)},
             {"gravity", report::Number(s.site.gravity())},
             {"source", s.site.known ? s.site.source : std::string("none")}};
-  return json{
+  json out{
       {"plumb_version", report::Version()},
       {"model", s.model.spec()},
       {"model_reference", {{"t_ref_s", s.model.t_ref_s}, {"temp_ref_c", s.model.temp_ref_c}}},
@@ -126,6 +156,16 @@ nlohmann::json TruthJson(const sim::Simulation& s, const SimulateArgs& a) {
       {"rate_hz", s.rate_hz},
       {"t0_s", s.t0_s},
       {"seed", a.seed}};
+  if (!s.board.empty()) {
+    json imus = json::array({BoardImuJson(0, s.model, s.truth, Quat::Identity(), Vec3::Zero(), 0.0)});
+    for (std::size_t i = 0; i < s.board.size(); ++i) {
+      const sim::BoardImuTruth& b = s.board[i];
+      imus.push_back(BoardImuJson(static_cast<int>(i + 1), b.model, b.truth, b.R_b_i,
+                                  b.lever_arm_m, b.time_offset_s));
+    }
+    out["imus"] = std::move(imus);
+  }
+  return out;
 }
 
 /// The true still segments as a segments file (CSV, sample indices, half-open).
@@ -175,8 +215,15 @@ class SimulateCommand : public Command {
         ->capture_default_str();
     app_->add_option("--truth", a.truth,
                      "True parameter PARAM=VALUE in its unit (matrix diagonals near 1), e.g. "
-                     "accel.bias.x=0.1 gyro_g_sensitivity.G.xy=1e-4; repeatable; others are "
-                     "ideal (or random with --random-truth)");
+                     "accel.bias.x=0.1 gyro_g_sensitivity.G.xy=1e-4, or of IMU k of a board "
+                     "imuK.PARAM=VALUE; repeatable; others are ideal (or random with "
+                     "--random-truth)");
+    app_->add_option("--imus", a.imus,
+                     "IMUs on the board: IMU 1.. of the same model, each rotated by 0.5-2 deg, "
+                     "1-5 cm from IMU 0 and 2 ms or less off its stamps (drawn from --seed), "
+                     "written as acc1_x.. columns")
+        ->check(CLI::Range(1, 16))
+        ->capture_default_str();
     app_->add_option("--random-truth", a.random_truth,
                      "Draw every free parameter from N(nominal, (SCALE x typical size)^2) before "
                      "--truth applies; 0 = ideal IMU")
@@ -281,14 +328,8 @@ class SimulateCommand : public Command {
     options.truth = a.random_truth > 0
                         ? sim::RandomParameters(options.model, a.random_truth, a.seed)
                         : options.model.ZeroParameters();
-    for (const auto& setting : a.truth) {
-      const auto eq = setting.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        throw UsageError("--truth must be PARAM=VALUE (got '" + setting + "')");
-      }
-      sim::SetParameter(options.model, options.truth, setting.substr(0, eq),
-                        ParseNumber(setting.substr(eq + 1), "--truth " + setting));
-    }
+    options.board = sim::RandomBoard(a.imus, options.model, a.random_truth, a.seed);
+    for (const auto& setting : a.truth) SetTruth(setting, options);
     options.temperature = ParseTemperature(a.temperature);
     options.record_temperature = !a.no_temperature;
     options.t0_s = a.t0_s;
@@ -301,7 +342,9 @@ class SimulateCommand : public Command {
               << sim.session.series.duration_s() << " s at " << sim.rate_hz << " Hz, "
               << sim.truth_segments.size() << " still holds; model " << sim.model.spec()
               << "; noise per sample " << sim.accel_sigma << " m/s^2, " << sim.gyro_sigma
-              << " rad/s; site " << (sim.site.known ? "given" : "none (no Earth rate)") << "\n";
+              << " rad/s; site " << (sim.site.known ? "given" : "none (no Earth rate)");
+    if (!sim.board.empty()) std::cout << "; " << sim.board.size() + 1 << " IMUs on one board";
+    std::cout << "\n";
     if (!a.truth_json.empty()) {
       report::WriteJson(a.truth_json, TruthJson(sim, a));
       std::cout << "wrote " << a.truth_json << "\n";
@@ -314,6 +357,32 @@ class SimulateCommand : public Command {
   }
 
  private:
+  /// One --truth PARAM=VALUE or imuK.PARAM=VALUE into `options`.
+  static void SetTruth(const std::string& setting, sim::SimulationOptions& options) {
+    const auto eq = setting.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw UsageError("--truth must be PARAM=VALUE (got '" + setting + "')");
+    }
+    std::string name = setting.substr(0, eq);
+    const double value = ParseNumber(setting.substr(eq + 1), "--truth " + setting);
+    const model::Model* model = &options.model;
+    model::ParameterBlocks* truth = &options.truth;
+    if (name.rfind("imu", 0) == 0 && name.find('.') != std::string::npos) {
+      const std::string k = name.substr(3, name.find('.') - 3);
+      const int imu = std::atoi(k.c_str());
+      if (k.empty() || k.find_first_not_of("0123456789") != std::string::npos || imu < 1 ||
+          imu > static_cast<int>(options.board.size())) {
+        throw UsageError("--truth " + setting + ": the board has IMU 1 to " +
+                         std::to_string(options.board.size()) + " (--imus " +
+                         std::to_string(options.board.size() + 1) + ")");
+      }
+      model = &options.board[static_cast<std::size_t>(imu - 1)].model;
+      truth = &options.board[static_cast<std::size_t>(imu - 1)].truth;
+      name = name.substr(name.find('.') + 1);
+    }
+    sim::SetParameter(*model, *truth, name, value);
+  }
+
   /// The schedule the flags name (sim::NamedSchedule: its defaults for what is not given).
   sim::Schedule MakeSchedule() const {
     const SimulateArgs& a = args_;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -58,6 +59,74 @@ TEST(NativeCsv, RoundTripIsBitExact) {
   EXPECT_EQ(read.source, path);
   EXPECT_TRUE(read.warnings.empty());
   ExpectIdentical(written.series, read.series);
+}
+
+TEST(NativeCsv, TheBoardsOtherImusRoundTripBitExact) {
+  // SPEC 6: IMU k in acc{k}_x.. on IMU 0's time column; one without gyroscope, one with.
+  TempDir dir;
+  Session written = RandomSession(2000, true, true);
+  Session second = RandomSession(2000, false, true);
+  Session third = RandomSession(2000, true, false);
+  second.series.t_s = third.series.t_s = written.series.t_s;
+  std::reverse(second.series.acc.begin(), second.series.acc.end());
+  written.other_imus = {BoardImu{1, "", second.series, {}}, BoardImu{2, "", third.series, {}}};
+  const std::string path = dir.File("board.csv");
+  WriteNativeCsv(path, written);
+  const Session read = ReadNativeCsv(path);
+  ExpectIdentical(written.series, read.series);
+  ASSERT_EQ(read.other_imus.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(read.other_imus[i].instance, static_cast<int>(i + 1));
+    ExpectIdentical(written.other_imus[i].series, read.other_imus[i].series);
+  }
+  EXPECT_EQ(read.other_imus[0].name, "acc1_x..");
+}
+
+TEST(NativeCsv, AnotherImuOnOtherStampsIsNotWritten) {
+  TempDir dir;
+  Session written = RandomSession(10, true, false);
+  Session other = RandomSession(10, true, false);
+  other.series.t_s[4] += 1e-3;
+  written.other_imus = {BoardImu{1, "", other.series, {}}};
+  const std::string path = dir.File("board.csv");
+  try {
+    WriteNativeCsv(path, written);
+    ADD_FAILURE() << "written";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("IMU 1's stamps are not IMU 0's"), std::string::npos);
+  }
+}
+
+TEST(NativeCsv, AnotherImusColumnsByNameAndTheFirstGapEndsThem) {
+  // acc1 and acc2 in any order; acc4 without acc3 is not read as an IMU.
+  TempDir dir;
+  const std::string path = dir.Write("board.csv",
+                                     "\xEF\xBB\xBF# board\n"
+                                     "acc2_z,time_s,acc_x,acc_y,acc_z,acc1_x,acc1_y,acc1_z,acc2_x,"
+                                     "acc2_y,acc4_x,temp1_c\n"
+                                     "-9.5,0.5,0.1,0.2,-9.8,1,2,3,4,5,6,30.5\n"
+                                     "-9.6,0.6,0.1,0.2,-9.8,1,2,3,4,5,6,30.75\n");
+  const Session s = ReadNativeCsv(path);
+  ASSERT_EQ(s.other_imus.size(), 2u);
+  EXPECT_EQ(s.other_imus[0].series.acc[1], Vec3f(1, 2, 3));
+  EXPECT_EQ(s.other_imus[0].series.temp_c[1], 30.75f);
+  EXPECT_EQ(s.other_imus[1].series.acc[0], Vec3f(4, 5, -9.5f));
+  EXPECT_FALSE(s.other_imus[1].series.has_temperature());
+  EXPECT_DOUBLE_EQ(s.other_imus[1].series.t_s[1], 0.6);
+}
+
+TEST(NativeCsv, AnotherImuMissingAnAxisIsAnErrorNamingIt) {
+  TempDir dir;
+  const std::string path = dir.Write("board.csv",
+                                     "time_s,acc_x,acc_y,acc_z,acc1_x,acc1_y\n"
+                                     "0.5,0.1,0.2,-9.8,1,2\n");
+  try {
+    ReadNativeCsv(path);
+    ADD_FAILURE() << "read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), path);
+    EXPECT_NE(std::string(e.what()).find("acc1_z"), std::string::npos) << e.what();
+  }
 }
 
 TEST(NativeCsv, RoundTripAccelerometerOnly) {

@@ -30,9 +30,10 @@ model::ParameterBlocks SmallParameters(const model::Model& m, std::uint64_t seed
 }
 
 /// Runs the gradient checker on a still residual of `sensor` and returns its max error.
-/// `weights`: the wander processes' bridge-mean weights (none: a constant bias).
+/// `weights`: the wander processes' bridge-mean weights (none: a constant bias); `mounted`: the
+/// residual of another IMU of the board, at a rotation R_b_i of a few degrees.
 double StillJacobianError(const std::string& spec, model::Sensor sensor,
-                          std::vector<double> weights = {}) {
+                          std::vector<double> weights = {}, bool mounted = false) {
   model::Model m = model::Model::Parse(spec);
   const auto theta = SmallParameters(m, 7);
   StillMeasurement meas;
@@ -40,11 +41,16 @@ double StillJacobianError(const std::string& spec, model::Sensor sensor,
   meas.sqrt_info = Vec3(100, 120, 90);
   meas.dt_s = 40.0;
   meas.dtemp_c = 3.0;
-  std::unique_ptr<ceres::CostFunction> cost(StillResidual::Create(
-      m, sensor, meas, Vec3(0, 0, 9.81), Vec3(4.5e-5, 0, -5.7e-5), Vec3::Zero(), weights));
+  const Vec3 g_n(0, 0, 9.81), omega_ie_n(4.5e-5, 0, -5.7e-5);
+  std::unique_ptr<ceres::CostFunction> cost(
+      mounted ? StillResidual::CreateMounted(m, sensor, meas, g_n, omega_ie_n, Vec3::Zero(), weights)
+              : StillResidual::Create(m, sensor, meas, g_n, omega_ie_n, Vec3::Zero(), weights));
   const Quat q = Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())).normalized();
   const double q_block[4] = {q.x(), q.y(), q.z(), q.w()};
+  const Quat mount = Quat(Eigen::AngleAxisd(0.03, Vec3(-2, 1, 0.5).normalized())).normalized();
+  const double mount_block[4] = {mount.x(), mount.y(), mount.z(), mount.w()};
   std::vector<const double*> params = {q_block};
+  if (mounted) params.push_back(mount_block);
   for (int t : StillResidual::TermsOf(m, sensor)) params.push_back(theta[static_cast<std::size_t>(t)].data());
   // Wander states: start and end of each process.
   const double states[2][2][3] = {{{0.01, -0.02, 0.005}, {0.015, -0.01, 0.0}},
@@ -55,6 +61,7 @@ double StillJacobianError(const std::string& spec, model::Sensor sensor,
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifold.get();
+  if (mounted) manifolds[1] = manifold.get();
   return testing::JacobianError(*cost, params, manifolds);
 }
 
@@ -104,6 +111,51 @@ TEST(StillResidual, GyroJacobianMatchesNumericBase) {
 
 TEST(StillResidual, AccelJacobianMatchesNumericWithEffects) {
   EXPECT_LT(StillJacobianError("base+accel_bias_drift", model::Sensor::kAccel), 1e-8);
+}
+
+TEST(StillResidual, MountedJacobianMatchesNumeric) {
+  EXPECT_LT(StillJacobianError("base", model::Sensor::kAccel, {}, true), 1e-8);
+  // A still gyroscope sees its mount through Earth rate only (5e-5 rad/s): that block's
+  // Jacobian is 2e4 times smaller than the residual, and the central difference's rounding
+  // (eps |r| / step) is 4e-8 of it.
+  EXPECT_LT(StillJacobianError("base", model::Sensor::kGyro, {0.5}, true), 2e-7);
+  EXPECT_LT(StillJacobianError("base+gyro_g_sensitivity", model::Sensor::kGyro, {0.5, 0.42}, true),
+            2e-7);
+}
+
+/// The residual of a still accelerometer pose, `mounted` or not, at attitude q_n_b (and mount
+/// q_b_i), for a base model with a few parameters set.
+Vec3 AccelResidual(bool mounted, const Quat& R_n_b, const Quat& R_b_i = Quat::Identity()) {
+  model::Model m = model::Model::Parse("base");
+  const auto theta = SmallParameters(m, 11);
+  StillMeasurement meas;
+  meas.mean = Vec3(0.3, -0.2, -9.7);
+  meas.sqrt_info = Vec3(100, 120, 90);
+  const Vec3 g_n(0, 0, 9.81);
+  std::unique_ptr<ceres::CostFunction> cost(
+      mounted ? StillResidual::CreateMounted(m, model::Sensor::kAccel, meas, g_n, Vec3::Zero(),
+                                             Vec3::Zero(), {})
+              : StillResidual::Create(m, model::Sensor::kAccel, meas, g_n, Vec3::Zero()));
+  const double q[4] = {R_n_b.x(), R_n_b.y(), R_n_b.z(), R_n_b.w()};
+  const double q_b_i[4] = {R_b_i.x(), R_b_i.y(), R_b_i.z(), R_b_i.w()};
+  std::vector<const double*> p = {q};
+  if (mounted) p.push_back(q_b_i);
+  p.push_back(theta[static_cast<std::size_t>(m.BaseTerm(model::Sensor::kAccel))].data());
+  Vec3 r;
+  cost->Evaluate(p.data(), r.data(), nullptr);
+  return r;
+}
+
+TEST(StillResidual, AMountedImuSeesThePoseThroughItsMount) {
+  // R_n_i = R_n_b R_b_i: the mounted residual at (R_n_b, R_b_i) is the plain one at R_n_b R_b_i,
+  // and a mount at the identity changes nothing.
+  const Quat R_n_b = Quat(Eigen::AngleAxisd(0.9, Vec3(0.3, -1, 2).normalized()));
+  const Quat R_b_i = Quat(Eigen::AngleAxisd(0.02, Vec3(1, 1, -0.4).normalized()));
+  EXPECT_LT((AccelResidual(true, R_n_b, R_b_i) - AccelResidual(false, R_n_b * R_b_i)).norm(), 1e-9);
+  EXPECT_LT((AccelResidual(true, R_n_b, Quat::Identity()) - AccelResidual(false, R_n_b)).norm(),
+            1e-12);
+  // The mount matters: 0.02 rad of tilt moves 9.8 m/s^2 by about 0.2 m/s^2, 20 sigma here.
+  EXPECT_GT((AccelResidual(true, R_n_b, R_b_i) - AccelResidual(false, R_n_b)).norm(), 5.0);
 }
 
 TEST(StillResidual, ZeroResidualAtTruth) {

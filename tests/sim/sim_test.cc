@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 #include "plumb/geo/site.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
@@ -85,6 +86,112 @@ TEST(Simulate, NoiselessTurnIntegratesToTheCommandedAngle) {
   const Quat expected = Quat(Eigen::AngleAxisd(angle, axis));
   EXPECT_LT(AngleBetween(sim.true_R_n_b[1], expected), 1e-12);
   EXPECT_EQ(sim.truth_segments[1].begin, 1200u);
+}
+
+/// A board IMU (SPEC 6) at `R_b_i`, `lever_arm_m` and `time_offset_s`, ideal unless `truth`.
+BoardImuTruth BoardImuAt(const Quat& R_b_i, const Vec3& lever_arm_m, double time_offset_s) {
+  BoardImuTruth b;
+  b.R_b_i = R_b_i;
+  b.lever_arm_m = lever_arm_m;
+  b.time_offset_s = time_offset_s;
+  return b;
+}
+
+TEST(SimulateBoard, AnotherImuSeesTheBodyThroughItsMount) {
+  // Noiseless and ideal: a still pose's specific force and Earth rate in IMU i's frame are
+  // R_b_i^T of IMU 0's, whatever its lever arm and time offset (nothing moves).
+  Schedule schedule;
+  schedule.Hold(1.0).Turn(Vec3(1, 1, 0).normalized(), 2.0, 2.0).Hold(1.0);
+  SimulationOptions options;
+  options.site = TestSite();
+  const Quat R_b_i(Eigen::AngleAxisd(0.03, Vec3(1, -2, 0.5).normalized()));
+  options.board = {BoardImuAt(R_b_i, Vec3(0.03, -0.02, 0.01), 0.004)};
+  const Simulation sim = Simulate(schedule, options);
+  ASSERT_EQ(sim.session.other_imus.size(), 1u);
+  const BoardImu& imu = sim.session.other_imus[0];
+  EXPECT_EQ(imu.instance, 1);
+  EXPECT_EQ(imu.series.t_s, sim.session.series.t_s);  // IMU 0's stamps
+  const Mat3 R_i_b = R_b_i.toRotationMatrix().transpose();
+  for (const StillSegment& segment : sim.truth_segments) {
+    for (std::size_t k = segment.begin + 10; k + 10 < segment.end; k += 37) {
+      const Vec3 acc0 = sim.session.series.acc[k].cast<double>();
+      const Vec3 gyr0 = sim.session.series.gyr[k].cast<double>();
+      EXPECT_LT((imu.series.acc[k].cast<double>() - R_i_b * acc0).norm(), 1e-5) << k;
+      EXPECT_LT((imu.series.gyr[k].cast<double>() - R_i_b * gyr0).norm(), 1e-11) << k;
+    }
+  }
+}
+
+TEST(SimulateBoard, ALeverArmAddsTheCentripetalAndEulerAccelerations) {
+  // Noiseless, ideal, no Earth rate: in a turn the IMU at r sees f_b + alpha x r +
+  // omega x (omega x r), the body's motion taken from the truth at the same instant.
+  Schedule schedule;
+  schedule.Hold(0.5).Turn(Vec3(0.2, -0.5, 1).normalized(), 3.0, 1.5).Hold(0.5);
+  SimulationOptions options;
+  const Vec3 r(0.04, -0.03, 0.02);
+  options.board = {BoardImuAt(Quat::Identity(), r, 0.0)};
+  const Simulation sim = Simulate(schedule, options);
+  const ImuSeries& imu = sim.session.other_imus[0].series;
+  double largest = 0.0;
+  for (std::size_t k = 200; k < 800; k += 13) {
+    const model::SensorInput<double> in = TrueInput(sim, sim.session.series.t_s[k]);
+    const Vec3 expected = in.f_b + in.alpha_b.cross(r) + in.omega_b.cross(in.omega_b.cross(r));
+    EXPECT_LT((imu.acc[k].cast<double>() - expected).norm(), 2e-5) << k;
+    largest = std::max(largest, (expected - in.f_b).norm());
+  }
+  EXPECT_GT(largest, 0.1);  // the lever arm's accelerations are there to see (m/s^2)
+}
+
+TEST(SimulateBoard, ATimeOffsetShiftsWhatTheSamplesSee) {
+  // Ideal IMUs at the same place: IMU 1's sample stamped t measured the motion at t + dt, so
+  // with dt one sample interval it reads IMU 0's next sample.
+  Schedule schedule;
+  schedule.Hold(0.5).Turn(Vec3(1, 0, 0), 1.5, 1.0).Hold(0.5);
+  SimulationOptions options;
+  options.board = {BoardImuAt(Quat::Identity(), Vec3::Zero(), 1.0 / options.rate_hz)};
+  const Simulation sim = Simulate(schedule, options);
+  const ImuSeries& imu0 = sim.session.series;
+  const ImuSeries& imu1 = sim.session.other_imus[0].series;
+  double moved = 0.0;
+  for (std::size_t k = 150; k < 650; k += 7) {
+    EXPECT_LT((imu1.gyr[k] - imu0.gyr[k + 1]).norm(), 1e-6) << k;
+    moved = std::max(moved, static_cast<double>((imu0.gyr[k] - imu0.gyr[k + 1]).norm()));
+  }
+  EXPECT_GT(moved, 1e-3);  // one sample apart is measurably apart
+}
+
+TEST(SimulateBoard, ImuZeroIsTheSameWithOrWithoutABoard) {
+  // Each IMU draws from its own generator: adding IMUs changes no bit of IMU 0, and the board
+  // IMUs' noise is their own.
+  SimulationOptions options = SimulationOptions::TypicalMems();
+  options.hand.translation_m = 0.1;
+  options.hand.vibration_accel = 0.3;
+  const Schedule schedule = MultiPose(4, 2.0, 1.0, 5);
+  const Simulation alone = Simulate(schedule, options);
+  options.board = {BoardImuAt(Quat::Identity(), Vec3::Zero(), 0.0),
+                   BoardImuAt(Quat::Identity(), Vec3::Zero(), 0.0)};
+  const Simulation board = Simulate(schedule, options);
+  EXPECT_EQ(board.session.series.acc, alone.session.series.acc);
+  EXPECT_EQ(board.session.series.gyr, alone.session.series.gyr);
+  EXPECT_EQ(board.session.series.temp_c, alone.session.series.temp_c);
+  ASSERT_EQ(board.session.other_imus.size(), 2u);
+  EXPECT_NE(board.session.other_imus[0].series.acc, board.session.series.acc);
+  EXPECT_NE(board.session.other_imus[0].series.acc, board.session.other_imus[1].series.acc);
+  EXPECT_EQ(board.session.other_imus[1].series.temp_c, board.session.series.temp_c);
+}
+
+TEST(SimulateBoard, ItsOwnModelAndTruthApply) {
+  // A board IMU's own error model: the still mean of its accelerometer is F_i f_i + b_i.
+  SimulationOptions options;
+  BoardImuTruth b = BoardImuAt(Quat(Eigen::AngleAxisd(0.02, Vec3::UnitX())), Vec3::Zero(), 0.0);
+  SetParameter(b.model, b.truth, "accel.bias.y", 0.2);
+  SetParameter(b.model, b.truth, "accel.matrix.zz", 1.01);
+  options.board = {b};
+  const Simulation sim = Simulate(PaperStatic(1.0), options);
+  const Vec3 f_i = b.R_b_i.toRotationMatrix().transpose() * Vec3(0, 0, -units::kStandardGravity);
+  const Vec3 expected(f_i.x(), f_i.y() + 0.2, 1.01 * f_i.z());
+  EXPECT_LT((sim.session.other_imus[0].series.acc[100].cast<double>() - expected).norm(), 1e-5);
+  EXPECT_EQ(sim.board[0].model.t_ref_s, options.t0_s);
 }
 
 TEST(Simulate, WhiteNoiseSigmaMatchesTheDensity) {
@@ -400,6 +507,14 @@ TEST(Simulate, BadOptionsThrowNamingTheField) {
   EXPECT_THROW(Schedule().Turn(Vec3::Zero(), 1.0, 1.0), Error);
   EXPECT_THROW(Schedule().Hold(-1.0), Error);
   EXPECT_THROW(MultiPose(0, 1.0, 1.0, 1), Error);
+  SimulationOptions board;
+  board.board = {BoardImuAt(Quat::Identity(), Vec3::Zero(), 2.0)};
+  try {
+    Simulate(PaperStatic(1.0), board);
+    ADD_FAILURE() << "a time offset of 2 s was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("board IMU 1: time offset 2"), std::string::npos) << e.what();
+  }
 }
 
 TEST(TemperatureProfile, RampAndUpDownValues) {

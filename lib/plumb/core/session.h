@@ -21,10 +21,24 @@ struct SiteInput {
   std::string source;     ///< "flags", "gps" or "file"
 };
 
+/// Another IMU of the same board (SPEC 6, "Several IMUs of one board"): its samples on its own
+/// stamps and in its own frame, as read.
+struct BoardImu {
+  int instance = 0;   ///< the log's sensor instance, or k of a native CSV's acc{k}_x columns
+  std::string name;   ///< where it was read from, e.g. "IMU2", "SCALED_IMU3", "acc1_x.."
+  ImuSeries series;
+  /// What the firmware applied to these samples that the reader did not undo (as
+  /// Session::firmware_left).
+  std::vector<std::string> firmware_left;
+};
+
 /// A recorded session: samples, where they came from, optional segments and site.
 struct Session {
   std::string source;              ///< file name(s) it was read from
-  ImuSeries series;
+  ImuSeries series;                ///< IMU 0's samples: its accelerometer defines the body frame
+  /// The board's other IMUs (IMU 1, 2, ...), when the input has them and the caller asked for
+  /// them; empty otherwise.
+  std::vector<BoardImu> other_imus;
   std::vector<StillSegment> given_segments;  ///< stated by the user; empty means detect
   std::optional<SiteInput> site;
   /// What the reader skipped, repaired or assumed (notice.h lists the codes).

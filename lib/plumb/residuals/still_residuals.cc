@@ -7,9 +7,10 @@ namespace plumb::residuals {
 StillResidual::StillResidual(const model::Model& model, model::Sensor sensor,
                              std::vector<int> terms, StillMeasurement measurement,
                              const Vec3& g_n, const Vec3& omega_ie_n, const Vec3& omega_eb_b,
-                             std::vector<double> wander_weights)
+                             std::vector<double> wander_weights, bool mounted)
     : model_(&model), sensor_(sensor), terms_(std::move(terms)), m_(measurement), g_n_(g_n),
-      omega_ie_n_(omega_ie_n), omega_eb_b_(omega_eb_b), wander_weights_(std::move(wander_weights)) {
+      omega_ie_n_(omega_ie_n), omega_eb_b_(omega_eb_b), wander_weights_(std::move(wander_weights)),
+      first_term_block_(mounted ? 2 : 1) {
   for (int t : terms_) effects_.emplace_back(*model.terms()[static_cast<std::size_t>(t)].effect);
 }
 
@@ -26,12 +27,16 @@ std::vector<int> StillResidual::TermsOf(const model::Model& model, model::Sensor
 template <typename T>
 Vec3T<T> StillResidual::PredictT(T const* const* parameters) const {
   const Eigen::Map<const Eigen::Quaternion<T>> q_n_b(parameters[0]);
-  const Mat3T<T> R_b_n = q_n_b.toRotationMatrix().transpose();
-  const model::SensorInput<T> in =
-      model::AtRest<T>(R_b_n, g_n_, omega_ie_n_, omega_eb_b_, T(m_.dt_s), T(m_.dtemp_c));
+  Mat3T<T> R_n_i = q_n_b.toRotationMatrix();  // the sensing IMU's frame into NED
+  if (first_term_block_ == 2) {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_b_i(parameters[1]);
+    R_n_i = R_n_i * q_b_i.toRotationMatrix();
+  }
+  const model::SensorInput<T> in = model::AtRest<T>(R_n_i.transpose(), g_n_, omega_ie_n_,
+                                                    omega_eb_b_, T(m_.dt_s), T(m_.dtemp_c));
   model::SensorOutput<T> out;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
-    effects_[i].Apply(parameters[i + 1], in, out);
+    effects_[i].Apply(parameters[i + static_cast<std::size_t>(first_term_block_)], in, out);
   }
   return sensor_ == model::Sensor::kAccel ? out.acc : out.gyr;
 }
@@ -40,7 +45,7 @@ template <typename T>
 bool StillResidual::operator()(T const* const* parameters, T* residuals) const {
   Vec3T<T> predicted = PredictT(parameters);
   for (std::size_t p = 0; p < wander_weights_.size(); ++p) {
-    const std::size_t w = terms_.size() + 1 + 2 * p;
+    const std::size_t w = terms_.size() + static_cast<std::size_t>(first_term_block_) + 2 * p;
     const Eigen::Map<const Vec3T<T>> s_k(parameters[w]), e_k(parameters[w + 1]);
     predicted += T(wander_weights_[p]) * (s_k + e_k);
   }
@@ -49,11 +54,29 @@ bool StillResidual::operator()(T const* const* parameters, T* residuals) const {
   return true;
 }
 
-Vec3 StillResidual::Predict(const double* q_k, const model::ParameterBlocks& theta) const {
+Vec3 StillResidual::Predict(const double* q_k, const model::ParameterBlocks& theta,
+                            const Quat& R_b_i) const {
+  const double q_b_i[4] = {R_b_i.x(), R_b_i.y(), R_b_i.z(), R_b_i.w()};
   std::vector<const double*> p = {q_k};
+  if (first_term_block_ == 2) p.push_back(q_b_i);
   for (int t : terms_) p.push_back(theta[static_cast<std::size_t>(t)].data());
   return PredictT<double>(p.data());
 }
+
+namespace {
+
+ceres::CostFunction* Cost(StillResidual* functor, const model::Model& model,
+                          const std::vector<int>& terms, std::size_t processes, bool mounted) {
+  auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, autodiff::kJetStride>(functor);
+  cost->AddParameterBlock(4);
+  if (mounted) cost->AddParameterBlock(4);
+  for (int t : terms) cost->AddParameterBlock(model.terms()[static_cast<std::size_t>(t)].effect->info().size());
+  for (std::size_t p = 0; p < 2 * processes; ++p) cost->AddParameterBlock(3);
+  cost->SetNumResiduals(3);
+  return cost;
+}
+
+}  // namespace
 
 ceres::CostFunction* StillResidual::Create(const model::Model& model, model::Sensor sensor,
                                            StillMeasurement measurement, const Vec3& g_n,
@@ -61,14 +84,20 @@ ceres::CostFunction* StillResidual::Create(const model::Model& model, model::Sen
                                            std::vector<double> wander_weights) {
   auto terms = TermsOf(model, sensor);
   const std::size_t processes = wander_weights.size();
-  auto* functor = new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n,
-                                    omega_eb_b, std::move(wander_weights));
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, autodiff::kJetStride>(functor);
-  cost->AddParameterBlock(4);
-  for (int t : terms) cost->AddParameterBlock(model.terms()[static_cast<std::size_t>(t)].effect->info().size());
-  for (std::size_t p = 0; p < 2 * processes; ++p) cost->AddParameterBlock(3);
-  cost->SetNumResiduals(3);
-  return cost;
+  return Cost(new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n, omega_eb_b,
+                                std::move(wander_weights)),
+              model, terms, processes, false);
+}
+
+ceres::CostFunction* StillResidual::CreateMounted(const model::Model& model, model::Sensor sensor,
+                                                  StillMeasurement measurement, const Vec3& g_n,
+                                                  const Vec3& omega_ie_n, const Vec3& omega_eb_b,
+                                                  std::vector<double> wander_weights) {
+  auto terms = TermsOf(model, sensor);
+  const std::size_t processes = wander_weights.size();
+  return Cost(new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n, omega_eb_b,
+                                std::move(wander_weights), true),
+              model, terms, processes, true);
 }
 
 template bool StillResidual::operator()<double>(double const* const*, double*) const;

@@ -49,6 +49,19 @@ void ValidateOptions(const SimulationOptions& o) {
     throw Error("simulation site has non-finite gravity or Earth rate");
   }
   o.temperature.Validate();
+  for (std::size_t i = 0; i < o.board.size(); ++i) {
+    const BoardImuTruth& b = o.board[i];
+    const std::string imu = "board IMU " + std::to_string(i + 1);
+    if (!b.lever_arm_m.allFinite()) throw Error("simulation option " + imu + ": lever arm not finite");
+    if (!std::isfinite(b.time_offset_s) || std::abs(b.time_offset_s) > 1.0) {
+      throw Error("simulation option " + imu + ": time offset " + Number(b.time_offset_s) +
+                  " s must be finite and within +-1 s");
+    }
+    if (!b.R_b_i.coeffs().allFinite() || std::abs(b.R_b_i.norm() - 1.0) > 1e-9) {
+      throw Error("simulation option " + imu + ": R_b_i is not a unit quaternion");
+    }
+    if (!std::isfinite(b.model.temp_ref_c)) throw Error(imu + ": model temp_ref_c must be finite");
+  }
 }
 
 /// The truth blocks in the model's layout (zeros when empty); throws on a mismatch.
@@ -133,11 +146,13 @@ class Hand {
   Vec3 Acceleration(const HandTurn& turn, double u, double T) const {
     return hand_.translation_m * kTwoPi / (T * T) * std::sin(kTwoPi * u) * turn.d_n;
   }
-  /// The vibration folded into one accelerometer sample, m/s^2.
-  Vec3 Vibration(const HandTurn& turn, double u) {
+  /// The vibration's per-sample sigma u into the turn, m/s^2.
+  double VibrationSigma(const HandTurn& turn, double u) const {
     const double s = std::sin(kPi * u);
-    return hand_.vibration_accel * turn.vibration_scale * s * s * noise_.Draw();
+    return hand_.vibration_accel * turn.vibration_scale * s * s;
   }
+  /// The vibration folded into one accelerometer sample of IMU 0, m/s^2.
+  Vec3 Vibration(const HandTurn& turn, double u) { return VibrationSigma(turn, u) * noise_.Draw(); }
 
  private:
   HandHeldTurns hand_;
@@ -157,6 +172,75 @@ class Instability {
  private:
   double phi_ = 0.0, step_ = 0.0;
   Vec3 state_ = Vec3::Zero();
+};
+
+/// The noise of one IMU's outputs from its own generator: per sample white noise (accelerometer,
+/// then gyroscope), then the bias walks' steps and the instabilities' (only when on), in that
+/// order.
+class OutputNoise {
+ public:
+  OutputNoise(const SimulationOptions& o, double accel_sigma, double gyro_sigma, std::uint64_t seed)
+      : noise_{std::mt19937_64(seed)},
+        accel_sigma_(accel_sigma),
+        gyro_sigma_(gyro_sigma),
+        accel_walk_step_(o.accel_bias_walk_density / std::sqrt(o.rate_hz)),
+        gyro_walk_step_(o.gyro_bias_walk_density / std::sqrt(o.rate_hz)),
+        accel_instability_(o.accel_bias_instability, o.bias_instability_time_s, o.rate_hz),
+        gyro_instability_(o.gyro_bias_instability, o.bias_instability_time_s, o.rate_hz) {}
+
+  /// The biases' wander at this sample (m/s^2, rad/s).
+  struct Wander {
+    Vec3 acc, gyr;
+  };
+
+  /// Adds this sample's white noise and the wander to `out`, advances the wander by one sample
+  /// and returns the wander the sample carried.
+  Wander Add(model::SensorOutput<double>& out) {
+    const Vec3 accel_white = noise_.Draw();
+    const Vec3 gyro_white = noise_.Draw();
+    const Wander wander{accel_walk_ + accel_instability_.value(),
+                        gyro_walk_ + gyro_instability_.value()};
+    // (y + wander) + white, in that order: the sums of sessions simulated before.
+    out.acc = out.acc + wander.acc + accel_sigma_ * accel_white;
+    out.gyr = out.gyr + wander.gyr + gyro_sigma_ * gyro_white;
+    accel_walk_ += accel_walk_step_ * noise_.Draw();
+    gyro_walk_ += gyro_walk_step_ * noise_.Draw();
+    // Drawn after the walk, and only when on: sessions without instability keep the noise
+    // sequence they had before it existed.
+    if (accel_instability_.on()) accel_instability_.Step(noise_);
+    if (gyro_instability_.on()) gyro_instability_.Step(noise_);
+    return wander;
+  }
+
+  /// A draw for the vibration of this IMU (a hand's turn).
+  Vec3 Draw() { return noise_.Draw(); }
+
+ private:
+  NoiseSource noise_;
+  double accel_sigma_, gyro_sigma_, accel_walk_step_, gyro_walk_step_;
+  Vec3 accel_walk_ = Vec3::Zero(), gyro_walk_ = Vec3::Zero();
+  Instability accel_instability_, gyro_instability_;
+};
+
+/// The inputs of the IMU at `b`'s place and in its frame, from the body's at that instant
+/// (BoardImuTruth).
+model::SensorInput<double> MountedInput(const model::SensorInput<double>& body,
+                                        const BoardImuTruth& b) {
+  const Mat3 R_i_b = b.R_b_i.toRotationMatrix().transpose();
+  const Vec3& r = b.lever_arm_m;
+  model::SensorInput<double> in = body;
+  in.f_b = R_i_b * (body.f_b + body.alpha_b.cross(r) + body.omega_b.cross(body.omega_b.cross(r)));
+  in.omega_b = R_i_b * body.omega_b;
+  in.alpha_b = R_i_b * body.alpha_b;
+  return in;
+}
+
+/// One board IMU while it is simulated: its truth, its noise and its samples.
+struct BoardImuRun {
+  const BoardImuTruth* truth;
+  std::vector<const double*> theta;
+  OutputNoise noise;
+  ImuSeries* series;
 };
 
 }  // namespace
@@ -235,14 +319,68 @@ model::SensorInput<double> TrueInput(const Simulation& sim, double t_s) {
                   sim.temperature.At(t_rel_s, sim.schedule.duration_s()) - sim.model.temp_ref_c);
 }
 
+namespace {
+
+/// The board's other IMUs as simulated: models referred to t0_s, blocks checked, and their
+/// series in `session` (IMU 0's columns: the gyroscope when its model has one, the temperature
+/// when recorded).
+std::vector<BoardImuRun> StartBoard(Simulation& sim, const SimulationOptions& options,
+                                    std::size_t n) {
+  for (const BoardImuTruth& b : options.board) {
+    BoardImuTruth used = b;
+    used.model.t_ref_s = options.t0_s;
+    used.truth = CheckedTruth(used.model, b.truth);
+    sim.board.push_back(std::move(used));
+  }
+  sim.session.other_imus.resize(sim.board.size());
+  std::vector<BoardImuRun> runs;
+  for (std::size_t i = 0; i < sim.board.size(); ++i) {
+    BoardImu& imu = sim.session.other_imus[i];
+    imu.instance = static_cast<int>(i + 1);
+    imu.name = "imu" + std::to_string(i + 1);
+    imu.series.reserve(n);
+    if (!sim.board[i].model.has_gyro()) imu.series.gyr.clear();
+    if (!options.record_temperature) imu.series.temp_c.clear();
+    // Each IMU's generator: the main seed mixed with its number (any fixed map would do).
+    BoardImuRun run{&sim.board[i], {}, OutputNoise(options, sim.accel_sigma, sim.gyro_sigma,
+                                                   options.seed ^ (0xD1B54A32D192ED03ULL * (i + 1))),
+                    &imu.series};
+    for (const auto& block : sim.board[i].truth) run.theta.push_back(block.data());
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+/// One sample of a board IMU stamped t_s: the motion at t_s + its time offset, a hand's
+/// translation a_n (IMU 0's instant) and, in a hand's turn, vibration of `vibration_sigma`.
+void BoardSample(BoardImuRun& run, const Simulation& sim, const SimulationOptions& options,
+                 double t_s, double temp_c, const Vec3& a_n, double vibration_sigma) {
+  const BoardImuTruth& b = *run.truth;
+  const double t_rel_s = t_s + b.time_offset_s - options.t0_s;
+  const model::SensorInput<double> body =
+      InputFor(sim.schedule.At(t_rel_s), sim.site, t_s + b.time_offset_s - b.model.t_ref_s,
+               temp_c - b.model.temp_ref_c, a_n);
+  model::SensorOutput<double> out = b.model.Predict(run.theta.data(), MountedInput(body, b));
+  if (vibration_sigma > 0.0) out.acc += vibration_sigma * run.noise.Draw();
+  run.noise.Add(out);
+  ImuSeries& series = *run.series;
+  series.t_s.push_back(t_s);
+  series.acc.push_back(Quantise(out.acc, options.accel_quantum).cast<float>());
+  if (b.model.has_gyro()) series.gyr.push_back(Quantise(out.gyr, options.gyro_quantum).cast<float>());
+  if (options.record_temperature) series.temp_c.push_back(static_cast<float>(temp_c));
+}
+
+}  // namespace
+
 Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) {
   if (schedule.empty()) throw Error("cannot simulate an empty schedule; add still or turn steps");
   ValidateOptions(options);
   const double rate_hz = options.rate_hz;
   const double n_real = std::ceil(schedule.duration_s() * rate_hz - kGridTolerance);
-  if (n_real > kMaxSamples) {
+  if (n_real * static_cast<double>(1 + options.board.size()) > kMaxSamples) {
     throw Error("simulation of " + Number(schedule.duration_s()) + " s at " +
-                Number(rate_hz) + " Hz exceeds 200 million samples");
+                Number(rate_hz) + " Hz of " + std::to_string(1 + options.board.size()) +
+                " IMUs exceeds 200 million samples");
   }
   const std::size_t n = static_cast<std::size_t>(std::max(0.0, n_real));
 
@@ -257,8 +395,6 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
   sim.rate_hz = rate_hz;
   sim.accel_sigma = options.accel_noise_density * std::sqrt(rate_hz);
   sim.gyro_sigma = options.gyro_noise_density * std::sqrt(rate_hz);
-  const double accel_walk_step = options.accel_bias_walk_density / std::sqrt(rate_hz);
-  const double gyro_walk_step = options.gyro_bias_walk_density / std::sqrt(rate_hz);
   const bool gyro = sim.model.has_gyro();
 
   Session& session = sim.session;
@@ -271,13 +407,8 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
   if (!gyro) series.gyr.clear();
   if (options.record_temperature) series.temp_c.reserve(n);
 
-  NoiseSource noise{std::mt19937_64(options.seed)};
-  Vec3 accel_walk = Vec3::Zero();
-  Vec3 gyro_walk = Vec3::Zero();
-  Instability accel_instability(options.accel_bias_instability, options.bias_instability_time_s,
-                                rate_hz);
-  Instability gyro_instability(options.gyro_bias_instability, options.bias_instability_time_s,
-                               rate_hz);
+  OutputNoise noise(options, sim.accel_sigma, sim.gyro_sigma, options.seed);
+  std::vector<BoardImuRun> board = StartBoard(sim, options, n);
   std::vector<const double*> theta;
   for (const auto& block : sim.truth) theta.push_back(block.data());
   // The hand's generator: the main one's seed with its bits mixed (any fixed map would do).
@@ -303,30 +434,21 @@ Simulation Simulate(const Schedule& schedule, const SimulationOptions& options) 
                                                      temp_c - sim.model.temp_ref_c, a_n);
       model::SensorOutput<double> out = sim.model.Predict(theta.data(), in);
       if (by_hand) out.acc += hand.Vibration(turn, u);
-      const Vec3 accel_white = noise.Draw();
-      const Vec3 gyro_white = noise.Draw();
-      const Vec3 accel_wander = accel_walk + accel_instability.value();
-      const Vec3 gyro_wander = gyro_walk + gyro_instability.value();
-      const Vec3 acc = out.acc + accel_wander + sim.accel_sigma * accel_white;
-      const Vec3 gyr = out.gyr + gyro_wander + sim.gyro_sigma * gyro_white;
+      const OutputNoise::Wander wander = noise.Add(out);
       series.t_s.push_back(t_s);
-      series.acc.push_back(Quantise(acc, options.accel_quantum).cast<float>());
-      if (gyro) series.gyr.push_back(Quantise(gyr, options.gyro_quantum).cast<float>());
+      series.acc.push_back(Quantise(out.acc, options.accel_quantum).cast<float>());
+      if (gyro) series.gyr.push_back(Quantise(out.gyr, options.gyro_quantum).cast<float>());
       if (options.record_temperature) series.temp_c.push_back(static_cast<float>(temp_c));
+      const double vibration = by_hand ? hand.VibrationSigma(turn, u) : 0.0;
+      for (BoardImuRun& run : board) BoardSample(run, sim, options, t_s, temp_c, a_n, vibration);
       if (k == begin) {
         still.R_n_b = motion.R_n_b;
         still.f_b = in.f_b;
         still.omega_b = in.omega_b;
       }
-      still.accel_bias_walk += accel_wander;
-      still.gyro_bias_walk += gyro_wander;
+      still.accel_bias_walk += wander.acc;
+      still.gyro_bias_walk += wander.gyr;
       still.mean_temp_c += temp_c;
-      accel_walk += accel_walk_step * noise.Draw();
-      gyro_walk += gyro_walk_step * noise.Draw();
-      // Drawn after the walk, and only when on: sessions without instability keep the noise
-      // sequence they had before it existed.
-      if (accel_instability.on()) accel_instability.Step(noise);
-      if (gyro_instability.on()) gyro_instability.Step(noise);
     }
     if (!schedule.is_still(i) || end == begin) continue;
     const double count = static_cast<double>(end - begin);

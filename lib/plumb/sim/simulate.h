@@ -74,6 +74,25 @@ struct HandHeldTurns {
   bool on() const { return translation_m > 0.0 || vibration_accel > 0.0; }
 };
 
+/// Another IMU of the simulated board (SPEC 6, "Several IMUs of one board"). It is sampled on
+/// IMU 0's stamps, with the noise levels of SimulationOptions drawn from its own generator, and
+/// sees the motion at its own place and in its own frame:
+///   f_i     = R_b_i^T (f_b + alpha_b x r + omega_b x (omega_b x r))   (r = lever_arm_m)
+///   omega_i = R_b_i^T omega_b,  alpha_i = R_b_i^T alpha_b
+/// at the instant t + time_offset_s of its sample stamped t. A hand's translation (HandHeldTurns)
+/// moves the whole board, taken at IMU 0's instant; its vibration is drawn per IMU.
+struct BoardImuTruth {
+  Quat R_b_i = Quat::Identity();    ///< its frame into the body frame (IMU 0's accelerometer's)
+  Vec3 lever_arm_m = Vec3::Zero();  ///< where it sits, body frame, m, from IMU 0
+  /// Added to its stamps, the true time of its samples, s: its sample stamped t measured the
+  /// motion at t + time_offset_s; finite, |offset| <= 1 s.
+  double time_offset_s = 0.0;
+  /// Its true error model and parameter blocks (empty: the ideal IMU); the model's t_ref_s is
+  /// replaced by t0_s, as IMU 0's.
+  model::Model model = model::Model::Parse("base");
+  model::ParameterBlocks truth;
+};
+
 /// Everything the simulator needs besides the schedule.
 struct SimulationOptions {
   /// Sample rate, Hz, in (0, 100000].
@@ -116,6 +135,8 @@ struct SimulationOptions {
   double t0_s = 0.0;
   /// Seed of the std::mt19937_64 that draws the noise.
   std::uint64_t seed = 1;
+  /// The board's other IMUs, IMU 1, 2, ... (none by default: one IMU).
+  std::vector<BoardImuTruth> board;
 
   /// Noise of a typical consumer MEMS IMU on a small UAV (ICM-20602/42688 class):
   /// accelerometer white 1e-3 m/s^2/sqrt(Hz) (100 ug/sqrt(Hz)), gyroscope 7e-5 rad/s/sqrt(Hz)
@@ -145,7 +166,9 @@ struct StillTruth {
 /// A simulated session and its truth.
 struct Simulation {
   /// The native samples (time_s from t0_s, acc, gyr unless the model has no gyroscope, temp_c
-  /// if recorded), source "simulated ...", site set when options.site.known. given_segments is
+  /// if recorded), source "simulated ...", site set when options.site.known; the board's other
+  /// IMUs in other_imus (instance k, name "imu<k>"), each with the gyroscope when its model has
+  /// one and the temperature when IMU 0 has it. given_segments is
   /// empty (so segmentation is exercised); copy truth_segments into it to skip detection.
   Session session;
   /// The still steps as sample ranges [begin, end) (samples whose time lies in the step),
@@ -159,6 +182,8 @@ struct Simulation {
   /// The true model as used (t_ref_s = t0_s) and its parameter blocks.
   model::Model model;
   model::ParameterBlocks truth;
+  /// The board's other IMUs as simulated (their models' t_ref_s = t0_s, their blocks filled).
+  std::vector<BoardImuTruth> board;
   /// The site, schedule and temperature profile used.
   geo::Site site;
   Schedule schedule;

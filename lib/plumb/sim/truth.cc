@@ -4,6 +4,7 @@
 #include <random>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
 
 namespace plumb::sim {
 
@@ -45,6 +46,38 @@ model::ParameterBlocks RandomParameters(const model::Model& model, double scale,
     }
   }
   return theta;
+}
+
+std::vector<BoardImuTruth> RandomBoard(int n_imus, const model::Model& model, double truth_scale,
+                                       std::uint64_t seed) {
+  if (n_imus < 1 || n_imus > 16) {
+    throw Error("a board of " + std::to_string(n_imus) + " IMUs: give 1 to 16");
+  }
+  // Its own stream: the seed's bits mixed (any fixed map would do), so that the board does not
+  // repeat the draws of the noise or of IMU 0's truth made from the same seed.
+  std::mt19937_64 rng(seed ^ 0xA0761D6478BD642FULL);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto direction = [&] {
+    const double x = normal(rng), y = normal(rng), z = normal(rng);
+    return Vec3(x, y, z).normalized();
+  };
+  std::vector<BoardImuTruth> board;
+  for (int k = 1; k < n_imus; ++k) {
+    BoardImuTruth b;
+    const double angle_deg =
+        kBoardRotationMin_deg + (kBoardRotationMax_deg - kBoardRotationMin_deg) * unit(rng);
+    const Vec3 axis = direction();
+    b.R_b_i = Quat(Eigen::AngleAxisd(angle_deg / units::kDegPerRad, axis));
+    const double length_m =
+        kBoardLeverArmMin_m + (kBoardLeverArmMax_m - kBoardLeverArmMin_m) * unit(rng);
+    b.lever_arm_m = length_m * direction();
+    b.time_offset_s = kBoardTimeOffsetMax_s * (2.0 * unit(rng) - 1.0);
+    b.model = model;
+    b.truth = RandomParameters(model, truth_scale, rng());
+    board.push_back(std::move(b));
+  }
+  return board;
 }
 
 }  // namespace plumb::sim
