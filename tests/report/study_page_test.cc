@@ -149,7 +149,61 @@ TEST(StudyPage, OnePoseDrawsTheDeterminedCombinations) {
     return d.name == "study_fit_gravity_m_s2.csv";
   });
   ASSERT_NE(csv, vary.job.data.end());
-  EXPECT_TRUE(Contains(csv->content, "\n1,9.80665,1.1,0.2,2.4,,,,,,,,0.039,1e-05,4e-05,")) << csv->content;
+  EXPECT_TRUE(Contains(csv->content, "\n1,9.80665,1.1,0.2,2.4,,,,,,,,,,0.039,1e-05,4e-05,")) << csv->content;
+}
+
+TEST(StudyPage, WithoutAnUncertainFactorNoFirstOrderSpreadIsDrawn) {
+  const study::Study s = MakeStudy();
+  const StudyFigurePlan plan = PlanStudyFigures(s, Points(s, kRows));
+  // The column is there, empty: no factor has a sigma.
+  const std::string& csv = plan.job.data.front().content;
+  EXPECT_TRUE(Contains(csv, ",mean_error0,sd_error0,mean_sigma0,sd_first_order0,mean_error1,")) << csv;
+  EXPECT_TRUE(Contains(csv, "\n0,WGS84,1,0.2,2.4,,-1e-06,1e-05,4e-05,,0.0002,")) << csv;
+  EXPECT_FALSE(Contains(plan.job.script, "sd_first_order")) << plan.job.script;
+  for (const auto& fig : plan.figures) EXPECT_FALSE(fig.first_order) << fig.file;
+}
+
+TEST(StudyPage, AnUncertainFactorsFirstOrderSpreadIsDrawnAboutTheMeanError) {
+  // Gravity known to 0.01 m/s^2: a row with d/dg = -0.1 per m/s^2 has sd_first_order 1e-3
+  // (0.01 * 0.1); a row without a sensitivity has none, and no line.
+  const study::Study s = study::ParseStudy(nlohmann::json::parse(R"({"name": "u", "seed": 1,
+    "runs": 3, "design": "one_at_a_time", "fit": {"method": "generalized"},
+    "base": {"poses": 12, "still_s": 5, "turn_s": 2, "rate_hz": 100},
+    "factors": [{"name": "fit_gravity_m_s2", "levels": [9.78, 9.80665], "sigma": 0.01},
+                {"name": "still_s", "levels": [5, 10]}]})"),
+                                           "u.json");
+  ASSERT_EQ(study::SensitivityFactors(s), std::vector<std::string>{"fit_gravity_m_s2"});
+  std::vector<study::ParameterSummary> rows = kRows;
+  rows[0].mean_d_dp = {-0.1};
+  const StudyFigurePlan plan = PlanStudyFigures(s, Points(s, rows));
+  const std::string& csv = plan.job.data.front().content;
+  EXPECT_TRUE(Contains(csv, "\n0,WGS84,1,0.2,2.4,,-1e-06,1e-05,4e-05,0.001,0.0002,1e-05,4e-05,,")) << csv;
+  // Row 0 (columns 7-10): the pair mean +- sd_first_order, with a legend entry, once per
+  // factor; rows 1 and 2 (columns 11-14, 15-18) have no value, and no line.
+  const std::string& gp = plan.job.script;
+  EXPECT_TRUE(Contains(gp, "using 1:($7+$10) with lines dt 2")) << gp;
+  EXPECT_TRUE(Contains(gp, "using 1:($7-$10) with lines dt 2")) << gp;
+  EXPECT_TRUE(Contains(gp, "title 'mean +- sd_first_order'")) << gp;
+  EXPECT_FALSE(Contains(gp, "$14)")) << gp;
+  EXPECT_FALSE(Contains(gp, "$18)")) << gp;
+  std::size_t drawn = 0;
+  for (const auto& fig : plan.figures) {
+    EXPECT_EQ(fig.first_order, fig.parameter == "accel.matrix.zz") << fig.file;
+    drawn += fig.first_order ? 1 : 0;
+  }
+  EXPECT_EQ(drawn, 2u);  // against each factor
+  if (!GnuplotOnPath()) return;
+  // gnuplot draws every figure of it (the sums over empty fields are skipped, not an error).
+  testing::TempDir dir;
+  const GnuplotOutcome out = RunGnuplot(dir.path().string(), plan.job);
+  ASSERT_TRUE(out.ran) << out.message;
+  EXPECT_EQ(out.written.size(), plan.job.outputs.size()) << out.message;
+  const auto svgs = TakeSvgFiles(dir.path().string(), out.written);
+  const auto zz = std::find_if(svgs.begin(), svgs.end(), [](const InlineFigure& f) {
+    return f.file == "error_fit_gravity_m_s2_0.svg";
+  });
+  ASSERT_NE(zz, svgs.end());
+  EXPECT_TRUE(Contains(zz->svg, "mean +- sd_first_order")) << zz->svg;
 }
 
 TEST(StudyPage, ThePageGroupsTheDrawnFiguresByFactor) {

@@ -11,14 +11,20 @@
 //                       parameter: the other coefficients may change with it, and the name
 //                       then says "(coefficients vary)"), the signed mean error (estimate -
 //                       truth) over the runs with its spread (+- 1 standard deviation over the
-//                       runs, as error bars), and +- the mean sigma the fit reported, against
-//                       the factor; the y axis in the parameter's unit
+//                       runs, as error bars), +- the mean sigma the fit reported (about zero),
+//                       and, where the study has uncertain factors (Factor::sigma) with an
+//                       analytic sensitivity, the mean error +- sd_first_order (the spread over
+//                       the runs they predict to first order, study::FirstOrderCovariance, about
+//                       the mean error as the bars are), against the factor; the y axis in the
+//                       parameter's unit
 // The x axis is the factor in its unit (study::FactorUnit), logarithmic when every value is
 // positive and they span a factor 50 or more. A factor with a value that names a category
 // (study::FactorLevelName: fit_gravity_m_s2 = 0 is "WGS84") is drawn as categories, one tic
 // per value, named, in value order. Every line has a legend entry. The data are one CSV per
-// factor with a '#' header line; non-finite values are left empty (gnuplot skips them), and a
-// series with no finite value is not drawn (gnuplot stops at such a plot).
+// factor with a '#' header line (per row: mean_error, sd_error, mean_sigma, sd_first_order);
+// non-finite values are left empty (gnuplot skips them), and a series with no finite value is
+// not drawn (gnuplot stops at such a plot): which ones have values is decided from the
+// summaries as the file is made.
 #pragma once
 
 #include <string>
@@ -36,6 +42,7 @@ struct StudyFigure {
   std::size_t factor = 0;  ///< index in Study::factors
   std::string parameter;  ///< the row's name; "" for the NEES figure
   std::string unit;       ///< the parameter's unit ("" for the NEES figure or none)
+  bool first_order = false;  ///< an error figure that draws mean +- sd_first_order
 };
 
 struct StudyFigurePlan {

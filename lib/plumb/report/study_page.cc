@@ -55,7 +55,8 @@ std::string FiguresSection(const study::Study& study, const std::vector<study::P
       const std::string caption =
           fig.parameter.empty() ? "NEES per degree of freedom, with its 95 % band"
                                 : "error of " + WithUnit(fig.parameter, fig.unit) +
-                                      ": mean over the runs, +- 1 sd, and +- the mean sigma";
+                                      ": mean over the runs, +- 1 sd, and +- the mean sigma" +
+                                      (fig.first_order ? "; mean +- the first-order spread" : "");
       links += std::string(links.empty() ? "" : ", ") + "<a href=\"#" + id + "\">" +
                HtmlEscape(fig.parameter.empty() ? "NEES" : fig.parameter) + "</a>";
       body += "<figure id=\"" + id + "\">\n" + drawn->svg + "\n<figcaption>" + HtmlEscape(caption) +
@@ -74,8 +75,10 @@ std::string FiguresSection(const study::Study& study, const std::vector<study::P
          "pose, the combinations the data determine) the signed error, estimate - truth, in the "
          "parameter's unit: its mean over the runs (points), +- 1 standard deviation over the runs "
          "(bars), and +- the mean sigma the fit reported (dashed). A mean outside the dashed lines "
-         "is a bias the sigma does not cover. A factor whose value names a case (gravity 0: WGS84's) "
-         "is drawn by level.</p>\n<nav class=\"toc\"><ul>\n" + toc + "</ul></nav>\n" + sections;
+         "is a bias the sigma does not cover. Where a factor is uncertain (its sigma), the mean +- "
+         "sd_first_order (dashed, orange) is the spread over the runs its analytic sensitivity "
+         "predicts. A factor whose value names a case (gravity 0: WGS84's) is drawn by level.</p>\n"
+         "<nav class=\"toc\"><ul>\n" + toc + "</ul></nav>\n" + sections;
 }
 
 /// Two table cells: a NEES per dof (marked when outside its band, "n/a" without runs) and

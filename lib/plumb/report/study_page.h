@@ -2,7 +2,8 @@
 // their runs, failures and NEES, and per factor the figures drawn by gnuplot (study_figures.h):
 // the NEES per degree of freedom with its 95 % band, and for every parameter the study scores
 // (on one pose, the combinations the data determine) the signed mean error with its spread
-// over the runs and +- the mean sigma the fit reported, against the factor (the other factors
+// over the runs, +- the mean sigma the fit reported and, for uncertain factors, the mean +-
+// the first-order spread they predict (sd_first_order), against the factor (the other factors
 // held at the first point's values), with units. The figures are grouped by factor, a section
 // each with a heading, and listed in a table of contents. The figures are SVGs inside the
 // page (inline_svg.h): the page needs no file beside it.
