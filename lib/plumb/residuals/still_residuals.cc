@@ -65,8 +65,15 @@ Vec3 StillResidual::Predict(const double* q_k, const model::ParameterBlocks& the
 
 namespace {
 
-ceres::CostFunction* Cost(StillResidual* functor, const model::Model& model,
-                          const std::vector<int>& terms, std::size_t processes, bool mounted) {
+/// The cost function of a still residual (`mounted`: with the block q_b_i after q_k).
+ceres::CostFunction* Cost(const model::Model& model, model::Sensor sensor,
+                          StillMeasurement measurement, const Vec3& g_n, const Vec3& omega_ie_n,
+                          const Vec3& omega_eb_b, std::vector<double> wander_weights,
+                          bool mounted) {
+  const std::vector<int> terms = StillResidual::TermsOf(model, sensor);
+  const std::size_t processes = wander_weights.size();
+  auto* functor = new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n, omega_eb_b,
+                                    std::move(wander_weights), mounted);
   auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, autodiff::kJetStride>(functor);
   cost->AddParameterBlock(4);
   if (mounted) cost->AddParameterBlock(4);
@@ -82,22 +89,16 @@ ceres::CostFunction* StillResidual::Create(const model::Model& model, model::Sen
                                            StillMeasurement measurement, const Vec3& g_n,
                                            const Vec3& omega_ie_n, const Vec3& omega_eb_b,
                                            std::vector<double> wander_weights) {
-  auto terms = TermsOf(model, sensor);
-  const std::size_t processes = wander_weights.size();
-  return Cost(new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n, omega_eb_b,
-                                std::move(wander_weights)),
-              model, terms, processes, false);
+  return Cost(model, sensor, measurement, g_n, omega_ie_n, omega_eb_b, std::move(wander_weights),
+              false);
 }
 
 ceres::CostFunction* StillResidual::CreateMounted(const model::Model& model, model::Sensor sensor,
                                                   StillMeasurement measurement, const Vec3& g_n,
                                                   const Vec3& omega_ie_n, const Vec3& omega_eb_b,
                                                   std::vector<double> wander_weights) {
-  auto terms = TermsOf(model, sensor);
-  const std::size_t processes = wander_weights.size();
-  return Cost(new StillResidual(model, sensor, terms, measurement, g_n, omega_ie_n, omega_eb_b,
-                                std::move(wander_weights), true),
-              model, terms, processes, true);
+  return Cost(model, sensor, measurement, g_n, omega_ie_n, omega_eb_b, std::move(wander_weights),
+              true);
 }
 
 template bool StillResidual::operator()<double>(double const* const*, double*) const;
