@@ -36,8 +36,8 @@ struct BoardImu {
 struct Session {
   std::string source;              ///< file name(s) it was read from
   ImuSeries series;                ///< IMU 0's samples: its accelerometer defines the body frame
-  /// The board's other IMUs (IMU 1, 2, ...), when the input has them and the caller asked for
-  /// them; empty otherwise.
+  /// The board's other IMUs (IMU 1, 2, ...) where the input has them (a native CSV's acc{k}_x
+  /// columns, a simulated board); empty otherwise. The fit calibrates IMU 0 (`series`).
   std::vector<BoardImu> other_imus;
   std::vector<StillSegment> given_segments;  ///< stated by the user; empty means detect
   std::optional<SiteInput> site;
