@@ -1,6 +1,7 @@
 #include "plumb/io/text/native_csv.h"
 
 #include <charconv>
+#include <filesystem>
 #include <fstream>
 #include <vector>
 
@@ -115,6 +116,9 @@ char* PutRow(char* out, char* end, const ImuSeries& s, std::size_t i) {
 
 Session ReadNativeCsv(const std::string& path) {
   Session session = ReadTextTable(path, NativeCsvOptions());
+  // The other IMUs' columns are read by reading the file again: a stream (a FIFO) can be read
+  // once only, and opening it again would wait for a writer that never comes.
+  if (!std::filesystem::is_regular_file(path)) return session;
   const std::string header = HeaderLine(path);
   for (int k = 1; Names(header, ColumnName("acc", k, "_x")); ++k) {
     Session imu = ReadTextTable(path, BoardImuOptions(k));
