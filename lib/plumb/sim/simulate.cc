@@ -339,8 +339,6 @@ std::vector<BoardImuRun> StartBoard(Simulation& sim, const SimulationOptions& op
     imu.instance = static_cast<int>(i + 1);
     imu.name = "imu" + std::to_string(i + 1);
     imu.series.reserve(n);
-    if (!sim.board[i].model.has_gyro()) imu.series.gyr.clear();
-    if (!options.record_temperature) imu.series.temp_c.clear();
     // Each IMU's generator: the main seed mixed with its number (any fixed map would do).
     BoardImuRun run{&sim.board[i], {}, OutputNoise(options, sim.accel_sigma, sim.gyro_sigma,
                                                    options.seed ^ (0xD1B54A32D192ED03ULL * (i + 1))),

@@ -1,12 +1,14 @@
 #include "plumb/io/text/native_csv.h"
 
+#include <algorithm>
 #include <charconv>
-#include <filesystem>
 #include <fstream>
 #include <vector>
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/atomic_file.h"
+#include "plumb/io/common/stream_spool.h"
+#include "plumb/io/common/text_scan.h"
 #include "plumb/io/text/text_table.h"
 
 namespace plumb::io {
@@ -56,9 +58,10 @@ std::string ColumnName(const char* stem, int k, const char* tail) {
   return stem + (k == 0 ? std::string() : std::to_string(k)) + tail;
 }
 
-/// The first line that is neither blank nor a '#' comment: the header ("" when none).
+/// The first line that is neither blank nor a '#' comment: the header ("" when none). A stream
+/// (a FIFO) is read from the copy a StreamSpool holds, as every reader reads it.
 std::string HeaderLine(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(OpenPath(path));
   std::string line;
   while (std::getline(in, line)) {
     if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
@@ -66,20 +69,6 @@ std::string HeaderLine(const std::string& path) {
     if (first != std::string::npos && line[first] != '#') return line;
   }
   return "";
-}
-
-/// Whether the comma-separated `header` names `column`.
-bool Names(const std::string& header, const std::string& column) {
-  std::size_t start = 0;
-  while (start <= header.size()) {
-    std::size_t stop = header.find(',', start);
-    if (stop == std::string::npos) stop = header.size();
-    std::string field = header.substr(start, stop - start);
-    const std::size_t a = field.find_first_not_of(" \t\r"), b = field.find_last_not_of(" \t\r");
-    if (a != std::string::npos && field.substr(a, b + 1 - a) == column) return true;
-    start = stop + 1;
-  }
-  return false;
 }
 
 /// The native layout of the board's IMU k.
@@ -116,11 +105,11 @@ char* PutRow(char* out, char* end, const ImuSeries& s, std::size_t i) {
 
 Session ReadNativeCsv(const std::string& path) {
   Session session = ReadTextTable(path, NativeCsvOptions());
-  // The other IMUs' columns are read by reading the file again: a stream (a FIFO) can be read
-  // once only, and opening it again would wait for a writer that never comes.
-  if (!std::filesystem::is_regular_file(path)) return session;
-  const std::string header = HeaderLine(path);
-  for (int k = 1; Names(header, ColumnName("acc", k, "_x")); ++k) {
+  const std::vector<std::string> columns = detail::SplitNames(HeaderLine(path), ',');
+  auto names = [&columns](const std::string& column) {
+    return std::find(columns.begin(), columns.end(), column) != columns.end();
+  };
+  for (int k = 1; names(ColumnName("acc", k, "_x")); ++k) {
     Session imu = ReadTextTable(path, BoardImuOptions(k));
     session.other_imus.push_back(BoardImu{k, ColumnName("acc", k, "_x.."), std::move(imu.series), {}});
   }
@@ -145,8 +134,8 @@ void WriteNativeCsv(const std::string& path, const Session& session) {
   AtomicFileWriter file(path);
   file.Write(header);
   constexpr std::size_t kChunk = std::size_t{1} << 20;
-  const std::size_t kMaxRow = 32 * (1 + 7 * (1 + session.other_imus.size()));
-  std::string buffer(kChunk + kMaxRow, '\0');
+  const std::size_t max_row = 32 * (1 + 7 * (1 + session.other_imus.size()));
+  std::string buffer(kChunk + max_row, '\0');
   char* const begin = buffer.data();
   char* const end = begin + buffer.size();
   char* out = begin;
