@@ -1,12 +1,15 @@
 // The motion residual: zero on exactly integrated data, Jacobian against numeric differences.
 #include "plumb/residuals/motion_residual.h"
+#include "plumb/residuals/mounted_motion_residual.h"
 
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <string>
 
 #include "plumb/model/registry.h"
 #include "plumb/residuals/manifolds.h"
@@ -47,8 +50,10 @@ TEST(MotionResidual, IntegratesAKnownTurn) {
 
 /// Jacobian error of the motion residual for `spec` with small non-zero parameters, the
 /// attitudes off the turn by 0.01 rad and Earth rate present (or not: without it the
-/// sensitivities are carried in the interval's start frame, another code path).
-double MotionJacobianError(const std::string& spec, int processes = 0, bool earth = true) {
+/// sensitivities are carried in the interval's start frame, another code path); `mounted`:
+/// the residual of an IMU mounted at a rotation R_b_i of 2 degrees (mounted_motion_residual.h).
+double MotionJacobianError(const std::string& spec, int processes = 0, bool earth = true,
+                           bool mounted = false) {
   Quat dR_true;
   const MotionSamples s = Turn(&dR_true);
   const model::Model m = model::Model::Parse(spec);
@@ -61,13 +66,19 @@ double MotionJacobianError(const std::string& spec, int processes = 0, bool eart
   for (std::size_t t = 2; t < theta.size(); ++t) {
     for (std::size_t i = 0; i < theta[t].size(); ++i) theta[t][i] = 1e-4 * (1.0 + static_cast<double>(i));
   }
+  const Vec3 omega_ie_n = earth ? Vec3(4e-5, 0, -5e-5) : Vec3::Zero();
   std::unique_ptr<ceres::CostFunction> cost(
-      MotionResidual::Create(m, s, earth ? Vec3(4e-5, 0, -5e-5) : Vec3::Zero(), processes));
+      mounted ? static_cast<ceres::CostFunction*>(new MountedMotionResidual(
+                    m, std::make_shared<const MotionSamples>(s), omega_ie_n, processes))
+              : MotionResidual::Create(m, s, omega_ie_n, processes));
   const Quat qa = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 0, 1).normalized()));
   const Quat qb = qa * dR_true * Quat(Eigen::AngleAxisd(0.01, Vec3::UnitX()));
+  const Quat mount(Eigen::AngleAxisd(0.035, Vec3(-1, 2, 0.5).normalized()));
   const double a[4] = {qa.x(), qa.y(), qa.z(), qa.w()};
   const double b[4] = {qb.x(), qb.y(), qb.z(), qb.w()};
+  const double q_b_i[4] = {mount.x(), mount.y(), mount.z(), mount.w()};
   std::vector<const double*> params = {a, b};
+  if (mounted) params.push_back(q_b_i);
   for (const auto& block : theta) params.push_back(block.data());
   // Wander states: from and to of each process.
   const double states[2][2][3] = {{{2e-3, -1e-3, 4e-4}, {-5e-4, 3e-3, 1e-3}},
@@ -76,6 +87,7 @@ double MotionJacobianError(const std::string& spec, int processes = 0, bool eart
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifolds[1] = manifold.get();
+  if (mounted) manifolds[2] = manifold.get();
   return testing::JacobianError(*cost, params, manifolds);
 }
 
@@ -135,6 +147,67 @@ TEST(MotionResidual, JacobianMatchesNumericWithoutEarthRate) {
     SCOPED_TRACE(name);
     EXPECT_LT(MotionJacobianError("base+" + name, 0, false), 1e-7);
   }
+}
+
+TEST(MountedMotionResidual, JacobianMatchesNumeric) {
+  for (int processes : {0, 2}) {
+    for (bool earth : {true, false}) {
+      SCOPED_TRACE(std::to_string(processes) + (earth ? " with Earth rate" : " without"));
+      EXPECT_LT(MotionJacobianError("base", processes, earth, true), 1e-7);
+      EXPECT_LT(MotionJacobianError("base+gyro_g_sensitivity+gyro_scale_nonlinearity", processes,
+                                    earth, true),
+                3e-7);
+    }
+  }
+}
+
+/// The residual of the turn between attitudes `from` and `to`, plain or of an IMU mounted at
+/// `R_b_i`, for a base model with a few parameters set.
+Vec3 TurnResidual(const Quat& from, const Quat& to, const Quat* R_b_i) {
+  Quat dR_true;
+  const MotionSamples s = Turn(&dR_true);
+  const model::Model m = model::Model::Parse("base");
+  auto theta = m.ZeroParameters();
+  theta[1][0] = 0.01;
+  theta[1][9] = 0.002;
+  const Vec3 omega_ie_n(4e-5, 0, -5e-5);
+  std::unique_ptr<ceres::CostFunction> cost(
+      R_b_i ? static_cast<ceres::CostFunction*>(new MountedMotionResidual(
+                  m, std::make_shared<const MotionSamples>(s), omega_ie_n))
+            : MotionResidual::Create(m, s, omega_ie_n));
+  const double a[4] = {from.x(), from.y(), from.z(), from.w()};
+  const double b[4] = {to.x(), to.y(), to.z(), to.w()};
+  std::vector<const double*> params = {a, b};
+  double mount[4];
+  if (R_b_i) {
+    std::copy_n(R_b_i->coeffs().data(), 4, mount);
+    params.push_back(mount);
+  }
+  for (const auto& block : theta) params.push_back(block.data());
+  Vec3 r;
+  cost->Evaluate(params.data(), r.data(), nullptr);
+  return r;
+}
+
+// A mounted IMU is an IMU at R_n_i = R_n_b R_b_i: its residual at (R_k, R_k+1, R_b_i) is the
+// plain one at (R_k R_b_i, R_k+1 R_b_i), and a mount at the identity changes
+// nothing; and the residual does not depend on which of two mounts the same pair of IMU
+// attitudes is reached through.
+TEST(MountedMotionResidual, AnImuMountedIsAnImuAtItsOwnAttitude) {
+  Quat dR_true;
+  Turn(&dR_true);
+  const Quat from = Quat(Eigen::AngleAxisd(0.4, Vec3(0.2, 1, -0.3).normalized()));
+  const Quat to = from * dR_true * Quat(Eigen::AngleAxisd(0.02, Vec3(1, -1, 0).normalized()));
+  const Quat mount(Eigen::AngleAxisd(0.03, Vec3(0.5, -1, 2).normalized()));
+  const Quat identity = Quat::Identity();
+  const Vec3 plain = TurnResidual(from, to, nullptr);
+  EXPECT_LT((TurnResidual(from, to, &identity) - plain).norm(), 1e-13 * plain.norm());
+  const Vec3 mounted = TurnResidual(from, to, &mount);
+  EXPECT_LT((mounted - TurnResidual(from * mount, to * mount, nullptr)).norm(), 1e-12 * mounted.norm());
+  EXPECT_GT((mounted - plain).norm(), 1e-3 * plain.norm());  // the mount matters
+  const Quat other(Eigen::AngleAxisd(0.05, Vec3(1, 0.3, 0).normalized()));
+  const Quat shift = mount * other.inverse();  // (R_k shift) other = R_k mount
+  EXPECT_LT((TurnResidual(from * shift, to * shift, &other) - mounted).norm(), 1e-9 * mounted.norm());
 }
 
 // A precomputed evaluation (cached_cost_function.h) is handed out only at the same values
