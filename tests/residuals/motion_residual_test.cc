@@ -73,12 +73,12 @@ double MotionJacobianError(const std::string& spec, int processes = 0, bool eart
               : MotionResidual::Create(m, s, omega_ie_n, processes));
   const Quat qa = Quat(Eigen::AngleAxisd(0.3, Vec3(1, 0, 1).normalized()));
   const Quat qb = qa * dR_true * Quat(Eigen::AngleAxisd(0.01, Vec3::UnitX()));
-  const Quat mount(Eigen::AngleAxisd(0.035, Vec3(-1, 2, 0.5).normalized()));
+  const Vec3 rho = 0.035 * Vec3(-1, 2, 0.5).normalized();  // with a lever arm and time offset
   const double a[4] = {qa.x(), qa.y(), qa.z(), qa.w()};
   const double b[4] = {qb.x(), qb.y(), qb.z(), qb.w()};
-  const double q_b_i[4] = {mount.x(), mount.y(), mount.z(), mount.w()};
+  const double mount[7] = {rho.x(), rho.y(), rho.z(), 0.02, -0.01, 0.03, 1e-3};
   std::vector<const double*> params = {a, b};
-  if (mounted) params.push_back(q_b_i);
+  if (mounted) params.push_back(mount);
   for (const auto& block : theta) params.push_back(block.data());
   // Wander states: from and to of each process.
   const double states[2][2][3] = {{{2e-3, -1e-3, 4e-4}, {-5e-4, 3e-3, 1e-3}},
@@ -87,7 +87,6 @@ double MotionJacobianError(const std::string& spec, int processes = 0, bool eart
   const auto manifold = AttitudeManifold();
   std::vector<const ceres::Manifold*> manifolds(params.size(), nullptr);
   manifolds[0] = manifolds[1] = manifold.get();
-  if (mounted) manifolds[2] = manifold.get();
   return testing::JacobianError(*cost, params, manifolds);
 }
 
@@ -178,9 +177,11 @@ Vec3 TurnResidual(const Quat& from, const Quat& to, const Quat* R_b_i) {
   const double a[4] = {from.x(), from.y(), from.z(), from.w()};
   const double b[4] = {to.x(), to.y(), to.z(), to.w()};
   std::vector<const double*> params = {a, b};
-  double mount[4];
+  double mount[7] = {};  // no lever arm or time offset: they do not enter
   if (R_b_i) {
-    std::copy_n(R_b_i->coeffs().data(), 4, mount);
+    const Eigen::AngleAxisd aa(*R_b_i);
+    const Vec3 rho = aa.angle() * aa.axis();
+    std::copy_n(rho.data(), 3, mount);
     params.push_back(mount);
   }
   for (const auto& block : theta) params.push_back(block.data());

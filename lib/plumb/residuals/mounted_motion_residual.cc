@@ -3,6 +3,8 @@
 #include <array>
 #include <vector>
 
+#include "plumb/model/board_mount.h"
+
 namespace plumb::residuals {
 namespace {
 
@@ -19,12 +21,12 @@ MountedMotionResidual::MountedMotionResidual(const model::Model& model,
   set_num_residuals(3);
   std::vector<int32_t>& sizes = *mutable_parameter_block_sizes();
   sizes = inner_.parameter_block_sizes();
-  sizes.insert(sizes.begin() + 2, 4);  // q_b_i after the two attitudes
+  sizes.insert(sizes.begin() + 2, model::board_mount::kSize);  // after the two attitudes
 }
 
 bool MountedMotionResidual::EvaluateUncached(double const* const* parameters, double* residuals,
                                              double** jacobians) const {
-  const Quat R_b_i = QuatOf(parameters[2]).normalized();
+  const Quat R_b_i = model::board_mount::Rotation(parameters[2]);
   const std::array<Quat, 2> R_n_b = {QuatOf(parameters[0]).normalized(),
                                      QuatOf(parameters[1]).normalized()};
   // The IMU's own attitudes R_n_i = R_n_b R_b_i at both poses.
@@ -56,8 +58,11 @@ bool MountedMotionResidual::EvaluateUncached(double const* const* parameters, do
     r_H_d_b += r_H_d_n_i * R_n_b[j].toRotationMatrix();
   }
   if (jacobians[2]) {
-    Eigen::Map<Ambient> r_H_q_b_i(jacobians[2]);
-    r_H_q_b_i = r_H_d_b * 4.0 * LeftPlusJacobian(QuatOf(parameters[2])).transpose();
+    using MountJacobian = Eigen::Matrix<double, 3, model::board_mount::kSize, Eigen::RowMajor>;
+    Eigen::Map<MountJacobian> r_H_mount(jacobians[2]);
+    r_H_mount.setZero();  // the lever arm and the time offset do not enter
+    r_H_mount.middleCols<3>(model::board_mount::kRotation) =
+        r_H_d_b * model::board_mount::LeftPerturbation_H_rotation(parameters[2]);
   }
   return true;
 }

@@ -1,6 +1,12 @@
 #include "plumb/residuals/still_residuals.h"
 
+#include <ceres/rotation.h>
+
 #include <Eigen/Geometry>
+#include <algorithm>
+
+#include "plumb/core/so3.h"
+#include "plumb/model/board_mount.h"
 
 namespace plumb::residuals {
 
@@ -29,8 +35,9 @@ Vec3T<T> StillResidual::PredictT(T const* const* parameters) const {
   const Eigen::Map<const Eigen::Quaternion<T>> q_n_b(parameters[0]);
   Mat3T<T> R_n_i = q_n_b.toRotationMatrix();  // the sensing IMU's frame into NED
   if (first_term_block_ == 2) {
-    const Eigen::Map<const Eigen::Quaternion<T>> q_b_i(parameters[1]);
-    R_n_i = R_n_i * q_b_i.toRotationMatrix();
+    Mat3T<T> R_b_i;  // column-major, as ceres::AngleAxisToRotationMatrix writes it
+    ceres::AngleAxisToRotationMatrix(parameters[1] + model::board_mount::kRotation, R_b_i.data());
+    R_n_i = R_n_i * R_b_i;
   }
   const model::SensorInput<T> in = model::AtRest<T>(R_n_i.transpose(), g_n_, omega_ie_n_,
                                                     omega_eb_b_, T(m_.dt_s), T(m_.dtemp_c));
@@ -56,16 +63,18 @@ bool StillResidual::operator()(T const* const* parameters, T* residuals) const {
 
 Vec3 StillResidual::Predict(const double* q_k, const model::ParameterBlocks& theta,
                             const Quat& R_b_i) const {
-  const double q_b_i[4] = {R_b_i.x(), R_b_i.y(), R_b_i.z(), R_b_i.w()};
+  double mount[model::board_mount::kSize] = {};
+  const Vec3 rho = so3::Log(R_b_i.toRotationMatrix());
+  std::copy_n(rho.data(), 3, mount + model::board_mount::kRotation);
   std::vector<const double*> p = {q_k};
-  if (first_term_block_ == 2) p.push_back(q_b_i);
+  if (first_term_block_ == 2) p.push_back(mount);
   for (int t : terms_) p.push_back(theta[static_cast<std::size_t>(t)].data());
   return PredictT<double>(p.data());
 }
 
 namespace {
 
-/// The cost function of a still residual (`mounted`: with the block q_b_i after q_k).
+/// The cost function of a still residual (`mounted`: with IMU i's board_mount block after q_k).
 ceres::CostFunction* Cost(const model::Model& model, model::Sensor sensor,
                           StillMeasurement measurement, const Vec3& g_n, const Vec3& omega_ie_n,
                           const Vec3& omega_eb_b, std::vector<double> wander_weights,
@@ -76,7 +85,7 @@ ceres::CostFunction* Cost(const model::Model& model, model::Sensor sensor,
                                     std::move(wander_weights), mounted);
   auto* cost = new ceres::DynamicAutoDiffCostFunction<StillResidual, autodiff::kJetStride>(functor);
   cost->AddParameterBlock(4);
-  if (mounted) cost->AddParameterBlock(4);
+  if (mounted) cost->AddParameterBlock(model::board_mount::kSize);
   for (int t : terms) cost->AddParameterBlock(model.terms()[static_cast<std::size_t>(t)].effect->info().size());
   for (std::size_t p = 0; p < 2 * processes; ++p) cost->AddParameterBlock(3);
   cost->SetNumResiduals(3);

@@ -27,14 +27,16 @@
 // estimation/calibration_problem.cc).
 //
 // Another IMU of the same board (SPEC 6, "Several IMUs of one board") sits in the body at a
-// rotation R_b_i (its frame into the body frame, which IMU 0's accelerometer defines): it
+// rotation R_b_i (its frame into the body frame, which IMU 0's accelerometer defines;
+// model/board_mount.h): it
 // sees the inputs in its own frame, f_i = R_b_i^T f_b and omega_i = R_b_i^T omega_b, as an IMU
 // at attitude R_n_i = R_n_b R_b_i. A still pose has no angular rate or acceleration, so its
 // lever arm and time offset do not enter. CreateMounted makes that residual, with the pose's
 // attitude shared by every IMU of the board.
 //
 // Parameter blocks, in order: q_k (4, Eigen order x y z w, unit quaternion of R_n_b), then
-// (CreateMounted only) q_b_i (4, the same order, R_b_i), then the blocks of the model terms
+// (CreateMounted only) IMU i's board_mount block (7: R_b_i's rotation vector, its lever arm and
+// time offset, model/board_mount.h; only the rotation enters), then the blocks of the model terms
 // listed in `terms` (their sizes in info().size()), then, per entry of `wander_weights`, s_p (3)
 // and e_p (3) in sensor units.
 // Units: g_n in m/s^2 (NED, down positive), omega in rad/s, outputs in sensor units.
@@ -70,8 +72,8 @@ class StillResidual {
                                      const Vec3& omega_ie_n,
                                      const Vec3& omega_eb_b = Vec3::Zero(), std::vector<double> wander_weights = {});
 
-  /// The same for an IMU mounted at R_b_i in the body (file comment): the parameter block
-  /// q_b_i follows q_k.
+  /// The same for an IMU mounted at R_b_i in the body (file comment): its board_mount block
+  /// follows q_k.
   static ceres::CostFunction* CreateMounted(const model::Model& model, model::Sensor sensor,
                                             StillMeasurement measurement, const Vec3& g_n,
                                             const Vec3& omega_ie_n, const Vec3& omega_eb_b,
@@ -97,7 +99,7 @@ class StillResidual {
   StillMeasurement m_;
   Vec3 g_n_, omega_ie_n_, omega_eb_b_;
   std::vector<double> wander_weights_;  // per wander process: w_p
-  int first_term_block_ = 1;            // 2 when q_b_i follows q_k (mounted)
+  int first_term_block_ = 1;            // 2 when the board_mount block follows q_k (mounted)
 };
 
 }  // namespace plumb::residuals
