@@ -3,26 +3,20 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "plumb/core/error.h"
-#include "plumb/estimation/turn_noise.h"
+#include "plumb/model/board_mount.h"
 #include "plumb/residuals/bias_walk_residual.h"
 #include "plumb/residuals/held_combination.h"
 #include "plumb/residuals/manifolds.h"
 #include "plumb/residuals/motion_residual.h"
+#include "plumb/residuals/mounted_motion_residual.h"
 #include "plumb/residuals/still_residuals.h"
 #include "plumb/residuals/velocity_residual.h"
 
 namespace plumb::estimation {
 namespace {
-
-/// Adds the diagonal of M diag(v) M^T to the variances behind `sqrt_info` (1 / sigma).
-void AddVariance(Vec3& sqrt_info, const Mat3& M, const Vec3& v) {
-  const Mat3 cov = M * v.asDiagonal() * M.transpose();
-  for (int i = 0; i < 3; ++i) {
-    sqrt_info[i] = 1.0 / std::sqrt(1.0 / (sqrt_info[i] * sqrt_info[i]) + cov(i, i));
-  }
-}
 
 /// Shortest time a bias-walk factor spans, s: keeps its weight finite where two instants
 /// coincide.
@@ -62,173 +56,109 @@ double TypicalSize(const model::EffectInfo& info, int i, const Mat3& F, const Ma
 
 }  // namespace
 
+ProblemImu CalibrationProblem::MakeImu(const ImuSeries& series, model::Model model,
+                                       StillSet still, const NoiseModel& noise,
+                                       const StartingValues& start, bool mounted) const {
+  ProblemImu imu;
+  imu.series = &series;
+  imu.model = std::move(model);
+  imu.still = std::move(still);
+  imu.noise = noise;
+  imu.start = start;
+  imu.mounted = mounted;
+  imu.has_gyro = imu.model.has_gyro();
+  imu.wander = noise.Wander(imu.has_gyro);
+  imu.still_gyro = imu.has_gyro && options_.use_still_gyro;
+  bool needs_velocity = false;
+  for (const auto& term : imu.model.terms()) {
+    needs_velocity = needs_velocity || term.effect->info().excitation.angular_acceleration;
+  }
+  const bool motion_on = options_.use_motion && imu.has_gyro;
+  // The board's other IMUs have no velocity residual yet: their lever arms and time offsets
+  // are held (ProblemImu::Fixed).
+  imu.velocity_on = !mounted && motion_on && options_.accel_in_motion.value_or(needs_velocity);
+  imu.SetMeasurements();
+  imu.SetMotionSamples();
+  return imu;
+}
+
 CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model model,
                                        const geo::Site& site, StillSet still,
                                        model::ParameterBlocks theta, const NoiseModel& noise,
                                        const StartingValues& start,
-                                       const CalibrationOptions& options)
-    : series_(series),
-      model_(std::move(model)),
-      site_(site),
-      options_(options),
-      still_(std::move(still)),
-      noise_(noise),
-      start_(start) {
-  has_gyro_ = model_.has_gyro();
-  for (const auto& block : theta) {
-    block_offset_.push_back(values_.size());
-    values_.insert(values_.end(), block.begin(), block.end());
+                                       const CalibrationOptions& options,
+                                       std::vector<BoardImuInput> board)
+    : site_(site), options_(options) {
+  imus_.push_back(MakeImu(series, std::move(model), std::move(still), noise, start, false));
+  std::vector<model::ParameterBlocks> starts = {std::move(theta)};
+  for (BoardImuInput& other : board) {
+    imus_.push_back(MakeImu(*other.series, std::move(other.model), std::move(other.still),
+                            other.noise, other.start, true));
+    imus_.back().name_prefix = "imu" + std::to_string(other.instance) + ".";
+    model::ParameterBlocks blocks = std::move(other.theta);
+    std::vector<double> mount(model::board_mount::kSize, 0.0);
+    const Vec3 rho = so3::Log(other.R_b_i.toRotationMatrix());
+    std::copy_n(rho.data(), 3, mount.begin() + model::board_mount::kRotation);
+    blocks.push_back(std::move(mount));
+    starts.push_back(std::move(blocks));
+  }
+  // The values: every IMU's term blocks, then the attitudes, then every IMU's wander states.
+  int first_term = 0;
+  for (std::size_t i = 0; i < imus_.size(); ++i) {
+    imus_[i].first_term = first_term;
+    first_term += imus_[i].num_terms();
+    for (const auto& block : starts[i]) {
+      imus_[i].block_offset.push_back(values_.size());
+      values_.insert(values_.end(), block.begin(), block.end());
+    }
   }
   q_offset_ = values_.size();
-  for (const auto& s : still_.poses) values_.insert(values_.end(), s.q.begin(), s.q.end());
-  walk_offset_ = values_.size();
-  wander_ = noise_.Wander(has_gyro_);
-  values_.resize(values_.size() + 6 * wander_.size() * still_.poses.size(), 0.0);
-  still_gyro_ = has_gyro_ && options_.use_still_gyro;
-  bool needs_velocity = false;
-  for (const auto& term : model_.terms()) {
-    needs_velocity = needs_velocity || term.effect->info().excitation.angular_acceleration;
+  for (const auto& s : imus_[0].still.poses) values_.insert(values_.end(), s.q.begin(), s.q.end());
+  for (ProblemImu& imu : imus_) {
+    imu.walk_offset = values_.size();
+    values_.resize(values_.size() + 6 * imu.wander.size() * imu.still.poses.size(), 0.0);
   }
-  const bool motion_on = options_.use_motion && has_gyro_;
-  velocity_on_ = motion_on && options_.accel_in_motion.value_or(needs_velocity);
-  SetMeasurements(noise);
-  SetMotionSamples();
-  velocity_info_.assign(still_.motions.size(), Vec3::Ones());
-  SetMotionWeights(Mat3::Identity() / start_.gyro_rad_per_unit,
-                   Mat3::Identity() * start_.accel.scale);
-}
-
-void CalibrationProblem::SetMeasurements(const NoiseModel& noise) {
-  for (auto& s : still_.poses) {
-    const double n = static_cast<double>(s.stats.count);
-    residuals::StillMeasurement m;
-    m.dt_s = s.stats.t_mid_s - model_.t_ref_s;
-    m.dtemp_c = std::isfinite(s.stats.temp_mean_c) ? s.stats.temp_mean_c - model_.temp_ref_c : 0.0;
-    m.mean = s.stats.acc_mean;
-    for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_acc[i]) / noise.sigma_acc[i];
-    // Each wander process has a state at both ends of the segment; its bridge between them
-    // adds BridgeMeanVariance (the walk's K^2 T / 12) to the variance of the segment's mean.
-    const double T = s.stats.t_end_s - s.stats.t_begin_s;
-    // Quantisation (IEEE Q) adds 2 Q^2 / T^2 (noise_model.h).
-    auto add_bridges = [&](Vec3& sqrt_info, model::Sensor sensor) {
-      Vec3 var = sqrt_info.cwiseAbs2().cwiseInverse();
-      for (const WanderProcess& w : wander_) {
-        if (w.sensor == sensor) var += w.BridgeMeanVariance(T);
-      }
-      const Vec3& Q = sensor == model::Sensor::kAccel ? noise.quantisation_acc : noise.quantisation_gyr;
-      if (T > 0) var += Q.cwiseAbs2() * (2.0 / (T * T));
-      sqrt_info = var.cwiseSqrt().cwiseInverse();
-    };
-    add_bridges(m.sqrt_info, model::Sensor::kAccel);
-    s.acc_measurement = m;
-    if (still_gyro_) {
-      m.mean = s.stats.gyr_mean;
-      for (int i = 0; i < 3; ++i) m.sqrt_info[i] = std::sqrt(n / noise.tau_gyr[i]) / noise.sigma_gyr[i];
-      add_bridges(m.sqrt_info, model::Sensor::kGyro);
-      s.gyr_measurement = m;
-    }
+  SetMotionWeights(Mat3::Identity() / start.gyro_rad_per_unit, Mat3::Identity() * start.accel.scale);
+  for (std::size_t i = 1; i < imus_.size(); ++i) {
+    const StartingValues& s = imus_[i].start;
+    imus_[i].SetMotionWeights(Mat3::Identity() / s.gyro_rad_per_unit,
+                              Mat3::Identity() * s.accel.scale, site_.gravity(),
+                              options_.turn_vibration);
   }
 }
 
-void CalibrationProblem::SetMotionSamples() {
-  const ImuSeries& series = series_;
-  for (const auto& mo : still_.motions) {
-    residuals::MotionSamples ms;
-    std::vector<Vec3> dy;
-    const std::size_t n = mo.last + 1 - mo.first;
-    ms.dt_s.reserve(n);
-    ms.acc.reserve(n);
-    ms.gyr.reserve(n);
-    ms.dtemp_c.reserve(n);
-    dy.reserve(n);
-    for (std::size_t i = mo.first; i <= mo.last; ++i) {
-      ms.dt_s.push_back(series.t_s[i] - model_.t_ref_s);
-      ms.acc.push_back(series.acc[i].cast<double>());
-      ms.gyr.push_back(series.gyr[i].cast<double>());
-      ms.dtemp_c.push_back(series.has_temperature() ? series.temp_c[i] - model_.temp_ref_c : 0.0);
-      const std::size_t a = i > 0 ? i - 1 : i, b = std::min(i + 1, series.size() - 1);
-      const double h = series.t_s[b] - series.t_s[a];
-      dy.push_back(h > 0 ? Vec3((series.gyr[b] - series.gyr[a]).cast<double>() / h) : Vec3::Zero());
-    }
-    ms.alpha_b.resize(dy.size());
-    motion_samples_.push_back(std::make_shared<residuals::MotionSamples>(std::move(ms)));
-    output_rate_.push_back(std::move(dy));
-  }
-}
-
-// The angular acceleration input of the effects (time_offset, accel_size_effect) is the
-// derivative of the corrected rate, E^-1 d y_g / dt (central differences). The velocity
-// residual's variance: the accelerometer's white noise or the turn's measured vibration summed
-// over the steps, and gravity tilted by the attitude random walk of the gyroscope's (mean over
-// the axes), which moves the velocity only across gravity (turn_noise.h).
 void CalibrationProblem::SetMotionWeights(const Mat3& E, const Mat3& F) {
-  const auto& motions = still_.motions;
-  const Mat3 E_inv = E.inverse();
-  const Mat3 F_inv = F.inverse();
-  const Mat3 cov_f = F_inv * noise_.sigma_acc.cwiseAbs2().asDiagonal() * F_inv.transpose();
-  const Mat3 cov_rate = E_inv * noise_.sigma_gyr.cwiseAbs2().asDiagonal() * E_inv.transpose();
-  const double g = site_.gravity();
-  TurnNoise turn_noise;
-  turn_noise.measure_vibration = options_.turn_vibration;
-  turn_noise.cov_f = cov_f;
-  turn_noise.tau_acc = noise_.tau_acc;
-  turn_noise.var_rate = cov_rate.trace() / 3.0 * noise_.tau_gyr.mean();
-  for (std::size_t k = 0; k < motions.size(); ++k) {
-    // New samples (problems built before keep reading theirs).
-    auto samples = std::make_shared<residuals::MotionSamples>(*motion_samples_[k]);
-    for (std::size_t i = 0; i < output_rate_[k].size(); ++i) {
-      samples->alpha_b[i] = E_inv * output_rate_[k][i];
-    }
-    const auto& mo = motions[k];
-    const double steps = static_cast<double>(mo.last - mo.first);
-    const double dt = (series_.t_s[mo.last] - series_.t_s[mo.first]) / std::max(1.0, steps);
-    for (int i = 0; i < 3; ++i) {
-      const double sigma_rate = std::sqrt(cov_rate(i, i));  // rad/s per sample
-      samples->sqrt_info[i] =
-          1.0 / (sigma_rate * dt * std::sqrt(std::max(1.0, steps) * noise_.tau_gyr[i]));
-    }
-    // Each gyroscope wander process about the line from e_k to s_k+1 integrates to an angle:
-    // a Brownian bridge over the interval T to K^2 T^3 / 12 per sensor axis, through E^-1.
-    // The instability is taken as the walk of equal short-time spread, K^2 = 2 s^2 / tau
-    // (exact for T << tau; turns last seconds, correlation times tens of seconds and more).
-    const double T = series_.t_s[mo.last] - series_.t_s[mo.first];
-    for (std::size_t p : WanderOf(model::Sensor::kGyro)) {
-      AddVariance(samples->sqrt_info, E_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
-    }
-    // Quantisation: the integrated angle carries 2 Q^2 (noise_model.h).
-    AddVariance(samples->sqrt_info, E_inv, 2.0 * noise_.quantisation_gyr.cwiseAbs2());
-    // The velocity residual, where the fit has one (a pass over the turn's samples): the white
-    // noise or the turn's measured vibration (turn_noise.h), then each accelerometer wander
-    // process about its line (the velocity residual takes the line off): its bridge's mean
-    // over T, times T, through F^-1; the instability as the walk of equal short-time spread,
-    // as for the rotation above.
-    if (velocity_on_) {
-      const Vec3 var_v = TurnVelocityVariance(*samples, E_inv, F_inv, turn_noise,
-                                              start_.Down(still_.poses[mo.from]), g);
-      velocity_info_[k] = var_v.cwiseSqrt().cwiseInverse();
-      for (std::size_t p : WanderOf(model::Sensor::kAccel)) {
-        AddVariance(velocity_info_[k], F_inv, wander_[p].ShortTimeWalk2() * (T * T * T / 12.0));
-      }
-    }
-    motion_samples_[k] = std::move(samples);
-  }
+  imus_[0].SetMotionWeights(E, F, site_.gravity(), options_.turn_vibration);
 }
 
 void CalibrationProblem::SetMotionWeightsFromSolution() {
-  const std::vector<const double*> blocks = ModelBlocks();
-  const auto linear = model_.Predict(blocks.data(), model::SensorInput<double>());
-  SetMotionWeights(linear.E, linear.F);
+  for (std::size_t i = 0; i < imus_.size(); ++i) {
+    const std::vector<const double*> blocks = TermBlocks(i);
+    const auto linear = imus_[i].model.Predict(blocks.data(), model::SensorInput<double>());
+    imus_[i].SetMotionWeights(linear.E, linear.F, site_.gravity(), options_.turn_vibration);
+  }
+}
+
+std::pair<std::size_t, int> CalibrationProblem::TermOf(int t) const {
+  std::size_t i = imus_.size() - 1;
+  while (i > 0 && t < imus_[i].first_term) --i;
+  return {i, t - imus_[i].first_term};
+}
+
+std::vector<const double*> CalibrationProblem::TermBlocks(std::size_t imu) const {
+  std::vector<const double*> out;
+  for (std::size_t offset : imus_[imu].block_offset) out.push_back(values_.data() + offset);
+  return out;
 }
 
 std::vector<const double*> CalibrationProblem::ModelBlocks() const {
-  std::vector<const double*> out;
-  for (int t = 0; t < model_.num_terms(); ++t) out.push_back(block(t));
+  std::vector<const double*> out = TermBlocks(0);
   return out;
 }
 
 model::ParameterBlocks CalibrationProblem::theta() const {
   model::ParameterBlocks out;
-  for (int t = 0; t < model_.num_terms(); ++t) out.emplace_back(block(t), block(t) + block_size(t));
+  for (int t = 0; t < model().num_terms(); ++t) out.emplace_back(block(t), block(t) + block_size(t));
   return out;
 }
 
@@ -241,17 +171,20 @@ void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
                                             const std::vector<ParameterIndex>& held_extra,
                                             bool free_probes) {
   ceres::Problem* problem = built.problem.get();
-  for (int t = 0; t < model_.num_terms(); ++t) {
+  for (int t = 0; t < num_terms(); ++t) {
+    const auto [imu, local] = TermOf(t);
+    const ProblemImu& u = imus_[imu];
     double* values = block(t);
     const int size = block_size(t);
-    const auto& term = model_.terms()[static_cast<std::size_t>(t)];
     problem->AddParameterBlock(values, size);
-    if (free_probes && term.probe) continue;
+    const bool probe = local < u.model.num_terms() &&
+                       u.model.terms()[static_cast<std::size_t>(local)].probe;
+    if (free_probes && probe) continue;
     std::vector<int> held;
-    for (std::size_t i = 0; i < term.fixed.size(); ++i) {
+    for (int i = 0; i < size; ++i) {
       const bool extra = std::find(held_extra.begin(), held_extra.end(),
-                                   std::make_pair(t, static_cast<int>(i))) != held_extra.end();
-      if (term.fixed[i] || extra) held.push_back(static_cast<int>(i));
+                                   std::make_pair(t, i)) != held_extra.end();
+      if (u.Fixed(local, i) || extra) held.push_back(i);
     }
     if (static_cast<int>(held.size()) == size) {
       problem->SetParameterBlockConstant(values);
@@ -260,8 +193,8 @@ void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
       problem->SetManifold(values, built.manifolds.back().get());
     }
   }
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    const StillPose& s = still_.poses[k];
+  for (std::size_t k = 0; k < still().poses.size(); ++k) {
+    const StillPose& s = still().poses[k];
     problem->AddParameterBlock(q(k), 4);
     if (s.known) {
       problem->SetParameterBlockConstant(q(k));
@@ -272,120 +205,133 @@ void CalibrationProblem::AddParameterBlocks(BuiltProblem& built,
       problem->SetManifold(q(k), built.manifolds.back().get());
     }
   }
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    for (std::size_t p = 0; p < wander_.size(); ++p) {
-      for (bool end : {false, true}) problem->AddParameterBlock(wander(k, p, end), 3);
+  for (std::size_t i = 0; i < imus_.size(); ++i) {
+    for (std::size_t k = 0; k < still().poses.size(); ++k) {
+      for (std::size_t p = 0; p < imus_[i].wander.size(); ++p) {
+        for (bool end : {false, true}) problem->AddParameterBlock(wander(i, k, p, end), 3);
+      }
     }
   }
 }
 
-void CalibrationProblem::AddResiduals(BuiltProblem& built) {
+void CalibrationProblem::AddResiduals(BuiltProblem& built, std::size_t imu) {
   using residuals::StillResidual;
+  const ProblemImu& u = imus_[imu];
+  const bool mounted = u.mounted;
   ceres::Problem* problem = built.problem.get();
-  const auto acc_terms = StillResidual::TermsOf(model_, model::Sensor::kAccel);
-  const auto gyr_terms = StillResidual::TermsOf(model_, model::Sensor::kGyro);
-  auto blocks_of = [&](const std::vector<int>& terms, double* q_k) {
-    std::vector<double*> blocks = {q_k};
-    for (int t : terms) blocks.push_back(block(t));
-    return blocks;
+  BuiltProblem::ImuBlocks own;
+  auto& acc_ids = mounted ? own.acc : built.acc;
+  auto& gyr_ids = mounted ? own.gyr : built.gyr;
+  auto& motion_ids = mounted ? own.motion : built.motion;
+  // The IMU's term blocks: its model's (all, or those of one sensor), after its attitude
+  // blocks and, for another IMU of the board, its mount.
+  std::vector<double*> model_blocks;
+  for (int local = 0; local < u.model.num_terms(); ++local) {
+    model_blocks.push_back(block(u.first_term + local));
+  }
+  auto blocks_of = [&](const std::vector<int>& terms, std::vector<double*> leading) {
+    if (mounted) leading.push_back(mount(imu));
+    for (int t : terms) leading.push_back(model_blocks[static_cast<std::size_t>(t)]);
+    return leading;
   };
-  std::vector<double*> all_terms;
-  for (int t = 0; t < model_.num_terms(); ++t) all_terms.push_back(block(t));
-  const std::vector<std::size_t> acc_wander = WanderOf(model::Sensor::kAccel);
-  const std::vector<std::size_t> gyr_wander = WanderOf(model::Sensor::kGyro);
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    const StillPose& s = still_.poses[k];
-    std::vector<double*> acc_blocks = blocks_of(acc_terms, q(k));
-    std::vector<double*> gyr_blocks = blocks_of(gyr_terms, q(k));
+  const auto acc_terms = StillResidual::TermsOf(u.model, model::Sensor::kAccel);
+  const auto gyr_terms = StillResidual::TermsOf(u.model, model::Sensor::kGyro);
+  std::vector<int> all_terms(static_cast<std::size_t>(u.model.num_terms()));
+  std::iota(all_terms.begin(), all_terms.end(), 0);
+  const std::vector<std::size_t> acc_wander = u.WanderOf(model::Sensor::kAccel);
+  const std::vector<std::size_t> gyr_wander = u.WanderOf(model::Sensor::kGyro);
+  auto make_still = mounted ? &StillResidual::CreateMounted : &StillResidual::Create;
+  for (std::size_t k = 0; k < u.still.poses.size(); ++k) {
+    const StillPose& s = u.still.poses[k];
+    std::vector<double*> acc_blocks = blocks_of(acc_terms, {q(k)});
+    std::vector<double*> gyr_blocks = blocks_of(gyr_terms, {q(k)});
     const double T = s.stats.t_end_s - s.stats.t_begin_s;
     std::vector<double> acc_weights, gyr_weights;
     for (std::size_t p : acc_wander) {
-      acc_blocks.insert(acc_blocks.end(), {wander(k, p, false), wander(k, p, true)});
-      acc_weights.push_back(wander_[p].BridgeMeanWeight(T));
+      acc_blocks.insert(acc_blocks.end(), {wander(imu, k, p, false), wander(imu, k, p, true)});
+      acc_weights.push_back(u.wander[p].BridgeMeanWeight(T));
     }
     for (std::size_t p : gyr_wander) {
-      gyr_blocks.insert(gyr_blocks.end(), {wander(k, p, false), wander(k, p, true)});
-      gyr_weights.push_back(wander_[p].BridgeMeanWeight(T));
+      gyr_blocks.insert(gyr_blocks.end(), {wander(imu, k, p, false), wander(imu, k, p, true)});
+      gyr_weights.push_back(u.wander[p].BridgeMeanWeight(T));
     }
-    built.acc.push_back(
-        s.spinning ? nullptr
-                   : problem->AddResidualBlock(
-                         StillResidual::Create(model_, model::Sensor::kAccel, s.acc_measurement,
-                                               site_.g_n, site_.omega_ie_n, Vec3::Zero(),
-                                               acc_weights),
-                         nullptr, acc_blocks));
-    built.gyr.push_back(
-        still_gyro_ ? problem->AddResidualBlock(
-                          StillResidual::Create(model_, model::Sensor::kGyro, s.gyr_measurement,
-                                                site_.g_n, site_.omega_ie_n,
-                                                s.segment.known_omega_eb_b.value_or(Vec3::Zero()),
-                                                gyr_weights),
-                          nullptr, gyr_blocks)
-                    : nullptr);
+    const bool spinning = still().poses[k].spinning;
+    acc_ids.push_back(spinning ? nullptr
+                               : problem->AddResidualBlock(
+                                     make_still(u.model, model::Sensor::kAccel, s.acc_measurement,
+                                                site_.g_n, site_.omega_ie_n, Vec3::Zero(),
+                                                acc_weights),
+                                     nullptr, acc_blocks));
+    gyr_ids.push_back(
+        u.still_gyro
+            ? problem->AddResidualBlock(
+                  make_still(u.model, model::Sensor::kGyro, s.gyr_measurement, site_.g_n,
+                             site_.omega_ie_n,
+                             still().poses[k].segment.known_omega_eb_b.value_or(Vec3::Zero()),
+                             gyr_weights),
+                  nullptr, gyr_blocks)
+            : nullptr);
   }
-  const auto& motions = still_.motions;
+  const auto& motions = u.still.motions;
   for (std::size_t k = 0; k < motions.size(); ++k) {
     const auto& mo = motions[k];
-    std::vector<double*> blocks = {q(mo.from), q(mo.from + 1)};
-    blocks.insert(blocks.end(), all_terms.begin(), all_terms.end());
+    std::vector<double*> blocks = blocks_of(all_terms, {q(mo.from), q(mo.from + 1)});
     for (std::size_t p : gyr_wander) {
-      blocks.insert(blocks.end(), {wander(mo.from, p, true), wander(mo.from + 1, p, false)});
+      blocks.insert(blocks.end(), {wander(imu, mo.from, p, true), wander(imu, mo.from + 1, p, false)});
     }
-    auto* motion = new residuals::MotionResidual(model_, motion_samples_[k], site_.omega_ie_n,
-                                                 static_cast<int>(gyr_wander.size()));
-    built.motion.push_back(problem->AddResidualBlock(motion, nullptr, blocks));
+    const int processes = static_cast<int>(gyr_wander.size());
+    residuals::CachedCostFunction* motion =
+        mounted ? static_cast<residuals::CachedCostFunction*>(new residuals::MountedMotionResidual(
+                      u.model, u.motion_samples[k], site_.omega_ie_n, processes))
+                : new residuals::MotionResidual(u.model, u.motion_samples[k], site_.omega_ie_n,
+                                                processes);
+    motion_ids.push_back(problem->AddResidualBlock(motion, nullptr, blocks));
     if (built.evaluation) {
-      built.evaluation->Add(motion, blocks, static_cast<double>(motion_samples_[k]->size()));
+      built.evaluation->Add(motion, blocks, static_cast<double>(u.motion_samples[k]->size()));
     }
-    if (velocity_on_) {
-      std::vector<double*> vblocks = {q(mo.from)};
-      vblocks.insert(vblocks.end(), all_terms.begin(), all_terms.end());
-      for (const auto* processes : {&acc_wander, &gyr_wander}) {
-        for (std::size_t p : *processes) {
-          vblocks.insert(vblocks.end(), {wander(mo.from, p, true), wander(mo.from + 1, p, false)});
+    if (u.velocity_on) {
+      std::vector<double*> vblocks = blocks_of(all_terms, {q(mo.from)});
+      for (const auto* processes_of : {&acc_wander, &gyr_wander}) {
+        for (std::size_t p : *processes_of) {
+          vblocks.insert(vblocks.end(), {wander(imu, mo.from, p, true), wander(imu, mo.from + 1, p, false)});
         }
       }
       built.velocity.push_back(problem->AddResidualBlock(
-          residuals::VelocityResidual::Create(model_, motion_samples_[k], site_.g_n,
-                                              site_.omega_ie_n, velocity_info_[k],
+          residuals::VelocityResidual::Create(u.model, u.motion_samples[k], site_.g_n,
+                                              site_.omega_ie_n, u.velocity_info[k],
                                               static_cast<int>(acc_wander.size()),
                                               static_cast<int>(gyr_wander.size())),
           nullptr, vblocks));
     }
   }
+  if (mounted) built.board.push_back(std::move(own));
 }
 
-std::vector<std::size_t> CalibrationProblem::WanderOf(model::Sensor sensor) const {
-  std::vector<std::size_t> out;
-  for (std::size_t p = 0; p < wander_.size(); ++p) {
-    if (wander_[p].sensor == sensor) out.push_back(p);
-  }
-  return out;
-}
-
-void CalibrationProblem::AddWanderFactors(BuiltProblem& built, std::size_t p) {
-  const WanderProcess& w = wander_[p];
+void CalibrationProblem::AddWanderFactors(BuiltProblem& built, std::size_t imu, std::size_t p) {
+  const ProblemImu& u = imus_[imu];
+  const WanderProcess& w = u.wander[p];
+  std::vector<ceres::ResidualBlockId>& ids = imu == 0 ? built.walk : built.board[imu - 1].walk;
   auto add = [&](double* from, double* to, double span_s) {
     const double dt = std::max(span_s, kMinWalkSpan_s);
     const Vec3 inv_sigma = w.StepSigma(dt).cwiseInverse();
-    built.walk.push_back(
+    ids.push_back(
         from == nullptr
             ? built.problem->AddResidualBlock(
                   residuals::BiasWalkResidual::CreateAnchor(inv_sigma), nullptr, to)
             : built.problem->AddResidualBlock(
                   residuals::BiasWalkResidual::Create(inv_sigma, w.Phi(dt)), nullptr, from, to));
-    built.walk_process.push_back(p);
+    if (imu == 0) built.walk_process.push_back(p);
   };
-  const auto& poses = still_.poses;
+  const auto& poses = u.still.poses;
   for (std::size_t k = 0; k < poses.size(); ++k) {
     const auto& stats = poses[k].stats;
     if (k == 0) {
-      add(nullptr, wander(0, p, false), stats.t_begin_s - model_.t_ref_s);
+      add(nullptr, wander(imu, 0, p, false), stats.t_begin_s - u.model.t_ref_s);
     } else {
-      add(wander(k - 1, p, true), wander(k, p, false),
+      add(wander(imu, k - 1, p, true), wander(imu, k, p, false),
           stats.t_begin_s - poses[k - 1].stats.t_end_s);
     }
-    add(wander(k, p, false), wander(k, p, true), stats.t_end_s - stats.t_begin_s);
+    add(wander(imu, k, p, false), wander(imu, k, p, true), stats.t_end_s - stats.t_begin_s);
   }
 }
 
@@ -393,15 +339,19 @@ BuiltProblem CalibrationProblem::Build(const Gauge& gauge, bool free_probes) {
   BuiltProblem built;
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  if (!still_.motions.empty()) {
+  if (!still().motions.empty()) {
     built.evaluation = std::make_unique<ParallelEvaluation>(options_.run_jobs);
     problem_options.evaluation_callback = built.evaluation.get();
   }
   built.problem = std::make_unique<ceres::Problem>(problem_options);
   if (built.evaluation) built.evaluation->SetProblem(built.problem.get());
   AddParameterBlocks(built, gauge.parameters, free_probes);
-  AddResiduals(built);
-  for (std::size_t p = 0; p < wander_.size(); ++p) AddWanderFactors(built, p);
+  for (std::size_t i = 0; i < imus_.size(); ++i) AddResiduals(built, i);
+  // IMU 0's wander factors last before the held combinations: walk_estimate.cc reads them as
+  // the last rows.
+  for (std::size_t i = imus_.size(); i-- > 0;) {
+    for (std::size_t p = 0; p < imus_[i].wander.size(); ++p) AddWanderFactors(built, i, p);
+  }
   AddHeldCombinations(built, gauge.combinations);
   return built;
 }
@@ -429,32 +379,64 @@ void CalibrationProblem::AddHeldCombinations(BuiltProblem& built,
   }
 }
 
-UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
-                                           const std::vector<ParameterIndex>& held) {
-  UnknownColumns out;
-  const std::vector<const double*> blocks = ModelBlocks();
-  const auto linear = model_.Predict(blocks.data(), model::SensorInput<double>());
-  for (int t = 0; t < model_.num_terms(); ++t) {
+void CalibrationProblem::AddTermColumns(const ceres::Problem& problem,
+                                        const std::vector<ParameterIndex>& held,
+                                        std::size_t imu, UnknownColumns& out) {
+  const ProblemImu& u = imus_[imu];
+  const std::vector<const double*> blocks = TermBlocks(imu);
+  const auto linear = u.model.Predict(blocks.data(), model::SensorInput<double>());
+  for (int local = 0; local < u.num_terms(); ++local) {
+    const int t = u.first_term + local;
     double* values = block(t);
     if (problem.IsParameterBlockConstant(values)) continue;
     out.blocks.push_back(values);
-    const auto& term = model_.terms()[static_cast<std::size_t>(t)];
-    const auto& info = term.effect->info();
+    const model::EffectInfo& info = u.TermInfo(local);
     for (int i = 0; i < info.size(); ++i) {
-      if (term.fixed[static_cast<std::size_t>(i)] ||
+      if (u.Fixed(local, i) ||
           std::find(held.begin(), held.end(), ParameterIndex(t, i)) != held.end()) {
         continue;
       }
-      out.names.push_back(info.ParameterName(i));
+      const std::string& name = info.parameters[static_cast<std::size_t>(i)].name;
+      out.names.push_back(u.name_prefix + (info.prefix.empty() ? name : info.ParameterName(i)));
       out.values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal + values[i]);
       out.typical.push_back(TypicalSize(info, i, linear.F, linear.E));
       out.is_model.push_back(true);
       out.model_index.emplace_back(t, i);
     }
   }
+}
+
+void CalibrationProblem::AddWanderColumns(std::size_t imu, UnknownColumns& out) {
+  const ProblemImu& u = imus_[imu];
+  for (std::size_t k = 0; k < u.still.poses.size(); ++k) {
+    for (std::size_t p = 0; p < u.wander.size(); ++p) {
+      const WanderProcess& w = u.wander[p];
+      for (bool end : {false, true}) {
+        out.blocks.push_back(wander(imu, k, p, end));
+        for (int i = 0; i < 3; ++i) {
+          out.names.push_back(
+              u.name_prefix +
+              (w.kind == WanderProcess::Kind::kWalk ? "walk[" : "instability[") +
+              std::to_string(k) + "]." +
+              (w.sensor == model::Sensor::kGyro ? "gyro." : "accel.") +
+              (end ? "end." : "start.") + kAxisName[i]);
+          out.values.push_back(std::nan(""));
+          out.typical.push_back(0.0);
+          out.is_model.push_back(false);
+          out.model_index.emplace_back(-1, static_cast<int>(k));
+        }
+      }
+    }
+  }
+}
+
+UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
+                                           const std::vector<ParameterIndex>& held) {
+  UnknownColumns out;
+  for (std::size_t i = 0; i < imus_.size(); ++i) AddTermColumns(problem, held, i, out);
   const char* kTangentName[3] = {"north", "east", "down"};
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    const StillPose& s = still_.poses[k];
+  for (std::size_t k = 0; k < still().poses.size(); ++k) {
+    const StillPose& s = still().poses[k];
     if (s.known) continue;
     out.blocks.push_back(q(k));
     const int first = s.heading_only ? 2 : 0;
@@ -468,25 +450,7 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
     }
   }
   out.first_wander = out.names.size();
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    for (std::size_t p = 0; p < wander_.size(); ++p) {
-      const WanderProcess& w = wander_[p];
-      for (bool end : {false, true}) {
-        out.blocks.push_back(wander(k, p, end));
-        for (int i = 0; i < 3; ++i) {
-          out.names.push_back(
-              std::string(w.kind == WanderProcess::Kind::kWalk ? "walk[" : "instability[") +
-              std::to_string(k) + "]." +
-              (w.sensor == model::Sensor::kGyro ? "gyro." : "accel.") +
-              (end ? "end." : "start.") + kAxisName[i]);
-          out.values.push_back(std::nan(""));
-          out.typical.push_back(0.0);
-          out.is_model.push_back(false);
-          out.model_index.emplace_back(-1, static_cast<int>(k));
-        }
-      }
-    }
-  }
+  for (std::size_t i = 0; i < imus_.size(); ++i) AddWanderColumns(i, out);
   return out;
 }
 
@@ -516,8 +480,8 @@ ProbeJacobian CalibrationProblem::ProbeColumns(const BuiltProblem& probe,
   out.unknown_names = columns.names;
   out.unknown_is_model = columns.is_model;
   std::vector<double*> blocks = columns.blocks;
-  for (int t = 0; t < model_.num_terms(); ++t) {
-    const auto& term = model_.terms()[static_cast<std::size_t>(t)];
+  for (int t = 0; t < model().num_terms(); ++t) {
+    const auto& term = model().terms()[static_cast<std::size_t>(t)];
     if (!term.probe) continue;
     blocks.push_back(block(t));
     for (int i = 0; i < term.effect->info().size(); ++i) {
@@ -576,22 +540,22 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     }
   };
   Vec3 ss_acc = Vec3::Zero(), ss_gyr = Vec3::Zero(), ss_mot = Vec3::Zero(), ss_vel = Vec3::Zero();
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    const StillPose& s = still_.poses[k];
+  for (std::size_t k = 0; k < still().poses.size(); ++k) {
+    const StillPose& s = still().poses[k];
     StillSegmentFit f;
     f.segment = s.segment;
     f.t_mid_s = s.stats.t_mid_s;
     f.count = s.stats.count;
     f.acc_mean = s.stats.acc_mean;
-    if (has_gyro_) f.gyr_mean = s.stats.gyr_mean;
+    if (imus_[0].has_gyro) f.gyr_mean = s.stats.gyr_mean;
     f.R_n_b = R_n_b(k);
     f.attitude_known = s.known;
     const double T = s.stats.t_end_s - s.stats.t_begin_s;
-    for (std::size_t p = 0; p < wander_.size(); ++p) {
-      const Vec3 mean = wander_[p].BridgeMeanWeight(T) *
-                        (Eigen::Map<const Vec3>(wander(k, p, false)) +
-                         Eigen::Map<const Vec3>(wander(k, p, true)));
-      (wander_[p].sensor == model::Sensor::kAccel ? f.acc_walk : f.gyr_walk) += mean;
+    for (std::size_t p = 0; p < imus_[0].wander.size(); ++p) {
+      const Vec3 mean = imus_[0].wander[p].BridgeMeanWeight(T) *
+                        (Eigen::Map<const Vec3>(wander(0, k, p, false)) +
+                         Eigen::Map<const Vec3>(wander(0, k, p, true)));
+      (imus_[0].wander[p].sensor == model::Sensor::kAccel ? f.acc_walk : f.gyr_walk) += mean;
     }
     // Residuals are measured minus predicted, whitened by sqrt_info: unwhiten to report them.
     double w[3];
@@ -609,30 +573,30 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
     }
     fit.still.push_back(f);
   }
-  const auto& motions = still_.motions;
+  const auto& motions = still().motions;
   for (std::size_t k = 0; k < motions.size(); ++k) {
     const MotionInterval& mo = motions[k];
     MotionFit f;
     f.from = mo.from;
     f.to = mo.from + 1;
-    f.duration_s = series_.t_s[mo.last] - series_.t_s[mo.first];
+    f.duration_s = imus_[0].series->t_s[mo.last] - imus_[0].series->t_s[mo.first];
     double w[3];
     evaluate(built.motion[k], w);
     f.whitened = Vec3(w[0], w[1], w[2]);
-    f.rotation_residual = f.whitened.cwiseQuotient(motion_samples_[k]->sqrt_info);
+    f.rotation_residual = f.whitened.cwiseQuotient(imus_[0].motion_samples[k]->sqrt_info);
     ss_mot += f.rotation_residual.cwiseAbs2();
     if (k < built.velocity.size()) {
       evaluate(built.velocity[k], w);
       f.has_velocity = true;
       f.velocity_whitened = Vec3(w[0], w[1], w[2]);
-      f.velocity_residual = f.velocity_whitened.cwiseQuotient(velocity_info_[k]);
+      f.velocity_residual = f.velocity_whitened.cwiseQuotient(imus_[0].velocity_info[k]);
       ss_vel += f.velocity_residual.cwiseAbs2();
     }
     fit.motion.push_back(f);
   }
-  const double ns = static_cast<double>(still_.poses.size());
-  fit.rms_acc = (ss_acc / static_cast<double>(still_.AtRestMeans(false).size())).cwiseSqrt();
-  if (still_gyro_) fit.rms_gyr = (ss_gyr / ns).cwiseSqrt();
+  const double ns = static_cast<double>(still().poses.size());
+  fit.rms_acc = (ss_acc / static_cast<double>(still().AtRestMeans(false).size())).cwiseSqrt();
+  if (imus_[0].still_gyro) fit.rms_gyr = (ss_gyr / ns).cwiseSqrt();
   if (!motions.empty()) fit.rms_motion = (ss_mot / static_cast<double>(motions.size())).cwiseSqrt();
   fit.velocity_segments = static_cast<int>(built.velocity.size());
   if (fit.velocity_segments > 0) {
@@ -642,12 +606,12 @@ void CalibrationProblem::ReportResiduals(const BuiltProblem& built, FitReport& f
 
 void CalibrationProblem::TakeValues(const CalibrationProblem& from) {
   if (from.values_.size() != values_.size() || from.q_offset_ != q_offset_ ||
-      from.still_.poses.size() != still_.poses.size()) {
+      from.still().poses.size() != still().poses.size()) {
     throw Error("calibration problem: TakeValues between problems of different layouts");
   }
   std::copy(from.values_.begin(), from.values_.end(), values_.begin());
-  for (std::size_t k = 0; k < still_.poses.size(); ++k) {
-    if (still_.poses[k].known) std::copy(still_.poses[k].q.begin(), still_.poses[k].q.end(), q(k));
+  for (std::size_t k = 0; k < still().poses.size(); ++k) {
+    if (still().poses[k].known) std::copy(still().poses[k].q.begin(), still().poses[k].q.end(), q(k));
   }
 }
 

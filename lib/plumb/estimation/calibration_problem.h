@@ -15,11 +15,16 @@
 //                         w (s_k + e_k) (the process's bridge mean), in the motion residual
 //                         linear between e_k and s_k+1, and tied by the Markov factors
 //                         t_ref -> s_0 -> e_0 -> s_1 -> ... (residuals/bias_walk_residual.h)
+// The board's other IMUs (SPEC 6, "Several IMUs of one board"; problem_imu.h) share the poses'
+// attitudes: each has its model's blocks and a board_mount block (its rotation R_b_i into the
+// body, model/board_mount.h), its own still and motion residuals (mounted: at the attitudes
+// R_k R_b_i) and its own wander states; no velocity residual yet, so their lever arms and time
+// offsets are held.
 // The problem owns the values (theta, the poses' attitudes) that Ceres works on, so a
 // ceres::Problem can be built from them again (with other parameters held) and its residuals
 // and Jacobians handed out: the observability analysis, the covariance, diagnose's probe
-// columns and the per-segment residuals all read them here. The values lie in one buffer, model
-// blocks in term order then the attitudes in pose order, so that every ordering by address
+// columns and the per-segment residuals all read them here. The values lie in one buffer, term
+// blocks IMU by IMU in term order, then the attitudes in pose order, then the wander states, so that every ordering by address
 // (ceres::Covariance sorts parameter blocks by address) is the same on every run: results do
 // not depend on how the heap happened to be laid out.
 //
@@ -42,6 +47,7 @@
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/options.h"
 #include "plumb/estimation/parallel_evaluation.h"
+#include "plumb/estimation/problem_imu.h"
 #include "plumb/estimation/still_set.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
@@ -49,7 +55,9 @@
 
 namespace plumb::estimation {
 
-/// A (term, index) pair naming one scalar model parameter.
+/// A (term, index) pair naming one scalar parameter: the terms are counted over every IMU of
+/// the problem, IMU 0's model's first, then each other IMU's model's and its board_mount block
+/// (CalibrationProblem::imus(), ProblemImu::first_term).
 using ParameterIndex = std::pair<int, int>;
 
 /// What a fit holds where it starts besides the model's fixed parameters (solve.h): one
@@ -86,6 +94,13 @@ struct BuiltProblem {
   std::vector<ceres::ResidualBlockId> walk;      ///< bias-wander factors, when the bias wanders
   std::vector<std::size_t> walk_process;         ///< per wander factor: its process (Wander order)
   std::vector<ceres::ResidualBlockId> held;      ///< per held combination (Gauge)
+  /// The board's other IMUs' residuals (CalibrationProblem::imus()[i + 1]).
+  struct ImuBlocks {
+    std::vector<ceres::ResidualBlockId> acc, gyr;  ///< per still pose
+    std::vector<ceres::ResidualBlockId> motion;    ///< per motion interval
+    std::vector<ceres::ResidualBlockId> walk;      ///< its bias-wander factors
+  };
+  std::vector<ImuBlocks> board;
 };
 
 /// The free unknowns of a built problem as Jacobian columns, in order: model parameters
@@ -107,19 +122,23 @@ struct UnknownColumns {
 class CalibrationProblem {
  public:
   /// `theta` and the poses' attitudes hold the starting values (Initialize); `start` gives
-  /// the starting linear parts for the first motion weights.
+  /// the starting linear parts for the first motion weights. `board`: the board's other IMUs
+  /// fitted with it (SPEC 6; problem_imu.h), each with its model's blocks and a board_mount
+  /// block as its terms after IMU 0's (ParameterIndex counts the terms of every IMU, IMU 0's
+  /// first); none: IMU 0 alone.
   CalibrationProblem(const ImuSeries& series, model::Model model, const geo::Site& site,
                      StillSet still, model::ParameterBlocks theta, const NoiseModel& noise,
-                     const StartingValues& start, const CalibrationOptions& options);
+                     const StartingValues& start, const CalibrationOptions& options,
+                     std::vector<BoardImuInput> board = {});
   CalibrationProblem(const CalibrationProblem&) = delete;  // Ceres points into the values
   CalibrationProblem& operator=(const CalibrationProblem&) = delete;
 
-  /// Whitening of the motion residuals (the white gyroscope noise carried through E^-1 and
-  /// integrated over the interval's steps) and of the velocity residuals, and the angular
+  /// Whitening of IMU 0's motion residuals (the white gyroscope noise carried through E^-1 and
+  /// integrated over the interval's steps) and of its velocity residuals, and the angular
   /// acceleration input E^-1 d y_g / dt, from the linear parts E and F.
   void SetMotionWeights(const Mat3& E, const Mat3& F);
-  /// Sets the motion weights from the current theta's linear parts (before the final solve,
-  /// so that chi^2 does not depend on the starting values).
+  /// Sets every IMU's motion weights from the current values of its linear parts (before the
+  /// final solve, so that chi^2 does not depend on the starting values).
   void SetMotionWeightsFromSolution();
 
   /// A problem on the current values. `gauge`: parameters held at their values besides the
@@ -142,16 +161,21 @@ class CalibrationProblem {
   /// columns `columns` then every probe term's block.
   ProbeJacobian ProbeColumns(const BuiltProblem& probe, const UnknownColumns& columns);
   /// Per-segment and per-interval residuals of `built` at the current values, and their RMS,
-  /// into `fit`.
+  /// into `fit` (IMU 0's).
   void ReportResiduals(const BuiltProblem& built, FitReport& fit) const;
 
-  const model::Model& model() const { return model_; }
-  const StillSet& still() const { return still_; }
-  /// The current model parameter blocks (a copy), one per term.
+  /// IMU 0's model, poses and intervals.
+  const model::Model& model() const { return imus_[0].model; }
+  const StillSet& still() const { return imus_[0].still; }
+  /// The IMUs of the fit: IMU 0, then the board's others in the order given.
+  const std::vector<ProblemImu>& imus() const { return imus_; }
+  /// IMU 0's current model parameter blocks (a copy), one per term.
   model::ParameterBlocks theta() const;
-  /// Where Ceres keeps each term's block, in term order (for model::Model::Predict and
-  /// ceres::Covariance on a built problem).
+  /// Where Ceres keeps each of IMU 0's term blocks, in term order (for model::Model::Predict
+  /// and ceres::Covariance on a built problem).
   std::vector<const double*> ModelBlocks() const;
+  /// The same for IMU `imu`'s terms (its model's, then its board_mount block).
+  std::vector<const double*> TermBlocks(std::size_t imu) const;
   /// The current attitude R_n_b of pose k.
   Quat R_n_b(std::size_t k) const;
   /// Saves the current values (theta and the attitudes), and puts them back (the solve's
@@ -163,61 +187,62 @@ class CalibrationProblem {
   /// looks like under this problem's assumptions (sensitivity.h). Throws plumb::Error when the
   /// layouts differ.
   void TakeValues(const CalibrationProblem& from);
-  /// The processes the biases wander by (NoiseModel::Wander): BuiltProblem::walk_process
+  /// The processes IMU 0's biases wander by (NoiseModel::Wander): BuiltProblem::walk_process
   /// indexes them.
-  const std::vector<WanderProcess>& WanderProcesses() const { return wander_; }
+  const std::vector<WanderProcess>& WanderProcesses() const { return imus_[0].wander; }
   /// The gyroscope is integrated between poses (there are motion intervals).
-  bool has_motion() const { return has_gyro_ && !still_.motions.empty(); }
+  bool has_motion() const { return imus_[0].has_gyro && !still().motions.empty(); }
 
  private:
-  void SetMeasurements(const NoiseModel& noise);
-  void SetMotionSamples();
+  ProblemImu MakeImu(const ImuSeries& series, model::Model model, StillSet still,
+                     const NoiseModel& noise, const StartingValues& start, bool mounted) const;
   void AddParameterBlocks(BuiltProblem& built, const std::vector<ParameterIndex>& held,
                           bool free_probes);
-  void AddResiduals(BuiltProblem& built);
+  /// Adds IMU `imu`'s still, motion and velocity residuals (IMU 0's into built.acc, .gyr,
+  /// .motion, .velocity; the others' into built.board[imu - 1]).
+  void AddResiduals(BuiltProblem& built, std::size_t imu);
   void AddHeldCombinations(BuiltProblem& built, const std::vector<Gauge::Combination>& held);
-  double* block(int term) { return values_.data() + block_offset_[static_cast<std::size_t>(term)]; }
-  const double* block(int term) const {
-    return values_.data() + block_offset_[static_cast<std::size_t>(term)];
+  /// The IMU and its own term of the problem's term t (ParameterIndex::first).
+  std::pair<std::size_t, int> TermOf(int t) const;
+  int num_terms() const { return imus_.back().first_term + imus_.back().num_terms(); }
+  double* block(int t) {
+    const auto [imu, local] = TermOf(t);
+    return values_.data() + imus_[imu].block_offset[static_cast<std::size_t>(local)];
   }
-  int block_size(int term) const {
-    return model_.terms()[static_cast<std::size_t>(term)].effect->info().size();
+  const double* block(int t) const { return const_cast<CalibrationProblem*>(this)->block(t); }
+  int block_size(int t) const {
+    const auto [imu, local] = TermOf(t);
+    return imus_[imu].TermInfo(local).size();
   }
-  /// The state of wander process p (wander_ order) in pose k, at the segment's first (`end`
+  /// IMU `imu`'s board_mount block (mounted IMUs only).
+  double* mount(std::size_t imu) {
+    return values_.data() + imus_[imu].block_offset[static_cast<std::size_t>(imus_[imu].model.num_terms())];
+  }
+  /// The state of IMU `imu`'s wander process p in pose k, at the segment's first (`end`
   /// false) or last sample (3 values, sensor units).
-  double* wander(std::size_t k, std::size_t p, bool end) {
-    return values_.data() + walk_offset_ + 6 * (wander_.size() * k + p) + (end ? 3 : 0);
+  double* wander(std::size_t imu, std::size_t k, std::size_t p, bool end) {
+    const ProblemImu& u = imus_[imu];
+    return values_.data() + u.walk_offset + 6 * (u.wander.size() * k + p) + (end ? 3 : 0);
   }
-  const double* wander(std::size_t k, std::size_t p, bool end) const {
-    return const_cast<CalibrationProblem*>(this)->wander(k, p, end);
+  const double* wander(std::size_t imu, std::size_t k, std::size_t p, bool end) const {
+    return const_cast<CalibrationProblem*>(this)->wander(imu, k, p, end);
   }
-  /// The wander processes of `sensor` (indices into wander_).
-  std::vector<std::size_t> WanderOf(model::Sensor sensor) const;
-  /// Adds the Markov factors of wander process p to `built`.
-  void AddWanderFactors(BuiltProblem& built, std::size_t p);
+  /// Adds the Markov factors of IMU `imu`'s wander process p to `built` (IMU 0's into
+  /// built.walk).
+  void AddWanderFactors(BuiltProblem& built, std::size_t imu, std::size_t p);
   double* q(std::size_t k) { return values_.data() + q_offset_ + 4 * k; }
   const double* q(std::size_t k) const { return values_.data() + q_offset_ + 4 * k; }
+  /// Adds the columns of IMU `imu`'s free term blocks to `out`.
+  void AddTermColumns(const ceres::Problem& problem, const std::vector<ParameterIndex>& held,
+                      std::size_t imu, UnknownColumns& out);
+  /// Adds the columns of IMU `imu`'s wander states to `out`.
+  void AddWanderColumns(std::size_t imu, UnknownColumns& out);
 
-  const ImuSeries& series_;
-  model::Model model_;
   geo::Site site_;
   CalibrationOptions options_;
-  StillSet still_;
-  std::vector<double> values_;              // model blocks in term order, then q_k per pose
-  std::vector<std::size_t> block_offset_;   // per term: offset of its block in values_
-  std::size_t q_offset_ = 0;                // offset of the first attitude in values_
-  std::size_t walk_offset_ = 0;             // offset of the first bias-wander state
-  NoiseModel noise_;
-  std::vector<WanderProcess> wander_;       // noise_.Wander(has_gyro_): 6 values per pose each
-  StartingValues start_;
-  bool has_gyro_ = false;
-  bool still_gyro_ = false;   // still gyroscope residuals are used
-  bool velocity_on_ = false;  // velocity residuals are used
-  /// Per motion: its samples, shared by the residuals of every problem built (SetMotionWeights
-  /// replaces them rather than changing what a built problem reads).
-  std::vector<residuals::SharedMotionSamples> motion_samples_;
-  std::vector<std::vector<Vec3>> output_rate_;  // per motion, per sample: d y_g / dt, units/s
-  std::vector<Vec3> velocity_info_;             // per motion: 1 / sigma of the velocity residual
+  std::vector<ProblemImu> imus_;           // IMU 0, then the board's others
+  std::vector<double> values_;             // term blocks (IMU by IMU), q_k per pose, wander
+  std::size_t q_offset_ = 0;               // offset of the first attitude in values_
   std::vector<double> saved_values_;
 };
 

@@ -9,6 +9,7 @@
 #include "plumb/core/option_name.h"
 #include "plumb/core/units.h"
 #include "plumb/estimation/advice.h"
+#include "plumb/estimation/board.h"
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/covariance.h"
 #include "plumb/estimation/fitted_problem.h"
@@ -56,7 +57,8 @@ model::Model ModelForSession(const model::Model& requested, const ImuSeries& ser
 
 FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
                          const model::Model& model_in, const geo::Site& site,
-                         const CalibrationOptions& options, CalibrationResult& result) {
+                         const CalibrationOptions& options, CalibrationResult& result,
+                         const std::vector<BoardImu>& board) {
   options.Validate();
   Calibration& cal = result.calibration;
   FitReport& fit = result.fit;
@@ -99,10 +101,14 @@ FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment
   }
   cal.noise = out.noise.Levels();
 
+  // 1-3 for the board's other IMUs (board.h).
+  std::vector<BoardImuInput> others =
+      PrepareBoard(board, series, still, cal.model, site, options, fit);
+
   // 4. The problem; 5. the solve (the problem stays where Ceres points into its values).
   out.problem = std::make_unique<CalibrationProblem>(series, cal.model, site, std::move(still),
                                                      std::move(theta), out.noise, out.start,
-                                                     options);
+                                                     options, std::move(others));
   out.solution = SolveWithGauge(*out.problem, options, fit);
   return out;
 }

@@ -10,6 +10,7 @@
 
 #include "plumb/core/imu_series.h"
 #include "plumb/core/segment.h"
+#include "plumb/core/session.h"
 #include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
@@ -34,10 +35,12 @@ struct FittedProblem {
 
 /// Stages 1-5 of Calibrate (the still set, the noise model and the wander's levels, starting
 /// values, the problem, the solve with its gauge); fills `result`'s method, site, model,
-/// units, noise, notes and warnings.
+/// units, noise, notes and warnings. `board`: the board's other IMUs fitted with IMU 0
+/// (`series`; board.h), which must outlive the problem; none: IMU 0 alone.
 FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
                          const model::Model& model, const geo::Site& site,
-                         const CalibrationOptions& options, CalibrationResult& result);
+                         const CalibrationOptions& options, CalibrationResult& result,
+                         const std::vector<BoardImu>& board = {});
 
 /// Stages 6-8 of Calibrate on a fitted problem (FitProblem's, same arguments): the analysis,
 /// parameters and covariance, the fit's residuals, advice and gates, into `result`.

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "plumb/core/imu_series.h"
@@ -81,6 +82,14 @@ struct StillSet {
 /// every one turns at a stated rate.
 StillSet MakeStillSet(const ImuSeries& series, const std::vector<StillSegment>& segments,
                       bool earth_rate_seen, bool motion_on, const CalibrationOptions& options);
+
+/// IMU 0's poses and motion intervals as another IMU of the board samples them (SPEC 6): each
+/// pose its samples stamped within the pose's first and last sample times, with their
+/// statistics, each interval from the last sample of one pose to the first of the next; the
+/// attitudes and their flags as IMU 0's (the problem's own). Throws
+/// plumb::InsufficientDataError naming `name` when a pose holds fewer than 2 of its samples.
+StillSet StillSetOnBoardImu(const StillSet& imu0, const ImuSeries& series0,
+                            const ImuSeries& series, const std::string& name);
 
 /// The gauge: the first pose of each motion-joined chain holds its heading unless a known
 /// attitude in the chain fixes it; without a gyroscope every pose's heading is held.

@@ -1,0 +1,32 @@
+// plumb/estimation/board.h — stages 1-3 of the backend for the board's other IMUs (SPEC 6,
+// "Several IMUs of one board"), before the problem (stage 4) takes them with IMU 0.
+//
+// For each IMU: its samples of IMU 0's poses and motion intervals (StillSetOnBoardImu), its
+// noise model (EstimateNoise) with its wander's levels from its own still data
+// (AssignWanderLevels), its model's starting values (Initialize, on its own samples), and
+// where it starts in the body: R_b_i = R_n_b^T R_n_i, IMU 0's starting attitude of each pose
+// against its own, averaged over the poses (the chordal mean: the rotation nearest the mean
+// of their matrices). Its model is IMU 0's spec, without the gyroscope's terms when it has no
+// gyroscope.
+#pragma once
+
+#include <vector>
+
+#include "plumb/core/session.h"
+#include "plumb/estimation/fit_report.h"
+#include "plumb/estimation/options.h"
+#include "plumb/estimation/problem_imu.h"
+#include "plumb/estimation/still_set.h"
+#include "plumb/geo/site.h"
+#include "plumb/model/model.h"
+
+namespace plumb::estimation {
+
+/// The board's other IMUs as the problem takes them; notes on their wander levels go to
+/// `fit.notes`, prefixed with the IMU. `board` must outlive the problem (its series).
+std::vector<BoardImuInput> PrepareBoard(const std::vector<BoardImu>& board,
+                                        const ImuSeries& series0, const StillSet& still0,
+                                        const model::Model& model, const geo::Site& site,
+                                        const CalibrationOptions& options, FitReport& fit);
+
+}  // namespace plumb::estimation
