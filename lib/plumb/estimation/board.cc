@@ -1,9 +1,13 @@
 #include "plumb/estimation/board.h"
 
 #include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
 #include <optional>
+#include <utility>
 #include <string>
 
+#include "plumb/estimation/covariance.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
 #include "plumb/estimation/wander_levels.h"
@@ -69,6 +73,76 @@ std::vector<BoardImuInput> PrepareBoard(const std::vector<BoardImu>& board,
     out.push_back(std::move(in));
   }
   return out;
+}
+
+namespace {
+
+/// The column of the problem's parameter (t, i) among `columns`, or -1 when it is held.
+Eigen::Index ColumnOf(const UnknownColumns& columns, int t, int i) {
+  const auto& index = columns.model_index;
+  const auto at = std::find(index.begin(), index.end(), std::make_pair(t, i));
+  return at == index.end() ? -1 : static_cast<Eigen::Index>(at - index.begin());
+}
+
+/// IMU `imu` of the problem as calibrated; the columns of its parameters appended to `column_of`.
+BoardImuCalibration ReportBoardImu(const CalibrationProblem& problem, std::size_t imu,
+                                   const UnknownColumns& columns,
+                                   const ObservabilityAnalysis& analysis,
+                                   std::vector<Eigen::Index>& column_of) {
+  const ProblemImu& u = problem.imus()[imu];
+  BoardImuCalibration out;
+  out.instance = u.instance;
+  out.model = u.model;
+  out.has_gyro = u.has_gyro;
+  out.noise = u.noise.Levels();
+  out.acc_unit = u.series->acc_unit;
+  out.gyr_unit = u.series->gyr_unit;
+  const std::vector<const double*> blocks = problem.TermBlocks(imu);
+  for (int local = 0; local < u.num_terms(); ++local) {
+    const model::EffectInfo& info = u.TermInfo(local);
+    const double* block = blocks[static_cast<std::size_t>(local)];
+    out.theta.emplace_back(block, block + info.size());
+    const bool mount = local == u.model.num_terms();
+    for (int i = 0; i < info.size(); ++i) {
+      const model::ParameterInfo& p = info.parameters[static_cast<std::size_t>(i)];
+      ParameterEstimate e;
+      e.name = u.name_prefix + (info.prefix.empty() ? p.name : info.ParameterName(i));
+      e.place = {local, i};
+      e.unit = mount ? p.unit : ParameterUnit(u.model, e.place, *u.series);
+      e.value = p.nominal + block[i];
+      e.fixed = u.Fixed(local, i);
+      const Eigen::Index c = ColumnOf(columns, u.first_term + local, i);
+      column_of.push_back(c);
+      e.observable = c >= 0 && analysis.observable[static_cast<std::size_t>(c)];
+      if (c >= 0 && e.observable && !e.fixed) e.sigma = std::sqrt(analysis.covariance(c, c));
+      out.parameters.push_back(std::move(e));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void ReportBoard(const CalibrationProblem& problem, const UnknownColumns& columns,
+                 const ObservabilityAnalysis& analysis,
+                 const std::vector<Eigen::Index>& column_of, Calibration& calibration) {
+  if (problem.imus().size() < 2) return;
+  std::vector<Eigen::Index> all = column_of;
+  for (std::size_t i = 1; i < problem.imus().size(); ++i) {
+    calibration.board.push_back(ReportBoardImu(problem, i, columns, analysis, all));
+  }
+  const auto n = static_cast<Eigen::Index>(all.size());
+  Eigen::MatrixXd& cov = calibration.board_covariance;
+  cov = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    for (Eigen::Index b = 0; b < n; ++b) {
+      const Eigen::Index ca = all[static_cast<std::size_t>(a)], cb = all[static_cast<std::size_t>(b)];
+      if (ca >= 0 && cb >= 0) cov(a, b) = analysis.covariance(ca, cb);
+    }
+  }
+  // IMU 0's own block as its parameters report it (covariance.h).
+  const Eigen::Index n0 = calibration.covariance.rows();
+  cov.topLeftCorner(n0, n0) = calibration.covariance;
 }
 
 }  // namespace plumb::estimation

@@ -7,13 +7,17 @@
 // where it starts in the body: R_b_i = R_n_b^T R_n_i, IMU 0's starting attitude of each pose
 // against its own, averaged over the poses (the chordal mean: the rotation nearest the mean
 // of their matrices). Its model is IMU 0's spec, without the gyroscope's terms when it has no
-// gyroscope.
+// gyroscope. After the fit (stage 6), ReportBoard gives their parameters and the one
+// covariance over every IMU's.
 #pragma once
 
 #include <vector>
 
 #include "plumb/core/session.h"
+#include "plumb/estimation/calibration.h"
+#include "plumb/estimation/calibration_problem.h"
 #include "plumb/estimation/fit_report.h"
+#include "plumb/estimation/observability.h"
 #include "plumb/estimation/options.h"
 #include "plumb/estimation/problem_imu.h"
 #include "plumb/estimation/still_set.h"
@@ -28,5 +32,14 @@ std::vector<BoardImuInput> PrepareBoard(const std::vector<BoardImu>& board,
                                         const ImuSeries& series0, const StillSet& still0,
                                         const model::Model& model, const geo::Site& site,
                                         const CalibrationOptions& options, FitReport& fit);
+
+/// Stage 6 for the board's other IMUs: each one's parameters with their sigmas (from
+/// `analysis`, the fit with every unknown free, over `columns`) into calibration.board, and
+/// the covariance over IMU 0's parameters (calibration.parameters, whose block is
+/// calibration.covariance) and theirs into calibration.board_covariance. Nothing without a
+/// board.
+void ReportBoard(const CalibrationProblem& problem, const UnknownColumns& columns,
+                 const ObservabilityAnalysis& analysis,
+                 const std::vector<Eigen::Index>& column_of, Calibration& calibration);
 
 }  // namespace plumb::estimation

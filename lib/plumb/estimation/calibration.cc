@@ -1,5 +1,8 @@
 #include "plumb/estimation/calibration.h"
 
+#include <Eigen/Core>
+
+#include "plumb/model/board_mount.h"
 #include "plumb/model/effects/accel_linear.h"
 #include "plumb/model/effects/gyro_linear.h"
 
@@ -32,6 +35,38 @@ Mat3 Calibration::GyroMatrix() const {
 }
 
 Vec3 Calibration::GyroBias() const {
+  const int t = model.BaseTerm(model::Sensor::kGyro);
+  if (!has_gyro || t < 0) return Vec3::Zero();
+  return model::gyro_linear::Bias(theta[static_cast<std::size_t>(t)]);
+}
+
+Quat BoardImuCalibration::R_b_i() const {
+  return model::board_mount::Rotation(theta.back().data());
+}
+
+Vec3 BoardImuCalibration::LeverArm() const {
+  return Eigen::Map<const Vec3>(theta.back().data() + model::board_mount::kLeverArm);
+}
+
+double BoardImuCalibration::TimeOffset() const {
+  return theta.back()[model::board_mount::kTimeOffset];
+}
+
+Mat3 BoardImuCalibration::AccelMatrix() const {
+  return model.Predict(theta, model::SensorInput<double>()).F;
+}
+
+Vec3 BoardImuCalibration::AccelBias() const {
+  const int t = model.BaseTerm(model::Sensor::kAccel);
+  return t < 0 ? Vec3::Zero() : model::accel_linear::Bias(theta[static_cast<std::size_t>(t)]);
+}
+
+Mat3 BoardImuCalibration::GyroMatrix() const {
+  if (!has_gyro) return Mat3::Identity();
+  return model.Predict(theta, model::SensorInput<double>()).E;
+}
+
+Vec3 BoardImuCalibration::GyroBias() const {
   const int t = model.BaseTerm(model::Sensor::kGyro);
   if (!has_gyro || t < 0) return Vec3::Zero();
   return model::gyro_linear::Bias(theta[static_cast<std::size_t>(t)]);

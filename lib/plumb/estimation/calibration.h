@@ -112,6 +112,36 @@ struct NoiseLevels {
   Vec3 quantisation_gyr = Vec3::Zero();
 };
 
+/// Another IMU of the board as calibrated with IMU 0 (SPEC 6, "Several IMUs of one board"):
+/// its model and parameters, and where it sits in the body (model/board_mount.h).
+struct BoardImuCalibration {
+  int instance = 1;  ///< its number on the board
+  model::Model model;
+  /// Its model's blocks, then its board_mount block (7 values): one per term of `model`, and
+  /// one more.
+  model::ParameterBlocks theta;
+  /// Its model's parameters in model order, then its mount's seven (rotation.x..z, lever_arm.x..z,
+  /// time_offset); named as the fit names them ("imu1.accel.bias.x", "imu1.rotation.x"), each
+  /// with `place` in `theta` (the mount's term: model.num_terms()).
+  std::vector<ParameterEstimate> parameters;
+  NoiseLevels noise;
+  bool has_gyro = false;
+  std::string acc_unit = "m/s^2";
+  std::string gyr_unit = "rad/s";
+
+  /// R_b_i, its frame into the body frame (IMU 0's accelerometer's).
+  Quat R_b_i() const;
+  /// Its lever arm from IMU 0, m, body frame, and its time offset, s (held at zero: no residual
+  /// of the fit sees them yet).
+  Vec3 LeverArm() const;
+  double TimeOffset() const;
+  /// F, b_a, E, b_g of its own base effects, as Calibration's.
+  Mat3 AccelMatrix() const;
+  Vec3 AccelBias() const;
+  Mat3 GyroMatrix() const;
+  Vec3 GyroBias() const;
+};
+
 struct Calibration {
   /// Label of the method ("generalized", or a paper method run on the backend).
   std::string method = "generalized";
@@ -131,6 +161,12 @@ struct Calibration {
   bool has_gyro = false;
   std::string acc_unit = "m/s^2";  ///< units of the accelerometer samples (see ImuSeries)
   std::string gyr_unit = "rad/s";
+  /// The board's other IMUs fitted with this one (empty: IMU 0 alone).
+  std::vector<BoardImuCalibration> board;
+  /// With a board: one covariance over `parameters` then every board IMU's, in that order (SI
+  /// units squared; zero rows for fixed parameters, the pseudo-inverse's values for
+  /// unobservable ones); empty without one.
+  Eigen::MatrixXd board_covariance;
 
   /// The forward quantities of SPEC section 1, from the base effects' blocks: F (sensor units
   /// per m/s^2), b_a (sensor units), E (sensor units per rad/s), b_g (sensor units). Without a

@@ -94,6 +94,7 @@ CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model mod
   for (BoardImuInput& other : board) {
     imus_.push_back(MakeImu(*other.series, std::move(other.model), std::move(other.still),
                             other.noise, other.start, true));
+    imus_.back().instance = other.instance;
     imus_.back().name_prefix = "imu" + std::to_string(other.instance) + ".";
     model::ParameterBlocks blocks = std::move(other.theta);
     std::vector<double> mount(model::board_mount::kSize, 0.0);

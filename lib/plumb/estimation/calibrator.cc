@@ -120,13 +120,20 @@ FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment
 CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegment>& segments,
                             const model::Model& model_in, const geo::Site& site,
                             const CalibrationOptions& options) {
+  return CalibrateBoard(series, {}, segments, model_in, site, options);
+}
+
+CalibrationResult CalibrateBoard(const ImuSeries& series, const std::vector<BoardImu>& board,
+                                 const std::vector<StillSegment>& segments,
+                                 const model::Model& model_in, const geo::Site& site,
+                                 const CalibrationOptions& options) {
   CalibrationResult result;
-  FittedProblem fitted = FitProblem(series, segments, model_in, site, options, result);
+  FittedProblem fitted = FitProblem(series, segments, model_in, site, options, result, board);
   FinishCalibration(series, segments, options, fitted, result);
   // 9. How far the sigmas rest on wander levels the session could not measure.
   if (const std::optional<CalibrationOptions> at_bound = OptionsAtTheWanderBound(
           fitted.noise, fitted.wander_bounds, result.fit.still_segments, options)) {
-    const CalibrationResult bound = Calibrate(series, segments, model_in, site, *at_bound);
+    const CalibrationResult bound = CalibrateBoard(series, board, segments, model_in, site, *at_bound);
     if (const std::optional<std::string> w = SigmaRestsOnTheTypicalWander(result, bound)) {
       result.fit.warnings.push_back(Notice{"sigma_rests_on_wander", *w, {Option::kNoiseFrom}});
     }
@@ -155,6 +162,7 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   cal.parameters = ReportParameters(cal.model, cal.theta, series, columns, analysis, column_of);
   ComputeCovariance(solution.fitted(), problem.ModelBlocks(), analysis, column_of, options, cal,
                     fit.warnings);
+  ReportBoard(problem, columns, analysis, column_of, cal);
 
   // 7. The fit: chi^2, degrees of freedom and the residuals.
   fit.chi2 = 2.0 * at.cost;

@@ -16,6 +16,8 @@
 
 #include <vector>
 
+#include "plumb/core/session.h"
+
 #include "plumb/core/imu_series.h"
 #include "plumb/core/segment.h"
 #include "plumb/estimation/options.h"
@@ -32,5 +34,15 @@ namespace plumb::estimation {
 CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegment>& segments,
                             const model::Model& model, const geo::Site& site,
                             const CalibrationOptions& options = {});
+
+/// The same with the board's other IMUs in the one fit (SPEC 6, "Several IMUs of one board";
+/// Session::other_imus): their still attitudes shared with `series` (IMU 0, whose segments
+/// these are), each IMU with `model` (without the gyroscope's terms when it has none) and its
+/// rotation into the body; they are reported in Calibration::board with one covariance over
+/// every IMU (Calibration::board_covariance).
+CalibrationResult CalibrateBoard(const ImuSeries& series, const std::vector<BoardImu>& board,
+                                 const std::vector<StillSegment>& segments,
+                                 const model::Model& model, const geo::Site& site,
+                                 const CalibrationOptions& options = {});
 
 }  // namespace plumb::estimation

@@ -11,24 +11,6 @@
 namespace plumb::estimation {
 namespace {
 
-/// Unit of a reported parameter: the catalogue's SI unit, or, for the base effects on
-/// unscaled sensor output, that output's unit (bias) and unit per SI input (matrix).
-std::string UnitOf(const model::Model& model, model::ParameterPlace place, const ImuSeries& series) {
-  const model::EffectInfo& info = model.terms()[static_cast<std::size_t>(place.term)].effect->info();
-  const int i = place.index;
-  const std::string& si = info.parameters[static_cast<std::size_t>(i)].unit;
-  const bool accel = info.sensor == model::Sensor::kAccel;
-  const std::string& out = accel ? series.acc_unit : series.gyr_unit;
-  const std::string in = accel ? "m/s^2" : "rad/s";
-  if (out == in || info.input_side) return si;
-  if (!info.linear_stage) {
-    // Additive terms are in output units: "rad/s per m/s^2" becomes "counts per m/s^2".
-    return info.ScalesWithOutput(i) ? out + si.substr(in.size()) : si;
-  }
-  const bool matrix = model.Role(place) != model::ParameterRole::kBias;
-  return matrix ? out + " per " + in : out;
-}
-
 /// ceres::Covariance over the free model blocks of `fitted` into `cov` (zero elsewhere);
 /// false when Ceres finds the problem singular or there is nothing to compute.
 bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
@@ -69,6 +51,25 @@ bool CeresCovariance(ceres::Problem& fitted, const model::Model& model,
 
 }  // namespace
 
+// The catalogue's SI unit, or, for the base effects on unscaled sensor output, that output's
+// unit (bias) and unit per SI input (matrix).
+std::string ParameterUnit(const model::Model& model, model::ParameterPlace place,
+                          const ImuSeries& series) {
+  const model::EffectInfo& info = model.terms()[static_cast<std::size_t>(place.term)].effect->info();
+  const int i = place.index;
+  const std::string& si = info.parameters[static_cast<std::size_t>(i)].unit;
+  const bool accel = info.sensor == model::Sensor::kAccel;
+  const std::string& out = accel ? series.acc_unit : series.gyr_unit;
+  const std::string in = accel ? "m/s^2" : "rad/s";
+  if (out == in || info.input_side) return si;
+  if (!info.linear_stage) {
+    // Additive terms are in output units: "rad/s per m/s^2" becomes "counts per m/s^2".
+    return info.ScalesWithOutput(i) ? out + si.substr(in.size()) : si;
+  }
+  const bool matrix = model.Role(place) != model::ParameterRole::kBias;
+  return matrix ? out + " per " + in : out;
+}
+
 std::vector<ParameterEstimate> ReportParameters(const model::Model& model,
                                                 const model::ParameterBlocks& theta,
                                                 const ImuSeries& series,
@@ -86,7 +87,7 @@ std::vector<ParameterEstimate> ReportParameters(const model::Model& model,
       ParameterEstimate p;
       p.name = info.ParameterName(i);
       p.place = {t, i};
-      p.unit = UnitOf(model, p.place, series);
+      p.unit = ParameterUnit(model, p.place, series);
       p.value = values[static_cast<std::size_t>(flat)];
       p.fixed = term.fixed[static_cast<std::size_t>(i)];
       const auto& index = columns.model_index;

@@ -29,6 +29,11 @@ namespace plumb::estimation {
 /// Every parameter of the model with its value, unit (the sensor's output units where the
 /// series is not SI), fixed and observable flags; sigma is left NaN. `column_of` receives,
 /// per parameter, its column among `columns` (-1 when it has none: fixed, or its block held).
+/// The unit of the parameter at `place` of `model` as reported for `series`'s outputs (SI, or
+/// the output's unit where the parameter is in it).
+std::string ParameterUnit(const model::Model& model, model::ParameterPlace place,
+                          const ImuSeries& series);
+
 std::vector<ParameterEstimate> ReportParameters(const model::Model& model,
                                                 const model::ParameterBlocks& theta,
                                                 const ImuSeries& series,

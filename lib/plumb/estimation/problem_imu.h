@@ -47,6 +47,7 @@ struct ProblemImu {
   std::vector<WanderProcess> wander;  ///< noise.Wander(has_gyro): 6 values per pose each
   StartingValues start;
   bool mounted = false;      ///< another IMU of the board: a board_mount block after its model's
+  int instance = 0;          ///< its number on the board (IMU 0: 0)
   /// Put before its unknowns' names: "" for IMU 0, "imuK." for another IMU of the board.
   std::string name_prefix;
   bool has_gyro = false;

@@ -1,10 +1,14 @@
 #include "plumb/report/calibration_text.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "plumb/core/number_text.h"
+#include "plumb/core/units.h"
 #include "plumb/estimation/uncertainty.h"
 
 namespace plumb::report {
@@ -19,6 +23,39 @@ std::string Pad(const std::string& text) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%12s", text.c_str());
   return buf;
+}
+
+/// The table of `parameters`: value, sigma (and sigma * `scale` when scale > 1), unit.
+std::string ParameterTable(const std::vector<estimation::ParameterEstimate>& parameters,
+                           double scale) {
+  const bool scaled = scale > 1.0;
+  std::string out;
+  char line[192];
+  std::snprintf(line, sizeof line, "%-34s %15s %12s%s  %s\n", "parameter", "value", "sigma",
+                scaled ? "       scaled" : "", "unit");
+  out += line;
+  for (const auto& p : parameters) {
+    const bool none = p.fixed || !p.observable;
+    std::string sigma = p.fixed ? "fixed" : !p.observable ? "unobservable" : FormattedText("%.3g", p.sigma);
+    const std::string extra = !scaled ? "" : " " + Pad(none ? "" : FormattedText("%.3g", scale * p.sigma));
+    std::snprintf(line, sizeof line, "%-34s %15.8g %12s%s  %s\n", p.name.c_str(), p.value,
+                  sigma.c_str(), extra.c_str(), p.unit.c_str());
+    out += line;
+  }
+  return out;
+}
+
+/// The board's other IMUs (SPEC 6): each one's rotation into the body and its parameters.
+std::string BoardText(const estimation::Calibration& c, double scale) {
+  std::string out;
+  for (const auto& b : c.board) {
+    const Eigen::AngleAxisd aa(b.R_b_i());
+    out += "\nimu" + std::to_string(b.instance) + ", fitted with IMU 0 (the attitudes shared): " +
+           "rotation into the body " + FormattedText("%.4g", aa.angle() * units::kDegPerRad) +
+           " deg about " + Vec(aa.axis(), "%.3f") + "; lever arm and time offset held at 0 (not fitted yet)\n";
+    out += ParameterTable(b.parameters, scale);
+  }
+  return out;
 }
 
 }  // namespace
@@ -110,18 +147,8 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   const double scale = estimation::SigmaScale(fit);
   const bool scaled = scale > 1.0;
   if (scaled) os << OverDispersionNote(fit);
-  char line[192];
-  std::snprintf(line, sizeof line, "%-34s %15s %12s%s  %s\n", "parameter", "value", "sigma",
-                scaled ? "       scaled" : "", "unit");
-  os << line;
-  for (const auto& p : c.parameters) {
-    const bool none = p.fixed || !p.observable;
-    std::string sigma = p.fixed ? "fixed" : !p.observable ? "unobservable" : FormattedText("%.3g", p.sigma);
-    const std::string extra = !scaled ? "" : " " + Pad(none ? "" : FormattedText("%.3g", scale * p.sigma));
-    std::snprintf(line, sizeof line, "%-34s %15.8g %12s%s  %s\n", p.name.c_str(), p.value,
-                  sigma.c_str(), extra.c_str(), p.unit.c_str());
-    os << line;
-  }
+  os << ParameterTable(c.parameters, scale);
+  os << BoardText(c, scale);
   if (!c.observability.unobservable.empty()) {
     os << "\nunobservable directions (moving along them changes no prediction):\n";
     for (const auto& u : c.observability.unobservable) os << "  " << u << "\n";

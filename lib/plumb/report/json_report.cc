@@ -1,5 +1,6 @@
 #include "plumb/report/json_report.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
 #include <map>
@@ -7,6 +8,7 @@
 #include "plumb/document/calibration_keys.h"
 #include "plumb/estimation/uncertainty.h"
 #include "plumb/io/common/atomic_file.h"
+#include "plumb/model/board_mount.h"
 #include "plumb/report/version.h"
 
 namespace plumb::report {
@@ -353,6 +355,81 @@ json CovarianceJson(const estimation::CalibrationResult& r) {
                 {keys::kMatrix, Rows(scale * scale * combos.matrix)}}}};
 }
 
+/// The mount of a board IMU as SPEC 6's "imus" entries give it: "rotation" {matrix, vector,
+/// sigma}, "lever_arm" {value, sigma}, "time_offset" {value, sigma} (sigma null where held or
+/// undetermined); IMU 0's is the identity with zero sigma.
+json MountJson(const Quat& R_b_i, const Vec3& rho_sigma, const Vec3& lever_arm,
+               const Vec3& lever_sigma, double time_offset, double time_sigma) {
+  auto sigmas = [](const Vec3& v) {
+    return json::array({Number(v.x()), Number(v.y()), Number(v.z())});
+  };
+  const Eigen::AngleAxisd aa(R_b_i);
+  return json{{"rotation",
+               {{keys::kMatrix, Matrix(R_b_i.toRotationMatrix())},
+                {"vector", Vector(aa.angle() * aa.axis())},
+                {keys::kSigma, sigmas(rho_sigma)}}},
+              {"lever_arm", {{keys::kValue, Vector(lever_arm)}, {keys::kSigma, sigmas(lever_sigma)}}},
+              {"time_offset", {{keys::kValue, Number(time_offset)}, {keys::kSigma, Number(time_sigma)}}}};
+}
+
+/// One board IMU's entry of "imus": its sensors, parameters and mount.
+json BoardImuJson(const estimation::BoardImuCalibration& b, double sigma_scale) {
+  json entry{{"instance", b.instance}, {keys::kModel, b.model.spec()}};
+  entry[keys::kAccel] = Sensor(b.AccelMatrix(), b.AccelBias(),
+                               Correction(b.AccelMatrix(), b.AccelBias(), "f_i = matrix (y_a - offset)",
+                                          ExtraEffects(b.model, model::Sensor::kAccel)));
+  entry[keys::kGyro] = b.has_gyro ? Sensor(b.GyroMatrix(), b.GyroBias(),
+                                           Correction(b.GyroMatrix(), b.GyroBias(),
+                                                      "omega_i = matrix (y_g - offset)",
+                                                      ExtraEffects(b.model, model::Sensor::kGyro)))
+                                  : json(nullptr);
+  entry[keys::kParameters] = json::array();
+  for (const auto& p : b.parameters) entry[keys::kParameters].push_back(ParameterJson(p, sigma_scale));
+  // The mount's seven parameters close the list (board_mount.h's layout).
+  const std::size_t m = b.parameters.size() - model::board_mount::kSize;
+  auto sigma = [&](int i) {
+    const auto& p = b.parameters[m + static_cast<std::size_t>(i)];
+    return p.fixed || !p.observable ? std::nan("") : sigma_scale * p.sigma;
+  };
+  using model::board_mount::kLeverArm;
+  using model::board_mount::kRotation;
+  const Vec3 rho_sigma(sigma(kRotation), sigma(kRotation + 1), sigma(kRotation + 2));
+  const Vec3 lever_sigma(sigma(kLeverArm), sigma(kLeverArm + 1), sigma(kLeverArm + 2));
+  entry.update(MountJson(b.R_b_i(), rho_sigma, b.LeverArm(), lever_sigma, b.TimeOffset(),
+                         sigma(model::board_mount::kTimeOffset)));
+  return entry;
+}
+
+/// SPEC 6's "imus" (IMU 0 first, at the identity) and the one covariance over every IMU's
+/// parameters ("imus_covariance": parameters, units, matrix; scaled as "covariance").
+void AddBoardJson(const estimation::CalibrationResult& r, json& doc) {
+  const estimation::Calibration& c = r.calibration;
+  if (c.board.empty()) return;
+  const double scale = estimation::SigmaScale(r.fit);
+  json imu0{{"instance", 0}, {keys::kModel, c.model.spec()}};
+  imu0[keys::kAccel] = doc[keys::kAccel];
+  imu0[keys::kGyro] = doc[keys::kGyro];
+  imu0.update(MountJson(Quat::Identity(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0.0, 0.0));
+  json imus = json::array({imu0});
+  json names = json::array(), units = json::array();
+  for (const auto& p : c.parameters) {
+    names.push_back(p.name);
+    units.push_back(p.unit);
+  }
+  for (const auto& b : c.board) {
+    imus.push_back(BoardImuJson(b, scale));
+    for (const auto& p : b.parameters) {
+      names.push_back(p.name);
+      units.push_back(p.unit);
+    }
+  }
+  doc["imus"] = imus;
+  doc["imus_covariance"] = {{keys::kParameters, names},
+                            {"units", units},
+                            {keys::kMatrix, Rows(scale * scale * c.board_covariance)},
+                            {keys::kSigmaScaledByChi2, scale > 1.0}};
+}
+
 json GatesJson(const estimation::FitReport& fit) {
   json gates = json::array();
   for (const auto& g : fit.gates) gates.push_back({{"name", g.name}, {"message", g.message}});
@@ -390,6 +467,7 @@ json ToJson(const estimation::CalibrationResult& r) {
     doc[keys::kParameters].push_back(ParameterJson(p, sigma_scale));
   }
   doc[keys::kCovariance] = CovarianceJson(r);
+  AddBoardJson(r, doc);
   doc[keys::kFit] = FitJson(r);
   doc["gates"] = GatesJson(r.fit);
   doc[keys::kObservability] = ObservabilityJson(r.calibration.observability, sigma_scale);

@@ -20,6 +20,14 @@
 //   covariance {parameters [names], units [], matrix [[...]], sigma_scaled_by_chi2,
 //               sigma_scale, determined {combinations [texts], matrix [[...]]}}
 //                                                 see CovarianceJson
+//   imus [{instance, model, accel, gyro, parameters, rotation {matrix, vector, sigma},
+//          lever_arm {value, sigma}, time_offset {value, sigma}}]   only with the board's
+//        other IMUs in the fit (SPEC 6): IMU 0 first (instance 0, the identity, its keys as
+//        the top level's), then each other IMU, its parameters named "imuK.accel.bias.x",
+//        "imuK.rotation.x", ...
+//   imus_covariance {parameters [names], units [], matrix [[...]], sigma_scaled_by_chi2}
+//        with them: one covariance over every IMU's parameters (IMU 0's first), scaled as
+//        "covariance"
 //   fit {chi2, dof, chi2_dof, num_residuals, residual_rms {accel, gyro, motion},
 //        segments {still, motion}, converged, iterations (over every solve), solves,
 //        last_solve_iterations (the count in solver), solver, chi2_above_band,
