@@ -181,8 +181,8 @@ TEST(FlightLogBoard, ArduPilotPlaneReadsIMU2BesideIMU) {
   EXPECT_NEAR((imu2.size() - 1) / (imu2.t_s.back() - imu2.t_s.front()), 49.988, 1e-3);
   EXPECT_NEAR(imu2.t_s.front(), s.series.t_s.front(), 0.02);
   EXPECT_NEAR(imu2.t_s.back(), s.series.t_s.back(), 0.02);
-  // IMU2's own correction (INS_ACC2*) is said, prefixed with its instance.
-  EXPECT_TRUE(HasWarning(s, "IMU instance 1 (IMU2): ", "INS_ACC2")) << s.warnings.size();
+  // IMU2's own correction (INS_ACC2*) is said, under its stream and instance.
+  EXPECT_TRUE(HasWarning(s, "IMU2 of IMU instance 1: ", "INS_ACC2")) << s.warnings.size();
 }
 
 TEST(FlightLogBoard, ADeclaredInstanceWithoutRowsIsAnErrorNamingIt) {
@@ -253,8 +253,8 @@ TEST(FlightLogBoard, TlogReadsTheScaledImusBesideRawImu) {
   EXPECT_EQ(all, (std::vector<int>{1, 2}));
   const Session s = ExpectBoardAsAlone(log, {}, all, {"SCALED_IMU2", "SCALED_IMU3"}, 301);
   // Their correction (INS_ACC2OFFS, INS_ACC3OFFS, ...) undone, each said under its instance.
-  EXPECT_TRUE(HasWarning(s, "IMU instance 1 (SCALED_IMU2): ", "INS_ACC2OFFS"));
-  EXPECT_TRUE(HasWarning(s, "IMU instance 2 (SCALED_IMU3): ", "INS_ACC3OFFS"));
+  EXPECT_TRUE(HasWarning(s, "SCALED_IMU2 instance 1: ", "INS_ACC2OFFS"));
+  EXPECT_TRUE(HasWarning(s, "SCALED_IMU3 instance 2: ", "INS_ACC3OFFS"));
   for (const BoardImu& imu : s.other_imus) EXPECT_TRUE(imu.firmware_left.empty()) << imu.name;
   // In reverse order: as listed.
   const Session reversed = log.Select(Board({}, {2, 1}));

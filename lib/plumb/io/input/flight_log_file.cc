@@ -233,7 +233,9 @@ BoardImu FlightLog::SelectBoardImu(const FlightLogSelection& imu0, int instance,
   for (Notice& n : s.warnings) {
     const auto same = [&n](const Notice& m) { return SameNotice(n, m); };
     if (std::any_of(shared.begin(), shared.end(), same)) continue;  // said once, for IMU 0
-    n.message = who + n.message;
+    // The readers name the stream and instance in most of their messages ("IMU2 of IMU
+    // instance 1: ..."); the others are prefixed with them.
+    if (n.message.find(info.name) == std::string::npos) n.message = who + n.message;
     warnings->push_back(std::move(n));
   }
   return out;
