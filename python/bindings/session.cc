@@ -343,6 +343,93 @@ std::vector<Option> OptionsFrom(const py::handle& list) {
   return out;
 }
 
+/// One of Session::other_imus as Python sees it: the session that holds its samples (kept alive
+/// by this object, as a session's own views keep it alive) and its place in other_imus.
+struct PyBoardImu {
+  std::shared_ptr<PySession> owner;
+  std::size_t index = 0;
+  const BoardImu& imu() const { return owner->session.other_imus[index]; }
+};
+
+/// The getter of a numpy view over one column of a board IMU's series (as SeriesView), kept
+/// alive by the Python BoardImu (which keeps its session).
+template <typename Column>
+auto BoardSeriesView(Column ImuSeries::*column, std::size_t cols) {
+  return [column, cols](const py::object& self) {
+    const auto& v = self.cast<const PyBoardImu&>().imu().series.*column;
+    using Item = typename Column::value_type;
+    if constexpr (std::is_same_v<Item, double>) {
+      return View(v.data(), v.size(), cols, sizeof(Item), self);
+    } else {
+      return View(v.empty() ? nullptr : v[0].data(), v.size(), cols, sizeof(Item), self);
+    }
+  };
+}
+
+py::object BoardTemp(const py::object& self) {
+  const ImuSeries& s = self.cast<const PyBoardImu&>().imu().series;
+  if (!s.has_temperature()) return py::none();
+  return View(s.temp_c.data(), s.size(), 0, sizeof(float), self);
+}
+
+/// Session.other_imus: one BoardImu per other IMU of the board, in the session's order.
+py::list OtherImusOf(const std::shared_ptr<PySession>& s) {
+  py::list out;
+  for (std::size_t i = 0; i < s->session.other_imus.size(); ++i) {
+    out.append(py::cast(PyBoardImu{s, i}));
+  }
+  return out;
+}
+
+/// The state of a series (SessionState's keys time, acc, gyr, temp, acc_unit, gyr_unit).
+void PutSeries(const ImuSeries& x, py::dict& d) {
+  d["time"] = Copy(x.t_s.data(), x.size(), 0);
+  d["acc"] = Copy(x.acc.empty() ? nullptr : x.acc[0].data(), x.acc.size(), 3);
+  d["gyr"] = Copy(x.gyr.empty() ? nullptr : x.gyr[0].data(), x.gyr.size(), 3);
+  d["temp"] = Copy(x.temp_c.data(), x.temp_c.size(), 0);
+  d["acc_unit"] = x.acc_unit;
+  d["gyr_unit"] = x.gyr_unit;
+}
+
+/// The series PutSeries put in `d`.
+void TakeSeries(const py::dict& d, ImuSeries& x) {
+  Fill<double>(d["time"], 1, x.t_s);
+  Fill<float>(d["acc"], 3, x.acc);
+  Fill<float>(d["gyr"], 3, x.gyr);
+  Fill<float>(d["temp"], 1, x.temp_c);
+  x.acc_unit = d["acc_unit"].cast<std::string>();
+  x.gyr_unit = d["gyr_unit"].cast<std::string>();
+}
+
+/// Session::other_imus as state: dicts of instance, name, firmware_left and the series' keys.
+py::list OtherImusState(const std::vector<BoardImu>& imus) {
+  py::list out;
+  for (const BoardImu& imu : imus) {
+    py::dict d;
+    d["instance"] = imu.instance;
+    d["name"] = imu.name;
+    d["firmware_left"] = imu.firmware_left;
+    PutSeries(imu.series, d);
+    out.append(std::move(d));
+  }
+  return out;
+}
+
+/// What OtherImusState made.
+std::vector<BoardImu> OtherImusOfState(const py::handle& state) {
+  std::vector<BoardImu> out;
+  for (const auto& item : state) {
+    const py::dict d = item.cast<py::dict>();
+    BoardImu imu;
+    imu.instance = d["instance"].cast<int>();
+    imu.name = d["name"].cast<std::string>();
+    imu.firmware_left = d["firmware_left"].cast<std::vector<std::string>>();
+    TakeSeries(d, imu.series);
+    out.push_back(std::move(imu));
+  }
+  return out;
+}
+
 }  // namespace
 
 py::list NoticesState(const std::vector<Notice>& notices) {
@@ -365,12 +452,7 @@ py::dict SessionState(const PySession& p) {
   const ImuSeries& x = s.series;
   py::dict d;
   d["version"] = 1;
-  d["time"] = Copy(x.t_s.data(), x.size(), 0);
-  d["acc"] = Copy(x.acc.empty() ? nullptr : x.acc[0].data(), x.acc.size(), 3);
-  d["gyr"] = Copy(x.gyr.empty() ? nullptr : x.gyr[0].data(), x.gyr.size(), 3);
-  d["temp"] = Copy(x.temp_c.data(), x.temp_c.size(), 0);
-  d["acc_unit"] = x.acc_unit;
-  d["gyr_unit"] = x.gyr_unit;
+  PutSeries(x, d);
   d["source"] = s.source;
   d["inputs"] = p.inputs;
   d["warnings"] = NoticesState(s.warnings);
@@ -398,6 +480,7 @@ py::dict SessionState(const PySession& p) {
                                  m.max_ground_speed_m_s, m.max_climb_m_s, m.ground_distance_m));
   }
   d["log_motion"] = motion;
+  d["other_imus"] = OtherImusState(s.other_imus);
   return d;
 }
 
@@ -407,13 +490,7 @@ std::shared_ptr<PySession> SessionOfState(const py::dict& d) {
   }
   auto out = std::make_shared<PySession>();
   Session& s = out->session;
-  ImuSeries& x = s.series;
-  Fill<double>(d["time"], 1, x.t_s);
-  Fill<float>(d["acc"], 3, x.acc);
-  Fill<float>(d["gyr"], 3, x.gyr);
-  Fill<float>(d["temp"], 1, x.temp_c);
-  x.acc_unit = d["acc_unit"].cast<std::string>();
-  x.gyr_unit = d["gyr_unit"].cast<std::string>();
+  TakeSeries(d, s.series);
   s.source = d["source"].cast<std::string>();
   out->inputs = d["inputs"].cast<std::vector<std::string>>();
   s.warnings = NoticesOfState(d["warnings"]);
@@ -454,10 +531,48 @@ std::shared_ptr<PySession> SessionOfState(const py::dict& d) {
     m.ground_distance_m = t[6].cast<double>();
     s.log_motion.push_back(std::move(m));
   }
+  // A state pickled before sessions had other IMUs has none.
+  if (d.contains("other_imus")) s.other_imus = OtherImusOfState(d["other_imus"]);
   return out;
 }
 
+void RegisterBoardImu(py::module_& m) {
+  py::class_<PyBoardImu>(
+      m, "BoardImu",
+      "Another IMU of the same board (Session.other_imus): its samples on its own stamps and in "
+      "its own frame, as read (numpy views over the session's storage, read-only).")
+      .def_property_readonly("instance", [](const PyBoardImu& b) { return b.imu().instance; },
+                             "The log's sensor instance (0-based), or k of a native CSV's "
+                             "acc{k}_x columns.")
+      .def_property_readonly("name", [](const PyBoardImu& b) { return b.imu().name; },
+                             "Where it was read from, e.g. 'IMU2', 'SCALED_IMU3', 'acc1_x..'.")
+      .def_property_readonly("time", BoardSeriesView(&ImuSeries::t_s, 0),
+                             "Sample times, s (float64, N), on the log's clock.")
+      .def_property_readonly("acc", BoardSeriesView(&ImuSeries::acc, 3),
+                             "Accelerometer output, m/s^2 (float32, N x 3), in its own frame.")
+      .def_property_readonly("gyr", BoardSeriesView(&ImuSeries::gyr, 3),
+                             "Gyroscope output, rad/s (float32, N x 3; 0 x 3 without one).")
+      .def_property_readonly("temp", &BoardTemp,
+                             "Sensor temperature, degC (float32, N); None without.")
+      .def_property_readonly("acc_unit", [](const PyBoardImu& b) { return b.imu().series.acc_unit; },
+                             "Unit of acc: 'm/s^2', or 'counts' for unscaled output.")
+      .def_property_readonly("gyr_unit", [](const PyBoardImu& b) { return b.imu().series.gyr_unit; },
+                             "Unit of gyr: 'rad/s', or 'counts' for unscaled output.")
+      .def_property_readonly("has_gyro", [](const PyBoardImu& b) { return b.imu().series.has_gyro(); },
+                             "Whether it has gyroscope samples.")
+      .def_property_readonly("firmware_left", [](const PyBoardImu& b) { return b.imu().firmware_left; },
+                             "Corrections the flight controller applied to it that the reader "
+                             "did not undo; empty for the sensor's own output.")
+      .def("__len__", [](const PyBoardImu& b) { return b.imu().series.size(); },
+           "Number of samples.")
+      .def("__repr__", [](const PyBoardImu& b) {
+        return "<plumb.BoardImu " + std::to_string(b.imu().instance) + " " + b.imu().name +
+               ": " + std::to_string(b.imu().series.size()) + " samples>";
+      });
+}
+
 void RegisterSession(py::module_& m) {
+  RegisterBoardImu(m);
   py::class_<PySession, std::shared_ptr<PySession>>(
       m, "Session",
       "A recorded session: the samples (numpy views over plumb's own storage, read-only, no "
@@ -516,6 +631,11 @@ void RegisterSession(py::module_& m) {
                              "not undo; empty when the samples are the sensor's own output.")
       .def_property_readonly("log_params", [](const PySession& s) { return s.session.log_params; },
                              "A flight log's firmware parameters (name -> value).")
+      .def_property_readonly("other_imus", &OtherImusOf,
+                             "The board's other IMUs (plumb.BoardImu: instance, name, time, "
+                             "acc, gyr, temp, firmware_left), where the input has them (a "
+                             "native CSV's acc{k}_x columns); empty otherwise. The session's "
+                             "own samples are IMU 0's, whose frame is the body frame.")
       .def_property_readonly("vehicle_motion", &VehicleMotionOf,
                              "Where a flight log says the vehicle flew or moved (its land "
                              "detector, its GPS): dicts evidence ('airborne' or 'gps_moving'), "

@@ -14,6 +14,7 @@ as plumb.open.
 """
 
 from ._plumb import (  # noqa: F401
+    BoardImu,
     Calibration,
     Diagnosis,
     Error,
@@ -38,7 +39,7 @@ from ._plumb import (  # noqa: F401
 )
 
 __all__ = [
-    "Calibration", "Diagnosis", "Error", "InputError", "InsufficientDataError",
+    "BoardImu", "Calibration", "Diagnosis", "Error", "InputError", "InsufficientDataError",
     "MissingFileError", "PlumbWarning", "Result", "Session", "Simulation", "calibrate",
     "diagnose", "load_calibration", "simulate", "study_json", "sweep_point", "sweep_point_json",
     "sweep_points", "write_csv",

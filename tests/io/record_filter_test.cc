@@ -312,8 +312,10 @@ TEST(RecordFilter, DecodedInThePassAsFromBodiesOnDamagedLogs) {
         const ULog kept = ParseULog(b.data(), b.size(), "damaged", Px4SessionTopics());
         EXPECT_EQ(all.MessageCounts(), kept.MessageCounts());
         EXPECT_EQ(all.warnings.Describe(), kept.warnings.Describe());
-        EXPECT_EQ(ImuText(all, ULogImuStreams, ULogSession),
-                  ImuText(kept, ULogImuStreams, ULogSession));
+        const auto session = [](const ULog& log, const FlightLogSelection& pick) {
+          return ULogSession(log, pick);
+        };
+        EXPECT_EQ(ImuText(all, ULogImuStreams, session), ImuText(kept, ULogImuStreams, session));
       } else {
         const DataflashLog all = ParseDataflash(b.data(), b.size(), "damaged");
         const DataflashLog kept =

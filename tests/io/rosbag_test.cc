@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "io/io_test_util.h"
 #include "io/rosbag_builder.h"
 #include "plumb/core/error.h"
 #include "plumb/io/input/flight_log_file.h"
@@ -327,6 +328,47 @@ TEST(RosBag, SessionClockFrameAndGyroNotGiven) {
   EXPECT_EQ(RosBagSession(b, pick).series.size(), 6u);
   pick.from_s = kSec + 500.0;
   EXPECT_THROW(RosBagSession(b, pick), InputError);
+}
+
+TEST(RosBag, FlightLogReadsTheBagsOtherImuTopics) {
+  // FlightLogSelection::other_imus: a bag's instance k is its IMU topic k, read on the clock
+  // and window of IMU 0 (here the topic /b, instance 1, by name).
+  std::string bytes = RosBagStart();
+  bytes += RosChunkRecord("lz4", ImuRecords(0, "/a", 20) + ImuRecords(1, "/b", 10));
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "two.bag").string();
+  {
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  const FlightLog log = FlightLog::Open(path);
+  EXPECT_EQ(BoardInstances(log.Summary(), 1), std::vector<int>{0});
+  FlightLogSelection pick;
+  pick.stream = "/b";
+  pick.receive_time = true;
+  pick.other_imus = {0};
+  const Session s = log.Select(pick);
+  ASSERT_EQ(s.other_imus.size(), 1u);
+  const BoardImu& a = s.other_imus[0];
+  EXPECT_EQ(a.instance, 0);
+  EXPECT_EQ(a.name, "/a");
+  FlightLogSelection alone;
+  alone.stream = "/a";
+  alone.receive_time = true;
+  const Session expected = log.Select(alone);
+  EXPECT_EQ(a.series.t_s, expected.series.t_s);
+  EXPECT_EQ(a.series.acc, expected.series.acc);
+  EXPECT_DOUBLE_EQ(a.series.t_s[0], kSec + 1 + 5e-6);  // the record time, not the stamp
+  EXPECT_EQ(s.series.size(), 10u);
+  pick.other_imus = {1};  // /b is IMU 0
+  try {
+    log.Select(pick);
+    ADD_FAILURE() << "/b listed as another IMU";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("IMU instance 1 is IMU 0"), std::string::npos) << e.what();
+  }
+  pick.other_imus = {2};
+  EXPECT_THROW(log.Select(pick), InputError);
 }
 
 TEST(RosBag, FlightLogAndOpenInputsReadABagFile) {

@@ -350,6 +350,55 @@ class Pickling(unittest.TestCase):
             self.assertEqual(getattr(u, name), getattr(s, name), name)
         np.testing.assert_array_equal(u.temp, s.temp)
 
+    def test_the_boards_other_imus_are_exposed_and_round_trip(self):
+        # A native CSV with IMU 1 (accelerometer, gyroscope, temperature) and IMU 2
+        # (accelerometer only) on IMU 0's time column (SPEC 6, "Several IMUs of one board").
+        path = out("board.csv")
+        with open(path, "w") as f:
+            f.write("time_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,acc1_x,acc1_y,acc1_z,"
+                    "gyr1_x,gyr1_y,gyr1_z,temp1_c,acc2_x,acc2_y,acc2_z\n")
+            for i in range(5):
+                f.write(f"{0.01 * i},0.1,0.2,-9.8,0.001,0.002,0.003,"
+                        f"{i},0.5,-9.75,0.01,0.02,{0.03 * i},30.25,4,5,-9.5\n")
+        s = plumb.open(path)
+        self.assertEqual(len(s), 5)
+        imus = s.other_imus
+        self.assertEqual([(b.instance, b.name, len(b)) for b in imus],
+                         [(1, "acc1_x..", 5), (2, "acc2_x..", 5)])
+        self.assertIsInstance(imus[0], plumb.BoardImu)
+        np.testing.assert_array_equal(imus[0].acc[:, 0], np.arange(5, dtype=np.float32))
+        np.testing.assert_array_equal(imus[0].temp, np.full(5, 30.25, dtype=np.float32))
+        np.testing.assert_array_equal(imus[0].time, s.time)
+        self.assertTrue(imus[0].has_gyro)
+        self.assertFalse(imus[1].has_gyro)
+        self.assertEqual(imus[1].gyr.shape, (0, 3))
+        self.assertIsNone(imus[1].temp)
+        self.assertEqual(imus[1].firmware_left, [])
+        self.assertFalse(imus[0].acc.flags.writeable)
+        acc = imus[0].acc
+        del s, imus  # the view keeps the session's storage alive
+        np.testing.assert_array_equal(acc[:, 0], np.arange(5, dtype=np.float32))
+        s = plumb.open(path)
+        u = pickle.loads(pickle.dumps(s))
+        self.assertEqual(len(u.other_imus), 2)
+        for a, b in zip(u.other_imus, s.other_imus):
+            self.assertEqual((a.instance, a.name, a.firmware_left, a.acc_unit, a.gyr_unit),
+                             (b.instance, b.name, b.firmware_left, b.acc_unit, b.gyr_unit))
+            for name in ["time", "acc", "gyr"]:
+                np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+                self.assertEqual(getattr(a, name).dtype, getattr(b, name).dtype)
+            self.assertEqual(a.temp is None, b.temp is None)
+        np.testing.assert_array_equal(u.other_imus[0].temp, s.other_imus[0].temp)
+        # Written back, the unpickled session reads as the file did.
+        again = out("board_again.csv")
+        plumb.write_csv(u, again)
+        self.assertEqual([(b.name, b.acc.tolist(), b.gyr.tolist()) for b in plumb.open(again).other_imus],
+                         [(b.name, b.acc.tolist(), b.gyr.tolist()) for b in s.other_imus])
+        # A session without other IMUs has an empty list, pickled or not.
+        m, _ = mikoff()
+        self.assertEqual(m.other_imus, [])
+        self.assertEqual(pickle.loads(pickle.dumps(m)).other_imus, [])
+
     def test_result_round_trip(self):
         s, r = mikoff()
         u = pickle.loads(pickle.dumps(r))

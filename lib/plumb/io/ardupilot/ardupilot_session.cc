@@ -139,12 +139,14 @@ std::optional<SiteInput> SiteFromDataflash(const DataflashLog& log) {
   return MedianSite(std::move(lats), std::move(lngs), std::move(alts));
 }
 
-Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection) {
+Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection,
+                         ImuStreamInfo* chosen) {
   if (selection.imu < 0) throw Error("ArdupilotSession: the IMU instance must be >= 0");
   ImuStreamInfo info;
   Session s;
   // Throws when absent, gyro-only or empty; the stream's samples are decoded once.
   s.series = DataflashStream(log, selection, &info);
+  if (chosen != nullptr) *chosen = info;
   const std::string stream = info.name;
   const int instance = info.instance;
   const std::string label = stream + " of IMU instance " + std::to_string(instance);

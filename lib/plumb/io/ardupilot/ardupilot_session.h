@@ -49,7 +49,9 @@ std::vector<LogMotion> DataflashMotion(const DataflashLog& log, double t_end_s);
 /// The session of one IMU stream of a decoded log (see DataflashStream for the selection and
 /// ArdupilotSession's file comment for the undo). Throws plumb::InputError naming the log when
 /// the stream is absent or gyroscope-only, or the window holds fewer than 2 samples.
-Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection);
+/// `chosen` (optional): set to the description of the stream read (its name and instance).
+Session ArdupilotSession(const DataflashLog& log, const FlightLogSelection& selection,
+                         ImuStreamInfo* chosen = nullptr);
 
 /// Compatibility: the default stream of options.imu (same as the selection with stream "").
 Session ArdupilotSession(const DataflashLog& log, const ArdupilotSessionOptions& options);

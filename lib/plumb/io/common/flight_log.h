@@ -66,6 +66,13 @@ struct FlightLogSelection {
   std::optional<double> from_s;  ///< keep samples at or after this log time, s
   std::optional<double> to_s;    ///< keep samples at or before this log time, s
   bool undo_correction = true;   ///< recover the sensor's own output from the log's parameters
+  /// The board's other IMUs to read besides `imu` (Session::other_imus; SPEC "Several IMUs of
+  /// one board"): sensor instances, 0-based, in the order given, each read from the reader's
+  /// default stream for that instance (as `imu` = k with an empty `stream` picks it; for a ROS
+  /// bag, the IMU topic of index k) with the same window, clock and undo_correction as IMU 0.
+  /// Each at most once, none equal to IMU 0's instance. Empty: IMU 0 alone. FlightLog::Select
+  /// reads them; the formats' own session functions (ArdupilotSession, ...) ignore them.
+  std::vector<int> other_imus;
 };
 
 /// A flight log's contents as `plumb info` shows them.

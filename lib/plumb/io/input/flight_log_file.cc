@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -155,6 +156,42 @@ FlightLogSummary FlightLog::Summary() const {
   throw Error("FlightLog::Summary: no log");
 }
 
+std::vector<int> BoardInstances(const FlightLogSummary& summary, int imu0) {
+  std::vector<int> out;
+  for (const ImuStreamInfo& i : summary.imus) {
+    if (i.instance != imu0 && i.samples >= 2 && i.has_accel) out.push_back(i.instance);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+namespace {
+
+/// Throws plumb::Error when `instances` (FlightLogSelection::other_imus) lists one twice or
+/// lists `imu0`, IMU 0's instance (the board's IMUs are each read once).
+void CheckBoardInstances(const std::string& source, const std::vector<int>& instances,
+                         int imu0) {
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    const std::string k = std::to_string(instances[i]);
+    if (instances[i] < 0) throw Error(source + ": board IMU instance " + k + " must be >= 0");
+    if (instances[i] == imu0) {
+      throw Error(source + ": IMU instance " + k +
+                  " is IMU 0 (the body frame); list only the board's other IMUs");
+    }
+    if (std::find(instances.begin(), instances.begin() + static_cast<std::ptrdiff_t>(i),
+                  instances[i]) != instances.begin() + static_cast<std::ptrdiff_t>(i)) {
+      throw Error(source + ": IMU instance " + k + " is listed twice among the board's IMUs");
+    }
+  }
+}
+
+bool SameNotice(const Notice& a, const Notice& b) {
+  return a.code == b.code && a.message == b.message;
+}
+
+}  // namespace
+
 Session FlightLog::Select(const FlightLogSelection& selection) const {
   if (selection.receive_time && !IsRosBag(format_)) {
     throw InputError(source_, "",
@@ -162,18 +199,62 @@ Session FlightLog::Select(const FlightLogSelection& selection) const {
                          OptionText(Option::kClock, "receive") + " is for ROS bags)",
                      {Option::kClock});
   }
+  ImuStreamInfo imu0;
+  Session s = SelectStream(selection, &imu0);
+  CheckBoardInstances(source_, selection.other_imus, imu0.instance);
+  const std::vector<Notice> shared = s.warnings;  // IMU 0's: what the log says of every stream
+  for (const int instance : selection.other_imus) {
+    s.other_imus.push_back(SelectBoardImu(selection, instance, shared, &s.warnings));
+  }
+  return s;
+}
+
+BoardImu FlightLog::SelectBoardImu(const FlightLogSelection& imu0, int instance,
+                                   const std::vector<Notice>& shared,
+                                   std::vector<Notice>* warnings) const {
+  FlightLogSelection one = imu0;  // the same window, clock and undo_correction
+  one.imu = instance;
+  one.stream.clear();  // the reader's default stream of the instance
+  one.other_imus.clear();
+  if (IsRosBag(format_)) {  // a bag's instance k is its IMU topic k (imu 0 picks no topic)
+    const auto& topics = std::get<RosBag>(log_).imu_topics;
+    if (static_cast<std::size_t>(instance) < topics.size()) {
+      one.stream = topics[static_cast<std::size_t>(instance)].topic;
+    }
+  }
+  ImuStreamInfo info;
+  Session s = SelectStream(one, &info);
+  BoardImu out;
+  out.instance = instance;
+  out.name = info.name;
+  out.series = std::move(s.series);
+  out.firmware_left = std::move(s.firmware_left);
+  const std::string who = "IMU instance " + std::to_string(instance) + " (" + info.name + "): ";
+  for (Notice& n : s.warnings) {
+    const auto same = [&n](const Notice& m) { return SameNotice(n, m); };
+    if (std::any_of(shared.begin(), shared.end(), same)) continue;  // said once, for IMU 0
+    // The readers name the stream and instance in most of their messages ("IMU2 of IMU
+    // instance 1: ..."); the others are prefixed with them.
+    if (n.message.find(info.name) == std::string::npos) n.message = who + n.message;
+    warnings->push_back(std::move(n));
+  }
+  return out;
+}
+
+Session FlightLog::SelectStream(const FlightLogSelection& selection,
+                                ImuStreamInfo* chosen) const {
   switch (format_) {
     case FlightLogFormat::kDataflashBinary:
     case FlightLogFormat::kDataflashText:
-      return ArdupilotSession(std::get<DataflashLog>(log_), selection);
+      return ArdupilotSession(std::get<DataflashLog>(log_), selection, chosen);
     case FlightLogFormat::kMavlinkTlog:
-      return TlogSession(std::get<MavlinkLog>(log_), selection);
+      return TlogSession(std::get<MavlinkLog>(log_), selection, chosen);
     case FlightLogFormat::kPx4ULog:
-      return ULogSession(std::get<ULog>(log_), selection);
+      return ULogSession(std::get<ULog>(log_), selection, chosen);
     case FlightLogFormat::kRosBag:
     case FlightLogFormat::kRos2Mcap:
     case FlightLogFormat::kRos2Db3:
-      return RosBagSession(std::get<RosBag>(log_), selection);
+      return RosBagSession(std::get<RosBag>(log_), selection, chosen);
     case FlightLogFormat::kNone:
       break;
   }

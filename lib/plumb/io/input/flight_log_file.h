@@ -10,6 +10,7 @@
 
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "plumb/core/session.h"
 #include "plumb/io/ardupilot/dataflash.h"
@@ -47,6 +48,12 @@ FlightLogFormat SniffFlightLog(const std::string& path);
 /// kNone).
 const char* FlightLogFormatName(FlightLogFormat format);
 
+/// The instances `--imus all` reads besides IMU 0 (SPEC "Several IMUs of one board"): every
+/// instance of summary.imus other than `imu0` with a stream of at least 2 samples that carries
+/// accelerometer samples, ascending, each once. A declared stream without samples (an IMU3
+/// format in a log that wrote no IMU3 record) is not one.
+std::vector<int> BoardInstances(const FlightLogSummary& summary, int imu0);
+
 /// A decoded flight log of any supported format.
 class FlightLog {
  public:
@@ -67,10 +74,21 @@ class FlightLog {
   /// selection.undo_correction and the log says what it was (the session's warnings say which
   /// inputs were raw and which reconstructed), the site from the log's GPS. Throws
   /// plumb::InputError naming the log when the stream is absent or holds too few samples.
+  /// selection.other_imus: Session::other_imus, one BoardImu per instance in that order, read
+  /// as IMU 0 is (window, clock, undo_correction); their warnings join the session's, each
+  /// prefixed "IMU instance k (STREAM): " (those the log's reading gives every stream, said
+  /// once). Throws plumb::InputError naming the log and the instance when one is absent or
+  /// holds too few samples, plumb::Error when one is listed twice or is IMU 0's.
   Session Select(const FlightLogSelection& selection) const;
 
  private:
   FlightLog() = default;
+  /// The session of one stream (selection.other_imus not read), and that stream's description.
+  Session SelectStream(const FlightLogSelection& selection, ImuStreamInfo* chosen) const;
+  /// The board's IMU `instance` read as `imu0` (the selection of IMU 0) says; its warnings
+  /// that `shared` (IMU 0's) lacks appended to `warnings`, prefixed with the instance.
+  BoardImu SelectBoardImu(const FlightLogSelection& imu0, int instance,
+                          const std::vector<Notice>& shared, std::vector<Notice>* warnings) const;
   FlightLogFormat format_ = FlightLogFormat::kNone;
   std::string source_;
   std::variant<DataflashLog, MavlinkLog, ULog, RosBag> log_;

@@ -450,7 +450,8 @@ std::map<std::string, double> TlogParams(const MavlinkLog& log) {
   return params;
 }
 
-Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) {
+Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection,
+                    ImuStreamInfo* chosen_info) {
   if (selection.imu < 0) throw Error("TlogSession: the IMU instance must be >= 0");
   const std::optional<MavlinkVehicle> vehicle = TlogVehicle(log);
   if (!vehicle) {
@@ -476,6 +477,7 @@ Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection) 
   }
   const StreamData& d = streams[static_cast<std::size_t>(chosen)];
   const ImuStreamInfo& info = infos[static_cast<std::size_t>(chosen)];
+  if (chosen_info != nullptr) *chosen_info = info;
   const Units units = StreamUnits(d.kind, ardupilot);
 
   Session s;

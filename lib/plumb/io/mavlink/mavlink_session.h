@@ -93,7 +93,9 @@ std::map<std::string, double> TlogParams(const MavlinkLog& log);
 /// say which message the samples came from, in which units, what was reconstructed and what
 /// taken as logged, plus the reader's own warnings. Throws plumb::InputError naming the log
 /// when the stream is absent or the window holds fewer than 2 samples.
-Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection);
+/// `chosen` (optional): set to the description of the stream read (its name and instance).
+Session TlogSession(const MavlinkLog& log, const FlightLogSelection& selection,
+                    ImuStreamInfo* chosen = nullptr);
 
 /// The log as `plumb info` shows it: format "mavlink-tlog", format_detail "MAVLink v1 N
 /// frames, v2 M frames (K signed), C CRC-checked, autopilot A (system S, component C)" (the

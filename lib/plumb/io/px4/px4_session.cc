@@ -522,7 +522,8 @@ std::map<std::string, double> ULogParams(const ULog& log) {
   return out;
 }
 
-Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
+Session ULogSession(const ULog& log, const FlightLogSelection& selection,
+                    ImuStreamInfo* chosen_info) {
   // The candidates: the sources of the instance (and the stream) selected, the only ones whose
   // samples are decoded (Select looks at no other).
   std::vector<StreamSource> sources;
@@ -552,6 +553,7 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection) {
                                          " stream (sensor_combined, vehicle_imu or sensor_accel)");
   }
   const auto chosen = static_cast<std::size_t>(src - sources.data());
+  if (chosen_info != nullptr) *chosen_info = infos[chosen];
   Session s;
   s.source = log.source + " (" + KindName(src->kind) + " instance " +
              std::to_string(src->instance) + ")";

@@ -68,7 +68,9 @@ std::map<std::string, double> ULogParams(const ULog& log);
 /// increase are dropped. Warnings say which inputs were taken raw and which were
 /// reconstructed, with the parameter values. Throws plumb::InputError naming the log when the
 /// stream is absent or the window holds fewer than 2 samples.
-Session ULogSession(const ULog& log, const FlightLogSelection& selection);
+/// `chosen` (optional): set to the description of the stream read (its name and instance).
+Session ULogSession(const ULog& log, const FlightLogSelection& selection,
+                    ImuStreamInfo* chosen = nullptr);
 
 /// The log as `plumb info` shows it: format "px4-ulog", format_detail "ULog version N, K
 /// subscriptions[, data appended at M offset(s)]", the IMU streams, the GPS site, ULogParams(),

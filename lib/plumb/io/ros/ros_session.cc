@@ -155,7 +155,8 @@ std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag) {
   return out;
 }
 
-Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection) {
+Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection,
+                      ImuStreamInfo* chosen_info) {
   const std::size_t chosen = Choose(bag, selection);
   const RosImuTopic& t = bag.imu_topics[chosen];
   if (!t.samples.empty() && t.acc_not_given == t.samples.size()) {
@@ -165,6 +166,7 @@ Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection) {
   }
   Extracted e = Extract(t, selection.receive_time);
   const ImuStreamInfo info = Describe(t, static_cast<int>(chosen), e.series, e.left_out);
+  if (chosen_info != nullptr) *chosen_info = info;
   Session s;
   s.source = bag.source + " (" + t.topic + ")";
   for (const std::string& w : bag.warnings.Describe()) {

@@ -43,7 +43,9 @@ std::vector<ImuStreamInfo> RosBagImuStreams(const RosBag& bag);
 /// the topic is absent (listing the IMU topics), when several IMU topics and none is named
 /// (pointing to Option::kTopic), when the topic gives no linear_acceleration, or when the
 /// window holds fewer than 2 samples.
-Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection);
+/// `chosen` (optional): set to the description of the stream read (its name and instance).
+Session RosBagSession(const RosBag& bag, const FlightLogSelection& selection,
+                      ImuStreamInfo* chosen = nullptr);
 
 /// The bag as `plumb info` shows it: format RosBagFormatName(bag.kind), format_detail "ROS bag
 /// 2.0, N chunks (bz2 4), K connections, indexed", "MCAP, N chunks (zstd N), K channels" or
