@@ -49,7 +49,7 @@ class CalibrateCommand : public Command {
                                  "still poses joined by turns");
     app_->footer("Example (the bundled session: the result as JSON and ArduPilot parameters):\n  plumb calibrate data/mikoff/imu0.log --columns ax,ay,az,gx,gy,gz --rate 100 --json cal.json --export ardupilot=cal.param");
     CalibrateArgs& a = args_;
-    AddInputOptions(app_, a.input);
+    AddInputOptions(app_, a.input, true);
     app_->add_option("--method", a.method,
                      "Calibration method: generalized (least squares), or the seed paper's "
                      "procedures as printed: paper-benchmark (section 4, six poses and turns "

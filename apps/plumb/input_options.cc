@@ -4,11 +4,13 @@
 
 #include <array>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
 #include <optional>
 #include <sstream>
+#include <system_error>
 
 #include "commands.h"
 #include "plumb/core/error.h"
@@ -54,6 +56,31 @@ bool TableOptionsGiven(const InputArgs& args) {
   return false;
 }
 
+/// --imus into `o` (io::InputOptions::all_imus, FlightLogSelection::imu and other_imus): "all",
+/// or instances of which the first is IMU 0 (--imu, if given, must agree).
+void SetBoard(const InputArgs& a, io::InputOptions& o) {
+  if (a.imus.empty()) return;
+  if (a.imus == "all") {
+    o.all_imus = true;
+    return;
+  }
+  std::vector<int> instances;
+  for (const std::string& field : io::SplitList(a.imus, ',')) {
+    int k = -1;
+    const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), k);
+    if (error != std::errc() || end != field.data() + field.size() || k < 0) {
+      throw UsageError("--imus " + a.imus + ": give 'all' or instances as 0,1,2 (0-based)");
+    }
+    instances.push_back(k);
+  }
+  if (a.imu_given != nullptr && a.imu_given->count() > 0 && a.imu != instances.front()) {
+    throw UsageError("--imu " + std::to_string(a.imu) + " and --imus " + a.imus +
+                     " name different IMUs 0; give one");
+  }
+  o.flight_log.imu = instances.front();
+  o.flight_log.other_imus.assign(instances.begin() + 1, instances.end());
+}
+
 /// The library's options from the flags, with `before_read` refusing, input by input, what the
 /// command line does not accept for that kind of input: a malformed INPUT, the two-file form
 /// with --format native, --format table without --columns, malformed table flags when a table
@@ -85,6 +112,7 @@ io::InputOptions MakeInputOptions(const InputArgs& a, const std::vector<std::str
   o.acc.offset = a.acc_offset;
   o.gyr.offset = a.gyr_offset;
   o.flight_log.imu = a.imu;
+  SetBoard(a, o);
   // --topic names a ROS bag's topic, --stream a log's message or topic: the library keeps
   // either in FlightLogSelection::stream (a bag's streams are its topics).
   if (!a.topic.empty() && !a.stream.empty() && a.topic != a.stream) {
@@ -139,7 +167,7 @@ void AddInputFiles(const InputArgs& args, FileRoles& roles) {
   if (!args.gyr_file.empty()) roles.inputs.push_back({"--gyr", args.gyr_file});
 }
 
-void AddInputOptions(CLI::App* app, InputArgs& a) {
+void AddInputOptions(CLI::App* app, InputArgs& a, bool board) {
   app->add_option("INPUT", a.inputs,
                   "Input files: plumb's native CSV, a text table (see --columns), an "
                   "accelerometer and a gyroscope table as acc.txt,gyr.txt, or a flight log: "
@@ -149,9 +177,18 @@ void AddInputOptions(CLI::App* app, InputArgs& a) {
   auto* logs = app->add_option_group(
       "Flight logs", "Reading an ArduPilot .bin/.log, MAVLink .tlog or PX4 .ulg log, or a ROS "
                      "bag (`plumb info LOG` lists its IMU streams)");
-  logs->add_option("--imu", a.imu, "IMU instance of the log, 0-based (IMU = 0, IMU2 = 1, ...)")
-      ->check(NonNegative)
-      ->capture_default_str();
+  a.imu_given =
+      logs->add_option("--imu", a.imu, "IMU instance of the log, 0-based (IMU = 0, IMU2 = 1, ...)")
+          ->check(NonNegative)
+          ->capture_default_str();
+  if (board) {
+    logs->add_option("--imus", a.imus,
+                     "The board's IMUs fitted together (one input: a flight log, or a native "
+                     "CSV with acc1_x.. columns): 'all', or instances as 0,1,2, the first "
+                     "IMU 0, whose accelerometer defines the body frame; the still attitudes "
+                     "are shared, each IMU has its model and its rotation into the body")
+        ->type_name("all|K,K,...");
+  }
   logs->add_option("--stream", a.stream,
                    "IMU stream (message or topic) of that instance, as `plumb info` names it, "
                    "e.g. IMU, ACC+GYR, ISBD_ACC, SCALED_IMU2, sensor_combined, vehicle_imu, "

@@ -58,6 +58,10 @@ struct InputArgs {
   CLI::Option* from = nullptr;
   CLI::Option* to = nullptr;
   bool as_logged = false;          ///< --as-logged: keep the firmware's correction
+  /// --imus (commands that fit the board, AddInputOptions's `board`): "all", or instances
+  /// "0,1,2" (the first is IMU 0); empty: IMU 0 alone.
+  std::string imus;
+  CLI::Option* imu_given = nullptr;  ///< --imu, to tell it from its default
   /// --max-memory: bytes the run may use (SIZE: 1e6, 500M, 2G, 2GiB); 0 = the memory the
   /// system says is available (MemAvailable).
   std::uint64_t max_memory = 0;
@@ -66,8 +70,9 @@ struct InputArgs {
   std::vector<CLI::Option*> table_only;
 };
 
-/// Registers INPUT... and every input option on `app`.
-void AddInputOptions(CLI::App* app, InputArgs& args);
+/// Registers INPUT... and every input option on `app`; with `board`, --imus too (the commands
+/// that fit the board's IMUs together, SPEC 6).
+void AddInputOptions(CLI::App* app, InputArgs& args, bool board = false);
 
 /// Adds the files INPUT..., --acc and --gyr name to `roles`' inputs (file_roles.h).
 void AddInputFiles(const InputArgs& args, FileRoles& roles);

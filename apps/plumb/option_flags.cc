@@ -36,6 +36,7 @@ const char* Flag(Option option) {
     case Option::kTruthJson: return "'plumb simulate --truth-json'";
     case Option::kTopic: return "--topic";
     case Option::kClock: return "--clock";
+    case Option::kImus: return "--imus";
   }
   return "";
 }

@@ -33,6 +33,7 @@ const char* Keyword(Option option) {
     case Option::kCalibrationJson: return "Result.save";
     case Option::kTopic: return "topic";
     case Option::kClock: return "clock";
+    case Option::kImus: return "imus";
     case Option::kNoiseFrom:
     case Option::kExport:
     case Option::kExportUndetermined:

@@ -6,6 +6,8 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <utility>
 #include <map>
@@ -14,6 +16,9 @@
 #include "plumb/core/so3.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/fitted_problem.h"
+#include "plumb/geo/site.h"
+#include "plumb/io/input/flight_log_file.h"
+#include "plumb/segmentation/still_detector.h"
 #include "plumb/model/board_mount.h"
 #include "plumb/report/calibration_text.h"
 #include "plumb/report/json_report.h"
@@ -229,6 +234,31 @@ TEST(BoardFit, CalibrateBoardReportsEveryImu) {
   const std::string text = report::FullReport(r);
   EXPECT_NE(text.find("imu2, fitted with IMU 0"), std::string::npos) << text;
   EXPECT_NE(text.find("imu2.rotation.z"), std::string::npos) << text;
+}
+
+// A real board (SPEC 6's check): plane408's IMU and IMU2 still on the bench, one pose. Gravity
+// alone cannot show a turn about itself, so the analysis names IMU2's rotation about the
+// vertical among what the data cannot determine.
+TEST(BoardFit, ARealBoardStillInOnePoseCannotShowItsYaw) {
+  const std::string path = std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane408_centre_point.BIN";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  const io::FlightLog log = io::FlightLog::Open(path);
+  io::FlightLogSelection pick;
+  pick.other_imus = {1};
+  const Session s = log.Select(pick);
+  ASSERT_EQ(s.other_imus.size(), 1u);
+  const auto segments = segmentation::DetectStillSegments(s.series, {}).segments;
+  model::Model m = model::Model::Parse("base");
+  m.t_ref_s = s.series.t_s.front();
+  const geo::Site site = geo::ResolveSite(std::nullopt, s.site, std::nullopt);
+  const CalibrationResult r = CalibrateBoard(s.series, s.other_imus, segments, m, site);
+  if (std::getenv("PLUMB_PRINT")) std::cout << report::FullReport(r);
+  ASSERT_EQ(r.calibration.board.size(), 1u);
+  bool yaw_named = false;
+  for (const std::string& u : r.calibration.observability.unobservable) {
+    yaw_named = yaw_named || u.find("imu1.rotation.z") != std::string::npos;
+  }
+  EXPECT_TRUE(yaw_named) << report::FullReport(r);
 }
 
 }  // namespace

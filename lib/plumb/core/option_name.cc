@@ -42,6 +42,7 @@ std::string LibraryName(Option option) {
     case Option::kTruthJson: return "the plumb command's simulate";
     case Option::kTopic: return "FlightLogSelection::stream (a ROS bag's topic)";
     case Option::kClock: return "InputOptions::clock";
+    case Option::kImus: return "InputOptions::all_imus (FlightLogSelection::other_imus)";
   }
   return "an option";
 }

@@ -46,6 +46,7 @@ enum class Option {
   kTruthJson,           ///< the truth file of the command `plumb simulate` (no library call)
   kTopic,               ///< FlightLogSelection::stream, a ROS bag's sensor_msgs/Imu topic
   kClock,               ///< InputOptions::clock, which clock the times follow
+  kImus,                ///< InputOptions::all_imus / FlightLogSelection::other_imus, the board's IMUs
 };
 
 /// The option's library name: the C++ field or argument, e.g. "CalibrationOptions::max_iterations".

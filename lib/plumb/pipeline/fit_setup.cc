@@ -50,7 +50,8 @@ FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResu
 
 estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit) {
   try {
-    return estimation::Calibrate(session.series, fit.segments, fit.model, fit.site, fit.options);
+    return estimation::CalibrateBoard(session.series, session.other_imus, fit.segments, fit.model,
+                                      fit.site, fit.options);
   } catch (const Error& e) {
     const std::vector<estimation::Gate> gates =
         estimation::CheckSamples(session.series, fit.segments);

@@ -72,9 +72,10 @@ struct FitSetup {
 FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResult& segmentation,
                     FitRequest request);
 
-/// estimation::Calibrate on the session with `fit`. When it throws plumb::Error, the error
-/// also lists the samples' gates (estimation::CheckSamples: samples out of range, a saturated
-/// axis), often the reason, as "gate failed: NAME: SOURCE: MESSAGE" lines.
+/// estimation::CalibrateBoard on the session (IMU 0 with Session::other_imus, the board's IMUs
+/// the input was asked for; none: estimation::Calibrate) with `fit`. When it throws
+/// plumb::Error, the error also lists the samples' gates (estimation::CheckSamples: samples out
+/// of range, a saturated axis), often the reason, as "gate failed: NAME: SOURCE: MESSAGE" lines.
 estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit);
 
 /// "the fit of SOURCE failed a gate (name)" / "... failed N gates (names)": for errors and

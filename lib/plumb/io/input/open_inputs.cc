@@ -141,12 +141,11 @@ InputKind KindOf(const InputFile& input, const InputOptions& o) {
   return InputKind::kNativeCsv;
 }
 
-/// The samples of a text session inside the time window [from_s, to_s] (the file's own times:
-/// its time column, or the clock InputOptions::rate_hz gives), as a flight log's reader keeps its window.
-/// Throws InputError naming the file when fewer than 2 samples are left.
-void KeepWindow(Session& s, const FlightLogSelection& window) {
+/// The samples of `in` inside the time window [from_s, to_s] (the file's own times: its time
+/// column, or the clock InputOptions::rate_hz gives), as a flight log's reader keeps its
+/// window. Throws InputError naming `source` when fewer than 2 samples are left.
+void KeepWindow(ImuSeries& in, const FlightLogSelection& window, const std::string& source) {
   if (!window.from_s && !window.to_s) return;
-  ImuSeries& in = s.series;
   if (in.empty()) return;
   const double t_start = in.t_s.front(), t_end = in.t_s.back();
   ImuSeries out;
@@ -161,14 +160,48 @@ void KeepWindow(Session& s, const FlightLogSelection& window) {
     if (in.has_temperature()) out.temp_c.push_back(in.temp_c[i]);
   }
   if (out.size() < 2) {
-    throw InputError(s.source, "", EmptyWindowMessage(window.from_s, window.to_s, t_start, t_end));
+    throw InputError(source, "", EmptyWindowMessage(window.from_s, window.to_s, t_start, t_end));
   }
   in = std::move(out);
 }
 
+/// Whether `o` asks for the board's other IMUs.
+bool BoardAsked(const InputOptions& o) { return o.all_imus || !o.flight_log.other_imus.empty(); }
+
+/// A native CSV's board as `o` asks for it (InputOptions::all_imus): every other IMU, the
+/// instances listed in their order, or none.
+void ChooseNativeBoard(Session& s, const InputOptions& o) {
+  if (o.all_imus) return;
+  if (BoardAsked(o) && o.flight_log.imu != 0) {
+    throw InputError(s.source, "",
+                     "a native CSV's IMU 0 is its acc_x.. columns: list it first (0," +
+                         std::to_string(o.flight_log.imu) + ")");
+  }
+  std::vector<BoardImu> chosen;
+  for (const int k : o.flight_log.other_imus) {
+    const auto it = std::find_if(s.other_imus.begin(), s.other_imus.end(),
+                                 [k](const BoardImu& b) { return b.instance == k; });
+    if (it == s.other_imus.end()) {
+      throw InputError(s.source, "",
+                       "no IMU " + std::to_string(k) + " (columns acc" + std::to_string(k) +
+                           "_x..): the file has " + std::to_string(s.other_imus.size() + 1) +
+                           " IMU(s)");
+    }
+    chosen.push_back(*it);
+  }
+  s.other_imus = std::move(chosen);
+}
+
 Session Read(const InputFile& input, InputKind kind, const InputOptions& o) {
+  if (BoardAsked(o) && kind != InputKind::kFlightLog && kind != InputKind::kNativeCsv) {
+    throw InputError(input.path, "",
+                     "only a flight log or plumb's native CSV carries several IMUs (" +
+                         OptionText(Option::kImus) + ")",
+                     {Option::kImus});
+  }
   const auto windowed = [&](Session s) {
-    KeepWindow(s, o.flight_log);
+    KeepWindow(s.series, o.flight_log, s.source);
+    for (BoardImu& b : s.other_imus) KeepWindow(b.series, o.flight_log, s.source + " " + b.name);
     return s;
   };
   switch (kind) {
@@ -182,14 +215,18 @@ Session Read(const InputFile& input, InputKind kind, const InputOptions& o) {
     case InputKind::kFlightLog: {
       FlightLogSelection selection = o.flight_log;
       if (o.clock == Clock::kReceive) selection.receive_time = true;
-      return FlightLog::Open(input.path, o.run_jobs).Select(selection);
+      const FlightLog log = FlightLog::Open(input.path, o.run_jobs);
+      if (o.all_imus) selection.other_imus = BoardInstances(log.Summary(), selection.imu);
+      return log.Select(selection);
     }
     case InputKind::kTextTable:
       return windowed(ReadTextTable(input.path, TableOptions(o, false)));
     case InputKind::kNativeCsv:
       break;
   }
-  return windowed(ReadNative(input.path, o.format == InputFormat::kNative, o.not_native_hint));
+  Session s = ReadNative(input.path, o.format == InputFormat::kNative, o.not_native_hint);
+  ChooseNativeBoard(s, o);
+  return windowed(std::move(s));
 }
 
 /// Joins `next` after `joined`, keeping the clock when it increases.
@@ -229,30 +266,37 @@ void Append(Session& joined, Session next) {
 
 namespace {
 
-/// Replaces the session's stamps by the uniform clock fitted through them, and says so.
-void UseUniformClock(Session& s) {
-  const signal::TimeBase base = signal::AnalyseTimeBase(s.series.t_s);
+/// Replaces the stamps of `series` (of `s`, named `name`) by the uniform clock fitted through
+/// them, and says so in s's warnings.
+void UseUniformClock(Session& s, ImuSeries& series, const std::string& name) {
+  const signal::TimeBase base = signal::AnalyseTimeBase(series.t_s);
   if (base.kind == signal::ClockKind::kTooShort) {
     s.warnings.push_back(Notice{"clock_kept",
-                                s.source + ": too few samples (" + std::to_string(base.samples) +
+                                name + ": too few samples (" + std::to_string(base.samples) +
                                     ") to fit a uniform clock; the stamps are kept",
                                 {}});
     return;
   }
   if (base.kind == signal::ClockKind::kIrregular) {
     s.warnings.push_back(Notice{"clock_kept",
-                                s.source + ": no uniform clock fits these stamps (irregular "
+                                name + ": no uniform clock fits these stamps (irregular "
                                            "intervals, e.g. telemetry); the stamps are kept",
                                 {}});
     return;
   }
-  signal::ApplyUniformClock(base, s.series.t_s);
+  signal::ApplyUniformClock(base, series.t_s);
   std::ostringstream note;
-  note << std::setprecision(6) << s.source << ": times from a uniform " << base.rate_hz()
+  note << std::setprecision(6) << name << ": times from a uniform " << base.rate_hz()
        << " Hz clock fitted through the stamps (jitter RMS " << std::setprecision(3)
        << base.jitter_rms_s * 1e3 << " ms removed; " << base.dropped
        << " dropped samples kept as gaps)";
   s.warnings.push_back(Notice{"clock_uniform", note.str(), {}});
+}
+
+/// UseUniformClock on IMU 0 and every other IMU of the board.
+void UseUniformClock(Session& s) {
+  UseUniformClock(s, s.series, s.source);
+  for (BoardImu& b : s.other_imus) UseUniformClock(s, b.series, s.source + " " + b.name);
 }
 
 }  // namespace
@@ -267,6 +311,11 @@ double UnitFactor(GyrUnit unit) {
 
 Session OpenInputs(const std::vector<InputFile>& inputs, const InputOptions& options) {
   if (inputs.empty()) throw Error("OpenInputs: no input");
+  if (BoardAsked(options) && inputs.size() > 1) {
+    throw InputError(inputs[1].path, "",
+                     "the board's IMUs (" + OptionText(Option::kImus) + ") come from one input",
+                     {Option::kImus});
+  }
   std::vector<std::string> paths;
   for (const InputFile& input : inputs) {
     paths.push_back(input.path);

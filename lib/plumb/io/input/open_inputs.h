@@ -35,6 +35,10 @@
 // into body FRD axes. With the unit kCounts the values are taken as unscaled sensor counts
 // and the session's acc_unit / gyr_unit say "counts" (for every input, whatever its kind).
 //
+// The board's other IMUs (InputOptions::all_imus, FlightLogSelection::other_imus) come with
+// one input, a flight log or a native CSV, each on its own stamps, in the same window and
+// clock as IMU 0.
+//
 // Several inputs are joined one after the other into one session: a later input's times are
 // kept when they start after the previous input's last time, otherwise shifted to start 1000 s
 // after it (longer than any motion the calibrator integrates, so no motion is assumed between
@@ -179,6 +183,15 @@ struct InputOptions {
   /// The window (from_s, to_s) applies to every input, on its own times: a flight log's log
   /// time, a table's time column or the clock its rate gives (each file of several alike).
   FlightLogSelection flight_log;
+
+  // ---- The board's IMUs (SPEC 6, "Several IMUs of one board") ----
+  /// Every IMU the input has besides IMU 0 goes into Session::other_imus (a flight log's other
+  /// instances, FlightLogSelection::other_imus then ignored; a native CSV's acc{k}_x.. columns).
+  /// Otherwise flight_log.other_imus's instances (a native CSV's k), or none: IMU 0 alone, the
+  /// default (a native CSV's other columns are then dropped). A native CSV's IMU 0 is its
+  /// acc_x.. columns (flight_log.imu 0). Only one input, a flight log or native CSV, carries
+  /// several IMUs; asking them of any other is an InputError.
+  bool all_imus = false;
 
   // ---- Time ----
   /// Clock::kUniform replaces each input's stamps by its fitted uniform clock (said in the

@@ -1,0 +1,123 @@
+// The board's IMUs fitted together from the command line (issue 38, SPEC 6 --imus): a
+// simulated three-IMU board's native CSV and a real ArduPilot log with IMU and IMU2, as a
+// user meets them; and the inputs that cannot carry a board refused with the reason.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "run_tool.h"
+
+namespace plumb::cli {
+namespace {
+
+using nlohmann::json;
+using testing::Contains;
+using testing::Plumb;
+using testing::ReadJson;
+using testing::TempDir;
+using testing::ToolRun;
+
+/// `plumb simulate` of a three-IMU board (16 poses, white noise, a site) into `dir`: the CSV
+/// and its truth.
+std::pair<std::string, std::string> SimulateBoard(const TempDir& dir) {
+  const std::string csv = dir.File("board.csv"), truth = dir.File("truth.json");
+  const ToolRun run = Plumb({"simulate", "--out", csv, "--imus", "3", "--random-truth", "1",
+                             "--poses", "16", "--rate", "100", "--seed", "5", "--accel-rw", "0",
+                             "--gyro-rw", "0", "--accel-bi", "0", "--gyro-bi", "0",
+                             "--truth-json", truth, "--lat", "51.64", "--lon", "-1.2",
+                             "--height", "100"},
+                            dir);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return {csv, truth};
+}
+
+TEST(BoardCli, ASimulatedBoardsImusAreCalibratedTogether) {
+  TempDir dir;
+  const auto [csv, truth_path] = SimulateBoard(dir);
+  const std::string out = dir.File("cal.json");
+  const ToolRun run = Plumb({"calibrate", csv, "--imus", "all", "--constant-bias", "--json", out,
+                             "--lat", "51.64", "--lon", "-1.2", "--height", "100"},
+                            dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "imu2, fitted with IMU 0")) << run.out;
+  const json doc = ReadJson(out);
+  const json truth = ReadJson(truth_path);
+  ASSERT_EQ(doc["imus"].size(), 3u);
+  ASSERT_EQ(truth["imus"].size(), 3u);
+  for (std::size_t k = 1; k < 3; ++k) {
+    const json& imu = doc["imus"][k];
+    EXPECT_EQ(imu["instance"], static_cast<int>(k));
+    // Each rotation within 4 sigma of the truth, about every axis.
+    for (std::size_t a = 0; a < 3; ++a) {
+      const double value = imu["rotation"]["vector"][a];
+      const double sigma = imu["rotation"]["sigma"][a];
+      const double true_value = truth["imus"][k]["rotation"]["vector"][a];
+      EXPECT_LT(std::abs(value - true_value), 4.0 * sigma) << "imu" << k << " axis " << a;
+    }
+  }
+  const std::size_t n = doc["imus_covariance"]["parameters"].size();
+  EXPECT_EQ(doc["imus_covariance"]["matrix"].size(), n);
+  EXPECT_EQ(doc["imus_covariance"]["parameters"][n - 1], "imu2.time_offset");
+
+  // --imus 0,2: IMU 2 alone beside IMU 0.
+  const std::string two = dir.File("two.json");
+  const ToolRun pair = Plumb({"calibrate", csv, "--imus", "0,2", "--constant-bias", "--json",
+                              two, "--lat", "51.64", "--lon", "-1.2", "--height", "100"},
+                             dir);
+  ASSERT_EQ(pair.exit_code, 0) << pair.err;
+  const json doc2 = ReadJson(two);
+  ASSERT_EQ(doc2["imus"].size(), 2u);
+  EXPECT_EQ(doc2["imus"][1]["instance"], 2);
+  // Without --imus the file's other IMUs are not fitted: IMU 0 alone, as before.
+  const std::string alone = dir.File("alone.json");
+  ASSERT_EQ(Plumb({"calibrate", csv, "--constant-bias", "--json", alone}, dir).exit_code, 0);
+  EXPECT_FALSE(ReadJson(alone).contains("imus"));
+}
+
+TEST(BoardCli, WhatCannotCarryABoardIsRefusedWithTheReason) {
+  TempDir dir;
+  const auto [csv, truth] = SimulateBoard(dir);
+  // A native CSV's IMU 0 is its acc_x.. columns; IMU 7 is not in the file.
+  ToolRun run = Plumb({"calibrate", csv, "--imus", "1,0"}, dir);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_TRUE(Contains(run.err, "list it first")) << run.err;
+  run = Plumb({"calibrate", csv, "--imus", "0,7"}, dir);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_TRUE(Contains(run.err, "no IMU 7")) << run.err;
+  // Not a list of instances.
+  run = Plumb({"calibrate", csv, "--imus", "0,x"}, dir);
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_TRUE(Contains(run.err, "--imus 0,x")) << run.err;
+  // Two inputs: the board comes from one.
+  run = Plumb({"calibrate", csv, csv, "--imus", "all"}, dir);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_TRUE(Contains(run.err, "come from one input")) << run.err;
+  // Commands that do not fit the board do not take the flag.
+  run = Plumb({"allan", csv, "--imus", "all"}, dir);
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+}
+
+TEST(BoardCli, ARealLogsTwoImusStillInOnePose) {
+  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane408_centre_point.BIN";
+  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  TempDir dir;
+  const std::string out = dir.File("cal.json");
+  const ToolRun run = Plumb({"calibrate", log, "--imus", "all", "--json", out}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json doc = ReadJson(out);
+  ASSERT_EQ(doc["imus"].size(), 2u);
+  EXPECT_EQ(doc["imus"][1]["instance"], 1);
+  // One pose: gravity cannot show IMU2's turn about itself; the output says so.
+  bool yaw_named = false;
+  for (const auto& u : doc["observability"]["unobservable"]) {
+    yaw_named = yaw_named || u.get<std::string>().find("imu1.rotation.z") != std::string::npos;
+  }
+  EXPECT_TRUE(yaw_named) << doc["observability"].dump();
+}
+
+}  // namespace
+}  // namespace plumb::cli
