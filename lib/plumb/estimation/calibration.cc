@@ -20,25 +20,36 @@ const char* LevelSourceName(LevelSource source) {
   return "none";
 }
 
-Mat3 Calibration::AccelMatrix() const {
+namespace {
+
+// The forward quantities of SPEC section 1 from a model's blocks (IMU 0's, or a board IMU's,
+// whose blocks end with its mount's, which the model does not read).
+Mat3 AccelMatrixOf(const model::Model& model, const model::ParameterBlocks& theta) {
   return model.Predict(theta, model::SensorInput<double>()).F;
 }
 
-Vec3 Calibration::AccelBias() const {
+Vec3 AccelBiasOf(const model::Model& model, const model::ParameterBlocks& theta) {
   const int t = model.BaseTerm(model::Sensor::kAccel);
   return t < 0 ? Vec3::Zero() : model::accel_linear::Bias(theta[static_cast<std::size_t>(t)]);
 }
 
-Mat3 Calibration::GyroMatrix() const {
+Mat3 GyroMatrixOf(const model::Model& model, const model::ParameterBlocks& theta, bool has_gyro) {
   if (!has_gyro) return Mat3::Identity();
   return model.Predict(theta, model::SensorInput<double>()).E;
 }
 
-Vec3 Calibration::GyroBias() const {
+Vec3 GyroBiasOf(const model::Model& model, const model::ParameterBlocks& theta, bool has_gyro) {
   const int t = model.BaseTerm(model::Sensor::kGyro);
   if (!has_gyro || t < 0) return Vec3::Zero();
   return model::gyro_linear::Bias(theta[static_cast<std::size_t>(t)]);
 }
+
+}  // namespace
+
+Mat3 Calibration::AccelMatrix() const { return AccelMatrixOf(model, theta); }
+Vec3 Calibration::AccelBias() const { return AccelBiasOf(model, theta); }
+Mat3 Calibration::GyroMatrix() const { return GyroMatrixOf(model, theta, has_gyro); }
+Vec3 Calibration::GyroBias() const { return GyroBiasOf(model, theta, has_gyro); }
 
 Quat BoardImuCalibration::R_b_i() const {
   return model::board_mount::Rotation(theta.back().data());
@@ -52,24 +63,9 @@ double BoardImuCalibration::TimeOffset() const {
   return theta.back()[model::board_mount::kTimeOffset];
 }
 
-Mat3 BoardImuCalibration::AccelMatrix() const {
-  return model.Predict(theta, model::SensorInput<double>()).F;
-}
-
-Vec3 BoardImuCalibration::AccelBias() const {
-  const int t = model.BaseTerm(model::Sensor::kAccel);
-  return t < 0 ? Vec3::Zero() : model::accel_linear::Bias(theta[static_cast<std::size_t>(t)]);
-}
-
-Mat3 BoardImuCalibration::GyroMatrix() const {
-  if (!has_gyro) return Mat3::Identity();
-  return model.Predict(theta, model::SensorInput<double>()).E;
-}
-
-Vec3 BoardImuCalibration::GyroBias() const {
-  const int t = model.BaseTerm(model::Sensor::kGyro);
-  if (!has_gyro || t < 0) return Vec3::Zero();
-  return model::gyro_linear::Bias(theta[static_cast<std::size_t>(t)]);
-}
+Mat3 BoardImuCalibration::AccelMatrix() const { return AccelMatrixOf(model, theta); }
+Vec3 BoardImuCalibration::AccelBias() const { return AccelBiasOf(model, theta); }
+Mat3 BoardImuCalibration::GyroMatrix() const { return GyroMatrixOf(model, theta, has_gyro); }
+Vec3 BoardImuCalibration::GyroBias() const { return GyroBiasOf(model, theta, has_gyro); }
 
 }  // namespace plumb::estimation
