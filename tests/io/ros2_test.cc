@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/db3.h"
 #include "plumb/io/ros/mcap.h"
+#include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/ros_session.h"
 
 namespace plumb::io {
@@ -308,6 +310,46 @@ TEST(CdrImu, StampTimesAreExact) {
             static_cast<double>(1352907204u) + static_cast<double>(593772365u) * 1e-9);
   EXPECT_EQ(bag.imu_topics[0].receive_s[0],
             static_cast<double>(1352907204u) + static_cast<double>(594176427u) * 1e-9);
+}
+
+TEST(CdrImu, EveryCutAndFrameIdLengthDecodesAsTheGeneralPath) {
+  // Little-endian messages take DecodeCdrImu's fixed-offset path; the same message big endian
+  // takes the general one. Both agree on every frame_id length, and a message cut anywhere
+  // before its last covariance is refused by both with the same words.
+  for (std::size_t length = 0; length <= 17; ++length) {
+    Ros2Imu m = Nth(7);
+    m.frame_id = std::string(length, 'f');
+    const std::string little = CdrImu(m, true);
+    const std::string big = CdrImu(m, false);
+    ASSERT_EQ(little.size(), big.size());
+    for (std::size_t n = 0; n <= little.size() + 1; ++n) {
+      const std::string a = little.substr(0, std::min(n, little.size())) +
+                            (n > little.size() ? std::string(1, '\0') : std::string());
+      const std::string b = big.substr(0, std::min(n, big.size())) +
+                            (n > big.size() ? std::string(1, '\0') : std::string());
+      detail::RosImuMessage ma, mb;
+      std::string why_a, why_b;
+      const bool ok_a = detail::DecodeCdrImu(reinterpret_cast<const std::uint8_t*>(a.data()),
+                                             a.size(), &ma, &why_a);
+      const bool ok_b = detail::DecodeCdrImu(reinterpret_cast<const std::uint8_t*>(b.data()),
+                                             b.size(), &mb, &why_b);
+      ASSERT_EQ(ok_a, ok_b) << length << " " << n;
+      EXPECT_EQ(ok_a, n >= little.size()) << length << " " << n;
+      EXPECT_EQ(why_a, why_b) << length << " " << n;
+      if (!ok_a) continue;
+      EXPECT_EQ(ma.sec, mb.sec);
+      EXPECT_EQ(ma.nsec, mb.nsec);
+      EXPECT_EQ(ma.frame_id, m.frame_id);
+      EXPECT_EQ(mb.frame_id, m.frame_id);
+      EXPECT_EQ(ma.acc, mb.acc);
+      EXPECT_EQ(ma.gyr, mb.gyr);
+      EXPECT_EQ(ma.acc, Vec3(m.acc[0], m.acc[1], m.acc[2]));
+      for (int i = 0; i < 4; ++i) EXPECT_EQ(ma.orientation[i], mb.orientation[i]);
+      EXPECT_EQ(ma.orientation_cov0, mb.orientation_cov0);
+      EXPECT_EQ(ma.gyr_cov0, mb.gyr_cov0);
+      EXPECT_EQ(ma.acc_cov0, mb.acc_cov0);
+    }
+  }
 }
 
 // --- .db3 -------------------------------------------------------------------------------
