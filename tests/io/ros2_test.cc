@@ -6,11 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -350,6 +353,64 @@ TEST(CdrImu, EveryCutAndFrameIdLengthDecodesAsTheGeneralPath) {
       EXPECT_EQ(ma.acc_cov0, mb.acc_cov0);
     }
   }
+}
+
+TEST(CdrImu, EveryValueGivesTheSameSampleAndCountsInEitherByteOrder) {
+  // A little-endian message is appended straight from its bytes (AppendCdrImuFast); a
+  // big-endian one through DecodeCdrImu's general path and AppendImu. Both give the same
+  // floats, bit for bit (values beyond the float range saturated), and the same counts.
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> values = {0.0, -0.0, -1.0, 9.80665, 1e39, -1e39, kInf, nan,
+                                      std::nextafter(double{std::numeric_limits<float>::max()},
+                                                     kInf)};
+  std::string little = McapSchema(1) + McapChannel(1, 1, "/imu");
+  std::string big = little;
+  int count = 0;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    for (int slot = 0; slot < 10; ++slot) {
+      Ros2Imu m = Nth(count);
+      const double v = values[k];
+      const double w = values[(k + 1 + static_cast<std::size_t>(slot)) % values.size()];
+      switch (slot) {
+        case 0: m.acc = {v, w, 1.0}; break;
+        case 1: m.acc = {1.0, v, w}; break;
+        case 2: m.acc[2] = v; m.acc_cov0 = w; break;
+        case 3: m.gyr = {v, w, 1.0}; break;
+        case 4: m.gyr = {1.0, v, w}; break;
+        case 5: m.gyr[2] = v; m.gyr_cov0 = w; break;
+        case 6: m.orientation = {v, v, w, v}; m.orientation_cov0 = w; break;
+        case 7: m.orientation = {v, v, v, v}; m.orientation_cov0 = v; break;
+        case 8: m.acc_cov0 = v; m.gyr_cov0 = w; break;
+        default: m.acc = {v, v, v}; m.gyr = {w, w, w}; break;
+      }
+      const std::uint64_t at = kReceiveNs + static_cast<std::uint64_t>(count) * 1000u;
+      little += McapMessage(1, at, CdrImu(m, true));
+      big += McapMessage(1, at, CdrImu(m, false));
+      ++count;
+    }
+  }
+  const RosBag a = Parse(Mcap(little));
+  const RosBag b = Parse(Mcap(big));
+  const RosImuTopic& ta = a.imu_topics.at(0);
+  const RosImuTopic& tb = b.imu_topics.at(0);
+  ASSERT_EQ(ta.samples.size(), static_cast<std::size_t>(count));
+  ASSERT_EQ(tb.samples.size(), static_cast<std::size_t>(count));
+  const auto same_bytes = [](const auto& x, const auto& y) {
+    return x.size() == y.size() &&
+           std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
+  };
+  EXPECT_TRUE(same_bytes(ta.samples.t_s, tb.samples.t_s));
+  EXPECT_TRUE(same_bytes(ta.receive_s, tb.receive_s));
+  EXPECT_TRUE(same_bytes(ta.samples.acc, tb.samples.acc));
+  EXPECT_TRUE(same_bytes(ta.samples.gyr, tb.samples.gyr));
+  EXPECT_EQ(ta.acc_not_given, tb.acc_not_given);
+  EXPECT_EQ(ta.gyr_not_given, tb.gyr_not_given);
+  EXPECT_EQ(ta.orientation_not_given, tb.orientation_not_given);
+  EXPECT_EQ(ta.orientation_zero, tb.orientation_zero);
+  EXPECT_GT(ta.acc_not_given, 0u);
+  EXPECT_GT(ta.orientation_zero, 0u);
+  EXPECT_TRUE(std::isinf(ta.samples.acc[4 * 10 + 0][0]));  // 1e39: +infinity
 }
 
 // --- .db3 -------------------------------------------------------------------------------

@@ -114,4 +114,13 @@ void SetFrameId(RosImuTopic* t, std::string_view frame_id) {
   t->frame_id = std::string(frame_id.substr(0, 256));
 }
 
+std::size_t ReserveImu(RosImuTopic* t, std::size_t n) {
+  t->samples.t_s.reserve(n);
+  t->samples.acc.reserve(n);
+  t->samples.gyr.reserve(n);
+  t->receive_s.reserve(n);
+  return std::min({t->samples.t_s.capacity(), t->samples.acc.capacity(),
+                   t->samples.gyr.capacity(), t->receive_s.capacity()});
+}
+
 }  // namespace plumb::io::detail

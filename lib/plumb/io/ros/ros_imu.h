@@ -136,6 +136,29 @@ inline void AppendImu(RosImuTopic* t, const RosImuMessage& m, std::int64_t recei
   CountNotGiven(t, m.orientation_cov0, m.gyr_cov0, m.acc_cov0, m.orientation);
 }
 
+/// DecodeCdrImu and AppendImu at once for the usual message (CdrImuDoublesAt): the same
+/// sample and counts, its 13 doubles read straight from the message's bytes at their fixed
+/// offsets. False, `t` untouched, for any other message, which DecodeCdrImu then decodes (or
+/// says what is wrong with).
+inline bool AppendCdrImuFast(RosImuTopic* t, const std::uint8_t* p, std::size_t n,
+                             std::int64_t receive_sec, std::uint32_t receive_nsec) {
+  const std::size_t at = CdrImuDoublesAt(p, n);
+  if (at == 0) return false;
+  const std::uint8_t* d = p + at;
+  const auto v = [d](std::size_t i) { return LoadLittleEndian<double>(d + 8 * i); };
+  if (t->samples.empty()) SetFrameId(t, CdrImuFrameId(p));
+  AppendSample(t, LoadLittleEndian<std::int32_t>(p + 4), LoadLittleEndian<std::uint32_t>(p + 8),
+               receive_sec, receive_nsec, Vec3(v(25), v(26), v(27)), Vec3(v(13), v(14), v(15)));
+  const double orientation[4] = {v(0), v(1), v(2), v(3)};
+  CountNotGiven(t, v(4), v(16), v(28), orientation);
+  return true;
+}
+
+/// Room for `n` samples in all in `t`'s vectors (samples.t_s, acc, gyr and receive_s,
+/// together: std::vector::reserve), so that appending does not grow them one doubling at a
+/// time. Returns the samples all four have room for (at least `n`).
+std::size_t ReserveImu(RosImuTopic* t, std::size_t n);
+
 /// Splits a time in nanoseconds (MCAP's log_time, a .db3 timestamp) into seconds and
 /// nanoseconds (0 to 999999999) for AppendImu.
 inline void SplitNanoseconds(std::int64_t ns, std::int64_t* sec, std::uint32_t* nsec) {
