@@ -9,17 +9,26 @@
 // Header, then its data section (Schema, Channel, Chunk and MessageIndex records, up to
 // DataEnd) again and again up to about kTargetBytes, then a Footer; written once into a
 // temporary file removed at exit, held by the page cache (this measures the reader, not the
-// disk). Counters: MB/s of file, imu_msgs (IMU messages decoded per read) and msgs/s.
+// disk). Counters: bytes_per_second of file, items_per_second (IMU messages decoded), MB (of
+// file) and imu_msgs (IMU messages decoded per read).
 // BM_McapZstd/<copy> and BM_McapLz4/<copy> decompress the same file's chunks with libzstd alone
-// (ZSTD_decompressDCtx) or liblz4 alone (LZ4F_decompress) into one buffer of the chunk's size
-// and one byte (as the reader's): the floor under BM_ReadMcap of a compressed file.
+// (ZSTD_decompressDCtx, into one buffer of the largest chunk's size and one byte, as the
+// reader's) or liblz4 alone (LZ4F_decompress, into one buffer with room for the frames' 4 MiB
+// block, as the reader's since liblz4 then decodes a block without copying it;
+// BM_McapLz4/ardrone_imu_lz4_chunk_room with room for the chunk's size and one byte, as the
+// reader had before: liblz4 then decodes into its own buffer and copies each chunk out): the
+// floor under BM_ReadMcap of a compressed file. Their <copy>_crc32 variants then check each
+// chunk's CRC-32 (libdeflate_crc32, the reader's detail::Crc32) on the chunk just
+// decompressed, in cache, as the reader does: decompression and check, the floor under the
+// whole read. items_per_second counts chunks, "MB out" the bytes decompressed per pass.
 // BM_ReadMcap/ardrone_imu_zstd_decompressed reads the repeated zstd file with its chunks stored
 // decompressed (compression "", the same records and CRCs): the same messages as
 // BM_ReadMcap/ardrone_imu_zstd without the decompression, i.e. the reader's own share (the
 // records walked, the CRCs checked, the messages decoded), which libzstd alone does not do.
 // BM_McapCrc32/ardrone_imu_zstd computes the CRC-32 (libdeflate_crc32, as the reader) of every
-// chunk's records of that decompressed copy: the share of BM_ReadMcap/ardrone_imu_zstd that
-// checking the chunks' uncompressed_crc costs.
+// chunk's records of that decompressed copy, read from memory (bytes_per_second: of records
+// checked). BM_McapCrc32Chunk/libdeflate_in_cache: libdeflate_crc32 of one 256 KiB chunk held
+// in cache, again and again: the check's own speed where the reader does it.
 // Skipped with the reason when the fixtures cannot be made (data, node or the npm packages
 // absent).
 #include <benchmark/benchmark.h>
@@ -200,13 +209,12 @@ const std::string* Repeated(const std::string& name, std::string* why) {
   return &slot->path();
 }
 
-void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t messages) {
-  const double iterations = static_cast<double>(state.iterations());
-  state.counters["MB/s"] = benchmark::Counter(iterations * static_cast<double>(bytes) / 1e6,
-                                              benchmark::Counter::kIsRate);
-  state.counters["msgs/s"] =
-      benchmark::Counter(iterations * static_cast<double>(messages), benchmark::Counter::kIsRate);
-  state.counters["imu_msgs"] = static_cast<double>(messages);
+/// Per pass: `bytes` processed (bytes_per_second), `items` decoded (items_per_second: IMU
+/// messages, or chunks for the baselines).
+void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t items) {
+  const auto iterations = static_cast<std::int64_t>(state.iterations());
+  state.SetBytesProcessed(iterations * static_cast<std::int64_t>(bytes));
+  state.SetItemsProcessed(iterations * static_cast<std::int64_t>(items));
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
 }
 
@@ -225,6 +233,7 @@ void BM_ReadMcap(benchmark::State& state, const std::string& name) {
     benchmark::DoNotOptimize(messages);
   }
   SetCounters(state, std::filesystem::file_size(*file), messages);
+  state.counters["imu_msgs"] = static_cast<double>(messages);
 }
 BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_uncompressed, std::string("ardrone_imu.mcap"))
     ->Unit(benchmark::kMillisecond)
@@ -260,18 +269,28 @@ std::optional<McapBytes> LoadMcap(benchmark::State& state, const std::string& na
   return out;
 }
 
-/// Decompresses every chunk of the repeated `name` with `decompress` (false: failed).
+/// Decompresses every chunk of the repeated `name` with `decompress` (false: failed) into one
+/// buffer of `room` bytes (at least the largest chunk's size and one byte), then, when
+/// `check_crc`, checks its CRC-32 with libdeflate_crc32 (the chunk's records in cache, as in
+/// the reader).
 template <typename Decompress>
-void DecompressChunks(benchmark::State& state, const std::string& name, Decompress decompress) {
+void DecompressChunks(benchmark::State& state, const std::string& name, Decompress decompress,
+                      bool check_crc, std::size_t room) {
   const std::optional<McapBytes> mcap = LoadMcap(state, name);
   if (!mcap) return;
   const std::vector<char>& bytes = mcap->bytes;
+  const auto* p = reinterpret_cast<const std::uint8_t*>(bytes.data());
   const std::vector<TopRecord>& records = mcap->records;
   // One buffer for all (as the reader's, never resized per chunk: resizing a vector per chunk
-  // made liblz4 alone 3 to 5 times slower), each chunk given its size and one byte as room.
-  std::size_t largest = 0;
-  for (const TopRecord& r : records) largest = std::max<std::size_t>(largest, r.size);
-  std::vector<char> out(largest + 1);
+  // made liblz4 alone 3 to 5 times slower).
+  std::size_t largest = 0, chunks = 0, out_bytes = 0;
+  for (const TopRecord& r : records) {
+    largest = std::max<std::size_t>(largest, r.size);
+    chunks += r.op == 0x06;
+    out_bytes += r.op == 0x06 ? r.size : 0;
+  }
+  std::vector<char> out(std::max<std::size_t>(largest + 1, room));
+  const auto* q = reinterpret_cast<const std::uint8_t*>(out.data());
   for (auto _ : state) {
     for (const TopRecord& r : records) {
       if (r.op != 0x06) continue;
@@ -280,37 +299,65 @@ void DecompressChunks(benchmark::State& state, const std::string& name, Decompre
         state.SkipWithError("decompression failed");
         return;
       }
+      if (check_crc && libdeflate_crc32(0, q, r.size) !=
+                           plumb::io::LoadLittleEndian<std::uint32_t>(p + r.begin + 9 + 24)) {
+        state.SkipWithError("a chunk's CRC-32 differs");
+        return;
+      }
       benchmark::ClobberMemory();
     }
   }
-  SetCounters(state, bytes.size(), 0);
+  SetCounters(state, bytes.size(), chunks);
+  state.counters["MB out"] = static_cast<double>(out_bytes) / 1e6;
 }
 
-void BM_McapZstd(benchmark::State& state, const std::string& name) {
+void BM_McapZstd(benchmark::State& state, const std::string& name, bool check_crc) {
   ZSTD_DCtx* ctx = ZSTD_createDCtx();
-  DecompressChunks(state, name, [ctx](const char* in, std::size_t n, std::size_t size, char* out) {
+  const auto decompress = [ctx](const char* in, std::size_t n, std::size_t size, char* out) {
     const std::size_t rc = ZSTD_decompressDCtx(ctx, out, size + 1, in, n);
     return !ZSTD_isError(rc) && rc == size;
-  });
+  };
+  DecompressChunks(state, name, decompress, check_crc, 0);
   ZSTD_freeDCtx(ctx);
 }
-BENCHMARK_CAPTURE(BM_McapZstd, ardrone_imu_zstd, std::string("ardrone_imu_zstd.mcap"))
+BENCHMARK_CAPTURE(BM_McapZstd, ardrone_imu_zstd, std::string("ardrone_imu_zstd.mcap"), false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_McapZstd, ardrone_imu_zstd_crc32, std::string("ardrone_imu_zstd.mcap"), true)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-void BM_McapLz4(benchmark::State& state, const std::string& name) {
+/// Room for the LZ4 frames' largest block (4 MiB: the fixtures' frames state it, @mcap/core's
+/// default), into which liblz4 decodes a block directly, as the reader gives it (Lz4Whole).
+constexpr std::size_t kLz4Room = std::size_t{4} << 20;
+
+/// liblz4 alone on every chunk, given `room` bytes of output (0: the chunk's size and one
+/// byte, less than a block, so that liblz4 decodes into its own buffer and copies out).
+void BM_McapLz4(benchmark::State& state, const std::string& name, bool check_crc,
+                std::size_t room) {
   LZ4F_dctx* ctx = nullptr;
   LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION);
-  DecompressChunks(state, name, [ctx](const char* in, std::size_t n, std::size_t size, char* out) {
+  const auto decompress = [ctx, room](const char* in, std::size_t n, std::size_t size,
+                                      char* out) {
     LZ4F_resetDecompressionContext(ctx);  // as the reader does at each chunk
-    std::size_t out_size = size + 1;
+    std::size_t out_size = std::max<std::size_t>(size + 1, room);
     std::size_t in_size = n;
     const std::size_t rc = LZ4F_decompress(ctx, out, &out_size, in, &in_size, nullptr);
     return !LZ4F_isError(rc) && rc == 0 && out_size == size;
-  });
+  };
+  DecompressChunks(state, name, decompress, check_crc, room);
   LZ4F_freeDecompressionContext(ctx);
 }
-BENCHMARK_CAPTURE(BM_McapLz4, ardrone_imu_lz4, std::string("ardrone_imu_lz4.mcap"))
+BENCHMARK_CAPTURE(BM_McapLz4, ardrone_imu_lz4, std::string("ardrone_imu_lz4.mcap"), false,
+                  kLz4Room)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_McapLz4, ardrone_imu_lz4_crc32, std::string("ardrone_imu_lz4.mcap"), true,
+                  kLz4Room)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_McapLz4, ardrone_imu_lz4_chunk_room, std::string("ardrone_imu_lz4.mcap"),
+                  false, std::size_t{0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -320,9 +367,10 @@ void BM_McapCrc32(benchmark::State& state, const std::string& name) {
   const std::vector<char>& bytes = mcap->bytes;
   const auto* p = reinterpret_cast<const std::uint8_t*>(bytes.data());
   const std::vector<TopRecord>& records = mcap->records;
-  std::size_t checked = 0;
+  std::size_t checked = 0, chunks = 0;
   for (auto _ : state) {
     checked = 0;
+    chunks = 0;
     for (const TopRecord& r : records) {
       if (r.op != 0x06) continue;
       const auto stated = plumb::io::LoadLittleEndian<std::uint32_t>(p + r.begin + 9 + 24);
@@ -331,14 +379,33 @@ void BM_McapCrc32(benchmark::State& state, const std::string& name) {
         return;
       }
       checked += r.data_end - r.data_begin;
+      ++chunks;
     }
     benchmark::DoNotOptimize(checked);
   }
-  SetCounters(state, bytes.size(), 0);
-  state.counters["MB checked"] = static_cast<double>(checked) / 1e6;
+  SetCounters(state, checked, chunks);
 }
 BENCHMARK_CAPTURE(BM_McapCrc32, ardrone_imu_zstd, std::string("ardrone_imu_zstd_decompressed"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+/// libdeflate_crc32 of one 256 KiB chunk (pseudo-random bytes) held in cache, again and again:
+/// the check's own speed where the reader does it, on a chunk just decompressed;
+/// BM_McapCrc32/ardrone_imu_zstd reads its records from memory instead.
+void BM_McapCrc32Chunk(benchmark::State& state) {
+  std::vector<std::uint8_t> chunk(std::size_t{256} << 10);
+  std::uint64_t x = 0x9E3779B97F4A7C15ull;  // xorshift64
+  for (std::uint8_t& b : chunk) {
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    b = static_cast<std::uint8_t>(x >> 56);
+  }
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(libdeflate_crc32(0, chunk.data(), chunk.size()));
+  }
+  SetCounters(state, chunk.size(), 1);
+}
+BENCHMARK(BM_McapCrc32Chunk)->Name("BM_McapCrc32Chunk/libdeflate_in_cache");
 
 }  // namespace

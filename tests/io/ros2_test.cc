@@ -6,10 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -18,6 +22,7 @@
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/db3.h"
 #include "plumb/io/ros/mcap.h"
+#include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/ros_session.h"
 
 namespace plumb::io {
@@ -308,6 +313,104 @@ TEST(CdrImu, StampTimesAreExact) {
             static_cast<double>(1352907204u) + static_cast<double>(593772365u) * 1e-9);
   EXPECT_EQ(bag.imu_topics[0].receive_s[0],
             static_cast<double>(1352907204u) + static_cast<double>(594176427u) * 1e-9);
+}
+
+TEST(CdrImu, EveryCutAndFrameIdLengthDecodesAsTheGeneralPath) {
+  // Little-endian messages take DecodeCdrImu's fixed-offset path; the same message big endian
+  // takes the general one. Both agree on every frame_id length, and a message cut anywhere
+  // before its last covariance is refused by both with the same words.
+  for (std::size_t length = 0; length <= 17; ++length) {
+    Ros2Imu m = Nth(7);
+    m.frame_id = std::string(length, 'f');
+    const std::string little = CdrImu(m, true);
+    const std::string big = CdrImu(m, false);
+    ASSERT_EQ(little.size(), big.size());
+    for (std::size_t n = 0; n <= little.size() + 1; ++n) {
+      const std::string a = little.substr(0, std::min(n, little.size())) +
+                            (n > little.size() ? std::string(1, '\0') : std::string());
+      const std::string b = big.substr(0, std::min(n, big.size())) +
+                            (n > big.size() ? std::string(1, '\0') : std::string());
+      detail::RosImuMessage ma, mb;
+      std::string why_a, why_b;
+      const bool ok_a = detail::DecodeCdrImu(reinterpret_cast<const std::uint8_t*>(a.data()),
+                                             a.size(), &ma, &why_a);
+      const bool ok_b = detail::DecodeCdrImu(reinterpret_cast<const std::uint8_t*>(b.data()),
+                                             b.size(), &mb, &why_b);
+      ASSERT_EQ(ok_a, ok_b) << length << " " << n;
+      EXPECT_EQ(ok_a, n >= little.size()) << length << " " << n;
+      EXPECT_EQ(why_a, why_b) << length << " " << n;
+      if (!ok_a) continue;
+      EXPECT_EQ(ma.sec, mb.sec);
+      EXPECT_EQ(ma.nsec, mb.nsec);
+      EXPECT_EQ(ma.frame_id, m.frame_id);
+      EXPECT_EQ(mb.frame_id, m.frame_id);
+      EXPECT_EQ(ma.acc, mb.acc);
+      EXPECT_EQ(ma.gyr, mb.gyr);
+      EXPECT_EQ(ma.acc, Vec3(m.acc[0], m.acc[1], m.acc[2]));
+      for (int i = 0; i < 4; ++i) EXPECT_EQ(ma.orientation[i], mb.orientation[i]);
+      EXPECT_EQ(ma.orientation_cov0, mb.orientation_cov0);
+      EXPECT_EQ(ma.gyr_cov0, mb.gyr_cov0);
+      EXPECT_EQ(ma.acc_cov0, mb.acc_cov0);
+    }
+  }
+}
+
+TEST(CdrImu, EveryValueGivesTheSameSampleAndCountsInEitherByteOrder) {
+  // A little-endian message is appended straight from its bytes (AppendCdrImuFast); a
+  // big-endian one through DecodeCdrImu's general path and AppendImu. Both give the same
+  // floats, bit for bit (values beyond the float range saturated), and the same counts.
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> values = {0.0, -0.0, -1.0, 9.80665, 1e39, -1e39, kInf, nan,
+                                      std::nextafter(double{std::numeric_limits<float>::max()},
+                                                     kInf)};
+  std::string little = McapSchema(1) + McapChannel(1, 1, "/imu");
+  std::string big = little;
+  int count = 0;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    for (int slot = 0; slot < 10; ++slot) {
+      Ros2Imu m = Nth(count);
+      const double v = values[k];
+      const double w = values[(k + 1 + static_cast<std::size_t>(slot)) % values.size()];
+      switch (slot) {
+        case 0: m.acc = {v, w, 1.0}; break;
+        case 1: m.acc = {1.0, v, w}; break;
+        case 2: m.acc[2] = v; m.acc_cov0 = w; break;
+        case 3: m.gyr = {v, w, 1.0}; break;
+        case 4: m.gyr = {1.0, v, w}; break;
+        case 5: m.gyr[2] = v; m.gyr_cov0 = w; break;
+        case 6: m.orientation = {v, v, w, v}; m.orientation_cov0 = w; break;
+        case 7: m.orientation = {v, v, v, v}; m.orientation_cov0 = v; break;
+        case 8: m.acc_cov0 = v; m.gyr_cov0 = w; break;
+        default: m.acc = {v, v, v}; m.gyr = {w, w, w}; break;
+      }
+      const std::uint64_t at = kReceiveNs + static_cast<std::uint64_t>(count) * 1000u;
+      little += McapMessage(1, at, CdrImu(m, true));
+      big += McapMessage(1, at, CdrImu(m, false));
+      ++count;
+    }
+  }
+  const RosBag a = Parse(Mcap(little));
+  const RosBag b = Parse(Mcap(big));
+  const RosImuTopic& ta = a.imu_topics.at(0);
+  const RosImuTopic& tb = b.imu_topics.at(0);
+  ASSERT_EQ(ta.samples.size(), static_cast<std::size_t>(count));
+  ASSERT_EQ(tb.samples.size(), static_cast<std::size_t>(count));
+  const auto same_bytes = [](const auto& x, const auto& y) {
+    return x.size() == y.size() &&
+           std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
+  };
+  EXPECT_TRUE(same_bytes(ta.samples.t_s, tb.samples.t_s));
+  EXPECT_TRUE(same_bytes(ta.receive_s, tb.receive_s));
+  EXPECT_TRUE(same_bytes(ta.samples.acc, tb.samples.acc));
+  EXPECT_TRUE(same_bytes(ta.samples.gyr, tb.samples.gyr));
+  EXPECT_EQ(ta.acc_not_given, tb.acc_not_given);
+  EXPECT_EQ(ta.gyr_not_given, tb.gyr_not_given);
+  EXPECT_EQ(ta.orientation_not_given, tb.orientation_not_given);
+  EXPECT_EQ(ta.orientation_zero, tb.orientation_zero);
+  EXPECT_GT(ta.acc_not_given, 0u);
+  EXPECT_GT(ta.orientation_zero, 0u);
+  EXPECT_TRUE(std::isinf(ta.samples.acc[4 * 10 + 0][0]));  // 1e39: +infinity
 }
 
 // --- .db3 -------------------------------------------------------------------------------

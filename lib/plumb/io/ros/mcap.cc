@@ -103,7 +103,38 @@ class Parser {
                            std::string* past_end);
   void Schema(const Record& r, std::size_t at);
   void Channel(const Record& r, std::size_t at);
-  void Message(const Record& r, std::size_t at);
+  /// A Message record: counted, and decoded (ImuMessage) when of an IMU channel. Inline: most
+  /// records are messages, many of other topics.
+  void Message(const Record& r, std::size_t at) {
+    if (r.len < 22) {
+      BadRecord(at);
+      return;
+    }
+    const auto channel = LoadLittleEndian<std::uint16_t>(r.body);
+    ++bag_->messages;
+    if (channel >= slots_.size() || slots_[channel].conn == nullptr) {
+      Orphan(at);
+      return;
+    }
+    Slot& slot = slots_[channel];
+    ++slot.messages;
+    if (slot.topic >= 0) ImuMessage(static_cast<std::size_t>(slot.topic), r, at);
+  }
+  /// A Message record (whole: at least its 22 bytes of fields) of IMU topic `topic`.
+  void ImuMessage(std::size_t topic, const Record& r, std::size_t at);
+  void Orphan(std::size_t at) {
+    RosBagWarnings& w = bag_->warnings;
+    if (w.orphan_messages++ == 0) w.first_orphan = at;
+  }
+  /// Adds the messages counted in the slots to their connections.
+  void CountMessages();
+  /// A message of IMU topic `t` that AppendCdrImuFast does not take: decoded by DecodeCdrImu,
+  /// false when it does not decode (counted as malformed, the first with where and why).
+  bool Decode(RosImuTopic* t, const std::uint8_t* p, std::size_t n, std::size_t at,
+              detail::RosImuMessage* m);
+  /// Room in `t` for its next sample (see the definition); returns the samples it has room
+  /// for.
+  std::size_t Room(RosImuTopic* t) const;
   void BadRecord(std::size_t at) {
     if (bag_->warnings.bad_records++ == 0) bag_->warnings.first_bad_record = at;
   }
@@ -120,6 +151,7 @@ class Parser {
   RosBag* bag_;
   const LogFile* file_;
   std::size_t released_ = 0;
+  std::size_t read_to_ = 0;  ///< the file offset past the top-level record being read
   bool footer_ = false;
   struct SchemaInfo {
     std::string name;
@@ -129,8 +161,13 @@ class Parser {
   struct Slot {
     RosConnection* conn = nullptr;  ///< nullptr: not defined (yet)
     int topic = -1;                 ///< index in imu_topics, -1: not decoded
+    /// Its messages read, added to conn->messages at the end (CountMessages): a count here,
+    /// beside the slot a message looks up anyway, rather than in the connection's map node.
+    std::size_t messages = 0;
   };
   std::vector<Slot> slots_;
+  /// By index in imu_topics: the samples its four vectors have room for (Room's).
+  std::vector<std::size_t> room_;
   detail::ChunkBuffers chunk_;  ///< a decompressed chunk and the decompressors, reused
 };
 
@@ -162,10 +199,13 @@ void Parser::Run() {
   while (pos < size_ && !footer_) {
     if (!Frame(data_, size_, pos, &r)) {
       bag_->warnings.cut_at = pos;
+      read_to_ = size_;
       if (r.body != nullptr && r.op == kOpChunk) Chunk(r, pos, true);
       bag_->warnings.messages_read = bag_->messages;
+      CountMessages();
       return;
     }
+    read_to_ = r.end;
     TopRecord(r, pos);
     pos = r.end;
     if (file_ != nullptr && pos >= released_ + LogFile::kReleaseStep) {
@@ -173,6 +213,7 @@ void Parser::Run() {
       released_ = pos;
     }
   }
+  CountMessages();
   if (!footer_) {
     bag_->warnings.notes.push_back(
         "cut short: the file ends at byte " + std::to_string(size_) +
@@ -297,6 +338,7 @@ void Parser::Channel(const Record& r, std::size_t at) {
   if (c.type == kImuSchema) {
     if (encoding == "cdr") {
       imu = detail::ImuTopicIndex(bag_, c.topic);
+      room_.resize(bag_->imu_topics.size());  // a new topic's: 0, grown at its first sample
     } else {
       bag_->warnings.notes.push_back(
           "channel " + std::to_string(id) + " (" + c.topic + "): sensor_msgs/msg/Imu in '" +
@@ -308,39 +350,61 @@ void Parser::Channel(const Record& r, std::size_t at) {
   slots_[id] = Slot{&stored, imu};
 }
 
-void Parser::Message(const Record& r, std::size_t at) {
-  RosBagWarnings& w = bag_->warnings;
-  if (r.len < 22) {
-    BadRecord(at);
-    return;
+void Parser::CountMessages() {
+  for (Slot& slot : slots_) {
+    if (slot.conn != nullptr) slot.conn->messages += slot.messages;
+    slot.messages = 0;
   }
-  const auto channel = LoadLittleEndian<std::uint16_t>(r.body);
+}
+
+void Parser::ImuMessage(std::size_t topic, const Record& r, std::size_t at) {
   const auto log_time = LoadLittleEndian<std::uint64_t>(r.body + 6);
-  ++bag_->messages;
-  if (channel >= slots_.size() || slots_[channel].conn == nullptr) {
-    if (w.orphan_messages++ == 0) w.first_orphan = at;
-    return;
-  }
-  const Slot& slot = slots_[channel];
-  ++slot.conn->messages;
-  if (slot.topic < 0) return;
-  RosImuTopic& t = bag_->imu_topics[static_cast<std::size_t>(slot.topic)];
-  detail::RosImuMessage m;
-  std::string why;
-  if (!detail::DecodeCdrImu(r.body + 22, r.len - 22, &m, &why)) {
-    ++t.malformed;
-    if (w.malformed_imu++ == 0) {
-      w.first_malformed_imu = at;
-      w.first_malformed_why = "the message " + std::to_string(t.samples.size() + t.malformed - 1) +
-                              " of " + t.topic + ", in the record at byte " +
-                              std::to_string(at) + ", " + why;
-    }
-    return;
-  }
+  RosImuTopic& t = bag_->imu_topics[topic];
+  if (t.samples.t_s.size() >= room_[topic]) room_[topic] = Room(&t);
   std::int64_t sec = 0;
   std::uint32_t nsec = 0;
   detail::SplitNanoseconds(static_cast<std::int64_t>(log_time), &sec, &nsec);
-  detail::AppendImu(&t, m, sec, nsec);
+  // The usual message appended straight from its bytes; any other decoded in general (out of
+  // line: DecodeCdrImu, which says what is wrong with one that does not decode), then appended.
+  const std::uint8_t* cdr = r.body + 22;
+  if (detail::AppendCdrImuFast(&t, cdr, r.len - 22, sec, nsec)) return;
+  detail::RosImuMessage m;
+  if (Decode(&t, cdr, r.len - 22, at, &m)) detail::AppendImu(&t, m, sec, nsec);
+}
+
+bool Parser::Decode(RosImuTopic* t, const std::uint8_t* p, std::size_t n, std::size_t at,
+                    detail::RosImuMessage* m) {
+  std::string why;
+  if (detail::DecodeCdrImu(p, n, m, &why)) return true;
+  RosBagWarnings& w = bag_->warnings;
+  ++t->malformed;
+  if (w.malformed_imu++ == 0) {
+    w.first_malformed_imu = at;
+    w.first_malformed_why = "the message " + std::to_string(t->samples.size() + t->malformed - 1) +
+                            " of " + t->topic + ", in the record at byte " + std::to_string(at) +
+                            ", " + why;
+  }
+  return false;
+}
+
+/// Grows the topic's vectors, full, to the samples the file holds if the rest of it is like
+/// the part read (the topic's samples per byte of file so far, the record being read counted
+/// whole, an eighth more), at least 1.5 times their size (twice, and 1024 at least, before the
+/// projection means anything) and at most 16 times. A file of one IMU topic throughout is read
+/// with a few reallocations, each a copy of all the samples so far, instead of one at every
+/// doubling; a file whose first part misleads the projection costs at most the growth
+/// doubling would (the 16 times bound the room reserved ahead, its pages never touched).
+std::size_t Parser::Room(RosImuTopic* t) const {
+  const std::size_t n = t->samples.t_s.size();
+  std::size_t want = std::max<std::size_t>(2 * n, 1024);
+  if (n >= 1024 && read_to_ > 0 && read_to_ < size_) {
+    const double projected =
+        static_cast<double>(n) * (static_cast<double>(size_) / static_cast<double>(read_to_)) *
+        1.125;
+    want = std::max<std::size_t>(
+        n + n / 2, static_cast<std::size_t>(std::min(projected, 16.0 * static_cast<double>(n))));
+  }
+  return detail::ReserveImu(t, want);
 }
 
 /// ParseMcap, releasing the pages of `file` (or nullptr) behind the parser.

@@ -168,6 +168,35 @@ bool Bz2(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
   return false;
 }
 
+/// The largest block of the LZ4 frame starting at [in, in + n) as its header states it (the BD
+/// byte: 64 KiB to 4 MiB), or 0 when the bytes do not start an LZ4 frame.
+std::size_t Lz4BlockMax(const std::uint8_t* in, std::size_t n) {
+  if (n < 6 || LoadLittleEndian<std::uint32_t>(in) != 0x184D2204u) return 0;
+  const unsigned id = (in[5] >> 4) & 7u;
+  return id < 4 ? 0 : std::size_t{1} << (16 + 2 * (id - 4));
+}
+
+/// liblz4 decodes a block straight into the output only when the output has room for the
+/// frame's largest block; else into its own buffer, copied out after (LZ4F_decompress).
+/// @mcap/core states 4 MiB blocks, larger than its chunks: with room for `declared` bytes and
+/// one, every chunk was decoded then copied, and that memcpy's time varied from one process to
+/// the next, more than half of an MCAP lz4 read in some (docs/performance.md). So when the
+/// frame's block is larger than that room, the whole frame is first decoded in one call into a
+/// buffer of the block's size (at most 4 MiB, kept from chunk to chunk); a frame that does not
+/// then give exactly `declared` bytes (damaged, cut, of another size) is decoded again by Lz4's
+/// loop, which says what is wrong and keeps what came out before the fault, as ever.
+bool Lz4Whole(LZ4F_dctx* ctx, const std::uint8_t* in, std::size_t n, std::uint32_t declared,
+              std::vector<std::uint8_t>* out) {
+  const std::size_t block = Lz4BlockMax(in, n);
+  if (block <= std::size_t{declared} + 1) return false;
+  Reserve(out, block);
+  LZ4F_resetDecompressionContext(ctx);
+  std::size_t out_size = out->size();
+  std::size_t in_size = n;
+  const std::size_t hint = LZ4F_decompress(ctx, out->data(), &out_size, in, &in_size, nullptr);
+  return !LZ4F_isError(hint) && hint == 0 && out_size == declared;
+}
+
 bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut,
          ChunkBuffers* buffers, std::size_t* out_size, std::string* why) {
   if (buffers->lz4 == nullptr &&
@@ -177,8 +206,12 @@ bool Lz4(const std::uint8_t* in, std::size_t n, std::uint32_t declared, bool cut
     return false;
   }
   LZ4F_dctx* ctx = buffers->lz4;
-  LZ4F_resetDecompressionContext(ctx);  // a frame left part way by the last chunk
   std::vector<std::uint8_t>* out = &buffers->out;
+  if (!cut && Lz4Whole(ctx, in, n, declared, out)) {
+    *out_size = declared;
+    return true;
+  }
+  LZ4F_resetDecompressionContext(ctx);  // a frame left part way by the last chunk
   std::size_t used = 0;
   std::size_t fed = 0;
   std::size_t hint = 1;

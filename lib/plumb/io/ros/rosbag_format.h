@@ -87,11 +87,12 @@ class ChunkBuffers {
 /// Decompresses a chunk's data [in, in + n) of `compression` ("none", "bz2", "lz4" (the LZ4
 /// frame format), "zstd" (MCAP's; a zstd frame), as liblz4 and libzstd decode them) into the
 /// first `*out_size` bytes of `buffers->out`, reused from chunk to chunk: grown as data comes
-/// out (never ahead of it, never past `declared` + 1 bytes), never shrunk. True when the data
-/// decompressed to its end and to exactly `declared` bytes; false with `why` otherwise, the
-/// buffer then holding what came out before the fault (the records there are still whole: a
-/// caller reads them). `cut`: the data was cut by the end of the file (the fault expected;
-/// `why` says where it ended).
+/// out (never ahead of it, never past `declared` + 1 bytes; an LZ4 frame whose blocks are
+/// larger than that is given room for one block, 4 MiB at most, so that liblz4 decodes it
+/// without a copy), never shrunk. True when the data decompressed to its end and to exactly
+/// `declared` bytes; false with `why` otherwise, the buffer then holding what came out before
+/// the fault (the records there are still whole: a caller reads them). `cut`: the data was cut
+/// by the end of the file (the fault expected; `why` says where it ended).
 bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::size_t n,
                      std::uint32_t declared, bool cut, ChunkBuffers* buffers,
                      std::size_t* out_size, std::string* why);
