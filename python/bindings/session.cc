@@ -116,6 +116,23 @@ io::InputOptions Options(Keywords& k) {
     }
     o.flight_log.stream = *topic;
   }
+  // The board's IMUs (SPEC 6, --imus): "all", or instances of which the first is IMU 0.
+  if (auto imus = k.Take<py::object>("imus")) {
+    if (py::isinstance<py::str>(*imus)) {
+      if (imus->cast<std::string>() != "all") throw Error("open: imus must be 'all' or a list of instances");
+      o.all_imus = true;
+    } else {
+      const auto instances = imus->cast<std::vector<int>>();
+      if (instances.empty() || *std::min_element(instances.begin(), instances.end()) < 0) {
+        throw Error("open: imus must be 'all' or a list of instances >= 0, the first IMU 0");
+      }
+      if (k.Given("imu") && o.flight_log.imu != instances.front()) {
+        throw Error("open: imu and imus name different IMUs 0; give one");
+      }
+      o.flight_log.imu = instances.front();
+      o.flight_log.other_imus.assign(instances.begin() + 1, instances.end());
+    }
+  }
   if (auto from = k.Take<double>("from_s")) o.flight_log.from_s = *from;
   if (auto to = k.Take<double>("to_s")) o.flight_log.to_s = *to;
   o.flight_log.undo_correction = !k.Take<bool>("as_logged", false);

@@ -360,7 +360,9 @@ class Pickling(unittest.TestCase):
             for i in range(5):
                 f.write(f"{0.01 * i},0.1,0.2,-9.8,0.001,0.002,0.003,"
                         f"{i},0.5,-9.75,0.01,0.02,{0.03 * i},30.25,4,5,-9.5\n")
-        s = plumb.open(path)
+        self.assertEqual(plumb.open(path).other_imus, [])  # IMU 0 alone unless imus= asks
+        self.assertEqual([b.instance for b in plumb.open(path, imus=[0, 2]).other_imus], [2])
+        s = plumb.open(path, imus="all")
         self.assertEqual(len(s), 5)
         imus = s.other_imus
         self.assertEqual([(b.instance, b.name, len(b)) for b in imus],
@@ -378,7 +380,7 @@ class Pickling(unittest.TestCase):
         acc = imus[0].acc
         del s, imus  # the view keeps the session's storage alive
         np.testing.assert_array_equal(acc[:, 0], np.arange(5, dtype=np.float32))
-        s = plumb.open(path)
+        s = plumb.open(path, imus="all")
         u = pickle.loads(pickle.dumps(s))
         self.assertEqual(len(u.other_imus), 2)
         for a, b in zip(u.other_imus, s.other_imus):
@@ -392,7 +394,7 @@ class Pickling(unittest.TestCase):
         # Written back, the unpickled session reads as the file did.
         again = out("board_again.csv")
         plumb.write_csv(u, again)
-        self.assertEqual([(b.name, b.acc.tolist(), b.gyr.tolist()) for b in plumb.open(again).other_imus],
+        self.assertEqual([(b.name, b.acc.tolist(), b.gyr.tolist()) for b in plumb.open(again, imus="all").other_imus],
                          [(b.name, b.acc.tolist(), b.gyr.tolist()) for b in s.other_imus])
         # A session without other IMUs has an empty list, pickled or not.
         m, _ = mikoff()
