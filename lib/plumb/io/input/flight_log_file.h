@@ -48,10 +48,10 @@ FlightLogFormat SniffFlightLog(const std::string& path);
 /// kNone).
 const char* FlightLogFormatName(FlightLogFormat format);
 
-/// The instances `--imus all` reads besides IMU 0 (SPEC "Several IMUs of one board"): every
-/// instance of summary.imus other than `imu0` with a stream of at least 2 samples that carries
-/// accelerometer samples, ascending, each once. A declared stream without samples (an IMU3
-/// format in a log that wrote no IMU3 record) is not one.
+/// The instances InputOptions::all_imus reads besides IMU 0 (SPEC "Several IMUs of one
+/// board"): every instance of summary.imus other than `imu0` with a stream of at least 2
+/// samples that carries accelerometer samples, ascending, each once. A declared stream without
+/// samples (an IMU3 format in a log that wrote no IMU3 record) is not one.
 std::vector<int> BoardInstances(const FlightLogSummary& summary, int imu0);
 
 /// A decoded flight log of any supported format.
