@@ -106,7 +106,7 @@ BoardImuCalibration ReportBoardImu(const CalibrationProblem& problem, std::size_
     for (int i = 0; i < info.size(); ++i) {
       const model::ParameterInfo& p = info.parameters[static_cast<std::size_t>(i)];
       ParameterEstimate e;
-      e.name = u.name_prefix + (info.prefix.empty() ? p.name : info.ParameterName(i));
+      e.name = u.ParameterName(local, i);
       e.place = {local, i};
       e.unit = mount ? p.unit : ParameterUnit(u.model, e.place, *u.series);
       e.value = p.nominal + block[i];

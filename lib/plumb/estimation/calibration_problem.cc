@@ -397,8 +397,7 @@ void CalibrationProblem::AddTermColumns(const ceres::Problem& problem,
           std::find(held.begin(), held.end(), ParameterIndex(t, i)) != held.end()) {
         continue;
       }
-      const std::string& name = info.parameters[static_cast<std::size_t>(i)].name;
-      out.names.push_back(u.name_prefix + (info.prefix.empty() ? name : info.ParameterName(i)));
+      out.names.push_back(u.ParameterName(local, i));
       out.values.push_back(info.parameters[static_cast<std::size_t>(i)].nominal + values[i]);
       out.typical.push_back(TypicalSize(info, i, linear.F, linear.E));
       out.is_model.push_back(true);

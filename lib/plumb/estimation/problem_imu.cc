@@ -32,6 +32,12 @@ bool ProblemImu::Fixed(int local, int i) const {
   return model.terms()[static_cast<std::size_t>(local)].fixed[static_cast<std::size_t>(i)];
 }
 
+std::string ProblemImu::ParameterName(int local, int i) const {
+  const model::EffectInfo& info = TermInfo(local);
+  const std::string& name = info.parameters[static_cast<std::size_t>(i)].name;
+  return name_prefix + (info.prefix.empty() ? name : info.ParameterName(i));
+}
+
 std::vector<std::size_t> ProblemImu::WanderOf(model::Sensor sensor) const {
   std::vector<std::size_t> out;
   for (std::size_t p = 0; p < wander.size(); ++p) {

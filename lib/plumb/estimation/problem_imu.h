@@ -69,6 +69,9 @@ struct ProblemImu {
   /// Whether parameter i of term `local` is held in every fit (the model's fixed ones; the
   /// mount's lever arm and time offset, which no residual sees yet).
   bool Fixed(int local, int i) const;
+  /// The full name of parameter i of term `local`, as the fit's columns and the report name
+  /// it: the prefix, then the effect's name ("imu1.accel.bias.x"; the mount's "imu1.rotation.x").
+  std::string ParameterName(int local, int i) const;
   /// Its wander processes of `sensor` (indices into `wander`).
   std::vector<std::size_t> WanderOf(model::Sensor sensor) const;
 
