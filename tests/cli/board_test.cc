@@ -117,6 +117,11 @@ TEST(BoardCli, ARealLogsTwoImusStillInOnePose) {
     yaw_named = yaw_named || u.get<std::string>().find("imu1.rotation.z") != std::string::npos;
   }
   EXPECT_TRUE(yaw_named) << doc["observability"].dump();
+  // The text says what the one pose determines of the mount and what it cannot show.
+  EXPECT_NE(run.out.find("rotation into the body not determined by these data"), std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("not seen at all: imu1.rotation.z"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("\n  imu1.rotation.x + "), std::string::npos) << run.out;
 }
 
 }  // namespace

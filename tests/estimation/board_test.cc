@@ -11,6 +11,7 @@
 #include <iostream>
 #include <utility>
 #include <map>
+#include <set>
 #include <string>
 
 #include "plumb/core/so3.h"
@@ -254,6 +255,25 @@ TEST(BoardFit, ARealBoardStillInOnePoseCannotShowItsYaw) {
   const CalibrationResult r = CalibrateBoard(s.series, s.other_imus, segments, m, site);
   if (std::getenv("PLUMB_PRINT")) std::cout << report::FullReport(r);
   ASSERT_EQ(r.calibration.board.size(), 1u);
+  // The mount the data cannot determine is held where it starts, at the square mount, by its
+  // own rotation as the gauge: the fit neither turns it along a null direction of its
+  // gyroscope's matrix nor fails a gate.
+  for (const Gate& g : r.fit.gates) ADD_FAILURE() << g.name << ": " << g.message;
+  EXPECT_LT(Eigen::AngleAxisd(r.calibration.board[0].R_b_i()).angle(), 1e-9);
+  // One pose: IMU2's tilt (rotation.x, .y) is determined only with the accelerometers' bias
+  // difference, to a hundredth of a degree; its turn about gravity (rotation.z) not at all.
+  std::set<std::string> leading;
+  for (const Combination& d : r.calibration.observability.determined) {
+    std::size_t lead = 0;
+    for (std::size_t i = 1; i < d.names.size(); ++i) {
+      if (std::abs(d.coefficients[i]) > std::abs(d.coefficients[lead])) lead = i;
+    }
+    if (d.names[lead].rfind("imu1.rotation.", 0) != 0) continue;
+    leading.insert(d.names[lead]);
+    EXPECT_LT(d.sigma / std::abs(d.coefficients[lead]), 1e-3) << d.text;
+  }
+  EXPECT_EQ(leading, (std::set<std::string>{"imu1.rotation.x", "imu1.rotation.y"}))
+      << report::FullReport(r);
   bool yaw_named = false;
   for (const std::string& u : r.calibration.observability.unobservable) {
     yaw_named = yaw_named || u.find("imu1.rotation.z") != std::string::npos;

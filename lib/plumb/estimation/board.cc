@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <utility>
@@ -15,16 +16,45 @@
 namespace plumb::estimation {
 namespace {
 
-/// The rotation nearest (in the Frobenius norm) the mean of R_n_b(k)^T R_n_i(k) over the poses.
+/// The rotation nearest (in the Frobenius norm) `m`.
+Mat3 NearestRotation(const Mat3& m) {
+  const Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 D = Mat3::Identity();
+  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixU() * D * svd.matrixV().transpose();
+}
+
+/// The rotation among the 24 that map axes onto axes (a board's IMU mounted square to it)
+/// nearest `R`: the one with the largest trace of P^T R.
+Mat3 NearestRightAngleRotation(const Mat3& R) {
+  Mat3 best = Mat3::Identity();
+  double best_trace = -4.0;
+  std::array<int, 3> axis = {0, 1, 2};
+  do {
+    for (int signs = 0; signs < 8; ++signs) {
+      Mat3 P = Mat3::Zero();
+      for (int r = 0; r < 3; ++r) P(r, axis[r]) = (signs >> r & 1) != 0 ? -1.0 : 1.0;
+      const double trace = (P.transpose() * R).trace();
+      if (P.determinant() > 0 && trace > best_trace) {
+        best = P;
+        best_trace = trace;
+      }
+    }
+  } while (std::next_permutation(axis.begin(), axis.end()));
+  return best;
+}
+
+/// The starting R_b_i: the rotation nearest the mean of R_n_b(k)^T R_n_i(k) over the poses.
+/// From one pose that rotation is only the turn between the two accelerometers' gravity
+/// directions, biases included, and the data cannot tell a mount from a bias: start (and,
+/// where it stays undetermined, hold) at the nearest square mount, as a bias starts at 0.
 Quat StartingMount(const StillSet& imu0, const StillSet& imu) {
   Mat3 sum = Mat3::Zero();
   for (std::size_t k = 0; k < imu0.poses.size(); ++k) {
     sum += (imu0.poses[k].R_n_b().conjugate() * imu.poses[k].R_n_b()).toRotationMatrix();
   }
-  const Eigen::JacobiSVD<Mat3> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Mat3 D = Mat3::Identity();
-  D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
-  return Quat(Mat3(svd.matrixU() * D * svd.matrixV().transpose())).normalized();
+  const Mat3 mean = NearestRotation(sum);
+  return Quat(imu0.poses.size() < 2 ? NearestRightAngleRotation(mean) : mean).normalized();
 }
 
 /// Its noise model with the wander's levels assigned from its own still data.

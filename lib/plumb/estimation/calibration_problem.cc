@@ -382,13 +382,12 @@ void CalibrationProblem::AddHeldCombinations(BuiltProblem& built,
 
 void CalibrationProblem::AddTermColumns(const ceres::Problem& problem,
                                         const std::vector<ParameterIndex>& held,
-                                        std::size_t imu, bool mounts, UnknownColumns& out) {
+                                        std::size_t imu, TermRange locals,
+                                        UnknownColumns& out) {
   const ProblemImu& u = imus_[imu];
   const std::vector<const double*> blocks = TermBlocks(imu);
   const auto linear = u.model.Predict(blocks.data(), model::SensorInput<double>());
-  const int model_terms = u.model.num_terms();
-  for (int local = mounts ? model_terms : 0; local < (mounts ? u.num_terms() : model_terms);
-       ++local) {
+  for (int local = locals.first; local < locals.end; ++local) {
     const int t = u.first_term + local;
     double* values = block(t);
     if (problem.IsParameterBlockConstant(values)) continue;
@@ -438,8 +437,12 @@ UnknownColumns CalibrationProblem::Columns(const ceres::Problem& problem,
   // The mounts first: where the data cannot determine a mount (a rotation about gravity seen
   // in one pose), its own rotation is held as the gauge (observability.h: pivots in column
   // order) rather than a combination of its gyroscope's matrix that turns it far away.
-  for (std::size_t i = 1; i < imus_.size(); ++i) AddTermColumns(problem, held, i, true, out);
-  for (std::size_t i = 0; i < imus_.size(); ++i) AddTermColumns(problem, held, i, false, out);
+  for (std::size_t i = 0; i < imus_.size(); ++i) {
+    AddTermColumns(problem, held, i, {imus_[i].model.num_terms(), imus_[i].num_terms()}, out);
+  }
+  for (std::size_t i = 0; i < imus_.size(); ++i) {
+    AddTermColumns(problem, held, i, {0, imus_[i].model.num_terms()}, out);
+  }
   const char* kTangentName[3] = {"north", "east", "down"};
   for (std::size_t k = 0; k < still().poses.size(); ++k) {
     const StillPose& s = still().poses[k];

@@ -104,8 +104,8 @@ struct BuiltProblem {
 };
 
 /// The free unknowns of a built problem as Jacobian columns, in order: the board's mounts (IMU
-/// by IMU), the model parameters (IMU by IMU, term by term), then attitude tangents (pose by pose: north, east, down as free), then the
-/// bias-wander states (pose by pose; per process of NoiseModel::Wander, start then end).
+/// by IMU), the model parameters (IMU by IMU, term by term), then attitude tangents (pose by
+/// pose: north, east, down as free), then the bias-wander states (pose by pose; per process of NoiseModel::Wander, start then end).
 struct UnknownColumns {
   std::vector<double*> blocks;          ///< parameter blocks in column order
   std::vector<std::string> names;       ///< per column, e.g. "accel.bias.x", "attitude[3].down"
@@ -232,10 +232,15 @@ class CalibrationProblem {
   void AddWanderFactors(BuiltProblem& built, std::size_t imu, std::size_t p);
   double* q(std::size_t k) { return values_.data() + q_offset_ + 4 * k; }
   const double* q(std::size_t k) const { return values_.data() + q_offset_ + 4 * k; }
-  /// Adds the columns of IMU `imu`'s free model blocks (or, with `mounts`, of its
-  /// board_mount block) to `out`.
+  /// IMU-local terms [first, end): its model's are [0, model.num_terms()), its mount the one
+  /// after them.
+  struct TermRange {
+    int first = 0;
+    int end = 0;
+  };
+  /// Adds the columns of IMU `imu`'s free blocks among its terms `locals` to `out`.
   void AddTermColumns(const ceres::Problem& problem, const std::vector<ParameterIndex>& held,
-                      std::size_t imu, bool mounts, UnknownColumns& out);
+                      std::size_t imu, TermRange locals, UnknownColumns& out);
   /// Adds the columns of IMU `imu`'s wander states to `out`.
   void AddWanderColumns(std::size_t imu, UnknownColumns& out);
 

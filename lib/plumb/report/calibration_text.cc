@@ -1,6 +1,7 @@
 #include "plumb/report/calibration_text.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -9,6 +10,7 @@
 
 #include "plumb/core/number_text.h"
 #include "plumb/core/units.h"
+#include "plumb/estimation/observability.h"
 #include "plumb/estimation/uncertainty.h"
 
 namespace plumb::report {
@@ -45,14 +47,89 @@ std::string ParameterTable(const std::vector<estimation::ParameterEstimate>& par
   return out;
 }
 
+/// The rotation parameters (rotation.x..z, rad) of board IMU `b`, in axis order.
+std::vector<const estimation::ParameterEstimate*> RotationParameters(
+    const estimation::BoardImuCalibration& b) {
+  std::vector<const estimation::ParameterEstimate*> out;
+  for (const auto& p : b.parameters) {
+    if (p.place.term == b.model.num_terms() && p.place.index < 3) out.push_back(&p);
+  }
+  return out;
+}
+
+/// Where the data determine `rotation` only together with other parameters (one still pose:
+/// a tilt of the IMU trades with the accelerometers' bias difference, g * tilt, and a turn
+/// about gravity is not seen), each determined combination led by one of its components,
+/// divided by that component's coefficient: the component's value once the others are known.
+std::string UndeterminedMountText(const estimation::Calibration& c,
+                                  const std::vector<const estimation::ParameterEstimate*>& rotation) {
+  std::string out;
+  std::vector<bool> led(rotation.size(), false);
+  for (const estimation::Combination& d : c.observability.determined) {
+    std::size_t lead = rotation.size();
+    double lead_coefficient = 0.0, largest = 0.0;
+    for (std::size_t i = 0; i < d.names.size(); ++i) {
+      largest = std::max(largest, std::abs(d.coefficients[i]));
+      for (std::size_t r = 0; r < rotation.size(); ++r) {
+        if (d.names[i] == rotation[r]->name &&
+            std::abs(d.coefficients[i]) > std::abs(lead_coefficient)) {
+          lead = r;
+          lead_coefficient = d.coefficients[i];
+        }
+      }
+    }
+    // Led by a rotation: its coefficient the combination's largest (g per rad against a
+    // bias's 1 per m/s^2), not a trace of one in a gyroscope's combination.
+    if (lead == rotation.size() || std::abs(lead_coefficient) < largest || led[lead]) continue;
+    led[lead] = true;
+    Eigen::VectorXd coefficients(static_cast<Eigen::Index>(d.names.size()));
+    for (std::size_t i = 0; i < d.names.size(); ++i) {
+      coefficients(static_cast<Eigen::Index>(i)) = d.coefficients[i] / lead_coefficient;
+    }
+    const double value = d.value / lead_coefficient;
+    const double sigma = d.sigma / std::abs(lead_coefficient);
+    out += "  " + estimation::FormatCombination(coefficients, d.names, false) + " = " +
+           FormattedText("%.4g", value) + " +- " + FormattedText("%.2g", sigma) + " rad (" +
+           FormattedText("%.4g", value * units::kDegPerRad) + " +- " +
+           FormattedText("%.2g", sigma * units::kDegPerRad) + " deg)\n";
+  }
+  std::string unseen;
+  for (std::size_t r = 0; r < rotation.size(); ++r) {
+    if (!led[r] && !rotation[r]->observable) unseen += (unseen.empty() ? "" : ", ") + rotation[r]->name;
+  }
+  if (!unseen.empty()) {
+    out += "  not seen at all: " + unseen +
+           " (a turn about gravity, which still poses in one orientation cannot show)\n";
+  }
+  return out;
+}
+
+/// Board IMU `b`'s rotation into the body: determined (angle, axis, sigmas) or what of it is.
+std::string MountText(const estimation::Calibration& c, const estimation::BoardImuCalibration& b) {
+  const std::vector<const estimation::ParameterEstimate*> rotation = RotationParameters(b);
+  const Eigen::AngleAxisd aa(b.R_b_i());
+  const std::string held = FormattedText("%.4g", aa.angle() * units::kDegPerRad) + " deg about " +
+                           Vec(aa.axis(), "%.3f");
+  const bool determined = std::all_of(rotation.begin(), rotation.end(), [](const auto* p) {
+    return p->observable && std::isfinite(p->sigma);
+  });
+  if (determined) {
+    return "rotation into the body " + held + ", sigma about x, y, z " +
+           Vec(Vec3(rotation[0]->sigma, rotation[1]->sigma, rotation[2]->sigma) *
+                   units::kDegPerRad, "%.2g") +
+           " deg\n";
+  }
+  return "rotation into the body not determined by these data (held at " + held +
+         "); what they determine of it:\n" + UndeterminedMountText(c, rotation);
+}
+
 /// The board's other IMUs (SPEC 6): each one's rotation into the body and its parameters.
 std::string BoardText(const estimation::Calibration& c, double scale) {
   std::string out;
   for (const auto& b : c.board) {
-    const Eigen::AngleAxisd aa(b.R_b_i());
-    out += "\nimu" + std::to_string(b.instance) + ", fitted with IMU 0 (the attitudes shared): " +
-           "rotation into the body " + FormattedText("%.4g", aa.angle() * units::kDegPerRad) +
-           " deg about " + Vec(aa.axis(), "%.3f") + "; lever arm and time offset held at 0 (not fitted yet)\n";
+    out += "\nimu" + std::to_string(b.instance) +
+           ", fitted with IMU 0 (the attitudes shared); lever arm and time offset held at 0 "
+           "(not fitted yet); " + MountText(c, b);
     out += ParameterTable(b.parameters, scale);
   }
   return out;
