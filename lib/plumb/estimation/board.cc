@@ -8,6 +8,7 @@
 #include <utility>
 #include <string>
 
+#include "plumb/core/units.h"
 #include "plumb/estimation/covariance.h"
 #include "plumb/estimation/initialization.h"
 #include "plumb/estimation/noise_model.h"
@@ -44,8 +45,25 @@ Mat3 NearestRightAngleRotation(const Mat3& R) {
   return best;
 }
 
+/// Still poses whose gravity directions lie within this angle of each other are one
+/// orientation for the mount's start: 5 deg is a tilt an accelerometer's bias mimics (0.5 m/s^2
+/// of bias, common before calibration, is 3 deg), so such poses say nothing of the tilt.
+inline constexpr double kOneOrientationRad = 5.0 * units::kRadPerDeg;
+
+/// Whether the poses of `still` see gravity from one orientation only (kOneOrientationRad).
+bool OneOrientation(const StillSet& still) {
+  for (const StillPose& a : still.poses) {
+    for (const StillPose& b : still.poses) {
+      const Vec3 down_a = a.R_n_b().conjugate() * Vec3::UnitZ();
+      const Vec3 down_b = b.R_n_b().conjugate() * Vec3::UnitZ();
+      if (std::acos(std::clamp(down_a.dot(down_b), -1.0, 1.0)) > kOneOrientationRad) return false;
+    }
+  }
+  return true;
+}
+
 /// The starting R_b_i: the rotation nearest the mean of R_n_b(k)^T R_n_i(k) over the poses.
-/// From one pose that rotation is only the turn between the two accelerometers' gravity
+/// From one orientation that rotation is only the turn between the two accelerometers' gravity
 /// directions, biases included, and the data cannot tell a mount from a bias: start (and,
 /// where it stays undetermined, hold) at the nearest square mount, as a bias starts at 0.
 Quat StartingMount(const StillSet& imu0, const StillSet& imu) {
@@ -54,7 +72,7 @@ Quat StartingMount(const StillSet& imu0, const StillSet& imu) {
     sum += (imu0.poses[k].R_n_b().conjugate() * imu.poses[k].R_n_b()).toRotationMatrix();
   }
   const Mat3 mean = NearestRotation(sum);
-  return Quat(imu0.poses.size() < 2 ? NearestRightAngleRotation(mean) : mean).normalized();
+  return Quat(OneOrientation(imu0) ? NearestRightAngleRotation(mean) : mean).normalized();
 }
 
 /// Its noise model with the wander's levels assigned from its own still data.

@@ -57,55 +57,93 @@ std::vector<const estimation::ParameterEstimate*> RotationParameters(
   return out;
 }
 
-/// Where the data determine `rotation` only together with other parameters (one still pose:
-/// a tilt of the IMU trades with the accelerometers' bias difference, g * tilt, and a turn
-/// about gravity is not seen), each determined combination led by one of its components,
-/// divided by that component's coefficient: the component's value once the others are known.
-std::string UndeterminedMountText(const estimation::Calibration& c,
-                                  const std::vector<const estimation::ParameterEstimate*>& rotation) {
-  std::string out;
-  std::vector<bool> led(rotation.size(), false);
-  for (const estimation::Combination& d : c.observability.determined) {
-    std::size_t lead = rotation.size();
-    double lead_coefficient = 0.0, largest = 0.0;
-    for (std::size_t i = 0; i < d.names.size(); ++i) {
-      largest = std::max(largest, std::abs(d.coefficients[i]));
-      for (std::size_t r = 0; r < rotation.size(); ++r) {
-        if (d.names[i] == rotation[r]->name &&
-            std::abs(d.coefficients[i]) > std::abs(lead_coefficient)) {
-          lead = r;
-          lead_coefficient = d.coefficients[i];
-        }
+/// The rotation (index into `rotation`) that leads combination `d`: its coefficient the
+/// combination's largest (g per rad against a bias's 1 per m/s^2; a tie with the accelerometer
+/// matrix's term, which tilts alike), not a trace of one in a gyroscope's combination;
+/// rotation.size() when none does.
+std::size_t LeadingRotation(const estimation::Combination& d,
+                            const std::vector<const estimation::ParameterEstimate*>& rotation) {
+  constexpr double kLeadShare = 0.999;  // its own largest, to rounding
+  std::size_t lead = rotation.size();
+  double lead_coefficient = 0.0, largest = 0.0;
+  for (std::size_t i = 0; i < d.names.size(); ++i) {
+    largest = std::max(largest, std::abs(d.coefficients[i]));
+    for (std::size_t r = 0; r < rotation.size(); ++r) {
+      if (d.names[i] == rotation[r]->name &&
+          std::abs(d.coefficients[i]) > std::abs(lead_coefficient)) {
+        lead = r;
+        lead_coefficient = d.coefficients[i];
       }
     }
-    // Led by a rotation: its coefficient the combination's largest (g per rad against a
-    // bias's 1 per m/s^2), not a trace of one in a gyroscope's combination.
-    if (lead == rotation.size() || std::abs(lead_coefficient) < largest || led[lead]) continue;
-    led[lead] = true;
-    Eigen::VectorXd coefficients(static_cast<Eigen::Index>(d.names.size()));
-    for (std::size_t i = 0; i < d.names.size(); ++i) {
-      coefficients(static_cast<Eigen::Index>(i)) = d.coefficients[i] / lead_coefficient;
-    }
-    const double value = d.value / lead_coefficient;
-    const double sigma = d.sigma / std::abs(lead_coefficient);
-    out += "  " + estimation::FormatCombination(coefficients, d.names, false) + " = " +
-           FormattedText("%.4g", value) + " +- " + FormattedText("%.2g", sigma) + " rad (" +
-           FormattedText("%.4g", value * units::kDegPerRad) + " +- " +
-           FormattedText("%.2g", sigma * units::kDegPerRad) + " deg)\n";
   }
-  std::string unseen;
+  return std::abs(lead_coefficient) < kLeadShare * largest ? rotation.size() : lead;
+}
+
+/// Combination `d` divided by the coefficient of `name`: that parameter's value (rad) once the
+/// others are known, with its sigma, and `remark` after it.
+std::string LedCombinationText(const estimation::Combination& d, const std::string& name,
+                               const std::string& remark) {
+  double lead_coefficient = 1.0;
+  for (std::size_t i = 0; i < d.names.size(); ++i) {
+    if (d.names[i] == name) lead_coefficient = d.coefficients[i];
+  }
+  Eigen::VectorXd coefficients(static_cast<Eigen::Index>(d.names.size()));
+  for (std::size_t i = 0; i < d.names.size(); ++i) {
+    coefficients(static_cast<Eigen::Index>(i)) = d.coefficients[i] / lead_coefficient;
+  }
+  const double value = d.value / lead_coefficient;
+  const double sigma = d.sigma / std::abs(lead_coefficient);
+  return "  " + estimation::FormatCombination(coefficients, d.names, false) + " = " +
+         FormattedText("%.4g", value) + " +- " + FormattedText("%.2g", sigma) + " rad (" +
+         FormattedText("%.4g", value * units::kDegPerRad) + " +- " +
+         FormattedText("%.2g", sigma * units::kDegPerRad) + " deg)" + remark + "\n";
+}
+
+/// Where the data determine `rotation` only together with other parameters (one still pose:
+/// a tilt of the IMU trades with the accelerometers' bias difference, g * tilt, and a turn
+/// about gravity is not seen): each component alone where determined, else the determined (or
+/// weakly determined) combination it leads, divided by its coefficient: the component's value
+/// once the others are known; and the components nothing determines.
+std::string UndeterminedMountText(const estimation::Calibration& c,
+                                  const std::vector<const estimation::ParameterEstimate*>& rotation,
+                                  bool one_orientation) {
+  std::string out;
+  std::vector<bool> said(rotation.size(), false);
   for (std::size_t r = 0; r < rotation.size(); ++r) {
-    if (!led[r] && !rotation[r]->observable) unseen += (unseen.empty() ? "" : ", ") + rotation[r]->name;
+    const estimation::ParameterEstimate& p = *rotation[r];
+    if (!p.observable || !std::isfinite(p.sigma)) continue;
+    said[r] = true;
+    out += LedCombinationText({p.name, p.value, p.sigma, 0.0, {p.name}, {1.0}}, p.name, "");
   }
-  if (!unseen.empty()) {
-    out += "  not seen at all: " + unseen +
-           " (a turn about gravity, which still poses in one orientation cannot show)\n";
+  const std::pair<const std::vector<estimation::Combination>*, const char*> lists[] = {
+      {&c.observability.determined, ""},
+      {&c.observability.weakly_determined,
+       ": weakly determined, held where it starts (see the weakly determined combinations)"}};
+  for (const auto& [list, remark] : lists) {
+    for (const estimation::Combination& d : *list) {
+      const std::size_t lead = LeadingRotation(d, rotation);
+      if (lead == rotation.size() || said[lead]) continue;
+      said[lead] = true;
+      out += LedCombinationText(d, rotation[lead]->name, remark);
+    }
+  }
+  std::string unsaid;
+  for (std::size_t r = 0; r < rotation.size(); ++r) {
+    if (!said[r]) unsaid += (unsaid.empty() ? "" : ", ") + rotation[r]->name;
+  }
+  if (!unsaid.empty()) {
+    out += "  " + unsaid +
+           (one_orientation
+                ? ": not seen at all (a turn about gravity, which still poses in one orientation "
+                  "cannot show)\n"
+                : ": leads no combination these data determine (see the unobservable directions)\n");
   }
   return out;
 }
 
 /// Board IMU `b`'s rotation into the body: determined (angle, axis, sigmas) or what of it is.
-std::string MountText(const estimation::Calibration& c, const estimation::BoardImuCalibration& b) {
+std::string MountText(const estimation::Calibration& c, const estimation::FitReport& fit,
+                      const estimation::BoardImuCalibration& b) {
   const std::vector<const estimation::ParameterEstimate*> rotation = RotationParameters(b);
   const Eigen::AngleAxisd aa(b.R_b_i());
   const std::string held = FormattedText("%.4g", aa.angle() * units::kDegPerRad) + " deg about " +
@@ -120,16 +158,18 @@ std::string MountText(const estimation::Calibration& c, const estimation::BoardI
            " deg\n";
   }
   return "rotation into the body not determined by these data (held at " + held +
-         "); what they determine of it:\n" + UndeterminedMountText(c, rotation);
+         "); what they determine of it:\n" +
+         UndeterminedMountText(c, rotation, fit.distinct_poses <= 1);
 }
 
 /// The board's other IMUs (SPEC 6): each one's rotation into the body and its parameters.
-std::string BoardText(const estimation::Calibration& c, double scale) {
+std::string BoardText(const estimation::Calibration& c, const estimation::FitReport& fit,
+                      double scale) {
   std::string out;
   for (const auto& b : c.board) {
     out += "\nimu" + std::to_string(b.instance) +
            ", fitted with IMU 0 (the attitudes shared); lever arm and time offset held at 0 "
-           "(not fitted yet); " + MountText(c, b);
+           "(not fitted yet); " + MountText(c, fit, b);
     out += ParameterTable(b.parameters, scale);
   }
   return out;
@@ -225,7 +265,7 @@ std::string FullReport(const estimation::CalibrationResult& result) {
   const bool scaled = scale > 1.0;
   if (scaled) os << OverDispersionNote(fit);
   os << ParameterTable(c.parameters, scale);
-  os << BoardText(c, scale);
+  os << BoardText(c, fit, scale);
   if (!c.observability.unobservable.empty()) {
     os << "\nunobservable directions (moving along them changes no prediction):\n";
     for (const auto& u : c.observability.unobservable) os << "  " << u << "\n";
