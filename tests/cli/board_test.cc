@@ -101,14 +101,28 @@ TEST(BoardCli, WhatCannotCarryABoardIsRefusedWithTheReason) {
   EXPECT_EQ(run.exit_code, 2) << run.err;
 }
 
-TEST(BoardCli, ARealLogsTwoImusStillInOnePose) {
-  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/plane408_centre_point.BIN";
-  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
-  TempDir dir;
+/// `calibrate LOG --imus all --json` in the temporary folder `dir`: the run and its JSON
+/// (null when it wrote none).
+struct RealBoardRun {
+  ToolRun run;
+  json doc;
+};
+RealBoardRun CalibrateRealBoard(const std::string& log, const TempDir& dir) {
   const std::string out = dir.File("cal.json");
-  const ToolRun run = Plumb({"calibrate", log, "--imus", "all", "--json", out}, dir);
+  RealBoardRun r{Plumb({"calibrate", log, "--imus", "all", "--json", out}, dir), json()};
+  if (std::filesystem::exists(out)) r.doc = ReadJson(out);
+  return r;
+}
+
+#define PLUMB_SHARED_LOG(var, relative)                                              \
+  const std::string var = std::string(PLUMB_SHARED_DATA_DIR) + "/" + (relative);     \
+  if (!std::filesystem::exists(var)) GTEST_SKIP() << "shared data absent: " << var
+
+TEST(BoardCli, ARealLogsTwoImusStillInOnePose) {
+  PLUMB_SHARED_LOG(log, "ardupilot/plane408_centre_point.BIN");
+  TempDir dir;
+  const auto [run, doc] = CalibrateRealBoard(log, dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  const json doc = ReadJson(out);
   ASSERT_EQ(doc["imus"].size(), 2u);
   EXPECT_EQ(doc["imus"][1]["instance"], 1);
   // One pose: gravity cannot show IMU2's turn about itself; the output says so.
@@ -126,13 +140,10 @@ TEST(BoardCli, ARealLogsTwoImusStillInOnePose) {
 
 // The other real logs with several IMUs (issue 38's list): each says what its data can tell.
 TEST(BoardCli, ThreeMavlinkStreamsOfOneBoardConverge) {
-  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/mavlink/plane385_disarmed.tlog";
-  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  PLUMB_SHARED_LOG(log, "mavlink/plane385_disarmed.tlog");
   TempDir dir;
-  const std::string out = dir.File("cal.json");
-  const ToolRun run = Plumb({"calibrate", log, "--imus", "all", "--json", out}, dir);
+  const auto [run, doc] = CalibrateRealBoard(log, dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  const json doc = ReadJson(out);
   ASSERT_EQ(doc["imus"].size(), 3u);  // RAW_IMU, SCALED_IMU2, SCALED_IMU3
   // Each mount starts square (the poses share one orientation), and the fit converges there.
   EXPECT_TRUE(doc["gates"].empty()) << doc["gates"].dump();
@@ -140,13 +151,10 @@ TEST(BoardCli, ThreeMavlinkStreamsOfOneBoardConverge) {
 }
 
 TEST(BoardCli, AFlightsThreeImusAreNotTakenForStill) {
-  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/px4/sample_log_small.ulg";
-  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  PLUMB_SHARED_LOG(log, "px4/sample_log_small.ulg");
   TempDir dir;
-  const std::string out = dir.File("cal.json");
-  const ToolRun run = Plumb({"calibrate", log, "--imus", "all", "--json", out}, dir);
+  const auto [run, doc] = CalibrateRealBoard(log, dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  const json doc = ReadJson(out);
   ASSERT_EQ(doc["imus"].size(), 3u);  // sensor_combined, vehicle_imu 1 and 2
   bool not_still = false;
   for (const auto& g : doc["gates"]) not_still = not_still || g["name"] == "not_still";
@@ -154,10 +162,9 @@ TEST(BoardCli, AFlightsThreeImusAreNotTakenForStill) {
 }
 
 TEST(BoardCli, ALogWithoutAStillHoldSaysSo) {
-  const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/ardupilot/copter36_chibios.bin";
-  if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+  PLUMB_SHARED_LOG(log, "ardupilot/copter36_chibios.bin");
   TempDir dir;
-  const ToolRun run = Plumb({"calibrate", log, "--imus", "all"}, dir);
+  const auto [run, doc] = CalibrateRealBoard(log, dir);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("no still segment"), std::string::npos) << run.err;
 }
