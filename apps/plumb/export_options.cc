@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "fit_options.h"
 #include "plumb/core/error.h"
+#include "plumb/export/board_export.h"
 #include "plumb/export/export.h"
 #include "plumb/export/kalibr.h"
 #include "plumb/io/common/atomic_file.h"
@@ -18,7 +19,9 @@ void AddExportOptions(CLI::App* app, ExportArgs& a) {
                   "(Mission Planner .param: INS_ACCOFFS/ACCSCAL/GYROFFS, INS_TCALn_* when a "
                   "temperature term was fitted), px4 (QGroundControl .params: CAL_ACCn_*, "
                   "CAL_GYROn_*, TC_A/TC_G), kalibr (imu.yaml noise densities and random walks), "
-                  "json (all three); prints what each target cannot represent, in numbers")
+                  "json (all three); prints what each target cannot represent, in numbers. With "
+                  "--imus, every IMU of the board under its own instance's names (kalibr: "
+                  "Kalibr's multi-IMU yaml)")
       ->type_name("FORMAT=FILE");
   a.imu_option = app->add_option("--export-imu", a.imu,
                                  "IMU instance in the exported parameter names, 0-based "
@@ -101,8 +104,16 @@ nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const Expo
   options.system_id = session.system_id;
   if (a.sysid_option != nullptr && a.sysid_option->count() > 0) options.system_id = a.sysid;
   options.keep_gyro_offsets = a.keep_gyro_offsets;
+  // A board fit (--imus) writes every IMU's instance in each file.
+  const std::vector<exporter::BoardImuExport> board =
+      result.calibration.board.empty()
+          ? std::vector<exporter::BoardImuExport>{}
+          : exporter::BoardImuExports(result.calibration, series, result.fit.still,
+                                      session.other_imus, options.imu);
   for (const ExportRequest& r : requests) {
-    const exporter::ExportOutput e = exporter::Export(r.format, result.calibration, series, result.fit.still, options);
+    const exporter::ExportOutput e =
+        board.empty() ? exporter::Export(r.format, result.calibration, series, result.fit.still, options)
+                      : exporter::ExportBoard(r.format, board, options);
     io::WriteFileAtomic(r.path, e.text);
     out << "\n";
     for (const std::string& line : e.lines) out << line << "\n";

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,69 @@ TEST(BoardCli, WhatCannotCarryABoardIsRefusedWithTheReason) {
   // Commands that do not fit the board do not take the flag.
   run = Plumb({"allan", csv, "--imus", "all"}, dir);
   EXPECT_EQ(run.exit_code, 2) << run.err;
+}
+
+/// The value of `name` in a Mission Planner .param text, NaN when absent; ADD_FAILURE when it
+/// is written twice.
+double ParamValue(const std::string& text, const std::string& name) {
+  double value = std::nan("");
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(name + ",", 0) != 0) continue;
+    if (!std::isnan(value)) ADD_FAILURE() << name << " written twice";
+    value = std::stod(line.substr(name.size() + 1));
+  }
+  return value;
+}
+
+/// The true value of parameter `name` of IMU `k` in a `plumb simulate` truth file.
+double TrueValue(const json& truth, std::size_t k, const std::string& name) {
+  const json& parameters = k == 0 ? truth["parameters"] : truth["imus"][k]["parameters"];
+  const std::string full = k == 0 ? name : "imu" + std::to_string(k) + "." + name;
+  for (const json& p : parameters) {
+    if (p["name"] == full) return p["value"];
+  }
+  ADD_FAILURE() << full << " not in the truth";
+  return std::nan("");
+}
+
+// Exports of a board: every instance under the firmware's own names, in one file per format.
+TEST(BoardCli, ExportsWriteEveryInstanceUnderItsOwnNames) {
+  TempDir dir;
+  const auto [csv, truth_path] = SimulateBoard(dir);
+  const std::string out = dir.File("cal.json"), ardupilot = dir.File("imu.param"),
+                    px4 = dir.File("imu.params"), kalibr = dir.File("imu.yaml");
+  const ToolRun run = Plumb({"calibrate", csv, "--imus", "all", "--constant-bias", "--json", out,
+                             "--lat", "51.64", "--lon", "-1.2", "--height", "100", "--export",
+                             "ardupilot=" + ardupilot, "--export", "px4=" + px4, "--export",
+                             "kalibr=" + kalibr},
+                            dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json truth = ReadJson(truth_path);
+  const std::string param = testing::ReadAll(ardupilot), params = testing::ReadAll(px4);
+  const char* ardupilot_stem[] = {"INS_ACC", "INS_ACC2", "INS_ACC3"};
+  for (std::size_t k = 0; k < 3; ++k) {
+    // ArduPilot's offsets are the accelerometer's biases (acc = (raw - OFFS) .* SCAL), each
+    // IMU's under its instance's name, within a misalignment's reach of its truth (a few
+    // mrad of g: the diagonal correction cannot hold the rest).
+    const double offset = ParamValue(param, std::string(ardupilot_stem[k]) + "OFFS_X");
+    EXPECT_NEAR(offset, TrueValue(truth, k, "accel.bias.x"), 0.05) << "IMU " << k;
+    const std::string gyro = k == 0 ? "INS_GYROFFS_Z" : "INS_GYR" + std::to_string(k + 1) + "OFFS_Z";
+    EXPECT_FALSE(std::isnan(ParamValue(param, gyro))) << gyro;
+    EXPECT_TRUE(Contains(params, "\tCAL_ACC" + std::to_string(k) + "_XOFF\t")) << params;
+    EXPECT_TRUE(Contains(params, "\tCAL_GYRO" + std::to_string(k) + "_ZOFF\t")) << params;
+  }
+  // Kalibr's IMU set: imu0..imu2, each T_i_b's rotation the transpose of its R_b_i.
+  const std::string yaml = testing::ReadAll(kalibr);
+  const json doc = ReadJson(out);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::string key = "\nimu" + std::to_string(k) + ":\n  T_i_b:\n    - [";
+    const auto at = yaml.find(key);
+    ASSERT_NE(at, std::string::npos) << yaml;
+    const double c01 = std::stod(yaml.substr(yaml.find(", ", at) + 2));
+    const double r10 = doc["imus"][k]["rotation"]["matrix"][1][0];
+    EXPECT_NEAR(c01, r10, 1e-15) << "imu" << k;
+  }
 }
 
 /// `calibrate LOG --imus all --json` in the temporary folder `dir`: the run and its JSON

@@ -128,24 +128,32 @@ void AssignHeadingGauge(StillSet& set, bool has_gyro) {
   }
 }
 
+StillSegment SegmentOnBoardImu(const StillSegment& segment, const ImuSeries& series0,
+                               const ImuSeries& series) {
+  const double t_begin = series0.t_s[segment.begin];
+  const double t_end = series0.t_s[segment.end - 1];
+  const auto begin = std::lower_bound(series.t_s.begin(), series.t_s.end(), t_begin);
+  const auto end = std::upper_bound(begin, series.t_s.end(), t_end);
+  StillSegment own = segment;
+  own.begin = static_cast<std::size_t>(begin - series.t_s.begin());
+  own.end = static_cast<std::size_t>(end - series.t_s.begin());
+  return own;
+}
+
 StillSet StillSetOnBoardImu(const StillSet& imu0, const ImuSeries& series0,
                             const ImuSeries& series, const std::string& name) {
   StillSet set;
   set.joined_to_previous = imu0.joined_to_previous;
   for (const StillPose& pose : imu0.poses) {
-    const double t_begin = series0.t_s[pose.segment.begin];
-    const double t_end = series0.t_s[pose.segment.end - 1];
-    const auto begin = std::lower_bound(series.t_s.begin(), series.t_s.end(), t_begin);
-    const auto end = std::upper_bound(begin, series.t_s.end(), t_end);
-    if (end - begin < 2) {
-      throw InsufficientDataError(name + " has " + std::to_string(end - begin) +
+    StillPose own = pose;
+    own.segment = SegmentOnBoardImu(pose.segment, series0, series);
+    if (own.segment.count() < 2) {
+      throw InsufficientDataError(name + " has " + std::to_string(own.segment.count()) +
                                   " samples in the still pose " + pose.segment.label + " (" +
-                                  std::to_string(t_begin) + " .. " + std::to_string(t_end) +
+                                  std::to_string(series0.t_s[pose.segment.begin]) + " .. " +
+                                  std::to_string(series0.t_s[pose.segment.end - 1]) +
                                   " s): each IMU of the board needs at least 2 in every pose");
     }
-    StillPose own = pose;
-    own.segment.begin = static_cast<std::size_t>(begin - series.t_s.begin());
-    own.segment.end = static_cast<std::size_t>(end - series.t_s.begin());
     own.stats = signal::ComputeSegmentStats(series, own.segment);
     set.poses.push_back(std::move(own));
   }

@@ -83,6 +83,12 @@ struct StillSet {
 StillSet MakeStillSet(const ImuSeries& series, const std::vector<StillSegment>& segments,
                       bool earth_rate_seen, bool motion_on, const CalibrationOptions& options);
 
+/// IMU 0's still segment `segment` (of `series0`) as another IMU of the board samples it: its
+/// samples in `series` stamped within the segment's first and last sample times (possibly
+/// none).
+StillSegment SegmentOnBoardImu(const StillSegment& segment, const ImuSeries& series0,
+                               const ImuSeries& series);
+
 /// IMU 0's poses and motion intervals as another IMU of the board samples them (SPEC 6): each
 /// pose its samples stamped within the pose's first and last sample times, with their
 /// statistics, each interval from the last sample of one pose to the first of the next; the

@@ -22,6 +22,7 @@
 //   device_id               export.cc: the device id the log records, written
 //   system_id               export.cc: the PX4 vehicle id written (kSystemId when not given)
 //   board_frame             export.cc: the axes are the log's board frame
+//   board_mount             board_export.cc: where a board IMU sits, which no parameter holds
 //   no_still_segment        firmware.cc, kalibr.cc: nothing at rest to measure on
 //   undetermined            firmware.cc: directions the session does not determine
 //   noise_model_only        kalibr.cc: imu.yaml holds the noise model only

@@ -1,10 +1,13 @@
 #include "plumb/export/kalibr.h"
 
+#include "plumb/core/number_text.h"
+
 #include <cmath>
 #include <cstdio>
 #include <optional>
 
 #include "plumb/core/error.h"
+#include "plumb/core/number_text.h"
 #include "plumb/core/option_name.h"
 #include "plumb/signal/allan.h"
 #include "plumb/signal/axis_view.h"
@@ -214,29 +217,66 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   return imu;
 }
 
-std::string KalibrYaml(const KalibrImu& imu) {
-  std::string text = "# Kalibr IMU noise model from plumb (white noise densities and bias random "
-                     "walks of the session)\n";
-  for (const Notice& note : imu.notes) text += "# " + note.message + "\n";
+namespace {
+
+/// Kalibr's keys of one IMU, each line led by `indent`.
+std::string KalibrImuKeys(const KalibrImu& imu, const std::string& indent) {
   const bool bound = !(imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved));
   const std::string walk_comment = bound ? "  # upper bound from a short session" : "";
-  text += "rostopic: " + imu.rostopic + "\n";
-  text += "update_rate: " + Number(imu.update_rate_hz) + "  # Hz\n";
+  std::string text = indent + "rostopic: " + imu.rostopic + "\n";
+  text += indent + "update_rate: " + Number(imu.update_rate_hz) + "  # Hz\n";
   // Where the written (largest) value came from.
   const auto origin = [](const Vec3& v, const std::array<bool, 3>& ieee) {
     Eigen::Index axis = 0;
     v.maxCoeff(&axis);
     return std::string(ieee[axis] ? ", N of the IEEE noise fit" : "");
   };
-  text += "accelerometer_noise_density: " + Number(imu.accelerometer_noise_density()) +
+  text += indent + "accelerometer_noise_density: " + Number(imu.accelerometer_noise_density()) +
           "  # m/s^2/sqrt(Hz)" + origin(imu.accel.white, imu.accel.white_from_ieee) + "\n";
-  text += "accelerometer_random_walk: " + Number(imu.accelerometer_random_walk()) +
+  text += indent + "accelerometer_random_walk: " + Number(imu.accelerometer_random_walk()) +
           "  # m/s^3/sqrt(Hz)" + walk_comment + "\n";
   if (imu.has_gyro) {
-    text += "gyroscope_noise_density: " + Number(imu.gyroscope_noise_density()) +
+    text += indent + "gyroscope_noise_density: " + Number(imu.gyroscope_noise_density()) +
             "  # rad/s/sqrt(Hz)" + origin(imu.gyro.white, imu.gyro.white_from_ieee) + "\n";
-    text += "gyroscope_random_walk: " + Number(imu.gyroscope_random_walk()) +
+    text += indent + "gyroscope_random_walk: " + Number(imu.gyroscope_random_walk()) +
             "  # rad/s^2/sqrt(Hz)" + walk_comment + "\n";
+  }
+  return text;
+}
+
+}  // namespace
+
+std::string KalibrYaml(const KalibrImu& imu) {
+  std::string text = "# Kalibr IMU noise model from plumb (white noise densities and bias random "
+                     "walks of the session)\n";
+  for (const Notice& note : imu.notes) text += "# " + note.message + "\n";
+  return text + KalibrImuKeys(imu, "");
+}
+
+std::string KalibrImuSetYaml(const std::vector<KalibrBoardImu>& imus) {
+  std::string text = "# Kalibr IMU set from plumb: imu0 defines the body frame; each IMU's "
+                     "noise model, T_i_b (body to IMU) and time_offset (s, added to its stamps)\n";
+  for (std::size_t k = 0; k < imus.size(); ++k) {
+    for (const Notice& note : imus[k].noise.notes) {
+      text += "# imu" + std::to_string(k) + ": " + note.message + "\n";
+    }
+  }
+  for (std::size_t k = 0; k < imus.size(); ++k) {
+    const KalibrBoardImu& imu = imus[k];
+    // T_i_b maps body coordinates into the IMU's: rotation R_b_i^T, and the body origin
+    // (IMU 0) seen from the IMU, -R_b_i^T r.
+    const Mat3 C_i_b = imu.R_b_i.toRotationMatrix().transpose();
+    const Vec3 t = -C_i_b * imu.lever_arm_m;
+    text += "imu" + std::to_string(k) + ":\n  T_i_b:\n";
+    // 17 significant digits (a double round-trips), and no "-0".
+    const auto entry = [](double v) { return FormattedText("%.17g", v == 0.0 ? 0.0 : v); };
+    for (int r = 0; r < 3; ++r) {
+      text += "    - [" + entry(C_i_b(r, 0)) + ", " + entry(C_i_b(r, 1)) + ", " +
+              entry(C_i_b(r, 2)) + ", " + entry(t(r)) + "]\n";
+    }
+    text += "    - [0, 0, 0, 1]\n";
+    text += "  time_offset: " + Number(imu.time_offset_s) + "  # s\n";
+    text += KalibrImuKeys(imu.noise, "  ");
   }
   return text;
 }

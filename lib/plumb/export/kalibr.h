@@ -95,4 +95,21 @@ KalibrImu KalibrNoise(const estimation::Calibration& calibration, const ImuSerie
 /// Kalibr's imu.yaml text (comments say which values are upper bounds).
 std::string KalibrYaml(const KalibrImu& imu);
 
+/// One IMU of a board for Kalibr's IMU set: its noise, and where it sits in the body (IMU 0's
+/// accelerometer frame; SPEC 6): R_b_i its frame into the body, its lever arm from IMU 0 (m,
+/// body frame) and its time offset (s, added to its stamps).
+struct KalibrBoardImu {
+  KalibrImu noise;
+  Quat R_b_i = Quat::Identity();
+  Vec3 lever_arm_m = Vec3::Zero();
+  double time_offset_s = 0.0;
+};
+
+/// Kalibr's multi-IMU yaml (kalibr_common ImuSetParameters, as kalibr_calibrate_imu_camera
+/// writes it for several IMUs): keys imu0, imu1, ... in `imus` order, each with T_i_b (4x4,
+/// body to IMU: its rotation C_i_b = R_b_i^T and translation -C_i_b r, as Kalibr's
+/// IccImu.getTransformationFromBodyToImu), time_offset (Kalibr adds it to the IMU's stamps, as
+/// plumb's) and the noise keys of KalibrYaml; the notes as comments, per IMU.
+std::string KalibrImuSetYaml(const std::vector<KalibrBoardImu>& imus);
+
 }  // namespace plumb::exporter
