@@ -80,7 +80,16 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
   const bool ardupilot = format == "ardupilot";
   const std::string flag = ardupilot ? "INS_GYR_CAL" : "SENS_IMU_AUTOCAL";
   const std::string offsets = ardupilot ? "INS_GYR*OFFS" : "CAL_GYRO" + std::to_string(set.imu) + "_*OFF";
-  if (options.keep_gyro_offsets) {
+  if (!options.log_params.empty() && !logged(flag)) {
+    // The log lists the firmware's parameters, and this one is not among them (PX4 before
+    // SENS_IMU_AUTOCAL existed): that firmware measures no offsets at boot, and a parameter
+    // it does not have would only make the ground station complain.
+    set.notes.push_back(Notice{"gyro_offsets_kept",
+                               "the firmware of the log has no " + flag +
+                                   " (its parameters do not list it): it keeps these " + offsets +
+                                   ", and " + flag + " is not written",
+                               {}});
+  } else if (options.keep_gyro_offsets) {
     set.parameters.push_back({flag, 0.0, true});
     set.notes.push_back(Notice{"gyro_offsets_kept",
                                flag + " 0 (" + OptionText(Option::kKeepGyroOffsets) +
