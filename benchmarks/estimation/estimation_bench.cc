@@ -1,6 +1,7 @@
 // Speed of the full calibration (SPEC section 7): imu_tk's own data (imu_tk takes about 1 s
 // of calibration on this kind of machine), mikoff's imu0 (bundled), and a simulated one-hour
-// 1 kHz session; the cost of many poses (BM_CalibratePoses/60 and /600). Reading and segmentation are measured apart (io and segmentation benches)
+// 1 kHz session; the cost of many poses (BM_CalibratePoses/60 and /600) and of a board's
+// three IMUs against one (BM_CalibrateBoard/1 and /3). Reading and segmentation are measured apart (io and segmentation benches)
 // and, for the end-to-end figure, together in BM_EndToEndImuTk.
 //
 //   build/benchmarks/estimation/plumb_bench_estimation --benchmark_counters_tabular=true
@@ -113,6 +114,35 @@ void BM_CalibratePoses(benchmark::State& state) {
   state.counters["poses"] = poses;
 }
 BENCHMARK(BM_CalibratePoses)->Arg(60)->Arg(600)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+/// The cost of a board (issue 38: three IMUs at most 3.5 times one): a simulated three-IMU
+/// board, 16 still poses of 20 s joined by 3 s turns at 100 Hz, typical MEMS noise; fitted
+/// with IMU 0 alone (/1) and with all three (/3) on the same samples, the default options.
+void BM_CalibrateBoard(benchmark::State& state) {
+  const auto imus = static_cast<std::size_t>(state.range(0));
+  sim::SimulationOptions opt = sim::SimulationOptions::TypicalMems();
+  opt.rate_hz = 100.0;
+  opt.truth = sim::RandomParameters(opt.model, 1.0, 3);
+  opt.board = sim::RandomBoard(3, opt.model, 1.0, 4);
+  opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
+  opt.seed = 3;
+  const sim::Simulation sim = sim::Simulate(sim::MultiPose(16, 20.0, 3.0, 3), opt);
+  const std::vector<BoardImu> board(sim.session.other_imus.begin(),
+                                    sim.session.other_imus.begin() + (imus - 1));
+  const auto seg = segmentation::DetectStillSegments(sim.session.series, {});
+  model::Model m = model::Model::Parse("base");
+  m.t_ref_s = sim.session.series.t_s.front();
+  estimation::CalibrationResult r;
+  for (auto _ : state) {
+    r = estimation::CalibrateBoard(sim.session.series, board, seg.segments, m, sim.site);
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["imus"] = static_cast<double>(imus);
+  state.counters["unknowns"] = static_cast<double>(r.calibration.observability.num_unknowns);
+  state.counters["chi2_dof"] = r.fit.chi2_dof();
+  state.counters["iterations"] = r.fit.iterations;
+}
+BENCHMARK(BM_CalibrateBoard)->Arg(1)->Arg(3)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace plumb
