@@ -277,6 +277,23 @@ TEST(VehicleState, TheFilesSayAndKeepWhatTheFirmwareWouldReplace) {
   EXPECT_TRUE(note(px4, "system_id")->options.empty());  // given: nothing to point to
 }
 
+TEST(VehicleState, AFirmwareWithoutTheBootCalibrationFlagGetsANoteInsteadOfIt) {
+  // A PX4 log from before SENS_IMU_AUTOCAL (../shared/data/px4/sample_log_small.ulg): its
+  // parameter table has the accelerometer calibration and not the flag, so the flag is not
+  // written; an ArduPilot file from the same log says nothing of ArduPilot's table.
+  const Session s = MakeSession("base", model::Model::Parse("base").ZeroParameters(), SixFaces(),
+                                {25, 25, 25, 25, 25, 25});
+  ExportOptions options;
+  options.log_params = {{"CAL_ACC0_XOFF", 0.1}, {"CAL_ACC0_ID", 1245450}};
+  options.keep_gyro_offsets = true;
+  const ExportOutput px4 = Export("px4", s.r.calibration, s.series, s.r.fit.still, options);
+  EXPECT_EQ(px4.text.find("\tSENS_IMU_AUTOCAL\t"), std::string::npos) << px4.text;
+  EXPECT_NE(px4.text.find("the firmware of the log has no SENS_IMU_AUTOCAL"), std::string::npos)
+      << px4.text;
+  const ExportOutput ardupilot = Export("ardupilot", s.r.calibration, s.series, s.r.fit.still, options);
+  EXPECT_NE(ardupilot.text.find("\nINS_GYR_CAL,0\n"), std::string::npos) << ardupilot.text;
+}
+
 TEST(Evaluate, OffDiagonalTermMatchesTheHandComputation) {
   model::Model m = model::Model::Parse("base");
   model::ParameterBlocks theta = m.ZeroParameters();

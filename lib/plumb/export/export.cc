@@ -80,7 +80,13 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
   const bool ardupilot = format == "ardupilot";
   const std::string flag = ardupilot ? "INS_GYR_CAL" : "SENS_IMU_AUTOCAL";
   const std::string offsets = ardupilot ? "INS_GYR*OFFS" : "CAL_GYRO" + std::to_string(set.imu) + "_*OFF";
-  if (!options.log_params.empty() && !logged(flag)) {
+  // The log is of this firmware when its parameters include the firmware's accelerometer
+  // calibration (a PX4 file exported from an ArduPilot log says nothing of PX4's table).
+  const std::string family = ardupilot ? "INS_ACC" : "CAL_ACC";
+  const auto same_firmware = options.log_params.lower_bound(family);
+  const bool of_this_firmware = same_firmware != options.log_params.end() &&
+                                same_firmware->first.rfind(family, 0) == 0;
+  if (of_this_firmware && !logged(flag)) {
     // The log lists the firmware's parameters, and this one is not among them (PX4 before
     // SENS_IMU_AUTOCAL existed): that firmware measures no offsets at boot, and a parameter
     // it does not have would only make the ground station complain.
