@@ -15,9 +15,11 @@
 #include "jobs.h"
 #include "paper_methods.h"
 #include "plumb/core/error.h"
+#include "plumb/estimation/board_agreement.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/io/text/segments_file.h"
 #include "plumb/model/model.h"
+#include "plumb/report/board_agreement_text.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"
 #include "plumb/segmentation/given_segments.h"
@@ -57,7 +59,7 @@ class CalibrateCommand : public Command {
                      "needs --lat --lon)")
         ->check(CLI::IsMember({"generalized", "paper-benchmark", "paper-static"}))
         ->capture_default_str();
-    AddModelOption(app_, a.fit);
+    AddModelOption(app_, a.fit, true);
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
     app_->add_option("--json", a.json_path, "Write the result as JSON to FILE (atomically; - for stdout, the text then on stderr)")
@@ -130,6 +132,9 @@ class CalibrateCommand : public Command {
 
     const estimation::CalibrationResult result = CalibrateWithProgress(session, fit);
     std::cout << report::CalibrationSummary(result, session.source);
+    const std::vector<estimation::ImuAgreement> agreement =
+        estimation::BoardAgreement(result, series, session.other_imus);
+    if (!agreement.empty()) std::cout << "\n" << report::BoardAgreementText(agreement);
     PrintWarnings(result.fit.warnings);
     std::optional<estimation::CalibrationResult> baseline;
     if (!a.baseline.empty()) {
@@ -138,7 +143,9 @@ class CalibrateCommand : public Command {
       before.temp_ref_c = model.temp_ref_c;
       estimation::CalibrationOptions same = options;  // the same residuals in both fits
       same.accel_in_motion = result.fit.velocity_segments > 0;
-      baseline = estimation::Calibrate(series, segments, before, site, same);
+      // With the board, the board again: its IMUs without a model of their own take --baseline.
+      baseline = estimation::CalibrateBoard(series, session.other_imus, segments, before, site,
+                                            same, fit.board_models);
       std::cout << "\n" << report::BeforeAfterSummary(*baseline, result);
     }
 
@@ -157,6 +164,7 @@ class CalibrateCommand : public Command {
                            {"chi2_drop", baseline->fit.chi2 - result.fit.chi2}};
       }
       if (!exports.empty()) doc["export"] = exported;
+      if (!agreement.empty()) doc["board_agreement"] = report::BoardAgreementJson(agreement);
       WriteJsonOutput(a.json_path, doc);
     }
     return 0;

@@ -17,9 +17,11 @@
 #include "fit_options.h"
 #include "input_options.h"
 #include "plumb/core/error.h"
+#include "plumb/diagnostics/board_diagnosis.h"
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/diagnostics/residual_analysis.h"
 #include "plumb/io/common/atomic_file.h"
+#include "plumb/report/board_diagnosis_text.h"
 #include "plumb/report/diagnosis_json.h"
 #include "plumb/report/json_report.h"
 #include "plumb/report/summary.h"
@@ -55,9 +57,10 @@ class DiagnoseCommand : public Command {
         "effect not in the model, ranked, the best confirmed by refitting");
     app_->footer("Example (which effect the base model misses on the bundled session):\n  plumb diagnose data/mikoff/imu0.log --columns ax,ay,az,gx,gy,gz --rate 100 --json diagnosis.json");
     DiagnoseArgs& a = args_;
-    AddInputOptions(app_, a.input);
+    AddInputOptions(app_, a.input, true);
     app_->add_option("--model", a.fit.model, "The model to diagnose (a spec, see 'plumb effects')")
         ->capture_default_str();
+    AddImuModelOption(app_, a.fit);
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
     app_->add_option("--json", a.json_path, "Write the diagnosis as JSON to FILE (atomically; - for stdout, the text then on stderr)")
@@ -129,19 +132,17 @@ class DiagnoseCommand : public Command {
     std::cout << report::TimeBaseLine(time_base);
     std::cout << report::SegmentationSummary(seg, a.segments.segments_path, a.segments.verbose)
               << "\n";
-    const diagnostics::Diagnosis d =
-        diagnostics::Diagnose(series, seg.segments, model, site, options);
     diagnostics::ResidualAnalysisOptions ra_options;
     ra_options.significance = a.significance;
-    const diagnostics::ResidualAnalysis ra = diagnostics::AnalyseResiduals(series, d.fit, ra_options);
-    std::cout << "plumb diagnose: " << report::FitVerdict(d.fit.fit) << "\n"
-              << report::GateLines(d.fit.fit, session.source) << report::ResidualAnalysisText(ra) << report::DiagnosisText(d);
-    // Before and after: the user's fit, and the refit advised (else the best one made).
-    const diagnostics::Candidate* shown = diagnostics::Recommended(d);
-    if (shown == nullptr) shown = diagnostics::BestRefitted(d);
-    if (shown != nullptr) {
-      std::cout << "\n" << report::BeforeAfterSummary(d.fit, *shown->refit);
+    if (!session.other_imus.empty()) {
+      RunBoard(session, seg.segments, fit, options, ra_options, time_base);
+      return 0;
     }
+    const diagnostics::Diagnosis d =
+        diagnostics::Diagnose(series, seg.segments, model, site, options);
+    const diagnostics::ResidualAnalysis ra = diagnostics::AnalyseResiduals(series, d.fit, ra_options);
+    std::cout << "plumb diagnose: ";
+    PrintDiagnosis(d, ra, session.source);
     PrintWarnings(d.fit.fit.warnings);
 
     if (!a.json_path.empty()) {
@@ -149,14 +150,61 @@ class DiagnoseCommand : public Command {
       doc["time_base"] = report::TimeBaseJson(time_base);
       WriteJsonOutput(a.json_path, doc);
     }
-    if (!a.residuals_path.empty()) {
-      io::WriteFileAtomic(a.residuals_path, report::ResidualsCsv(ra.samples));
-      std::cout << "wrote " << a.residuals_path << "\n";
-    }
+    WriteResiduals(ra);
     return 0;
   }
 
  private:
+  /// The verdict, gates, residual analysis and candidates of one diagnosis, and its refit
+  /// advised (else the best one made) before and after.
+  static void PrintDiagnosis(const diagnostics::Diagnosis& d,
+                             const diagnostics::ResidualAnalysis& ra, const std::string& source) {
+    std::cout << report::FitVerdict(d.fit.fit) << "\n"
+              << report::GateLines(d.fit.fit, source) << report::ResidualAnalysisText(ra)
+              << report::DiagnosisText(d);
+    const diagnostics::Candidate* shown = diagnostics::Recommended(d);
+    if (shown == nullptr) shown = diagnostics::BestRefitted(d);
+    if (shown != nullptr) {
+      std::cout << "\n" << report::BeforeAfterSummary(d.fit, *shown->refit);
+    }
+  }
+
+  /// --imus: the board's IMUs each alone, then together (diagnostics/board_diagnosis.h).
+  void RunBoard(const Session& session, const std::vector<StillSegment>& segments,
+                const FitSetup& fit, const diagnostics::DiagnoseOptions& options,
+                const diagnostics::ResidualAnalysisOptions& ra_options,
+                const signal::TimeBase& time_base) const {
+    const diagnostics::BoardDiagnosis d =
+        diagnostics::DiagnoseBoard(session.series, session.other_imus, segments, fit.model,
+                                   fit.site, options, fit.board_models);
+    std::vector<diagnostics::ResidualAnalysis> analyses;
+    for (std::size_t k = 0; k < d.imus.size(); ++k) {
+      const ImuSeries& series = k == 0 ? session.series : session.other_imus[k - 1].series;
+      analyses.push_back(diagnostics::AnalyseResiduals(series, d.imus[k].diagnosis.fit, ra_options));
+    }
+    std::cout << "plumb diagnose: " << report::BoardDiagnosisSummary(d);
+    for (std::size_t k = 0; k < d.imus.size(); ++k) {
+      std::cout << "\n" << report::BoardImuLabel(k, d.imus[k].name, d.imus[k].instance) << " alone: ";
+      PrintDiagnosis(d.imus[k].diagnosis, analyses[k], session.source);
+    }
+    std::cout << "\nall IMUs together: " << report::FitVerdict(d.board.fit) << "\n"
+              << report::GateLines(d.board.fit, session.source);
+    PrintWarnings(d.board.fit.warnings);
+    if (!args_.json_path.empty()) {
+      nlohmann::json doc = report::BoardDiagnosisJson(d, analyses);
+      doc["time_base"] = report::TimeBaseJson(time_base);
+      WriteJsonOutput(args_.json_path, doc);
+    }
+    WriteResiduals(analyses.front());
+  }
+
+  /// --residuals: IMU 0's per-sample residuals.
+  void WriteResiduals(const diagnostics::ResidualAnalysis& ra) const {
+    if (args_.residuals_path.empty()) return;
+    io::WriteFileAtomic(args_.residuals_path, report::ResidualsCsv(ra.samples));
+    std::cout << "wrote " << args_.residuals_path << "\n";
+  }
+
   DiagnoseArgs args_;
 };
 

@@ -19,11 +19,22 @@
 
 namespace plumb::cli {
 
-void AddModelOption(CLI::App* app, FitArgs& a) {
+void AddModelOption(CLI::App* app, FitArgs& a, bool board) {
   app->add_option("--model", a.model,
                   "Error model spec: base, paper, or base+EFFECT[:OPTION]+... "
                   "(see 'plumb effects')")
       ->capture_default_str();
+  if (board) AddImuModelOption(app, a);
+}
+
+void AddImuModelOption(CLI::App* app, FitArgs& a) {
+  app->add_option("--imu-model", a.imu_models,
+                  "With --imus: board IMU K's own error model (K as its parameters are "
+                  "named, imuK.accel.bias.x), e.g. 2=base+gyro_g_sensitivity; repeatable; the "
+                  "others take --model")
+      ->type_name("K=SPEC")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 }
 
 namespace {
@@ -163,6 +174,27 @@ FitSetup PrepareFit(Session& session, const segmentation::SegmentationResult& se
                     const SiteArgs& site_args, const FitArgs& fit, const InputArgs& input) {
   pipeline::FitRequest request;
   request.model = ParseModelOption("--model", fit.model);
+  for (const std::string& given : fit.imu_models) {
+    const std::size_t eq = given.find('=');
+    int instance = -1;
+    try {
+      std::size_t used = 0;
+      instance = eq == std::string::npos ? -1 : std::stoi(given.substr(0, eq), &used);
+      if (used != eq) instance = -1;
+    } catch (const std::exception&) {
+      instance = -1;
+    }
+    if (instance < 0) {
+      throw UsageError("--imu-model " + given + ": give K=SPEC, K the board IMU's number as its "
+                       "parameters are named (imuK.), e.g. 2=base+gyro_g_sensitivity");
+    }
+    if (!request.imu_models
+             .emplace(instance, ParseModelOption("--imu-model " + given.substr(0, eq),
+                                                 given.substr(eq + 1)))
+             .second) {
+      throw UsageError("--imu-model: IMU " + std::to_string(instance) + " given twice");
+    }
+  }
   request.temp_ref_c = fit.temp_ref_c;
   request.level_north = fit.level_north;
   request.site = site_args.given_site();

@@ -24,6 +24,9 @@ namespace plumb::cli {
 
 struct FitArgs {
   std::string model = "base";      ///< --model SPEC
+  /// --imu-model K=SPEC (repeatable): board IMU K's own model (K as its parameters are named,
+  /// imuK.), the others --model's.
+  std::vector<std::string> imu_models;
   bool strict = false;             ///< --strict: fail when the data cannot determine the model
                                    ///< (exit 1) or the fit fails a gate (exit 3)
   double heading_deg = 0.0;        ///< --heading: first still pose's x axis from north, degrees
@@ -45,8 +48,11 @@ struct FitArgs {
 /// The exit code of a failed gate under --strict (SPEC section 8).
 inline constexpr int kExitGateFailed = 3;
 
-/// Registers --model on `app`.
-void AddModelOption(CLI::App* app, FitArgs& args);
+/// Registers --model on `app`, and --imu-model for commands that fit the board (`board`).
+void AddModelOption(CLI::App* app, FitArgs& args, bool board = false);
+
+/// Registers --imu-model on `app`.
+void AddImuModelOption(CLI::App* app, FitArgs& args);
 
 /// The model `spec` given to `option` (--model, --baseline); a spec that names no model (an
 /// unknown effect, a repeated one, no base) is a usage error naming the option (exit 2).

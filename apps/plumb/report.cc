@@ -28,6 +28,7 @@
 #include "input_options.h"
 #include "plumb/core/error.h"
 #include "plumb/diagnostics/diagnose.h"
+#include "plumb/estimation/board_agreement.h"
 #include "plumb/diagnostics/residual_analysis.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/export/export.h"
@@ -176,14 +177,14 @@ class ReportCommand : public Command {
         "calibrated and how well (DIR/index.html)");
     app_->footer("Example (calibration and diagnosis of the bundled session on one page):\n  plumb report data/mikoff/imu0.log --columns ax,ay,az,gx,gy,gz --rate 100 --out report");
     ReportArgs& a = args_;
-    AddInputOptions(app_, a.input);
+    AddInputOptions(app_, a.input, true);
     app_->add_option("--out", a.out_dir,
                      "Folder of the page (created when missing): index.html (the figures inside "
                      "it), and beside it result.json, diagnose.json, allan.json, residuals.csv, "
                      "figures.gp and its CSV data")
         ->type_name("DIR")
         ->required();
-    AddModelOption(app_, a.fit);
+    AddModelOption(app_, a.fit, true);
     AddSiteOptions(app_, a.site);
     AddGravityOption(app_, a.site);
     app_->add_flag("--diagnose,!--no-diagnose", a.diagnose,
@@ -296,6 +297,7 @@ class ReportCommand : public Command {
       }
     }
     PreviewExports(session, result, extras);
+    extras.board_agreement = estimation::BoardAgreement(result, series, session.other_imus);
     const std::string page = report::HtmlReport(Summarise(session, a.input), seg, result,
                                                 analysis, diagnosis ? &*diagnosis : nullptr,
                                                 extras);

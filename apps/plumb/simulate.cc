@@ -357,30 +357,18 @@ class SimulateCommand : public Command {
   }
 
  private:
-  /// One --truth PARAM=VALUE or imuK.PARAM=VALUE into `options`.
+  /// One --truth PARAM=VALUE or imuK.PARAM=VALUE into `options` (sim::SetTruth).
   static void SetTruth(const std::string& setting, sim::SimulationOptions& options) {
     const auto eq = setting.find('=');
     if (eq == std::string::npos || eq == 0) {
       throw UsageError("--truth must be PARAM=VALUE (got '" + setting + "')");
     }
-    std::string name = setting.substr(0, eq);
     const double value = ParseNumber(setting.substr(eq + 1), "--truth " + setting);
-    const model::Model* model = &options.model;
-    model::ParameterBlocks* truth = &options.truth;
-    if (name.rfind("imu", 0) == 0 && name.find('.') != std::string::npos) {
-      const std::string k = name.substr(3, name.find('.') - 3);
-      const int imu = std::atoi(k.c_str());
-      if (k.empty() || k.find_first_not_of("0123456789") != std::string::npos || imu < 1 ||
-          imu > static_cast<int>(options.board.size())) {
-        throw UsageError("--truth " + setting + ": the board has IMU 1 to " +
-                         std::to_string(options.board.size()) + " (--imus " +
-                         std::to_string(options.board.size() + 1) + ")");
-      }
-      model = &options.board[static_cast<std::size_t>(imu - 1)].model;
-      truth = &options.board[static_cast<std::size_t>(imu - 1)].truth;
-      name = name.substr(name.find('.') + 1);
+    try {
+      sim::SetTruth(options, setting.substr(0, eq), value);
+    } catch (const Error& e) {
+      throw UsageError("--truth " + setting + ": " + e.what());
     }
-    sim::SetParameter(*model, *truth, name, value);
   }
 
   /// The schedule the flags name (sim::NamedSchedule: its defaults for what is not given).

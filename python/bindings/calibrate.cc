@@ -29,7 +29,10 @@ Keywords (the command's options, '-' as '_'):
   (rad/s^2/sqrt(Hz)), estimate_rw (bool), accel_bi (m/s^2), gyro_bi (rad/s), bi_time (s),
   constant_bias (bool): the bias wander, each level a number in SI or a text with a datasheet's
   unit as the command takes it ('4 deg/h', '40 ug', '0.3 deg/h/sqrt(h)', '10 ug/sqrt(h)');
-  white_turns (bool: the turns' velocity residuals weighted by the white noise alone).
+  white_turns (bool: the turns' velocity residuals weighted by the white noise alone);
+  imu_models (dict: a board IMU's own model, {2: 'base+gyro_g_sensitivity'}, the number as its
+  parameters are named, imu2.; the others take model). A session opened with imus= is fitted
+  as one board: Result.imus, Result.imus_covariance.
 Returns a Result; the fit's warnings (and gravity's) are also emitted as plumb.PlumbWarning
 (warnings module). Raises plumb.Error (plumb.InsufficientDataError when the data cannot
 support the model).)doc";
@@ -249,6 +252,15 @@ FitInputs PrepareFit(const PySession& s, const std::string& model_spec, const py
     o.max_iterations = k.Take<int>("max_iterations", o.max_iterations);
     if (o.max_iterations < 1) throw Error("max_iterations must be >= 1");
     WanderOptions(k, o);
+    // The board's IMUs' own models (SPEC 6; the command's --imu-model K=SPEC).
+    if (const std::optional<py::object> own = k.Take<py::object>("imu_models")) {
+      if (!py::isinstance<py::dict>(*own)) {
+        throw Error("imu_models must be a dict of IMU number (as in imuK.) to model spec");
+      }
+      for (const auto& [key, spec] : own->cast<py::dict>()) {
+        request.imu_models.emplace(key.cast<int>(), model::Model::Parse(spec.cast<std::string>()));
+      }
+    }
   }
   out.setup = pipeline::PrepareFit(s.session, out.segmentation, std::move(request));
   return out;
@@ -323,6 +335,40 @@ void RegisterCalibrate(py::module_& m) {
           },
           "chi2, dof, chi2_dof, RMS, convergence, verdict ... (the JSON's fit) and gates (the "
           "checks failed: name, its stable code; message; options, the keywords it points to).")
+      .def_property_readonly(
+          "imus",
+          [](const PyResult& r) -> py::object {
+            if (!r.document.contains("imus")) return py::none();
+            return ToPython(r.document["imus"]);
+          },
+          "With the board's IMUs (plumb.open(..., imus=...)): one dict per IMU, IMU 0 first, as "
+          "the JSON's imus: instance, model, accel, gyro, effects, parameters, rotation (matrix, "
+          "vector, sigma: its frame into the body), lever_arm, time_offset; None without a board.")
+      .def_property_readonly(
+          "imus_covariance",
+          [](const PyResult& r) -> py::object {
+            if (!r.document.contains("imus_covariance")) return py::none();
+            const nlohmann::json& c = r.document["imus_covariance"];
+            const auto n = static_cast<Eigen::Index>(c["parameters"].size());
+            Eigen::MatrixXd m(n, n);
+            for (Eigen::Index i = 0; i < n; ++i) {
+              for (Eigen::Index j = 0; j < n; ++j) {
+                const nlohmann::json& v = c["matrix"][static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+                m(i, j) = v.is_number() ? v.get<double>() : std::nan("");
+              }
+            }
+            return Matrix(m);
+          },
+          "With the board's IMUs: the one covariance over every IMU's parameters (numpy, rows "
+          "as imus_parameter_names: IMU 0's, then imu1.*, ...), scaled as covariance; None "
+          "without a board.")
+      .def_property_readonly(
+          "imus_parameter_names",
+          [](const PyResult& r) -> py::object {
+            if (!r.document.contains("imus_covariance")) return py::none();
+            return ToPython(r.document["imus_covariance"]["parameters"]);
+          },
+          "The names of imus_covariance's rows and columns; None without a board.")
       .def_property_readonly("site", [](const PyResult& r) { return ToPython(r.document["site"]); },
                              "The site used: lat_deg, lon_deg (degrees), height_m (m), gravity "
                              "(m/s^2), source.")

@@ -19,7 +19,9 @@ truth (`plumb simulate`): still poses joined by turns, the true model's outputs,
 Keywords (the command's options, '-' as '_'):
   schedule='multipose'|'paper-static'|'paper-benchmark'; poses (multipose, 12); still_s (hold,
   s: 5, paper-static 60, paper-benchmark 20); turn_s (s: 2, paper-benchmark 3); rate (Hz, 200);
-  model ('base'); truth (dict parameter name -> value, SI); random_truth (x typical, 0);
+  model ('base'); truth (dict parameter name -> value, SI; 'imuK.NAME' for board IMU K);
+  random_truth (x typical, 0); imus (IMUs on one board, 1: IMU 1.. as --imus places them,
+  in session.other_imus);
   accel_noise (m/s^2/sqrt(Hz)), gyro_noise (rad/s/sqrt(Hz)), accel_rw (m/s^3/sqrt(Hz)),
   gyro_rw (rad/s^2/sqrt(Hz)), accel_bi (m/s^2), gyro_bi (rad/s), bi_time (s),
   quantisation_acc (m/s^2), quantisation_gyr (rad/s): default a typical MEMS IMU;
@@ -95,8 +97,9 @@ std::shared_ptr<PySimulation> Simulate(const py::kwargs& kwargs) {
   const double random_truth = k.Take<double>("random_truth", 0.0);
   o.truth = random_truth > 0 ? sim::RandomParameters(o.model, random_truth, seed)
                              : o.model.ZeroParameters();
+  o.board = sim::RandomBoard(k.Take<int>("imus", 1), o.model, random_truth, seed);
   for (const auto& [name, value] : k.Take<std::map<std::string, double>>("truth", {})) {
-    sim::SetParameter(o.model, o.truth, name, value);
+    sim::SetTruth(o, name, value);
   }
   o.temperature =
       Temperature(k.Take<py::object>("temperature", py::make_tuple("ramp", 25.0, 35.0)));
@@ -117,11 +120,20 @@ std::shared_ptr<PySimulation> Simulate(const py::kwargs& kwargs) {
   return out;
 }
 
+/// IMU 0's true parameters by name, then each board IMU's, prefixed imuK. (SPEC 6).
 py::dict Truth(const PySimulation& s) {
-  const auto names = s.simulation.model.ParameterNames();
-  const auto values = model::ReportedValues(s.simulation.model, s.simulation.truth);
   py::dict out;
-  for (std::size_t i = 0; i < names.size(); ++i) out[names[i].c_str()] = values[i];
+  const auto add = [&](const std::string& prefix, const model::Model& m,
+                       const model::ParameterBlocks& theta) {
+    const auto names = m.ParameterNames();
+    const auto values = model::ReportedValues(m, theta);
+    for (std::size_t i = 0; i < names.size(); ++i) out[(prefix + names[i]).c_str()] = values[i];
+  };
+  add("", s.simulation.model, s.simulation.truth);
+  for (std::size_t i = 0; i < s.simulation.board.size(); ++i) {
+    const sim::BoardImuTruth& b = s.simulation.board[i];
+    add("imu" + std::to_string(i + 1) + ".", b.model, b.truth);
+  }
   return out;
 }
 
@@ -134,7 +146,7 @@ void RegisterSimulate(py::module_& m) {
                     "The simulated samples as a Session (its source says 'simulated ...').")
       .def_property_readonly("truth", &Truth,
                              "The true parameters: name -> value, SI (as calibrate reports "
-                             "them).")
+                             "them), the board's other IMUs' prefixed imuK. (imus=).")
       .def_property_readonly(
           "truth_segments",
           [](const PySimulation& s) {

@@ -233,5 +233,124 @@ TEST(BoardCli, ALogWithoutAStillHoldSaysSo) {
   EXPECT_NE(run.err.find("no still segment"), std::string::npos) << run.err;
 }
 
+// diagnose --imus (issue 38, item 4): the IMU whose misfit is its own is named, with the
+// effect it misses; the board refitted with that IMU's own model loses the misfit.
+TEST(BoardCli, DiagnoseNamesTheImuWhoseMisfitIsItsOwnAndItsAdviceLowersTheBoardsMisfit) {
+  TempDir dir;
+  const std::string csv = dir.File("board.csv"), truth_path = dir.File("truth.json");
+  ASSERT_EQ(Plumb({"simulate", "--out", csv, "--imus", "3", "--model", "base+gyro_g_sensitivity",
+                   "--truth", "imu2.gyro_g_sensitivity.G.xy=1e-3", "--truth",
+                   "imu2.gyro_g_sensitivity.G.zx=-7e-4", "--poses", "16", "--rate", "100",
+                   "--seed", "7", "--accel-rw", "0", "--gyro-rw", "0", "--accel-bi", "0",
+                   "--gyro-bi", "0", "--truth-json", truth_path},
+                  dir)
+                .exit_code,
+            0);
+  const std::string diagnosis = dir.File("diagnosis.json");
+  const ToolRun run = Plumb({"diagnose", csv, "--imus", "all", "--candidates",
+                             "gyro_g_sensitivity,accel_scale_nonlinearity", "--json", diagnosis},
+                            dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "IMU 1 (acc1_x.., instance 1) alone: chi2/dof")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "): within its noise\n  IMU 2 (acc2_x.., instance 2) alone:"))
+      << run.out;
+  EXPECT_TRUE(Contains(run.out, "a misfit of its own")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "together (IMUs 0, 1, the attitudes shared")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "--imu-model 2=base+gyro_g_sensitivity: chi2/dof")) << run.out;
+  const json doc = ReadJson(diagnosis);
+  ASSERT_EQ(doc["imus"].size(), 3u);
+  EXPECT_FALSE(doc["imus"][0]["own_misfit"].get<bool>());
+  EXPECT_FALSE(doc["imus"][1]["own_misfit"].get<bool>());
+  EXPECT_TRUE(doc["imus"][2]["own_misfit"].get<bool>());
+  EXPECT_EQ(doc["imus"][2]["recommendation"], "base+gyro_g_sensitivity");
+  EXPECT_EQ(doc["board"]["rigid"]["imus"], json::array({0, 1}));
+  EXPECT_TRUE(doc["board"]["rigid"]["holds"].get<bool>());
+  ASSERT_TRUE(doc["board"]["next"]["advised"].get<bool>()) << doc["board"]["next"].dump();
+  EXPECT_EQ(doc["board"]["next"]["flags"],
+            json::array({"--imu-model", "2=base+gyro_g_sensitivity"}));
+
+  // The advice followed: the board's chi2/dof within its band, G found within 4 sigma.
+  const std::string cal = dir.File("cal.json");
+  const ToolRun fit = Plumb({"calibrate", csv, "--imus", "all", "--constant-bias", "--imu-model",
+                             "2=base+gyro_g_sensitivity", "--json", cal},
+                            dir);
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  const json c = ReadJson(cal);
+  EXPECT_LT(c["fit"]["chi2_dof"].get<double>(), 1.5) << c["fit"].dump();
+  EXPECT_EQ(c["imus"][2]["model"], "base+gyro_g_sensitivity");
+  EXPECT_EQ(c["imus"][1]["model"], "base");
+  // G (row-major, xx..zz) of IMU 2 only: xy (1) and zx (6) as planted, within 4 sigma.
+  EXPECT_FALSE(c["effects"].contains("gyro_g_sensitivity"));
+  const json& g = c["imus"][2]["effects"]["gyro_g_sensitivity"];
+  for (const auto& [i, truth] : {std::pair{1, 1e-3}, std::pair{6, -7e-4}}) {
+    const double value = g["parameters"][i], sigma = g["sigma"][i];
+    EXPECT_LT(std::abs(value - truth), 4.0 * sigma) << "G[" << i << "] " << value << " +- " << sigma;
+  }
+}
+
+// The IMUs against ArduPilot's pre-arm check (estimation/board_agreement.h), on the real boards:
+// what the firmware compares before and after, and, where the poses cannot determine the
+// accelerometers, that "after" matches them by construction. The report page shows it too.
+TEST(BoardCli, TheRealBoardsAgainstArduPilotsPreArmCheck) {
+  PLUMB_SHARED_LOG(plane385, "mavlink/plane385_disarmed.tlog");
+  PLUMB_SHARED_LOG(plane408, "ardupilot/plane408_centre_point.BIN");
+  TempDir dir;
+  const auto [run, doc] = CalibrateRealBoard(plane385, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "imu1 (2 poses): accel 1.51 -> 0 m/s^2")) << run.out;
+  EXPECT_TRUE(Contains(run.out, "outside ArduPilot's check before, within it after, at the poses "
+                                "recorded, which do not determine")) << run.out;
+  ASSERT_EQ(doc["board_agreement"].size(), 2u);
+  const json& imu1 = doc["board_agreement"][0];
+  EXPECT_FALSE(imu1["within_before"].get<bool>());
+  EXPECT_TRUE(imu1["within_after"].get<bool>());
+  EXPECT_TRUE(imu1["matched_by_construction"].get<bool>());
+  EXPECT_GT(imu1["accel"]["before"].get<double>(), imu1["accel"]["limit"].get<double>());
+  EXPECT_DOUBLE_EQ(doc["board_agreement"][1]["accel"]["limit"].get<double>(), 2.25);  // IMU3
+
+  TempDir other;
+  const auto [one, doc408] = CalibrateRealBoard(plane408, other);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  EXPECT_TRUE(Contains(one.out, "imu1 (1 pose): accel 0.5 -> 0 m/s^2")) << one.out;
+
+  const ToolRun page = Plumb({"report", plane385, "--imus", "all", "--no-figures", "--out",
+                              dir.File("report")},
+                             dir);
+  ASSERT_EQ(page.exit_code, 0) << page.err;
+  const std::string html = testing::ReadAll(dir.File("report") + "/index.html");
+  EXPECT_TRUE(Contains(html, "<h2 id=\"board\">The board's IMUs</h2>"));
+  EXPECT_TRUE(Contains(html, "<td>imu2</td><td><code>base</code></td><td>not determined by these data"));
+  EXPECT_TRUE(Contains(html, "1.5 &rarr; ")) << html.substr(html.find("id=\"board\""), 1500);
+}
+
+// diagnose --imus on the real logs with several IMUs: what each can and cannot judge.
+TEST(BoardCli, DiagnoseOnTheRealBoardsSaysWhatTheirDataCanJudge) {
+  struct Case {
+    const char* log;
+    std::vector<std::string> said;
+  };
+  const std::vector<Case> cases = {
+      {"mavlink/plane385_disarmed.tlog",
+       {"IMU 1 (SCALED_IMU2, instance 1) alone: chi2/dof",
+        "IMU 2 (SCALED_IMU3, instance 2) alone: chi2/dof",
+        "together: not tested: IMU 0's fit alone failed a gate (nonlinear)"}},
+      {"ardupilot/plane408_centre_point.BIN",
+       {"IMU 1 (IMU2, instance 1) alone: no degrees of freedom left",
+        "together: not tested: sharing the attitudes adds no constraint these data can test"}},
+      {"px4/sample_log_small.ulg", {"the fit failed a gate (not_still)"}},
+  };
+  for (const Case& c : cases) {
+    const std::string log = std::string(PLUMB_SHARED_DATA_DIR) + "/" + c.log;
+    if (!std::filesystem::exists(log)) GTEST_SKIP() << "shared data absent: " << log;
+    TempDir dir;
+    const ToolRun run = Plumb({"diagnose", log, "--imus", "all"}, dir);
+    ASSERT_EQ(run.exit_code, 0) << c.log << ": " << run.err;
+    for (const std::string& s : c.said) EXPECT_TRUE(Contains(run.out, s)) << c.log << ": " << run.out;
+    // No IMU of these boards is blamed, and nothing is advised for the board.
+    EXPECT_FALSE(Contains(run.out, "a misfit of its own")) << c.log << ": " << run.out;
+    EXPECT_FALSE(Contains(run.out, "  next: ")) << c.log << ": " << run.out;
+  }
+}
+
 }  // namespace
 }  // namespace plumb::cli

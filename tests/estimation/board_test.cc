@@ -15,6 +15,7 @@
 #include <string>
 
 #include "plumb/core/so3.h"
+#include "plumb/estimation/board_agreement.h"
 #include "plumb/estimation/calibrator.h"
 #include "plumb/estimation/fitted_problem.h"
 #include "plumb/geo/site.h"
@@ -235,6 +236,26 @@ TEST(BoardFit, CalibrateBoardReportsEveryImu) {
   const std::string text = report::FullReport(r);
   EXPECT_NE(text.find("imu2, fitted with IMU 0"), std::string::npos) << text;
   EXPECT_NE(text.find("imu2.rotation.z"), std::string::npos) << text;
+
+  // At rest, once each IMU is corrected, what separates it from IMU 0 is its turn: g 2 sin(a/2)
+  // at most (ArduPilot's z halved can only shrink it), reached within a third over 12 poses;
+  // taken out, the noise of two poses' means is left (5 sigma of their difference's norm).
+  const std::vector<ImuAgreement> agreement =
+      BoardAgreement(r, s.session.series, s.session.other_imus);
+  const double per_mean = std::sqrt(2.0 / static_cast<double>(r.fit.still.front().count));
+  ASSERT_EQ(agreement.size(), 2u);
+  for (std::size_t i = 0; i < agreement.size(); ++i) {
+    const ImuAgreement& a = agreement[i];
+    EXPECT_EQ(a.instance, static_cast<int>(i) + 1);
+    EXPECT_EQ(a.poses, 12);
+    const double turn = s.site.gravity() * 2.0 * std::sin(0.5 * Eigen::AngleAxisd(s.board[i].R_b_i).angle());
+    EXPECT_LT(a.accel_after, turn + 0.005) << i;
+    EXPECT_GT(a.accel_after, turn / 3.0) << i;
+    EXPECT_LT(a.accel_in_body, 5.0 * per_mean * c.noise.acc.maxCoeff()) << i;
+    EXPECT_LT(a.gyro_in_body, 5.0 * per_mean * c.noise.gyr.maxCoeff()) << i;
+    EXPECT_DOUBLE_EQ(a.accel_limit, i == 0 ? kArduPilotAccelThreshold_m_s2
+                                           : 3.0 * kArduPilotAccelThreshold_m_s2);
+  }
 }
 
 // A real board (SPEC 6's check): plane408's IMU and IMU2 still on the bench, one pose. Gravity

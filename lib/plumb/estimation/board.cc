@@ -101,16 +101,17 @@ NoiseModel BoardImuNoise(const BoardImu& imu, const StillSet& still, bool has_gy
 }  // namespace
 
 std::vector<BoardImuInput> PrepareBoard(const std::vector<BoardImu>& board,
+                                        const std::vector<model::Model>& models,
                                         const ImuSeries& series0, const StillSet& still0,
-                                        const model::Model& model, const geo::Site& site,
-                                        const CalibrationOptions& options, FitReport& fit) {
+                                        const geo::Site& site, const CalibrationOptions& options,
+                                        FitReport& fit) {
   std::vector<BoardImuInput> out;
-  for (const BoardImu& imu : board) {
+  for (std::size_t k = 0; k < board.size(); ++k) {
+    const BoardImu& imu = board[k];
     BoardImuInput in;
     in.instance = imu.instance;
     in.series = &imu.series;
-    in.model = model;
-    if (!imu.series.has_gyro()) in.model.DropGyro();
+    in.model = models.at(k);
     const bool has_gyro = in.model.has_gyro();
     in.still = StillSetOnBoardImu(still0, series0, imu.series, "imu" + std::to_string(imu.instance));
     in.theta = in.model.ZeroParameters();

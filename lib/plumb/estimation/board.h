@@ -6,9 +6,9 @@
 // (AssignWanderLevels), its model's starting values (Initialize, on its own samples), and
 // where it starts in the body: R_b_i = R_n_b^T R_n_i, IMU 0's starting attitude of each pose
 // against its own, averaged over the poses (the chordal mean: the rotation nearest the mean
-// of their matrices). Its model is IMU 0's spec, without the gyroscope's terms when it has no
-// gyroscope. After the fit (stage 6), ReportBoard gives their parameters and the one
-// covariance over every IMU's.
+// of their matrices). Its model is its own (calibrator.h, CalibrateBoard), or IMU 0's spec,
+// without the gyroscope's terms when it has no gyroscope. After the fit (stage 6), ReportBoard
+// gives their parameters and the one covariance over every IMU's.
 #pragma once
 
 #include <vector>
@@ -26,12 +26,14 @@
 
 namespace plumb::estimation {
 
-/// The board's other IMUs as the problem takes them; notes on their wander levels go to
-/// `fit.notes`, prefixed with the IMU. `board` must outlive the problem (its series).
+/// The board's other IMUs as the problem takes them, each with its model of `models` (one per
+/// IMU, checked against its samples); notes on their wander levels go to `fit.notes`, prefixed
+/// with the IMU. `board` must outlive the problem (its series).
 std::vector<BoardImuInput> PrepareBoard(const std::vector<BoardImu>& board,
+                                        const std::vector<model::Model>& models,
                                         const ImuSeries& series0, const StillSet& still0,
-                                        const model::Model& model, const geo::Site& site,
-                                        const CalibrationOptions& options, FitReport& fit);
+                                        const geo::Site& site, const CalibrationOptions& options,
+                                        FitReport& fit);
 
 /// Stage 6 for the board's other IMUs: each one's parameters with their sigmas (from
 /// `analysis`, the fit with every unknown free, over `columns`) into calibration.board, and

@@ -1,6 +1,7 @@
 #include "plumb/estimation/calibration.h"
 
 #include <Eigen/Core>
+#include <cmath>
 
 #include "plumb/model/board_mount.h"
 #include "plumb/model/effects/accel_linear.h"
@@ -53,6 +54,19 @@ Vec3 Calibration::GyroBias() const { return GyroBiasOf(model, theta, has_gyro); 
 
 Quat BoardImuCalibration::R_b_i() const {
   return model::board_mount::Rotation(theta.back().data());
+}
+
+const ParameterEstimate& BoardImuCalibration::MountParameter(int index) const {
+  return parameters.at(parameters.size() - model::board_mount::kSize +
+                       static_cast<std::size_t>(index));
+}
+
+bool BoardImuCalibration::RotationDetermined() const {
+  for (int i = 0; i < 3; ++i) {
+    const ParameterEstimate& p = MountParameter(model::board_mount::kRotation + i);
+    if (!p.observable || !std::isfinite(p.sigma)) return false;
+  }
+  return true;
 }
 
 Vec3 BoardImuCalibration::LeverArm() const {

@@ -131,6 +131,12 @@ struct BoardImuCalibration {
 
   /// R_b_i, its frame into the body frame (IMU 0's accelerometer's).
   Quat R_b_i() const;
+  /// Its mount's parameter `index` (model/board_mount.h's layout: rotation.x..z, lever_arm.x..z,
+  /// time_offset), among `parameters` (their last seven).
+  const ParameterEstimate& MountParameter(int index) const;
+  /// Whether the fit determined its rotation into the body: each rotation parameter observable,
+  /// with a finite sigma.
+  bool RotationDetermined() const;
   /// Its lever arm from IMU 0, m, body frame, and its time offset, s (held at zero: no residual
   /// of the fit sees them yet).
   Vec3 LeverArm() const;

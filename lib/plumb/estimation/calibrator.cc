@@ -53,12 +53,39 @@ model::Model ModelForSession(const model::Model& requested, const ImuSeries& ser
   return model;
 }
 
+/// Each of the board's other IMUs' model (its own of `board_models`, else IMU 0's `model`, with
+/// IMU 0's references) checked against its samples as ModelForSession checks IMU 0's; the
+/// warnings prefixed with the IMU.
+std::vector<model::Model> BoardModelsForSession(const std::vector<BoardImu>& board,
+                                                const std::vector<model::Model>& board_models,
+                                                const model::Model& model, const geo::Site& site,
+                                                std::vector<Notice>& warnings) {
+  if (!board_models.empty() && board_models.size() != board.size()) {
+    throw Error("calibrate: " + std::to_string(board_models.size()) + " models for the board's " +
+                std::to_string(board.size()) + " other IMUs; give one per IMU, or none");
+  }
+  std::vector<model::Model> models;
+  for (std::size_t k = 0; k < board.size(); ++k) {
+    model::Model requested = board_models.empty() ? model : board_models[k];
+    requested.t_ref_s = model.t_ref_s;
+    requested.temp_ref_c = model.temp_ref_c;
+    std::vector<Notice> own;
+    models.push_back(ModelForSession(requested, board[k].series, site, own));
+    for (Notice& n : own) {
+      n.message = "imu" + std::to_string(board[k].instance) + ": " + n.message;
+      warnings.push_back(std::move(n));
+    }
+  }
+  return models;
+}
+
 }  // namespace
 
 FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
                          const model::Model& model_in, const geo::Site& site,
                          const CalibrationOptions& options, CalibrationResult& result,
-                         const std::vector<BoardImu>& board) {
+                         const std::vector<BoardImu>& board,
+                         const std::vector<model::Model>& board_models) {
   options.Validate();
   Calibration& cal = result.calibration;
   FitReport& fit = result.fit;
@@ -101,9 +128,10 @@ FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment
   }
   cal.noise = out.noise.Levels();
 
-  // 1-3 for the board's other IMUs (board.h).
+  // 1-3 for the board's other IMUs (board.h), each model checked against its own samples.
   std::vector<BoardImuInput> others =
-      PrepareBoard(board, series, still, cal.model, site, options, fit);
+      PrepareBoard(board, BoardModelsForSession(board, board_models, cal.model, site, fit.warnings),
+                   series, still, site, options, fit);
 
   // 4. The problem; 5. the solve (the problem stays where Ceres points into its values).
   out.problem = std::make_unique<CalibrationProblem>(series, cal.model, site, std::move(still),
@@ -126,14 +154,17 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
 CalibrationResult CalibrateBoard(const ImuSeries& series, const std::vector<BoardImu>& board,
                                  const std::vector<StillSegment>& segments,
                                  const model::Model& model_in, const geo::Site& site,
-                                 const CalibrationOptions& options) {
+                                 const CalibrationOptions& options,
+                                 const std::vector<model::Model>& board_models) {
   CalibrationResult result;
-  FittedProblem fitted = FitProblem(series, segments, model_in, site, options, result, board);
+  FittedProblem fitted =
+      FitProblem(series, segments, model_in, site, options, result, board, board_models);
   FinishCalibration(series, segments, options, fitted, result);
   // 9. How far the sigmas rest on wander levels the session could not measure.
   if (const std::optional<CalibrationOptions> at_bound = OptionsAtTheWanderBound(
           fitted.noise, fitted.wander_bounds, result.fit.still_segments, options)) {
-    const CalibrationResult bound = CalibrateBoard(series, board, segments, model_in, site, *at_bound);
+    const CalibrationResult bound =
+        CalibrateBoard(series, board, segments, model_in, site, *at_bound, board_models);
     if (const std::optional<std::string> w = SigmaRestsOnTheTypicalWander(result, bound)) {
       result.fit.warnings.push_back(Notice{"sigma_rests_on_wander", *w, {Option::kNoiseFrom}});
     }

@@ -37,12 +37,15 @@ CalibrationResult Calibrate(const ImuSeries& series, const std::vector<StillSegm
 
 /// The same with the board's other IMUs in the one fit (SPEC 6, "Several IMUs of one board";
 /// Session::other_imus): their still attitudes shared with `series` (IMU 0, whose segments
-/// these are), each IMU with `model` (without the gyroscope's terms when it has none) and its
-/// rotation into the body; they are reported in Calibration::board with one covariance over
-/// every IMU (Calibration::board_covariance).
+/// these are), each IMU with its error model and its rotation into the body; they are reported
+/// in Calibration::board with one covariance over every IMU (Calibration::board_covariance).
+/// Each IMU's model is its own of `board_models` (one per IMU of `board`, in order), or, with
+/// none given, `model`; without the gyroscope's terms when it has none. Throws plumb::Error
+/// when `board_models` is neither empty nor one per IMU.
 CalibrationResult CalibrateBoard(const ImuSeries& series, const std::vector<BoardImu>& board,
                                  const std::vector<StillSegment>& segments,
                                  const model::Model& model, const geo::Site& site,
-                                 const CalibrationOptions& options = {});
+                                 const CalibrationOptions& options = {},
+                                 const std::vector<model::Model>& board_models = {});
 
 }  // namespace plumb::estimation

@@ -36,11 +36,13 @@ struct FittedProblem {
 /// Stages 1-5 of Calibrate (the still set, the noise model and the wander's levels, starting
 /// values, the problem, the solve with its gauge); fills `result`'s method, site, model,
 /// units, noise, notes and warnings. `board`: the board's other IMUs fitted with IMU 0
-/// (`series`; board.h), which must outlive the problem; none: IMU 0 alone.
+/// (`series`; board.h), which must outlive the problem; none: IMU 0 alone. `board_models`:
+/// their models as CalibrateBoard takes them.
 FittedProblem FitProblem(const ImuSeries& series, const std::vector<StillSegment>& segments,
                          const model::Model& model, const geo::Site& site,
                          const CalibrationOptions& options, CalibrationResult& result,
-                         const std::vector<BoardImu>& board = {});
+                         const std::vector<BoardImu>& board = {},
+                         const std::vector<model::Model>& board_models = {});
 
 /// Stages 6-8 of Calibrate on a fitted problem (FitProblem's, same arguments): the analysis,
 /// parameters and covariance, the fit's residuals, advice and gates, into `result`.

@@ -96,10 +96,7 @@ std::vector<BoardImuExport> BoardImuExports(const estimation::Calibration& calib
     imu.R_b_i = b.R_b_i();
     imu.lever_arm_m = b.LeverArm();
     imu.time_offset_s = b.TimeOffset();
-    imu.mount_determined = std::all_of(b.parameters.begin(), b.parameters.end(), [&](const auto& p) {
-      const bool rotation = p.place.term == b.model.num_terms() && p.place.index < 3;
-      return !rotation || (p.observable && std::isfinite(p.sigma));
-    });
+    imu.mount_determined = b.RotationDetermined();
     out.push_back(std::move(imu));
   }
   return out;

@@ -1,6 +1,7 @@
 // See fit_setup.h.
 #include "plumb/pipeline/fit_setup.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "plumb/core/error.h"
@@ -23,6 +24,36 @@ segmentation::SegmentationResult FindSegments(const ImuSeries& series,
   return segmentation::DetectStillSegments(series, detector);
 }
 
+namespace {
+
+/// FitSetup::board_models: each other IMU's model of `own` (by instance), else `model`; none
+/// when `own` is empty.
+std::vector<model::Model> BoardModels(const std::vector<BoardImu>& board,
+                                      const std::map<int, model::Model>& own,
+                                      const model::Model& model) {
+  std::vector<model::Model> models;
+  if (own.empty()) return models;
+  std::string instances;
+  for (const BoardImu& imu : board) {
+    instances += (instances.empty() ? "" : ", ") + std::to_string(imu.instance);
+  }
+  for (const auto& [instance, m] : own) {
+    if (std::none_of(board.begin(), board.end(),
+                     [&](const BoardImu& imu) { return imu.instance == instance; })) {
+      throw Error("a model is given for imu" + std::to_string(instance) +
+                  ", which is not among the board's other IMUs fitted (" +
+                  (instances.empty() ? std::string("none") : instances) + ")");
+    }
+  }
+  for (const BoardImu& imu : board) {
+    const auto it = own.find(imu.instance);
+    models.push_back(it == own.end() ? model : it->second);
+  }
+  return models;
+}
+
+}  // namespace
+
 FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResult& segmentation,
                     FitRequest request) {
   FitSetup out;
@@ -43,6 +74,7 @@ FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResu
   out.model = std::move(request.model);
   out.model.t_ref_s = session.series.t_s.front();
   out.model.temp_ref_c = request.temp_ref_c;
+  out.board_models = BoardModels(session.other_imus, request.imu_models, out.model);
   out.options = std::move(request.options);
   out.options.log_motion = session.log_motion;
   return out;
@@ -51,7 +83,7 @@ FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResu
 estimation::CalibrationResult CalibrateSession(const Session& session, const FitSetup& fit) {
   try {
     return estimation::CalibrateBoard(session.series, session.other_imus, fit.segments, fit.model,
-                                      fit.site, fit.options);
+                                      fit.site, fit.options, fit.board_models);
   } catch (const Error& e) {
     const std::vector<estimation::Gate> gates =
         estimation::CheckSamples(session.series, fit.segments);

@@ -5,6 +5,7 @@
 // requests below; everything after that is here, once.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,9 @@ struct FitRequest {
   /// The model, parsed by the front end (which names its option in a parse error); PrepareFit
   /// sets its time reference to the first sample and its temperature reference to temp_ref_c.
   model::Model model;
+  /// Models of the board's other IMUs of their own (SPEC 6), by the instance their parameters
+  /// are named for ("imu2.accel.bias.x": 2); the others take `model`.
+  std::map<int, model::Model> imu_models;
   /// Reference temperature of the temperature terms, degC.
   double temp_ref_c = 25.0;
   /// The first still pose is level with x north, its attitude known and held.
@@ -62,13 +66,17 @@ struct FitSetup {
                                        ///< FitRequest::level_north
   geo::Site site;                      ///< the request's, else the log's GPS, else none
   model::Model model;                  ///< the request's, time and temperature references set
+  /// One per Session::other_imus: FitRequest::imu_models's, else `model`; empty when the
+  /// request gave none (estimation::CalibrateBoard's board_models).
+  std::vector<model::Model> board_models;
   estimation::CalibrationOptions options;  ///< the request's
   /// The session's warnings, and the note that a fixed gravity overrides WGS84 gravity at a
   /// known site (a calibration document's input warnings).
   std::vector<Notice> input_warnings;
 };
 
-/// The fit's inputs for `session` and its segmentation, from `request`.
+/// The fit's inputs for `session` and its segmentation, from `request`. Throws plumb::Error
+/// when request.imu_models names an instance the session's board has not.
 FitSetup PrepareFit(const Session& session, const segmentation::SegmentationResult& segmentation,
                     FitRequest request);
 

@@ -12,6 +12,7 @@
 #include "plumb/core/units.h"
 #include "plumb/estimation/observability.h"
 #include "plumb/estimation/uncertainty.h"
+#include "plumb/model/board_mount.h"
 
 namespace plumb::report {
 namespace {
@@ -51,9 +52,7 @@ std::string ParameterTable(const std::vector<estimation::ParameterEstimate>& par
 std::vector<const estimation::ParameterEstimate*> RotationParameters(
     const estimation::BoardImuCalibration& b) {
   std::vector<const estimation::ParameterEstimate*> out;
-  for (const auto& p : b.parameters) {
-    if (p.place.term == b.model.num_terms() && p.place.index < 3) out.push_back(&p);
-  }
+  for (int i = 0; i < 3; ++i) out.push_back(&b.MountParameter(model::board_mount::kRotation + i));
   return out;
 }
 
@@ -148,10 +147,7 @@ std::string MountText(const estimation::Calibration& c, const estimation::FitRep
   const Eigen::AngleAxisd aa(b.R_b_i());
   const std::string held = FormattedText("%.4g", aa.angle() * units::kDegPerRad) + " deg about " +
                            Vec(aa.axis(), "%.3f");
-  const bool determined = std::all_of(rotation.begin(), rotation.end(), [](const auto* p) {
-    return p->observable && std::isfinite(p->sigma);
-  });
-  if (determined) {
+  if (b.RotationDetermined()) {
     return "rotation into the body " + held + ", sigma about x, y, z " +
            Vec(Vec3(rotation[0]->sigma, rotation[1]->sigma, rotation[2]->sigma) *
                    units::kDegPerRad, "%.2g") +

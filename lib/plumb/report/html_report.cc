@@ -1,5 +1,6 @@
 #include "plumb/report/html_report.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cctype>
@@ -9,6 +10,8 @@
 #include <sstream>
 
 #include "plumb/core/error.h"
+#include "plumb/core/units.h"
+#include "plumb/model/board_mount.h"
 #include "plumb/estimation/uncertainty.h"
 #include "plumb/report/calibration_text.h"
 #include "plumb/report/export_section.h"
@@ -186,6 +189,72 @@ std::string ModelSection(const estimation::CalibrationResult& r) {
     const auto& info = term.effect->info();
     out += "<tr>" + Td(Code(info.name + (info.option.empty() ? "" : ":" + info.option))) +
            Td(Code(info.term)) + TdNum(std::to_string(info.size())) + "</tr>\n";
+  }
+  return out + "</table>\n";
+}
+
+/// "0.41 &rarr; 0.17" in `scale` units, the "after" marked when beyond `limit`.
+std::string BeforeAfterCell(double before, double after, double limit, double scale) {
+  const std::string shown = G2(after * scale);
+  return TdNum(G2(before * scale) + " &rarr; " +
+               (after > limit ? "<span class=\"warn\">" + shown + "</span>" : shown));
+}
+
+/// The board's other IMUs (SPEC 6): each one's rotation into the body with its sigma, and its
+/// disagreement with IMU 0 at rest before and after the calibration against ArduPilot's
+/// pre-arm check (estimation/board_agreement.h).
+std::string BoardSection(const estimation::CalibrationResult& r, const PageExtras& extras) {
+  const estimation::Calibration& c = r.calibration;
+  if (c.board.empty()) return "";
+  const double scale = estimation::SigmaScale(r.fit);
+  std::string out =
+      "<h2 id=\"board\">The board's IMUs</h2>\n<p>Fitted with IMU 0, the still attitudes "
+      "shared; IMU 0's accelerometer defines the body frame. The rotation is each IMU's frame "
+      "into the body (rotation vector, deg, &plusmn; sigma); the disagreement is the largest "
+      "over the still poses, as ArduPilot's pre-arm check measures it (accelerometers: z "
+      "halved, within " + G2(estimation::kArduPilotAccelThreshold_m_s2) + " m/s^2, " +
+      G2(estimation::kArduPilotAccelThreshold_m_s2 * estimation::kArduPilotThirdImuFactor) +
+      " from IMU3 on; gyroscopes within " +
+      G2(estimation::kArduPilotGyroThreshold_rad_s * units::kDegPerRad) +
+      " deg/s), before &rarr; after the calibration, and what is left once the IMUs' turn is "
+      "taken out. The firmware turns every IMU by one board orientation, so their turn "
+      "between them stays in its comparison.</p>\n<table>\n" +
+      HeaderRow({"IMU", "model", "rotation into the body (deg)", "accel (m/s^2)",
+                 "accel, turned", "gyro (deg/s)", "gyro, turned"});
+  for (std::size_t k = 0; k < c.board.size(); ++k) {
+    const estimation::BoardImuCalibration& b = c.board[k];
+    std::string rotation;
+    if (b.RotationDetermined()) {
+      const Eigen::AngleAxisd aa(b.R_b_i());
+      const Vec3 rho = aa.angle() * aa.axis() * units::kDegPerRad;
+      for (int i = 0; i < 3; ++i) {
+        rotation += (i ? ", " : "") + G3(rho[i]) + " &plusmn; " +
+                    G2(scale * b.MountParameter(model::board_mount::kRotation + i).sigma *
+                       units::kDegPerRad);
+      }
+    } else {
+      rotation = "not determined by these data (see the observability section)";
+    }
+    out += "<tr>" + Td("imu" + std::to_string(b.instance)) + Td(Code(b.model.spec())) +
+           Td(rotation);
+    const estimation::ImuAgreement* a = nullptr;
+    for (const auto& each : extras.board_agreement) {
+      if (each.instance == b.instance) a = &each;
+    }
+    if (a == nullptr) {
+      out += Td("") + Td("") + Td("") + Td("") + "</tr>\n";
+      continue;
+    }
+    out += BeforeAfterCell(a->accel_before, a->accel_after, a->accel_limit, 1.0) +
+           TdNum(G2(a->accel_in_body));
+    if (a->has_gyro) {
+      out += BeforeAfterCell(a->gyro_before, a->gyro_after,
+                             estimation::kArduPilotGyroThreshold_rad_s, units::kDegPerRad) +
+             TdNum(G2(a->gyro_in_body * units::kDegPerRad));
+    } else {
+      out += Td("no gyroscope") + Td("");
+    }
+    out += "</tr>\n";
   }
   return out + "</table>\n";
 }
@@ -598,6 +667,7 @@ std::string HtmlReport(const InputSummary& input,
   page += FigureSection(extras);
   page += ParameterSection(result);
   page += MatrixSection(result);
+  page += BoardSection(result, extras);
   page += ExportSection(extras.exports, extras.export_commands, extras.exports_note);
   page += ObservabilitySection(result);
   page += DiagnosisSection(diagnosis, extras.next_command);

@@ -32,6 +32,7 @@
 
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/diagnostics/residual_analysis.h"
+#include "plumb/estimation/board_agreement.h"
 #include "plumb/estimation/result.h"
 #include "plumb/export/export.h"
 #include "plumb/report/figures.h"
@@ -73,6 +74,9 @@ struct PageExtras {
   /// The command to run next when the diagnosis finds a significant effect (the refit with
   /// diagnostics::NextModelSpec); "" for none.
   std::string next_command;
+  /// With the board's IMUs (SPEC 6): each other IMU against IMU 0 at rest
+  /// (estimation::BoardAgreement), for the page's "The board's IMUs" section.
+  std::vector<estimation::ImuAgreement> board_agreement;
 };
 
 /// Escapes & < > " ' for HTML text and attribute values; invalid UTF-8 passes unchanged.

@@ -98,17 +98,24 @@ json EffectJson(const model::EffectInfo& info,
   return e;
 }
 
-json EffectsJson(const estimation::CalibrationResult& r) {
+/// "effects" of `model`'s terms beyond the linear stage, from `parameters` named `prefix` +
+/// the effect's names ("imu2." for a board IMU's, "" for IMU 0's).
+json EffectsOf(const model::Model& model, const std::vector<estimation::ParameterEstimate>& parameters,
+               const std::string& prefix, double sigma_scale) {
   std::map<std::string, const estimation::ParameterEstimate*> by_name;
-  for (const auto& p : r.calibration.parameters) by_name[p.name] = &p;
+  for (const auto& p : parameters) {
+    if (p.name.compare(0, prefix.size(), prefix) == 0) by_name[p.name.substr(prefix.size())] = &p;
+  }
   json effects = json::object();
-  for (const auto& term : r.calibration.model.terms()) {
+  for (const auto& term : model.terms()) {
     const auto& info = term.effect->info();
-    if (!info.linear_stage) {
-      effects[info.name] = EffectJson(info, by_name, estimation::SigmaScale(r.fit));
-    }
+    if (!info.linear_stage) effects[info.name] = EffectJson(info, by_name, sigma_scale);
   }
   return effects;
+}
+
+json EffectsJson(const estimation::CalibrationResult& r) {
+  return EffectsOf(r.calibration.model, r.calibration.parameters, "", estimation::SigmaScale(r.fit));
 }
 
 json LinearityJson(const estimation::LinearityReport& l) {
@@ -383,12 +390,12 @@ json BoardImuJson(const estimation::BoardImuCalibration& b, double sigma_scale) 
                                                       "omega_i = matrix (y_g - offset)",
                                                       ExtraEffects(b.model, model::Sensor::kGyro)))
                                   : json(nullptr);
+  entry["effects"] =
+      EffectsOf(b.model, b.parameters, "imu" + std::to_string(b.instance) + ".", sigma_scale);
   entry[keys::kParameters] = json::array();
   for (const auto& p : b.parameters) entry[keys::kParameters].push_back(ParameterJson(p, sigma_scale));
-  // The mount's seven parameters close the list (board_mount.h's layout).
-  const std::size_t m = b.parameters.size() - model::board_mount::kSize;
   auto sigma = [&](int i) {
-    const auto& p = b.parameters[m + static_cast<std::size_t>(i)];
+    const auto& p = b.MountParameter(i);
     return p.fixed || !p.observable ? std::nan("") : sigma_scale * p.sigma;
   };
   using model::board_mount::kLeverArm;
@@ -409,6 +416,7 @@ void AddBoardJson(const estimation::CalibrationResult& r, json& doc) {
   json imu0{{"instance", 0}, {keys::kModel, c.model.spec()}};
   imu0[keys::kAccel] = doc[keys::kAccel];
   imu0[keys::kGyro] = doc[keys::kGyro];
+  imu0["effects"] = doc["effects"];
   imu0.update(MountJson(Quat::Identity(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), 0.0, 0.0));
   json imus = json::array({imu0});
   json names = json::array(), units = json::array();

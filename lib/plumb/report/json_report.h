@@ -20,7 +20,7 @@
 //   covariance {parameters [names], units [], matrix [[...]], sigma_scaled_by_chi2,
 //               sigma_scale, determined {combinations [texts], matrix [[...]]}}
 //                                                 see CovarianceJson
-//   imus [{instance, model, accel, gyro, parameters, rotation {matrix, vector, sigma},
+//   imus [{instance, model, accel, gyro, effects, parameters, rotation {matrix, vector, sigma},
 //          lever_arm {value, sigma}, time_offset {value, sigma}}]   only with the board's
 //        other IMUs in the fit (SPEC 6): IMU 0 first (instance 0, the identity, its keys as
 //        the top level's), then each other IMU, its parameters named "imuK.accel.bias.x",

@@ -30,6 +30,25 @@ void SetParameter(const model::Model& model, model::ParameterBlocks& theta,
   theta[k][i] = reported_value - info.parameters[i].nominal;
 }
 
+void SetTruth(SimulationOptions& options, const std::string& name, double reported_value) {
+  const std::size_t dot = name.find('.');
+  if (name.rfind("imu", 0) != 0 || dot == std::string::npos) {
+    SetParameter(options.model, options.truth, name, reported_value);
+    return;
+  }
+  const std::string k = name.substr(3, dot - 3);
+  const bool digits = !k.empty() && k.find_first_not_of("0123456789") == std::string::npos;
+  const int imu = digits && k.size() < 4 ? std::stoi(k) : 0;
+  if (imu < 1 || imu > static_cast<int>(options.board.size())) {
+    throw Error(name + ": " + (options.board.empty()
+                                   ? std::string("the session has no other IMU")
+                                   : "the board has IMU 1 to " +
+                                         std::to_string(options.board.size())));
+  }
+  BoardImuTruth& b = options.board[static_cast<std::size_t>(imu - 1)];
+  SetParameter(b.model, b.truth, name.substr(dot + 1), reported_value);
+}
+
 model::ParameterBlocks RandomParameters(const model::Model& model, double scale,
                                         std::uint64_t seed) {
   if (!std::isfinite(scale) || scale < 0.0) {

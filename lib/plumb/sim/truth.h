@@ -18,6 +18,11 @@ namespace plumb::sim {
 void SetParameter(const model::Model& model, model::ParameterBlocks& theta,
                   const std::string& full_name, double reported_value);
 
+/// SetParameter on IMU 0's truth (options.model, options.truth), or on board IMU K's
+/// (options.board[K - 1]) for a name "imuK.PARAM" (SPEC 6's names: "imu2.accel.bias.x"). Throws
+/// plumb::Error, naming the board's IMUs, when K is not one of them, and as SetParameter.
+void SetTruth(SimulationOptions& options, const std::string& name, double reported_value);
+
 /// Random true parameters: every parameter that is not held fixed is drawn from
 /// N(0, (scale * typical)^2) around its nominal value (typical from the effect's
 /// ParameterInfo); fixed ones stay at nominal. Deterministic for a seed. scale >= 0, finite.
