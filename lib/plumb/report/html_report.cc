@@ -256,7 +256,8 @@ std::string BoardSection(const estimation::CalibrationResult& r, const PageExtra
     }
     out += "</tr>\n";
   }
-  return out + "</table>\n";
+  return out + "</table>\n<p>The diagnosis below is IMU 0's; " + Code("plumb diagnose --imus") +
+         " diagnoses each IMU alone and the board across.</p>\n";
 }
 
 std::string FitSection(const estimation::CalibrationResult& r) {
