@@ -6,6 +6,7 @@
 #include "plumb/core/number_text.h"
 #include "plumb/report/diagnosis_json.h"
 #include "plumb/report/json_report.h"
+#include "plumb/report/summary.h"
 
 namespace plumb::report {
 namespace {
@@ -17,14 +18,10 @@ std::string Chi2Text(double chi2, int dof, double limit) {
          " dof (band up to " + SignificantText(limit / dof, 3) + ")";
 }
 
-/// ": its fit failed a gate (nonlinear): not to be judged", or empty.
+/// ", but the fit failed a gate (nonlinear): not to be trusted as it stands", or "".
 std::string GateText(const estimation::FitReport& fit) {
   if (fit.gates.empty()) return "";
-  std::string names;
-  for (const auto& g : fit.gates) names += (names.empty() ? "" : ", ") + g.name;
-  return ", but the fit failed " +
-         (fit.gates.size() == 1 ? std::string("a gate") : std::to_string(fit.gates.size()) + " gates") +
-         " (" + names + "): not to be trusted as it stands";
+  return ", but the fit " + FailedGatesText(fit) + ": not to be trusted as it stands";
 }
 
 std::string ImuLine(std::size_t k, const diagnostics::ImuDiagnosis& imu) {

@@ -69,16 +69,21 @@ std::string SegmentationSummary(const segmentation::SegmentationResult& s,
   return os.str();
 }
 
+std::string FailedGatesText(const estimation::FitReport& fit) {
+  if (fit.gates.empty()) return "";
+  std::string names;
+  for (const auto& g : fit.gates) names += (names.empty() ? "" : ", ") + g.name;
+  const std::size_t n = fit.gates.size();
+  return "failed " + (n == 1 ? std::string("a gate") : std::to_string(n) + " gates") + " (" +
+         names + ")";
+}
+
 std::string FitVerdict(const estimation::FitReport& fit) {
   if (!fit.gates.empty()) {
     // Whatever chi^2/dof says, a failed gate means the fit is not to be trusted as it stands.
-    std::string names;
-    for (const auto& g : fit.gates) names += (names.empty() ? "" : ", ") + g.name;
     const std::string value =
         fit.dof > 0 ? "chi2/dof " + Format("%.3g", fit.chi2_dof()) : std::string("no dof left");
-    const std::size_t n = fit.gates.size();
-    return value + ", but the fit failed " + (n == 1 ? std::string("a gate") : std::to_string(n) + " gates") +
-           " (" + names + "): not to be trusted as it stands";
+    return value + ", but the fit " + FailedGatesText(fit) + ": not to be trusted as it stands";
   }
   if (fit.dof <= 0) {
     return "no degrees of freedom left: the fit cannot be judged (record more still poses)";

@@ -25,6 +25,10 @@ std::string SegmentationSummary(const segmentation::SegmentationResult& segmenta
 /// with the noise" then.
 std::string FitVerdict(const estimation::FitReport& fit);
 
+/// "failed a gate (nonlinear)" or "failed 2 gates (one_pose, nonlinear)": the gates `fit`
+/// failed, as every verdict names them; "" when it failed none.
+std::string FailedGatesText(const estimation::FitReport& fit);
+
 /// One line per failed gate: "gate failed: NAME: [SOURCE: ]MESSAGE" (empty when all passed).
 std::string GateLines(const estimation::FitReport& fit, const std::string& source = "");
 
