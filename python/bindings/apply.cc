@@ -157,10 +157,28 @@ std::string Repr(const PyCalibration& c) {
 
 }  // namespace
 
-std::shared_ptr<PyCalibration> CalibrationOfText(const std::string& text, const std::string& name) {
+namespace {
+
+/// IMU `imu`'s calibration in `doc` (read from `path`): IMU 0 as a lone IMU's; a board's IMU k
+/// through its own calibration into the body frame (correction::ReadBoardCalibrationFile).
+correction::CalibrationFile ImuOf(const nlohmann::json& doc, const std::string& path, int imu) {
+  if (imu == 0) return correction::ReadCalibrationFile(doc, path);
+  std::vector<correction::CalibrationFile> board = correction::ReadBoardCalibrationFile(doc, path);
+  std::string have;
+  for (auto& c : board) {
+    if (c.instance == imu) return std::move(c);
+    have += (have.empty() ? "" : ", ") + std::to_string(c.instance);
+  }
+  throw InputError(path, "key 'imus'", "no calibration of IMU " + std::to_string(imu) +
+                                           " (it calibrates IMU " + have + ")");
+}
+
+}  // namespace
+
+std::shared_ptr<PyCalibration> CalibrationOfText(const std::string& text, const std::string& name,
+                                                 int imu) {
   auto out = std::make_shared<PyCalibration>();
-  out->file = correction::ReadCalibrationFile(
-      ParseJsonText(name, [&] { return nlohmann::json::parse(text); }), name);
+  out->file = ImuOf(ParseJsonText(name, [&] { return nlohmann::json::parse(text); }), name, imu);
   out->text = text;
   return out;
 }
@@ -205,22 +223,32 @@ void RegisterApply(py::module_& m) {
            py::arg("sigma") = false, py::arg("acc_unit") = "m/s^2", py::arg("gyr_unit") = "rad/s",
            kApplyDoc)
       .def("__repr__", &Repr)
-      .def(py::pickle([](const PyCalibration& c) { return py::make_tuple(1, c.file.path, c.text); },
-                      [](const py::tuple& t) { return CalibrationOfText(t[2].cast<std::string>(),
-                                                                        t[1].cast<std::string>()); }));
+      .def_property_readonly("imu", [](const PyCalibration& c) { return c.file.instance; },
+                             "The board's IMU it calibrates (SPEC 6; 0 for a lone IMU). A board "
+                             "IMU's apply() gives its samples in the body frame.")
+      .def(py::pickle(
+          [](const PyCalibration& c) {
+            return py::make_tuple(2, c.file.path, c.text, c.file.instance);
+          },
+          [](const py::tuple& t) {
+            const int imu = t[0].cast<int>() >= 2 ? t[3].cast<int>() : 0;
+            return CalibrationOfText(t[2].cast<std::string>(), t[1].cast<std::string>(), imu);
+          }));
   m.def(
       "load_calibration",
-      [](const std::string& path) {
+      [](const std::string& path, int imu) {
         if (!std::filesystem::exists(path)) throw MissingFile(path);
         const nlohmann::json doc = io::ReadJsonFile(path);
         auto out = std::make_shared<PyCalibration>();
-        out->file = correction::ReadCalibrationFile(doc, path);
+        out->file = ImuOf(doc, path, imu);
         out->text = doc.dump();
         return out;
       },
-      py::arg("path"),
-      "Read a `plumb calibrate --json` file (Result.save writes one). Raises plumb.InputError "
-      "naming the file and the key when it is not such a document.");
+      py::arg("path"), py::kw_only(), py::arg("imu") = 0,
+      "Read a `plumb calibrate --json` file (Result.save writes one); imu=k: IMU k of a board's "
+      "(calibrate --imus), whose apply() gives its samples in the body frame, as plumb apply "
+      "--imus. Raises plumb.InputError naming the file and the key when it is not such a "
+      "document or has no IMU k.");
 }
 
 }  // namespace plumb::python

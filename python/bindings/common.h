@@ -71,8 +71,9 @@ struct PyCalibration {
   std::string text;
 };
 /// The calibration in the JSON document `text` (a `plumb calibrate --json` document), named
-/// `name` in messages, read as load_calibration reads a file.
-std::shared_ptr<PyCalibration> CalibrationOfText(const std::string& text, const std::string& name);
+/// `name` in messages, read as load_calibration reads a file: IMU `imu` of a board's (SPEC 6).
+std::shared_ptr<PyCalibration> CalibrationOfText(const std::string& text, const std::string& name,
+                                                 int imu = 0);
 
 /// A session's state for pickle (a dict of copies: the arrays, units, source, inputs,
 /// warnings, site, segments, the log's parameters and motion) and the session it restores,

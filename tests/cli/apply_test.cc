@@ -22,26 +22,10 @@ namespace {
 using nlohmann::json;
 using testing::Contains;
 using testing::Plumb;
+using testing::ReadCsv;
 using testing::ReadJson;
 using testing::TempDir;
 using testing::ToolRun;
-
-/// A CSV with a header: column name -> values.
-std::map<std::string, std::vector<double>> ReadCsv(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> names;
-  std::stringstream header(line);
-  for (std::string name; std::getline(header, name, ',');) names.push_back(name);
-  std::map<std::string, std::vector<double>> columns;
-  while (std::getline(in, line)) {
-    std::stringstream row(line);
-    std::string field;
-    for (std::size_t c = 0; std::getline(row, field, ','); ++c) columns[names[c]].push_back(std::stod(field));
-  }
-  return columns;
-}
 
 const char* const kNoNoise[] = {"--accel-noise", "0", "--gyro-noise", "0", "--accel-rw", "0",
                                 "--gyro-rw",     "0", "--accel-bi",   "0", "--gyro-bi",  "0"};

@@ -3,8 +3,10 @@
 // user meets them; and the inputs that cannot carry a board refused with the reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -18,6 +20,7 @@ namespace {
 using nlohmann::json;
 using testing::Contains;
 using testing::Plumb;
+using testing::ReadCsv;
 using testing::ReadJson;
 using testing::TempDir;
 using testing::ToolRun;
@@ -100,6 +103,68 @@ TEST(BoardCli, WhatCannotCarryABoardIsRefusedWithTheReason) {
   // Commands that do not fit the board do not take the flag.
   run = Plumb({"allan", csv, "--imus", "all"}, dir);
   EXPECT_EQ(run.exit_code, 2) << run.err;
+}
+
+// apply --imus (SPEC 6): every IMU through its own calibration, into the body frame; at rest
+// the IMUs then agree where their raw samples did not; one file for them all where they share
+// the stamps, or one per IMU; what does not match is refused with the reason.
+TEST(BoardCli, ApplyCorrectsEveryImuIntoTheBodyFrame) {
+  TempDir dir;
+  const auto [csv, truth_path] = SimulateBoard(dir);
+  const std::string cal = dir.File("cal.json"), one = dir.File("one.csv");
+  ASSERT_EQ(Plumb({"calibrate", csv, "--imus", "all", "--constant-bias", "--json", cal, "--lat",
+                   "51.64", "--lon", "-1.2", "--height", "100"},
+                  dir)
+                .exit_code,
+            0);
+  const ToolRun run = Plumb({"apply", cal, csv, "--imus", "all", "--out", one, "--sigma"}, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(Contains(run.out, "to 3 IMUs, each in the body frame")) << run.out;
+  const auto raw = ReadCsv(csv), corrected = ReadCsv(one);
+  // The first pose is still: the mean of each IMU against IMU 0's over its first second.
+  const auto gap = [](const std::map<std::string, std::vector<double>>& c, const std::string& k) {
+    double largest = 0.0;
+    for (const char* axis : {"x", "y", "z"}) {
+      const std::vector<double>& a0 = c.at(std::string("acc_") + axis);
+      const std::vector<double>& ak = c.at("acc" + k + "_" + axis);
+      double sum = 0.0;
+      for (std::size_t i = 0; i < 100; ++i) sum += ak[i] - a0[i];
+      largest = std::max(largest, std::abs(sum / 100.0));
+    }
+    return largest;
+  };
+  for (const std::string k : {"1", "2"}) {
+    EXPECT_GT(gap(raw, k), 0.05) << "imu" << k << " raw";           // turned 0.5-2 deg, own bias
+    EXPECT_LT(gap(corrected, k), 0.01) << "imu" << k << " corrected";  // noise / 10 and sigma
+    EXPECT_GT(corrected.at("acc" + k + "_y_sigma")[0], 0.0);
+  }
+  // One file per IMU: IMU k's file holds the one file's acc{k}_ columns in the usual ones.
+  const std::vector<std::string> files = {dir.File("i0.csv"), dir.File("i1.csv"), dir.File("i2.csv")};
+  ASSERT_EQ(Plumb({"apply", cal, csv, "--imus", "all", "--out", files[0], "--out", files[1],
+                   "--out", files[2]},
+                  dir)
+                .exit_code,
+            0);
+  EXPECT_EQ(ReadCsv(files[2]).at("acc_z"), corrected.at("acc2_z"));
+  EXPECT_EQ(ReadCsv(files[0]).at("gyr_x"), corrected.at("gyr_x"));
+  // Two files for three IMUs; an IMU the calibration did not fit.
+  ToolRun refused = Plumb({"apply", cal, csv, "--imus", "all", "--out", files[0], "--out",
+                           files[1]},
+                          dir);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_TRUE(Contains(refused.err, "2 --out given for 3 IMUs: give one per IMU, IMU 0 first, or "
+                                    "one for them all (they share their stamps)"))
+      << refused.err;
+  const std::string pair = dir.File("pair.json");
+  ASSERT_EQ(Plumb({"calibrate", csv, "--imus", "0,2", "--constant-bias", "--json", pair}, dir)
+                .exit_code,
+            0);
+  refused = Plumb({"apply", pair, csv, "--imus", "0,1", "--out", dir.File("x.csv")}, dir);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_TRUE(Contains(refused.err, "pair.json:key 'imus': no calibration of IMU 1 (it "
+                                    "calibrates IMU 0, 2)"))
+      << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("x.csv")));
 }
 
 /// The value of `name` in a Mission Planner .param text, NaN when absent; ADD_FAILURE when it
@@ -231,6 +296,43 @@ TEST(BoardCli, ALogWithoutAStillHoldSaysSo) {
   const auto [run, doc] = CalibrateRealBoard(log, dir);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("no still segment"), std::string::npos) << run.err;
+}
+
+// apply --imus on the real boards: ArduPilot's IMU and IMU2 share their stamps (one file or
+// two); PX4's three instances each have their own (one file each). A board whose data
+// determine only combinations of a mount has no sigma to propagate, and apply says so.
+TEST(BoardCli, ApplyOnTheRealBoards) {
+  PLUMB_SHARED_LOG(plane, "ardupilot/plane408_centre_point.BIN");
+  PLUMB_SHARED_LOG(px4, "px4/sample_log_small.ulg");
+  TempDir dir;
+  const auto [run, doc] = CalibrateRealBoard(plane, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string cal = dir.File("cal.json");
+  const std::string a = dir.File("a.csv"), b = dir.File("b.csv"), ab = dir.File("ab.csv");
+  ToolRun applied = Plumb({"apply", cal, plane, "--imus", "all", "--out", a, "--out", b}, dir);
+  ASSERT_EQ(applied.exit_code, 0) << applied.err;
+  EXPECT_EQ(ReadCsv(b).at("acc_x").size(), 2216u);
+  applied = Plumb({"apply", cal, plane, "--imus", "all", "--out", ab}, dir);
+  ASSERT_EQ(applied.exit_code, 0) << applied.err;
+  EXPECT_EQ(ReadCsv(ab).at("acc1_z"), ReadCsv(b).at("acc_z"));
+  applied = Plumb({"apply", cal, plane, "--imus", "all", "--out", ab, "--sigma"}, dir);
+  EXPECT_EQ(applied.exit_code, 1);
+  EXPECT_TRUE(Contains(applied.err, "has no covariance over its parameters to propagate"))
+      << applied.err;
+
+  TempDir px4_dir;
+  const auto [px4_run, px4_doc] = CalibrateRealBoard(px4, px4_dir);
+  ASSERT_EQ(px4_run.exit_code, 0) << px4_run.err;
+  const std::string px4_cal = px4_dir.File("cal.json");
+  applied = Plumb({"apply", px4_cal, px4, "--imus", "all", "--out", px4_dir.File("u.csv")}, px4_dir);
+  EXPECT_EQ(applied.exit_code, 2);
+  EXPECT_TRUE(Contains(applied.err, "they have stamps of their own")) << applied.err;
+  applied = Plumb({"apply", px4_cal, px4, "--imus", "all", "--out", px4_dir.File("u0.csv"),
+                   "--out", px4_dir.File("u1.csv"), "--out", px4_dir.File("u2.csv")},
+                  px4_dir);
+  ASSERT_EQ(applied.exit_code, 0) << applied.err;
+  EXPECT_TRUE(Contains(applied.out, "u2.csv (IMU 2)")) << applied.out;
+  EXPECT_FALSE(ReadCsv(px4_dir.File("u2.csv")).at("gyr_z").empty());
 }
 
 // diagnose --imus (issue 38, item 4): the IMU whose misfit is its own is named, with the

@@ -13,6 +13,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -84,6 +85,23 @@ inline std::string LineStarting(const std::string& text, const std::string& pref
 inline nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
+}
+
+/// A CSV with a header (plumb's native CSV): column name -> values.
+inline std::map<std::string, std::vector<double>> ReadCsv(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream header(line);
+  for (std::string name; std::getline(header, name, ',');) names.push_back(name);
+  std::map<std::string, std::vector<double>> columns;
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    std::string field;
+    for (std::size_t c = 0; std::getline(row, field, ','); ++c) columns[names[c]].push_back(std::stod(field));
+  }
+  return columns;
 }
 
 }  // namespace plumb::cli::testing

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "plumb/core/error.h"
+#include "plumb/core/so3.h"
 #include "plumb/correction/apply.h"
 #include "plumb/correction/calibration_file.h"
 #include "plumb/model/registry.h"
@@ -230,6 +231,101 @@ TEST(Correction, AnAccelerometerOnlyDocumentReadsBack) {
   EXPECT_EQ(file.model.spec(), m.spec());
   EXPECT_FALSE(file.model.has_gyro());
   EXPECT_EQ(model::ReportedValues(file.model, file.theta), model::ReportedValues(m, theta));
+}
+
+/// A board's calibration document: IMU 0 ideal (`base`), IMU 1 ideal but turned by `rho` in
+/// the body, with a covariance over IMU 1's rotation.x alone (sigma `sigma_x`, rad).
+json BoardDocument(const Vec3& rho, double sigma_x) {
+  const model::Model m = model::Model::Parse("base");
+  json doc = Document(m, m.ZeroParameters());
+  json imu1 = Document(m, m.ZeroParameters());
+  imu1.erase("model_reference");
+  for (json& p : imu1["parameters"]) p["name"] = "imu1." + p["name"].get<std::string>();
+  const char* axes[] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    imu1["parameters"].push_back({{"name", std::string("imu1.rotation.") + axes[a]},
+                                  {"value", rho[a]}});
+  }
+  imu1["instance"] = 1;
+  doc["imus"] = json::array({json{{"instance", 0}}, imu1});
+  doc["imus_covariance"] = {{"parameters", {"imu1.rotation.x"}},
+                            {"matrix", {{sigma_x * sigma_x}}}};
+  return doc;
+}
+
+// A board's IMU k (SPEC 6): corrected through its own calibration into the body frame, R_b_k
+// times its own corrected sample; --sigma propagates its rotation's covariance too.
+TEST(Correction, ABoardsImuIsWrittenInTheBodyFrameWithItsRotationsSigma) {
+  const Vec3 rho(0.02, 0.0, 0.0);  // IMU 1 turned 1.15 deg about x
+  const double sigma_x = 1e-3;     // rad
+  const std::vector<CalibrationFile> board = ReadBoardCalibrationFile(BoardDocument(rho, sigma_x), "b.json");
+  ASSERT_EQ(board.size(), 2u);
+  EXPECT_EQ(board[1].instance, 1);
+  EXPECT_EQ(board[1].mount_rotation, rho);
+  ASSERT_EQ(board[1].covariance_names, std::vector<std::string>{"rotation.x"});
+  // IMU 1 level in the body: it sees gravity in its own frame, R_b_1^T (0, 0, -g).
+  const Vec3 f_b(0.0, 0.0, -9.8);
+  const Vec3 f_1 = so3::Exp(rho).transpose() * f_b;
+  ImuSeries series;
+  series.t_s = {0.0, 0.01};
+  series.acc = {f_1.cast<float>(), f_1.cast<float>()};
+  series.gyr = {Vec3f::Zero(), Vec3f::Zero()};
+  ApplyOptions options;
+  options.uncertainty = true;
+  const CorrectedSeries c = ApplyCalibration(board[1], series, options);
+  EXPECT_LT((c.f_b[0] - f_b).norm(), 1e-5);
+  // d(R f)/d rho_x at f = (0, 0, -g): -[R f]x e_x = (0, -g, 0) to first order; sigma g sigma_x.
+  EXPECT_NEAR(c.f_sigma[0].y(), 9.8 * sigma_x, 1e-3 * 9.8 * sigma_x);
+  EXPECT_LT(c.f_sigma[0].x(), 1e-9);
+  // An axis of the rotation its data did not determine (one pose: the turn about gravity) is
+  // named, and no sigma is propagated for it.
+  json one_pose = BoardDocument(rho, sigma_x);
+  one_pose["imus"][1]["parameters"].back()["observable"] = false;  // imu1.rotation.z
+  one_pose["imus_covariance"] = {{"parameters", {"imu1.rotation.x", "imu1.rotation.z"}},
+                                 {"matrix", {{sigma_x * sigma_x, 0.0}, {0.0, 1.0}}}};
+  const CalibrationFile yaw_unseen = ReadBoardCalibrationFile(one_pose, "b.json")[1];
+  EXPECT_EQ(yaw_unseen.undetermined, std::vector<std::string>{"rotation.z"});
+  EXPECT_EQ(yaw_unseen.covariance_names, std::vector<std::string>{"rotation.x"});
+  // IMU 0 reads as the document's top level, in its own (the body) frame.
+  EXPECT_EQ(board[0].instance, 0);
+  EXPECT_EQ(board[0].mount_rotation, Vec3::Zero());
+}
+
+// A board's entry that is not IMU k's is refused naming the file and the key in it.
+TEST(Correction, ABoardsEntryIsCheckedAsItsOwnCalibration) {
+  const auto refusal = [](const json& doc) -> std::string {
+    try {
+      ReadBoardCalibrationFile(doc, "b.json");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  json doc = BoardDocument(Vec3::Zero(), 1e-3);
+  EXPECT_EQ(refusal(doc), "");
+  json unprefixed = doc;
+  unprefixed["imus"][1]["parameters"][0]["name"] = "accel.matrix.xx";
+  EXPECT_EQ(refusal(unprefixed),
+            "b.json:key 'imus[1].parameters[0].name': 'accel.matrix.xx' lacks the prefix 'imu1.' "
+            "of IMU 1");
+  json twice = doc;
+  twice["imus"][1]["instance"] = 0;
+  for (json& p : twice["imus"][1]["parameters"]) {
+    std::string name = p["name"];
+    p["name"] = "imu0." + name.substr(5);
+  }
+  EXPECT_EQ(refusal(twice), "b.json:key 'imus[1].instance': IMU 0 given twice (first at [0])");
+  json no_value = doc;
+  no_value["imus"][1]["parameters"].erase(0);
+  EXPECT_EQ(refusal(no_value), "b.json, imus[1]:key 'parameters': no value for 'accel.matrix.xx'");
+  json no_rotation = doc;
+  no_rotation["imus"][1]["parameters"].erase(no_rotation["imus"][1]["parameters"].size() - 1);
+  EXPECT_EQ(refusal(no_rotation), "b.json:key 'imus': IMU 1 has no value for 'imu1.rotation.z'");
+  json bad_covariance = doc;
+  bad_covariance["imus_covariance"]["matrix"] = {{-1.0}};
+  EXPECT_EQ(refusal(bad_covariance),
+            "b.json:key 'imus_covariance.matrix': the covariance has a negative variance on row "
+            "0 (-1)");
 }
 
 }  // namespace

@@ -6,6 +6,7 @@ study as `plumb sweep` writes it."""
 import csv
 import json
 import os
+import pickle
 import shutil
 import subprocess
 import unittest
@@ -177,6 +178,36 @@ class CliEqual(unittest.TestCase):
                                    time=self.session.time)
         np.testing.assert_array_equal(f2, f)
         np.testing.assert_array_equal(w2, w)
+
+    def test_board_apply_equals_plumb_apply(self):
+        # A board's IMU 2 (SPEC 6): load_calibration(imu=2) applies its own calibration into
+        # the body frame, as plumb apply --imus writes its acc2_ columns.
+        board = out("board_apply.csv")
+        run("simulate", "--out", board, "--imus", "3", "--random-truth", "1", "--poses", "6",
+            "--rate", "50", "--seed", "4")
+        run("calibrate", board, "--imus", "all", "--json", out("board_apply.json"))
+        run("apply", out("board_apply.json"), board, "--imus", "all", "--out",
+            out("board_corrected.csv"), "--sigma")
+        header, table = read_csv(out("board_corrected.csv"))
+        imu2 = plumb.open(board, imus="all").other_imus[1]
+        calibration = plumb.load_calibration(out("board_apply.json"), imu=2)
+        self.assertEqual(calibration.imu, 2)
+        self.assertIn("rotation.x", calibration.parameter_names)
+        f, w, fs, ws = calibration.apply(imu2.acc, imu2.gyr, imu2.temp, time=imu2.time,
+                                         sigma=True)
+        def printed(a):
+            return np.array([[float(f"{x:.9g}") for x in row] for row in a])
+        def columns(*names):
+            return table[:, [header.index(n) for n in names]]
+        np.testing.assert_array_equal(printed(f), columns("acc2_x", "acc2_y", "acc2_z"))
+        np.testing.assert_array_equal(printed(w), columns("gyr2_x", "gyr2_y", "gyr2_z"))
+        np.testing.assert_array_equal(printed(fs), columns("acc2_x_sigma", "acc2_y_sigma",
+                                                           "acc2_z_sigma"))
+        # It pickles as IMU 2's; an IMU the board has not is named.
+        self.assertEqual(pickle.loads(pickle.dumps(calibration)).imu, 2)
+        with self.assertRaises(plumb.InputError) as raised:
+            plumb.load_calibration(out("board_apply.json"), imu=5)
+        self.assertIn("no calibration of IMU 5 (it calibrates IMU 0, 1, 2)", str(raised.exception))
 
     def test_simulate_equals_plumb_simulate(self):
         run("simulate", "--out", out("sim.csv"), "--random-truth", "1", "--poses", "6",

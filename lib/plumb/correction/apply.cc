@@ -6,6 +6,7 @@
 #include "plumb/core/error.h"
 #include "plumb/core/number_text.h"
 #include "plumb/core/option_name.h"
+#include "plumb/core/so3.h"
 
 namespace plumb::correction {
 namespace {
@@ -46,12 +47,20 @@ Vec3 AngularAcceleration(const ImuSeries& s, std::size_t i, const Mat3& E_inv) {
   return E_inv * (s.gyr[b].cast<double>() - s.gyr[a].cast<double>()) / dt;
 }
 
-/// Corrects sample i with the blocks `theta` (the model's linear parts inverted once per theta).
+/// A calibration's values: its model's blocks and, for a board's IMU k, its mount's rotation
+/// vector (CalibrationFile::mount_rotation).
+struct Values {
+  model::ParameterBlocks theta;
+  Vec3 rho = Vec3::Zero();
+};
+
+/// Corrects sample i with `values` (the model's linear parts inverted once per theta), in the
+/// body frame: R_b_k = Exp(rho) times IMU k's own corrected sample. `values` must outlive it.
 class Corrector {
  public:
-  Corrector(const CalibrationFile& c, const ImuSeries& s, const model::ParameterBlocks& theta,
-            int steps)
-      : c_(c), s_(s), steps_(steps) {
+  Corrector(const CalibrationFile& c, const ImuSeries& s, const Values& values, int steps)
+      : c_(c), s_(s), steps_(steps), R_b_k_(so3::Exp(values.rho)) {
+    const model::ParameterBlocks& theta = values.theta;
     for (const auto& block : theta) blocks_.push_back(block.data());
     const model::SensorOutput<double> linear = c.model.Predict(blocks_.data(), model::SensorInput<double>());
     F_inv_ = linear.F.inverse();
@@ -63,14 +72,16 @@ class Corrector {
     if (s_.has_temperature()) in.dtemp_c = static_cast<double>(s_.temp_c[i]) - c_.model.temp_ref_c;
     in.alpha_b = AngularAcceleration(s_, i, E_inv_);
     const Vec3 y_g = s_.has_gyro() ? Vec3(s_.gyr[i].cast<double>()) : Vec3::Zero();
-    return c_.model.Correct(blocks_.data(), Vec3(s_.acc[i].cast<double>()), y_g, in, F_inv_, E_inv_,
-                            steps_);
+    const auto [f, omega] = c_.model.Correct(blocks_.data(), Vec3(s_.acc[i].cast<double>()), y_g,
+                                             in, F_inv_, E_inv_, steps_);
+    return {R_b_k_ * f, R_b_k_ * omega};
   }
 
  private:
   const CalibrationFile& c_;
   const ImuSeries& s_;
   int steps_;
+  Mat3 R_b_k_;
   std::vector<const double*> blocks_;
   Mat3 F_inv_, E_inv_;
 };
@@ -79,15 +90,20 @@ class Corrector {
 /// parameter of the covariance is set up once; each sample's J is made and used in turn.
 void Propagate(const CalibrationFile& c, const ImuSeries& s, int steps, CorrectedSeries& out) {
   const auto n = static_cast<Eigen::Index>(c.covariance_names.size());
-  std::vector<model::ParameterBlocks> moved;  // +h, -h per parameter (the Correctors point in)
+  std::vector<Values> moved;  // +h, -h per parameter (the Correctors point in)
   std::vector<double> step;
   moved.reserve(static_cast<std::size_t>(2 * n));
   for (Eigen::Index j = 0; j < n; ++j) {
-    const auto [t, k] = *c.model.FindParameter(c.covariance_names[static_cast<std::size_t>(j)]);
+    const std::string& name = c.covariance_names[static_cast<std::size_t>(j)];
     const double h = 1e-3 * std::sqrt(std::max(c.covariance(j, j), 0.0)) + 1e-12;
     for (double sign : {1.0, -1.0}) {
-      moved.push_back(c.theta);
-      moved.back()[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)] += sign * h;
+      moved.push_back({c.theta, c.mount_rotation});
+      if (const auto at = c.model.FindParameter(name)) {
+        moved.back().theta[static_cast<std::size_t>(at->first)]
+                          [static_cast<std::size_t>(at->second)] += sign * h;
+      } else {  // "rotation.x|y|z" (CalibrationFile::mount_rotation)
+        moved.back().rho[name.back() - 'x'] += sign * h;
+      }
     }
     step.push_back(h);
   }
@@ -116,7 +132,8 @@ CorrectedSeries ApplyCalibration(const CalibrationFile& calibration, const ImuSe
   if (options.newton_steps < 0) throw Error("apply: newton_steps must be >= 0");
   CheckFits(calibration, series);
   const int steps = options.newton_steps + 1;  // the first step is the linear inverse
-  const Corrector correct(calibration, series, calibration.theta, steps);
+  const Values values{calibration.theta, calibration.mount_rotation};  // outlives `correct`
+  const Corrector correct(calibration, series, values, steps);
   CorrectedSeries out;
   out.f_b.resize(series.size());
   if (series.has_gyro()) out.omega_b.resize(series.size());

@@ -77,6 +77,9 @@ CalibrationFile CalibrationFromDocument(const document::CalibrationDocument& d) 
   for (std::size_t j = 0; j < names.size(); ++j) {
     if (!seen[j]) throw InputError(path, KeyPlace("parameters"), "no value for '" + names[j] + "'");
   }
+  for (const document::DocumentParameter& p : d.parameters) {
+    if (!p.observable && !p.fixed) out.undetermined.push_back(p.name);
+  }
   CheckMatrices(out);
   for (std::size_t i = 0; i < d.covariance_names.size(); ++i) {
     if (!out.model.FindParameter(d.covariance_names[i])) {
@@ -94,6 +97,81 @@ CalibrationFile ReadCalibrationFile(const nlohmann::json& doc, const std::string
   document::ReadOptions options;
   options.still_segments = false;  // apply reads no segment (a truth document's are poses)
   return CalibrationFromDocument(document::ReadCalibrationDocument(doc, path, options));
+}
+
+namespace {
+
+/// The mount's rotation vector from its parameters "rotation.x|y|z".
+Vec3 MountRotation(const document::BoardImuDocument& imu, const std::string& path) {
+  Vec3 rho = Vec3::Zero();
+  const std::string axes = "xyz";
+  for (int a = 0; a < 3; ++a) {
+    const std::string name = std::string("rotation.") + axes[static_cast<std::size_t>(a)];
+    const auto p = std::find_if(imu.mount.begin(), imu.mount.end(),
+                                [&](const document::DocumentParameter& q) { return q.name == name; });
+    if (p == imu.mount.end()) {
+      throw InputError(path, KeyPlace("imus"), "IMU " + std::to_string(imu.instance) +
+                                                   " has no value for 'imu" +
+                                                   std::to_string(imu.instance) + "." + name + "'");
+    }
+    rho[a] = p->value;
+  }
+  return rho;
+}
+
+/// The block of the board's covariance over IMU k's free, observable parameters of `file`'s
+/// model and its rotation, prefix taken off (the lever arm and time offset move no corrected
+/// sample), as a lone IMU's "covariance" is over its determined parameters; an unobservable
+/// rotation axis joins CalibrationFile::undetermined.
+void SetBoardCovariance(const document::BoardDocument& board,
+                        const document::BoardImuDocument& imu, CalibrationFile& file) {
+  const std::string prefix = "imu" + std::to_string(imu.instance) + ".";
+  std::vector<document::DocumentParameter> own_parameters = imu.document.parameters;
+  own_parameters.insert(own_parameters.end(), imu.mount.begin(), imu.mount.end());
+  const auto entry = [&](const std::string& name) -> const document::DocumentParameter* {
+    for (const auto& p : own_parameters) {
+      if (p.name == name) return &p;
+    }
+    return nullptr;
+  };
+  std::vector<Eigen::Index> rows;
+  file.covariance_names.clear();
+  file.covariance.resize(0, 0);
+  for (std::size_t i = 0; i < board.covariance_names.size(); ++i) {
+    const std::string& name = board.covariance_names[i];
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string own = name.substr(prefix.size());
+    if (!file.model.FindParameter(own) && own.rfind("rotation.", 0) != 0) continue;
+    const document::DocumentParameter* p = entry(own);
+    if (p != nullptr && p->fixed) continue;
+    if (p != nullptr && !p->observable) {
+      if (own.rfind("rotation.", 0) == 0) file.undetermined.push_back(own);
+      continue;
+    }
+    rows.push_back(static_cast<Eigen::Index>(i));
+    file.covariance_names.push_back(own);
+  }
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  file.covariance.resize(n, n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    for (Eigen::Index c = 0; c < n; ++c) file.covariance(r, c) = board.covariance(rows[r], rows[c]);
+  }
+}
+
+}  // namespace
+
+std::vector<CalibrationFile> ReadBoardCalibrationFile(const nlohmann::json& doc,
+                                                      const std::string& path) {
+  std::vector<CalibrationFile> out = {ReadCalibrationFile(doc, path)};
+  const document::BoardDocument board = document::ReadBoardDocument(doc, path);
+  for (const document::BoardImuDocument& imu : board.imus) {
+    CalibrationFile file = CalibrationFromDocument(imu.document);
+    file.instance = imu.instance;
+    file.mount_rotation = MountRotation(imu, path);
+    SetBoardCovariance(board, imu, file);
+    out.push_back(std::move(file));
+  }
+  return out;
 }
 
 }  // namespace plumb::correction

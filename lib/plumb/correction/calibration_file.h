@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/types.h"
 #include "plumb/document/calibration_document.h"
 #include "plumb/model/model.h"
 
@@ -30,6 +31,16 @@ struct CalibrationFile {
   /// matrix, in their units squared; empty when the document has no covariance.
   std::vector<std::string> covariance_names;
   Eigen::MatrixXd covariance;
+  /// The board's IMU this calibrates (SPEC 6): 0 for IMU 0 or a calibration of one IMU.
+  int instance = 0;
+  /// IMU k's mount, the rotation vector rho of R_b_k (model/board_mount.h); zero for IMU 0.
+  /// ApplyCalibration writes the corrected samples in the body frame, R_b_k times IMU k's own.
+  /// The covariance may then be over "rotation.x", "rotation.y", "rotation.z" too.
+  Vec3 mount_rotation = Vec3::Zero();
+  /// The parameters the document marks unobservable (not fixed): their data determined only
+  /// combinations of them, so their values are one choice among many and no sigma covers
+  /// them; empty for a calibration its data determined.
+  std::vector<std::string> undetermined;
   /// Units of the samples the calibration was made on ("m/s^2", "rad/s" for SI; "counts"
   /// and the like for raw output), from the document's parameters; "" when not said.
   std::string acc_unit, gyr_unit;
@@ -39,6 +50,14 @@ struct CalibrationFile {
 /// "segments" left unread: a simulation's truth document is read as a calibration too), then
 /// CalibrationFromDocument. Throws plumb::InputError naming the file and the key.
 CalibrationFile ReadCalibrationFile(const nlohmann::json& doc, const std::string& path);
+
+/// Every IMU of a board's calibration (SPEC 6): IMU 0 as ReadCalibrationFile reads it, then
+/// each entry of "imus" as its own calibration (its instance, model, parameters and
+/// mount_rotation), its covariance the block of "imus_covariance" over its parameters and its
+/// rotation. One element when the document calibrates one IMU. Throws plumb::InputError
+/// naming the file and the key as ReadCalibrationFile and document::ReadBoardDocument do.
+std::vector<CalibrationFile> ReadBoardCalibrationFile(const nlohmann::json& doc,
+                                                      const std::string& path);
 
 /// The calibration of a document read. Throws plumb::InputError naming the file and the key
 /// when the model spec is missing or unknown, the reference is missing, a parameter of the model

@@ -9,6 +9,7 @@
 #include "plumb/core/number_text.h"
 #include "plumb/document/calibration_keys.h"
 #include "plumb/document/json_fields.h"
+#include "plumb/model/board_mount.h"
 
 namespace plumb::document {
 namespace {
@@ -159,32 +160,39 @@ Eigen::MatrixXd SquareMatrix(const json& m, std::size_t n, const std::string& pa
   return out;
 }
 
+/// {"parameters": [names], "matrix": [[...]]} at key `key` (messages): the names, each once,
+/// and a covariance over them.
+void ReadNamedCovariance(const json& cov, const std::string& key, const std::string& path,
+                         std::vector<std::string>& names_out, Eigen::MatrixXd& matrix_out) {
+  if (!cov.is_object() || !cov.contains(k::kParameters) || !cov.contains(k::kMatrix) ||
+      !cov.at(k::kParameters).is_array()) {
+    throw InputError(path, KeyPlace(key), "expected {parameters [...], matrix [[...]]}");
+  }
+  const json& names = cov.at(k::kParameters);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (!names[i].is_string()) {
+      throw InputError(path, KeyPlace(key + ".parameters[" + std::to_string(i) + "]"),
+                       "expected a parameter name, not " + names[i].dump());
+    }
+    names_out.push_back(names[i].get<std::string>());
+  }
+  if (const auto repeat = FirstRepeat(names_out)) {
+    throw InputError(path, KeyPlace(key + ".parameters[" + std::to_string(repeat->first) + "]"),
+                     "'" + names_out[repeat->first] + "' given twice (first at [" +
+                         std::to_string(repeat->second) + "])");
+  }
+  matrix_out = SquareMatrix(cov.at(k::kMatrix), names.size(), path, key + ".matrix");
+  if (const std::string p = CovarianceProblem(matrix_out); !p.empty()) {
+    throw InputError(path, KeyPlace(key + ".matrix"), p);
+  }
+}
+
 /// "covariance": {"parameters": [names], "matrix": [[...]], "sigma_scaled_by_chi2": bool,
 /// "determined": {"matrix": [[...]]}}; null or absent: none.
 void ReadCovariance(const json& root, const std::string& path, CalibrationDocument& d) {
   if (!root.contains(k::kCovariance) || root.at(k::kCovariance).is_null()) return;
   const json& cov = root.at(k::kCovariance);
-  if (!cov.is_object() || !cov.contains(k::kParameters) || !cov.contains(k::kMatrix) ||
-      !cov.at(k::kParameters).is_array()) {
-    throw InputError(path, KeyPlace("covariance"), "expected {parameters [...], matrix [[...]]}");
-  }
-  const json& names = cov.at(k::kParameters);
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (!names[i].is_string()) {
-      throw InputError(path, KeyPlace("covariance.parameters[" + std::to_string(i) + "]"),
-                       "expected a parameter name, not " + names[i].dump());
-    }
-    d.covariance_names.push_back(names[i].get<std::string>());
-  }
-  if (const auto repeat = FirstRepeat(d.covariance_names)) {
-    throw InputError(path, KeyPlace("covariance.parameters[" + std::to_string(repeat->first) + "]"),
-                     "'" + d.covariance_names[repeat->first] + "' given twice (first at [" +
-                         std::to_string(repeat->second) + "])");
-  }
-  d.covariance = SquareMatrix(cov.at(k::kMatrix), names.size(), path, "covariance.matrix");
-  if (const std::string p = CovarianceProblem(d.covariance); !p.empty()) {
-    throw InputError(path, KeyPlace("covariance.matrix"), p);
-  }
+  ReadNamedCovariance(cov, k::kCovariance, path, d.covariance_names, d.covariance);
   d.sigma_scaled_by_chi2 = BoolOr(cov, k::kSigmaScaledByChi2, false);
   if (cov.contains(k::kDetermined) && cov.at(k::kDetermined).is_object() &&
       cov.at(k::kDetermined).contains(k::kMatrix)) {
@@ -369,6 +377,88 @@ CalibrationDocument ReadCalibrationDocument(const json& root, const std::string&
   CheckMagnitudes(d);
   CheckSigmasAgree(d);
   return d;
+}
+
+namespace {
+
+/// The names of a board mount's parameters, without a prefix (model/board_mount.h).
+bool IsMountParameter(const std::string& name) {
+  static const model::EffectInfo kMount = model::board_mount::Describe();
+  return std::any_of(kMount.parameters.begin(), kMount.parameters.end(),
+                     [&](const model::ParameterInfo& p) { return p.name == name; });
+}
+
+/// Entry i of "imus", IMU k > 0: its own document (its keys, the root's model_reference) and
+/// its mount's parameters.
+BoardImuDocument ReadBoardImu(const json& root, const json& entry, std::size_t i,
+                              const std::string& path) {
+  const std::string where = std::string(k::kImus) + "[" + std::to_string(i) + "]";
+  BoardImuDocument out;
+  out.instance = static_cast<int>(detail::FiniteNumber(
+      Field(entry, k::kInstance, path, where + "." + k::kInstance, "the IMU's instance"), path,
+      where + "." + k::kInstance));
+  const std::string prefix = "imu" + std::to_string(out.instance) + ".";
+  json own = json::object();
+  for (const char* key : {k::kModel, k::kAccel, k::kGyro}) {
+    if (entry.contains(key)) own[key] = entry.at(key);
+  }
+  if (root.contains(k::kModelReference)) own[k::kModelReference] = root.at(k::kModelReference);
+  const json& params = Field(entry, k::kParameters, path, where + ".parameters", "a list");
+  if (!params.is_array()) throw InputError(path, KeyPlace(where + ".parameters"), "expected a list");
+  own[k::kParameters] = json::array();
+  const std::string own_path = path + ", " + where;
+  for (std::size_t j = 0; j < params.size(); ++j) {
+    DocumentParameter p = ReadParameter(params[j], own_path, j);
+    if (p.name.rfind(prefix, 0) != 0) {
+      throw InputError(path, KeyPlace(where + ".parameters[" + std::to_string(j) + "].name"),
+                       "'" + p.name + "' lacks the prefix '" + prefix + "' of IMU " +
+                           std::to_string(out.instance));
+    }
+    p.name.erase(0, prefix.size());
+    if (IsMountParameter(p.name)) {
+      out.mount.push_back(p);
+      continue;
+    }
+    json stripped = params[j];
+    stripped[k::kName] = p.name;
+    own[k::kParameters].push_back(stripped);
+  }
+  ReadOptions options;
+  options.still_segments = false;
+  out.document = ReadCalibrationDocument(own, own_path, options);
+  return out;
+}
+
+}  // namespace
+
+BoardDocument ReadBoardDocument(const json& root, const std::string& path) {
+  BoardDocument out;
+  if (!root.is_object() || !root.contains(k::kImus)) return out;
+  const json& imus = root.at(k::kImus);
+  if (!imus.is_array() || imus.empty() || !imus[0].is_object()) {
+    throw InputError(path, KeyPlace(k::kImus), "expected a list of the board's IMUs, IMU 0 first");
+  }
+  std::vector<std::string> instances = {"0"};
+  for (std::size_t i = 1; i < imus.size(); ++i) {
+    if (!imus[i].is_object()) {
+      throw InputError(path, KeyPlace(std::string(k::kImus) + "[" + std::to_string(i) + "]"),
+                       "expected {instance, model, parameters, ...}");
+    }
+    out.imus.push_back(ReadBoardImu(root, imus[i], i, path));
+    instances.push_back(std::to_string(out.imus.back().instance));
+  }
+  if (const auto repeat = FirstRepeat(instances)) {
+    throw InputError(path,
+                     KeyPlace(std::string(k::kImus) + "[" + std::to_string(repeat->first) + "]." +
+                              k::kInstance),
+                     "IMU " + instances[repeat->first] + " given twice (first at [" +
+                         std::to_string(repeat->second) + "])");
+  }
+  if (root.contains(k::kImusCovariance) && !root.at(k::kImusCovariance).is_null()) {
+    ReadNamedCovariance(root.at(k::kImusCovariance), k::kImusCovariance, path,
+                        out.covariance_names, out.covariance);
+  }
+  return out;
 }
 
 CalibrationDocument ReadCalibrationDocumentFile(const std::string& path,

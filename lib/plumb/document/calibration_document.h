@@ -95,6 +95,29 @@ struct CalibrationDocument {
   Eigen::MatrixXd determined_covariance;
 };
 
+/// One of a board's other IMUs in "imus" (SPEC 6, "Several IMUs of one board").
+struct BoardImuDocument {
+  int instance = 0;  ///< "instance": the log's sensor instance, or k of acc{k}_x columns
+  /// Its own calibration, read as ReadCalibrationDocument reads a document: its "model",
+  /// "parameters" (the "imuK." prefix taken off, the mount's left out), "accel" and "gyro",
+  /// with the document's "model_reference". Its path is "<file>, imus[i]", which its messages
+  /// name with the key inside that entry.
+  CalibrationDocument document;
+  /// The mount's parameters (model/board_mount.h's names, prefix taken off: "rotation.x",
+  /// "lever_arm.z", "time_offset"), each as the document gives it.
+  std::vector<DocumentParameter> mount;
+};
+
+/// A board's calibration: "imus" and "imus_covariance" (SPEC 6).
+struct BoardDocument {
+  /// IMU 1, 2, ... in the order written (IMU 0, at the identity, is the document itself);
+  /// empty when the document calibrates one IMU.
+  std::vector<BoardImuDocument> imus;
+  /// "imus_covariance": the names (IMU 0's bare, IMU k's prefixed "imuK.") and the matrix.
+  std::vector<std::string> covariance_names;
+  Eigen::MatrixXd covariance;
+};
+
 /// What ReadCalibrationDocument reads besides the calibration itself.
 struct ReadOptions {
   /// Read "segments" as the fit's still segments (label, acc_mean, count: compare's NEES over
@@ -121,6 +144,13 @@ struct ReadOptions {
 /// Keys neither use reads are not checked.
 CalibrationDocument ReadCalibrationDocument(const nlohmann::json& doc, const std::string& path,
                                             const ReadOptions& options = {});
+
+/// "imus" and "imus_covariance" of `doc` (from `path`): empty when it has no "imus". Throws
+/// plumb::InputError naming the file and the key when "imus" is not a list of {instance,
+/// model, parameters, ...} with IMU 0 first, an instance is given twice, a parameter of IMU k
+/// lacks its "imuK." prefix, an IMU's own entry fails ReadCalibrationDocument's checks, or
+/// "imus_covariance" is not a covariance over named parameters.
+BoardDocument ReadBoardDocument(const nlohmann::json& doc, const std::string& path);
 
 /// The file at `path` parsed (plumb::InputError naming it and the line and column when it is not
 /// JSON) and read as ReadCalibrationDocument reads a document.

@@ -56,6 +56,12 @@ inline constexpr const char* kLabel = "label";
 inline constexpr const char* kCount = "count";
 inline constexpr const char* kAccMean = "acc_mean";
 
+// A board's calibration (SPEC 6): "imus" [{instance, model, parameters, accel, gyro, ...}],
+// "imus_covariance" {parameters, matrix, ...}.
+inline constexpr const char* kImus = "imus";
+inline constexpr const char* kImusCovariance = "imus_covariance";
+inline constexpr const char* kInstance = "instance";
+
 /// The suffix of an accelerometer-only fit's model spec (model::Model::DropGyro).
 inline constexpr const char* kAccelerometerOnly = " (accelerometer only)";
 

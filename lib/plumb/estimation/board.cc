@@ -186,12 +186,24 @@ void ReportBoard(const CalibrationProblem& problem, const UnknownColumns& column
   for (Eigen::Index a = 0; a < n; ++a) {
     for (Eigen::Index b = 0; b < n; ++b) {
       const Eigen::Index ca = all[static_cast<std::size_t>(a)], cb = all[static_cast<std::size_t>(b)];
-      if (ca >= 0 && cb >= 0) cov(a, b) = analysis.covariance(ca, cb);
+      const auto determined = [&](Eigen::Index c) {
+        return c >= 0 && analysis.observable[static_cast<std::size_t>(c)];
+      };
+      if (determined(ca) && determined(cb)) cov(a, b) = analysis.covariance(ca, cb);
     }
   }
-  // IMU 0's own block as its parameters report it (covariance.h).
+  // Zero rows for fixed and unobservable parameters: an unobservable one's pseudo-inverse
+  // values mean nothing (observability.determined says what the data fix of it), and would
+  // make the matrix, written and read back, no covariance. IMU 0's own block as its
+  // parameters report it (covariance.h).
   const Eigen::Index n0 = calibration.covariance.rows();
-  cov.topLeftCorner(n0, n0) = calibration.covariance;
+  for (Eigen::Index a = 0; a < n0; ++a) {
+    for (Eigen::Index b = 0; b < n0; ++b) {
+      const bool determined = calibration.parameters[static_cast<std::size_t>(a)].observable &&
+                              calibration.parameters[static_cast<std::size_t>(b)].observable;
+      cov(a, b) = determined ? calibration.covariance(a, b) : 0.0;
+    }
+  }
 }
 
 }  // namespace plumb::estimation
