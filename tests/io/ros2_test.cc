@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/db3.h"
 #include "plumb/io/ros/mcap.h"
+#include "plumb/io/ros/read_ahead.h"
 #include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/ros_session.h"
 
@@ -233,6 +235,86 @@ TEST(McapReader, OtherChannelsCountedOrphansAndOtherEncodings) {
   EXPECT_EQ(counts[1].first, "/mag (sensor_msgs/msg/MagneticField)");
   EXPECT_EQ(counts[1].second, 1u);
   ASSERT_EQ(bag.imu_topics.size(), 1u);
+}
+
+/// The bytes of `v`, appended to `out`: samples compared bit for bit.
+template <typename T>
+void AppendBytes(std::ostringstream& out, const std::vector<T>& v) {
+  out.write(reinterpret_cast<const char*>(v.data()),
+            static_cast<std::streamsize>(v.size() * sizeof(T)));
+}
+
+/// All a read of `bytes` gives (counts, connections, warnings, the samples' bits), or the
+/// error it throws, as text; the chunks read ahead when there are `min_chunks` at least.
+std::string Everything(const std::string& bytes, std::size_t min_chunks) {
+  std::ostringstream out;
+  try {
+    const RosBag bag = detail::ParseMcapReadingAhead(
+        reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "t.mcap", min_chunks);
+    out << bag.chunks << ' ' << bag.messages << ' ' << bag.chunk_infos << '\n';
+    for (const auto& [c, n] : bag.compression) out << c << ' ' << n << '\n';
+    for (const auto& [id, c] : bag.connections) {
+      out << id << ' ' << c.topic << ' ' << c.type << ' ' << c.messages << '\n';
+    }
+    const RosBagWarnings& w = bag.warnings;
+    out << w.cut_at.value_or(0) << ' ' << w.cut_messages_kept << ' ' << w.messages_read << ' '
+        << w.bad_records << ' ' << w.first_bad_record << ' ' << w.damaged_chunks << ' '
+        << w.first_damaged_chunk << ' ' << w.first_damage << ' ' << w.orphan_messages << ' '
+        << w.first_orphan << ' ' << w.malformed_imu << ' ' << w.first_malformed_imu << ' '
+        << w.first_malformed_why << '\n';
+    for (const std::string& line : w.Describe()) out << line << '\n';
+    for (const RosImuTopic& t : bag.imu_topics) {
+      out << t.topic << ' ' << t.frame_id << ' ' << t.malformed << ' ' << t.samples.size() << '\n';
+      AppendBytes(out, t.samples.t_s);
+      AppendBytes(out, t.samples.acc);
+      AppendBytes(out, t.samples.gyr);
+      AppendBytes(out, t.receive_s);
+    }
+  } catch (const InputError& e) {
+    out << "InputError " << e.file() << ' ' << e.where() << ' ' << e.what();
+  }
+  return out.str();
+}
+
+/// Eight chunks of 10 messages (CRC-32 stated) and a top-level message among them.
+std::string EightChunks(const std::string& compression) {
+  std::string records;
+  for (int k = 0; k < 8; ++k) {
+    records += McapChunk(ImuRecords(10, 10 * k, k == 0), compression, true);
+    if (k == 2) records += McapMessage(1, kReceiveNs, CdrImu(Nth(1000)));
+  }
+  return Mcap(records);
+}
+
+// The chunks read ahead (on TBB's threads) or on the calling thread alone: the same bag, the
+// same warnings, the same error, for whole, cut, damaged and refused files.
+TEST(McapReader, ReadingChunksAheadGivesTheSameBag) {
+  const auto same = [](const std::string& bytes, const std::string& what) {
+    const std::string alone = Everything(bytes, std::numeric_limits<std::size_t>::max());
+    EXPECT_EQ(Everything(bytes, 0), alone) << what;
+    EXPECT_EQ(Everything(bytes, detail::kMcapChunksReadAhead), alone) << what;
+  };
+  for (const char* c : {"", "zstd", "lz4"}) {
+    const std::string whole = EightChunks(c);
+    ASSERT_EQ(Everything(whole, 0).rfind("8 81 0\n", 0), 0u) << Everything(whole, 0);
+    for (std::size_t cut = 8; cut <= whole.size(); cut += 3) {
+      same(whole.substr(0, cut), std::string(c) + " cut " + std::to_string(cut));
+    }
+    // A byte of each chunk's data changed in turn: a CRC error, a damaged chunk (zstd, lz4),
+    // or a message that no longer decodes.
+    for (std::size_t at = whole.size() / 16; at < whole.size(); at += whole.size() / 16) {
+      std::string damaged = whole;
+      damaged[at] = static_cast<char>(damaged[at] ^ 0x5a);
+      same(damaged, std::string(c) + " byte " + std::to_string(at) + " changed");
+    }
+  }
+  // An unknown compression and a chunk stating more than 1 GiB among the others.
+  std::string records = McapChunk(ImuRecords(10), "", true);
+  for (int k = 1; k < 6; ++k) records += McapChunk(ImuRecords(10, 10 * k, false), "zstd", true);
+  records += McapChunk(ImuRecords(10, 60, false), "bogus");
+  std::string huge = McapChunk(ImuRecords(10, 70, false), "", false);
+  huge[9 + 16 + 3] = 0x7f;  // uncompressed size's fourth byte: over 1 GiB
+  same(Mcap(records + huge + McapChunk(ImuRecords(10, 80, false), "lz4")), "bogus and huge");
 }
 
 TEST(CdrImu, BigEndianGivesTheSameValues) {

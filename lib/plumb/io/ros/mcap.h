@@ -19,6 +19,9 @@
 //        is read past.
 //
 // Decoding contract (one pass over the file held in memory, as the ROS 1 reader's):
+//  * A file of 64 chunks or more has its chunks decompressed and CRC-checked up to two ahead of
+//    their parse, on TBB's threads (a pipeline, io/ros/read_ahead.h), all else as below: the
+//    same samples, warnings and errors as read on one thread, which smaller files are.
 //  * The records are read linearly, chunk by chunk, up to the Footer; the summary section is
 //    read like the data (its Schema and Channel records repeat those already known) and never
 //    needed, so a file cut short gives the messages before the cut: the record at the cut and
