@@ -32,6 +32,11 @@
 // chunk's records of that decompressed copy, read from memory (bytes_per_second: of records
 // checked). BM_McapCrc32Chunk/libdeflate_in_cache: libdeflate_crc32 of one 256 KiB chunk held
 // in cache, again and again: the check's own speed where the reader does it.
+// BM_ParseMcapAhead/<copy>_{alone,ahead}: the fixture itself (9 chunks of 256 KiB) or its data
+// section repeated to about 10 MB (108 lz4, 126 zstd chunks), parsed from memory with the chunks
+// read ahead on TBB's threads (`ahead`) or on the calling thread alone (`alone`), whatever their
+// number (the reader itself reads ahead from detail::kMcapChunksReadAhead chunks): where the
+// pipeline pays.
 // Skipped with the reason when the fixtures cannot be made (data, node or the npm packages
 // absent).
 #include <benchmark/benchmark.h>
@@ -47,6 +52,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -55,6 +61,7 @@
 
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ros/mcap.h"
+#include "plumb/io/ros/read_ahead.h"
 
 namespace {
 
@@ -129,7 +136,8 @@ class RepeatedMcap {
       body_end = r.end;
     }
     path_ = (std::filesystem::temp_directory_path() /
-             ("plumb_bench_" + std::filesystem::path(source).filename().string()))
+             ("plumb_bench_" + std::to_string(target) + "_" +
+              std::filesystem::path(source).filename().string()))
                 .string();
     std::ofstream out(path_, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(body_begin));
@@ -194,11 +202,12 @@ class DecompressedMcap {
   std::string path_;
 };
 
-/// The repeated copy of fixture `name` ("ardrone_imu_zstd.mcap"), made once; nullptr with
-/// `why` when the fixtures are absent. `name` "ardrone_imu_zstd_decompressed": the zstd one's
-/// DecompressedMcap.
-const std::string* Repeated(const std::string& name, std::string* why) {
-  static std::map<std::string, std::unique_ptr<RepeatedMcap>> made;
+/// The repeated copy of fixture `name` ("ardrone_imu_zstd.mcap") up to about `target` bytes (0:
+/// the data section once), made once; nullptr with `why` when the fixtures are absent. `name`
+/// "ardrone_imu_zstd_decompressed": the zstd one's DecompressedMcap.
+const std::string* Repeated(const std::string& name, std::string* why,
+                            std::size_t target = kTargetBytes) {
+  static std::map<std::pair<std::string, std::size_t>, std::unique_ptr<RepeatedMcap>> made;
   static std::unique_ptr<DecompressedMcap> decompressed;
   const std::string dir = std::string(PLUMB_BINARY_DIR) + "/ros2_fixtures";
   *why = MakeFixtures(dir + "/ardrone_imu");
@@ -208,8 +217,8 @@ const std::string* Repeated(const std::string& name, std::string* why) {
     if (!decompressed) decompressed = std::make_unique<DecompressedMcap>(*zstd);
     return &decompressed->path();
   }
-  auto& slot = made[name];
-  if (!slot) slot = std::make_unique<RepeatedMcap>(dir + "/" + name, kTargetBytes);
+  auto& slot = made[{name, target}];
+  if (!slot) slot = std::make_unique<RepeatedMcap>(dir + "/" + name, target);
   return &slot->path();
 }
 
@@ -264,6 +273,48 @@ BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_zstd_decompressed,
                   std::string("ardrone_imu_zstd_decompressed"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+/// A small or middling copy read from memory (ParseMcap) with its chunks read ahead on TBB's
+/// threads (`ahead`) or on this thread alone, whatever their number: what the pipeline costs
+/// or gains below and above detail::kMcapChunksReadAhead. `target`: RepeatedMcap's.
+void BM_ParseMcapAhead(benchmark::State& state, const std::string& name, std::size_t target,
+                       bool ahead) {
+  std::string why;
+  const std::string* file = Repeated(name, &why, target);
+  if (file == nullptr) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  std::ifstream in(*file, std::ios::binary);
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
+  const std::size_t min_chunks = ahead ? 0 : std::numeric_limits<std::size_t>::max();
+  std::size_t chunks = 0;
+  const double cpu_before = ProcessCpuMs();
+  for (auto _ : state) {
+    const plumb::io::RosBag read =
+        plumb::io::detail::ParseMcapReadingAhead(data, bytes.size(), "bench", min_chunks);
+    chunks = read.chunks;
+    benchmark::DoNotOptimize(chunks);
+  }
+  const double cpu_ms = ProcessCpuMs() - cpu_before;
+  SetCounters(state, bytes.size(), chunks);
+  state.counters["chunks"] = static_cast<double>(chunks);
+  state.counters["process_cpu_ms"] = cpu_ms / static_cast<double>(state.iterations());
+}
+#define PLUMB_PARSE_AHEAD(copy, file, target)                                                   \
+  BENCHMARK_CAPTURE(BM_ParseMcapAhead, copy##_alone, std::string(file), target, false)         \
+      ->Unit(benchmark::kMillisecond)                                                          \
+      ->UseRealTime();                                                                         \
+  BENCHMARK_CAPTURE(BM_ParseMcapAhead, copy##_ahead, std::string(file), target, true)          \
+      ->Unit(benchmark::kMillisecond)                                                          \
+      ->UseRealTime()
+PLUMB_PARSE_AHEAD(zstd_fixture, "ardrone_imu_zstd.mcap", 0);
+PLUMB_PARSE_AHEAD(lz4_fixture, "ardrone_imu_lz4.mcap", 0);
+PLUMB_PARSE_AHEAD(zstd_10MB, "ardrone_imu_zstd.mcap", 10000000);
+PLUMB_PARSE_AHEAD(lz4_10MB, "ardrone_imu_lz4.mcap", 10000000);
+#undef PLUMB_PARSE_AHEAD
+
 
 /// The bytes of the repeated `name` and its top-level records (nullopt, the state skipped,
 /// when it cannot be made).
