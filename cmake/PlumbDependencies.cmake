@@ -30,11 +30,6 @@ find_path(PLUMB_SQLITE3_INCLUDE_DIR sqlite3.h REQUIRED)
 find_library(PLUMB_SQLITE3_LIBRARY sqlite3 REQUIRED)
 find_path(PLUMB_DEFLATE_INCLUDE_DIR libdeflate.h REQUIRED)
 find_library(PLUMB_DEFLATE_LIBRARY deflate REQUIRED)
-# oneTBB (libtbb-dev): a large MCAP file's chunks decompressed on other threads while the
-# chunk before is parsed (io/ros/read_ahead.h, tbb::parallel_pipeline). Linked privately by
-# io_ros; found here, which the installed plumbConfig.cmake includes, because a static
-# plumb_io_ros names TBB::tbb in its link interface.
-find_package(TBB REQUIRED)
 
 # Debian ships GeographicLib with a Find module only; wrap it in an imported target.
 if(NOT TARGET GeographicLib::GeographicLib)

@@ -11,9 +11,12 @@
 // temporary file removed at exit, held by the page cache (this measures the reader, not the
 // disk). Counters: bytes_per_second of file, items_per_second (IMU messages decoded), MB (of
 // file), imu_msgs (IMU messages decoded per read) and process_cpu_ms (the CPU time of all the
-// process's threads per read, getrusage: the reader decompresses a large file's chunks on a
+// process's threads per read, getrusage: BM_ReadMcapAhead's runner decompresses chunks on a
 // second thread, which the CPU column, the benchmark's thread alone, leaves out; the Time
-// column is wall time, UseRealTime).
+// column is wall time, UseRealTime). BM_ReadMcap reads with no JobRunner (on the calling
+// thread alone, as `plumb --jobs 1`); BM_ReadMcapAhead/<copy> the same file with a runner of
+// two threads (TwoThreads), as `plumb` reads it on a machine of two cores or more: the chunks
+// decompressed and CRC-checked up to three ahead of their parse.
 // BM_McapZstd/<copy> and BM_McapLz4/<copy> decompress the same file's chunks with libzstd alone
 // (ZSTD_decompressDCtx, into one buffer of the largest chunk's size and one byte, as the
 // reader's) or liblz4 alone (LZ4F_decompress, into one buffer with room for the frames' 4 MiB
@@ -34,9 +37,9 @@
 // in cache, again and again: the check's own speed where the reader does it.
 // BM_ParseMcapAhead/<copy>_{alone,ahead}: the fixture itself (9 chunks of 256 KiB) or its data
 // section repeated to about 10 MB (108 lz4, 126 zstd chunks), parsed from memory with the chunks
-// read ahead on TBB's threads (`ahead`) or on the calling thread alone (`alone`), whatever their
-// number (the reader itself reads ahead from detail::kMcapChunksReadAhead chunks): where the
-// pipeline pays.
+// read ahead through TwoThreads (`ahead`) or on the calling thread alone (`alone`), whatever
+// their number (the reader itself reads ahead from detail::kMcapChunksReadAhead chunks): where
+// reading ahead pays.
 // Skipped with the reason when the fixtures cannot be made (data, node or the npm packages
 // absent).
 #include <benchmark/benchmark.h>
@@ -46,19 +49,22 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
-#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "plumb/core/jobs.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ros/mcap.h"
 #include "plumb/io/ros/read_ahead.h"
@@ -240,7 +246,23 @@ double ProcessCpuMs() {
   return ms(usage.ru_utime) + ms(usage.ru_stime);
 }
 
-void BM_ReadMcap(benchmark::State& state, const std::string& name) {
+/// The jobs at once on two threads, this one and one started for the call, each taking the
+/// next job as it comes free. ReadMcap calls its runner once per file (two jobs), so starting a
+/// thread per call costs a few microseconds a read, and no thread is left waiting between
+/// reads (an OpenMP team's would spin there, on a core the next benchmark wants).
+void TwoThreads(int count, const std::function<void(int)>& job) {
+  std::atomic<int> next{0};
+  const auto work = [&] {
+    for (int k = next++; k < count; k = next++) job(k);
+  };
+  std::thread other(work);
+  work();
+  other.join();
+}
+
+/// ReadMcap of the repeated `name` through `run_jobs` (empty: on this thread alone).
+void ReadMcapWith(benchmark::State& state, const std::string& name,
+                  const plumb::JobRunner& run_jobs) {
   std::string why;
   const std::string* file = Repeated(name, &why);
   if (file == nullptr) {
@@ -250,7 +272,7 @@ void BM_ReadMcap(benchmark::State& state, const std::string& name) {
   std::size_t messages = 0;
   const double cpu_before = ProcessCpuMs();
   for (auto _ : state) {
-    const plumb::io::RosBag read = plumb::io::ReadMcap(*file);
+    const plumb::io::RosBag read = plumb::io::ReadMcap(*file, run_jobs);
     messages = 0;
     for (const plumb::io::RosImuTopic& t : read.imu_topics) messages += t.samples.size();
     benchmark::DoNotOptimize(messages);
@@ -259,6 +281,13 @@ void BM_ReadMcap(benchmark::State& state, const std::string& name) {
   SetCounters(state, std::filesystem::file_size(*file), messages);
   state.counters["imu_msgs"] = static_cast<double>(messages);
   state.counters["process_cpu_ms"] = cpu_ms / static_cast<double>(state.iterations());
+}
+
+void BM_ReadMcap(benchmark::State& state, const std::string& name) {
+  ReadMcapWith(state, name, {});
+}
+void BM_ReadMcapAhead(benchmark::State& state, const std::string& name) {
+  ReadMcapWith(state, name, TwoThreads);
 }
 BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_uncompressed, std::string("ardrone_imu.mcap"))
     ->Unit(benchmark::kMillisecond)
@@ -273,10 +302,23 @@ BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_zstd_decompressed,
                   std::string("ardrone_imu_zstd_decompressed"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_uncompressed, std::string("ardrone_imu.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_zstd, std::string("ardrone_imu_zstd.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_lz4, std::string("ardrone_imu_lz4.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_zstd_decompressed,
+                  std::string("ardrone_imu_zstd_decompressed"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
-/// A small or middling copy read from memory (ParseMcap) with its chunks read ahead on TBB's
-/// threads (`ahead`) or on this thread alone, whatever their number: what the pipeline costs
-/// or gains below and above detail::kMcapChunksReadAhead. `target`: RepeatedMcap's.
+/// A small or middling copy read from memory (ParseMcap) with its chunks read ahead through
+/// TwoThreads (`ahead`) or on this thread alone, whatever their number: what reading ahead
+/// costs or gains below and above detail::kMcapChunksReadAhead. `target`: RepeatedMcap's.
 void BM_ParseMcapAhead(benchmark::State& state, const std::string& name, std::size_t target,
                        bool ahead) {
   std::string why;
@@ -288,12 +330,12 @@ void BM_ParseMcapAhead(benchmark::State& state, const std::string& name, std::si
   std::ifstream in(*file, std::ios::binary);
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
-  const std::size_t min_chunks = ahead ? 0 : std::numeric_limits<std::size_t>::max();
+  const plumb::JobRunner run_jobs = ahead ? plumb::JobRunner(TwoThreads) : plumb::JobRunner();
   std::size_t chunks = 0;
   const double cpu_before = ProcessCpuMs();
   for (auto _ : state) {
     const plumb::io::RosBag read =
-        plumb::io::detail::ParseMcapReadingAhead(data, bytes.size(), "bench", min_chunks);
+        plumb::io::detail::ParseMcapReadingAhead(data, bytes.size(), "bench", run_jobs, 0);
     chunks = read.chunks;
     benchmark::DoNotOptimize(chunks);
   }

@@ -3,15 +3,18 @@
 #include "plumb/io/ros/mcap.h"
 
 #include <algorithm>
+#include <condition_variable>
 #include <cstdio>
 #include <exception>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <string_view>
 #include <unordered_map>
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/core/jobs.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/common/stream_spool.h"
 #include "plumb/io/ros/read_ahead.h"
@@ -81,10 +84,16 @@ const std::uint8_t* Bytes(std::string_view v) {
 
 class Parser {
  public:
-  /// `min_chunks`: the chunks the file has at least when they are read ahead (ReadAhead).
+  /// `min_chunks`: the chunks the file has at least when they are read ahead through
+  /// `run_jobs` (RunAhead); an empty `run_jobs`: never.
   Parser(const std::uint8_t* data, std::size_t size, RosBag* bag, const LogFile* file,
-         std::size_t min_chunks)
-      : data_(data), size_(size), bag_(bag), file_(file), min_chunks_(min_chunks) {}
+         std::size_t min_chunks, const JobRunner& run_jobs)
+      : data_(data),
+        size_(size),
+        bag_(bag),
+        file_(file),
+        min_chunks_(min_chunks),
+        run_jobs_(run_jobs) {}
 
   void Run();
 
@@ -111,7 +120,8 @@ class Parser {
     std::exception_ptr error;        ///< thrown while opening: rethrown where the parse is
   };
   /// The records of the file from `pos` up to and including the next chunk (or the Footer, a
-  /// record cut by the file's end, the end), the chunk opened ahead of their parse.
+  /// record cut by the file's end, the end; or kStretchRecords records, none a chunk), the
+  /// chunk opened ahead of their parse.
   struct Stretch {
     std::vector<std::pair<Record, std::size_t>> records;  ///< each with its file offset
     bool cut = false;                                     ///< the last runs past the file's end
@@ -128,8 +138,13 @@ class Parser {
                            OpenedChunk* out);
   /// The records from `pos` (the first after the Header) to the end, on this thread alone.
   void RunInOrder(std::size_t pos);
-  /// The same, each chunk opened ahead on TBB's threads while the chunk before is parsed.
+  /// The same, the chunks opened up to kStretchesInFlight - 1 stretches ahead of the parse
+  /// through run_jobs_ (see the definition).
   void RunAhead(std::size_t pos);
+  /// Opens the chunk of stretch `s` (when it ends with one): OpenCatching.
+  static void OpenStretch(Stretch* s);
+  /// Parses the records of stretch `s` in order, as RunInOrder would.
+  void ParseStretch(const Stretch& s);
   /// Whether the records from `pos` hold at least `n` chunks (looked for up to the n-th).
   bool ChunksAtLeast(std::size_t pos, std::size_t n) const;
   /// Frames the next stretch of records from `*pos` into `s` (false when there are none).
@@ -198,6 +213,7 @@ class Parser {
   RosBag* bag_;
   const LogFile* file_;
   std::size_t min_chunks_;
+  const JobRunner& run_jobs_;
   std::size_t released_ = 0;
   std::size_t read_to_ = 0;  ///< the file offset past the top-level record being read
   bool footer_ = false;
@@ -218,8 +234,12 @@ class Parser {
   /// By index in imu_topics: the samples its four vectors have room for (Room's).
   std::vector<std::size_t> room_;
   detail::ChunkBuffers chunk_;  ///< a decompressed chunk and the decompressors, reused
-  /// Stretches in flight when reading ahead: one parsed, two opened ahead at most.
-  static constexpr std::size_t kStretchesInFlight = 3;
+  /// Stretches in flight when reading ahead (framed and not yet parsed), each in its own
+  /// slot with its own ChunkBuffers: one parsed, three opened ahead at most.
+  static constexpr std::size_t kStretchesInFlight = 4;
+  /// Records a stretch holds at most: a long run of top-level records without a chunk is
+  /// framed a stretch at a time, not whole.
+  static constexpr std::size_t kStretchRecords = 1024;
 };
 
 bool Parser::Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r) {
@@ -247,7 +267,7 @@ void Parser::Run() {
     throw InputError(bag_->source, "byte " + std::to_string(pos),
                      "the MCAP Header record runs past the end of the file");
   }
-  if (ChunksAtLeast(pos, min_chunks_)) {
+  if (run_jobs_ && ChunksAtLeast(pos, min_chunks_)) {
     RunAhead(pos);
   } else {
     RunInOrder(pos);
@@ -274,28 +294,94 @@ void Parser::RunInOrder(std::size_t pos) {
   }
 }
 
+// Two jobs through run_jobs_, each taking, as long as there is one, the next task: parse the
+// next stretch in file order once its chunk is opened and no job is parsing; else frame the
+// next stretch (in order, in a free slot: at most kStretchesInFlight framed and not parsed) and
+// open its chunk; else wait for the other job's task in progress. A job waits only while the
+// other one is doing a task, so one job alone (a runner that runs them one after another)
+// reads the whole file in order, and the jobs never depend on each other being at once. The
+// parse touches only what RunInOrder's would (the bag, the counts, the page release), in the
+// same order; opening touches only its slot. What the parse throws stops both jobs and is
+// rethrown here: the first error in file order (an opening's is kept in its slot and rethrown
+// by the parse where RunInOrder would meet it).
 void Parser::RunAhead(std::size_t pos) {
-  const auto stretches = std::make_unique<Stretch[]>(kStretchesInFlight);
-  detail::ReadAhead(
-      kStretchesInFlight,
-      [&](std::size_t slot) { return FrameStretch(&pos, &stretches[slot]); },
-      [&](std::size_t slot) {
-        Stretch& s = stretches[slot];
-        if (s.has_chunk) OpenCatching(s.records.back().first, s.cut, &s.buffers, &s.chunk);
-      },
-      [&](std::size_t slot) {
-        const Stretch& s = stretches[slot];
-        for (std::size_t i = 0; i < s.records.size(); ++i) {
-          const auto& [r, at] = s.records[i];
-          const bool last = i + 1 == s.records.size();
-          const OpenedChunk* opened = last && s.has_chunk ? &s.chunk : nullptr;
-          if (last && s.cut) {
-            CutAt(r, at, opened);
-          } else {
-            Whole(r, at, opened);
-          }
+  const auto slots = std::make_unique<Stretch[]>(kStretchesInFlight);
+  enum class SlotState : std::uint8_t { kFree, kOpening, kOpened };
+  SlotState state[kStretchesInFlight] = {};
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::size_t framed = 0;  // stretches framed; stretch i is in slot i % kStretchesInFlight
+  std::size_t parsed = 0;  // stretches parsed
+  bool more = true;        // stretches left to frame
+  bool parsing = false;
+  bool stop = false;
+  std::exception_ptr error;
+  const auto job = [&](int) {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stop && (more || parsed < framed)) {
+      Stretch& next = slots[parsed % kStretchesInFlight];
+      if (!parsing && parsed < framed && state[parsed % kStretchesInFlight] == SlotState::kOpened) {
+        parsing = true;
+        lock.unlock();
+        std::exception_ptr thrown;
+        try {
+          ParseStretch(next);
+        } catch (...) {
+          thrown = std::current_exception();
         }
-      });
+        lock.lock();
+        parsing = false;
+        state[parsed % kStretchesInFlight] = SlotState::kFree;
+        ++parsed;
+        if (thrown) {
+          error = thrown;
+          stop = true;
+        }
+        changed.notify_all();
+        continue;
+      }
+      if (more && framed < parsed + kStretchesInFlight) {
+        const std::size_t slot = framed % kStretchesInFlight;
+        try {
+          more = FrameStretch(&pos, &slots[slot]);
+        } catch (...) {  // memory running out
+          error = std::current_exception();
+          stop = true;
+          break;
+        }
+        if (!more) continue;
+        ++framed;
+        state[slot] = SlotState::kOpening;
+        lock.unlock();
+        OpenStretch(&slots[slot]);
+        lock.lock();
+        state[slot] = SlotState::kOpened;
+        changed.notify_all();
+        continue;
+      }
+      changed.wait(lock);  // the other job is parsing or opening: it notifies when done
+    }
+    changed.notify_all();
+  };
+  RunJobs(run_jobs_, 2, job);
+  if (error) std::rethrow_exception(error);
+}
+
+void Parser::OpenStretch(Stretch* s) {
+  if (s->has_chunk) OpenCatching(s->records.back().first, s->cut, &s->buffers, &s->chunk);
+}
+
+void Parser::ParseStretch(const Stretch& s) {
+  for (std::size_t i = 0; i < s.records.size(); ++i) {
+    const auto& [r, at] = s.records[i];
+    const bool last = i + 1 == s.records.size();
+    const OpenedChunk* opened = last && s.has_chunk ? &s.chunk : nullptr;
+    if (last && s.cut) {
+      CutAt(r, at, opened);
+    } else {
+      Whole(r, at, opened);
+    }
+  }
 }
 
 bool Parser::ChunksAtLeast(std::size_t pos, std::size_t n) const {
@@ -325,7 +411,7 @@ bool Parser::FrameStretch(std::size_t* pos, Stretch* s) const {
       break;
     }
     *pos = r.op == kOpFooter ? size_ : r.end;  // nothing is read past the Footer
-    if (r.op == kOpFooter || r.op == kOpChunk) break;
+    if (r.op == kOpFooter || r.op == kOpChunk || s->records.size() >= kStretchRecords) break;
   }
   return !s->records.empty();
 }
@@ -574,7 +660,8 @@ std::size_t Parser::Room(RosImuTopic* t) const {
 
 /// ParseMcap, releasing the pages of `file` (or nullptr) behind the parser.
 RosBag ParseFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
-                 const LogFile* file, std::size_t min_chunks = detail::kMcapChunksReadAhead) {
+                 const LogFile* file, const JobRunner& run_jobs = {},
+                 std::size_t min_chunks = detail::kMcapChunksReadAhead) {
   RosBag bag;
   bag.kind = RosBagKind::kMcap;
   bag.source = source;
@@ -589,7 +676,7 @@ RosBag ParseFrom(const std::uint8_t* data, std::size_t size, const std::string& 
                                              std::string(1, static_cast<char>(data[5])) +
                                              "'); plumb reads version 0");
   }
-  Parser(data, size, &bag, file, min_chunks).Run();
+  Parser(data, size, &bag, file, min_chunks, run_jobs).Run();
   return bag;
 }
 
@@ -600,14 +687,15 @@ RosBag ParseMcap(const std::uint8_t* data, std::size_t size, const std::string& 
 }
 
 RosBag detail::ParseMcapReadingAhead(const std::uint8_t* data, std::size_t size,
-                                     const std::string& source, std::size_t min_chunks) {
-  return ParseFrom(data, size, source, nullptr, min_chunks);
+                                     const std::string& source, const JobRunner& run_jobs,
+                                     std::size_t min_chunks) {
+  return ParseFrom(data, size, source, nullptr, run_jobs, min_chunks);
 }
 
-RosBag ReadMcap(const std::string& path) {
+RosBag ReadMcap(const std::string& path, const JobRunner& run_jobs) {
   const LogFile file(path, "MCAP file");
   try {
-    RosBag bag = ParseFrom(file.data(), file.size(), path, &file);
+    RosBag bag = ParseFrom(file.data(), file.size(), path, &file, run_jobs);
     file.ThrowIfCut();
     return bag;
   } catch (const Error&) {
