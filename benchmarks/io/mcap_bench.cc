@@ -10,7 +10,13 @@
 // DataEnd) again and again up to about kTargetBytes, then a Footer; written once into a
 // temporary file removed at exit, held by the page cache (this measures the reader, not the
 // disk). Counters: bytes_per_second of file, items_per_second (IMU messages decoded), MB (of
-// file) and imu_msgs (IMU messages decoded per read).
+// file), imu_msgs (IMU messages decoded per read) and process_cpu_ms (the CPU time of all the
+// process's threads per read, getrusage: BM_ReadMcapAhead's runner decompresses chunks on a
+// second thread, which the CPU column, the benchmark's thread alone, leaves out; the Time
+// column is wall time, UseRealTime). BM_ReadMcap reads with no JobRunner (on the calling
+// thread alone, as `plumb --jobs 1`); BM_ReadMcapAhead/<copy> the same file with a runner of
+// two threads (TwoThreads), as `plumb` reads it on a machine of two cores or more: the chunks
+// decompressed and CRC-checked up to three ahead of their parse.
 // BM_McapZstd/<copy> and BM_McapLz4/<copy> decompress the same file's chunks with libzstd alone
 // (ZSTD_decompressDCtx, into one buffer of the largest chunk's size and one byte, as the
 // reader's) or liblz4 alone (LZ4F_decompress, into one buffer with room for the frames' 4 MiB
@@ -29,28 +35,39 @@
 // chunk's records of that decompressed copy, read from memory (bytes_per_second: of records
 // checked). BM_McapCrc32Chunk/libdeflate_in_cache: libdeflate_crc32 of one 256 KiB chunk held
 // in cache, again and again: the check's own speed where the reader does it.
+// BM_ParseMcapAhead/<copy>_{alone,ahead}: the fixture itself (9 chunks of 256 KiB) or its data
+// section repeated to about 10 MB (108 lz4, 126 zstd chunks), parsed from memory with the chunks
+// read ahead through TwoThreads (`ahead`) or on the calling thread alone (`alone`), whatever
+// their number (the reader itself reads ahead from detail::kMcapChunksReadAhead chunks): where
+// reading ahead pays.
 // Skipped with the reason when the fixtures cannot be made (data, node or the npm packages
 // absent).
 #include <benchmark/benchmark.h>
 #include <libdeflate.h>
+#include <sys/resource.h>
 #include <lz4frame.h>
 #include <zstd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "plumb/core/jobs.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ros/mcap.h"
+#include "plumb/io/ros/read_ahead.h"
 
 namespace {
 
@@ -125,7 +142,8 @@ class RepeatedMcap {
       body_end = r.end;
     }
     path_ = (std::filesystem::temp_directory_path() /
-             ("plumb_bench_" + std::filesystem::path(source).filename().string()))
+             ("plumb_bench_" + std::to_string(target) + "_" +
+              std::filesystem::path(source).filename().string()))
                 .string();
     std::ofstream out(path_, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(body_begin));
@@ -190,11 +208,12 @@ class DecompressedMcap {
   std::string path_;
 };
 
-/// The repeated copy of fixture `name` ("ardrone_imu_zstd.mcap"), made once; nullptr with
-/// `why` when the fixtures are absent. `name` "ardrone_imu_zstd_decompressed": the zstd one's
-/// DecompressedMcap.
-const std::string* Repeated(const std::string& name, std::string* why) {
-  static std::map<std::string, std::unique_ptr<RepeatedMcap>> made;
+/// The repeated copy of fixture `name` ("ardrone_imu_zstd.mcap") up to about `target` bytes (0:
+/// the data section once), made once; nullptr with `why` when the fixtures are absent. `name`
+/// "ardrone_imu_zstd_decompressed": the zstd one's DecompressedMcap.
+const std::string* Repeated(const std::string& name, std::string* why,
+                            std::size_t target = kTargetBytes) {
+  static std::map<std::pair<std::string, std::size_t>, std::unique_ptr<RepeatedMcap>> made;
   static std::unique_ptr<DecompressedMcap> decompressed;
   const std::string dir = std::string(PLUMB_BINARY_DIR) + "/ros2_fixtures";
   *why = MakeFixtures(dir + "/ardrone_imu");
@@ -204,8 +223,8 @@ const std::string* Repeated(const std::string& name, std::string* why) {
     if (!decompressed) decompressed = std::make_unique<DecompressedMcap>(*zstd);
     return &decompressed->path();
   }
-  auto& slot = made[name];
-  if (!slot) slot = std::make_unique<RepeatedMcap>(dir + "/" + name, kTargetBytes);
+  auto& slot = made[{name, target}];
+  if (!slot) slot = std::make_unique<RepeatedMcap>(dir + "/" + name, target);
   return &slot->path();
 }
 
@@ -218,7 +237,32 @@ void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t items) 
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
 }
 
-void BM_ReadMcap(benchmark::State& state, const std::string& name) {
+/// The CPU time this process's threads have used, ms (user and system): a pipelined read's
+/// helper threads counted too, which the CPU column (the benchmark's thread) leaves out.
+double ProcessCpuMs() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto ms = [](const timeval& t) { return 1e3 * t.tv_sec + 1e-3 * t.tv_usec; };
+  return ms(usage.ru_utime) + ms(usage.ru_stime);
+}
+
+/// The jobs at once on two threads, this one and one started for the call, each taking the
+/// next job as it comes free. ReadMcap calls its runner once per file (two jobs), so starting a
+/// thread per call costs a few microseconds a read, and no thread is left waiting between
+/// reads (an OpenMP team's would spin there, on a core the next benchmark wants).
+void TwoThreads(int count, const std::function<void(int)>& job) {
+  std::atomic<int> next{0};
+  const auto work = [&] {
+    for (int k = next++; k < count; k = next++) job(k);
+  };
+  std::thread other(work);
+  work();
+  other.join();
+}
+
+/// ReadMcap of the repeated `name` through `run_jobs` (empty: on this thread alone).
+void ReadMcapWith(benchmark::State& state, const std::string& name,
+                  const plumb::JobRunner& run_jobs) {
   std::string why;
   const std::string* file = Repeated(name, &why);
   if (file == nullptr) {
@@ -226,14 +270,24 @@ void BM_ReadMcap(benchmark::State& state, const std::string& name) {
     return;
   }
   std::size_t messages = 0;
+  const double cpu_before = ProcessCpuMs();
   for (auto _ : state) {
-    const plumb::io::RosBag read = plumb::io::ReadMcap(*file);
+    const plumb::io::RosBag read = plumb::io::ReadMcap(*file, run_jobs);
     messages = 0;
     for (const plumb::io::RosImuTopic& t : read.imu_topics) messages += t.samples.size();
     benchmark::DoNotOptimize(messages);
   }
+  const double cpu_ms = ProcessCpuMs() - cpu_before;
   SetCounters(state, std::filesystem::file_size(*file), messages);
   state.counters["imu_msgs"] = static_cast<double>(messages);
+  state.counters["process_cpu_ms"] = cpu_ms / static_cast<double>(state.iterations());
+}
+
+void BM_ReadMcap(benchmark::State& state, const std::string& name) {
+  ReadMcapWith(state, name, {});
+}
+void BM_ReadMcapAhead(benchmark::State& state, const std::string& name) {
+  ReadMcapWith(state, name, TwoThreads);
 }
 BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_uncompressed, std::string("ardrone_imu.mcap"))
     ->Unit(benchmark::kMillisecond)
@@ -248,6 +302,61 @@ BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_zstd_decompressed,
                   std::string("ardrone_imu_zstd_decompressed"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_uncompressed, std::string("ardrone_imu.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_zstd, std::string("ardrone_imu_zstd.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_lz4, std::string("ardrone_imu_lz4.mcap"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_zstd_decompressed,
+                  std::string("ardrone_imu_zstd_decompressed"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// A small or middling copy read from memory (ParseMcap) with its chunks read ahead through
+/// TwoThreads (`ahead`) or on this thread alone, whatever their number: what reading ahead
+/// costs or gains below and above detail::kMcapChunksReadAhead. `target`: RepeatedMcap's.
+void BM_ParseMcapAhead(benchmark::State& state, const std::string& name, std::size_t target,
+                       bool ahead) {
+  std::string why;
+  const std::string* file = Repeated(name, &why, target);
+  if (file == nullptr) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  std::ifstream in(*file, std::ios::binary);
+  const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
+  const plumb::JobRunner run_jobs = ahead ? plumb::JobRunner(TwoThreads) : plumb::JobRunner();
+  std::size_t chunks = 0;
+  const double cpu_before = ProcessCpuMs();
+  for (auto _ : state) {
+    const plumb::io::RosBag read =
+        plumb::io::detail::ParseMcapReadingAhead(data, bytes.size(), "bench", run_jobs, 0);
+    chunks = read.chunks;
+    benchmark::DoNotOptimize(chunks);
+  }
+  const double cpu_ms = ProcessCpuMs() - cpu_before;
+  SetCounters(state, bytes.size(), chunks);
+  state.counters["chunks"] = static_cast<double>(chunks);
+  state.counters["process_cpu_ms"] = cpu_ms / static_cast<double>(state.iterations());
+}
+#define PLUMB_PARSE_AHEAD(copy, file, target)                                                   \
+  BENCHMARK_CAPTURE(BM_ParseMcapAhead, copy##_alone, std::string(file), target, false)         \
+      ->Unit(benchmark::kMillisecond)                                                          \
+      ->UseRealTime();                                                                         \
+  BENCHMARK_CAPTURE(BM_ParseMcapAhead, copy##_ahead, std::string(file), target, true)          \
+      ->Unit(benchmark::kMillisecond)                                                          \
+      ->UseRealTime()
+PLUMB_PARSE_AHEAD(zstd_fixture, "ardrone_imu_zstd.mcap", 0);
+PLUMB_PARSE_AHEAD(lz4_fixture, "ardrone_imu_lz4.mcap", 0);
+PLUMB_PARSE_AHEAD(zstd_10MB, "ardrone_imu_zstd.mcap", 10000000);
+PLUMB_PARSE_AHEAD(lz4_10MB, "ardrone_imu_lz4.mcap", 10000000);
+#undef PLUMB_PARSE_AHEAD
+
 
 /// The bytes of the repeated `name` and its top-level records (nullopt, the state skipped,
 /// when it cannot be made).

@@ -4,17 +4,22 @@
 // given), an all-zero quaternion, malformed messages; .db3 read without a byte written beside
 // it; and FlightLog recognising both by content.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <limits>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "io/ros2_builder.h"
@@ -22,6 +27,7 @@
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/db3.h"
 #include "plumb/io/ros/mcap.h"
+#include "plumb/io/ros/read_ahead.h"
 #include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/ros_session.h"
 
@@ -233,6 +239,175 @@ TEST(McapReader, OtherChannelsCountedOrphansAndOtherEncodings) {
   EXPECT_EQ(counts[1].first, "/mag (sensor_msgs/msg/MagneticField)");
   EXPECT_EQ(counts[1].second, 1u);
   ASSERT_EQ(bag.imu_topics.size(), 1u);
+}
+
+/// The bytes of `v`, appended to `out`: samples compared bit for bit.
+template <typename T>
+void AppendBytes(std::ostringstream& out, const std::vector<T>& v) {
+  out.write(reinterpret_cast<const char*>(v.data()),
+            static_cast<std::streamsize>(v.size() * sizeof(T)));
+}
+
+/// Runs the jobs on two threads at once, this one and one started for the call, each taking
+/// the next job as it comes free (as `plumb`'s runner, apps/plumb/jobs.cc). The library starts
+/// no thread; a test may.
+void TwoThreads(int count, const std::function<void(int)>& job) {
+  std::atomic<int> next{0};
+  const auto work = [&] {
+    for (int k = next++; k < count; k = next++) job(k);
+  };
+  std::thread other(work);
+  work();
+  other.join();
+}
+
+/// Runs the jobs on this thread, the last first: the reading must not depend on their order.
+void Backwards(int count, const std::function<void(int)>& job) {
+  for (int k = count - 1; k >= 0; --k) job(k);
+}
+
+/// The text of the error a read throws ("" when none): its file, place and words.
+template <typename Read>
+std::string ErrorOf(const Read& read) {
+  try {
+    read();
+  } catch (const InputError& e) {
+    return e.file() + " | " + e.where() + " | " + e.what();
+  }
+  return "";
+}
+
+/// All a read of `bytes` gives (counts, connections, warnings, the samples' bits), or the
+/// error it throws, as text; the chunks read ahead through `run_jobs` when it is not empty
+/// and there are `min_chunks` at least.
+std::string Everything(const std::string& bytes, const JobRunner& run_jobs,
+                       std::size_t min_chunks) {
+  std::ostringstream out;
+  try {
+    const RosBag bag = detail::ParseMcapReadingAhead(
+        reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(), "t.mcap", run_jobs,
+        min_chunks);
+    out << bag.chunks << ' ' << bag.messages << ' ' << bag.chunk_infos << '\n';
+    for (const auto& [c, n] : bag.compression) out << c << ' ' << n << '\n';
+    for (const auto& [id, c] : bag.connections) {
+      out << id << ' ' << c.topic << ' ' << c.type << ' ' << c.messages << '\n';
+    }
+    const RosBagWarnings& w = bag.warnings;
+    out << w.cut_at.value_or(0) << ' ' << w.cut_messages_kept << ' ' << w.messages_read << ' '
+        << w.bad_records << ' ' << w.first_bad_record << ' ' << w.damaged_chunks << ' '
+        << w.first_damaged_chunk << ' ' << w.first_damage << ' ' << w.orphan_messages << ' '
+        << w.first_orphan << ' ' << w.malformed_imu << ' ' << w.first_malformed_imu << ' '
+        << w.first_malformed_why << '\n';
+    for (const std::string& line : w.Describe()) out << line << '\n';
+    for (const RosImuTopic& t : bag.imu_topics) {
+      out << t.topic << ' ' << t.frame_id << ' ' << t.malformed << ' ' << t.samples.size() << '\n';
+      AppendBytes(out, t.samples.t_s);
+      AppendBytes(out, t.samples.acc);
+      AppendBytes(out, t.samples.gyr);
+      AppendBytes(out, t.receive_s);
+    }
+  } catch (const InputError& e) {
+    out << "InputError " << e.file() << ' ' << e.where() << ' ' << e.what();
+  }
+  return out.str();
+}
+
+/// Eight chunks of 10 messages (CRC-32 stated) and a top-level message among them.
+std::string EightChunks(const std::string& compression) {
+  std::string records;
+  for (int k = 0; k < 8; ++k) {
+    records += McapChunk(ImuRecords(10, 10 * k, k == 0), compression, true);
+    if (k == 2) records += McapMessage(1, kReceiveNs, CdrImu(Nth(1000)));
+  }
+  return Mcap(records);
+}
+
+// The chunks read ahead (through a runner of two threads, or one that runs the jobs last first)
+// or on the calling thread alone: the same bag, the same warnings, the same error, for whole,
+// cut, damaged and refused files.
+TEST(McapReader, ReadingChunksAheadGivesTheSameBag) {
+  const auto same = [](const std::string& bytes, const std::string& what) {
+    const std::string alone = Everything(bytes, {}, 0);
+    EXPECT_EQ(Everything(bytes, TwoThreads, 0), alone) << what;
+    EXPECT_EQ(Everything(bytes, Backwards, 0), alone) << what;
+    // Fewer chunks than the reader reads ahead from: read alone, no job run.
+    EXPECT_EQ(Everything(bytes, Backwards, detail::kMcapChunksReadAhead), alone) << what;
+  };
+  for (const char* c : {"", "zstd", "lz4"}) {
+    const std::string whole = EightChunks(c);
+    ASSERT_EQ(Everything(whole, TwoThreads, 0).rfind("8 81 0\n", 0), 0u)
+        << Everything(whole, TwoThreads, 0);
+    for (std::size_t cut = 8; cut <= whole.size(); cut += 3) {
+      same(whole.substr(0, cut), std::string(c) + " cut " + std::to_string(cut));
+    }
+    // A byte of each chunk's data changed in turn: a CRC error, a damaged chunk (zstd, lz4),
+    // or a message that no longer decodes.
+    for (std::size_t at = whole.size() / 16; at < whole.size(); at += whole.size() / 16) {
+      std::string damaged = whole;
+      damaged[at] = static_cast<char>(damaged[at] ^ 0x5a);
+      same(damaged, std::string(c) + " byte " + std::to_string(at) + " changed");
+    }
+  }
+  // An unknown compression and a chunk stating more than 1 GiB among the others.
+  std::string records = McapChunk(ImuRecords(10), "", true);
+  for (int k = 1; k < 6; ++k) records += McapChunk(ImuRecords(10, 10 * k, false), "zstd", true);
+  records += McapChunk(ImuRecords(10, 60, false), "bogus");
+  std::string huge = McapChunk(ImuRecords(10, 70, false), "", false);
+  huge[9 + 16 + 3] = 0x7f;  // uncompressed size's fourth byte: over 1 GiB
+  same(Mcap(records + huge + McapChunk(ImuRecords(10, 80, false), "lz4")), "bogus and huge");
+}
+
+// A file of 200 chunks (over detail::kMcapChunksReadAhead: ReadMcap reads them ahead through
+// its runner) read from disk through two threads and on one: the same bag; with a byte changed
+// in chunk 150 and in chunk 170, the same error, chunk 150's (the first in file order), naming
+// the file and the chunk's byte offset.
+TEST(McapReader, ReadAheadOfALargeFileReportsTheFirstCorruptChunk) {
+  const std::string head = test::kMcapMagic + test::McapHeader();
+  std::string records;
+  std::vector<std::size_t> chunk_at;
+  for (int k = 0; k < 200; ++k) {
+    chunk_at.push_back(head.size() + records.size());
+    records += McapChunk(ImuRecords(20, 20 * k, k == 0), k % 2 == 0 ? "zstd" : "lz4", true);
+    if (k % 7 == 3) records += McapMessage(1, kReceiveNs, CdrImu(Nth(5000 + k)));
+  }
+  const std::string whole = Mcap(records);
+  ASSERT_GE(chunk_at.size(), detail::kMcapChunksReadAhead);
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("plumb_ros2_test_read_ahead_" + std::to_string(::getpid()) + ".mcap"))
+                               .string();
+  const auto write = [&](const std::string& bytes) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  };
+  write(whole);
+  const RosBag alone = ReadMcap(path);
+  const RosBag ahead = ReadMcap(path, TwoThreads);
+  EXPECT_EQ(alone.chunks, 200u);
+  EXPECT_EQ(ahead.chunks, alone.chunks);
+  EXPECT_EQ(ahead.messages, alone.messages);
+  ASSERT_EQ(alone.imu_topics.size(), 1u);
+  ASSERT_EQ(ahead.imu_topics.size(), 1u);
+  EXPECT_EQ(alone.imu_topics[0].samples.size(), 200u * 20u + 29u);
+  EXPECT_EQ(ahead.imu_topics[0].samples.t_s, alone.imu_topics[0].samples.t_s);
+  EXPECT_EQ(ahead.imu_topics[0].samples.acc, alone.imu_topics[0].samples.acc);
+  EXPECT_EQ(ahead.imu_topics[0].samples.gyr, alone.imu_topics[0].samples.gyr);
+  EXPECT_EQ(ahead.imu_topics[0].receive_s, alone.imu_topics[0].receive_s);
+  EXPECT_EQ(Everything(whole, TwoThreads, detail::kMcapChunksReadAhead),
+            Everything(whole, {}, detail::kMcapChunksReadAhead));
+
+  // The uncompressed_crc's last byte of chunks 150 and 170 changed: a CRC error at each.
+  std::string damaged = whole;
+  for (const int k : {170, 150}) {
+    const std::size_t crc_byte = chunk_at[static_cast<std::size_t>(k)] + 9 + 8 + 8 + 8 + 3;
+    damaged[crc_byte] = static_cast<char>(damaged[crc_byte] ^ 0x01);
+  }
+  write(damaged);
+  const std::string serial = ErrorOf([&] { ReadMcap(path); });
+  EXPECT_EQ(serial, path + " | byte " + std::to_string(chunk_at[150]) + " | " +
+                        serial.substr(serial.rfind(" | ") + 3));
+  EXPECT_NE(serial.find("uncompressed_crc"), std::string::npos) << serial;
+  for (int run = 0; run < 5; ++run) EXPECT_EQ(ErrorOf([&] { ReadMcap(path, TwoThreads); }), serial);
+  EXPECT_EQ(ErrorOf([&] { ReadMcap(path, Backwards); }), serial);
+  std::filesystem::remove(path);
 }
 
 TEST(CdrImu, BigEndianGivesTheSameValues) {

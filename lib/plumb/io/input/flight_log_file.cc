@@ -124,7 +124,7 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
       out.log_ = ReadRosBag(path);
       break;
     case FlightLogFormat::kRos2Mcap:
-      out.log_ = ReadMcap(path);
+      out.log_ = ReadMcap(path, run_jobs);
       break;
     case FlightLogFormat::kRos2Db3:
       out.log_ = ReadDb3(path);

@@ -59,8 +59,9 @@ class FlightLog {
  public:
   /// Reads and decodes the log at `path`. Throws plumb::InputError naming the file when it is
   /// not a flight log plumb reads, and as the format's reader does. `run_jobs` (core/jobs.h):
-  /// a large .bin, .tlog or .ulg is read in two parts at once (SplitReadOptions; the same log
-  /// either way). Empty: one part.
+  /// a large .bin, .tlog or .ulg is read in two parts at once (SplitReadOptions), a large
+  /// .mcap has its chunks decompressed ahead of their parse (ReadMcap); the same log either
+  /// way. Empty: one part, on the calling thread.
   static FlightLog Open(const std::string& path, const JobRunner& run_jobs = {});
 
   FlightLogFormat format() const { return format_; }

@@ -213,8 +213,9 @@ struct InputOptions {
   /// one that goes on past this is refused. 0: the memory available (MemAvailable).
   std::uint64_t max_stream_bytes = 0;
   /// Runs independent jobs at once (core/jobs.h): the two files of the two-file form are read
-  /// at once, and a large .bin, .tlog or .ulg log in two parts (FlightLog::Open). Empty: one
-  /// after another. The session is the same either way.
+  /// at once, a large .bin, .tlog or .ulg log in two parts, and a large .mcap's chunks
+  /// decompressed ahead of their parse (FlightLog::Open). Empty: one after another. The
+  /// session is the same either way.
   JobRunner run_jobs;
 };
 

@@ -3,15 +3,21 @@
 #include "plumb/io/ros/mcap.h"
 
 #include <algorithm>
+#include <condition_variable>
 #include <cstdio>
+#include <exception>
 #include <fstream>
+#include <memory>
+#include <mutex>
 #include <string_view>
 #include <unordered_map>
 #include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/core/jobs.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/common/stream_spool.h"
+#include "plumb/io/ros/read_ahead.h"
 #include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/rosbag_format.h"
 
@@ -78,8 +84,16 @@ const std::uint8_t* Bytes(std::string_view v) {
 
 class Parser {
  public:
-  Parser(const std::uint8_t* data, std::size_t size, RosBag* bag, const LogFile* file)
-      : data_(data), size_(size), bag_(bag), file_(file) {}
+  /// `min_chunks`: the chunks the file has at least when they are read ahead through
+  /// `run_jobs` (RunAhead); an empty `run_jobs`: never.
+  Parser(const std::uint8_t* data, std::size_t size, RosBag* bag, const LogFile* file,
+         std::size_t min_chunks, const JobRunner& run_jobs)
+      : data_(data),
+        size_(size),
+        bag_(bag),
+        file_(file),
+        min_chunks_(min_chunks),
+        run_jobs_(run_jobs) {}
 
   void Run();
 
@@ -93,10 +107,58 @@ class Parser {
   /// The record at `pos` of [base, base + n). False when it runs past n (`r->len` then holds
   /// what is there of it; `r->body` nullptr when not even its opcode and length are).
   static bool Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r);
-  void TopRecord(const Record& r, std::size_t at);
+  /// A chunk made ready to parse: its fields read, its records decompressed (into the
+  /// ChunkBuffers given) and their CRC-32 computed where it is checked. Made by Open, which
+  /// touches nothing else, so that it may run on another thread ahead of the parse.
+  struct OpenedChunk {
+    bool fields_ok = false;  ///< every field is there (the records as far as a cut file goes)
+    std::uint64_t size = 0;  ///< uncompressed, as stated
+    std::uint32_t crc = 0;   ///< uncompressed_crc, 0: not given
+    std::string compression;
+    detail::ChunkBody body;
+    std::uint32_t computed_crc = 0;  ///< of body; set when the check applies (Checked)
+    std::exception_ptr error;        ///< thrown while opening: rethrown where the parse is
+  };
+  /// The records of the file from `pos` up to and including the next chunk (or the Footer, a
+  /// record cut by the file's end, the end; or kStretchRecords records, none a chunk), the
+  /// chunk opened ahead of their parse.
+  struct Stretch {
+    std::vector<std::pair<Record, std::size_t>> records;  ///< each with its file offset
+    bool cut = false;                                     ///< the last runs past the file's end
+    bool has_chunk = false;                               ///< the last is a Chunk record
+    OpenedChunk chunk;
+    detail::ChunkBuffers buffers;  ///< the chunk's decompressed records, reused
+  };
+  /// Whether the CRC-32 of an opened chunk is checked: a whole chunk that states one.
+  static bool Checked(const OpenedChunk& c, bool cut) {
+    return !cut && c.body.whole && c.crc != 0;
+  }
+  static void Open(const Record& r, bool cut, detail::ChunkBuffers* buffers, OpenedChunk* out);
+  static void OpenCatching(const Record& r, bool cut, detail::ChunkBuffers* buffers,
+                           OpenedChunk* out);
+  /// The records from `pos` (the first after the Header) to the end, on this thread alone.
+  void RunInOrder(std::size_t pos);
+  /// The same, the chunks opened up to kStretchesInFlight - 1 stretches ahead of the parse
+  /// through run_jobs_ (see the definition).
+  void RunAhead(std::size_t pos);
+  /// Opens the chunk of stretch `s` (when it ends with one): OpenCatching.
+  static void OpenStretch(Stretch* s);
+  /// Parses the records of stretch `s` in order, as RunInOrder would.
+  void ParseStretch(const Stretch& s);
+  /// Whether the records from `pos` hold at least `n` chunks (looked for up to the n-th).
+  bool ChunksAtLeast(std::size_t pos, std::size_t n) const;
+  /// Frames the next stretch of records from `*pos` into `s` (false when there are none).
+  bool FrameStretch(std::size_t* pos, Stretch* s) const;
+  /// The top-level record `r` at `at`, whole; `opened`: its chunk opened ahead, or nullptr.
+  void Whole(const Record& r, std::size_t at, const OpenedChunk* opened);
+  /// The top-level record at `at`, cut by the file's end: said, and the reading ends.
+  void CutAt(const Record& r, std::size_t at, const OpenedChunk* opened);
+  void TopRecord(const Record& r, std::size_t at, const OpenedChunk* opened);
   void Chunk(const Record& r, std::size_t at, bool cut);
-  /// Throws InputError naming the chunk at `at` when its records' CRC-32 is not `crc`.
-  void CheckCrc(const detail::ChunkBody& body, std::uint32_t crc, std::size_t at) const;
+  /// The chunk `c` opened from the Chunk record at `at`: counted, checked, its records read.
+  void UseChunk(const OpenedChunk& c, std::size_t at, bool cut);
+  /// Throws InputError naming the chunk at `at` when its records' CRC-32 is not the one stated.
+  void CheckCrc(const OpenedChunk& c, std::size_t at) const;
   /// The records of a chunk's data [p, p + n); `at`: the chunk's file offset. Returns the
   /// messages read; `past_end` says what ran past the data's end ("" when none).
   std::size_t ChunkRecords(const std::uint8_t* p, std::size_t n, std::size_t at,
@@ -150,9 +212,12 @@ class Parser {
   std::size_t size_;
   RosBag* bag_;
   const LogFile* file_;
+  std::size_t min_chunks_;
+  const JobRunner& run_jobs_;
   std::size_t released_ = 0;
   std::size_t read_to_ = 0;  ///< the file offset past the top-level record being read
   bool footer_ = false;
+  bool cut_ = false;  ///< a record ran past the file's end: the reading ended there
   struct SchemaInfo {
     std::string name;
   };
@@ -169,6 +234,12 @@ class Parser {
   /// By index in imu_topics: the samples its four vectors have room for (Room's).
   std::vector<std::size_t> room_;
   detail::ChunkBuffers chunk_;  ///< a decompressed chunk and the decompressors, reused
+  /// Stretches in flight when reading ahead (framed and not yet parsed), each in its own
+  /// slot with its own ChunkBuffers: one parsed, three opened ahead at most.
+  static constexpr std::size_t kStretchesInFlight = 4;
+  /// Records a stretch holds at most: a long run of top-level records without a chunk is
+  /// framed a stretch at a time, not whole.
+  static constexpr std::size_t kStretchRecords = 1024;
 };
 
 bool Parser::Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r) {
@@ -196,23 +267,12 @@ void Parser::Run() {
     throw InputError(bag_->source, "byte " + std::to_string(pos),
                      "the MCAP Header record runs past the end of the file");
   }
-  while (pos < size_ && !footer_) {
-    if (!Frame(data_, size_, pos, &r)) {
-      bag_->warnings.cut_at = pos;
-      read_to_ = size_;
-      if (r.body != nullptr && r.op == kOpChunk) Chunk(r, pos, true);
-      bag_->warnings.messages_read = bag_->messages;
-      CountMessages();
-      return;
-    }
-    read_to_ = r.end;
-    TopRecord(r, pos);
-    pos = r.end;
-    if (file_ != nullptr && pos >= released_ + LogFile::kReleaseStep) {
-      file_->Release(released_, pos);
-      released_ = pos;
-    }
+  if (run_jobs_ && ChunksAtLeast(pos, min_chunks_)) {
+    RunAhead(pos);
+  } else {
+    RunInOrder(pos);
   }
+  if (cut_) return;
   CountMessages();
   if (!footer_) {
     bag_->warnings.notes.push_back(
@@ -222,52 +282,243 @@ void Parser::Run() {
   }
 }
 
-void Parser::TopRecord(const Record& r, std::size_t at) {
+void Parser::RunInOrder(std::size_t pos) {
+  Record r;
+  while (pos < size_ && !footer_) {
+    if (!Frame(data_, size_, pos, &r)) {
+      CutAt(r, pos, nullptr);
+      return;
+    }
+    Whole(r, pos, nullptr);
+    pos = r.end;
+  }
+}
+
+// Two jobs through run_jobs_, each taking, as long as there is one, the next task: parse the
+// next stretch in file order once its chunk is opened and no job is parsing; else frame the
+// next stretch (in order, in a free slot: at most kStretchesInFlight framed and not parsed) and
+// open its chunk; else wait for the other job's task in progress. A job waits only while the
+// other one is doing a task, so one job alone (a runner that runs them one after another)
+// reads the whole file in order, and the jobs never depend on each other being at once. The
+// parse touches only what RunInOrder's would (the bag, the counts, the page release), in the
+// same order; opening touches only its slot. What the parse throws stops both jobs and is
+// rethrown here: the first error in file order (an opening's is kept in its slot and rethrown
+// by the parse where RunInOrder would meet it).
+void Parser::RunAhead(std::size_t pos) {
+  const auto slots = std::make_unique<Stretch[]>(kStretchesInFlight);
+  enum class SlotState : std::uint8_t { kFree, kOpening, kOpened };
+  SlotState state[kStretchesInFlight] = {};
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::size_t framed = 0;  // stretches framed; stretch i is in slot i % kStretchesInFlight
+  std::size_t parsed = 0;  // stretches parsed
+  bool more = true;        // stretches left to frame
+  bool parsing = false;
+  bool stop = false;
+  std::exception_ptr error;
+  const auto job = [&](int) {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stop && (more || parsed < framed)) {
+      Stretch& next = slots[parsed % kStretchesInFlight];
+      if (!parsing && parsed < framed && state[parsed % kStretchesInFlight] == SlotState::kOpened) {
+        parsing = true;
+        lock.unlock();
+        std::exception_ptr thrown;
+        try {
+          ParseStretch(next);
+        } catch (...) {
+          thrown = std::current_exception();
+        }
+        lock.lock();
+        parsing = false;
+        state[parsed % kStretchesInFlight] = SlotState::kFree;
+        ++parsed;
+        if (thrown) {
+          error = thrown;
+          stop = true;
+        }
+        changed.notify_all();
+        continue;
+      }
+      if (more && framed < parsed + kStretchesInFlight) {
+        const std::size_t slot = framed % kStretchesInFlight;
+        try {
+          more = FrameStretch(&pos, &slots[slot]);
+        } catch (...) {  // memory running out
+          error = std::current_exception();
+          stop = true;
+          break;
+        }
+        if (!more) continue;
+        ++framed;
+        state[slot] = SlotState::kOpening;
+        lock.unlock();
+        OpenStretch(&slots[slot]);
+        lock.lock();
+        state[slot] = SlotState::kOpened;
+        changed.notify_all();
+        continue;
+      }
+      changed.wait(lock);  // the other job is parsing or opening: it notifies when done
+    }
+    changed.notify_all();
+  };
+  RunJobs(run_jobs_, 2, job);
+  if (error) std::rethrow_exception(error);
+}
+
+void Parser::OpenStretch(Stretch* s) {
+  if (s->has_chunk) OpenCatching(s->records.back().first, s->cut, &s->buffers, &s->chunk);
+}
+
+void Parser::ParseStretch(const Stretch& s) {
+  for (std::size_t i = 0; i < s.records.size(); ++i) {
+    const auto& [r, at] = s.records[i];
+    const bool last = i + 1 == s.records.size();
+    const OpenedChunk* opened = last && s.has_chunk ? &s.chunk : nullptr;
+    if (last && s.cut) {
+      CutAt(r, at, opened);
+    } else {
+      Whole(r, at, opened);
+    }
+  }
+}
+
+bool Parser::ChunksAtLeast(std::size_t pos, std::size_t n) const {
+  std::size_t chunks = 0;
+  Record r;
+  while (chunks < n && pos < size_ && Frame(data_, size_, pos, &r) && r.op != kOpFooter) {
+    if (r.op == kOpChunk) ++chunks;
+    pos = r.end;
+  }
+  return chunks >= n;
+}
+
+// The stretches end where RunInOrder's loop would stop or a chunk is, so that they hold each
+// record once, in order, and nothing past where the reading ends.
+bool Parser::FrameStretch(std::size_t* pos, Stretch* s) const {
+  s->records.clear();
+  s->cut = false;
+  s->has_chunk = false;
+  Record r;
+  while (*pos < size_) {
+    const bool whole = Frame(data_, size_, *pos, &r);
+    s->records.emplace_back(r, *pos);
+    s->has_chunk = r.body != nullptr && r.op == kOpChunk;
+    if (!whole) {
+      s->cut = true;
+      *pos = size_;  // nothing more is read
+      break;
+    }
+    *pos = r.op == kOpFooter ? size_ : r.end;  // nothing is read past the Footer
+    if (r.op == kOpFooter || r.op == kOpChunk || s->records.size() >= kStretchRecords) break;
+  }
+  return !s->records.empty();
+}
+
+void Parser::Whole(const Record& r, std::size_t at, const OpenedChunk* opened) {
+  read_to_ = r.end;
+  TopRecord(r, at, opened);
+  if (file_ != nullptr && r.end >= released_ + LogFile::kReleaseStep) {
+    file_->Release(released_, r.end);
+    released_ = r.end;
+  }
+}
+
+void Parser::CutAt(const Record& r, std::size_t at, const OpenedChunk* opened) {
+  bag_->warnings.cut_at = at;
+  read_to_ = size_;
+  if (r.body != nullptr && r.op == kOpChunk) {
+    if (opened != nullptr) {
+      UseChunk(*opened, at, true);
+    } else {
+      Chunk(r, at, true);
+    }
+  }
+  bag_->warnings.messages_read = bag_->messages;
+  CountMessages();
+  cut_ = true;
+}
+
+void Parser::TopRecord(const Record& r, std::size_t at, const OpenedChunk* opened) {
   switch (r.op) {
     case kOpFooter: footer_ = true; break;
     case kOpSchema: Schema(r, at); break;
     case kOpChannel: Channel(r, at); break;
     case kOpMessage: Message(r, at); break;
-    case kOpChunk: Chunk(r, at, false); break;
+    case kOpChunk:
+      if (opened != nullptr) {
+        UseChunk(*opened, at, false);
+      } else {
+        Chunk(r, at, false);
+      }
+      break;
     case kOpChunkIndex: ++bag_->chunk_infos; break;
     default: break;  // the index, attachments, metadata, statistics; unknown opcodes
   }
 }
 
-void Parser::CheckCrc(const detail::ChunkBody& body, std::uint32_t crc, std::size_t at) const {
-  const std::uint32_t computed = detail::Crc32(body.data, body.size);
-  if (computed == crc) return;
+void Parser::CheckCrc(const OpenedChunk& c, std::size_t at) const {
+  if (c.computed_crc == c.crc) return;
   char what[160];
   std::snprintf(what, sizeof what,
                 "the chunk's %zu bytes of records do not match its uncompressed_crc (stated "
                 "%08x, computed %08x): the file is damaged there",
-                body.size, static_cast<unsigned>(crc), static_cast<unsigned>(computed));
+                c.body.size, static_cast<unsigned>(c.crc), static_cast<unsigned>(c.computed_crc));
   throw InputError(bag_->source, "byte " + std::to_string(at), what);
 }
 
-void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
+void Parser::Open(const Record& r, bool cut, detail::ChunkBuffers* buffers, OpenedChunk* out) {
   Fields f(r.body, r.len);
   f.Get<std::uint64_t>();  // message_start_time
   f.Get<std::uint64_t>();  // message_end_time
-  const std::uint64_t size = f.Get<std::uint64_t>();
-  const auto crc = f.Get<std::uint32_t>();  // uncompressed_crc, 0: not given
-  const std::string compression(f.String().substr(0, 32));
+  out->size = f.Get<std::uint64_t>();
+  out->crc = f.Get<std::uint32_t>();
+  out->compression = std::string(f.String().substr(0, 32));
   const std::uint64_t records_len = f.Get<std::uint64_t>();
   const std::string_view records = f.Bytes(records_len, cut);
-  if (!f.ok()) {
+  out->fields_ok = f.ok();
+  out->body = detail::ChunkBody{};
+  out->computed_crc = 0;
+  out->error = nullptr;
+  if (!out->fields_ok || out->size > detail::kRosMaxChunkBytes) return;
+  out->body = detail::OpenChunk(out->compression, Bytes(records), records.size(),
+                                static_cast<std::uint32_t>(out->size), cut, buffers);
+  if (Checked(*out, cut)) out->computed_crc = detail::Crc32(out->body.data, out->body.size);
+}
+
+// What opening throws (memory running out) is kept for the parse, which rethrows it where the
+// one-thread reading would have met it: after every record before the chunk was read.
+void Parser::OpenCatching(const Record& r, bool cut, detail::ChunkBuffers* buffers,
+                          OpenedChunk* out) {
+  try {
+    Open(r, cut, buffers, out);
+  } catch (...) {
+    out->error = std::current_exception();
+  }
+}
+
+void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
+  OpenedChunk c;
+  Open(r, cut, &chunk_, &c);
+  UseChunk(c, at, cut);
+}
+
+void Parser::UseChunk(const OpenedChunk& c, std::size_t at, bool cut) {
+  if (!c.fields_ok) {
     if (!cut) BadRecord(at);
     return;
   }
   ++bag_->chunks;
-  ++bag_->compression[compression.empty() ? "none" : compression];
-  if (size > detail::kRosMaxChunkBytes) {
-    Damaged(at, "chunk stating " + std::to_string(size) +
+  ++bag_->compression[c.compression.empty() ? "none" : c.compression];
+  if (c.size > detail::kRosMaxChunkBytes) {
+    Damaged(at, "chunk stating " + std::to_string(c.size) +
                     " bytes uncompressed, more than plumb reads (1 GiB)");
     return;
   }
-  const detail::ChunkBody body = detail::OpenChunk(
-      compression, Bytes(records), records.size(), static_cast<std::uint32_t>(size), cut, &chunk_);
-  if (!cut && body.whole && crc != 0) CheckCrc(body, crc, at);
+  if (c.error) std::rethrow_exception(c.error);
+  const detail::ChunkBody& body = c.body;
+  if (Checked(c, cut)) CheckCrc(c, at);
   std::string past_end;
   const std::size_t kept = ChunkRecords(body.data, body.size, at, &past_end);
   if (cut) {
@@ -409,7 +660,8 @@ std::size_t Parser::Room(RosImuTopic* t) const {
 
 /// ParseMcap, releasing the pages of `file` (or nullptr) behind the parser.
 RosBag ParseFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
-                 const LogFile* file) {
+                 const LogFile* file, const JobRunner& run_jobs = {},
+                 std::size_t min_chunks = detail::kMcapChunksReadAhead) {
   RosBag bag;
   bag.kind = RosBagKind::kMcap;
   bag.source = source;
@@ -424,7 +676,7 @@ RosBag ParseFrom(const std::uint8_t* data, std::size_t size, const std::string& 
                                              std::string(1, static_cast<char>(data[5])) +
                                              "'); plumb reads version 0");
   }
-  Parser(data, size, &bag, file).Run();
+  Parser(data, size, &bag, file, min_chunks, run_jobs).Run();
   return bag;
 }
 
@@ -434,10 +686,16 @@ RosBag ParseMcap(const std::uint8_t* data, std::size_t size, const std::string& 
   return ParseFrom(data, size, source, nullptr);
 }
 
-RosBag ReadMcap(const std::string& path) {
+RosBag detail::ParseMcapReadingAhead(const std::uint8_t* data, std::size_t size,
+                                     const std::string& source, const JobRunner& run_jobs,
+                                     std::size_t min_chunks) {
+  return ParseFrom(data, size, source, nullptr, run_jobs, min_chunks);
+}
+
+RosBag ReadMcap(const std::string& path, const JobRunner& run_jobs) {
   const LogFile file(path, "MCAP file");
   try {
-    RosBag bag = ParseFrom(file.data(), file.size(), path, &file);
+    RosBag bag = ParseFrom(file.data(), file.size(), path, &file, run_jobs);
     file.ThrowIfCut();
     return bag;
   } catch (const Error&) {

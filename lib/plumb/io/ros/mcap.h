@@ -19,6 +19,12 @@
 //        is read past.
 //
 // Decoding contract (one pass over the file held in memory, as the ROS 1 reader's):
+//  * Given a JobRunner (core/jobs.h; the library starts no thread), a file of 64 chunks or more
+//    has its chunks decompressed and CRC-checked up to three ahead of their parse (io/ros/
+//    read_ahead.h): two jobs run through the runner once, each taking the next task, the parse
+//    of the next chunk's records in file order or the opening of a chunk ahead; all else as
+//    below: the same samples, warnings and errors (the first in file order) as read on one
+//    thread, which smaller files and an empty runner are.
 //  * The records are read linearly, chunk by chunk, up to the Footer; the summary section is
 //    read like the data (its Schema and Channel records repeat those already known) and never
 //    needed, so a file cut short gives the messages before the cut: the record at the cut and
@@ -50,14 +56,16 @@
 #include <cstdint>
 #include <string>
 
+#include "plumb/core/jobs.h"
 #include "plumb/io/ros/rosbag.h"
 
 namespace plumb::io {
 
 /// Reads and decodes a .mcap file (see the file comment): RosBag with kind kMcap. Throws
 /// plumb::InputError(path, "byte N", what) when the file cannot be read or is not an MCAP
-/// file of version 0.
-RosBag ReadMcap(const std::string& path);
+/// file of version 0. `run_jobs`: a large file's chunks are decompressed ahead of their parse
+/// through it (the same bag either way); empty: on the calling thread alone.
+RosBag ReadMcap(const std::string& path, const JobRunner& run_jobs = {});
 
 /// Decodes an MCAP file held in memory; `source` names it in errors. Same contract.
 RosBag ParseMcap(const std::uint8_t* data, std::size_t size, const std::string& source);
