@@ -27,6 +27,7 @@
 #include "fit_options.h"
 #include "input_options.h"
 #include "plumb/core/error.h"
+#include "plumb/diagnostics/board_diagnosis.h"
 #include "plumb/diagnostics/diagnose.h"
 #include "plumb/estimation/board_agreement.h"
 #include "plumb/diagnostics/residual_analysis.h"
@@ -34,6 +35,7 @@
 #include "plumb/export/export.h"
 #include "plumb/io/common/atomic_file.h"
 #include "plumb/model/model.h"
+#include "plumb/report/board_diagnosis_text.h"
 #include "plumb/report/diagnosis_json.h"
 #include "plumb/report/figures.h"
 #include "plumb/report/gnuplot.h"
@@ -244,8 +246,16 @@ class ReportCommand : public Command {
     const estimation::CalibrationResult result = CalibrateWithProgress(session, fit);
     std::cout << report::FitVerdict(result.fit) << "\n" << report::GateLines(result.fit, session.source);
     if (const int code = StrictGateExit(result.fit, session.source, a.fit.strict)) return code;
+    // With the board's IMUs, diagnose --imus's diagnosis: each IMU alone (IMU 0's is the
+    // page's diagnosis) and the board across.
     std::optional<diagnostics::Diagnosis> diagnosis;
-    if (a.diagnose) diagnosis = RunDiagnosis(series, segments, model, site, options);
+    std::optional<diagnostics::BoardDiagnosis> board_diagnosis;
+    if (a.diagnose && !session.other_imus.empty()) {
+      board_diagnosis = RunBoardDiagnosis(session, fit);
+      if (board_diagnosis) diagnosis = board_diagnosis->imus.front().diagnosis;
+    } else if (a.diagnose) {
+      diagnosis = RunDiagnosis(series, segments, model, site, options);
+    }
 
     diagnostics::ResidualAnalysisOptions ra_options;
     ra_options.significance = a.significance;
@@ -259,7 +269,17 @@ class ReportCommand : public Command {
     report::WriteJson((dir / "result.json").string(),
                       report::CalibrationJson(result, seg, Summarise(session, a.input).inputs,
                                               session.warnings));
-    if (diagnosis) {
+    if (board_diagnosis) {
+      std::vector<diagnostics::ResidualAnalysis> analyses;
+      for (std::size_t k = 0; k < board_diagnosis->imus.size(); ++k) {
+        const ImuSeries& s = k == 0 ? series : session.other_imus[k - 1].series;
+        analyses.push_back(diagnostics::AnalyseResiduals(
+            s, board_diagnosis->imus[k].diagnosis.fit, ra_options));
+      }
+      report::WriteJson((dir / "diagnose.json").string(),
+                        report::BoardDiagnosisJson(*board_diagnosis, analyses));
+      files.insert(files.begin() + 1, "diagnose.json");
+    } else if (diagnosis) {
       report::WriteJson((dir / "diagnose.json").string(),
                         report::DiagnosisJson(*diagnosis, analysis));
       files.insert(files.begin() + 1, "diagnose.json");
@@ -292,10 +312,16 @@ class ReportCommand : public Command {
         extras.next_command = CalibrateCommand({"--clock"}, {"--clock", "uniform"});
       } else if (diagnostics::EstimateWanderNext(*diagnosis)) {
         extras.next_command = CalibrateCommand({}, {"--estimate-rw"});
+      } else if (board_diagnosis) {  // each IMU's advice, refitted together
+        if (board_diagnosis->next && board_diagnosis->next->advised) {
+          extras.next_command =
+              CalibrateCommand({"--model", "--imu-model"}, report::NextBoardFlags(*board_diagnosis));
+        }
       } else if (const auto spec = diagnostics::NextModelSpec(*diagnosis)) {
         extras.next_command = CalibrateCommand({"--model"}, {"--model", *spec});
       }
     }
+    if (board_diagnosis) extras.board_diagnosis = report::BoardDiagnosisSummary(*board_diagnosis);
     PreviewExports(session, result, extras);
     extras.board_agreement = estimation::BoardAgreement(result, series, session.other_imus);
     const std::string page = report::HtmlReport(Summarise(session, a.input), seg, result,
@@ -330,12 +356,9 @@ class ReportCommand : public Command {
     return 0;
   }
 
-  /// diagnose's ranking; a failure is a warning on the page and on stdout, not the end of
-  /// the report (the calibration itself succeeded).
-  std::optional<diagnostics::Diagnosis> RunDiagnosis(
-      const ImuSeries& series, const std::vector<StillSegment>& segments,
-      const model::Model& model, const geo::Site& site,
-      const estimation::CalibrationOptions& calibration) {
+  /// diagnose's options for a fit of `calibration`'s.
+  diagnostics::DiagnoseOptions DiagnoseOptionsFor(
+      const estimation::CalibrationOptions& calibration) const {
     diagnostics::DiagnoseOptions options;
     options.significance = args_.significance;
     options.confirm = args_.confirm;
@@ -344,6 +367,32 @@ class ReportCommand : public Command {
     options.on_stage = [](const std::string& stage) { Progress::Of().Stage(stage); };
     options.run_jobs = ParallelJobs(args_.jobs);
     options.calibration.run_jobs = options.run_jobs;  // the probe fit's motion residuals
+    return options;
+  }
+
+  /// diagnose --imus's: each IMU alone and the board across (diagnostics/board_diagnosis.h);
+  /// a failure is a warning, as RunDiagnosis's.
+  std::optional<diagnostics::BoardDiagnosis> RunBoardDiagnosis(const Session& session,
+                                                              const FitSetup& fit) const {
+    try {
+      diagnostics::BoardDiagnosis d = diagnostics::DiagnoseBoard(
+          session.series, session.other_imus, fit.segments, fit.model, fit.site,
+          DiagnoseOptionsFor(fit.options), fit.board_models);
+      std::cout << report::BoardDiagnosisSummary(d);
+      return d;
+    } catch (const Error& e) {
+      std::cerr << "warning: the diagnosis failed: " << e.what() << "\n";
+      return std::nullopt;
+    }
+  }
+
+  /// diagnose's ranking; a failure is a warning on the page and on stdout, not the end of
+  /// the report (the calibration itself succeeded).
+  std::optional<diagnostics::Diagnosis> RunDiagnosis(
+      const ImuSeries& series, const std::vector<StillSegment>& segments,
+      const model::Model& model, const geo::Site& site,
+      const estimation::CalibrationOptions& calibration) {
+    const diagnostics::DiagnoseOptions options = DiagnoseOptionsFor(calibration);
     try {
       diagnostics::Diagnosis d = diagnostics::Diagnose(series, segments, model, site, options);
       std::cout << report::DiagnosisText(d);

@@ -388,6 +388,21 @@ TEST(BoardCli, DiagnoseNamesTheImuWhoseMisfitIsItsOwnAndItsAdviceLowersTheBoards
     const double value = g["parameters"][i], sigma = g["sigma"][i];
     EXPECT_LT(std::abs(value - truth), 4.0 * sigma) << "G[" << i << "] " << value << " +- " << sigma;
   }
+
+  // report --imus: the page shows the same diagnosis of each IMU and the board, and its next
+  // command is the board's refit with IMU 2's advice; diagnose.json is diagnose --imus's.
+  const ToolRun page = Plumb({"report", csv, "--imus", "all", "--constant-bias", "--no-figures",
+                              "--out", dir.File("report")},
+                             dir);
+  ASSERT_EQ(page.exit_code, 0) << page.err;
+  const std::string html = testing::ReadAll(dir.File("report") + "/index.html");
+  EXPECT_TRUE(Contains(html, "IMU 2 (acc2_x.., instance 2) alone: chi2/dof")) << html;
+  EXPECT_TRUE(Contains(html, "a misfit of its own")) << html;
+  EXPECT_TRUE(Contains(html, "--imus all --constant-bias --imu-model 2=base+gyro_g_sensitivity</pre>"))
+      << "the page lacks the board's next command";
+  const json page_doc = ReadJson(dir.File("report") + "/diagnose.json");
+  ASSERT_EQ(page_doc["imus"].size(), 3u);
+  EXPECT_TRUE(page_doc["imus"][2]["own_misfit"].get<bool>());
 }
 
 // The IMUs against ArduPilot's pre-arm check (estimation/board_agreement.h), on the real boards:
@@ -423,6 +438,8 @@ TEST(BoardCli, TheRealBoardsAgainstArduPilotsPreArmCheck) {
   EXPECT_TRUE(Contains(html, "<h2 id=\"board\">The board's IMUs</h2>"));
   EXPECT_TRUE(Contains(html, "<td>imu2</td><td><code>base</code></td><td>not determined by these data"));
   EXPECT_TRUE(Contains(html, "1.5 &rarr; ")) << html.substr(html.find("id=\"board\""), 1500);
+  // Each IMU's diagnosis alone, and why the board cannot be judged across: IMU 0's own misfit.
+  EXPECT_TRUE(Contains(html, "IMU 0 alone: chi2/dof")) << "the page lacks the board's diagnosis";
 }
 
 // diagnose --imus on the real logs with several IMUs: what each can and cannot judge.

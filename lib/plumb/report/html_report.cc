@@ -256,8 +256,16 @@ std::string BoardSection(const estimation::CalibrationResult& r, const PageExtra
     }
     out += "</tr>\n";
   }
-  return out + "</table>\n<p>The diagnosis below is IMU 0's; " + Code("plumb diagnose --imus") +
-         " diagnoses each IMU alone and the board across.</p>\n";
+  out += "</table>\n";
+  if (extras.board_diagnosis.empty()) {
+    return out + "<p>The diagnosis below is IMU 0's; " + Code("plumb diagnose --imus") +
+           " diagnoses each IMU alone and the board across.</p>\n";
+  }
+  return out + "<p>Each IMU alone against its noise (a misfit of its own is named with the "
+               "effect it misses), the board together against them (do the IMUs move as one "
+               "rigid board?), and the board refitted with each IMU's advice, as " +
+         Code("plumb diagnose --imus") + " finds them; the diagnosis below is IMU 0's alone:</p>\n"
+         "<pre>" + HtmlEscape(extras.board_diagnosis) + "</pre>\n";
 }
 
 std::string FitSection(const estimation::CalibrationResult& r) {

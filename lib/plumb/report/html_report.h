@@ -77,6 +77,10 @@ struct PageExtras {
   /// With the board's IMUs (SPEC 6): each other IMU against IMU 0 at rest
   /// (estimation::BoardAgreement), for the page's "The board's IMUs" section.
   std::vector<estimation::ImuAgreement> board_agreement;
+  /// With the board's IMUs and the diagnosis: diagnose --imus's summary (each IMU alone, the
+  /// board across, each IMU's advice refitted together: report::BoardDiagnosisSummary); ""
+  /// without it.
+  std::string board_diagnosis;
 };
 
 /// Escapes & < > " ' for HTML text and attribute values; invalid UTF-8 passes unchanged.
