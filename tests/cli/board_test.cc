@@ -333,6 +333,21 @@ TEST(BoardCli, ApplyOnTheRealBoards) {
   ASSERT_EQ(applied.exit_code, 0) << applied.err;
   EXPECT_TRUE(Contains(applied.out, "u2.csv (IMU 2)")) << applied.out;
   EXPECT_FALSE(ReadCsv(px4_dir.File("u2.csv")).at("gyr_z").empty());
+
+  // Three MAVLink streams held still in two poses: no turn determines a gyroscope's matrix.
+  // apply says so, whether the value the fit left is a matrix it takes (a warning) or one no
+  // sensor has (the error, naming the IMU's entry).
+  PLUMB_SHARED_LOG(tlog, "mavlink/plane385_disarmed.tlog");
+  TempDir tlog_dir;
+  const auto [tlog_run, tlog_doc] = CalibrateRealBoard(tlog, tlog_dir);
+  ASSERT_EQ(tlog_run.exit_code, 0) << tlog_run.err;
+  applied = Plumb({"apply", tlog_dir.File("cal.json"), tlog, "--imus", "all", "--out",
+                   tlog_dir.File("t0.csv"), "--out", tlog_dir.File("t1.csv"), "--out",
+                   tlog_dir.File("t2.csv")},
+                  tlog_dir);
+  EXPECT_TRUE(applied.exit_code == 0 || applied.exit_code == 1) << applied.err;
+  EXPECT_TRUE(Contains(applied.err, "did not determine")) << applied.err;
+  EXPECT_TRUE(Contains(applied.err, "gyro.matrix")) << applied.err;
 }
 
 // diagnose --imus (issue 38, item 4): the IMU whose misfit is its own is named, with the

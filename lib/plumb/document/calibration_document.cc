@@ -74,7 +74,18 @@ void ReadModel(const json& root, const std::string& path, CalibrationDocument& d
   }
 }
 
-DocumentSensor ReadSensor(const json& sensor, const std::string& name, const std::string& path) {
+/// Whether the document marks a parameter of `sensor`'s matrix ("gyro.matrix.zx") unobservable:
+/// its value is one choice among many the data allow.
+bool MatrixUndetermined(const std::vector<DocumentParameter>& parameters,
+                        const std::string& sensor) {
+  const std::string prefix = sensor + ".matrix.";
+  return std::any_of(parameters.begin(), parameters.end(), [&](const DocumentParameter& p) {
+    return p.name.rfind(prefix, 0) == 0 && !p.observable && !p.fixed;
+  });
+}
+
+DocumentSensor ReadSensor(const json& sensor, const std::string& name, const std::string& path,
+                          const std::vector<DocumentParameter>& parameters) {
   DocumentSensor out;
   out.matrix = detail::Matrix3(
       Field(sensor, k::kMatrix, path, name + ".matrix", "3 rows of 3 numbers"), path,
@@ -82,6 +93,12 @@ DocumentSensor ReadSensor(const json& sensor, const std::string& name, const std
   out.bias = detail::Vector3(Field(sensor, k::kBias, path, name + ".bias", "[x, y, z]"), path,
                              name + ".bias");
   if (const std::string p = SensorMatrixProblem(out.matrix); !p.empty()) {
+    if (MatrixUndetermined(parameters, name)) {
+      throw InputError(path, KeyPlace(name + ".matrix"),
+                       "the matrix is " + p + ": its data did not determine it (" + name +
+                           ".matrix.* unobservable: a value the fit happened to leave, see "
+                           "'observability'); record turns about every axis to calibrate it");
+    }
     throw InputError(path, KeyPlace(name + ".matrix"),
                      "the matrix is " + p + ": not a sensor's calibration");
   }
@@ -341,10 +358,10 @@ CalibrationDocument ReadCalibrationDocument(const json& root, const std::string&
   ReadModel(root, path, d);
   ReadParameters(root, path, d);
   if (root.contains(k::kAccel) && !root.at(k::kAccel).is_null()) {
-    d.accel = ReadSensor(root.at(k::kAccel), k::kAccel, path);
+    d.accel = ReadSensor(root.at(k::kAccel), k::kAccel, path, d.parameters);
   }
   if (root.contains(k::kGyro) && !root.at(k::kGyro).is_null()) {
-    d.gyro = ReadSensor(root.at(k::kGyro), k::kGyro, path);
+    d.gyro = ReadSensor(root.at(k::kGyro), k::kGyro, path, d.parameters);
   }
   if (options.still_segments && root.contains(k::kSegments)) {
     const json& segments = root.at(k::kSegments);
