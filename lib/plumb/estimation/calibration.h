@@ -170,8 +170,9 @@ struct Calibration {
   /// The board's other IMUs fitted with this one (empty: IMU 0 alone).
   std::vector<BoardImuCalibration> board;
   /// With a board: one covariance over `parameters` then every board IMU's, in that order (SI
-  /// units squared; zero rows for fixed parameters, the pseudo-inverse's values for
-  /// unobservable ones); empty without one.
+  /// units squared; zero rows for fixed parameters and for unobservable ones, whose
+  /// pseudo-inverse values mean nothing: `observability.determined` says what the data fix
+  /// of them); empty without one.
   Eigen::MatrixXd board_covariance;
 
   /// The forward quantities of SPEC section 1, from the base effects' blocks: F (sensor units
