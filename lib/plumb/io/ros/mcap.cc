@@ -17,6 +17,7 @@
 #include "plumb/core/jobs.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/common/stream_spool.h"
+#include "plumb/io/ros/mcap_fields.h"
 #include "plumb/io/ros/read_ahead.h"
 #include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/rosbag_format.h"
@@ -24,59 +25,13 @@
 namespace plumb::io {
 namespace {
 
+using Fields = detail::McapFields;
+using namespace detail::mcap_op;
+
 constexpr std::uint8_t kMagic[] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 constexpr std::size_t kMagicSize = sizeof(kMagic);
 constexpr std::size_t kPrefixSize = 5;  // 0x89 "MCAP", whatever the version
 constexpr const char* kImuSchema = "sensor_msgs/msg/Imu";
-
-enum McapOp : std::uint8_t {
-  kOpHeader = 0x01,
-  kOpFooter = 0x02,
-  kOpSchema = 0x03,
-  kOpChannel = 0x04,
-  kOpMessage = 0x05,
-  kOpChunk = 0x06,
-  kOpChunkIndex = 0x08,
-};
-
-/// Reads a record's fields from [p, p + n), every length checked; ok() false once one ran past.
-class Fields {
- public:
-  Fields(const std::uint8_t* p, std::size_t n) : p_(p), n_(n) {}
-  bool ok() const { return ok_; }
-  std::size_t pos() const { return pos_; }
-  template <typename T>
-  T Get() {
-    if (!ok_ || n_ - pos_ < sizeof(T)) {
-      ok_ = false;
-      return T{};
-    }
-    const T v = LoadLittleEndian<T>(p_ + pos_);
-    pos_ += sizeof(T);
-    return v;
-  }
-  /// `count` bytes (as far as they go when `partial`: a cut chunk's records).
-  std::string_view Bytes(std::uint64_t count, bool partial = false) {
-    if (!ok_) return {};
-    if (count > n_ - pos_) {
-      if (!partial) {
-        ok_ = false;
-        return {};
-      }
-      count = n_ - pos_;
-    }
-    const std::string_view v(reinterpret_cast<const char*>(p_ + pos_), count);
-    pos_ += count;
-    return v;
-  }
-  std::string_view String() { return Bytes(Get<std::uint32_t>()); }
-
- private:
-  const std::uint8_t* p_;
-  std::size_t n_;
-  std::size_t pos_ = 0;
-  bool ok_ = true;
-};
 
 const std::uint8_t* Bytes(std::string_view v) {
   return reinterpret_cast<const std::uint8_t*>(v.data());
