@@ -15,7 +15,7 @@
 // second thread, which the CPU column, the benchmark's thread alone, leaves out; the Time
 // column is wall time, UseRealTime). BM_ReadMcap reads with no JobRunner (on the calling
 // thread alone, as `plumb --jobs 1`); BM_ReadMcapAhead/<copy> the same file with a runner of
-// two threads (TwoThreads), as `plumb` reads it on a machine of two cores or more: the chunks
+// two threads (OnTwoThreads), as `plumb` reads it on a machine of two cores or more: the chunks
 // decompressed and CRC-checked up to three ahead of their parse.
 // BM_McapZstd/<copy> and BM_McapLz4/<copy> decompress the same file's chunks with libzstd alone
 // (ZSTD_decompressDCtx, into one buffer of the largest chunk's size and one byte, as the
@@ -37,7 +37,7 @@
 // in cache, again and again: the check's own speed where the reader does it.
 // BM_ParseMcapAhead/<copy>_{alone,ahead}: the fixture itself (9 chunks of 256 KiB) or its data
 // section repeated to about 10 MB (108 lz4, 126 zstd chunks), parsed from memory with the chunks
-// read ahead through TwoThreads (`ahead`) or on the calling thread alone (`alone`), whatever
+// read ahead through OnTwoThreads (`ahead`) or on the calling thread alone (`alone`), whatever
 // their number (the reader itself reads ahead from detail::kMcapChunksReadAhead chunks): where
 // reading ahead pays.
 // Skipped with the reason when the fixtures cannot be made (data, node or the npm packages
@@ -65,6 +65,7 @@
 #include <vector>
 
 #include "plumb/core/jobs.h"
+#include "support/reverse_jobs.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ros/mcap.h"
 #include "plumb/io/ros/read_ahead.h"
@@ -246,19 +247,7 @@ double ProcessCpuMs() {
   return ms(usage.ru_utime) + ms(usage.ru_stime);
 }
 
-/// The jobs at once on two threads, this one and one started for the call, each taking the
-/// next job as it comes free. ReadMcap calls its runner once per file (two jobs), so starting a
-/// thread per call costs a few microseconds a read, and no thread is left waiting between
-/// reads (an OpenMP team's would spin there, on a core the next benchmark wants).
-void TwoThreads(int count, const std::function<void(int)>& job) {
-  std::atomic<int> next{0};
-  const auto work = [&] {
-    for (int k = next++; k < count; k = next++) job(k);
-  };
-  std::thread other(work);
-  work();
-  other.join();
-}
+using plumb::testing::OnTwoThreads;
 
 /// ReadMcap of the repeated `name` through `run_jobs` (empty: on this thread alone).
 void ReadMcapWith(benchmark::State& state, const std::string& name,
@@ -287,7 +276,7 @@ void BM_ReadMcap(benchmark::State& state, const std::string& name) {
   ReadMcapWith(state, name, {});
 }
 void BM_ReadMcapAhead(benchmark::State& state, const std::string& name) {
-  ReadMcapWith(state, name, TwoThreads);
+  ReadMcapWith(state, name, OnTwoThreads);
 }
 BENCHMARK_CAPTURE(BM_ReadMcap, ardrone_imu_uncompressed, std::string("ardrone_imu.mcap"))
     ->Unit(benchmark::kMillisecond)
@@ -317,7 +306,7 @@ BENCHMARK_CAPTURE(BM_ReadMcapAhead, ardrone_imu_zstd_decompressed,
     ->UseRealTime();
 
 /// A small or middling copy read from memory (ParseMcap) with its chunks read ahead through
-/// TwoThreads (`ahead`) or on this thread alone, whatever their number: what reading ahead
+/// OnTwoThreads (`ahead`) or on this thread alone, whatever their number: what reading ahead
 /// costs or gains below and above detail::kMcapChunksReadAhead. `target`: RepeatedMcap's.
 void BM_ParseMcapAhead(benchmark::State& state, const std::string& name, std::size_t target,
                        bool ahead) {
@@ -330,7 +319,7 @@ void BM_ParseMcapAhead(benchmark::State& state, const std::string& name, std::si
   std::ifstream in(*file, std::ios::binary);
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
-  const plumb::JobRunner run_jobs = ahead ? plumb::JobRunner(TwoThreads) : plumb::JobRunner();
+  const plumb::JobRunner run_jobs = ahead ? plumb::JobRunner(OnTwoThreads) : plumb::JobRunner();
   std::size_t chunks = 0;
   const double cpu_before = ProcessCpuMs();
   for (auto _ : state) {

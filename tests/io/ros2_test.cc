@@ -24,6 +24,7 @@
 
 #include "io/ros2_builder.h"
 #include "plumb/core/error.h"
+#include "support/reverse_jobs.h"
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/db3.h"
 #include "plumb/io/ros/mcap.h"
@@ -248,18 +249,7 @@ void AppendBytes(std::ostringstream& out, const std::vector<T>& v) {
             static_cast<std::streamsize>(v.size() * sizeof(T)));
 }
 
-/// Runs the jobs on two threads at once, this one and one started for the call, each taking
-/// the next job as it comes free (as `plumb`'s runner, apps/plumb/jobs.cc). The library starts
-/// no thread; a test may.
-void TwoThreads(int count, const std::function<void(int)>& job) {
-  std::atomic<int> next{0};
-  const auto work = [&] {
-    for (int k = next++; k < count; k = next++) job(k);
-  };
-  std::thread other(work);
-  work();
-  other.join();
-}
+using plumb::testing::OnTwoThreads;
 
 /// Runs the jobs on this thread, the last first: the reading must not depend on their order.
 void Backwards(int count, const std::function<void(int)>& job) {
@@ -328,15 +318,15 @@ std::string EightChunks(const std::string& compression) {
 TEST(McapReader, ReadingChunksAheadGivesTheSameBag) {
   const auto same = [](const std::string& bytes, const std::string& what) {
     const std::string alone = Everything(bytes, {}, 0);
-    EXPECT_EQ(Everything(bytes, TwoThreads, 0), alone) << what;
+    EXPECT_EQ(Everything(bytes, OnTwoThreads, 0), alone) << what;
     EXPECT_EQ(Everything(bytes, Backwards, 0), alone) << what;
     // Fewer chunks than the reader reads ahead from: read alone, no job run.
     EXPECT_EQ(Everything(bytes, Backwards, detail::kMcapChunksReadAhead), alone) << what;
   };
   for (const char* c : {"", "zstd", "lz4"}) {
     const std::string whole = EightChunks(c);
-    ASSERT_EQ(Everything(whole, TwoThreads, 0).rfind("8 81 0\n", 0), 0u)
-        << Everything(whole, TwoThreads, 0);
+    ASSERT_EQ(Everything(whole, OnTwoThreads, 0).rfind("8 81 0\n", 0), 0u)
+        << Everything(whole, OnTwoThreads, 0);
     for (std::size_t cut = 8; cut <= whole.size(); cut += 3) {
       same(whole.substr(0, cut), std::string(c) + " cut " + std::to_string(cut));
     }
@@ -380,7 +370,7 @@ TEST(McapReader, ReadAheadOfALargeFileReportsTheFirstCorruptChunk) {
   };
   write(whole);
   const RosBag alone = ReadMcap(path);
-  const RosBag ahead = ReadMcap(path, TwoThreads);
+  const RosBag ahead = ReadMcap(path, OnTwoThreads);
   EXPECT_EQ(alone.chunks, 200u);
   EXPECT_EQ(ahead.chunks, alone.chunks);
   EXPECT_EQ(ahead.messages, alone.messages);
@@ -391,7 +381,7 @@ TEST(McapReader, ReadAheadOfALargeFileReportsTheFirstCorruptChunk) {
   EXPECT_EQ(ahead.imu_topics[0].samples.acc, alone.imu_topics[0].samples.acc);
   EXPECT_EQ(ahead.imu_topics[0].samples.gyr, alone.imu_topics[0].samples.gyr);
   EXPECT_EQ(ahead.imu_topics[0].receive_s, alone.imu_topics[0].receive_s);
-  EXPECT_EQ(Everything(whole, TwoThreads, detail::kMcapChunksReadAhead),
+  EXPECT_EQ(Everything(whole, OnTwoThreads, detail::kMcapChunksReadAhead),
             Everything(whole, {}, detail::kMcapChunksReadAhead));
 
   // The uncompressed_crc's last byte of chunks 150 and 170 changed: a CRC error at each.
@@ -405,7 +395,7 @@ TEST(McapReader, ReadAheadOfALargeFileReportsTheFirstCorruptChunk) {
   EXPECT_EQ(serial, path + " | byte " + std::to_string(chunk_at[150]) + " | " +
                         serial.substr(serial.rfind(" | ") + 3));
   EXPECT_NE(serial.find("uncompressed_crc"), std::string::npos) << serial;
-  for (int run = 0; run < 5; ++run) EXPECT_EQ(ErrorOf([&] { ReadMcap(path, TwoThreads); }), serial);
+  for (int run = 0; run < 5; ++run) EXPECT_EQ(ErrorOf([&] { ReadMcap(path, OnTwoThreads); }), serial);
   EXPECT_EQ(ErrorOf([&] { ReadMcap(path, Backwards); }), serial);
   std::filesystem::remove(path);
 }
