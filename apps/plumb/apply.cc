@@ -22,8 +22,8 @@ namespace {
 struct ApplyArgs {
   std::string calibration;  ///< CALIBRATION.json
   InputArgs input;          ///< INPUT... and the input options (as calibrate's, with --imus)
-  /// --out FILE: one native CSV; a board whose IMUs have stamps of their own (a flight log's
-  /// instances) takes one --out per IMU, IMU 0 first.
+  /// --out FILE: one native CSV; with a board, one per IMU (IMU 0 first), or one for all where
+  /// they share IMU 0's stamps.
   std::vector<std::string> out_paths;
   bool sigma = false;       ///< --sigma: the calibration's uncertainty per sample
 };
@@ -119,21 +119,6 @@ bool SharedStamps(const std::vector<SessionImu>& imus) {
   return true;
 }
 
-/// The calibration of the session's IMU `instance` among a board's, or an error naming the
-/// calibration file and the IMUs it calibrates.
-const correction::CalibrationFile& CalibrationOf(
-    const std::vector<correction::CalibrationFile>& calibrations, int instance) {
-  std::string have;
-  for (const auto& c : calibrations) {
-    if (c.instance == instance) return c;
-    have += (have.empty() ? "" : ", ") + std::to_string(c.instance);
-  }
-  throw InputError(calibrations[0].path, "key 'imus'",
-                   "no calibration of IMU " + std::to_string(instance) +
-                       " (it calibrates IMU " + have + "): choose the IMUs with " +
-                       OptionText(Option::kImus) + " or calibrate the board with them");
-}
-
 /// Applies `calibration` to `series`, a sample that does not correct named with the input.
 correction::CorrectedSeries Corrected(const correction::CalibrationFile& calibration,
                                       const ImuSeries& series, const std::string& source,
@@ -217,7 +202,9 @@ class ApplyCommand : public Command {
                               : " (they have stamps of their own: one file cannot hold them)"));
     }
     std::vector<const correction::CalibrationFile*> calibration_of;  // each IMU's, in order
-    for (const SessionImu& u : imus) calibration_of.push_back(&CalibrationOf(calibrations, u.instance));
+    for (const SessionImu& u : imus) {
+      calibration_of.push_back(&correction::ImuCalibration(calibrations, u.instance));
+    }
     for (const correction::CalibrationFile* c : calibration_of) WarnUndetermined(*c, a.sigma);
     std::vector<CorrectedImu> corrected;
     for (std::size_t i = 0; i < imus.size(); ++i) {

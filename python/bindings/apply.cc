@@ -163,14 +163,7 @@ namespace {
 /// through its own calibration into the body frame (correction::ReadBoardCalibrationFile).
 correction::CalibrationFile ImuOf(const nlohmann::json& doc, const std::string& path, int imu) {
   if (imu == 0) return correction::ReadCalibrationFile(doc, path);
-  std::vector<correction::CalibrationFile> board = correction::ReadBoardCalibrationFile(doc, path);
-  std::string have;
-  for (auto& c : board) {
-    if (c.instance == imu) return std::move(c);
-    have += (have.empty() ? "" : ", ") + std::to_string(c.instance);
-  }
-  throw InputError(path, "key 'imus'", "no calibration of IMU " + std::to_string(imu) +
-                                           " (it calibrates IMU " + have + ")");
+  return correction::ImuCalibration(correction::ReadBoardCalibrationFile(doc, path), imu);
 }
 
 }  // namespace

@@ -160,6 +160,19 @@ void SetBoardCovariance(const document::BoardDocument& board,
 
 }  // namespace
 
+const CalibrationFile& ImuCalibration(const std::vector<CalibrationFile>& board, int instance) {
+  std::string have;
+  for (const CalibrationFile& c : board) {
+    if (c.instance == instance) return c;
+    have += (have.empty() ? "" : ", ") + std::to_string(c.instance);
+  }
+  throw InputError(board.front().path, KeyPlace("imus"),
+                   "no calibration of IMU " + std::to_string(instance) + " (it calibrates IMU " +
+                       have + "): choose the IMUs it calibrates (" + OptionText(Option::kImus) +
+                       "), or calibrate the board with them",
+                   {Option::kImus});
+}
+
 std::vector<CalibrationFile> ReadBoardCalibrationFile(const nlohmann::json& doc,
                                                       const std::string& path) {
   std::vector<CalibrationFile> out = {ReadCalibrationFile(doc, path)};

@@ -59,6 +59,10 @@ CalibrationFile ReadCalibrationFile(const nlohmann::json& doc, const std::string
 std::vector<CalibrationFile> ReadBoardCalibrationFile(const nlohmann::json& doc,
                                                       const std::string& path);
 
+/// The calibration of the board's IMU `instance` among `board` (ReadBoardCalibrationFile's);
+/// throws plumb::InputError naming the file and the IMUs it calibrates when it has none.
+const CalibrationFile& ImuCalibration(const std::vector<CalibrationFile>& board, int instance);
+
 /// The calibration of a document read. Throws plumb::InputError naming the file and the key
 /// when the model spec is missing or unknown, the reference is missing, a parameter of the model
 /// has no value or a value is not a parameter of the model, a sensor's matrix (from the
