@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.h"
@@ -192,14 +193,15 @@ class ApplyCommand : public Command {
     options.uncertainty = a.sigma;
     const std::vector<SessionImu> imus = SessionImus(session);
     // One file holds every IMU where they share IMU 0's stamps; one file per IMU always does.
-    const bool one_file = imus.size() == 1 || (a.out_paths.size() == 1 && SharedStamps(imus));
+    const bool shared = SharedStamps(imus);
+    const bool one_file = imus.size() == 1 || (a.out_paths.size() == 1 && shared);
     const std::size_t files = one_file ? 1 : imus.size();
     if (a.out_paths.size() != files) {
       throw UsageError(
           std::to_string(a.out_paths.size()) + " --out given for " + std::to_string(imus.size()) +
           " IMUs: give one per IMU, IMU 0 first" +
-          (SharedStamps(imus) ? ", or one for them all (they share their stamps)"
-                              : " (they have stamps of their own: one file cannot hold them)"));
+          (shared ? ", or one for them all (they share their stamps)"
+                  : " (they have stamps of their own: one file cannot hold them)"));
     }
     std::vector<const correction::CalibrationFile*> calibration_of;  // each IMU's, in order
     for (const SessionImu& u : imus) {
@@ -217,9 +219,9 @@ class ApplyCommand : public Command {
       if (one_file) {
         WriteCorrected(a.out_paths[0], corrected);
       } else {
-        CorrectedImu alone = corrected[f];
+        CorrectedImu alone = std::move(corrected[f]);  // written once, then not needed
         alone.k.clear();  // a file of its own: IMU k in the usual columns
-        WriteCorrected(a.out_paths[f], {alone});
+        WriteCorrected(a.out_paths[f], {std::move(alone)});
       }
       wrote += (f == 0 ? "" : ", ") + a.out_paths[f] +
                (one_file || imus.size() == 1 ? "" : " (IMU " + std::to_string(imus[f].instance) + ")");

@@ -101,8 +101,8 @@ void Propagate(const CalibrationFile& c, const ImuSeries& s, int steps, Correcte
       if (const auto at = c.model.FindParameter(name)) {
         moved.back().theta[static_cast<std::size_t>(at->first)]
                           [static_cast<std::size_t>(at->second)] += sign * h;
-      } else {  // "rotation.x|y|z" (CalibrationFile::mount_rotation)
-        moved.back().rho[name.back() - 'x'] += sign * h;
+      } else {  // an axis of the mount's rotation (calibration_file.h)
+        moved.back().rho[*MountRotationAxis(name)] += sign * h;
       }
     }
     step.push_back(h);

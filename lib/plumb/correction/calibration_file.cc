@@ -1,15 +1,23 @@
 #include "plumb/correction/calibration_file.h"
 
 #include <algorithm>
+#include <array>
 
 #include "plumb/core/calibration_checks.h"
 #include "plumb/core/error.h"
 #include "plumb/core/option_name.h"
+#include "plumb/model/board_mount.h"
 
 namespace plumb::correction {
 namespace {
 
 std::string KeyPlace(const std::string& name) { return "key '" + name + "'"; }
+
+/// The board mount's description (model/board_mount.h): its parameters' names.
+const model::EffectInfo& MountInfo() {
+  static const model::EffectInfo info = model::board_mount::Describe();
+  return info;
+}
 
 /// The message of a key a calibration to apply requires and the document lacks.
 std::string Missing() {
@@ -104,17 +112,21 @@ namespace {
 /// The mount's rotation vector from its parameters "rotation.x|y|z".
 Vec3 MountRotation(const document::BoardImuDocument& imu, const std::string& path) {
   Vec3 rho = Vec3::Zero();
-  const std::string axes = "xyz";
-  for (int a = 0; a < 3; ++a) {
-    const std::string name = std::string("rotation.") + axes[static_cast<std::size_t>(a)];
-    const auto p = std::find_if(imu.mount.begin(), imu.mount.end(),
-                                [&](const document::DocumentParameter& q) { return q.name == name; });
-    if (p == imu.mount.end()) {
-      throw InputError(path, KeyPlace("imus"), "IMU " + std::to_string(imu.instance) +
-                                                   " has no value for 'imu" +
-                                                   std::to_string(imu.instance) + "." + name + "'");
+  std::array<bool, 3> given = {false, false, false};
+  for (const document::DocumentParameter& p : imu.mount) {
+    if (const auto axis = MountRotationAxis(p.name)) {
+      rho[*axis] = p.value;
+      given[static_cast<std::size_t>(*axis)] = true;
     }
-    rho[a] = p->value;
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (given[static_cast<std::size_t>(a)]) continue;
+    const std::string name = MountInfo().parameters[static_cast<std::size_t>(
+                                                     model::board_mount::kRotation + a)]
+                                 .name;
+    throw InputError(path, KeyPlace("imus"), "IMU " + std::to_string(imu.instance) +
+                                                 " has no value for 'imu" +
+                                                 std::to_string(imu.instance) + "." + name + "'");
   }
   return rho;
 }
@@ -141,11 +153,12 @@ void SetBoardCovariance(const document::BoardDocument& board,
     const std::string& name = board.covariance_names[i];
     if (name.rfind(prefix, 0) != 0) continue;
     const std::string own = name.substr(prefix.size());
-    if (!file.model.FindParameter(own) && own.rfind("rotation.", 0) != 0) continue;
+    const bool rotation = MountRotationAxis(own).has_value();
+    if (!file.model.FindParameter(own) && !rotation) continue;
     const document::DocumentParameter* p = entry(own);
     if (p != nullptr && p->fixed) continue;
     if (p != nullptr && !p->observable) {
-      if (own.rfind("rotation.", 0) == 0) file.undetermined.push_back(own);
+      if (rotation) file.undetermined.push_back(own);
       continue;
     }
     rows.push_back(static_cast<Eigen::Index>(i));
@@ -171,6 +184,14 @@ const CalibrationFile& ImuCalibration(const std::vector<CalibrationFile>& board,
                        have + "): choose the IMUs it calibrates (" + OptionText(Option::kImus) +
                        "), or calibrate the board with them",
                    {Option::kImus});
+}
+
+std::optional<int> MountRotationAxis(const std::string& name) {
+  for (int a = 0; a < 3; ++a) {
+    const auto i = static_cast<std::size_t>(model::board_mount::kRotation + a);
+    if (MountInfo().parameters[i].name == name) return a;
+  }
+  return std::nullopt;
 }
 
 std::vector<CalibrationFile> ReadBoardCalibrationFile(const nlohmann::json& doc,

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,11 @@ struct CalibrationFile {
 /// "segments" left unread: a simulation's truth document is read as a calibration too), then
 /// CalibrationFromDocument. Throws plumb::InputError naming the file and the key.
 CalibrationFile ReadCalibrationFile(const nlohmann::json& doc, const std::string& path);
+
+/// The axis of the mount's rotation vector (CalibrationFile::mount_rotation) that a covariance
+/// name stands for: 0, 1, 2 for model/board_mount.h's "rotation.x", "rotation.y",
+/// "rotation.z"; nullopt for any other name.
+std::optional<int> MountRotationAxis(const std::string& name);
 
 /// Every IMU of a board's calibration (SPEC 6): IMU 0 as ReadCalibrationFile reads it, then
 /// each entry of "imus" as its own calibration (its instance, model, parameters and

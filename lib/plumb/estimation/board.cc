@@ -183,12 +183,12 @@ void ReportBoard(const CalibrationProblem& problem, const UnknownColumns& column
   const auto n = static_cast<Eigen::Index>(all.size());
   Eigen::MatrixXd& cov = calibration.board_covariance;
   cov = Eigen::MatrixXd::Zero(n, n);
+  const auto determined = [&](Eigen::Index c) {
+    return c >= 0 && analysis.observable[static_cast<std::size_t>(c)];
+  };
   for (Eigen::Index a = 0; a < n; ++a) {
     for (Eigen::Index b = 0; b < n; ++b) {
       const Eigen::Index ca = all[static_cast<std::size_t>(a)], cb = all[static_cast<std::size_t>(b)];
-      const auto determined = [&](Eigen::Index c) {
-        return c >= 0 && analysis.observable[static_cast<std::size_t>(c)];
-      };
       if (determined(ca) && determined(cb)) cov(a, b) = analysis.covariance(ca, cb);
     }
   }
