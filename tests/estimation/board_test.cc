@@ -25,6 +25,7 @@
 #include "plumb/report/calibration_text.h"
 #include "plumb/report/json_report.h"
 #include "plumb/estimation/solve.h"
+#include "plumb/estimation/uncertainty.h"
 #include "plumb/signal/chi_square.h"
 #include "plumb/sim/schedule.h"
 #include "plumb/sim/simulate.h"
@@ -43,20 +44,31 @@ struct BoardOutcome {
 
 /// A 16-pose session of a board of `imus` IMUs at 100 Hz, each IMU with random true
 /// parameters, rotations of 0.5-2 degrees, lever arms of 1-5 cm and time offsets within 2 ms
-/// (sim::RandomBoard); fitted with the true still segments given (attitudes unknown). With
-/// `realistic` noise (white, bias instability and walk, a temperature ramp) the fit models the
-/// wander (its default); with white noise it takes a constant bias.
-BoardOutcome FitBoard(std::uint64_t seed, int imus, bool realistic = false) {
+/// (sim::RandomBoard), with `realistic` noise (white, bias instability and walk, a temperature
+/// ramp) or white noise; `wander` scales the bias walk and instability of both sensors of every
+/// IMU.
+sim::Simulation SimulateBoard(std::uint64_t seed, int imus, bool realistic, double wander = 1.0) {
   sim::SimulationOptions opt = realistic ? sim::SimulationOptions::TypicalMems()
                                          : sim::SimulationOptions::WhiteMems();
+  opt.accel_bias_walk_density *= wander;
+  opt.gyro_bias_walk_density *= wander;
+  opt.accel_bias_instability *= wander;
+  opt.gyro_bias_instability *= wander;
   opt.rate_hz = 100.0;
   opt.model = model::Model::Parse("base");
   opt.truth = sim::RandomParameters(opt.model, 1.0, seed);
   opt.site = geo::Site::At(51.64, -1.2, 100.0, "flags");
   opt.seed = seed;
   opt.board = sim::RandomBoard(imus, opt.model, 1.0, seed + 1);
+  return sim::Simulate(sim::MultiPose(16, 5.0, 2.0, seed), opt);
+}
+
+/// SimulateBoard's session fitted with the true still segments given (attitudes unknown): with
+/// `realistic` noise the fit models the wander (its default); with white noise it takes a
+/// constant bias.
+BoardOutcome FitBoard(std::uint64_t seed, int imus, bool realistic = false) {
   BoardOutcome o;
-  o.sim = sim::Simulate(sim::MultiPose(16, 5.0, 2.0, seed), opt);
+  o.sim = SimulateBoard(seed, imus, realistic);
   std::vector<StillSegment> segments = o.sim.truth_segments;
   for (auto& s : segments) s.known_R_n_b.reset();
   CalibrationOptions options;
@@ -68,7 +80,8 @@ BoardOutcome FitBoard(std::uint64_t seed, int imus, bool realistic = false) {
 }
 
 /// The true value of every model parameter of the fit, by its column's name: IMU 0's, then
-/// each other IMU's ("imuK." prefixed) and its mount's rotation vector ("imuK.rotation.x").
+/// each other IMU's ("imuK." prefixed) and its mount's rotation vector ("imuK.rotation.x"),
+/// lever arm ("imuK.lever_arm.x") and time offset ("imuK.time_offset").
 std::map<std::string, double> Truth(const sim::Simulation& s) {
   std::map<std::string, double> truth;
   auto add = [&](const std::string& prefix, const model::Model& m, const model::ParameterBlocks& theta) {
@@ -81,7 +94,11 @@ std::map<std::string, double> Truth(const sim::Simulation& s) {
     const std::string prefix = "imu" + std::to_string(i + 1) + ".";
     add(prefix, s.board[i].model, s.board[i].truth);
     const Vec3 rho = so3::Log(s.board[i].R_b_i.toRotationMatrix());
-    for (int a = 0; a < 3; ++a) truth[prefix + "rotation." + kAxisName[a]] = rho[a];
+    for (int a = 0; a < 3; ++a) {
+      truth[prefix + "rotation." + kAxisName[a]] = rho[a];
+      truth[prefix + "lever_arm." + kAxisName[a]] = s.board[i].lever_arm_m[a];
+    }
+    truth[prefix + "time_offset"] = s.board[i].time_offset_s;
   }
   return truth;
 }
@@ -183,6 +200,66 @@ TEST(BoardFit, CovarianceIsHonestWithThreeImus) {
             << " .. " << hi << ")\n";
 }
 
+// Sessions from five times quieter to five times noisier than the typical MEMS sensor (walk
+// and instability of both sensors of every IMU scaled), calibrated as a user would
+// (CalibrateBoard) with the typical levels assumed (the default): as for one IMU
+// (calibrate_sim_test.cc), the formal sigmas are then conservative when the sensors are quiet,
+// and too small when they wander more, where every fit's chi2/dof above its band says so (it
+// is never called consistent).
+TEST(BoardFit, WanderFromQuietToNoisyIsConservativeOrFlagged) {
+  constexpr int kRuns = 12;
+  for (double wander : {0.2, 5.0}) {
+    double nees = 0.0;
+    int dof = 0, flagged = 0;
+    for (int run = 0; run < kRuns; ++run) {
+      const std::uint64_t seed = 9400 + static_cast<std::uint64_t>(run);
+      const sim::Simulation s = SimulateBoard(seed, 3, true, wander);
+      std::vector<StillSegment> segments = s.truth_segments;
+      for (auto& seg : segments) seg.known_R_n_b.reset();
+      const CalibrationResult r = CalibrateBoard(s.session.series, s.session.other_imus, segments,
+                                                 s.model, s.site, CalibrationOptions());
+      ASSERT_TRUE(r.fit.converged) << run;
+      flagged += Chi2AboveBand(r.fit);
+      // The NEES over every determined parameter of every IMU, with the one covariance.
+      const std::map<std::string, double> truth = Truth(s);
+      std::vector<const ParameterEstimate*> all;
+      for (const auto& p : r.calibration.parameters) all.push_back(&p);
+      for (const auto& b : r.calibration.board) {
+        for (const auto& p : b.parameters) all.push_back(&p);
+      }
+      std::vector<Eigen::Index> used;
+      for (std::size_t i = 0; i < all.size(); ++i) {
+        if (!all[i]->fixed && all[i]->observable) used.push_back(static_cast<Eigen::Index>(i));
+      }
+      const auto n = static_cast<Eigen::Index>(used.size());
+      Eigen::VectorXd e(n);
+      Eigen::MatrixXd P(n, n);
+      for (Eigen::Index a = 0; a < n; ++a) {
+        const auto i = static_cast<std::size_t>(used[static_cast<std::size_t>(a)]);
+        const ParameterEstimate& p = *all[i];
+        e[a] = p.value - truth.at(p.name);
+        for (Eigen::Index b = 0; b < n; ++b) {
+          P(a, b) = r.calibration.board_covariance(used[static_cast<std::size_t>(a)],
+                                                   used[static_cast<std::size_t>(b)]);
+        }
+      }
+      nees += e.dot(P.ldlt().solve(e));
+      dof += static_cast<int>(n);
+    }
+    const double lo = signal::ChiSquareQuantileExact(0.025, dof) / dof;
+    const double hi = signal::ChiSquareQuantileExact(0.975, dof) / dof;
+    if (wander < 1.0) {
+      EXPECT_LT(nees / dof, hi) << "quiet sensors";
+    } else {
+      EXPECT_GT(nees / dof, hi) << "noisy sensors";
+      EXPECT_EQ(flagged, kRuns) << "every fit of noisy sensors is flagged";
+    }
+    std::cout << wander << " x the typical wander, typical levels assumed: NEES/dof " << nees / dof
+              << " (95% band " << lo << " .. " << hi << "), chi2/dof above its band in "
+              << flagged << " of " << kRuns << "\n";
+  }
+}
+
 // CalibrateBoard reports every IMU: each board IMU's parameters (its model's and its mount's)
 // with sigmas, the one covariance over every IMU's, and the JSON's "imus" (SPEC 6: IMU 0 first
 // at the identity) and "imus_covariance"; the text report shows each IMU's rotation.
@@ -211,13 +288,16 @@ TEST(BoardFit, CalibrateBoardReportsEveryImu) {
     const std::size_t m = c.parameters.size();  // the mount's first
     EXPECT_EQ(b.parameters[m].name, "imu" + std::to_string(i + 1) + ".rotation.x");
     EXPECT_EQ(b.parameters[m].unit, "rad");
-    EXPECT_TRUE(b.parameters[m + model::board_mount::kLeverArm].fixed);  // not fitted yet
-    // The recovered rotation within 4 sigma of the truth, about each axis.
+    // The recovered rotation, lever arm and time offset within 4 sigma of the truth.
     const Vec3 rho = so3::Log(s.board[i].R_b_i.toRotationMatrix());
-    for (int a = 0; a < 3; ++a) {
+    std::vector<double> truth(rho.data(), rho.data() + 3);
+    truth.insert(truth.end(), s.board[i].lever_arm_m.data(), s.board[i].lever_arm_m.data() + 3);
+    truth.push_back(s.board[i].time_offset_s);
+    for (int a = 0; a < model::board_mount::kSize; ++a) {
       const ParameterEstimate& p = b.parameters[m + static_cast<std::size_t>(a)];
+      EXPECT_FALSE(p.fixed) << p.name;
       ASSERT_TRUE(std::isfinite(p.sigma)) << p.name;
-      EXPECT_LT(std::abs(p.value - rho[a]), 4.0 * p.sigma) << p.name;
+      EXPECT_LT(std::abs(p.value - truth[static_cast<std::size_t>(a)]), 4.0 * p.sigma) << p.name;
     }
     EXPECT_LT(b.R_b_i().angularDistance(s.board[i].R_b_i), 1e-3);
   }
@@ -230,7 +310,8 @@ TEST(BoardFit, CalibrateBoardReportsEveryImu) {
   EXPECT_EQ(doc["imus"][0]["rotation"]["vector"], nlohmann::json::array({0.0, 0.0, 0.0}));
   EXPECT_EQ(doc["imus"][2]["instance"], 2);
   EXPECT_TRUE(doc["imus"][1]["rotation"]["sigma"][2].is_number());
-  EXPECT_TRUE(doc["imus"][1]["lever_arm"]["sigma"][0].is_null());  // held
+  EXPECT_TRUE(doc["imus"][1]["lever_arm"]["sigma"][0].is_number());
+  EXPECT_TRUE(doc["imus"][1]["time_offset"]["sigma"].is_number());
   EXPECT_EQ(doc["imus_covariance"]["parameters"].size(), n);
   EXPECT_EQ(doc["imus_covariance"]["matrix"].size(), n);
   const std::string text = report::FullReport(r);

@@ -41,4 +41,8 @@ inline constexpr double kDegPerHourPerRadPerS = kDegPerRad * kSecondsPerHour;
 /// an angle random walk from deg/sqrt(s)).
 inline constexpr double kSqrtSecondsPerSqrtHour = 60.0;
 
+/// Centimetres per metre and milliseconds per second (a board's lever arms and clocks as shown).
+inline constexpr double kCmPerM = 100.0;
+inline constexpr double kMsPerS = 1e3;
+
 }  // namespace plumb::units

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "plumb/core/error.h"
+#include "plumb/estimation/board_turns.h"
 #include "plumb/model/board_mount.h"
 #include "plumb/residuals/bias_walk_residual.h"
 #include "plumb/residuals/held_combination.h"
@@ -74,9 +75,12 @@ ProblemImu CalibrationProblem::MakeImu(const ImuSeries& series, model::Model mod
     needs_velocity = needs_velocity || term.effect->info().excitation.angular_acceleration;
   }
   const bool motion_on = options_.use_motion && imu.has_gyro;
-  // The board's other IMUs have no velocity residual yet: their lever arms and time offsets
-  // are held (ProblemImu::Fixed).
+  // The board's other IMUs have no velocity residual: their accelerometers are compared with
+  // IMU 0's in the turns instead, which sees their lever arms and time offsets, where IMU 0's
+  // own accelerometer has no velocity residual in them (the two would share its noise).
   imu.velocity_on = !mounted && motion_on && options_.accel_in_motion.value_or(needs_velocity);
+  imu.turns_compared = mounted && options_.use_motion && imus_[0].has_gyro &&
+                       !imus_[0].velocity_on && !imu.still.motions.empty();
   imu.SetMeasurements();
   imu.SetMotionSamples();
   return imu;
@@ -102,6 +106,16 @@ CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model mod
     std::copy_n(rho.data(), 3, mount.begin() + model::board_mount::kRotation);
     blocks.push_back(std::move(mount));
     starts.push_back(std::move(blocks));
+    ProblemImu& added = imus_.back();
+    bool any_window = false;
+    for (std::size_t k = 0; added.turns_compared && k < added.still.motions.size(); ++k) {
+      auto windows = TurnWindows(*imus_[0].series, imus_[0].still.motions[k], imus_[0].model,
+                                 *added.series, added.still.motions[k], added.model);
+      for (const auto& w : windows) any_window = any_window || w.imu.count > 0;
+      added.turn_windows.push_back(
+          std::make_shared<const std::vector<residuals::BoardWindow>>(std::move(windows)));
+    }
+    added.turns_compared = any_window;
   }
   // The values: every IMU's term blocks, then the attitudes, then every IMU's wander states.
   int first_term = 0;
@@ -125,6 +139,7 @@ CalibrationProblem::CalibrationProblem(const ImuSeries& series, model::Model mod
     imus_[i].SetMotionWeights(Mat3::Identity() / s.gyro_rad_per_unit,
                               Mat3::Identity() * s.accel.scale, site_.gravity(),
                               options_.turn_vibration);
+    SetTurnWeights(i);
   }
 }
 
@@ -138,6 +153,7 @@ void CalibrationProblem::SetMotionWeightsFromSolution() {
     const auto linear = imus_[i].model.Predict(blocks.data(), model::SensorInput<double>());
     imus_[i].SetMotionWeights(linear.E, linear.F, site_.gravity(), options_.turn_vibration);
   }
+  for (std::size_t i = 1; i < imus_.size(); ++i) SetTurnWeights(i);
 }
 
 std::pair<std::size_t, int> CalibrationProblem::TermOf(int t) const {
@@ -305,7 +321,10 @@ void CalibrationProblem::AddResiduals(BuiltProblem& built, std::size_t imu) {
           nullptr, vblocks));
     }
   }
-  if (mounted) built.board.push_back(std::move(own));
+  if (mounted) {
+    AddTurnComparison(built, imu, own);
+    built.board.push_back(std::move(own));
+  }
 }
 
 void CalibrationProblem::AddWanderFactors(BuiltProblem& built, std::size_t imu, std::size_t p) {

@@ -98,6 +98,9 @@ struct BuiltProblem {
   struct ImuBlocks {
     std::vector<ceres::ResidualBlockId> acc, gyr;  ///< per still pose
     std::vector<ceres::ResidualBlockId> motion;    ///< per motion interval
+    /// Per motion interval with windows, when its turns are compared with IMU 0's (ProblemImu::
+    /// turns_compared): its accelerometer against IMU 0's (residuals/board_force_residual.h).
+    std::vector<ceres::ResidualBlockId> turns;
     std::vector<ceres::ResidualBlockId> walk;      ///< its bias-wander factors
   };
   std::vector<ImuBlocks> board;
@@ -201,6 +204,11 @@ class CalibrationProblem {
   /// Adds IMU `imu`'s still, motion and velocity residuals (IMU 0's into built.acc, .gyr,
   /// .motion, .velocity; the others' into built.board[imu - 1]).
   void AddResiduals(BuiltProblem& built, std::size_t imu);
+  /// Adds the comparison of IMU `imu`'s turns with IMU 0's (ProblemImu::turns_compared).
+  void AddTurnComparison(BuiltProblem& built, std::size_t imu, BuiltProblem::ImuBlocks& own);
+  /// Weighs IMU `imu`'s turn windows (board_turns.h) at the current values of both IMUs'
+  /// linear stages and its rotation.
+  void SetTurnWeights(std::size_t imu);
   void AddHeldCombinations(BuiltProblem& built, const std::vector<Gauge::Combination>& held);
   /// The IMU and its own term of the problem's term t (ParameterIndex::first).
   std::pair<std::size_t, int> TermOf(int t) const;

@@ -28,7 +28,7 @@ const model::EffectInfo& ProblemImu::TermInfo(int local) const {
 }
 
 bool ProblemImu::Fixed(int local, int i) const {
-  if (local == model.num_terms()) return i >= model::board_mount::kLeverArm;
+  if (local == model.num_terms()) return !turns_compared && i >= model::board_mount::kLeverArm;
   return model.terms()[static_cast<std::size_t>(local)].fixed[static_cast<std::size_t>(i)];
 }
 

@@ -22,6 +22,7 @@
 #include "plumb/estimation/still_set.h"
 #include "plumb/geo/site.h"
 #include "plumb/model/model.h"
+#include "plumb/residuals/board_force_residual.h"
 #include "plumb/residuals/measurements.h"
 
 namespace plumb::estimation {
@@ -53,6 +54,9 @@ struct ProblemImu {
   bool has_gyro = false;
   bool still_gyro = false;   ///< its still gyroscope residuals are used
   bool velocity_on = false;  ///< its velocity residuals are used
+  /// Another IMU of the board whose accelerometer is compared with IMU 0's in the turns
+  /// (residuals/board_force_residual.h): its lever arm and time offset are then free.
+  bool turns_compared = false;
   int first_term = 0;        ///< its first term among the problem's (ParameterIndex)
   std::vector<std::size_t> block_offset;  ///< per term (the mount last): offset in the buffer
   std::size_t walk_offset = 0;            ///< offset of its first wander state
@@ -61,13 +65,16 @@ struct ProblemImu {
   std::vector<residuals::SharedMotionSamples> motion_samples;
   std::vector<std::vector<Vec3>> output_rate;  ///< per motion, per sample: d y_g / dt, units/s
   std::vector<Vec3> velocity_info;             ///< per motion: 1 / sigma of its velocity residual
+  /// Per motion, where turns_compared: the turn's windows as it and IMU 0 sampled them
+  /// (estimation/board_turns.h), weighted; replaced, as motion_samples, when reweighted.
+  std::vector<residuals::SharedBoardWindows> turn_windows;
 
   /// Its terms: the model's, and the mount when mounted.
   int num_terms() const { return model.num_terms() + (mounted ? 1 : 0); }
   /// The description of its term `local` (the mount's: board_mount::Describe()).
   const model::EffectInfo& TermInfo(int local) const;
   /// Whether parameter i of term `local` is held in every fit (the model's fixed ones; the
-  /// mount's lever arm and time offset, which no residual sees yet).
+  /// mount's lever arm and time offset unless turns_compared: no other residual sees them).
   bool Fixed(int local, int i) const;
   /// The full name of parameter i of term `local`, as the fit's columns and the report name
   /// it: the prefix, then the effect's name ("imu1.accel.bias.x"; the mount's "imu1.rotation.x").

@@ -158,14 +158,34 @@ std::string MountText(const estimation::Calibration& c, const estimation::FitRep
          UndeterminedMountText(c, rotation, fit.distinct_poses <= 1);
 }
 
+/// Board IMU `b`'s place and clock on the board: its lever arm (cm) and time offset (ms) with
+/// sigma (`scale`d) where the turns determine them, or why they are not.
+std::string PlaceText(const estimation::BoardImuCalibration& b, double scale) {
+  using model::board_mount::kLeverArm;
+  using model::board_mount::kTimeOffset;
+  if (b.MountParameter(kTimeOffset).fixed) {
+    return "lever arm and time offset held at 0 (no turn, sampled finely enough by both, compares "
+           "its accelerometer with IMU 0's); ";
+  }
+  auto value = [&](int i, double unit) {
+    const estimation::ParameterEstimate& p = b.MountParameter(i);
+    if (!p.observable || !std::isfinite(p.sigma)) return std::string("not determined");
+    return FormattedText("%.3g", p.value * unit) + " +- " +
+           FormattedText("%.2g", scale * p.sigma * unit);
+  };
+  const double cm = units::kCmPerM;
+  return "lever arm x, y, z " + value(kLeverArm, cm) + ", " + value(kLeverArm + 1, cm) + ", " +
+         value(kLeverArm + 2, cm) + " cm and time offset " + value(kTimeOffset, units::kMsPerS) +
+         " ms, from the turns; ";
+}
+
 /// The board's other IMUs (SPEC 6): each one's rotation into the body and its parameters.
 std::string BoardText(const estimation::Calibration& c, const estimation::FitReport& fit,
                       double scale) {
   std::string out;
   for (const auto& b : c.board) {
-    out += "\nimu" + std::to_string(b.instance) +
-           ", fitted with IMU 0 (the attitudes shared); lever arm and time offset held at 0 "
-           "(not fitted yet); " + MountText(c, fit, b);
+    out += "\nimu" + std::to_string(b.instance) + ", fitted with IMU 0 (the attitudes shared); " +
+           PlaceText(b, scale) + MountText(c, fit, b);
     out += ParameterTable(b.parameters, scale);
   }
   return out;
