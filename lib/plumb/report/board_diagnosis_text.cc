@@ -43,7 +43,7 @@ std::string RigidText(const diagnostics::RigidBoardTest& t) {
   const std::string text =
       "  together (IMUs " + which + ", the attitudes shared, each its rotation into the body): "
       "chi2/dof " + SignificantText(t.chi2_board / t.dof_board, 3) + " on " +
-      std::to_string(t.dof_board) + " dof; sharing the attitudes adds chi2 " +
+      std::to_string(t.dof_board) + " dof; fitting them together adds chi2 " +
       SignificantText(t.difference(), 3) + " on " + std::to_string(t.constraints()) +
       " constraints (band up to " + SignificantText(t.limit, 3) + ")";
   if (t.holds()) return text + ": they move as one rigid board\n";
