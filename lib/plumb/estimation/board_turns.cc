@@ -128,22 +128,28 @@ void WeighTurnWindows(std::vector<residuals::BoardWindow>& windows, const TurnAc
 void CalibrationProblem::SetTurnWeights(std::size_t imu) {
   ProblemImu& u = imus_[imu];
   if (!u.turns_compared) return;
-  auto noise_of = [&](std::size_t i, const MotionInterval& turn) {
-    const ProblemImu& v = imus_[i];
-    const std::vector<const double*> blocks = TermBlocks(i);
-    TurnAccelNoise out;
-    out.F_inv = v.model.Predict(blocks.data(), model::SensorInput<double>()).F.inverse();
-    out.var_sample = v.noise.sigma_acc.cwiseAbs2().cwiseProduct(v.noise.tau_acc);
+  // Each IMU's scatter at rest, once (the turns' are their own).
+  auto at_rest = [&](const ProblemImu& v) {
     std::vector<std::pair<std::size_t, std::size_t>> still;
     for (const StillPose& pose : v.still.poses) {
       if (pose.segment.end > pose.segment.begin) {
         still.emplace_back(pose.segment.begin, pose.segment.end - 1);
       }
     }
-    const Vec3 at_rest = Scatter(*v.series, still);
+    return Scatter(*v.series, still);
+  };
+  const Vec3 rest0 = at_rest(imus_[0]), rest = at_rest(u);
+  auto noise_of = [&](std::size_t i, const MotionInterval& turn, const Vec3& rest_scatter) {
+    const ProblemImu& v = imus_[i];
+    const std::vector<const double*> blocks = TermBlocks(i);
+    TurnAccelNoise out;
+    out.F_inv = v.model.Predict(blocks.data(), model::SensorInput<double>()).F.inverse();
+    out.var_sample = v.noise.sigma_acc.cwiseAbs2().cwiseProduct(v.noise.tau_acc);
     const Vec3 in_turn = Scatter(*v.series, {{turn.first, turn.last}});
     for (int a = 0; a < 3 && options_.turn_vibration; ++a) {
-      if (at_rest[a] > 0.0 && in_turn[a] > 0.0) out.var_sample[a] *= in_turn[a] / at_rest[a];
+      if (rest_scatter[a] > 0.0 && in_turn[a] > 0.0) {
+        out.var_sample[a] *= in_turn[a] / rest_scatter[a];
+      }
     }
     for (std::size_t p : v.WanderOf(model::Sensor::kAccel)) {
       out.walk2.push_back(v.wander[p].ShortTimeWalk2());
@@ -154,8 +160,8 @@ void CalibrationProblem::SetTurnWeights(std::size_t imu) {
   const Mat3 R_b_i = model::board_mount::Rotation(mount(imu)).toRotationMatrix();
   for (std::size_t k = 0; k < u.turn_windows.size(); ++k) {
     auto windows = std::make_shared<std::vector<residuals::BoardWindow>>(*u.turn_windows[k]);
-    WeighTurnWindows(*windows, noise_of(0, imus_[0].still.motions[k]),
-                     noise_of(imu, u.still.motions[k]), R_b_i);
+    WeighTurnWindows(*windows, noise_of(0, imus_[0].still.motions[k], rest0),
+                     noise_of(imu, u.still.motions[k], rest), R_b_i);
     u.turn_windows[k] = std::move(windows);
   }
 }

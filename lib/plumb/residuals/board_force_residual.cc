@@ -146,7 +146,9 @@ BoardForceResidual::BoardForceResidual(const model::Model& model, const model::M
                                        SharedBoardWindows windows, int accel_wander,
                                        int accel_wander0)
     : model_(&model), model0_(&model0), windows_(std::move(windows)),
-      stencils_(Stencils(*windows_)), accel_wander_(accel_wander), accel_wander0_(accel_wander0) {}
+      stencils_(Stencils(*windows_)), accel_wander_(accel_wander), accel_wander0_(accel_wander0),
+      reads_alpha_(ReadsAngularAcceleration(model)),
+      reads_alpha0_(ReadsAngularAcceleration(model0)) {}
 
 ceres::CostFunction* BoardForceResidual::Create(const model::Model& model,
                                                 const model::Model& model0,
@@ -209,7 +211,7 @@ bool BoardForceResidual::operator()(double const* const* parameters, double* res
   std::vector<Vec3> f0, w0;
   Correct(*model0_, theta0, wander0, accel_wander0_, true, none, f0, w0);
   std::vector<Vec3> alpha_b = MeanRate(w0);
-  if (ReadsAngularAcceleration(*model0_)) {
+  if (reads_alpha0_) {
     Correct(*model0_, theta0, wander0, accel_wander0_, true, alpha_b, f0, w0);
     alpha_b = MeanRate(w0);
   }
@@ -228,7 +230,7 @@ bool BoardForceResidual::operator()(double const* const* parameters, double* res
   // IMU i, in its own frame.
   const Mat3 R_b_i = so3::Exp(model::board_mount::RotationVector(mount));
   std::vector<Vec3> alpha_i = none;
-  if (ReadsAngularAcceleration(*model_)) {
+  if (reads_alpha_) {
     for (std::size_t k = 0; k < n; ++k) alpha_i[k] = R_b_i.transpose() * alpha_b[k];
   }
   std::vector<Vec3> f, w;

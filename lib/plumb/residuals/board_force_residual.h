@@ -122,6 +122,7 @@ class BoardForceResidual {
   SharedBoardWindows windows_;
   EdgeStencils stencils_;
   int accel_wander_, accel_wander0_;
+  bool reads_alpha_, reads_alpha0_;  // some term of IMU i's (IMU 0's) model reads alpha_b
 };
 
 }  // namespace plumb::residuals
