@@ -102,6 +102,7 @@ nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const Expo
   options.allow_undetermined = a.undetermined;
   options.log_params = session.log_params;
   options.system_id = session.system_id;
+  options.device_ids = session.device_ids;
   if (a.sysid_option != nullptr && a.sysid_option->count() > 0) options.system_id = a.sysid;
   options.keep_gyro_offsets = a.keep_gyro_offsets;
   // A board fit (--imus) writes every IMU's instance in each file.
@@ -109,7 +110,7 @@ nlohmann::json RunExports(const std::vector<ExportRequest>& requests, const Expo
       result.calibration.board.empty()
           ? std::vector<exporter::BoardImuExport>{}
           : exporter::BoardImuExports(result.calibration, series, result.fit.still,
-                                      session.other_imus, options.imu);
+                                      session.other_imus, options.imu, session.device_ids);
   for (const ExportRequest& r : requests) {
     const exporter::ExportOutput e =
         board.empty() ? exporter::Export(r.format, result.calibration, series, result.fit.still, options)

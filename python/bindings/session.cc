@@ -418,6 +418,14 @@ void TakeSeries(const py::dict& d, ImuSeries& x) {
   x.gyr_unit = d["gyr_unit"].cast<std::string>();
 }
 
+/// A pickled state's device ids ((accel, gyro), each a number or None; absent in older states).
+py::tuple DeviceIdsState(const DeviceIds& ids) { return py::make_tuple(ids.accel, ids.gyro); }
+DeviceIds DeviceIdsOfState(const py::dict& d) {
+  if (!d.contains("device_ids")) return {};
+  const py::tuple t = d["device_ids"].cast<py::tuple>();
+  return {t[0].cast<std::optional<double>>(), t[1].cast<std::optional<double>>()};
+}
+
 /// Session::other_imus as state: dicts of instance, name, firmware_left and the series' keys.
 py::list OtherImusState(const std::vector<BoardImu>& imus) {
   py::list out;
@@ -426,6 +434,7 @@ py::list OtherImusState(const std::vector<BoardImu>& imus) {
     d["instance"] = imu.instance;
     d["name"] = imu.name;
     d["firmware_left"] = imu.firmware_left;
+    d["device_ids"] = DeviceIdsState(imu.device_ids);
     PutSeries(imu.series, d);
     out.append(std::move(d));
   }
@@ -441,6 +450,7 @@ std::vector<BoardImu> OtherImusOfState(const py::handle& state) {
     imu.instance = d["instance"].cast<int>();
     imu.name = d["name"].cast<std::string>();
     imu.firmware_left = d["firmware_left"].cast<std::vector<std::string>>();
+    imu.device_ids = DeviceIdsOfState(d);
     TakeSeries(d, imu.series);
     out.push_back(std::move(imu));
   }
@@ -491,6 +501,7 @@ py::dict SessionState(const PySession& p) {
   d["firmware_left"] = s.firmware_left;
   d["log_params"] = s.log_params;
   d["system_id"] = s.system_id ? py::object(py::int_(*s.system_id)) : py::object(py::none());
+  d["device_ids"] = DeviceIdsState(s.device_ids);
   py::list motion;
   for (const LogMotion& m : s.log_motion) {
     motion.append(py::make_tuple(m.t_begin_s, m.t_end_s, static_cast<int>(m.evidence), m.source,
@@ -536,6 +547,7 @@ std::shared_ptr<PySession> SessionOfState(const py::dict& d) {
   s.firmware_left = d["firmware_left"].cast<std::vector<std::string>>();
   s.log_params = d["log_params"].cast<std::map<std::string, double>>();
   if (!d["system_id"].is_none()) s.system_id = d["system_id"].cast<int>();
+  s.device_ids = DeviceIdsOfState(d);
   for (const auto& item : d["log_motion"]) {
     const py::tuple t = item.cast<py::tuple>();
     LogMotion m;

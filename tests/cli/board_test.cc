@@ -62,7 +62,16 @@ TEST(BoardCli, ASimulatedBoardsImusAreCalibratedTogether) {
       const double true_value = truth["imus"][k]["rotation"]["vector"][a];
       EXPECT_LT(std::abs(value - true_value), 4.0 * sigma) << "imu" << k << " axis " << a;
     }
+    // Its turns against IMU 0's: chi2 near one per value on a board the model fits (a few
+    // unknowns absorb a little; the spread of chi2/n is sqrt(2/n), 0.04 at 1400 values).
+    const json& turns = imu["turn_comparison"];
+    ASSERT_GT(turns["residuals"].get<int>(), 1000) << turns.dump();
+    const double per_value = turns["chi2"].get<double>() / turns["residuals"].get<double>();
+    EXPECT_GT(per_value, 0.8) << turns.dump();
+    EXPECT_LT(per_value, 1.2) << turns.dump();
+    EXPECT_TRUE(Contains(run.out, "(their comparison with IMU 0's: chi2 ")) << run.out;
   }
+  EXPECT_FALSE(doc["imus"][0].contains("turn_comparison"));
   const std::size_t n = doc["imus_covariance"]["parameters"].size();
   EXPECT_EQ(doc["imus_covariance"]["matrix"].size(), n);
   EXPECT_EQ(doc["imus_covariance"]["parameters"][n - 1], "imu2.time_offset");
@@ -288,6 +297,29 @@ TEST(BoardCli, AFlightsThreeImusAreNotTakenForStill) {
   bool not_still = false;
   for (const auto& g : doc["gates"]) not_still = not_still || g["name"] == "not_still";
   EXPECT_TRUE(not_still) << doc["gates"].dump();
+}
+
+// PX4 finds a sensor's calibration slot by its device id (CAL_ACCn_ID), not its instance: the
+// reader carries each instance's device ids (vehicle_imu accel_device_id, gyro_device_id), and
+// the export writes each IMU's values in the slot the log's parameters give that id.
+TEST(BoardCli, Px4ExportsFindEachImusSlotByItsDeviceId) {
+  PLUMB_SHARED_LOG(log, "px4/sample_log_small.ulg");
+  TempDir dir;
+  const std::string params = dir.File("board.params");
+  const ToolRun run = Plumb({"calibrate", log, "--imus", "all", "--export", "px4=" + params,
+                             "--export-anyway", "--export-undetermined"},
+                            dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string text = testing::ReadAll(params);
+  // The log's slots: 0 device 2424842, 1 device 3670050, 2 device 2621474 (accel and gyro).
+  const std::pair<int, const char*> slots[] = {{0, "2424842"}, {1, "3670050"}, {2, "2621474"}};
+  for (const auto& [n, id] : slots) {
+    const std::string k = std::to_string(n);
+    EXPECT_TRUE(Contains(text, "\tCAL_ACC" + k + "_ID\t" + id + "\t6\n")) << text;
+    EXPECT_TRUE(Contains(text, "\tCAL_GYRO" + k + "_ID\t" + id + "\t6\n")) << text;
+    EXPECT_TRUE(Contains(text, "CAL_ACC" + k + "_ID " + id + ": the sensor's device id, which the "
+                               "log's CAL_ACC" + k + "_ID holds")) << text;
+  }
 }
 
 TEST(BoardCli, ALogWithoutAStillHoldSaysSo) {

@@ -47,7 +47,7 @@ TEST_P(BoardExportOfARealLog, WritesOnlyNamesTheFirmwareHasWithItsDeviceIds) {
   options.log_params = s.log_params;
   options.keep_gyro_offsets = true;
   const ExportOutput out = ExportBoard(
-      c.format, BoardImuExports(r.calibration, s.series, r.fit.still, s.other_imus, 0), options);
+      c.format, BoardImuExports(r.calibration, s.series, r.fit.still, s.other_imus, 0, s.device_ids), options);
   const std::map<std::string, double> written =
       std::string(c.format) == "ardupilot" ? ReadArdupilotParamFile(out.text, c.log)
                                            : ReadPx4ParamsFile(out.text, c.log);

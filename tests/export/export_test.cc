@@ -191,7 +191,7 @@ TEST(Ardupilot, MalformedLineIsAnInputErrorNamingTheLine) {
 
 TEST(Px4, ParameterFileRoundTripsAndReproducesTheCorrection) {
   const FirmwareCorrection fw = ThermalCorrection();
-  const ParameterSet set = Px4Parameters(fw, 2);
+  const ParameterSet set = Px4Parameters(fw, Px4Slots::Same(2));
   const std::string text = Px4ParamsFile(set);
   EXPECT_NE(text.find("1\t1\tCAL_ACC2_XOFF\t"), std::string::npos) << text;
   EXPECT_NE(text.find("1\t1\tTC_A_ENABLE\t1\t6\n"), std::string::npos) << text;
@@ -201,7 +201,7 @@ TEST(Px4, ParameterFileRoundTripsAndReproducesTheCorrection) {
     EXPECT_NEAR(read.at(name), value, 1e-8 * std::max(1.0, std::abs(value))) << name;
   }
   EXPECT_EQ(read.at("TC_A2_TREF"), 25.0);
-  const FirmwareCorrection back = Px4Correction(read, 2);
+  const FirmwareCorrection back = Px4Correction(read, Px4Slots::Same(2));
   EXPECT_LT(MaxDifference(back.accel, fw.accel), 1e-7);
   EXPECT_LT(MaxDifference(back.gyro, fw.gyro), 1e-7);
   EXPECT_THROW(ReadPx4ParamsFile("1 1 CAL_ACC0_XOFF 0.1 9\n", "spaces.params"), InputError);
@@ -275,6 +275,68 @@ TEST(VehicleState, TheFilesSayAndKeepWhatTheFirmwareWouldReplace) {
   ASSERT_NE(note(plain, "system_id"), nullptr);
   EXPECT_EQ(note(plain, "system_id")->options, std::vector<Option>{Option::kSystemId});
   EXPECT_TRUE(note(px4, "system_id")->options.empty());  // given: nothing to point to
+}
+
+TEST(Px4, EachSensorsSlotIsTheOneHoldingItsDeviceId) {
+  // PX4 finds a sensor's calibration by its device id (sensor_calibration/Utilities.cpp,
+  // FindCurrentCalibrationIndex), not by its instance; a sensor no slot holds gets a free one,
+  // its instance's first (FindAvailableCalibrationIndex).
+  ExportOptions options;
+  options.imu = 0;
+  options.device_ids = {111.0, 222.0};
+  options.log_params = {{"CAL_ACC0_ID", 999}, {"CAL_ACC1_ID", 111},  {"CAL_GYRO0_ID", 222},
+                        {"CAL_GYRO1_ID", 999}, {"TC_A2_ID", 111},    {"TC_G0_ID", 0}};
+  const Px4Slots slots = Px4SlotsOf(options);
+  EXPECT_EQ(slots.acc, 1);
+  EXPECT_EQ(slots.gyro, 0);
+  EXPECT_EQ(slots.tc_acc, 2);
+  EXPECT_EQ(slots.tc_gyro, 0);  // held by no device: the instance's, free
+  // A new accelerometer: its instance's slot holds another device, so the first free one.
+  options.device_ids.accel = 333.0;
+  EXPECT_EQ(Px4SlotsOf(options).acc, 2);
+  // Every slot another device's: refused, naming them.
+  options.log_params["CAL_ACC2_ID"] = 444;
+  options.log_params["CAL_ACC3_ID"] = 555;
+  try {
+    Px4SlotsOf(options);
+    ADD_FAILURE() << "a calibration written over another sensor's slot";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no slot of CAL_ACC is free for device 333"),
+              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("CAL_ACC3_ID 555"), std::string::npos) << e.what();
+  }
+  // Without device ids: the instance's slots, as before.
+  options.device_ids = {};
+  options.imu = 3;
+  const Px4Slots same = Px4SlotsOf(options);
+  EXPECT_EQ(same.acc, 3);
+  EXPECT_EQ(same.gyro, 3);
+}
+
+TEST(Px4, TheFileWritesEachSensorInItsOwnSlotWithItsDeviceId) {
+  // Instance 0's accelerometer calibrated in slot 1, its gyroscope in slot 0: the file writes
+  // CAL_ACC1_* and CAL_GYRO0_*, each with the sensor's device id, and reads back the same.
+  model::Model m = model::Model::Parse("base+accel_temperature_bias");
+  model::ParameterBlocks theta = m.ZeroParameters();
+  theta[2] = {2e-3, -1e-3, 5e-4};
+  const Session s = MakeSession("base+accel_temperature_bias", theta, SixFaces(), {20, 24, 29, 33, 38, 45});
+  ExportOptions options;
+  options.device_ids = {1245450.0, 2162688.0};
+  options.log_params = {{"CAL_ACC0_ID", 1310986}, {"CAL_ACC1_ID", 1245450},
+                        {"CAL_GYRO0_ID", 2162688}, {"CAL_GYRO1_ID", 1310986}};
+  const ExportOutput px4 = Export("px4", s.r.calibration, s.series, s.r.fit.still, options);
+  for (const char* line : {"\n1\t1\tCAL_ACC1_XOFF\t", "\n1\t1\tCAL_ACC1_ID\t1245450\t6\n",
+                           "\n1\t1\tCAL_GYRO0_ZOFF\t", "\n1\t1\tCAL_GYRO0_ID\t2162688\t6\n",
+                           "\n1\t1\tTC_A0_ID\t1245450\t6\n"}) {
+    EXPECT_NE(px4.text.find(line), std::string::npos) << line << px4.text;
+  }
+  for (const char* absent : {"CAL_ACC0_", "CAL_GYRO1_", "CAL_ACC0_ID"}) {
+    EXPECT_EQ(px4.text.find(absent), std::string::npos) << absent << px4.text;
+  }
+  EXPECT_NE(px4.text.find("which the log's CAL_ACC1_ID holds"), std::string::npos) << px4.text;
+  // What the file's correction leaves is plumb's (read back from the slots written).
+  ASSERT_TRUE(px4.report.has_value());
+  EXPECT_LT(px4.report->accel_still.max_abs.maxCoeff(), 1e-3);
 }
 
 TEST(VehicleState, AFirmwareWithoutTheBootCalibrationFlagGetsANoteInsteadOfIt) {
@@ -545,6 +607,46 @@ TEST(Kalibr, RandomWalkOfTheIeeeFitWhereItIsResolved) {
   EXPECT_TRUE(imu.accel.walk_resolved);
   EXPECT_EQ(KalibrYaml(imu).find("upper bound"), std::string::npos);
   EXPECT_EQ(ToJson(imu)["accel"]["random_walk_source"][2], "ieee_fit");
+}
+
+TEST(Kalibr, EveryNumberReadsAsAYamlFloat) {
+  // Kalibr reads its yaml with PyYAML's safe_load (YAML 1.1), which takes "5e-05" for a string
+  // and "5.0e-05" for a float; a string then fails Kalibr's check `value <= 0.0`.
+  KalibrBoardImu board_imu;
+  KalibrImu& imu = board_imu.noise;
+  imu.has_gyro = true;
+  imu.update_rate_hz = 100.0;
+  imu.accel.white = Vec3(1e-5, 2e-6, 3e-6);
+  imu.accel.walk = Vec3::Constant(4e-4);
+  imu.gyro.white = Vec3::Constant(2.5e-5);
+  imu.gyro.walk = Vec3::Constant(3.0);
+  board_imu.time_offset_s = 5e-5;  // one sample at 20 kHz
+  const std::string set = KalibrImuSetYaml({board_imu});
+  for (const char* line : {"update_rate: 100.0  #", "accelerometer_noise_density: 1.0e-05  #",
+                           "accelerometer_random_walk: 0.0004  #",
+                           "gyroscope_noise_density: 2.5e-05  #",
+                           "gyroscope_random_walk: 3.0  #", "time_offset: 5.0e-05  #"}) {
+    EXPECT_NE(set.find(line), std::string::npos) << line << "\n" << set;
+  }
+  EXPECT_NE(KalibrYaml(imu).find("accelerometer_noise_density: 1.0e-05  #"), std::string::npos);
+}
+
+TEST(Kalibr, WhatKalibrCannotReadIsRefused) {
+  // Kalibr reads a gyroscope's noise for every IMU, and refuses a random walk of 0: an
+  // accelerometer-only session, or one with nothing still, is refused with the reason.
+  const Session accel_only = AccelOnly(400, 400, 0.005, 0.01, 1.0);
+  try {
+    Export("kalibr", accel_only.r.calibration, accel_only.series, accel_only.r.fit.still, {});
+    ADD_FAILURE() << "an accelerometer-only session exported to Kalibr";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no gyroscope"), std::string::npos) << e.what();
+  }
+  try {
+    KalibrNoise(accel_only.r.calibration, accel_only.series, {}, "/imu0");
+    ADD_FAILURE() << "a session with no still segment measured for Kalibr";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no still segment"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

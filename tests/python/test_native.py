@@ -350,6 +350,18 @@ class Pickling(unittest.TestCase):
             self.assertEqual(getattr(u, name), getattr(s, name), name)
         np.testing.assert_array_equal(u.temp, s.temp)
 
+    def test_a_boards_device_ids_round_trip(self):
+        # PX4's exports find each IMU's calibration slot by its sensors' device ids: a pickled
+        # session keeps them, IMU 0's and every other IMU's (vehicle_imu accel/gyro_device_id).
+        path = os.path.join(SOURCE, "../shared/data/px4/sample_log_small.ulg")
+        if not os.path.exists(path):
+            self.skipTest("shared data absent: " + path)
+        s = quietly(plumb.open, path, imus="all")
+        state = pickle.loads(pickle.dumps(s)).__getstate__()
+        self.assertEqual(state["device_ids"], (2424842.0, 2424842.0))
+        self.assertEqual([b["device_ids"] for b in state["other_imus"]],
+                         [(3670050.0, 3670050.0), (2621474.0, 2621474.0)])
+
     def test_the_boards_other_imus_are_exposed_and_round_trip(self):
         # A native CSV with IMU 1 (accelerometer, gyroscope, temperature) and IMU 2
         # (accelerometer only) on IMU 0's time column (SPEC 6, "Several IMUs of one board").

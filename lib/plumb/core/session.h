@@ -21,6 +21,15 @@ struct SiteInput {
   std::string source;     ///< "flags", "gps" or "file"
 };
 
+/// The firmware's identity of an IMU's two sensors, where the log records it (PX4's device
+/// ids: bus type, bus, address and device type packed in one number). PX4 matches a
+/// calibration slot to a sensor by it (CAL_ACCn_ID, CAL_GYROn_ID, TC_An_ID, TC_Gn_ID), not by
+/// the sensor's instance.
+struct DeviceIds {
+  std::optional<double> accel;  ///< the accelerometer's, unset when the input does not say
+  std::optional<double> gyro;   ///< the gyroscope's
+};
+
 /// Another IMU of the same board (SPEC 6, "Several IMUs of one board"): its samples on its own
 /// stamps and in its own frame, as read.
 struct BoardImu {
@@ -30,6 +39,7 @@ struct BoardImu {
   /// What the firmware applied to these samples that the reader did not undo (as
   /// Session::firmware_left).
   std::vector<std::string> firmware_left;
+  DeviceIds device_ids;  ///< its sensors' device ids, as Session::device_ids
 };
 
 /// A recorded session: samples, where they came from, optional segments and site.
@@ -51,6 +61,9 @@ struct Session {
   /// The firmware's parameters as a flight log records them (empty for other inputs): what
   /// the exports say about the vehicle (INS_GYR_CAL, SENS_IMU_AUTOCAL, the device ids).
   std::map<std::string, double> log_params;
+  /// IMU 0's sensors' device ids where the log records them: which calibration slot of the
+  /// firmware an export writes (PX4's CAL_ACCn_*, matched by CAL_ACCn_ID).
+  DeviceIds device_ids;
   /// The vehicle's MAVLink system id, when the log says it (SYSID_THISMAV, MAV_SYS_ID, or the
   /// system that sent a tlog's IMU frames).
   std::optional<int> system_id;

@@ -1,5 +1,8 @@
 #include "plumb/estimation/board.h"
 
+#include <ceres/cost_function.h>
+#include <ceres/problem.h>
+
 #include <Eigen/SVD>
 #include <algorithm>
 #include <array>
@@ -172,13 +175,20 @@ BoardImuCalibration ReportBoardImu(const CalibrationProblem& problem, std::size_
 
 }  // namespace
 
-void ReportBoard(const CalibrationProblem& problem, const UnknownColumns& columns,
-                 const ObservabilityAnalysis& analysis,
+void ReportBoard(const CalibrationProblem& problem, const BuiltProblem& built,
+                 const UnknownColumns& columns, const ObservabilityAnalysis& analysis,
                  const std::vector<Eigen::Index>& column_of, Calibration& calibration) {
   if (problem.imus().size() < 2) return;
   std::vector<Eigen::Index> all = column_of;
   for (std::size_t i = 1; i < problem.imus().size(); ++i) {
-    calibration.board.push_back(ReportBoardImu(problem, i, columns, analysis, all));
+    BoardImuCalibration b = ReportBoardImu(problem, i, columns, analysis, all);
+    for (const ceres::ResidualBlockId id : built.board[i - 1].turns) {
+      double cost = 0.0;
+      built.problem->EvaluateResidualBlock(id, false, &cost, nullptr, nullptr);
+      b.turn_chi2 += 2.0 * cost;
+      b.turn_residuals += built.problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+    }
+    calibration.board.push_back(std::move(b));
   }
   const auto n = static_cast<Eigen::Index>(all.size());
   Eigen::MatrixXd& cov = calibration.board_covariance;

@@ -38,9 +38,10 @@ std::vector<BoardImuInput> PrepareBoard(const std::vector<BoardImu>& board,
 /// Stage 6 for the board's other IMUs: each one's parameters with their sigmas (from
 /// `analysis`, the fit with every unknown free, over `columns`) into calibration.board, and
 /// the covariance over IMU 0's parameters (calibration.parameters, whose block is
-/// calibration.covariance) and theirs into calibration.board_covariance. Nothing without a
-/// board.
-void ReportBoard(const CalibrationProblem& problem, const UnknownColumns& columns,
+/// calibration.covariance) and theirs into calibration.board_covariance; each one's turn
+/// comparison's chi2 from `built` (the problem at the fit). Nothing without a board.
+void ReportBoard(const CalibrationProblem& problem, const BuiltProblem& built,
+                 const UnknownColumns& columns,
                  const ObservabilityAnalysis& analysis,
                  const std::vector<Eigen::Index>& column_of, Calibration& calibration);
 

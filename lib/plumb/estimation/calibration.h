@@ -128,6 +128,11 @@ struct BoardImuCalibration {
   bool has_gyro = false;
   std::string acc_unit = "m/s^2";
   std::string gyr_unit = "rad/s";
+  /// Its turns' comparison with IMU 0 at the fit (residuals/board_force_residual.h): chi2, the
+  /// sum of the squared whitened residuals, over `turn_residuals` values (0: no turn compared,
+  /// and its lever arm and time offset held).
+  double turn_chi2 = 0.0;
+  int turn_residuals = 0;
 
   /// R_b_i, its frame into the body frame (IMU 0's accelerometer's).
   Quat R_b_i() const;

@@ -193,7 +193,7 @@ void FinishCalibration(const ImuSeries& series, const std::vector<StillSegment>&
   cal.parameters = ReportParameters(cal.model, cal.theta, series, columns, analysis, column_of);
   ComputeCovariance(solution.fitted(), problem.ModelBlocks(), analysis, column_of, options, cal,
                     fit.warnings);
-  ReportBoard(problem, columns, analysis, column_of, cal);
+  ReportBoard(problem, solution.all_free, columns, analysis, column_of, cal);
 
   // 7. The fit: chi^2, degrees of freedom and the residuals.
   fit.chi2 = 2.0 * at.cost;

@@ -45,6 +45,7 @@ std::string MountNote(const BoardImuExport& imu) {
 ExportOutput ExportOne(const std::string& format, std::size_t k, const BoardImuExport& imu,
                        ExportOptions options) {
   options.imu = imu.instance;
+  options.device_ids = imu.device_ids;
   options.rostopic = KalibrTopic(options.rostopic, k);
   try {
     return Export(format, imu.calibration, *imu.series, imu.still, options);
@@ -73,7 +74,7 @@ std::vector<BoardImuExport> BoardImuExports(const estimation::Calibration& calib
                                             const ImuSeries& series0,
                                             const std::vector<estimation::StillSegmentFit>& still,
                                             const std::vector<BoardImu>& board,
-                                            int imu0_instance) {
+                                            int imu0_instance, const DeviceIds& imu0_device_ids) {
   if (board.size() != calibration.board.size()) {
     throw Error("the board's samples (" + std::to_string(board.size()) +
                 " IMUs) do not match its calibration (" +
@@ -81,6 +82,7 @@ std::vector<BoardImuExport> BoardImuExports(const estimation::Calibration& calib
   }
   std::vector<BoardImuExport> out(1);
   out[0].instance = imu0_instance;
+  out[0].device_ids = imu0_device_ids;
   out[0].calibration = calibration;
   out[0].calibration.board.clear();
   out[0].calibration.board_covariance.resize(0, 0);
@@ -90,6 +92,7 @@ std::vector<BoardImuExport> BoardImuExports(const estimation::Calibration& calib
     const estimation::BoardImuCalibration& b = calibration.board[k];
     BoardImuExport imu;
     imu.instance = board[k].instance;
+    imu.device_ids = board[k].device_ids;
     imu.calibration = estimation::BoardImuAlone(calibration, k);
     imu.series = &board[k].series;
     imu.still = estimation::StillFitsOnBoardImu(still, series0, board[k].series, b.R_b_i());

@@ -27,6 +27,7 @@ namespace plumb::exporter {
 /// One IMU of a board as ExportBoard takes it.
 struct BoardImuExport {
   int instance = 0;                     ///< the firmware instance its parameters are named for
+  DeviceIds device_ids;                 ///< its sensors' (PX4's slots follow them: Px4SlotsOf)
   estimation::Calibration calibration;  ///< the IMU alone (IMU 0: the fit's own, board cleared)
   const ImuSeries* series = nullptr;    ///< its samples
   std::vector<estimation::StillSegmentFit> still;  ///< the fit's still segments in its samples
@@ -37,14 +38,14 @@ struct BoardImuExport {
 };
 
 /// IMU 0 (`calibration` without its board, `series0`, the fit's `still`, firmware instance
-/// `imu0_instance`), then every IMU of calibration.board with its samples from `board` (the
+/// `imu0_instance`, device ids `imu0_device_ids`), then every IMU of calibration.board with its samples from `board` (the
 /// session's, in the same order; BoardImu::instance is its firmware instance). `series0` and
 /// `board` must outlive the result. Throws plumb::Error when `board` does not match.
 std::vector<BoardImuExport> BoardImuExports(const estimation::Calibration& calibration,
                                             const ImuSeries& series0,
                                             const std::vector<estimation::StillSegmentFit>& still,
                                             const std::vector<BoardImu>& board,
-                                            int imu0_instance);
+                                            int imu0_instance, const DeviceIds& imu0_device_ids);
 
 /// Export() of `format` for every IMU of `imus` (IMU 0 first) in one output: the firmware
 /// formats' parameters in one file (a parameter two IMUs write alike, such as INS_GYR_CAL,

@@ -65,10 +65,40 @@ void CheckDetermined(const std::string& format, const estimation::Calibration& c
               {Option::kExport, Option::kExportUndetermined});
 }
 
+/// PX4's calibration slots per sensor type (formats.h).
+constexpr int kPx4Slots = 4;
+
+/// A device id as the firmware prints it.
+std::string DeviceIdText(double id) { return std::to_string(std::llround(id)); }
+
+/// Px4SlotsOf for one sensor: `prefix` "CAL_ACC", "CAL_GYRO", "TC_A" or "TC_G".
+int Px4Slot(const std::string& prefix, const std::optional<double>& device_id, int instance,
+            const std::map<std::string, double>& log) {
+  if (!device_id || *device_id == 0.0) return instance;
+  const auto held = [&](int n) {
+    const auto it = log.find(prefix + std::to_string(n) + "_ID");
+    return it == log.end() ? 0.0 : it->second;
+  };
+  for (int n = 0; n < kPx4Slots; ++n) {
+    if (held(n) == *device_id) return n;
+  }
+  if (instance >= 0 && instance < kPx4Slots && held(instance) == 0.0) return instance;
+  std::string holders;
+  for (int n = 0; n < kPx4Slots; ++n) {
+    if (held(n) == 0.0) return n;
+    holders += (n > 0 ? ", " : "") + prefix + std::to_string(n) + "_ID " + DeviceIdText(held(n));
+  }
+  throw Error("PX4 export: no slot of " + prefix + " is free for device " +
+              DeviceIdText(*device_id) + " (" + holders +
+              "): writing one would move another sensor's calibration onto this one");
+}
+
 /// What the vehicle will do with the values, from the log's parameters: the boot-time gyro
 /// calibration that replaces the offsets (written off on request), the device ids the
 /// firmware matches a calibration by, the level left alone, the system id of the file.
-void AddVehicleState(const std::string& format, const ExportOptions& options, ParameterSet& set) {
+/// `slots`: PX4's, where its device ids are written (ArduPilot's names follow options.imu).
+void AddVehicleState(const std::string& format, const ExportOptions& options,
+                     const Px4Slots& slots, ParameterSet& set) {
   const auto logged = [&](const std::string& name) -> std::optional<double> {
     const auto it = options.log_params.find(name);
     return it == options.log_params.end() ? std::nullopt : std::optional<double>(it->second);
@@ -79,7 +109,7 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
   };
   const bool ardupilot = format == "ardupilot";
   const std::string flag = ardupilot ? "INS_GYR_CAL" : "SENS_IMU_AUTOCAL";
-  const std::string offsets = ardupilot ? "INS_GYR*OFFS" : "CAL_GYRO" + std::to_string(set.imu) + "_*OFF";
+  const std::string offsets = ardupilot ? "INS_GYR*OFFS" : "CAL_GYRO" + std::to_string(slots.gyro) + "_*OFF";
   // The log is of this firmware when its parameters include the firmware's accelerometer
   // calibration (a PX4 file exported from an ArduPilot log says nothing of PX4's table).
   const std::string family = ardupilot ? "INS_ACC" : "CAL_ACC";
@@ -115,24 +145,38 @@ void AddVehicleState(const std::string& format, const ExportOptions& options, Pa
     AddNotice(set.notes, "level_kept", "AHRS_TRIM_X/Y/Z (the level: how the board sits in the frame) are left "
                         "as they are: plumb calibrates the sensor, not its mounting");
   } else {
-    const std::string i = std::to_string(set.imu);
-    const std::pair<const char*, const char*> ids[] = {{"CAL_ACC", "TC_A"}, {"CAL_GYRO", "TC_G"}};
-    for (const auto& [cal, tc] : ids) {
-      const auto id = logged(std::string(cal) + i + "_ID");
+    struct Sensor {
+      std::string cal, tc;  // the slots' stems: "CAL_ACC1", "TC_A1"
+      std::optional<double> device_id;
+    };
+    const Sensor sensors[] = {
+        {"CAL_ACC" + std::to_string(slots.acc), "TC_A" + std::to_string(slots.tc_acc),
+         options.device_ids.accel},
+        {"CAL_GYRO" + std::to_string(slots.gyro), "TC_G" + std::to_string(slots.tc_gyro),
+         options.device_ids.gyro}};
+    for (const Sensor& s : sensors) {
+      // The sensor's own id where the log records it, else the one its slot holds.
+      const auto id = s.device_id && *s.device_id != 0.0 ? s.device_id : logged(s.cal + "_ID");
       if (!id || *id == 0.0) {
-        AddNotice(set.notes, "device_id_unknown", std::string(cal) + i + "_ID and " + tc + i +
+        AddNotice(set.notes, "device_id_unknown", s.cal + "_ID and " + s.tc +
                             "_ID are not written (the input does not record them): the "
                             "vehicle's device ids stay");
         continue;
       }
-      set.parameters.push_back({std::string(cal) + i + "_ID", *id, true});
+      set.parameters.push_back({s.cal + "_ID", *id, true});
       const bool thermal = std::any_of(set.parameters.begin(), set.parameters.end(), [&](const Parameter& p) {
-        return p.name.rfind(std::string(tc) + i + "_", 0) == 0;
+        return p.name.rfind(s.tc + "_", 0) == 0;
       });
-      if (thermal) set.parameters.push_back({std::string(tc) + i + "_ID", *id, true});
-      AddNotice(set.notes, "device_id", std::string(cal) + i + "_ID" + (thermal ? " and " + std::string(tc) + i + "_ID" : "") +
-                          " " + std::to_string(std::lround(*id)) +
-                          ": the device id the log records (the firmware applies these values only to it)");
+      if (thermal) set.parameters.push_back({s.tc + "_ID", *id, true});
+      const std::string slot = s.cal.substr(s.cal.size() - 1);
+      const std::string where =
+          !s.device_id ? ": the device id the log records for slot " + slot
+          : logged(s.cal + "_ID") == id
+              ? ": the sensor's device id, which the log's " + s.cal + "_ID holds"
+              : ": the sensor's device id, in slot " + slot + ", which no device holds in the log";
+      AddNotice(set.notes, "device_id", s.cal + "_ID" + (thermal ? " and " + s.tc + "_ID" : "") +
+                          " " + DeviceIdText(*id) + where +
+                          " (the firmware applies these values only to it)");
     }
   }
   set.system_id = options.system_id.value_or(1);
@@ -160,14 +204,15 @@ ExportOutput Firmware(const std::string& format, const estimation::Calibration& 
   FirmwareCorrection applied;
   if (format == "ardupilot") {
     set = ArdupilotParameters(target, options.imu);
-    AddVehicleState(format, options, set);
+    AddVehicleState(format, options, Px4Slots::Same(options.imu), set);
     out.text = ArdupilotParamFile(set);
     applied = ArdupilotCorrection(ReadArdupilotParamFile(out.text, format), options.imu);
   } else {
-    set = Px4Parameters(target, options.imu);
-    AddVehicleState(format, options, set);
+    const Px4Slots slots = Px4SlotsOf(options);
+    set = Px4Parameters(target, slots);
+    AddVehicleState(format, options, slots, set);
     out.text = Px4ParamsFile(set);
-    applied = Px4Correction(ReadPx4ParamsFile(out.text, format), options.imu);
+    applied = Px4Correction(ReadPx4ParamsFile(out.text, format), slots);
   }
   ExportReport report = Evaluate(c, series, still, applied, format, /*keeps_temperature=*/true);
   report.notes.insert(report.notes.end(), set.notes.begin(), set.notes.end());
@@ -189,6 +234,12 @@ ExportOutput Kalibr(const estimation::Calibration& c, const ImuSeries& series,
   ExportOutput out;
   out.format = "kalibr";
   const KalibrImu imu = KalibrNoise(c, series, still, options.rostopic);
+  // Kalibr reads the gyroscope's noise keys of every IMU (kalibr_common ConfigReader.py,
+  // ImuParameters.getGyroStatistics; IccImu reads them for each IMU of a set).
+  if (!imu.has_gyro) {
+    throw Error(OptionText(Option::kExport, "kalibr") + ": the session has no gyroscope, and "
+                "Kalibr reads gyroscope_noise_density and gyroscope_random_walk for every IMU");
+  }
   out.text = KalibrYaml(imu);
   char buf[256];
   std::snprintf(buf, sizeof buf,
@@ -234,6 +285,14 @@ ExportOutput Kalibr(const estimation::Calibration& c, const ImuSeries& series,
 }
 
 }  // namespace
+
+Px4Slots Px4SlotsOf(const ExportOptions& options) {
+  const auto& log = options.log_params;
+  const auto& ids = options.device_ids;
+  return {Px4Slot("CAL_ACC", ids.accel, options.imu, log),
+          Px4Slot("CAL_GYRO", ids.gyro, options.imu, log),
+          Px4Slot("TC_A", ids.accel, options.imu, log), Px4Slot("TC_G", ids.gyro, options.imu, log)};
+}
 
 const std::vector<std::string>& ExportFormats() {
   static const std::vector<std::string> formats = {"ardupilot", "px4", "kalibr", "json"};

@@ -23,7 +23,7 @@
 //   system_id               export.cc: the PX4 vehicle id written (kSystemId when not given)
 //   board_frame             export.cc: the axes are the log's board frame
 //   board_mount             board_export.cc: where a board IMU sits, which no parameter holds
-//   no_still_segment        firmware.cc, kalibr.cc: nothing at rest to measure on
+//   no_still_segment        firmware.cc: nothing at rest to measure on
 //   undetermined            firmware.cc: directions the session does not determine
 //   noise_model_only        kalibr.cc: imu.yaml holds the noise model only
 //   noise_terms_unresolved  kalibr.cc: the still data give no IEEE noise terms
@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/session.h"
 #include "plumb/estimation/calibration.h"
 #include "plumb/estimation/fit_report.h"
 #include "plumb/export/firmware.h"
@@ -61,11 +62,23 @@ struct ExportOptions {
   /// the device ids (CAL_*_ID, TC_*_ID) and the system id (QGroundControl's first column).
   std::map<std::string, double> log_params;
   std::optional<int> system_id;
+  /// The IMU's sensors' device ids (Session::device_ids): PX4's slots are the ones whose
+  /// CAL_ACCn_ID, CAL_GYROn_ID, TC_An_ID, TC_Gn_ID hold them, as the firmware finds them; `imu`
+  /// is then only the slot preferred where none does (Px4SlotsOf).
+  DeviceIds device_ids;
   /// Write what keeps plumb's gyroscope offsets: INS_GYR_CAL 0 (ArduPilot measures them at
   /// every boot while it is 1, the default) and SENS_IMU_AUTOCAL 0 (PX4 overwrites CAL_GYRO
   /// offsets at rest while it is 1).
   bool keep_gyro_offsets = false;
 };
+
+/// PX4's slots for the IMU of `options` (formats.h Px4Slots), as the firmware finds each
+/// sensor's: the n whose CAL_ACCn_ID (CAL_GYROn_ID, TC_An_ID, TC_Gn_ID) in the log is the
+/// sensor's device id; where none is, a slot no device holds (ID 0 or not in the log), the
+/// instance's first, as PX4 picks one for a new calibration (FindAvailableCalibrationIndex);
+/// where the device id is not known, the instance's. Throws plumb::Error when every slot holds
+/// another device.
+Px4Slots Px4SlotsOf(const ExportOptions& options);
 
 /// The formats Export() knows, in the order above.
 const std::vector<std::string>& ExportFormats();

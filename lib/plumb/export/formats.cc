@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <tuple>
 
 #include "plumb/core/error.h"
 
@@ -34,10 +35,10 @@ void CheckArdupilotImu(int imu) {
   }
 }
 
-void CheckPx4Imu(int imu) {
-  if (imu < 0 || imu > 3) {
-    throw Error("PX4 export: instance " + std::to_string(imu) +
-                " has no CAL_ACC/TC_A parameters (instances 0..3)");
+void CheckPx4Imu(int slot) {
+  if (slot < 0 || slot > 3) {
+    throw Error("PX4 export: instance " + std::to_string(slot) +
+                " has no CAL_ACC/TC_A parameters (PX4's calibration slots are 0..3)");
   }
 }
 
@@ -219,12 +220,12 @@ FirmwareCorrection ArdupilotCorrection(const std::map<std::string, double>& v, i
   return fw;
 }
 
-ParameterSet Px4Parameters(const FirmwareCorrection& fw, int imu) {
-  CheckPx4Imu(imu);
+ParameterSet Px4Parameters(const FirmwareCorrection& fw, const Px4Slots& slots) {
+  for (const int slot : {slots.acc, slots.gyro, slots.tc_acc, slots.tc_gyro}) CheckPx4Imu(slot);
   ParameterSet set;
   set.target = "px4";
-  set.imu = imu;
-  const std::string i = std::to_string(imu);
+  set.imu = slots.acc;
+  const std::string i = std::to_string(slots.acc), g = std::to_string(slots.gyro);
   for (int a = 0; a < 3; ++a) {
     set.parameters.push_back({"CAL_ACC" + i + "_" + kAxes[a] + "OFF", fw.accel.offset[a], false});
   }
@@ -233,18 +234,18 @@ ParameterSet Px4Parameters(const FirmwareCorrection& fw, int imu) {
   }
   if (fw.has_gyro) {
     for (int a = 0; a < 3; ++a) {
-      set.parameters.push_back({"CAL_GYRO" + i + "_" + kAxes[a] + "OFF", fw.gyro.offset[a], false});
+      set.parameters.push_back({"CAL_GYRO" + g + "_" + kAxes[a] + "OFF", fw.gyro.offset[a], false});
     }
   }
-  AddNotice(set.notes, "parameters_written", "PX4 parameters from plumb for instance " + i +
-                      ": acc = (acc_sensor - thermal - CAL_ACC" + i + "_OFF) .* CAL_ACC" + i +
-                      "_SCALE, gyr = gyr_sensor - thermal - CAL_GYRO" + i + "_OFF");
+  AddNotice(set.notes, "parameters_written", "PX4 parameters from plumb: acc = (acc_sensor - thermal - CAL_ACC" +
+                      i + "_OFF) .* CAL_ACC" + i + "_SCALE, gyr = gyr_sensor - thermal - CAL_GYRO" +
+                      g + "_OFF");
 
-  const std::pair<const DiagonalCorrection*, const char*> sensors[] = {{&fw.accel, "A"},
-                                                                       {&fw.gyro, "G"}};
-  for (const auto& [c, letter] : sensors) {
+  const std::tuple<const DiagonalCorrection*, const char*, int> sensors[] = {
+      {&fw.accel, "A", slots.tc_acc}, {&fw.gyro, "G", slots.tc_gyro}};
+  for (const auto& [c, letter, slot] : sensors) {
     if (!c->has_thermal || (c == &fw.gyro && !fw.has_gyro)) continue;
-    const std::string tc = std::string("TC_") + letter + i + "_";
+    const std::string tc = std::string("TC_") + letter + std::to_string(slot) + "_";
     set.parameters.push_back({std::string("TC_") + letter + "_ENABLE", 1.0, true});
     for (int k = 0; k < 4; ++k) {
       for (int a = 0; a < 3; ++a) {
@@ -259,9 +260,9 @@ ParameterSet Px4Parameters(const FirmwareCorrection& fw, int imu) {
   return set;
 }
 
-FirmwareCorrection Px4Correction(const std::map<std::string, double>& v, int imu) {
-  CheckPx4Imu(imu);
-  const std::string i = std::to_string(imu);
+FirmwareCorrection Px4Correction(const std::map<std::string, double>& v, const Px4Slots& slots) {
+  for (const int slot : {slots.acc, slots.gyro, slots.tc_acc, slots.tc_gyro}) CheckPx4Imu(slot);
+  const std::string i = std::to_string(slots.acc), g = std::to_string(slots.gyro);
   FirmwareCorrection fw;
   auto vec = [&](const std::string& prefix, const std::string& suffix) {
     return Vec3(Get(v, prefix + "X" + suffix), Get(v, prefix + "Y" + suffix),
@@ -269,13 +270,13 @@ FirmwareCorrection Px4Correction(const std::map<std::string, double>& v, int imu
   };
   fw.accel.offset = vec("CAL_ACC" + i + "_", "OFF");
   fw.accel.scale = vec("CAL_ACC" + i + "_", "SCALE");
-  fw.has_gyro = v.count("CAL_GYRO" + i + "_XOFF") > 0;
-  if (fw.has_gyro) fw.gyro.offset = vec("CAL_GYRO" + i + "_", "OFF");
-  const std::pair<DiagonalCorrection*, const char*> sensors[] = {{&fw.accel, "A"},
-                                                                 {&fw.gyro, "G"}};
-  for (const auto& [c, letter] : sensors) {
+  fw.has_gyro = v.count("CAL_GYRO" + g + "_XOFF") > 0;
+  if (fw.has_gyro) fw.gyro.offset = vec("CAL_GYRO" + g + "_", "OFF");
+  const std::tuple<DiagonalCorrection*, const char*, int> sensors[] = {
+      {&fw.accel, "A", slots.tc_acc}, {&fw.gyro, "G", slots.tc_gyro}};
+  for (const auto& [c, letter, slot] : sensors) {
     if (GetOr(v, std::string("TC_") + letter + "_ENABLE", 0.0) != 1.0) continue;
-    const std::string tc = std::string("TC_") + letter + i + "_";
+    const std::string tc = std::string("TC_") + letter + std::to_string(slot) + "_";
     c->has_thermal = true;
     c->thermal.t0_c = Get(v, tc + "TREF");
     c->temp_min_c = Get(v, tc + "TMIN");

@@ -59,9 +59,25 @@ ParameterSet ArdupilotParameters(const FirmwareCorrection& fw, int imu);
 /// temperature parameters mean no temperature correction.
 FirmwareCorrection ArdupilotCorrection(const std::map<std::string, double>& values, int imu);
 
-/// PX4 parameters for instance `imu` (0..3; CAL_ACC{imu}, TC_A{imu}).
-ParameterSet Px4Parameters(const FirmwareCorrection& fw, int imu);
-FirmwareCorrection Px4Correction(const std::map<std::string, double>& values, int imu);
+/// PX4's calibration slots (0..3) of one IMU's sensors. The firmware finds a sensor's
+/// calibration by its device id (PX4 src/lib/sensor_calibration/Utilities.cpp,
+/// FindCurrentCalibrationIndex: the n whose CAL_ACCn_ID is the device's; the thermal
+/// compensation likewise by TC_An_ID), so the accelerometer's slot, the gyroscope's and their
+/// thermal ones need not be the IMU's instance, nor each other.
+struct Px4Slots {
+  int acc = 0;      ///< CAL_ACC{acc}_*
+  int gyro = 0;     ///< CAL_GYRO{gyro}_*
+  int tc_acc = 0;   ///< TC_A{tc_acc}_*
+  int tc_gyro = 0;  ///< TC_G{tc_gyro}_*
+  /// Every slot the instance's (what a log without device ids leaves).
+  static Px4Slots Same(int instance) { return {instance, instance, instance, instance}; }
+};
+
+/// PX4 parameters in `slots` (each 0..3; CAL_ACC{acc}_*, CAL_GYRO{gyro}_*, TC_A{tc_acc}_*,
+/// TC_G{tc_gyro}_*). Throws plumb::Error for a slot outside 0..3.
+ParameterSet Px4Parameters(const FirmwareCorrection& fw, const Px4Slots& slots);
+FirmwareCorrection Px4Correction(const std::map<std::string, double>& values,
+                                 const Px4Slots& slots);
 
 /// Mission Planner's .param text: `#` comment lines (the notes), then `NAME,VALUE` per line,
 /// values with 9 significant digits (a float32 round-trips). MAVProxy (pymavlink mavparm.load)

@@ -174,7 +174,13 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   imu.update_rate_hz = 1.0 / dt_s;
   imu.has_gyro = c.has_gyro && series.has_gyro();
   const StillSegment* seg = LongestStill(still, series.size());
-  imu.longest_still_s = seg ? static_cast<double>(seg->count()) * dt_s : 0.0;
+  // Kalibr refuses a random walk <= 0 (kalibr_common ConfigReader.py, ImuParameters).
+  if (seg == nullptr) {
+    throw Error("Kalibr export: the session has no still segment, so the bias random walks "
+                "Kalibr needs (it refuses 0) cannot be measured; record the IMU still for a "
+                "minute or more");
+  }
+  imu.longest_still_s = static_cast<double>(seg->count()) * dt_s;
   std::array<bool, 3> accel_slope{}, gyro_slope{};
   imu.accel = Measure(series, signal::Sensor::kAccel, c.noise.acc, c.noise.tau_acc, dt_s, seg,
                       accel_slope);
@@ -190,7 +196,7 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
   for (const auto& s : still) segments.push_back(s.segment);
   std::optional<signal::StillNoise> ieee;
   try {
-    if (seg) ieee = signal::AnalyseStillNoise(series, segments);
+    ieee = signal::AnalyseStillNoise(series, segments);
   } catch (const InsufficientDataError& e) {
     AddNotice(imu.notes, "noise_terms_unresolved", std::string("no IEEE noise terms: ") + e.what());
   }
@@ -206,10 +212,7 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
     if (imu.has_gyro) AddNotice(imu.notes, "noise_terms_source", SourceNote("gyro", imu.gyro));
   }
   const bool resolved = imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved);
-  if (!seg) {
-    AddNotice(imu.notes, "no_still_segment", "no still segment: random walks unknown, written as 0");
-    imu.accel.walk = imu.gyro.walk = Vec3::Zero();
-  } else if (!resolved) {
+  if (!resolved) {
     AddNotice(imu.notes, "walk_upper_bound", "random walks not resolved by the IEEE fit are upper bounds (min over t "
                         "of ADEV(t) sqrt(3/t)): the longest still segment (" +
                         Number(imu.longest_still_s) + " s) is too short to show the +1/2 slope");
@@ -219,26 +222,39 @@ KalibrImu KalibrNoise(const estimation::Calibration& c, const ImuSeries& series,
 
 namespace {
 
+/// `v` as a YAML float that Kalibr's reader (PyYAML safe_load, YAML 1.1) reads as a number:
+/// 6 significant digits with a '.' always, "5.0e-05" rather than "5e-05" (YAML 1.1 reads a
+/// float without a '.' as a string, and Kalibr's check `value <= 0.0` then fails).
+std::string YamlFloat(double v) {
+  if (!std::isfinite(v)) throw Error("Kalibr export: a value is not finite (" + Number(v) + ")");
+  std::string text = FormattedText("%.6g", v == 0.0 ? 0.0 : v);
+  if (text.find('.') == std::string::npos) {
+    const std::size_t e = text.find('e');
+    text.insert(e == std::string::npos ? text.size() : e, ".0");
+  }
+  return text;
+}
+
 /// Kalibr's keys of one IMU, each line led by `indent`.
 std::string KalibrImuKeys(const KalibrImu& imu, const std::string& indent) {
   const bool bound = !(imu.accel.walk_resolved && (!imu.has_gyro || imu.gyro.walk_resolved));
   const std::string walk_comment = bound ? "  # upper bound from a short session" : "";
   std::string text = indent + "rostopic: " + imu.rostopic + "\n";
-  text += indent + "update_rate: " + Number(imu.update_rate_hz) + "  # Hz\n";
+  text += indent + "update_rate: " + YamlFloat(imu.update_rate_hz) + "  # Hz\n";
   // Where the written (largest) value came from.
   const auto origin = [](const Vec3& v, const std::array<bool, 3>& ieee) {
     Eigen::Index axis = 0;
     v.maxCoeff(&axis);
     return std::string(ieee[axis] ? ", N of the IEEE noise fit" : "");
   };
-  text += indent + "accelerometer_noise_density: " + Number(imu.accelerometer_noise_density()) +
+  text += indent + "accelerometer_noise_density: " + YamlFloat(imu.accelerometer_noise_density()) +
           "  # m/s^2/sqrt(Hz)" + origin(imu.accel.white, imu.accel.white_from_ieee) + "\n";
-  text += indent + "accelerometer_random_walk: " + Number(imu.accelerometer_random_walk()) +
+  text += indent + "accelerometer_random_walk: " + YamlFloat(imu.accelerometer_random_walk()) +
           "  # m/s^3/sqrt(Hz)" + walk_comment + "\n";
   if (imu.has_gyro) {
-    text += indent + "gyroscope_noise_density: " + Number(imu.gyroscope_noise_density()) +
+    text += indent + "gyroscope_noise_density: " + YamlFloat(imu.gyroscope_noise_density()) +
             "  # rad/s/sqrt(Hz)" + origin(imu.gyro.white, imu.gyro.white_from_ieee) + "\n";
-    text += indent + "gyroscope_random_walk: " + Number(imu.gyroscope_random_walk()) +
+    text += indent + "gyroscope_random_walk: " + YamlFloat(imu.gyroscope_random_walk()) +
             "  # rad/s^2/sqrt(Hz)" + walk_comment + "\n";
   }
   return text;
@@ -275,7 +291,7 @@ std::string KalibrImuSetYaml(const std::vector<KalibrBoardImu>& imus) {
               entry(C_i_b(r, 2)) + ", " + entry(t(r)) + "]\n";
     }
     text += "    - [0, 0, 0, 1]\n";
-    text += "  time_offset: " + Number(imu.time_offset_s) + "  # s\n";
+    text += "  time_offset: " + YamlFloat(imu.time_offset_s) + "  # s\n";
     text += KalibrImuKeys(imu.noise, "  ");
   }
   return text;

@@ -86,13 +86,14 @@ std::string RosTopicProblem(const std::string& topic);
 /// The noise of the session (file comment): the IEEE terms of the still segments `still`
 /// where resolved, otherwise the calibration's noise levels checked with the Allan deviation
 /// of the longest still segment that is not turning. Throws plumb::Error when `rostopic` is
-/// not a ROS topic name (RosTopicProblem), the outputs are not in SI or the series has fewer
-/// than two samples.
+/// not a ROS topic name (RosTopicProblem), the outputs are not in SI, the series has fewer
+/// than two samples or no still segment (Kalibr refuses a random walk of 0).
 KalibrImu KalibrNoise(const estimation::Calibration& calibration, const ImuSeries& series,
                       const std::vector<estimation::StillSegmentFit>& still,
                       const std::string& rostopic);
 
-/// Kalibr's imu.yaml text (comments say which values are upper bounds).
+/// Kalibr's imu.yaml text (comments say which values are upper bounds). Every number has a '.'
+/// ("5.0e-05"), as Kalibr's reader (PyYAML, YAML 1.1) needs to read it as a float.
 std::string KalibrYaml(const KalibrImu& imu);
 
 /// One IMU of a board for Kalibr's IMU set: its noise, and where it sits in the body (IMU 0's

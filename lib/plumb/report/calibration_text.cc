@@ -176,7 +176,9 @@ std::string PlaceText(const estimation::BoardImuCalibration& b, double scale) {
   const double cm = units::kCmPerM;
   return "lever arm x, y, z " + value(kLeverArm, cm) + ", " + value(kLeverArm + 1, cm) + ", " +
          value(kLeverArm + 2, cm) + " cm and time offset " + value(kTimeOffset, units::kMsPerS) +
-         " ms, from the turns; ";
+         " ms, from the turns (their comparison with IMU 0's: chi2 " +
+         FormattedText("%.4g", b.turn_chi2) + " on " + std::to_string(b.turn_residuals) +
+         " values); ";
 }
 
 /// The board's other IMUs (SPEC 6): each one's rotation into the body and its parameters.

@@ -404,6 +404,7 @@ json BoardImuJson(const estimation::BoardImuCalibration& b, double sigma_scale) 
   const Vec3 lever_sigma(sigma(kLeverArm), sigma(kLeverArm + 1), sigma(kLeverArm + 2));
   entry.update(MountJson(b.R_b_i(), rho_sigma, b.LeverArm(), lever_sigma, b.TimeOffset(),
                          sigma(model::board_mount::kTimeOffset)));
+  entry["turn_comparison"] = {{"chi2", Number(b.turn_chi2)}, {"residuals", b.turn_residuals}};
   return entry;
 }
 

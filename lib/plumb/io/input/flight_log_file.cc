@@ -229,6 +229,7 @@ BoardImu FlightLog::SelectBoardImu(const FlightLogSelection& imu0, int instance,
   out.name = info.name;
   out.series = std::move(s.series);
   out.firmware_left = std::move(s.firmware_left);
+  out.device_ids = s.device_ids;
   const std::string who = "IMU instance " + std::to_string(instance) + " (" + info.name + "): ";
   for (Notice& n : s.warnings) {
     const auto same = [&n](const Notice& m) { return SameNotice(n, m); };

@@ -279,6 +279,13 @@ std::optional<double> DeviceId(const ULog& log, const StreamSource& src, const s
                                std::string* how) {
   const std::string field = kind == "ACC" ? "accel_device_id" : "gyro_device_id";
   const ULogTopic* imu = src.kind == StreamKind::kVehicleImu ? src.topic : nullptr;
+  if (src.kind == StreamKind::kSensorAccel) {  // the driver's own topics name their device
+    const ULogTopic* raw = kind == "ACC" ? src.topic : src.gyro;
+    *how = (kind == "ACC" ? "sensor_accel" : "sensor_gyro") + std::string(" device_id");
+    const int c = raw == nullptr || raw->rows == 0 ? -1 : raw->ColumnIndex("device_id");
+    if (c < 0) return std::nullopt;
+    return raw->Value(0, static_cast<std::size_t>(c));
+  }
   if (src.kind == StreamKind::kCombined) {
     if (const auto prime = Param(log, "CAL_" + kind + "_PRIME"); prime && *prime != 0.0) {
       *how = "CAL_" + kind + "_PRIME";
@@ -583,6 +590,7 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection,
                                         whole.t_s.empty() ? 0.0 : whole.t_s.back()));
   }
   const std::string who = Who(*src);
+  const Px4Sensors sensors = SensorsOf(log, *src);
   if (src->kind == StreamKind::kSensorAccel) {
     s.warnings.push_back(Notice{
         "raw_sensor", who + "raw driver output (not calibrated by PX4), taken as logged", {}});
@@ -593,10 +601,11 @@ Session ULogSession(const ULog& log, const FlightLogSelection& selection,
                                 {}});
     s.firmware_left.push_back(who + "PX4 " + infos[chosen].applied);
   } else {
-    UndoPx4Correction(log.params, SensorsOf(log, *src), who, &s.series, &s.warnings,
+    UndoPx4Correction(log.params, sensors, who, &s.series, &s.warnings,
                       &s.firmware_left);
     WarnParamChanges(log, &s);
   }
+  s.device_ids = {sensors.acc_id, sensors.gyr_id};
   s.site = SiteFromULog(log);
   s.log_motion = ULogMotion(log, s.series.t_s.back());
   return s;

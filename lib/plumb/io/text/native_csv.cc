@@ -111,7 +111,7 @@ Session ReadNativeCsv(const std::string& path) {
   };
   for (int k = 1; names(ColumnName("acc", k, "_x")); ++k) {
     Session imu = ReadTextTable(path, BoardImuOptions(k));
-    session.other_imus.push_back(BoardImu{k, ColumnName("acc", k, "_x.."), std::move(imu.series), {}});
+    session.other_imus.push_back(BoardImu{k, ColumnName("acc", k, "_x.."), std::move(imu.series), {}, {}});
   }
   return session;
 }
