@@ -50,7 +50,8 @@ namespace plumb::exporter {
 
 struct ExportOptions {
   int imu = 0;                     ///< IMU instance for parameter names, 0-based (ArduPilot 0..2,
-                                   ///< PX4 0..3)
+                                   ///< PX4 0..3: the slot preferred where `device_ids` find
+                                   ///< none, Px4SlotsOf)
   std::string rostopic = "/imu0";  ///< Kalibr's rostopic
   /// Write firmware parameters even when the session does not determine the plumb parameters
   /// they come from (accelerometer diagonal and biases, gyroscope biases, temperature terms).
