@@ -232,13 +232,19 @@ TEST(Evaluate, DiagonalModelLeavesNoErrorThroughEitherFile) {
   }
 }
 
+/// Six faces between 20 and 45 degC with an accelerometer temperature bias: a session whose
+/// export writes thermal terms (TC_A*, INS_TCAL*).
+Session ThermalSession() {
+  const model::Model m = model::Model::Parse("base+accel_temperature_bias");
+  model::ParameterBlocks theta = m.ZeroParameters();
+  theta[2] = {2e-3, -1e-3, 5e-4};
+  return MakeSession("base+accel_temperature_bias", theta, SixFaces(), {20, 24, 29, 33, 38, 45});
+}
+
 TEST(VehicleState, TheFilesSayAndKeepWhatTheFirmwareWouldReplace) {
   // The boot-time gyro calibration (said, or turned off on request), the device ids the log
   // records (written, for the thermal terms too), the level left alone, the system id.
-  model::Model m = model::Model::Parse("base+accel_temperature_bias");
-  model::ParameterBlocks theta = m.ZeroParameters();
-  theta[2] = {2e-3, -1e-3, 5e-4};
-  const Session s = MakeSession("base+accel_temperature_bias", theta, SixFaces(), {20, 24, 29, 33, 38, 45});
+  const Session s = ThermalSession();
   ExportOptions options;
   options.log_params = {{"INS_GYR_CAL", 1}, {"SENS_IMU_AUTOCAL", 1}, {"CAL_ACC0_ID", 1245450},
                         {"CAL_GYRO0_ID", 2162688}};
@@ -316,10 +322,7 @@ TEST(Px4, EachSensorsSlotIsTheOneHoldingItsDeviceId) {
 TEST(Px4, TheFileWritesEachSensorInItsOwnSlotWithItsDeviceId) {
   // Instance 0's accelerometer calibrated in slot 1, its gyroscope in slot 0: the file writes
   // CAL_ACC1_* and CAL_GYRO0_*, each with the sensor's device id, and reads back the same.
-  model::Model m = model::Model::Parse("base+accel_temperature_bias");
-  model::ParameterBlocks theta = m.ZeroParameters();
-  theta[2] = {2e-3, -1e-3, 5e-4};
-  const Session s = MakeSession("base+accel_temperature_bias", theta, SixFaces(), {20, 24, 29, 33, 38, 45});
+  const Session s = ThermalSession();
   ExportOptions options;
   options.device_ids = {1245450.0, 2162688.0};
   options.log_params = {{"CAL_ACC0_ID", 1310986}, {"CAL_ACC1_ID", 1245450},

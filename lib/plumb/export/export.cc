@@ -146,14 +146,15 @@ void AddVehicleState(const std::string& format, const ExportOptions& options,
                         "as they are: plumb calibrates the sensor, not its mounting");
   } else {
     struct Sensor {
+      int slot;
       std::string cal, tc;  // the slots' stems: "CAL_ACC1", "TC_A1"
       std::optional<double> device_id;
     };
     const Sensor sensors[] = {
-        {"CAL_ACC" + std::to_string(slots.acc), "TC_A" + std::to_string(slots.tc_acc),
+        {slots.acc, "CAL_ACC" + std::to_string(slots.acc), "TC_A" + std::to_string(slots.tc_acc),
          options.device_ids.accel},
-        {"CAL_GYRO" + std::to_string(slots.gyro), "TC_G" + std::to_string(slots.tc_gyro),
-         options.device_ids.gyro}};
+        {slots.gyro, "CAL_GYRO" + std::to_string(slots.gyro),
+         "TC_G" + std::to_string(slots.tc_gyro), options.device_ids.gyro}};
     for (const Sensor& s : sensors) {
       // The sensor's own id where the log records it, else the one its slot holds.
       const auto id = s.device_id && *s.device_id != 0.0 ? s.device_id : logged(s.cal + "_ID");
@@ -168,7 +169,7 @@ void AddVehicleState(const std::string& format, const ExportOptions& options,
         return p.name.rfind(s.tc + "_", 0) == 0;
       });
       if (thermal) set.parameters.push_back({s.tc + "_ID", *id, true});
-      const std::string slot = s.cal.substr(s.cal.size() - 1);
+      const std::string slot = std::to_string(s.slot);
       const std::string where =
           !s.device_id ? ": the device id the log records for slot " + slot
           : logged(s.cal + "_ID") == id
