@@ -10,7 +10,14 @@
 // the reader, not the disk. Counters: MB/s of bag, imu_msgs (IMU messages decoded per read) and
 // msgs/s.
 // BM_ReadRosBag/<bag>_lz4 reads the same bag with each chunk recompressed as an LZ4 frame (as
-// `rosbag record --lz4` writes them).
+// `rosbag record --lz4` writes them). BM_ReadRosBag reads with no JobRunner (on the calling
+// thread alone, as `plumb --jobs 1`); BM_ReadRosBagAhead/<bag> the same file with a runner of
+// two threads (OnTwoThreads), as `plumb` reads it on a machine of two cores or more: the chunks
+// decompressed up to three ahead of their parse, on either thread. Their process_cpu_ms
+// counter is the CPU time of all the process's threads per read (getrusage), which the CPU
+// column (the benchmark's thread alone) leaves out; the Time column is wall time.
+// BM_ReadRealRosBag/<bag>_{alone,ahead} reads the real bag itself, a few chunks, with and
+// without the two-thread runner: where reading ahead pays.
 // BM_Bunzip2/<bag> and BM_Lz4/<bag>_lz4 decompress the same file's chunks with libbz2 alone
 // (BZ2_bzBuffToBuffDecompress) or liblz4 alone (LZ4F_decompress) into one buffer: the floor
 // under BM_ReadRosBag of a compressed bag.
@@ -18,6 +25,7 @@
 #include <benchmark/benchmark.h>
 #include <bzlib.h>
 #include <lz4frame.h>
+#include <sys/resource.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -29,9 +37,11 @@
 #include <string>
 #include <vector>
 
+#include "plumb/core/jobs.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/ros/rosbag.h"
 #include "plumb/io/ros/rosbag_format.h"
+#include "support/reverse_jobs.h"
 
 namespace {
 
@@ -170,21 +180,42 @@ void SetCounters(benchmark::State& state, std::size_t bytes, std::size_t message
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
 }
 
-void BM_ReadRosBag(benchmark::State& state, const std::string& relative, std::size_t target,
-                   bool lz4 = false) {
+/// The CPU time this process's threads have used, ms (user and system).
+double ProcessCpuMs() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto ms = [](const timeval& t) { return 1e3 * t.tv_sec + 1e-3 * t.tv_usec; };
+  return ms(usage.ru_utime) + ms(usage.ru_stime);
+}
+
+/// ReadRosBag of the repeated `relative` through `run_jobs` (empty: on this thread alone).
+void ReadRosBagWith(benchmark::State& state, const std::string& relative, std::size_t target,
+                    bool lz4, const plumb::JobRunner& run_jobs) {
   const RepeatedBag* bag = Repeated(relative, target, lz4);
   if (bag == nullptr) {
     state.SkipWithError(("shared data absent: " + relative).c_str());
     return;
   }
   std::size_t messages = 0;
+  const double cpu_before = ProcessCpuMs();
   for (auto _ : state) {
-    const plumb::io::RosBag read = plumb::io::ReadRosBag(bag->path());
+    const plumb::io::RosBag read = plumb::io::ReadRosBag(bag->path(), run_jobs);
     messages = 0;
     for (const plumb::io::RosImuTopic& t : read.imu_topics) messages += t.samples.size();
     benchmark::DoNotOptimize(messages);
   }
+  const double cpu_ms = ProcessCpuMs() - cpu_before;
   SetCounters(state, std::filesystem::file_size(bag->path()), messages);
+  state.counters["process_cpu_ms"] = cpu_ms / static_cast<double>(state.iterations());
+}
+
+void BM_ReadRosBag(benchmark::State& state, const std::string& relative, std::size_t target,
+                   bool lz4 = false) {
+  ReadRosBagWith(state, relative, target, lz4, {});
+}
+void BM_ReadRosBagAhead(benchmark::State& state, const std::string& relative,
+                        std::size_t target, bool lz4 = false) {
+  ReadRosBagWith(state, relative, target, lz4, plumb::testing::OnTwoThreads);
 }
 BENCHMARK_CAPTURE(BM_ReadRosBag, ardrone_imu_uncompressed,
                   std::string("ros/ardrone_imu_uncompressed.bag"), kTargetBytes)
@@ -200,6 +231,69 @@ BENCHMARK_CAPTURE(BM_ReadRosBag, phidgets_imu_upside_down_bz2,
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ReadRosBag, ardrone_imu_lz4, std::string("ros/ardrone_imu.bag"),
                   kTargetBytes, true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRosBagAhead, ardrone_imu_uncompressed,
+                  std::string("ros/ardrone_imu_uncompressed.bag"), kTargetBytes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRosBagAhead, ardrone_imu_bz2, std::string("ros/ardrone_imu.bag"),
+                  kTargetBz2Bytes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRosBagAhead, phidgets_imu_upside_down_bz2,
+                  std::string("ros/phidgets_imu_upside_down.bag"), kTargetBz2Bytes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRosBagAhead, ardrone_imu_lz4, std::string("ros/ardrone_imu.bag"),
+                  kTargetBytes, true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+/// The real bag `relative` itself (4 bz2, 10 bz2 or 3 uncompressed chunks), read through
+/// `run_jobs`, or on this thread alone: where reading ahead pays (detail::kRosChunksReadAhead).
+void BM_ReadRealRosBag(benchmark::State& state, const std::string& relative, bool ahead) {
+  const std::string path = std::string(PLUMB_SHARED_DATA_DIR) + "/" + relative;
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError(("shared data absent: " + relative).c_str());
+    return;
+  }
+  const plumb::JobRunner run_jobs =
+      ahead ? plumb::JobRunner(plumb::testing::OnTwoThreads) : plumb::JobRunner();
+  std::size_t messages = 0;
+  const double cpu_before = ProcessCpuMs();
+  for (auto _ : state) {
+    const plumb::io::RosBag read = plumb::io::ReadRosBag(path, run_jobs);
+    messages = 0;
+    for (const plumb::io::RosImuTopic& t : read.imu_topics) messages += t.samples.size();
+    benchmark::DoNotOptimize(messages);
+  }
+  const double cpu_ms = ProcessCpuMs() - cpu_before;
+  SetCounters(state, std::filesystem::file_size(path), messages);
+  state.counters["process_cpu_ms"] = cpu_ms / static_cast<double>(state.iterations());
+}
+BENCHMARK_CAPTURE(BM_ReadRealRosBag, ardrone_imu_bz2_alone, std::string("ros/ardrone_imu.bag"),
+                  false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRealRosBag, ardrone_imu_bz2_ahead, std::string("ros/ardrone_imu.bag"),
+                  true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRealRosBag, phidgets_bz2_alone,
+                  std::string("ros/phidgets_imu_upside_down.bag"), false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRealRosBag, phidgets_bz2_ahead,
+                  std::string("ros/phidgets_imu_upside_down.bag"), true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRealRosBag, ardrone_imu_uncompressed_alone,
+                  std::string("ros/ardrone_imu_uncompressed.bag"), false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ReadRealRosBag, ardrone_imu_uncompressed_ahead,
+                  std::string("ros/ardrone_imu_uncompressed.bag"), true)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -1,13 +1,19 @@
 // What the ROS bag readers' fuzz targets (rosbag, mcap, db3) do with the bag parsed from their
 // bytes: its warnings, counts and summary, and every IMU stream's session on both clocks
-// (header stamps and receive times), where a plumb::Error is an accepted answer.
+// (header stamps and receive times), where a plumb::Error is an accepted answer; and for the
+// readers that read chunks ahead (rosbag, mcap), the same bytes read ahead: the same bag or the
+// same error, else the target aborts.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "plumb/core/error.h"
+#include "plumb/core/jobs.h"
 #include "plumb/io/ros/ros_session.h"
 #include "plumb/io/ros/rosbag.h"
 
@@ -31,6 +37,49 @@ void ExerciseRosBag(const std::uint8_t* data, std::size_t size, Parse parse) {
       });
     }
   } catch (const Error&) {
+  }
+}
+
+/// What a reading gives, to compare two: its counts, warnings, topics and samples, or the
+/// error's words.
+inline std::string Reading(const std::function<io::RosBag()>& read) {
+  std::string out;
+  try {
+    const io::RosBag bag = read();
+    out = std::to_string(bag.chunks) + " " + std::to_string(bag.messages) + " " +
+          std::to_string(bag.chunk_infos) + "\n";
+    for (const std::string& line : bag.warnings.Describe()) out += line + "\n";
+    for (const auto& [name, count] : bag.MessageCounts()) out += name + std::to_string(count);
+    const auto bytes = [&out](const auto& v) {
+      out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(v[0]));
+    };
+    for (const io::RosImuTopic& t : bag.imu_topics) {
+      out += t.topic + " " + t.frame_id + " " + std::to_string(t.samples.size()) + "\n";
+      bytes(t.samples.t_s);
+      bytes(t.samples.acc);
+      bytes(t.samples.gyr);
+      bytes(t.receive_s);
+    }
+  } catch (const Error& e) {
+    out = std::string("error: ") + e.what();
+  }
+  return out;
+}
+
+/// [data, data + size) read in order (`in_order(data, size, name)`) and with every chunk read
+/// ahead through a runner that runs the jobs on this thread, the last first
+/// (`ahead(data, size, name, runner, 0)`, detail::ParseRosBagReadingAhead or
+/// detail::ParseMcapReadingAhead): aborts unless both give the same.
+template <typename InOrder, typename Ahead>
+void ExerciseReadAhead(const std::uint8_t* data, std::size_t size, InOrder in_order,
+                       Ahead ahead) {
+  const JobRunner backwards = [](int count, const std::function<void(int)>& job) {
+    for (int k = count - 1; k >= 0; --k) job(k);
+  };
+  const std::string name = "fuzz";
+  if (Reading([&] { return in_order(data, size, name); }) !=
+      Reading([&] { return ahead(data, size, name, backwards, 0); })) {
+    std::abort();
   }
 }
 

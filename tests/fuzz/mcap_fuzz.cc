@@ -8,8 +8,11 @@
 #include "plumb/io/ros/mcap.h"
 
 #include "exercise_ros_bag.h"
+#include "plumb/io/ros/read_ahead.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   plumb::fuzz::ExerciseRosBag(data, size, plumb::io::ParseMcap);
+  plumb::fuzz::ExerciseReadAhead(data, size, plumb::io::ParseMcap,
+                                 plumb::io::detail::ParseMcapReadingAhead);
   return 0;
 }

@@ -14,8 +14,11 @@
 #include "plumb/io/ros/rosbag.h"
 
 #include "exercise_ros_bag.h"
+#include "plumb/io/ros/read_ahead.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   plumb::fuzz::ExerciseRosBag(data, size, plumb::io::ParseRosBag);
+  plumb::fuzz::ExerciseReadAhead(data, size, plumb::io::ParseRosBag,
+                                 plumb::io::detail::ParseRosBagReadingAhead);
   return 0;
 }

@@ -1,8 +1,9 @@
 // The ROS 1 bags of ../shared/data/ros (real recordings) read by plumb (FlightLog, as `plumb
 // info` and every command read them) against Debian's python3-rosbag, an independent reader
 // (tests/io/rosbag_reference.py): message counts, the first and last messages' stamps, record
-// times and values; and the bz2 and uncompressed copies of the AR.Drone recording give the same
-// samples. Skipped with the reason when the data or python3-rosbag is absent.
+// times and values; the bz2 and uncompressed copies of the AR.Drone recording give the same
+// samples; and each bag read with its chunks ahead gives the same bag bit for bit. Skipped
+// with the reason when the data or python3-rosbag is absent.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -10,9 +11,11 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "io/ros_bag_text.h"
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/ros/ros_session.h"
 #include "plumb/io/ros/rosbag.h"
+#include "support/reverse_jobs.h"
 
 namespace plumb::io {
 namespace {
@@ -88,6 +91,21 @@ TEST(RosBagRealData, AgreesWithPythonRosbag) {
       EXPECT_EQ(count, r["messages"].at(topic).get<std::size_t>()) << name;
     }
     EXPECT_EQ(summary.imus.at(0).samples, r["imu"].begin().value()["count"].get<std::size_t>());
+  }
+}
+
+// The real bags' chunks (4 and 10 bz2, 3 uncompressed) read ahead through two threads, as
+// `plumb` reads them on a machine of two cores: the same bag as on the calling thread alone,
+// bit for bit.
+TEST(RosBagRealData, ReadAheadGivesTheSameBag) {
+  for (const char* name : {"ardrone_imu.bag", "ardrone_imu_uncompressed.bag",
+                           "phidgets_imu_upside_down.bag"}) {
+    const std::string b = Bag(name);
+    SKIP_IF_ABSENT(b);
+    const std::string alone = test::BagText([&] { return ReadRosBag(b); });
+    ASSERT_EQ(alone.rfind("InputError", 0), std::string::npos) << alone;
+    EXPECT_EQ(test::BagText([&] { return ReadRosBag(b, plumb::testing::OnTwoThreads); }), alone)
+        << name;
   }
 }
 

@@ -3,18 +3,23 @@
 // every byte, corrupt lengths, and the session's topic, clock and frame.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "io/io_test_util.h"
+#include "io/ros_bag_text.h"
 #include "io/rosbag_builder.h"
 #include "plumb/core/error.h"
 #include "plumb/io/input/flight_log_file.h"
 #include "plumb/io/input/open_inputs.h"
+#include "plumb/io/ros/read_ahead.h"
 #include "plumb/io/ros/ros_session.h"
 #include "plumb/io/ros/rosbag.h"
+#include "support/reverse_jobs.h"
 
 namespace plumb::io {
 namespace {
@@ -278,6 +283,139 @@ TEST(RosBag, CorruptLengthsAreCountedNeverFatal) {
     ASSERT_NO_THROW(b = Parse(RosBagStart() + chunk_record));
     EXPECT_EQ(b.warnings.damaged_chunks, 1u);
   }
+}
+
+// A message record's header is read at its places when it is the usual three fields (conn, op,
+// time) in any order, and walked otherwise: the same sample either way.
+TEST(RosBag, MessageHeadersInAnyFieldOrderReadAlike) {
+  using test::RosField;
+  const std::string conn = RosField("conn", test::Bytes(std::uint32_t{0}));
+  const std::string op = test::RosOpField(0x02);
+  const std::string time = RosField("time", test::RosTime(kSec + 1, 5000));
+  const std::string msg =
+      RosImuMessage(0, kSec, 7000, "/imu", {0.1, -0.2, 9.8}, {0.01, 0.0, -0.03});
+  const auto read = [&](const std::string& header) {
+    return test::BagText([&] {
+      return Parse(RosBagStart() +
+                   RosChunkRecord("none", RosConnectionRecord(0, "/imu") +
+                                              test::RosRecord(header, msg)));
+    });
+  };
+  const std::string usual = read(conn + op + time);
+  ASSERT_NE(usual.find("\n/imu /imu 0 1 "), std::string::npos) << usual;
+  EXPECT_EQ(read(op + conn + time), usual);
+  EXPECT_EQ(read(time + conn + op), usual);  // the AR.Drone bag's order
+  EXPECT_EQ(read(time + op + conn), usual);
+  EXPECT_EQ(read(conn + time + op), usual);
+  EXPECT_EQ(read(op + time + conn), usual);
+  EXPECT_EQ(read(conn + op + time + RosField("x", "1")), usual);  // walked: an extra field
+  // The usual size, another name: walked, the record has no time and is skipped.
+  const std::string tame = RosField("tame", test::RosTime(1, 2));
+  const RosBag other =
+      Parse(RosBagStart() + RosChunkRecord("none", RosConnectionRecord(0, "/imu") +
+                                                       test::RosRecord(conn + op + tame, msg)));
+  EXPECT_EQ(other.warnings.bad_records, 1u);
+  EXPECT_TRUE(other.imu_topics.empty() || other.imu_topics[0].samples.empty());
+}
+
+/// ReadRosBag's reading of `bytes` as text (test::BagText), the chunks read ahead through
+/// `run_jobs` when it is not empty and there are `min_chunks` at least.
+std::string Everything(const std::string& bytes, const JobRunner& run_jobs,
+                       std::size_t min_chunks) {
+  return test::BagText([&] {
+    return detail::ParseRosBagReadingAhead(reinterpret_cast<const std::uint8_t*>(bytes.data()),
+                                           bytes.size(), "t.bag", run_jobs, min_chunks);
+  });
+}
+
+/// Eight chunks of 10 IMU messages, with a top-level message among them, the IMU connection
+/// defined only after the chunks when `late_connection` (its messages kept aside until then),
+/// then the index.
+std::string EightChunks(const std::string& compression, bool late_connection) {
+  std::string bag = RosBagStart();
+  const std::size_t first_chunk = bag.size();
+  for (int k = 0; k < 8; ++k) {
+    bag += RosChunkRecord(compression,
+                          ImuRecords(0, "/imu/data_raw", 10, 10 * k, k == 0 && !late_connection));
+    if (k == 2) bag += ImuRecords(1, "/imu/other", 3);
+  }
+  bag += RosConnectionRecord(0, "/imu/data_raw");
+  bag += test::RosIndexRecords(0, first_chunk);
+  return bag;
+}
+
+// The chunks read ahead (through a runner of two threads, or one that runs the jobs last first)
+// or on the calling thread alone: the same bag, the same warnings, the same error, for whole,
+// cut, damaged and refused bags.
+TEST(RosBag, ReadingChunksAheadGivesTheSameBag) {
+  const auto same = [](const std::string& bytes, const std::string& what) {
+    const std::string alone = Everything(bytes, {}, 0);
+    EXPECT_EQ(Everything(bytes, plumb::testing::OnTwoThreads, 0), alone) << what;
+    EXPECT_EQ(Everything(bytes, test::Backwards, 0), alone) << what;
+    // Fewer chunks than the reader reads ahead from: read alone, no job run.
+    EXPECT_EQ(Everything(bytes, test::Backwards, 100), alone) << what;
+  };
+  for (const char* c : {"none", "bz2", "lz4"}) {
+    for (const bool late : {false, true}) {
+      const std::string whole = EightChunks(c, late);
+      const std::string name = std::string(c) + (late ? " late" : "");
+      ASSERT_EQ(Everything(whole, plumb::testing::OnTwoThreads, 0).rfind("8 83 1 0\n", 0), 0u)
+          << Everything(whole, plumb::testing::OnTwoThreads, 0);
+      // Every few bytes (bz2's chunks, slow to decompress, less often).
+      const std::size_t step = std::string(c) == "bz2" ? 97 : 13;
+      for (std::size_t cut = 0; cut <= whole.size(); cut += step) {
+        same(whole.substr(0, cut), name + " cut " + std::to_string(cut));
+      }
+      // A byte changed in turn: a damaged chunk, a record that does not parse, a message
+      // that no longer decodes.
+      for (std::size_t at = whole.size() / 16; at < whole.size(); at += whole.size() / 16) {
+        std::string damaged = whole;
+        damaged[at] = static_cast<char>(damaged[at] ^ 0x5a);
+        same(damaged, name + " byte " + std::to_string(at) + " changed");
+      }
+    }
+  }
+  // An unknown compression and a chunk stating more than 1 GiB among the others; a bag whose
+  // first record is not its header.
+  std::string bag = RosBagStart();
+  for (int k = 0; k < 6; ++k) {
+    bag += RosChunkRecord(k % 2 ? "lz4" : "bz2", ImuRecords(0, "/imu", 10, 10 * k, k == 0));
+  }
+  bag += RosChunkRecord("bogus", ImuRecords(0, "/imu", 10, 60, false));
+  std::string huge = RosChunkRecord("none", ImuRecords(0, "/imu", 10, 70, false));
+  const std::uint32_t over = 0xfffffff0u;
+  std::memcpy(&huge[huge.find("size=") + 5], &over, 4);
+  same(bag + huge + RosChunkRecord("lz4", ImuRecords(0, "/imu", 10, 80, false)), "bogus and huge");
+  same("#ROSBAG V2.0\n" + RosChunkRecord("none", ImuRecords(0, "/imu", 10)), "no bag header");
+}
+
+// A bag of 40 chunks read from disk through two threads (ReadRosBag reads them ahead from
+// detail::kRosChunksReadAhead) and on one: the same bag, whole, cut and with a chunk damaged.
+TEST(RosBag, ReadAheadFromDiskGivesTheSameBag) {
+  std::string bag = RosBagStart();
+  for (int k = 0; k < 40; ++k) {
+    bag += RosChunkRecord(k % 3 == 0 ? "bz2" : (k % 3 == 1 ? "lz4" : "none"),
+                          ImuRecords(0, "/imu/data_raw", 25, 25 * k, k == 0));
+  }
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("plumb_rosbag_test_read_ahead_" + std::to_string(::getpid()) + ".bag"))
+                               .string();
+  std::string damaged = bag;
+  damaged[bag.size() / 2] = static_cast<char>(damaged[bag.size() / 2] ^ 0x5a);
+  for (const std::string& bytes : {bag, bag.substr(0, bag.size() - 777), damaged}) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    const std::string alone = test::BagText([&] { return ReadRosBag(path); });
+    EXPECT_EQ(test::BagText([&] { return ReadRosBag(path, plumb::testing::OnTwoThreads); }), alone);
+    EXPECT_EQ(test::BagText([&] { return ReadRosBag(path, test::Backwards); }), alone);
+  }
+  const RosBag whole = [&] {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bag;
+    return ReadRosBag(path, plumb::testing::OnTwoThreads);
+  }();
+  EXPECT_EQ(whole.chunks, 40u);
+  ASSERT_EQ(whole.imu_topics.size(), 1u);
+  EXPECT_EQ(whole.imu_topics[0].samples.size(), 1000u);
+  std::filesystem::remove(path);
 }
 
 TEST(RosBag, RefusesWhatIsNotABag20) {

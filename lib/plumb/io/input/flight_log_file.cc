@@ -121,7 +121,7 @@ FlightLog FlightLog::Open(const std::string& path, const JobRunner& run_jobs) {
       out.log_ = ReadULog(path, Px4SessionTopics(), InParts(run_jobs));
       break;
     case FlightLogFormat::kRosBag:
-      out.log_ = ReadRosBag(path);
+      out.log_ = ReadRosBag(path, run_jobs);
       break;
     case FlightLogFormat::kRos2Mcap:
       out.log_ = ReadMcap(path, run_jobs);

@@ -3,12 +3,10 @@
 #include "plumb/io/ros/mcap.h"
 
 #include <algorithm>
-#include <condition_variable>
 #include <cstdio>
 #include <exception>
 #include <fstream>
 #include <memory>
-#include <mutex>
 #include <string_view>
 #include <unordered_map>
 #include <vector>
@@ -74,16 +72,7 @@ class Parser {
     std::uint32_t computed_crc = 0;  ///< of body; set when the check applies (Checked)
     std::exception_ptr error;        ///< thrown while opening: rethrown where the parse is
   };
-  /// The records of the file from `pos` up to and including the next chunk (or the Footer, a
-  /// record cut by the file's end, the end; or kStretchRecords records, none a chunk), the
-  /// chunk opened ahead of their parse.
-  struct Stretch {
-    std::vector<std::pair<Record, std::size_t>> records;  ///< each with its file offset
-    bool cut = false;                                     ///< the last runs past the file's end
-    bool has_chunk = false;                               ///< the last is a Chunk record
-    OpenedChunk chunk;
-    detail::ChunkBuffers buffers;  ///< the chunk's decompressed records, reused
-  };
+  using Stretch = detail::Stretch<Record, OpenedChunk>;
   /// Whether the CRC-32 of an opened chunk is checked: a whole chunk that states one.
   static bool Checked(const OpenedChunk& c, bool cut) {
     return !cut && c.body.whole && c.crc != 0;
@@ -93,17 +82,11 @@ class Parser {
                            OpenedChunk* out);
   /// The records from `pos` (the first after the Header) to the end, on this thread alone.
   void RunInOrder(std::size_t pos);
-  /// The same, the chunks opened up to kStretchesInFlight - 1 stretches ahead of the parse
-  /// through run_jobs_ (see the definition).
+  /// The same, the chunks opened up to detail::kStretchesInFlight - 1 stretches ahead of the
+  /// parse through run_jobs_ (detail::ReadAhead).
   void RunAhead(std::size_t pos);
-  /// Opens the chunk of stretch `s` (when it ends with one): OpenCatching.
-  static void OpenStretch(Stretch* s);
-  /// Parses the records of stretch `s` in order, as RunInOrder would.
-  void ParseStretch(const Stretch& s);
   /// Whether the records from `pos` hold at least `n` chunks (looked for up to the n-th).
   bool ChunksAtLeast(std::size_t pos, std::size_t n) const;
-  /// Frames the next stretch of records from `*pos` into `s` (false when there are none).
-  bool FrameStretch(std::size_t* pos, Stretch* s) const;
   /// The top-level record `r` at `at`, whole; `opened`: its chunk opened ahead, or nullptr.
   void Whole(const Record& r, std::size_t at, const OpenedChunk* opened);
   /// The top-level record at `at`, cut by the file's end: said, and the reading ends.
@@ -149,7 +132,7 @@ class Parser {
   /// false when it does not decode (counted as malformed, the first with where and why).
   bool Decode(RosImuTopic* t, const std::uint8_t* p, std::size_t n, std::size_t at,
               detail::RosImuMessage* m);
-  /// Room in `t` for its next sample (see the definition); returns the samples it has room
+  /// Room in `t` for its next sample (detail::ReserveImuAhead); returns the samples it has room
   /// for.
   std::size_t Room(RosImuTopic* t) const;
   void BadRecord(std::size_t at) {
@@ -189,12 +172,6 @@ class Parser {
   /// By index in imu_topics: the samples its four vectors have room for (Room's).
   std::vector<std::size_t> room_;
   detail::ChunkBuffers chunk_;  ///< a decompressed chunk and the decompressors, reused
-  /// Stretches in flight when reading ahead (framed and not yet parsed), each in its own
-  /// slot with its own ChunkBuffers: one parsed, three opened ahead at most.
-  static constexpr std::size_t kStretchesInFlight = 4;
-  /// Records a stretch holds at most: a long run of top-level records without a chunk is
-  /// framed a stretch at a time, not whole.
-  static constexpr std::size_t kStretchRecords = 1024;
 };
 
 bool Parser::Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r) {
@@ -249,94 +226,27 @@ void Parser::RunInOrder(std::size_t pos) {
   }
 }
 
-// Two jobs through run_jobs_, each taking, as long as there is one, the next task: parse the
-// next stretch in file order once its chunk is opened and no job is parsing; else frame the
-// next stretch (in order, in a free slot: at most kStretchesInFlight framed and not parsed) and
-// open its chunk; else wait for the other job's task in progress. A job waits only while the
-// other one is doing a task, so one job alone (a runner that runs them one after another)
-// reads the whole file in order, and the jobs never depend on each other being at once. The
-// parse touches only what RunInOrder's would (the bag, the counts, the page release), in the
-// same order; opening touches only its slot. What the parse throws stops both jobs and is
-// rethrown here: the first error in file order (an opening's is kept in its slot and rethrown
-// by the parse where RunInOrder would meet it).
+// The schedule is detail::ReadAhead's: stretches framed in order, opened on either job, parsed
+// in order. The parse touches only what RunInOrder's would (the bag, the counts, the page
+// release), in the same order; opening touches only its slot.
 void Parser::RunAhead(std::size_t pos) {
-  const auto slots = std::make_unique<Stretch[]>(kStretchesInFlight);
-  enum class SlotState : std::uint8_t { kFree, kOpening, kOpened };
-  SlotState state[kStretchesInFlight] = {};
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::size_t framed = 0;  // stretches framed; stretch i is in slot i % kStretchesInFlight
-  std::size_t parsed = 0;  // stretches parsed
-  bool more = true;        // stretches left to frame
-  bool parsing = false;
-  bool stop = false;
-  std::exception_ptr error;
-  const auto job = [&](int) {
-    std::unique_lock<std::mutex> lock(mutex);
-    while (!stop && (more || parsed < framed)) {
-      Stretch& next = slots[parsed % kStretchesInFlight];
-      if (!parsing && parsed < framed && state[parsed % kStretchesInFlight] == SlotState::kOpened) {
-        parsing = true;
-        lock.unlock();
-        std::exception_ptr thrown;
-        try {
-          ParseStretch(next);
-        } catch (...) {
-          thrown = std::current_exception();
-        }
-        lock.lock();
-        parsing = false;
-        state[parsed % kStretchesInFlight] = SlotState::kFree;
-        ++parsed;
-        if (thrown) {
-          error = thrown;
-          stop = true;
-        }
-        changed.notify_all();
-        continue;
-      }
-      if (more && framed < parsed + kStretchesInFlight) {
-        const std::size_t slot = framed % kStretchesInFlight;
-        try {
-          more = FrameStretch(&pos, &slots[slot]);
-        } catch (...) {  // memory running out
-          error = std::current_exception();
-          stop = true;
-          break;
-        }
-        if (!more) continue;
-        ++framed;
-        state[slot] = SlotState::kOpening;
-        lock.unlock();
-        OpenStretch(&slots[slot]);
-        lock.lock();
-        state[slot] = SlotState::kOpened;
-        changed.notify_all();
-        continue;
-      }
-      changed.wait(lock);  // the other job is parsing or opening: it notifies when done
-    }
-    changed.notify_all();
+  const auto frame = [this](std::size_t at, Record* r) { return Frame(data_, size_, at, r); };
+  const auto is_chunk = [](const Record& r, bool) {
+    return r.body != nullptr && r.op == kOpChunk;
   };
-  RunJobs(run_jobs_, 2, job);
-  if (error) std::rethrow_exception(error);
-}
-
-void Parser::OpenStretch(Stretch* s) {
-  if (s->has_chunk) OpenCatching(s->records.back().first, s->cut, &s->buffers, &s->chunk);
-}
-
-void Parser::ParseStretch(const Stretch& s) {
-  for (std::size_t i = 0; i < s.records.size(); ++i) {
-    const auto& [r, at] = s.records[i];
-    const bool last = i + 1 == s.records.size();
-    const OpenedChunk* opened = last && s.has_chunk ? &s.chunk : nullptr;
-    if (last && s.cut) {
-      CutAt(r, at, opened);
-    } else {
-      Whole(r, at, opened);
-    }
-  }
+  const auto footer = [](const Record& r) { return r.op == kOpFooter; };  // nothing read past it
+  const auto whole = [this](const Record& r, std::size_t at, const OpenedChunk* opened) {
+    Whole(r, at, opened);
+  };
+  const auto cut_at = [this](const Record& r, std::size_t at, const OpenedChunk* opened) {
+    CutAt(r, at, opened);
+  };
+  detail::ReadAhead<Stretch>(
+      run_jobs_, [&](Stretch& s) { return s.Frame(&pos, size_, frame, is_chunk, footer); },
+      [](Stretch& s) {
+        if (s.has_chunk) OpenCatching(s.records.back().first, s.cut, &s.buffers, &s.chunk);
+      },
+      [&](const Stretch& s) { s.Parse(whole, cut_at); });
 }
 
 bool Parser::ChunksAtLeast(std::size_t pos, std::size_t n) const {
@@ -347,28 +257,6 @@ bool Parser::ChunksAtLeast(std::size_t pos, std::size_t n) const {
     pos = r.end;
   }
   return chunks >= n;
-}
-
-// The stretches end where RunInOrder's loop would stop or a chunk is, so that they hold each
-// record once, in order, and nothing past where the reading ends.
-bool Parser::FrameStretch(std::size_t* pos, Stretch* s) const {
-  s->records.clear();
-  s->cut = false;
-  s->has_chunk = false;
-  Record r;
-  while (*pos < size_) {
-    const bool whole = Frame(data_, size_, *pos, &r);
-    s->records.emplace_back(r, *pos);
-    s->has_chunk = r.body != nullptr && r.op == kOpChunk;
-    if (!whole) {
-      s->cut = true;
-      *pos = size_;  // nothing more is read
-      break;
-    }
-    *pos = r.op == kOpFooter ? size_ : r.end;  // nothing is read past the Footer
-    if (r.op == kOpFooter || r.op == kOpChunk || s->records.size() >= kStretchRecords) break;
-  }
-  return !s->records.empty();
 }
 
 void Parser::Whole(const Record& r, std::size_t at, const OpenedChunk* opened) {
@@ -593,24 +481,8 @@ bool Parser::Decode(RosImuTopic* t, const std::uint8_t* p, std::size_t n, std::s
   return false;
 }
 
-/// Grows the topic's vectors, full, to the samples the file holds if the rest of it is like
-/// the part read (the topic's samples per byte of file so far, the record being read counted
-/// whole, an eighth more), at least 1.5 times their size (twice, and 1024 at least, before the
-/// projection means anything) and at most 16 times. A file of one IMU topic throughout is read
-/// with a few reallocations, each a copy of all the samples so far, instead of one at every
-/// doubling; a file whose first part misleads the projection costs at most the growth
-/// doubling would (the 16 times bound the room reserved ahead, its pages never touched).
 std::size_t Parser::Room(RosImuTopic* t) const {
-  const std::size_t n = t->samples.t_s.size();
-  std::size_t want = std::max<std::size_t>(2 * n, 1024);
-  if (n >= 1024 && read_to_ > 0 && read_to_ < size_) {
-    const double projected =
-        static_cast<double>(n) * (static_cast<double>(size_) / static_cast<double>(read_to_)) *
-        1.125;
-    want = std::max<std::size_t>(
-        n + n / 2, static_cast<std::size_t>(std::min(projected, 16.0 * static_cast<double>(n))));
-  }
-  return detail::ReserveImu(t, want);
+  return detail::ReserveImuAhead(t, read_to_, size_);
 }
 
 /// ParseMcap, releasing the pages of `file` (or nullptr) behind the parser.

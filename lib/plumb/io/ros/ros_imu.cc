@@ -114,6 +114,18 @@ void SetFrameId(RosImuTopic* t, std::string_view frame_id) {
   t->frame_id = std::string(frame_id.substr(0, 256));
 }
 
+std::size_t ReserveImuAhead(RosImuTopic* t, std::size_t read_to, std::size_t size) {
+  const std::size_t n = t->samples.t_s.size();
+  std::size_t want = std::max<std::size_t>(2 * n, 1024);
+  if (n >= 1024 && read_to > 0 && read_to < size) {
+    const double projected = static_cast<double>(n) *
+                             (static_cast<double>(size) / static_cast<double>(read_to)) * 1.125;
+    want = std::max<std::size_t>(
+        n + n / 2, static_cast<std::size_t>(std::min(projected, 16.0 * static_cast<double>(n))));
+  }
+  return ReserveImu(t, want);
+}
+
 std::size_t ReserveImu(RosImuTopic* t, std::size_t n) {
   t->samples.t_s.reserve(n);
   t->samples.acc.reserve(n);

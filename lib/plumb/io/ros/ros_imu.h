@@ -159,6 +159,16 @@ inline bool AppendCdrImuFast(RosImuTopic* t, const std::uint8_t* p, std::size_t 
 /// time. Returns the samples all four have room for (at least `n`).
 std::size_t ReserveImu(RosImuTopic* t, std::size_t n);
 
+/// Grows `t`'s vectors, full, to the samples the file holds if the rest of it is like the part
+/// read (the topic's samples per byte of file so far, `read_to` bytes of `size` read, the
+/// record being read counted whole, an eighth more), at least 1.5 times their size (twice, and
+/// 1024 at least, before the projection means anything: `read_to` 0 when it does not) and at
+/// most 16 times. A file of one IMU topic throughout is read with a few reallocations, each a
+/// copy of all the samples so far, instead of one at every doubling; a file whose first part
+/// misleads the projection costs at most the growth doubling would (the 16 times bound the
+/// room reserved ahead, its pages never touched). Returns the samples it has room for.
+std::size_t ReserveImuAhead(RosImuTopic* t, std::size_t read_to, std::size_t size);
+
 /// Splits a time in nanoseconds (MCAP's log_time, a .db3 timestamp) into seconds and
 /// nanoseconds (0 to 999999999) for AppendImu.
 inline void SplitNanoseconds(std::int64_t ns, std::int64_t* sec, std::uint32_t* nsec) {

@@ -3,12 +3,15 @@
 #include "plumb/io/ros/rosbag.h"
 
 #include <algorithm>
+#include <exception>
 #include <fstream>
 #include <unordered_map>
+#include <utility>
 
 #include "plumb/core/error.h"
 #include "plumb/io/common/log_common.h"
 #include "plumb/io/common/stream_spool.h"
+#include "plumb/io/ros/read_ahead.h"
 #include "plumb/io/ros/ros_imu.h"
 #include "plumb/io/ros/rosbag_format.h"
 
@@ -31,9 +34,16 @@ struct Pending {
 class Parser {
  public:
   /// `file`: the mapped file the bytes are, whose pages the parser releases behind it as it
-  /// goes (LogFile::Release), or nullptr.
-  Parser(const std::uint8_t* data, std::size_t size, RosBag* bag, const LogFile* file)
-      : data_(data), size_(size), bag_(bag), file_(file) {}
+  /// goes (LogFile::Release), or nullptr. `min_chunks`: the chunks the bag has at least when
+  /// they are read ahead through `run_jobs` (RunAhead); an empty `run_jobs`: never.
+  Parser(const std::uint8_t* data, std::size_t size, RosBag* bag, const LogFile* file,
+         std::size_t min_chunks, const JobRunner& run_jobs)
+      : data_(data),
+        size_(size),
+        bag_(bag),
+        file_(file),
+        min_chunks_(min_chunks),
+        run_jobs_(run_jobs) {}
 
   void Run();
 
@@ -55,9 +65,40 @@ class Parser {
   /// data run past n (`r->data_len` then holds what is there of the data, the header's fields
   /// parsed when the header is whole).
   static bool Frame(const std::uint8_t* base, std::size_t n, std::size_t pos, Record* r);
-
-  void TopRecord(const Record& r, std::size_t at);
+  /// A chunk made ready to parse: its records decompressed (into the ChunkBuffers given) when
+  /// its size is stated and within kRosMaxChunkBytes (else body is empty, and UseChunk says
+  /// why). Made by Open, which touches nothing else, so that it may run on another thread ahead
+  /// of the parse.
+  struct OpenedChunk {
+    detail::ChunkBody body;
+    std::exception_ptr error;  ///< thrown while opening: rethrown where the parse is
+  };
+  using Stretch = detail::Stretch<Record, OpenedChunk>;
+  /// Whether `r`, framed at top level, is a chunk record (its header parsed, op 0x05).
+  static bool IsChunk(const Record& r) {
+    return r.header != nullptr && r.header_ok && r.fields.has_op &&
+           r.fields.op == detail::kOpChunk;
+  }
+  /// Opens the chunk record `r` (cut: its data as far as the file goes) into `out`; an error
+  /// thrown is kept in `out` for the parse.
+  static void Open(const Record& r, bool cut, detail::ChunkBuffers* buffers, OpenedChunk* out);
+  /// The records from `pos` (the first after the bag header) to the end, on this thread alone.
+  void RunInOrder(std::size_t pos);
+  /// The same, the chunks opened up to detail::kStretchesInFlight - 1 stretches ahead of the
+  /// parse through run_jobs_ (detail::ReadAhead).
+  void RunAhead(std::size_t pos);
+  /// Whether the records from `pos` hold at least `n` chunks (looked for up to the n-th).
+  bool ChunksAtLeast(std::size_t pos, std::size_t n) const;
+  /// The top-level record `r` at `at`, whole; `opened`: its chunk opened ahead, or nullptr.
+  void Whole(const Record& r, std::size_t at, const OpenedChunk* opened);
+  /// The top-level record at `at`, cut by the file's end: said (a chunk's whole records
+  /// kept), and the reading ends.
+  void CutAt(const Record& r, std::size_t at, const OpenedChunk* opened);
+  void TopRecord(const Record& r, std::size_t at, const OpenedChunk* opened);
+  /// The chunk record `r` at `at`, opened here.
   void Chunk(const Record& r, std::size_t at, bool cut);
+  /// The chunk record `r` at `at`, opened (`c`): counted, its records read.
+  void UseChunk(const Record& r, const OpenedChunk& c, std::size_t at, bool cut);
   /// The records of a chunk's data [p, p + n); `at`: the chunk's file offset. Returns the
   /// message records read; `past_end` says what ran past the data's end ("" when none).
   std::size_t ChunkRecords(const std::uint8_t* p, std::size_t n, std::size_t at,
@@ -74,7 +115,14 @@ class Parser {
   std::size_t size_;
   RosBag* bag_;
   const LogFile* file_;
+  std::size_t min_chunks_;
+  const JobRunner& run_jobs_;
   std::size_t released_ = 0;  ///< the file is released up to here
+  std::size_t read_to_ = 0;   ///< the file offset past the top-level record being read
+  /// By index in imu_topics: the samples its four vectors have room for
+  /// (detail::ReserveImuAhead's).
+  std::vector<std::size_t> room_;
+  bool cut_ = false;          ///< a record ran past the file's end: the reading ended there
   /// A connection as a message finds it: its record, and its index in imu_topics (-1: not IMU).
   struct Slot {
     RosConnection* conn = nullptr;  ///< nullptr: not defined (yet)
@@ -136,38 +184,23 @@ void Parser::Run() {
                      "expected the bag header record (op 0x03) after \"#ROSBAG V2.0\"; the file "
                      "ends there");
   }
-  bool first = true;
   Record r;
-  while (pos < size_) {
-    const bool whole = Frame(data_, size_, pos, &r);
-    if (first) {
-      if (!whole || !r.header_ok || !r.fields.has_op || r.fields.op != detail::kOpBagHeader) {
-        throw InputError(bag_->source, "byte " + std::to_string(pos),
-                         "expected the bag header record (op 0x03) after \"#ROSBAG V2.0\"" +
-                             std::string(r.why.empty() ? "" : ": " + r.why));
-      }
-      first = false;
-    }
-    if (!whole) {
-      bag_->warnings.cut_at = pos;
-      // A chunk whose header is whole: its data as far as the file goes.
-      if (r.header != nullptr && r.header_ok && r.fields.has_op &&
-          r.fields.op == detail::kOpChunk && r.data != nullptr) {
-        Chunk(r, pos, true);
-      }
-      bag_->warnings.messages_read = bag_->messages;
-      break;
-    }
-    TopRecord(r, pos);
-    pos = r.end;
-    if (file_ != nullptr && pos >= released_ + LogFile::kReleaseStep) {
-      file_->Release(released_, pos);
-      released_ = pos;
-    }
+  const bool whole = Frame(data_, size_, pos, &r);
+  if (!whole || !r.header_ok || !r.fields.has_op || r.fields.op != detail::kOpBagHeader) {
+    throw InputError(bag_->source, "byte " + std::to_string(pos),
+                     "expected the bag header record (op 0x03) after \"#ROSBAG V2.0\"" +
+                         std::string(r.why.empty() ? "" : ": " + r.why));
+  }
+  Whole(r, pos, nullptr);
+  pos = r.end;
+  if (run_jobs_ && ChunksAtLeast(pos, min_chunks_)) {
+    RunAhead(pos);
+  } else {
+    RunInOrder(pos);
   }
   // Every record whole, but the bag header puts the index at the end or past it: cut at a
   // record boundary.
-  if (!bag_->warnings.cut_at && bag_->index_pos != 0 && bag_->index_pos >= size_) {
+  if (!cut_ && bag_->index_pos != 0 && bag_->index_pos >= size_) {
     bag_->warnings.cut_at = size_;
     bag_->warnings.index_past_end = bag_->index_pos;
     bag_->warnings.messages_read = bag_->messages;
@@ -175,7 +208,79 @@ void Parser::Run() {
   Finish();
 }
 
-void Parser::TopRecord(const Record& r, std::size_t at) {
+void Parser::RunInOrder(std::size_t pos) {
+  Record r;
+  while (pos < size_) {
+    if (!Frame(data_, size_, pos, &r)) {
+      CutAt(r, pos, nullptr);
+      return;
+    }
+    Whole(r, pos, nullptr);
+    pos = r.end;
+  }
+}
+
+// The schedule is detail::ReadAhead's: stretches framed in order, opened on either job, parsed
+// in order. The parse touches only what RunInOrder's would (the bag, the connections, the
+// pending messages, the page release), in the same order; opening touches only its slot.
+void Parser::RunAhead(std::size_t pos) {
+  const auto frame = [this](std::size_t at, Record* r) { return Frame(data_, size_, at, r); };
+  // A cut record is read only when it is a chunk whose data begins in the file (CutAt).
+  const auto is_chunk = [](const Record& r, bool whole) {
+    return IsChunk(r) && (whole || r.data != nullptr);
+  };
+  const auto whole = [this](const Record& r, std::size_t at, const OpenedChunk* opened) {
+    Whole(r, at, opened);
+  };
+  const auto cut_at = [this](const Record& r, std::size_t at, const OpenedChunk* opened) {
+    CutAt(r, at, opened);
+  };
+  detail::ReadAhead<Stretch>(
+      run_jobs_,
+      [&](Stretch& s) {
+        return s.Frame(&pos, size_, frame, is_chunk, [](const Record&) { return false; });
+      },
+      [](Stretch& s) {
+        if (s.has_chunk) Open(s.records.back().first, s.cut, &s.buffers, &s.chunk);
+      },
+      [&](const Stretch& s) { s.Parse(whole, cut_at); });
+}
+
+bool Parser::ChunksAtLeast(std::size_t pos, std::size_t n) const {
+  std::size_t chunks = 0;
+  Record r;
+  while (chunks < n && pos < size_ && Frame(data_, size_, pos, &r)) {
+    if (IsChunk(r)) ++chunks;
+    pos = r.end;
+  }
+  return chunks >= n;
+}
+
+void Parser::Whole(const Record& r, std::size_t at, const OpenedChunk* opened) {
+  read_to_ = r.end;
+  TopRecord(r, at, opened);
+  if (file_ != nullptr && r.end >= released_ + LogFile::kReleaseStep) {
+    file_->Release(released_, r.end);
+    released_ = r.end;
+  }
+}
+
+void Parser::CutAt(const Record& r, std::size_t at, const OpenedChunk* opened) {
+  bag_->warnings.cut_at = at;
+  read_to_ = size_;
+  // A chunk whose header is whole: its data as far as the file goes.
+  if (IsChunk(r) && r.data != nullptr) {
+    if (opened != nullptr) {
+      UseChunk(r, *opened, at, true);
+    } else {
+      Chunk(r, at, true);
+    }
+  }
+  bag_->warnings.messages_read = bag_->messages;
+  cut_ = true;
+}
+
+void Parser::TopRecord(const Record& r, std::size_t at, const OpenedChunk* opened) {
   RosBagWarnings& w = bag_->warnings;
   if (!r.header_ok || !r.fields.has_op) {
     if (w.bad_records++ == 0) w.first_bad_record = at;
@@ -183,7 +288,13 @@ void Parser::TopRecord(const Record& r, std::size_t at) {
   }
   switch (r.fields.op) {
     case detail::kOpBagHeader: bag_->index_pos = r.fields.index_pos; break;
-    case detail::kOpChunk: Chunk(r, at, false); break;
+    case detail::kOpChunk:
+      if (opened != nullptr) {
+        UseChunk(r, *opened, at, false);
+      } else {
+        Chunk(r, at, false);
+      }
+      break;
     case detail::kOpConnection: Connection(r, at); break;
     case detail::kOpMessageData: Message(r, at); break;
     case detail::kOpChunkInfo: ++bag_->chunk_infos; break;
@@ -192,10 +303,29 @@ void Parser::TopRecord(const Record& r, std::size_t at) {
   }
 }
 
+void Parser::Open(const Record& r, bool cut, detail::ChunkBuffers* buffers, OpenedChunk* out) {
+  out->body = detail::ChunkBody{};
+  out->error = nullptr;
+  if (!r.fields.has_size || r.fields.size > detail::kRosMaxChunkBytes) return;
+  try {
+    out->body = detail::OpenChunk(r.fields.compression.substr(0, 32), r.data, r.data_len,
+                                  r.fields.size, cut, buffers);
+  } catch (...) {  // memory running out
+    out->error = std::current_exception();
+  }
+}
+
 void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
+  OpenedChunk c;
+  Open(r, cut, &chunk_, &c);
+  UseChunk(r, c, at, cut);
+}
+
+void Parser::UseChunk(const Record& r, const OpenedChunk& c, std::size_t at, bool cut) {
   ++bag_->chunks;
   const std::string compression(r.fields.compression.substr(0, 32));
   ++bag_->compression[compression.empty() ? "none" : compression];
+  if (c.error) std::rethrow_exception(c.error);
   if (!r.fields.has_size) {
     Damaged(at, "chunk without its 'size' field");
     return;
@@ -205,8 +335,7 @@ void Parser::Chunk(const Record& r, std::size_t at, bool cut) {
                     " bytes uncompressed, more than plumb reads (1 GiB)");
     return;
   }
-  const detail::ChunkBody body =
-      detail::OpenChunk(compression, r.data, r.data_len, r.fields.size, cut, &chunk_);
+  const detail::ChunkBody& body = c.body;
   std::string past_end;
   const std::size_t kept = ChunkRecords(body.data, body.size, at, &past_end);
   if (cut) {
@@ -294,7 +423,10 @@ void Parser::Message(const Record& r, std::size_t at) {
 
 void Parser::Decode(int topic, std::uint32_t sec, std::uint32_t nsec, const std::uint8_t* p,
                     std::size_t n, std::size_t at) {
-  RosImuTopic& t = bag_->imu_topics[static_cast<std::size_t>(topic)];
+  const auto k = static_cast<std::size_t>(topic);
+  RosImuTopic& t = bag_->imu_topics[k];
+  if (k >= room_.size()) room_.resize(bag_->imu_topics.size());  // a new topic's: 0
+  if (t.samples.t_s.size() >= room_[k]) room_[k] = detail::ReserveImuAhead(&t, read_to_, size_);
   detail::RosImuMessage m;
   if (!detail::DecodeRosImu(p, n, &m)) {
     ++t.malformed;
@@ -410,9 +542,11 @@ std::vector<std::pair<std::string, std::size_t>> RosBag::MessageCounts() const {
 
 namespace {
 
-/// ParseRosBag, releasing the pages of `file` (or nullptr) behind the parser.
+/// ParseRosBag, releasing the pages of `file` (or nullptr) behind the parser, the chunks read
+/// ahead through `run_jobs` from `min_chunks` of them.
 RosBag ParseRosBagFrom(const std::uint8_t* data, std::size_t size, const std::string& source,
-                       const LogFile* file) {
+                       const LogFile* file, const JobRunner& run_jobs = {},
+                       std::size_t min_chunks = detail::kRosChunksReadAhead) {
   RosBag bag;
   bag.source = source;
   bag.size_bytes = size;
@@ -429,7 +563,7 @@ RosBag ParseRosBagFrom(const std::uint8_t* data, std::size_t size, const std::st
                      "ROS bag of another version (\"" + std::string(text, line) +
                          "\"); plumb reads ROS 1 bags of version 2.0");
   }
-  Parser(data, size, &bag, file).Run();
+  Parser(data, size, &bag, file, min_chunks, run_jobs).Run();
   return bag;
 }
 
@@ -439,10 +573,16 @@ RosBag ParseRosBag(const std::uint8_t* data, std::size_t size, const std::string
   return ParseRosBagFrom(data, size, source, nullptr);
 }
 
-RosBag ReadRosBag(const std::string& path) {
+RosBag detail::ParseRosBagReadingAhead(const std::uint8_t* data, std::size_t size,
+                                       const std::string& source, const JobRunner& run_jobs,
+                                       std::size_t min_chunks) {
+  return ParseRosBagFrom(data, size, source, nullptr, run_jobs, min_chunks);
+}
+
+RosBag ReadRosBag(const std::string& path, const JobRunner& run_jobs) {
   const LogFile file(path, "ROS bag");
   try {
-    RosBag bag = ParseRosBagFrom(file.data(), file.size(), path, &file);
+    RosBag bag = ParseRosBagFrom(file.data(), file.size(), path, &file, run_jobs);
     file.ThrowIfCut();
     return bag;
   } catch (const Error&) {

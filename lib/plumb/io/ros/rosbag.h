@@ -60,6 +60,7 @@
 #include <vector>
 
 #include "plumb/core/imu_series.h"
+#include "plumb/core/jobs.h"
 
 namespace plumb::io {
 
@@ -157,8 +158,10 @@ struct RosBag {
 };
 
 /// Reads and decodes a .bag file (see the file comment). Throws plumb::InputError(path,
-/// "byte N", what) when the file cannot be read or is not a ROS 1 bag 2.0.
-RosBag ReadRosBag(const std::string& path);
+/// "byte N", what) when the file cannot be read or is not a ROS 1 bag 2.0. `run_jobs`: a bag's
+/// chunks are decompressed ahead of their parse through it (the same bag either way); empty:
+/// on the calling thread alone.
+RosBag ReadRosBag(const std::string& path, const JobRunner& run_jobs = {});
 
 /// Decodes a bag held in memory; `source` names it in errors. Same contract as ReadRosBag.
 RosBag ParseRosBag(const std::uint8_t* data, std::size_t size, const std::string& source);

@@ -59,10 +59,42 @@ bool Load(std::string_view value, T* out) {
   return true;
 }
 
+/// Reads a message data record's usual header: its three fields "conn" (4 bytes), "op" (1) and
+/// "time" (8), each once, in any order (rosbag writes them in its std::map's order, older
+/// recorders in others), 38 bytes in all. Then `out` holds what ForEachField would find; false
+/// for any other header (`out` then partly written), which the general walk reads.
+bool UsualMessageFields(const std::uint8_t* p, std::size_t n, RosRecordFields* out) {
+  constexpr std::size_t kBytes = (4 + 9) + (4 + 4) + (4 + 13);
+  if (n != kBytes) return false;
+  std::size_t pos = 0;
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t len = LoadLittleEndian<std::uint32_t>(p + pos);
+    const std::uint8_t* f = p + pos + 4;
+    if (len == 9 && !out->has_conn && std::memcmp(f, "conn=", 5) == 0) {
+      out->conn = LoadLittleEndian<std::uint32_t>(f + 5);
+      out->has_conn = true;
+    } else if (len == 4 && !out->has_op && std::memcmp(f, "op=", 3) == 0) {
+      out->op = f[3];
+      out->has_op = true;
+    } else if (len == 13 && !out->has_time && std::memcmp(f, "time=", 5) == 0) {
+      const auto t = LoadLittleEndian<std::uint64_t>(f + 5);
+      out->sec = static_cast<std::uint32_t>(t & 0xffffffffu);
+      out->nsec = static_cast<std::uint32_t>(t >> 32);
+      out->has_time = true;
+    } else {
+      return false;
+    }
+    pos += 4 + len;
+  }
+  return true;  // each of the three once: 38 bytes exactly
+}
+
 }  // namespace
 
 bool ParseRecordFields(const std::uint8_t* p, std::size_t n, RosRecordFields* out,
                        std::string* why) {
+  *out = RosRecordFields{};
+  if (UsualMessageFields(p, n, out)) return true;  // most records of a bag are messages
   *out = RosRecordFields{};
   return ForEachField(p, n, why, [out](std::string_view name, std::string_view value) {
     if (name == "op") return out->has_op = Load(value, &out->op);
@@ -355,24 +387,6 @@ bool DecompressChunk(std::string_view compression, const std::uint8_t* in, std::
   if (compression == "zstd") return Zstd(in, n, declared, cut, buffers, out_size, why);
   *why = "unknown compression '" + std::string(compression.substr(0, 32)) + "'";
   return false;
-}
-
-bool DecodeRosImu(const std::uint8_t* p, std::size_t n, RosImuMessage* out) {
-  if (n < 16) return false;
-  out->sec = LoadLittleEndian<std::uint32_t>(p + 4);
-  out->nsec = LoadLittleEndian<std::uint32_t>(p + 8);
-  const std::uint32_t len = LoadLittleEndian<std::uint32_t>(p + 12);
-  if (len > n - 16 || n - 16 - len != kRosImuFixedBytes) return false;
-  out->frame_id = std::string_view(reinterpret_cast<const char*>(p + 16), len);
-  const std::uint8_t* d = p + 16 + len;
-  const auto f = [d](int i) { return LoadLittleEndian<double>(d + 8 * i); };
-  for (int i = 0; i < 4; ++i) out->orientation[i] = f(i);
-  out->orientation_cov0 = f(4);
-  out->gyr = Vec3(f(13), f(14), f(15));
-  out->gyr_cov0 = f(16);
-  out->acc = Vec3(f(25), f(26), f(27));
-  out->acc_cov0 = f(28);
-  return true;
 }
 
 }  // namespace plumb::io::detail

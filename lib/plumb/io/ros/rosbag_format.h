@@ -118,7 +118,23 @@ std::uint32_t Crc32(const std::uint8_t* p, std::size_t n);
 inline constexpr std::size_t kRosImuFixedBytes = 37 * 8;
 
 /// Decodes a sensor_msgs/Imu message [p, p + n). False when its size is not 16 + frame_id
-/// length + kRosImuFixedBytes.
-bool DecodeRosImu(const std::uint8_t* p, std::size_t n, RosImuMessage* out);
+/// length + kRosImuFixedBytes. Inline: the reader calls it once per message.
+inline bool DecodeRosImu(const std::uint8_t* p, std::size_t n, RosImuMessage* out) {
+  if (n < 16) return false;
+  out->sec = LoadLittleEndian<std::uint32_t>(p + 4);
+  out->nsec = LoadLittleEndian<std::uint32_t>(p + 8);
+  const std::uint32_t len = LoadLittleEndian<std::uint32_t>(p + 12);
+  if (len > n - 16 || n - 16 - len != kRosImuFixedBytes) return false;
+  out->frame_id = std::string_view(reinterpret_cast<const char*>(p + 16), len);
+  const std::uint8_t* d = p + 16 + len;
+  const auto f = [d](int i) { return LoadLittleEndian<double>(d + 8 * i); };
+  for (int i = 0; i < 4; ++i) out->orientation[i] = f(i);
+  out->orientation_cov0 = f(4);
+  out->gyr = Vec3(f(13), f(14), f(15));
+  out->gyr_cov0 = f(16);
+  out->acc = Vec3(f(25), f(26), f(27));
+  out->acc_cov0 = f(28);
+  return true;
+}
 
 }  // namespace plumb::io::detail
