@@ -10,13 +10,13 @@
 #include <cstdlib>
 #include <functional>
 #include <string>
-#include <vector>
 
 #include "plumb/core/error.h"
 #include "plumb/core/jobs.h"
 #include "plumb/io/ros/ros_session.h"
 #include "plumb/io/ros/rosbag.h"
 
+#include "../io/ros_bag_text.h"
 #include "select_every_stream.h"
 
 namespace plumb::fuzz {
@@ -40,32 +40,6 @@ void ExerciseRosBag(const std::uint8_t* data, std::size_t size, Parse parse) {
   }
 }
 
-/// What a reading gives, to compare two: its counts, warnings, topics and samples, or the
-/// error's words.
-inline std::string Reading(const std::function<io::RosBag()>& read) {
-  std::string out;
-  try {
-    const io::RosBag bag = read();
-    out = std::to_string(bag.chunks) + " " + std::to_string(bag.messages) + " " +
-          std::to_string(bag.chunk_infos) + "\n";
-    for (const std::string& line : bag.warnings.Describe()) out += line + "\n";
-    for (const auto& [name, count] : bag.MessageCounts()) out += name + std::to_string(count);
-    const auto bytes = [&out](const auto& v) {
-      out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(v[0]));
-    };
-    for (const io::RosImuTopic& t : bag.imu_topics) {
-      out += t.topic + " " + t.frame_id + " " + std::to_string(t.samples.size()) + "\n";
-      bytes(t.samples.t_s);
-      bytes(t.samples.acc);
-      bytes(t.samples.gyr);
-      bytes(t.receive_s);
-    }
-  } catch (const Error& e) {
-    out = std::string("error: ") + e.what();
-  }
-  return out;
-}
-
 /// [data, data + size) read in order (`in_order(data, size, name)`) and with every chunk read
 /// ahead through a runner that runs the jobs on this thread, the last first
 /// (`ahead(data, size, name, runner, 0)`, detail::ParseRosBagReadingAhead or
@@ -77,8 +51,8 @@ void ExerciseReadAhead(const std::uint8_t* data, std::size_t size, InOrder in_or
     for (int k = count - 1; k >= 0; --k) job(k);
   };
   const std::string name = "fuzz";
-  if (Reading([&] { return in_order(data, size, name); }) !=
-      Reading([&] { return ahead(data, size, name, backwards, 0); })) {
+  if (test::BagText([&] { return in_order(data, size, name); }) !=
+      test::BagText([&] { return ahead(data, size, name, backwards, 0); })) {
     std::abort();
   }
 }

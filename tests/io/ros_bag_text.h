@@ -1,6 +1,6 @@
-// All a ROS bag reader gives, as text (tests/io): its counts, connections, warnings and the
-// samples' bits, or the error it throws, so that two readings of a file compare whole
-// (the chunks read ahead or not).
+// All a ROS bag reader gives, as text (tests/io, and the rosbag and mcap fuzz targets): its
+// counts, connections, warnings and the samples' bits, or the error it throws, so that two
+// readings of a file compare whole (the chunks read ahead or not).
 #pragma once
 
 #include <functional>
@@ -20,8 +20,8 @@ void AppendBytes(std::ostringstream& out, const std::vector<T>& v) {
             static_cast<std::streamsize>(v.size() * sizeof(T)));
 }
 
-/// What `read()` gives (an io::RosBag) as text, or the InputError it throws (its file, place and
-/// words).
+/// What `read()` gives (an io::RosBag) as text, or the plumb::Error it throws (an InputError's
+/// file, place and words).
 inline std::string BagText(const std::function<io::RosBag()>& read) {
   std::ostringstream out;
   try {
@@ -51,6 +51,8 @@ inline std::string BagText(const std::function<io::RosBag()>& read) {
     }
   } catch (const InputError& e) {
     out << "InputError " << e.file() << ' ' << e.where() << ' ' << e.what();
+  } catch (const Error& e) {
+    out << "Error " << e.what();
   }
   return out.str();
 }
