@@ -4,6 +4,7 @@
 // predicts the change of the residual (which is linear in both).
 #include "plumb/residuals/board_force_residual.h"
 
+#include <ceres/dynamic_numeric_diff_cost_function.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -128,6 +129,78 @@ TEST(BoardForceResidual, ItsJacobianPredictsTheMountsChange) {
     worst = std::max(worst, std::abs(predicted - r1[row]));
   }
   EXPECT_LT(worst, 3e-6) << "the change itself is up to " << MaxAbs(r1);
+}
+
+/// Every block's columns, from the cost function BoardForceResidual::Create gives and from
+/// ceres::DynamicNumericDiffCostFunction over the same functor, at a mount and models away from
+/// zero, with `wander` accelerometer processes per IMU.
+void ExpectSameColumnsAsCeres(const model::Model& model, int wander) {
+  const Board board;
+  std::vector<BoardWindow> turn = board.Windows();
+  for (std::size_t w = 0; w < turn.size(); ++w) {  // along the wander's line
+    turn[w].imu0.line = turn[w].imu.line = (w + 0.5) / static_cast<double>(turn.size());
+  }
+  auto windows = std::make_shared<const std::vector<BoardWindow>>(std::move(turn));
+  std::unique_ptr<ceres::CostFunction> cost(
+      BoardForceResidual::Create(model, model, windows, wander, wander));
+  ceres::DynamicNumericDiffCostFunction<BoardForceResidual, ceres::CENTRAL> ceres_central(
+      new BoardForceResidual(model, model, windows, wander, wander));
+  // Values: every parameter of IMU i's and IMU 0's models moved off its start by a small
+  // amount of its own, each wander block a few milli-units.
+  std::vector<std::vector<double>> values;
+  values.push_back({board.rho.x(), board.rho.y(), board.rho.z(), board.r.x(), board.r.y(),
+                    board.r.z(), board.dt});
+  double offset = 1e-4;
+  for (int imu = 0; imu < 2; ++imu) {
+    for (auto block : model.ZeroParameters()) {
+      for (double& x : block) x += (offset += 3.7e-5);
+      values.push_back(block);
+    }
+  }
+  for (int p = 0; p < 4 * wander; ++p) values.push_back({2e-3 * p, -1e-3, 5e-4 * p});
+  for (const auto& v : values) ceres_central.AddParameterBlock(static_cast<int>(v.size()));
+  ceres_central.SetNumResiduals(cost->num_residuals());
+  ASSERT_EQ(cost->parameter_block_sizes(), ceres_central.parameter_block_sizes());
+  std::vector<const double*> blocks;
+  for (const auto& v : values) blocks.push_back(v.data());
+  const auto rows = static_cast<std::size_t>(cost->num_residuals());
+  std::vector<std::vector<double>> ours(values.size()), theirs(values.size());
+  std::vector<double*> ours_at, theirs_at;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    ours[i].assign(rows * values[i].size(), 0.0);
+    theirs[i].assign(rows * values[i].size(), 0.0);
+    ours_at.push_back(ours[i].data());
+    theirs_at.push_back(theirs[i].data());
+  }
+  std::vector<double> r_ours(rows), r_theirs(rows);
+  ASSERT_TRUE(cost->Evaluate(blocks.data(), r_ours.data(), ours_at.data()));
+  ASSERT_TRUE(ceres_central.Evaluate(blocks.data(), r_theirs.data(), theirs_at.data()));
+  EXPECT_EQ(r_ours, r_theirs);
+  // IMU i's gyroscope columns are zero where both models act as their linear stage (and so in
+  // Ceres's columns, to within its differences' rounding).
+  const bool linear = model.AtLinearStage(blocks.data() + 1) &&
+                      model.AtLinearStage(blocks.data() + 1 + model.num_terms());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const bool gyro_of_imu_i =
+        i >= 1 && i < 1 + static_cast<std::size_t>(model.num_terms()) &&
+        model.terms()[i - 1].effect->info().sensor == model::Sensor::kGyro;
+    if (linear && gyro_of_imu_i) {
+      EXPECT_LT(MaxAbs(theirs[i]), 1e-6) << "block " << i;
+      EXPECT_EQ(MaxAbs(ours[i]), 0.0) << "block " << i;
+      continue;
+    }
+    EXPECT_EQ(ours[i], theirs[i]) << "block " << i;
+    EXPECT_GT(MaxAbs(ours[i]), 0.0) << "block " << i;
+  }
+}
+
+// The staged differences recompute only what a block enters, and give Ceres's columns bit for
+// bit: both models at their linear stage, with wander processes, and with models that read the
+// angular acceleration (the size effect) and are not linear (the g-sensitivity).
+TEST(BoardForceResidual, ItsColumnsAreCeresCentralDifferences) {
+  ExpectSameColumnsAsCeres(model::Model::Parse("base"), 0);
+  ExpectSameColumnsAsCeres(model::Model::Parse("base"), 2);
+  ExpectSameColumnsAsCeres(model::Model::Parse("base+accel_size_effect+gyro_g_sensitivity"), 1);
 }
 
 }  // namespace

@@ -27,10 +27,11 @@ std::unique_ptr<Elimination> Elimination::Make(const Eigen::SparseMatrix<double>
   return out;
 }
 
-Eigen::MatrixXd Elimination::ScaledSolve(const Eigen::MatrixXd& A) const {
-  Eigen::MatrixXd X = ldlt_.solve(J_e_.transpose() * A);
-  const Eigen::MatrixXd R = A - J_e_ * X;
-  X += ldlt_.solve(J_e_.transpose() * R);  // refinement
+Eigen::MatrixXd Elimination::ScaledSolve(const RowMajorMatrix& A) const {
+  Eigen::MatrixXd X = ldlt_.solve(Eigen::MatrixXd(RowMajorMatrix(J_e_.transpose() * A)));
+  RowMajorMatrix residual = A;
+  residual.noalias() -= J_e_ * RowMajorMatrix(X);
+  X += ldlt_.solve(Eigen::MatrixXd(RowMajorMatrix(J_e_.transpose() * residual)));  // refinement
   return X;
 }
 
@@ -39,7 +40,9 @@ Eigen::MatrixXd Elimination::Solve(const Eigen::MatrixXd& A) const {
 }
 
 Eigen::MatrixXd Elimination::Project(const Eigen::MatrixXd& A) const {
-  return A - J_e_ * ScaledSolve(A);
+  RowMajorMatrix projected = A;
+  projected.noalias() -= J_e_ * RowMajorMatrix(ScaledSolve(projected));
+  return projected;
 }
 
 Eigen::MatrixXd Elimination::Reduced(const JobRunner& run_jobs) const {

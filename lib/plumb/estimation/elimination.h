@@ -63,7 +63,12 @@ class Elimination {
 
  private:
   Elimination(const Eigen::SparseMatrix<double>& J, Eigen::Index first);
-  Eigen::MatrixXd ScaledSolve(const Eigen::MatrixXd& A) const;
+  /// Rows of a dense operand stored together: the sparse products with J_e then add whole
+  /// rows at a time (one contiguous, vectorised update per nonzero of J_e) rather than one
+  /// column after another; every entry sums the same terms in the same order either way.
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  /// X minimising |A - J_e X| in J_e's scaled units (one refinement step).
+  Eigen::MatrixXd ScaledSolve(const RowMajorMatrix& A) const;
 
   const Eigen::SparseMatrix<double>& J_;
   Eigen::Index first_;

@@ -3,6 +3,7 @@
 #include "plumb/estimation/uncertainty.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -362,8 +363,19 @@ ObservabilityAnalysis AnalyseObservability(const ObservabilityInput& in) {
     d[j] = norm > 0 ? 1.0 / norm : 1.0;
   }
   const Eigen::MatrixXd Js = in.J * d.asDiagonal();
-  // One SVD; for m < n the thin V lacks the null directions beyond m, so take the full V.
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeFullV);
+  // One SVD; for m < n the thin V lacks the null directions beyond m, so take the full V. A
+  // Jacobian of many more rows than columns is first reduced to its triangular factor R
+  // (Js = Q R, Householder): R has Js's singular values and right vectors, and the SVD of the
+  // small square R costs far less than the bidiagonalisation of every row (LAPACK's dgesvd
+  // takes the same path for tall matrices).
+  Eigen::BDCSVD<Eigen::MatrixXd> svd;
+  if (Js.rows() > 2 * n) {
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Js);
+    svd.compute(qr.matrixQR().topRows(n).triangularView<Eigen::Upper>().toDenseMatrix(),
+                Eigen::ComputeFullV);
+  } else {
+    svd.compute(Js, Eigen::ComputeFullV);
+  }
   Eigen::VectorXd s = Eigen::VectorXd::Zero(n);
   s.head(svd.singularValues().size()) = svd.singularValues();
   const Eigen::MatrixXd& V = svd.matrixV();

@@ -38,10 +38,12 @@
 // The noise of alpha_w and gdot_w enters multiplied by r_i (centimetres) and dt_i (milliseconds)
 // and is left out.
 //
-// Jacobians: central differences (ceres::DynamicNumericDiffCostFunction), only over the blocks
-// the solver asks for, and not over IMU i's gyroscope terms where both models act as their
-// linear stage (its force then reads none of them: those columns are zero). The corrections are
-// then closed-form too, F^-1 (y - b_a).
+// Jacobians: central differences as ceres::DynamicNumericDiffCostFunction takes them (the same
+// steps and quotients, so the same bits), only over the blocks the solver asks for, and not over
+// IMU i's gyroscope terms where both models act as their linear stage (its force then reads none
+// of them: those columns are zero; the corrections are then closed-form too, F^-1 (y - b_a)).
+// A column recomputes only what its block enters: IMU i's blocks its force alone, the mount
+// the force at IMU i's place and the whitening, IMU 0's blocks the turn as IMU 0 saw it.
 //
 // Parameter blocks, in order: IMU i's board_mount block (7), every block of IMU i's model in
 // model order, every block of IMU 0's model in model order, then per accelerometer wander process
@@ -51,6 +53,7 @@
 
 #include <ceres/cost_function.h>
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -91,14 +94,51 @@ class BoardForceResidual {
   BoardForceResidual(const model::Model& model, const model::Model& model0,
                      SharedBoardWindows windows, int accel_wander, int accel_wander0);
 
-  /// The cost function: central differences over the blocks the file comment lists.
+  /// The cost function: the functor's central differences (Differentiate) over the blocks the
+  /// file comment lists.
   static ceres::CostFunction* Create(const model::Model& model, const model::Model& model0,
                                      SharedBoardWindows windows, int accel_wander,
                                      int accel_wander0);
 
   bool operator()(double const* const* parameters, double* residuals) const;
 
+  /// The residuals, and the central-difference Jacobian (Ceres's relative step kRelativeStep,
+  /// at least sqrt(epsilon); row-major, rows x block size) of every block whose `jacobians`
+  /// entry is not null. `block_sizes` are the blocks' sizes, in the file comment's order.
+  void Differentiate(double const* const* parameters, const std::vector<int32_t>& block_sizes,
+                     double* residuals, double** jacobians) const;
+
+  /// ceres::NumericDiffOptions::relative_step_size's default, which the columns take.
+  static constexpr double kRelativeStep = 1e-6;
+
  private:
+  /// The parameter blocks by role (file comment's order).
+  struct Blocks {
+    const double* mount = nullptr;
+    double const* const* theta = nullptr;    ///< IMU i's model
+    double const* const* theta0 = nullptr;   ///< IMU 0's model
+    double const* const* wander = nullptr;   ///< IMU i's accelerometer wander (from, to)
+    double const* const* wander0 = nullptr;  ///< IMU 0's
+  };
+  Blocks Split(double const* const* parameters) const;
+  /// The turn as IMU 0 saw it, per window: its corrected force f_0,w, the mean angular
+  /// acceleration alpha_w and A_w (file comment), body frame.
+  struct Imu0Turn {
+    std::vector<Vec3> f0, alpha_b;
+    std::vector<Mat3> A;
+  };
+  Imu0Turn TurnOfImu0(const Blocks& b) const;
+  /// g_w = f_0,w + A_w r_i, the specific force at IMU i's place, and its mean rate gdot_w.
+  struct ForceAtImu {
+    std::vector<Vec3> g, rate;
+  };
+  ForceAtImu AtImu(const Imu0Turn& turn, const Blocks& b) const;
+  /// f_i,w: IMU i's corrected specific force per window, in its frame.
+  std::vector<Vec3> ForceOfImu(const Imu0Turn& turn, const Blocks& b) const;
+  /// The whitened residuals (3 per window with samples of IMU i).
+  void Whiten(const Blocks& b, const ForceAtImu& g, const std::vector<Vec3>& f,
+              double* residuals) const;
+
   /// Each window's corrected specific force and rate of one IMU (IMU 0's means when `imu0`),
   /// from its blocks `theta`, the accelerometer wander blocks `wander` (b_from, b_to per
   /// process) and the angular acceleration per window in its frame, rad/s^2.
